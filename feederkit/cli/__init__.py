@@ -1,0 +1,1 @@
+"""The feederkit command line (typer): a thin layer over the library."""

@@ -1,0 +1,208 @@
+"""Part outlines: the flat shape as drawn, with holes, in millimetres (design.md, outline file).
+
+An :class:`Outline` is a validated value. The outline file is feederkit's own JSON format::
+
+    {"name": "bracket-a", "units": "mm", "vertices": [[x, y], ...],
+     "holes": [[[x, y], ...], ...], "com": [x, y]}
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import shapely
+from shapely.geometry import Polygon
+
+from feederkit.errors import InputError
+
+Point = tuple[float, float]
+
+UNIT_TO_MM: dict[str, float] = {
+    "mm": 1.0,
+    "cm": 10.0,
+    "m": 1000.0,
+    "in": 25.4,
+    "inch": 25.4,
+    "inches": 25.4,
+    "ft": 304.8,
+    "um": 0.001,
+}
+
+
+def unit_scale(units: str) -> float:
+    """Millimetres per unit of ``units``; an unknown unit is bad input."""
+    try:
+        return UNIT_TO_MM[units.strip().lower()]
+    except KeyError:
+        known = ", ".join(sorted(UNIT_TO_MM))
+        raise InputError(f"unknown unit {units!r} (known: {known})") from None
+
+
+@dataclass(frozen=True)
+class Outline:
+    """A flat part's outline in millimetres: outer boundary, holes, and an optional COM.
+
+    The COM, when given, overrides the centroid of the uniform plate with its holes.
+    """
+
+    name: str
+    vertices: tuple[Point, ...]
+    holes: tuple[tuple[Point, ...], ...] = ()
+    com: Point | None = None
+    units: str = "mm"
+
+    def polygon(self) -> Polygon:
+        """The outline as a shapely polygon with its holes."""
+        return Polygon(self.vertices, [list(h) for h in self.holes])
+
+
+def _points(raw: object, what: str, name: str) -> tuple[Point, ...]:
+    if not isinstance(raw, Sequence) or isinstance(raw, str | bytes):
+        raise InputError(f"{name}: {what} must be a list of [x, y] points")
+    pts: list[Point] = []
+    for p in raw:
+        if not isinstance(p, Sequence) or isinstance(p, str | bytes) or len(p) != 2:
+            raise InputError(f"{name}: {what} must be a list of [x, y] points, got {p!r}")
+        try:
+            x, y = float(p[0]), float(p[1])
+        except (TypeError, ValueError):
+            raise InputError(f"{name}: {what} has a non-numeric coordinate {p!r}") from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise InputError(f"{name}: {what} has a NaN or infinite coordinate {p!r}")
+        pts.append((x, y))
+    return tuple(pts)
+
+
+def _ring(pts: tuple[Point, ...], what: str, name: str) -> tuple[Point, ...]:
+    """Drop a closing duplicate and consecutive repeats; demand three distinct points."""
+    out: list[Point] = []
+    for p in pts:
+        if not out or p != out[-1]:
+            out.append(p)
+    if len(out) > 1 and out[0] == out[-1]:
+        out.pop()
+    if len(set(out)) < 3:
+        raise InputError(f"{name}: {what} needs at least three distinct points, got {len(set(out))}")
+    return tuple(out)
+
+
+def make_outline(
+    name: str,
+    vertices: Iterable[Sequence[float]],
+    holes: Iterable[Iterable[Sequence[float]]] = (),
+    com: Sequence[float] | None = None,
+    units: str = "mm",
+) -> Outline:
+    """Validate raw coordinates (in ``units``) and return an :class:`Outline` in millimetres.
+
+    Raises InputError for fewer than three distinct points, NaN or infinite coordinates,
+    zero area, a self-intersecting boundary, or holes outside the boundary.
+    """
+    if not isinstance(name, str) or not name.strip():
+        raise InputError("an outline needs a non-empty name")
+    scale = unit_scale(units)
+    outer = _ring(_points(list(vertices), "vertices", name), "the outline", name)
+    hole_rings = tuple(
+        _ring(_points(list(h), f"hole {i}", name), f"hole {i}", name) for i, h in enumerate(holes)
+    )
+    com_pt: Point | None = None
+    if com is not None:
+        (com_pt,) = _points([com], "com", name)
+    if scale != 1.0:
+        outer = tuple((x * scale, y * scale) for x, y in outer)
+        hole_rings = tuple(tuple((x * scale, y * scale) for x, y in h) for h in hole_rings)
+        if com_pt is not None:
+            com_pt = (com_pt[0] * scale, com_pt[1] * scale)
+    shell = Polygon(outer)
+    scale_len = math.sqrt(max(abs(shell.area), 0.0)) if shell.is_valid else 0.0
+    if not shapely.is_valid(Polygon(outer)):
+        reason = shapely.is_valid_reason(shell)
+        if abs(shell.area) <= 0.0 or "Too few points" in reason:
+            raise InputError(f"{name}: the outline has zero area")
+        raise InputError(f"{name}: the outline is self-intersecting ({reason})")
+    bounds = shell.bounds
+    size = max(bounds[2] - bounds[0], bounds[3] - bounds[1])
+    if shell.area <= 1e-12 * max(size, 1e-300) ** 2 or scale_len == 0.0:
+        raise InputError(f"{name}: the outline has zero area")
+    poly = Polygon(outer, [list(h) for h in hole_rings])
+    if hole_rings and not poly.is_valid:
+        raise InputError(
+            f"{name}: a hole crosses the outline or another hole ({shapely.is_valid_reason(poly)})"
+        )
+    return Outline(name=name, vertices=outer, holes=hole_rings, com=com_pt, units="mm")
+
+
+def outline_from_dict(data: object, default_name: str = "part") -> Outline:
+    """Read the outline file's JSON object (design.md) into a validated outline."""
+    if not isinstance(data, dict):
+        raise InputError(f"{default_name}: an outline file holds a JSON object")
+    name = data.get("name", default_name)
+    if not isinstance(name, str):
+        raise InputError(f"{default_name}: 'name' must be a string")
+    if "vertices" not in data:
+        raise InputError(f"{name}: the outline file has no 'vertices'")
+    units = data.get("units", "mm")
+    if not isinstance(units, str):
+        raise InputError(f"{name}: 'units' must be a string such as \"mm\"")
+    holes = data.get("holes") or []
+    if not isinstance(holes, list):
+        raise InputError(f"{name}: 'holes' must be a list of point lists")
+    return make_outline(name, data["vertices"], holes, data.get("com"), units)
+
+
+def outline_to_dict(outline: Outline) -> dict[str, object]:
+    """The outline file's JSON object for ``outline``."""
+    out: dict[str, object] = {
+        "name": outline.name,
+        "units": "mm",
+        "vertices": [list(p) for p in outline.vertices],
+    }
+    if outline.holes:
+        out["holes"] = [[list(p) for p in h] for h in outline.holes]
+    if outline.com is not None:
+        out["com"] = list(outline.com)
+    return out
+
+
+def load_outline_json(path: str | os.PathLike[str]) -> Outline:
+    """Load an outline file; unreadable or malformed files are bad input."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"{p}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: cannot read the file ({exc})") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    return outline_from_dict(data, default_name=p.stem)
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` to ``path`` atomically: a temporary file beside it, then a rename."""
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:
+    """Write the outline file for ``outline`` atomically."""
+    write_text_atomic(path, json.dumps(outline_to_dict(outline), indent=2) + "\n")
