@@ -6,6 +6,7 @@ joins vertex ``i`` to vertex ``i + 1``.
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Iterable, Sequence
 
@@ -44,33 +45,60 @@ def size_of(points: Sequence[Point]) -> float:
     return max(max(xs) - min(xs), max(ys) - min(ys))
 
 
-def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
-    """Remove duplicate vertices and vertices within ``length_tol`` of the line of their neighbours.
+def _chord_deviation(ring: Sequence[Point], i: int, k: int) -> float:
+    """Largest distance of ring points strictly between indices ``i`` and ``k`` (cyclic) from chord i-k."""
+    n = len(ring)
+    a, c = ring[i], ring[k]
+    dx, dy = c[0] - a[0], c[1] - a[1]
+    length = math.hypot(dx, dy)
+    worst = 0.0
+    j = (i + 1) % n
+    while j != k:
+        p = ring[j]
+        if length > 0.0:
+            d = abs(dx * (p[1] - a[1]) - dy * (p[0] - a[0])) / length
+        else:
+            d = math.hypot(p[0] - a[0], p[1] - a[1])
+        worst = max(worst, d)
+        j = (j + 1) % n
+    return worst
 
-    Repeats until stable, always removing the vertex that deviates least first, so that the
-    result does not depend on where the ring starts.
+
+def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
+    """Simplify a convex CCW ring: drop vertices while every original vertex stays within ``length_tol``.
+
+    A vertex may go when the chord joining its kept neighbours passes within ``length_tol`` of
+    every original hull vertex between them (the error is measured against the original
+    points, so it cannot drift along a flattened arc). The cheapest removal goes first, ties
+    broken by coordinates, so the result does not depend on where the ring starts. Kept
+    vertices are original vertices: the result lies inside the hull, at most ``length_tol``
+    from it, and stays convex.
     """
     ring = list(hull)
-    changed = True
-    while changed and len(ring) > 3:
-        changed = False
-        best_i, best_dev = -1, math.inf
-        n = len(ring)
-        for i in range(n):
-            a, b, c = ring[i - 1], ring[i], ring[(i + 1) % n]
-            ac = math.hypot(c[0] - a[0], c[1] - a[1])
-            if math.hypot(b[0] - a[0], b[1] - a[1]) <= length_tol:
-                dev = 0.0
-            elif ac <= length_tol:
-                dev = 0.0
-            else:
-                dev = abs(_cross(a, c, b)) / ac
-            if dev < best_dev:
-                best_i, best_dev = i, dev
-        if best_dev <= length_tol:
-            ring.pop(best_i)
-            changed = True
-    return ring
+    n = len(ring)
+    if n <= 3:
+        return ring
+    prev = [(i - 1) % n for i in range(n)]
+    nxt = [(i + 1) % n for i in range(n)]
+    alive = [True] * n
+    cost = [_chord_deviation(ring, prev[i], nxt[i]) for i in range(n)]
+    heap = [(cost[i], ring[i], i) for i in range(n)]
+    heapq.heapify(heap)
+    count = n
+    while heap and count > 3:
+        c, _, i = heapq.heappop(heap)
+        if not alive[i] or c != cost[i]:
+            continue  # stale entry
+        if c > length_tol:
+            break
+        alive[i] = False
+        count -= 1
+        a, b = prev[i], nxt[i]
+        nxt[a], prev[b] = b, a
+        for j in (a, b):
+            cost[j] = _chord_deviation(ring, prev[j], nxt[j])
+            heapq.heappush(heap, (cost[j], ring[j], j))
+    return [p for i, p in enumerate(ring) if alive[i]]
 
 
 def number_hull(hull: Sequence[Point], length_tol: float = 0.0) -> tuple[Point, ...]:
@@ -85,7 +113,11 @@ def number_hull(hull: Sequence[Point], length_tol: float = 0.0) -> tuple[Point, 
 
 
 def contact_hull(points: Iterable[Sequence[float]], length_tol: float | None = None) -> tuple[Point, ...]:
-    """The contact polygon of a set of outline points: convex, CCW, cleaned, numbered."""
+    """The contact polygon of a set of outline points: convex, CCW, simplified, numbered.
+
+    ``length_tol`` (mm) is the simplification tolerance of :func:`clean_hull`; by default
+    ``REL_LENGTH_TOL`` of the part's size (exact up to rounding).
+    """
     raw = convex_hull(points)
     if len(raw) < 3:
         return tuple(raw)
