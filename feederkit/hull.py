@@ -46,7 +46,7 @@ def size_of(points: Sequence[Point]) -> float:
 
 
 def _chord_deviation(ring: Sequence[Point], i: int, k: int) -> float:
-    """Largest distance of ring points strictly between indices ``i`` and ``k`` (cyclic) from chord i-k."""
+    """Largest distance from chord i-k of the ring points strictly between ``i`` and ``k``."""
     n = len(ring)
     a, c = ring[i], ring[k]
     dx, dy = c[0] - a[0], c[1] - a[1]
@@ -64,41 +64,149 @@ def _chord_deviation(ring: Sequence[Point], i: int, k: int) -> float:
     return worst
 
 
-def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
-    """Simplify a convex CCW ring: drop vertices while every original vertex stays within ``length_tol``.
-
-    A vertex may go when the chord joining its kept neighbours passes within ``length_tol`` of
-    every original hull vertex between them (the error is measured against the original
-    points, so it cannot drift along a flattened arc). The cheapest removal goes first, ties
-    broken by coordinates, so the result does not depend on where the ring starts. Kept
-    vertices are original vertices: the result lies inside the hull, at most ``length_tol``
-    from it, and stays convex.
-    """
-    ring = list(hull)
+def _simplify(ring: Sequence[Point], length_tol: float) -> list[int]:
+    """Indices of the vertices :func:`clean_hull` keeps (see there), in ring order."""
     n = len(ring)
     if n <= 3:
-        return ring
+        return list(range(n))
     prev = [(i - 1) % n for i in range(n)]
     nxt = [(i + 1) % n for i in range(n)]
     alive = [True] * n
-    cost = [_chord_deviation(ring, prev[i], nxt[i]) for i in range(n)]
-    heap = [(cost[i], ring[i], i) for i in range(n)]
+    stamp = [0] * n
+
+    def priority(i: int) -> float:
+        a, b, c = ring[prev[i]], ring[i], ring[nxt[i]]
+        return max(math.hypot(b[0] - a[0], b[1] - a[1]), math.hypot(c[0] - b[0], c[1] - b[1]))
+
+    heap = [(priority(i), ring[i], i, 0) for i in range(n)]
     heapq.heapify(heap)
     count = n
     while heap and count > 3:
-        c, _, i = heapq.heappop(heap)
-        if not alive[i] or c != cost[i]:
+        _, _, i, version = heapq.heappop(heap)
+        if not alive[i] or version != stamp[i]:
             continue  # stale entry
-        if c > length_tol:
-            break
+        if _chord_deviation(ring, prev[i], nxt[i]) > length_tol:
+            continue  # kept unless a neighbour goes (then it is queued again)
         alive[i] = False
         count -= 1
         a, b = prev[i], nxt[i]
         nxt[a], prev[b] = b, a
         for j in (a, b):
-            cost[j] = _chord_deviation(ring, prev[j], nxt[j])
-            heapq.heappush(heap, (cost[j], ring[j], j))
-    return [p for i, p in enumerate(ring) if alive[i]]
+            stamp[j] += 1
+            heapq.heappush(heap, (priority(j), ring[j], j, stamp[j]))
+    return [i for i in range(n) if alive[i]]
+
+
+DOMINANT_SIDE = 0.9
+"""A merged edge is a flat side when one original edge makes up this share of its length."""
+
+
+def _flat_side(ring: Sequence[Point], a: int, b: int) -> tuple[float, float, float] | None:
+    """The fence line (nx, ny, h), n.x = h, of the merged edge ring[a] -> ring[b] when it is a
+    flat side, else None (a run of flattened-arc chords: the chord itself is kept).
+
+    A flat side is one original edge that makes up at least :data:`DOMINANT_SIDE` of the
+    merged edge (plus the first chords of the arcs beside it); the line keeps that edge's
+    direction and touches the outermost covered point, as the fence does.
+    """
+    n = len(ring)
+    (ax, ay), (bx, by) = ring[a], ring[b]
+    chord = math.hypot(bx - ax, by - ay)
+    longest, best, j = 0.0, (0.0, 0.0), a
+    while j != b:
+        k = (j + 1) % n
+        ex, ey = ring[k][0] - ring[j][0], ring[k][1] - ring[j][1]
+        length = math.hypot(ex, ey)
+        if length > longest:
+            longest, best = length, (ex, ey)
+        j = k
+    if longest < DOMINANT_SIDE * chord:
+        return None
+    nx, ny = best[1] / longest, -best[0] / longest
+    h, j = -math.inf, a
+    while True:
+        h = max(h, nx * ring[j][0] + ny * ring[j][1])
+        if j == b:
+            return nx, ny, h
+        j = (j + 1) % n
+
+
+def _chord_line(p: Point, q: Point) -> tuple[float, float, float]:
+    dx, dy = q[0] - p[0], q[1] - p[1]
+    norm = math.hypot(dx, dy)
+    nx, ny = dy / norm, -dx / norm
+    return nx, ny, nx * p[0] + ny * p[1]
+
+
+def _distance_to_ring(ring: Sequence[Point], p: Point) -> float:
+    """Distance from ``p`` to the boundary of the ring (segment by segment)."""
+    best = math.inf
+    n = len(ring)
+    for i in range(n):
+        (ax, ay), (bx, by) = ring[i], ring[(i + 1) % n]
+        dx, dy = bx - ax, by - ay
+        len2 = dx * dx + dy * dy
+        t = 0.0 if len2 == 0.0 else max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / len2))
+        best = min(best, math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy))
+    return best
+
+
+def _refit(ring: Sequence[Point], kept: list[int], length_tol: float) -> list[Point] | None:
+    """Lay merged flat sides on their fence lines (see :func:`_flat_side`).
+
+    Other edges stay chords between kept vertices; a vertex moves only when an edge beside it
+    was refitted (to the intersection of the two lines). Returns None when the refit would
+    not give a strictly convex ring within ``2 * length_tol`` of the original hull.
+    """
+    n, m = len(ring), len(kept)
+    flats = [
+        None
+        if (kept[k] + 1) % n == kept[(k + 1) % m]
+        else _flat_side(ring, kept[k], kept[(k + 1) % m])
+        for k in range(m)
+    ]
+    if all(f is None for f in flats):
+        return None
+    out: list[Point] = []
+    for k in range(m):
+        before, after = flats[k - 1], flats[k]
+        if before is None and after is None:
+            out.append(ring[kept[k]])
+            continue
+        l1 = before or _chord_line(ring[kept[k - 1]], ring[kept[k]])
+        l2 = after or _chord_line(ring[kept[k]], ring[kept[(k + 1) % m]])
+        det = l1[0] * l2[1] - l1[1] * l2[0]
+        if abs(det) < 1e-12:
+            return None
+        x = (l1[2] * l2[1] - l1[1] * l2[2]) / det
+        y = (l1[0] * l2[2] - l1[2] * l2[0]) / det
+        if _distance_to_ring(ring, (x, y)) > 2 * length_tol + 1e-12 * (abs(x) + abs(y)):
+            return None
+        out.append((x, y))
+    for i in range(m):
+        if _cross(out[i - 1], out[i], out[(i + 1) % m]) <= 0:
+            return None
+    return out
+
+
+def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
+    """Simplify a convex CCW ring so that a fence feels it within ``length_tol``.
+
+    A vertex may go when the chord joining its kept neighbours passes within ``length_tol`` of
+    every original hull vertex between them (the error is measured against the original
+    points, so it cannot drift along a flattened arc). Vertices between the shortest edges go
+    first (ties broken by coordinates, so the result does not depend on where the ring
+    starts): runs of tiny chords merge among themselves before a long straight edge is
+    touched. A merged edge that is mostly one flat side is then laid on that side's fence
+    line (its direction, touching the outermost point it replaces), so flat sides keep their
+    exact direction and distance; other vertices are unchanged original points.
+    """
+    ring = list(hull)
+    kept = _simplify(ring, length_tol)
+    if len(kept) == len(ring):
+        return ring
+    refit = _refit(ring, kept, length_tol) if len(kept) >= 3 else None
+    return refit if refit is not None else [ring[i] for i in kept]
 
 
 def number_hull(hull: Sequence[Point], length_tol: float = 0.0) -> tuple[Point, ...]:
@@ -112,7 +220,9 @@ def number_hull(hull: Sequence[Point], length_tol: float = 0.0) -> tuple[Point, 
     return tuple(hull[start:]) + tuple(hull[:start])
 
 
-def contact_hull(points: Iterable[Sequence[float]], length_tol: float | None = None) -> tuple[Point, ...]:
+def contact_hull(
+    points: Iterable[Sequence[float]], length_tol: float | None = None
+) -> tuple[Point, ...]:
     """The contact polygon of a set of outline points: convex, CCW, simplified, numbered.
 
     ``length_tol`` (mm) is the simplification tolerance of :func:`clean_hull`; by default
@@ -126,7 +236,7 @@ def contact_hull(points: Iterable[Sequence[float]], length_tol: float | None = N
 
 
 def point_in_convex(hull: Sequence[Point], p: Point, margin: float = 0.0) -> bool:
-    """Whether p lies inside the CCW convex polygon at least ``margin`` away from every edge line."""
+    """Whether p lies inside the CCW convex polygon, more than ``margin`` from every edge line."""
     n = len(hull)
     for i in range(n):
         a, b = hull[i], hull[(i + 1) % n]

@@ -20,11 +20,20 @@ import bisect
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from feederkit.angles import norm360
+import numpy as np
+
+from feederkit.angles import ANGLE_EPS, norm360
 from feederkit.mechanics.actions import ActionRange, action_ranges, merge_boundaries
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
-from feederkit.sensors import Grouping, NoSensor, SensorModel, can_read_alike, split_by_reading
+from feederkit.sensors import (
+    Grouping,
+    NoSensor,
+    SensorModel,
+    ToleranceSensor,
+    can_read_alike,
+    split_by_reading,
+)
 
 
 @dataclass(frozen=True)
@@ -171,20 +180,170 @@ def image(machine: PushAlignMachine, mask: int, action: float) -> int:
     return out
 
 
+def _cell_events(machine: PushAlignMachine) -> tuple[tuple[tuple[float, int], ...], ...]:
+    """Per state, its action-range starts ``(lo, target)`` (cached on the machine)."""
+    ev = machine.__dict__.get("_events")
+    if ev is None:
+        ev = tuple(tuple((r.lo, r.target) for r in rs) for rs in machine.action_maps)
+        machine.__dict__["_events"] = ev
+    return ev
+
+
+_NUMPY_MIN_EVENTS = 256
+"""Sets with at least this many action-range boundaries are swept with numpy."""
+
+
+def _numpy_table(machine: PushAlignMachine):
+    """Per-state boundary and target arrays when every state has as many ranges and n <= 64."""
+    if "_table" in machine.__dict__:
+        return machine.__dict__["_table"]
+    maps = machine.action_maps
+    table = None
+    if 0 < machine.n <= 64 and len({len(rs) for rs in maps}) == 1:
+        los = np.array([[r.lo for r in rs] for rs in maps], dtype=float)
+        tgs = np.array([[r.target for r in rs] for rs in maps], dtype=np.int64)
+        table = (los, tgs)
+    machine.__dict__["_table"] = table
+    return table
+
+
+def _cells_sweep(machine: PushAlignMachine, mask: int, idx: list[int]) -> list[list]:
+    """The cells ``[lo, hi, image]`` of a set, by a sweep in pure Python."""
+    events = _cell_events(machine)
+    evs = sorted((lo, i, t) for i in idx for lo, t in events[i])
+    eps = ANGLE_EPS
+    # Cluster the sorted boundaries exactly as merge_boundaries does.
+    reps: list[float] = []
+    starts: list[int] = []
+    for k, (b, _i, _t) in enumerate(evs):
+        if not reps or b - reps[-1] > eps:
+            reps.append(b)
+            starts.append(k)
+    n_ev = len(evs)
+    if len(reps) > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        # The last cluster wraps into the first: its events restart each member's last range.
+        reps.pop()
+        n_ev = starts.pop()
+    m = len(reps)
+    # Before the first boundary every member is in its last action range.
+    count: dict[int, int] = {}
+    cur: dict[int, int] = {}
+    img = 0
+    for i in idx:
+        t = events[i][-1][1]
+        cur[i] = t
+        c = count.get(t, 0)
+        if c == 0:
+            img |= 1 << t
+        count[t] = c + 1
+    cells: list[list] = []
+    for k in range(m):
+        end = starts[k + 1] if k + 1 < m else n_ev
+        lo = reps[k]
+        hi = reps[k + 1] if k + 1 < m else reps[0] + 360.0
+        mid = (lo + hi) / 2.0
+        last_b = lo
+        for _b, i, t in evs[starts[k] : end]:
+            last_b = _b
+            old = cur[i]
+            if old == t:
+                continue
+            cur[i] = t
+            c = count[old] - 1
+            count[old] = c
+            if c == 0:
+                img &= ~(1 << old)
+            c = count.get(t, 0)
+            if c == 0:
+                img |= 1 << t
+            count[t] = c + 1
+        if last_b >= mid:  # a degenerate cell narrower than its own boundary cluster
+            cells.append([lo, hi, image(machine, mask, norm360(mid))])
+        else:
+            cells.append([lo, hi, img])
+    return cells
+
+
+def _cells_numpy(machine: PushAlignMachine, mask: int, idx: list[int], table) -> list[list] | None:
+    """The same cells as ``_cells_sweep`` with numpy (None: clusters too irregular, use the sweep)."""
+    los, tgs = table
+    k, r = len(idx), los.shape[1]
+    sel = np.array(idx)
+    lo_all = los[sel].ravel()
+    order = np.argsort(lo_all, kind="stable")
+    b = lo_all[order]
+    st = np.repeat(np.arange(k), r)[order]
+    tg = tgs[sel].ravel()[order]
+    eps = ANGLE_EPS
+    new = np.empty(len(b), dtype=bool)
+    new[0] = True
+    new[1:] = np.diff(b) > eps
+    first = np.flatnonzero(new)
+    last = np.append(first[1:] - 1, len(b) - 1)
+    if np.any(b[last] - b[first] > eps):
+        return None  # a chain of close boundaries: merge_boundaries's rule differs
+    cid = np.cumsum(new) - 1
+    reps = b[first]
+    m = len(reps)
+    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        keep = cid < m - 1
+        st, tg, cid = st[keep], tg[keep], cid[keep]
+        last = last[:-1]
+        m -= 1
+        reps = reps[:m]
+    grid = np.full((k, m + 1), -1, dtype=np.int64)
+    grid[:, 0] = tgs[sel, -1]
+    grid[st, cid + 1] = tg
+    pos = np.where(grid >= 0, np.arange(m + 1), 0)
+    np.maximum.accumulate(pos, axis=1, out=pos)
+    targets = np.take_along_axis(grid, pos, axis=1)[:, 1:]
+    bits = np.left_shift(np.uint64(1), targets.astype(np.uint64))
+    imgs = np.bitwise_or.reduce(bits, axis=0)
+    his = np.append(reps[1:], reps[0] + 360.0)
+    mids = (reps + his) / 2.0
+    bad = np.flatnonzero(b[last] >= mids)
+    if len(bad):
+        imgs = imgs.astype(object)
+        for c in bad.tolist():  # a degenerate cell narrower than its own boundary cluster
+            imgs[c] = image(machine, mask, norm360(float(mids[c])))
+    # Merge neighbours with equal images here; overlap_cells merges the rest.
+    keep = np.ones(m, dtype=bool)
+    keep[1:] = imgs[1:] != imgs[:-1]
+    starts = np.flatnonzero(keep)
+    ends = np.append(starts[1:] - 1, m - 1)
+    return [
+        [lo, hi, int(im)]
+        for lo, hi, im in zip(
+            reps[starts].tolist(), his[ends].tolist(), imgs[starts].tolist(), strict=True
+        )
+    ]
+
+
 def overlap_ranges(machine: PushAlignMachine, mask: int) -> list[SetAction]:
     """The overlap ranges of a set of states (section 3.2.2), neighbours with equal images merged.
 
     Merging is sound: every rotation inside the merged range sends the set to the same image,
     so its half-width is the rotation error the action really tolerates.
     """
+    return [SetAction(lo, hi, img) for lo, hi, img in overlap_cells(machine, mask)]
+
+
+def overlap_cells(machine: PushAlignMachine, mask: int) -> list[tuple[float, float, int]]:
+    """``overlap_ranges`` as plain ``(lo, hi, image)`` tuples (for planners' inner loops).
+
+    The cells are those of ``merge_boundaries`` (boundaries within ANGLE_EPS merged), each
+    with the image of its middle rotation, found by one sweep over the sorted boundaries
+    that keeps each member's successor up to date: O(k n log(k n)) for k states of a part
+    with n. Large sets of one part are swept with numpy.
+    """
     idx = members(mask)
-    bounds = merge_boundaries([[r.lo for r in machine.action_maps[i]] for i in idx])
-    m = len(bounds)
-    cells: list[list] = []
-    for k in range(m):
-        lo = bounds[k]
-        hi = bounds[k + 1] if k + 1 < m else bounds[0] + 360.0
-        cells.append([lo, hi, image(machine, mask, (lo + hi) / 2.0)])
+    table = _numpy_table(machine)
+    if table is not None and len(idx) * table[0].shape[1] >= _NUMPY_MIN_EVENTS:
+        cells = _cells_numpy(machine, mask, idx, table)
+    else:
+        cells = None
+    if cells is None:
+        cells = _cells_sweep(machine, mask, idx)
     merged: list[list] = []
     for cell in cells:
         if merged and merged[-1][2] == cell[2]:
@@ -199,14 +358,52 @@ def overlap_ranges(machine: PushAlignMachine, mask: int) -> list[SetAction]:
             merged[0][1] += 360.0
     if len(merged) == 1:
         merged[0][0], merged[0][1] = 0.0, 360.0
-    return [SetAction(lo, hi, img) for lo, hi, img in merged]
+    return [(lo, hi, img) for lo, hi, img in merged]
 
 
 def branches(machine: PushAlignMachine, mask: int, grouping: Grouping = "exact") -> list[Branch]:
     """Split a set of states by the sensor reading (exact reading branching by default)."""
+    if grouping == "exact" and isinstance(machine.sensor, ToleranceSensor):
+        return _tolerance_branches(machine, mask, machine.sensor.tolerance)
     idx = members(mask)
     split = split_by_reading(machine.sensor, [machine.states[i].diameter for i in idx], grouping)
     return [Branch(b.lo, b.hi, mask_of(idx[j] for j in b.members)) for b in split]
+
+
+def _tolerance_branches(machine: PushAlignMachine, mask: int, e: float) -> list[Branch]:
+    """``split_by_reading`` for a tolerance sensor and exact branching, by one sweep.
+
+    Same cells and the same membership test (``|d - x| < e`` at each cell's middle) as
+    ``feederkit.sensors.split_by_reading``; the states of a cell are a run of the set sorted
+    by diameter, so two pointers find them.
+    """
+    states = machine.states
+    order = sorted(members(mask), key=lambda i: states[i].diameter)
+    ds = [states[i].diameter for i in order]
+    points = sorted({d - e for d in ds} | {d + e for d in ds})
+    k = len(ds)
+    a = b = 0
+    out: list[list] = []
+    last_run = None
+    for lo, hi in zip(points, points[1:], strict=False):
+        x = (lo + hi) / 2.0
+        while a < k and ds[a] < x and not abs(ds[a] - x) < e:
+            a += 1
+        b = max(b, a)
+        while b < k and abs(ds[b] - x) < e:
+            b += 1
+        if a == b:
+            last_run = None
+            continue
+        if last_run == (a, b):
+            out[-1][1] = hi
+            continue
+        m = 0
+        for i in order[a:b]:
+            m |= 1 << i
+        out.append([lo, hi, m])
+        last_run = (a, b)
+    return [Branch(lo, hi, m) for lo, hi, m in out]
 
 
 def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:

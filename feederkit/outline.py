@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
@@ -59,22 +61,53 @@ class Outline:
 
     def polygon(self) -> Polygon:
         """The outline as a shapely polygon with its holes."""
-        return Polygon(self.vertices, [list(h) for h in self.holes])
+        return Polygon(np.asarray(self.vertices), [np.asarray(h) for h in self.holes])
+
+
+MAX_COORD_MM = 1e9
+"""Coordinates beyond this many millimetres (1000 km) are taken for a broken file."""
+
+
+def _as_list(raw: object) -> list | None:
+    """``raw`` as a list when it is a sequence or an array (not a string), else None."""
+    if isinstance(raw, str | bytes):
+        return None
+    tolist = getattr(raw, "tolist", None)
+    if callable(tolist) and not isinstance(raw, Sequence):
+        raw = tolist()
+    return list(raw) if isinstance(raw, Sequence) else None
+
+
+_PLAIN_PAIR = (list, tuple)
+_PLAIN = (float, int)
+
+
+def _coordinate(v: object) -> float:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise TypeError(v)
+    return float(v)
 
 
 def _points(raw: object, what: str, name: str) -> tuple[Point, ...]:
-    if not isinstance(raw, Sequence) or isinstance(raw, str | bytes):
+    seq = _as_list(raw)
+    if seq is None:
         raise InputError(f"{name}: {what} must be a list of [x, y] points")
     pts: list[Point] = []
-    for p in raw:
-        if not isinstance(p, Sequence) or isinstance(p, str | bytes) or len(p) != 2:
-            raise InputError(f"{name}: {what} must be a list of [x, y] points, got {p!r}")
-        try:
-            x, y = float(p[0]), float(p[1])
-        except (TypeError, ValueError):
-            raise InputError(f"{name}: {what} has a non-numeric coordinate {p!r}") from None
+    for p in seq:
+        if type(p) in _PLAIN_PAIR and len(p) == 2 and type(p[0]) in _PLAIN and type(p[1]) in _PLAIN:
+            x, y = float(p[0]), float(p[1])  # the common case, without the ABC checks below
+        else:
+            xy = _as_list(p)
+            if xy is None or len(xy) != 2:
+                raise InputError(f"{name}: {what} must be a list of [x, y] points, got {p!r}")
+            try:
+                x, y = _coordinate(xy[0]), _coordinate(xy[1])
+            except (TypeError, ValueError, OverflowError):
+                raise InputError(f"{name}: {what} has a non-numeric coordinate {p!r}") from None
         if not (math.isfinite(x) and math.isfinite(y)):
             raise InputError(f"{name}: {what} has a NaN or infinite coordinate {p!r}")
+        if abs(x) > MAX_COORD_MM or abs(y) > MAX_COORD_MM:
+            raise InputError(f"{name}: {what} has a coordinate beyond 1e9 mm {p!r}")
         pts.append((x, y))
     return tuple(pts)
 
@@ -88,7 +121,9 @@ def _ring(pts: tuple[Point, ...], what: str, name: str) -> tuple[Point, ...]:
     if len(out) > 1 and out[0] == out[-1]:
         out.pop()
     if len(set(out)) < 3:
-        raise InputError(f"{name}: {what} needs at least three distinct points, got {len(set(out))}")
+        raise InputError(
+            f"{name}: {what} needs at least three distinct points, got {len(set(out))}"
+        )
     return tuple(out)
 
 
@@ -106,32 +141,40 @@ def make_outline(
     """
     if not isinstance(name, str) or not name.strip():
         raise InputError("an outline needs a non-empty name")
-    scale = unit_scale(units)
-    outer = _ring(_points(list(vertices), "vertices", name), "the outline", name)
+    try:
+        scale = unit_scale(units)
+    except InputError as exc:
+        raise InputError(f"{name}: {exc}") from None
+    outer = _ring(_points(vertices, "vertices", name), "the outline", name)
+    hole_list = _as_list(holes)
+    if hole_list is None:
+        raise InputError(f"{name}: 'holes' must be a list of point lists")
     hole_rings = tuple(
-        _ring(_points(list(h), f"hole {i}", name), f"hole {i}", name) for i, h in enumerate(holes)
+        _ring(_points(h, f"hole {i}", name), f"hole {i}", name) for i, h in enumerate(hole_list)
     )
     com_pt: Point | None = None
     if com is not None:
-        (com_pt,) = _points([com], "com", name)
+        xy = _as_list(com)
+        if xy is None or len(xy) != 2:
+            raise InputError(f"{name}: 'com' must be [x, y], got {com!r}")
+        (com_pt,) = _points([xy], "com", name)
     if scale != 1.0:
         outer = tuple((x * scale, y * scale) for x, y in outer)
         hole_rings = tuple(tuple((x * scale, y * scale) for x, y in h) for h in hole_rings)
         if com_pt is not None:
             com_pt = (com_pt[0] * scale, com_pt[1] * scale)
-    shell = Polygon(outer)
-    scale_len = math.sqrt(max(abs(shell.area), 0.0)) if shell.is_valid else 0.0
-    if not shapely.is_valid(Polygon(outer)):
-        reason = shapely.is_valid_reason(shell)
-        if abs(shell.area) <= 0.0 or "Too few points" in reason:
-            raise InputError(f"{name}: the outline has zero area")
-        raise InputError(f"{name}: the outline is self-intersecting ({reason})")
+    shell = Polygon(np.asarray(outer))
     bounds = shell.bounds
     size = max(bounds[2] - bounds[0], bounds[3] - bounds[1])
-    if shell.area <= 1e-12 * max(size, 1e-300) ** 2 or scale_len == 0.0:
+    tiny_area = 1e-12 * size * size
+    if size <= 0.0 or shell.convex_hull.area <= tiny_area:
+        raise InputError(f"{name}: the outline has zero area (its points are collinear)")
+    if not shapely.is_valid(shell):
+        reason = shapely.is_valid_reason(shell)
+        raise InputError(f"{name}: the outline is self-intersecting ({reason})")
+    if shell.area <= tiny_area:
         raise InputError(f"{name}: the outline has zero area")
-    poly = Polygon(outer, [list(h) for h in hole_rings])
-    if hole_rings and not poly.is_valid:
+    if hole_rings and not (poly := Polygon(outer, [list(h) for h in hole_rings])).is_valid:
         raise InputError(
             f"{name}: a hole crosses the outline or another hole ({shapely.is_valid_reason(poly)})"
         )
@@ -150,7 +193,9 @@ def outline_from_dict(data: object, default_name: str = "part") -> Outline:
     units = data.get("units", "mm")
     if not isinstance(units, str):
         raise InputError(f"{name}: 'units' must be a string such as \"mm\"")
-    holes = data.get("holes") or []
+    holes = data.get("holes")
+    if holes is None:
+        holes = []
     if not isinstance(holes, list):
         raise InputError(f"{name}: 'holes' must be a list of point lists")
     return make_outline(name, data["vertices"], holes, data.get("com"), units)

@@ -61,7 +61,9 @@ def make_part(
     com = (float(com[0]), float(com[1]))
     margin = REL_LENGTH_TOL * size_of(hull)
     if not point_in_convex(hull, com, margin):
+        where = "on the boundary of" if point_in_convex(hull, com, -margin) else "outside"
         raise InputError(
-            f"{label}: the center of mass ({com[0]:g}, {com[1]:g}) lies outside the contact hull"
+            f"{label}: the center of mass ({com[0]:g}, {com[1]:g}) lies {where} the contact hull"
+            " (it must lie strictly inside)"
         )
     return Part(name=label, outline=outline, com=com, hull=hull, revision=revision)

@@ -121,9 +121,18 @@ def led_count(pitch: float, width: float) -> int:
     return max(0, math.ceil(width / pitch - 1e-12) - 1)
 
 
+LED_EDGE_REL = 1e-6
+"""A width within this fraction of the pitch of a beam's height may block that beam or not."""
+
+
 def led_counts(sensor: LedSensor, diameter: float) -> tuple[int, int]:
-    """The smallest and largest beam count a state of this diameter can block."""
-    return led_count(sensor.pitch, diameter - sensor.noise), led_count(sensor.pitch, diameter + sensor.noise)
+    """The smallest and largest beam count a state of this diameter can block.
+
+    Widths within ``LED_EDGE_REL * pitch`` of a beam's height count both ways, so a diameter
+    that sits on a beam (an exact multiple of the pitch) is not trusted to one count.
+    """
+    e = sensor.noise + LED_EDGE_REL * sensor.pitch
+    return led_count(sensor.pitch, diameter - e), led_count(sensor.pitch, diameter + e)
 
 
 def can_read_alike(sensor: SensorModel, d1: float, d2: float) -> bool:

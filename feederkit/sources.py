@@ -1,24 +1,99 @@
-"""Resolve a SOURCE argument (design.md): an outline file, a CAD file, or a catalog part name."""
+"""Resolve a SOURCE argument (design.md): an outline file, a CAD file, or a catalog part name.
+
+A SOURCE that names an existing file is read as a file (``.json``, ``.dxf``, ``.stl``,
+``.obj``, ``.ply``); otherwise it is a catalog part name, ``NAME`` (latest revision) or
+``NAME@REV``, looked up in ``catalog`` (default ``$FEEDERKIT_CATALOG`` or ``./feederkit.db``).
+"""
 
 from __future__ import annotations
 
+import dataclasses
+import re
+from dataclasses import dataclass
 from pathlib import Path
 
+from feederkit.catalog import default_catalog_path, get_revision, part_from_revision
 from feederkit.errors import InputError
-from feederkit.outline import load_outline_json
+from feederkit.importers import (
+    NOT_ORIENTABLE,
+    ImportOptions,
+    Orientability,
+    import_parts,
+    orientability,
+)
 from feederkit.part import Part, make_part
 
 Point = tuple[float, float]
 
+_REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>\d+)$")
 
-def load_part(source: str, *, com: Point | None = None, catalog: str | None = None) -> Part:
-    """Load one part from a SOURCE: an outline ``.json`` file (catalog and CAD files: see below).
+
+@dataclass(frozen=True)
+class LoadedPart:
+    """A part resolved from a SOURCE, with the import's warnings and its orientability."""
+
+    part: Part
+    warnings: tuple[str, ...]
+    orientability: Orientability
+    origin: str
+
+
+def _from_catalog(source: str, com: Point | None, catalog: str | None) -> LoadedPart:
+    db = Path(catalog) if catalog is not None else default_catalog_path()
+    if not db.is_file():
+        raise InputError(f"{source}: no such file or catalog part (no catalog at {db})")
+    m = _REVISION_RE.match(source)
+    name, rev = (m["name"], int(m["rev"])) if m else (source, None)
+    try:
+        revision = get_revision(db, name, rev)
+    except InputError as exc:
+        raise InputError(f"{source}: no such file or catalog part ({exc})") from None
+    part = part_from_revision(revision)
+    if com is not None:
+        part = make_part(
+            part.outline, com, hull_tolerance=revision.hull_tolerance, revision=part.revision
+        )
+    verdict = orientability(part, revision.hull_tolerance)
+    notes = [w for w in revision.warnings if not w.startswith(NOT_ORIENTABLE)]
+    if not verdict.orientable:
+        notes.append(f"{NOT_ORIENTABLE}: {verdict.reason}")
+    return LoadedPart(part, tuple(notes), verdict, f"catalog {db}")
+
+
+def load_part_with_warnings(
+    source: str,
+    *,
+    com: Point | None = None,
+    catalog: str | None = None,
+    options: ImportOptions | None = None,
+) -> LoadedPart:
+    """Load one part from a SOURCE with the warnings of its import (unitless drawing, ...).
+
+    ``options`` sets the CAD import (units, layers, tolerances, mesh pose); ``com`` overrides
+    the center of mass. Raises InputError naming the source when it is not a valid part.
+    """
+    opts = options or ImportOptions()
+    if com is not None:
+        opts = dataclasses.replace(opts, com=(float(com[0]), float(com[1])))
+    path = Path(source)
+    if path.is_file():
+        _, parts = import_parts(path, opts)
+        first = parts[0]
+        return LoadedPart(first.part, first.warnings, first.orientability, str(path))
+    if path.exists():
+        raise InputError(f"{source}: not a file")
+    return _from_catalog(source, opts.com, catalog)
+
+
+def load_part(
+    source: str,
+    *,
+    com: Point | None = None,
+    catalog: str | None = None,
+    options: ImportOptions | None = None,
+) -> Part:
+    """Load one part from a SOURCE: an outline or CAD file, or a catalog name (``NAME[@REV]``).
 
     Raises InputError naming the source when it cannot be read or is not a valid part.
     """
-    path = Path(source)
-    if path.suffix.lower() == ".json":
-        return make_part(load_outline_json(path), com)
-    if path.exists():
-        raise InputError(f"{source}: unsupported file type {path.suffix!r}")
-    raise InputError(f"{source}: no such file or catalog part")
+    return load_part_with_warnings(source, com=com, catalog=catalog, options=options).part

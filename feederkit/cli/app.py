@@ -10,6 +10,7 @@ import importlib
 import sys
 
 import typer
+from rich.markup import escape
 
 from feederkit.cli.common import err_console
 from feederkit.errors import FeederkitError
@@ -58,7 +59,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         app(args=argv, prog_name="feederkit")
     except FeederkitError as exc:
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True, markup=True)
+        err_console.print(
+            f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True, markup=True
+        )
         return exc.exit_code
     except SystemExit as exc:
         if exc.code is None:

@@ -46,7 +46,7 @@ class ImportOptions:
     allow_large: bool = False
 
     def as_key(self) -> dict[str, object]:
-        """The options that change the imported part (stored with a revision, compared on re-import)."""
+        """The options that change the imported part (stored with a revision, compared later)."""
         return {
             "units": self.units,
             "layers": sorted(self.layers),

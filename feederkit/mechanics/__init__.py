@@ -1,4 +1,4 @@
-"""Push-align mechanics of one part (Akella & Mason 1999, section 3), computed exactly from the hull.
+"""Push-align mechanics of one part (Akella & Mason 1999, section 3), exactly from the hull.
 
 The radius function is piecewise sinusoidal: on the normal cone of hull vertex ``v`` it is
 ``|v - c| cos(phi - angle(v - c))``. Everything here follows from that: stable edges are its
@@ -6,6 +6,8 @@ local minima, divergent orientations its local maxima, resting ranges the interv
 them, the push function maps each resting range onto its stable orientation.
 """
 
+from feederkit.mechanics.actions import ActionRange, OverlapRange, action_ranges, overlap_ranges
+from feederkit.mechanics.classes import PolygonClass, polygon_class
 from feederkit.mechanics.push import (
     PushFunction,
     StableState,
@@ -15,13 +17,24 @@ from feederkit.mechanics.push import (
     push_function,
     radius,
 )
+from feederkit.mechanics.symmetry import Symmetry, push_diameter_period, push_period, symmetry
 
 __all__ = [
+    "ActionRange",
+    "OverlapRange",
+    "PolygonClass",
     "PushFunction",
     "StableState",
+    "Symmetry",
+    "action_ranges",
     "diameter",
+    "overlap_ranges",
+    "polygon_class",
     "push",
     "push_diameter",
+    "push_diameter_period",
     "push_function",
+    "push_period",
     "radius",
+    "symmetry",
 ]

@@ -20,7 +20,10 @@ from feederkit.mechanics.push import PushFunction, push
 
 @dataclass(frozen=True)
 class ActionRange:
-    """Rotations ``lo < a < hi`` (deg, ``lo`` in [0, 360), ``hi`` may pass 360) taking a state to ``target``."""
+    """Rotations ``lo < a < hi`` taking a state to ``target``.
+
+    Degrees; ``lo`` in [0, 360), ``hi`` may pass 360.
+    """
 
     lo: float
     hi: float
@@ -52,7 +55,7 @@ class OverlapRange:
 
 
 def action_ranges(pf: PushFunction, state: int) -> tuple[ActionRange, ...]:
-    """The action ranges of ``state`` to every state (definition 9), starting at the smallest boundary."""
+    """The action ranges of ``state`` to every state (definition 9), smallest boundary first."""
     psi = pf.states[state].normal_deg
     bounds = sorted({norm360(psi - d) for d in pf.divergent_deg})
     out = []
@@ -65,7 +68,9 @@ def action_ranges(pf: PushFunction, state: int) -> tuple[ActionRange, ...]:
     return tuple(out)
 
 
-def merge_boundaries(boundary_lists: Sequence[Sequence[float]], eps: float = ANGLE_EPS) -> list[float]:
+def merge_boundaries(
+    boundary_lists: Sequence[Sequence[float]], eps: float = ANGLE_EPS
+) -> list[float]:
     """Sorted union of boundary angles in [0, 360), angles within ``eps`` merged into one."""
     allb = sorted(norm360(b) for bl in boundary_lists for b in bl)
     out: list[float] = []

@@ -6,11 +6,12 @@ the paper's table does (class 1: length 1).
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
-from feederkit.angles import ANGLE_EPS
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.symmetry import _shift_invariant, push_period, symmetry
+from feederkit.mechanics.symmetry import push_diameter_periods, push_periods, symmetry
 from feederkit.sensors import SensorModel, indistinguishable_sets
 
 CLASS_NAMES = {
@@ -45,22 +46,25 @@ class PolygonClass:
         return CLASS_NAMES[self.number]
 
 
-def _is_multiple(t: float, base: float) -> bool:
-    k = round(t / base)
-    return k >= 1 and abs(t - k * base) < 1e-6
+def polygon_class(
+    pf: PushFunction, sensor: SensorModel, sets: Sequence[Sequence[int]] | None = None
+) -> PolygonClass:
+    """Classify a part by Fig. 14 for ``sensor`` (a sensorless model gives class 7 or 8).
 
-
-def polygon_class(pf: PushFunction, sensor: SensorModel) -> PolygonClass:
-    """Classify a part by Fig. 14 for ``sensor`` (a sensorless model gives class 7 or 8)."""
+    Labels of the push-diameter function are the indistinguishable sets of definition 10.
+    Class 5 needs a common period of the (symmetric) push-diameter and push functions; ``p``
+    is then the number of such common periods, and ``p`` the push function's in class 8.
+    ``sets``: the indistinguishable sets of the states' diameters, when already known.
+    """
     diam = [s.diameter for s in pf.states]
-    sets = indistinguishable_sets(sensor, diam)
+    if sets is None:
+        sets = indistinguishable_sets(sensor, diam)
     n = len(diam)
     m = max(len(g) for g in sets)
-    tp = push_period(pf)
+    a = push_periods(pf)
     if len(sets) == 1:
-        if tp < 360.0:
-            p = round(360.0 / tp)
-            return PolygonClass(8, max(1, -(-2 * n // p) - 1), m, n, p)
+        if a > 1:
+            return PolygonClass(8, max(1, -(-2 * n // a) - 1), m, n, a)
         return PolygonClass(7, 2 * n - 1, m, n, 1)
     if m == 1:
         return PolygonClass(1, 1, m, n, 1)
@@ -75,13 +79,7 @@ def polygon_class(pf: PushFunction, sensor: SensorModel) -> PolygonClass:
         return PolygonClass(3, m, m, n, 1)
     if sym.kind == "quasi-symmetric":
         return PolygonClass(4, 2 * m - 1, m, n, 1)
-    stable = [s.normal_deg for s in pf.states]
-    t = sym.period_deg
-    k = 1
-    while k * t < 360.0 - ANGLE_EPS:
-        tk = k * t
-        if tp < 360.0 and _shift_invariant(stable, tk) and _is_multiple(tk, tp):
-            p = round(360.0 / tk)
-            return PolygonClass(5, max(1, -(-2 * m // p) - 1), m, n, p)
-        k += 1
+    p = math.gcd(a, push_diameter_periods(pf, labels))
+    if p > 1:
+        return PolygonClass(5, max(1, -(-2 * m // p) - 1), m, n, p)
     return PolygonClass(6, 2 * m - 1, m, n, 1)

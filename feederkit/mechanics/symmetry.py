@@ -1,89 +1,124 @@
 """Exact symmetry of the push and push-diameter functions (definitions 3, 6, 7, 8).
 
-Periods form a group: every period is a multiple of the smallest one, which divides 360.
-Values of the push-diameter function are compared through ``labels`` (one label per stable
+The shifts ``T`` under which a finite set of ``q`` angles on the circle maps onto itself form
+a group: the multiples of ``360 / b`` for some ``b`` dividing ``q``, and the shift by ``360 k / q``
+sends the ``i``-th angle (in circular order) to the ``(i + k)``-th. So the smallest period is
+found by testing the divisors ``k`` of ``q`` in increasing order, each in O(q): the number of
+periods ``b = q / k``. Periods of two functions combine through the gcd of their numbers of
+periods. Values of the push-diameter function are compared through ``labels`` (one per stable
 state): exact diameters for the part's own symmetry, indistinguishable sets for a sensor.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 
-from feederkit.angles import ANGLE_EPS, angle_close, norm360
+import numpy as np
+
+from feederkit.angles import ANGLE_EPS
 from feederkit.mechanics.push import PushFunction
 
 DIAMETER_REL_EPS = 1e-9
 """Diameters equal within this fraction of the part's size are the same diameter."""
 
 
-def _shift_invariant(angles: Sequence[float], shift: float, eps: float = ANGLE_EPS) -> bool:
-    """Whether the set of angles maps onto itself under ``+shift``."""
-    return all(any(angle_close(a + shift, b, eps) for b in angles) for a in angles)
+def _divisors(q: int) -> list[int]:
+    small = [k for k in range(1, math.isqrt(q) + 1) if q % k == 0]
+    return sorted(set(small) | {q // k for k in small})
 
 
-def _candidate_shifts(angles: Sequence[float]) -> list[float]:
-    if not angles:
-        return []
-    base = angles[0]
-    return sorted({norm360(a - base) for a in angles[1:]} - {0.0})
+def _invariant(angles: np.ndarray, k: int, ids: np.ndarray | None, eps: float) -> bool:
+    """Whether the shift by ``360 k / q`` sends angle ``i`` onto angle ``i + k``, ids kept."""
+    q = len(angles)
+    t = 360.0 * k / q
+    gap = np.mod(np.roll(angles, -k) - angles - t + 180.0, 360.0) - 180.0
+    if not bool(np.all(np.abs(gap) < eps)):
+        return False
+    return ids is None or bool(np.array_equal(np.roll(ids, -k), ids))
+
+
+def periods_of(
+    angles: Sequence[float], ids: Sequence[int] | None = None, eps: float = ANGLE_EPS
+) -> int:
+    """The number of periods ``b`` of a set of angles (with ids that a shift must keep).
+
+    Its smallest period is ``360 / b``; ``b = 1`` when only the full turn maps it onto itself.
+    An empty set has no structure to keep: it returns 0 (every shift is a period).
+    """
+    q = len(angles)
+    if q == 0:
+        return 0
+    order = np.argsort(np.mod(np.asarray(angles, dtype=float), 360.0), kind="stable")
+    a = np.mod(np.asarray(angles, dtype=float), 360.0)[order]
+    lab = None if ids is None else np.asarray(ids)[order]
+    for k in _divisors(q):
+        if k < q and _invariant(a, k, lab, eps):
+            return q // k
+    return 1
+
+
+def _period_deg(b: int) -> float:
+    return 360.0 / b if b > 0 else 0.0
+
+
+def push_periods(pf: PushFunction) -> int:
+    """Number of periods of the push function: stable and divergent orientations shift alike."""
+    s = np.array([x.normal_deg for x in pf.states])
+    d = np.array(pf.divergent_deg)
+    both = np.concatenate([s, d])
+    kind = np.concatenate([np.zeros(len(s), dtype=int), np.ones(len(d), dtype=int)])
+    return periods_of(both.tolist(), kind.tolist())
 
 
 def push_period(pf: PushFunction) -> float:
     """Smallest T in (0, 360] with p(phi + T) = p(phi) + T (definition 3); 360 when asymmetric."""
-    stable = [s.normal_deg for s in pf.states]
-    for t in _candidate_shifts(stable):
-        if t <= ANGLE_EPS:
-            continue
-        if _shift_invariant(stable, t) and _shift_invariant(pf.divergent_deg, t):
-            return t
-    return 360.0
+    return _period_deg(push_periods(pf))
 
 
 def exact_labels(pf: PushFunction) -> list[int]:
-    """Label each state by its diameter, equal diameters (within DIAMETER_REL_EPS) alike."""
+    """Label each state by its diameter; diameters within DIAMETER_REL_EPS of the size are alike."""
     eps = DIAMETER_REL_EPS * pf.part.size
-    reps: list[float] = []
-    labels = []
-    for s in pf.states:
-        for k, r in enumerate(reps):
-            if abs(s.diameter - r) <= eps:
-                labels.append(k)
-                break
-        else:
-            reps.append(s.diameter)
-            labels.append(len(reps) - 1)
+    diam = [s.diameter for s in pf.states]
+    order = sorted(range(len(diam)), key=lambda i: diam[i])
+    labels = [0] * len(diam)
+    label, last = -1, -math.inf
+    for i in order:
+        if diam[i] - last > eps:
+            label += 1
+        labels[i] = label
+        last = diam[i]
     return labels
 
 
-def _steps(pf: PushFunction, labels: Sequence[Hashable]) -> list[tuple[float, Hashable]]:
-    """Breakpoints of the push-diameter step function with the label that starts at each."""
-    m = len(pf.divergent_deg)
-    out = []
-    for k in range(m):
+def _steps(pf: PushFunction, labels: Sequence[Hashable]) -> tuple[list[float], list[int]]:
+    """Breakpoints of the push-diameter step function and an id of the label starting at each."""
+    ids: dict[Hashable, int] = {}
+    angles, out = [], []
+    for k, start in enumerate(pf.divergent_deg):
         here = labels[pf.range_state[k]]
-        before = labels[pf.range_state[k - 1]]
-        if here != before:
-            out.append((pf.divergent_deg[k], here))
-    return out
+        if here != labels[pf.range_state[k - 1]]:
+            angles.append(start)
+            out.append(ids.setdefault(here, len(ids)))
+    return angles, out
+
+
+def push_diameter_periods(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> int:
+    """Number of periods of the push-diameter function (definition 6); 0 when it is constant."""
+    labels = exact_labels(pf) if labels is None else labels
+    angles, ids = _steps(pf, labels)
+    return periods_of(angles, ids)
 
 
 def push_diameter_period(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> float:
     """Smallest T in (0, 360] with d(phi + T) = d(phi) (definition 6); 0 when d is constant."""
-    labels = exact_labels(pf) if labels is None else labels
-    steps = _steps(pf, labels)
-    if not steps:
-        return 0.0
-    base_angle, base_label = steps[0]
-    for angle, label in steps[1:]:
-        if label != base_label:
-            continue
-        t = norm360(angle - base_angle)
-        if t <= ANGLE_EPS:
-            continue
-        if all(any(angle_close(a + t, b) and la == lb for b, lb in steps) for a, la in steps):
-            return t
-    return 360.0
+    return _period_deg(push_diameter_periods(pf, labels))
+
+
+def stable_periods(pf: PushFunction) -> int:
+    """Number of periods of the set S of stable orientations (definitions 7 and 8)."""
+    return periods_of([s.normal_deg for s in pf.states])
 
 
 @dataclass(frozen=True)
@@ -91,11 +126,13 @@ class Symmetry:
     """The symmetry of a part's push and push-diameter functions.
 
     ``kind`` of the push-diameter function: ``"constant"`` (one value), ``"aperiodic"``,
-    ``"quasi-symmetric"`` (definition 7) or ``"symmetric"`` (definition 8). ``period_deg`` is
-    the push-diameter function's smallest symmetric period (or its smallest period when
-    quasi-symmetric); ``push_period_deg`` the push function's (definition 3).
-    ``part_period_deg`` is the smallest shift under which the part behaves identically
-    (push function and diameters alike): orientation is possible only up to it.
+    ``"quasi-symmetric"`` (definition 7: periodic, but no period maps the stable orientations
+    onto themselves) or ``"symmetric"`` (definition 8). ``period_deg`` is the push-diameter
+    function's smallest symmetric period when symmetric, its smallest period when
+    quasi-symmetric, 360 when aperiodic and 0 when constant. ``push_period_deg`` is the push
+    function's (definition 3). ``part_period_deg`` is the smallest shift under which the part
+    behaves identically (push function and exact diameters alike): orientation is possible
+    only up to it.
     """
 
     kind: str
@@ -112,35 +149,21 @@ class Symmetry:
 def symmetry(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> Symmetry:
     """Classify the push-diameter function by definitions 6-8 for the given state labels."""
     labels = exact_labels(pf) if labels is None else list(labels)
-    stable = [s.normal_deg for s in pf.states]
-    tp = push_period(pf)
-    part_t = _part_period(pf)
-    td = push_diameter_period(pf, labels)
-    if td == 0.0:
+    a = push_periods(pf)
+    part_b = push_diameter_periods(pf)
+    part_t = _period_deg(a if part_b == 0 else math.gcd(a, part_b))
+    b = push_diameter_periods(pf, labels)
+    tp = _period_deg(a)
+    if b == 0:
         return Symmetry("constant", 0.0, tp, part_t)
-    if td >= 360.0:
+    if b == 1:
         return Symmetry("aperiodic", 360.0, tp, part_t)
-    k = 1
-    while k * td < 360.0 - ANGLE_EPS:
-        if _shift_invariant(stable, k * td):
-            return Symmetry("symmetric", k * td, tp, part_t)
-        k += 1
-    return Symmetry("quasi-symmetric", td, tp, part_t)
+    g = math.gcd(b, stable_periods(pf))
+    if g > 1:
+        return Symmetry("symmetric", 360.0 / g, tp, part_t)
+    return Symmetry("quasi-symmetric", 360.0 / b, tp, part_t)
 
 
-def _part_period(pf: PushFunction) -> float:
+def part_period(pf: PushFunction) -> float:
     """Smallest shift preserving the push function and the exact diameters of the states."""
-    labels = exact_labels(pf)
-    stable = [s.normal_deg for s in pf.states]
-    for t in _candidate_shifts(stable):
-        if t <= ANGLE_EPS or not _shift_invariant(pf.divergent_deg, t):
-            continue
-        ok = True
-        for s in pf.states:
-            j = next((x for x in pf.states if angle_close(s.normal_deg + t, x.normal_deg)), None)
-            if j is None or labels[j.id] != labels[s.id]:
-                ok = False
-                break
-        if ok:
-            return t
-    return 360.0
+    return symmetry(pf).part_period_deg

@@ -2,12 +2,13 @@
 
 Uses only the plan file: a state's push is the state whose resting range holds the new fence
 orientation ``normal - action`` (design.md conventions); a state follows a branch when its
-possible readings meet the branch's closed reading range. With the tolerance model those are
-the open interval ``(d - e, d + e)``; with other models the nominal diameter ``d``.
+possible readings (``feederkit.sensors``) meet the branch's closed reading range.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from itertools import combinations
 
@@ -21,14 +22,13 @@ from feederkit.reports.planview import (
     StateEntry,
     leaves,
 )
+from feederkit.sensors import NoSensor, SensorModel, ToleranceSensor, led_counts, sensor_from_dict
 
 StateKey = tuple[str, int]
 """A state of the mix: (part name, state id)."""
 
 READING_EPS = 1e-9
-"""Relative slack (of the reading's size) when a nominal reading meets a range's endpoint."""
-
-TOLERANCE_KEYS = ("tolerance", "tolerance_mm", "epsilon", "e")
+"""Slack, in beam pitches, when an LED reading range's end meets a beam count."""
 
 
 @dataclass(frozen=True)
@@ -43,8 +43,8 @@ class Step:
 class Trace:
     """Possible states at each node (before its operation) and the operations that lead there."""
 
-    states: dict[int, tuple[StateKey, ...]]
-    paths: dict[int, tuple[Step, ...]]
+    states: Mapping[int, tuple[StateKey, ...]]
+    paths: Mapping[int, tuple[Step, ...]]
 
 
 @dataclass(frozen=True)
@@ -59,17 +59,6 @@ class Confusion:
     path: tuple[Step, ...]
 
 
-def tolerance_of(sensor: dict[str, object]) -> float:
-    """The half-width ``e`` of a tolerance sensor (mm); 0 for other models."""
-    if sensor.get("model") != "tolerance":
-        return 0.0
-    for key in TOLERANCE_KEYS:
-        value = sensor.get(key)
-        if isinstance(value, int | float) and not isinstance(value, bool):
-            return abs(float(value))
-    return 0.0
-
-
 def pushed(part: PartEntry, state: StateEntry, action_deg: float) -> StateEntry:
     """The state ``state`` settles into after a counter-clockwise rotation by ``action_deg``."""
     theta = norm360(state.normal_deg - action_deg)
@@ -80,20 +69,22 @@ def pushed(part: PartEntry, state: StateEntry, action_deg: float) -> StateEntry:
     return min(part.states, key=lambda s: abs(norm360(s.normal_deg - theta + 180.0) - 180.0))
 
 
-def reads_into(diameter: float, reading: tuple[float, float] | None, tolerance: float) -> bool:
+def reads_into(sensor: SensorModel, diameter: float, reading: tuple[float, float] | None) -> bool:
     """Whether a state of this diameter can give a reading in the closed range ``reading``."""
-    if reading is None:
+    if reading is None or isinstance(sensor, NoSensor):
         return True
     lo, hi = reading
-    if tolerance > 0.0:
-        return diameter - tolerance < hi and diameter + tolerance > lo
-    slack = READING_EPS * max(1.0, abs(diameter))
-    return lo - slack <= diameter <= hi + slack
+    if isinstance(sensor, ToleranceSensor):
+        return diameter - sensor.tolerance < hi and diameter + sensor.tolerance > lo
+    c0, c1 = led_counts(sensor, diameter)
+    first = math.ceil(lo / sensor.pitch - READING_EPS)
+    last = math.floor(hi / sensor.pitch + READING_EPS)
+    return max(c0, first) <= min(c1, last)
 
 
 def trace_plan(view: PlanView) -> Trace:
     """Follow every state of the mix through the plan from the root."""
-    tol = tolerance_of(view.sensor)
+    sensor = sensor_from_dict(view.sensor)
     states: dict[int, tuple[StateKey, ...]] = {}
     paths: dict[int, tuple[Step, ...]] = {}
     all_states = tuple((p.name, s.id) for p in view.parts for s in p.states)
@@ -113,7 +104,9 @@ def trace_plan(view: PlanView) -> Trace:
                 image.append(key)
         for b in node.branches:
             child = tuple(
-                k for k in image if reads_into(view.part(k[0]).state(k[1]).diameter, b.reading, tol)
+                k
+                for k in image
+                if reads_into(sensor, view.part(k[0]).state(k[1]).diameter, b.reading)
             )
             visit(b.next, child, (*path, Step(node.action_deg, b.reading)))
 
@@ -144,7 +137,6 @@ def confusions(view: PlanView, trace: Trace) -> list[Confusion]:
 
 def plan_depth(node: Node) -> int:
     """The worst-case number of operations below and including ``node``."""
-    if isinstance(node, ResultNode):
-        return 0
-    assert isinstance(node, OpNode)
-    return 1 + max(plan_depth(b.next) for b in node.branches)
+    if isinstance(node, OpNode):
+        return 1 + max(plan_depth(b.next) for b in node.branches)
+    return 0

@@ -1,0 +1,120 @@
+"""Changeovers: a named plan for a product mix, stored against the exact part revisions."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from feederkit.catalog.model import Changeover, ChangeoverInfo, check_name
+from feederkit.catalog.schema import transaction
+from feederkit.catalog.store import CatalogLike, _conn, current_user, now_utc
+from feederkit.errors import InputError
+
+
+def _revision_id(conn: sqlite3.Connection, name: str, revision: int) -> int:
+    row = conn.execute(
+        "SELECT r.id FROM revisions r JOIN parts p ON p.id = r.part_id "
+        "WHERE p.name = ? AND r.revision = ?",
+        (name, int(revision)),
+    ).fetchone()
+    if row is None:
+        raise InputError(f"no part {name!r} revision {revision} in the catalog")
+    return int(row[0])
+
+
+def save_changeover(
+    catalog: CatalogLike,
+    name: str,
+    part_revisions: Sequence[tuple[str, int]],
+    sensor: Mapping[str, Any],
+    plan_json: str,
+    *,
+    replace: bool = False,
+    created_by: str | None = None,
+) -> ChangeoverInfo:
+    """Store a changeover in one transaction: the mix's exact revisions, sensor, and plan JSON.
+
+    An existing name is refused unless ``replace``. Raises InputError for unknown parts or
+    revisions, an empty mix, a part listed twice, or a plan that is not JSON.
+    """
+    check_name(name, "changeover")
+    mix = [(str(n), int(r)) for n, r in part_revisions]
+    if not mix:
+        raise InputError(f"changeover {name!r}: the mix has no parts")
+    names = [n for n, _ in mix]
+    if len(set(names)) != len(names):
+        raise InputError(f"changeover {name!r}: a part is listed twice in the mix")
+    try:
+        json.loads(plan_json)
+        sensor_text = json.dumps(dict(sensor), sort_keys=True, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise InputError(
+            f"changeover {name!r}: the sensor or plan is not valid JSON ({exc})"
+        ) from None
+    who, when = created_by or current_user(), now_utc()
+    with _conn(catalog) as conn, transaction(conn):
+        ids = [_revision_id(conn, n, r) for n, r in mix]
+        old = conn.execute("SELECT id FROM changeovers WHERE name = ?", (name,)).fetchone()
+        if old is not None:
+            if not replace:
+                raise InputError(f"a changeover named {name!r} already exists")
+            conn.execute("DELETE FROM changeovers WHERE id = ?", (old[0],))
+        cur = conn.execute(
+            "INSERT INTO changeovers (name, created_at, created_by, sensor_json, plan_json) "
+            "VALUES (?, ?, ?, ?, ?)",
+            (name, when, who, sensor_text, plan_json),
+        )
+        cid = int(cur.lastrowid)
+        conn.executemany(
+            "INSERT INTO changeover_parts (changeover_id, position, revision_id) VALUES (?, ?, ?)",
+            [(cid, k, rid) for k, rid in enumerate(ids)],
+        )
+    return ChangeoverInfo(name, when, who, tuple(mix), json.loads(sensor_text))
+
+
+def _info(conn: sqlite3.Connection, row: Sequence[Any]) -> ChangeoverInfo:
+    parts = conn.execute(
+        "SELECT p.name, r.revision FROM changeover_parts cp JOIN revisions r "
+        "ON r.id = cp.revision_id JOIN parts p ON p.id = r.part_id "
+        "WHERE cp.changeover_id = ? ORDER BY cp.position",
+        (row[0],),
+    ).fetchall()
+    return ChangeoverInfo(
+        name=row[1],
+        created_at=row[2],
+        created_by=row[3],
+        parts=tuple((n, int(r)) for n, r in parts),
+        sensor=json.loads(row[4]),
+    )
+
+
+def get_changeover(catalog: CatalogLike, name: str) -> Changeover:
+    """The changeover ``name`` with its plan JSON text; InputError when there is none."""
+    with _conn(catalog) as conn:
+        row = conn.execute(
+            "SELECT id, name, created_at, created_by, sensor_json, plan_json FROM changeovers "
+            "WHERE name = ?",
+            (name,),
+        ).fetchone()
+        if row is None:
+            raise InputError(f"no changeover named {name!r} in the catalog")
+        return Changeover(info=_info(conn, row), plan_json=row[5])
+
+
+def list_changeovers(catalog: CatalogLike) -> list[ChangeoverInfo]:
+    """All changeovers (without their plans), sorted by name."""
+    with _conn(catalog) as conn:
+        rows = conn.execute(
+            "SELECT id, name, created_at, created_by, sensor_json FROM changeovers ORDER BY name"
+        ).fetchall()
+        return [_info(conn, row) for row in rows]
+
+
+def remove_changeover(catalog: CatalogLike, name: str) -> None:
+    """Delete a changeover (its parts stay); InputError when there is none."""
+    with _conn(catalog) as conn, transaction(conn):
+        cur = conn.execute("DELETE FROM changeovers WHERE name = ?", (name,))
+        if cur.rowcount == 0:
+            raise InputError(f"no changeover named {name!r} in the catalog")

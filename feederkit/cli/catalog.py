@@ -1,0 +1,485 @@
+"""``feederkit catalog``: the parts catalog from the command line (init, add, import, list, ...).
+
+No logic of its own: it parses options, calls :mod:`feederkit.catalog` and prints. The
+catalog is ``--catalog PATH``, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.db``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from feederkit.catalog import (
+    CATALOG_ENV,
+    DEFAULT_CATALOG,
+    SCHEMA_VERSION,
+    AddOutcome,
+    Revision,
+    add_file,
+    connect,
+    export_part,
+    get_revision,
+    import_directory,
+    list_changeovers,
+    list_parts,
+    remove_part,
+    revision_history,
+)
+from feederkit.cli.common import console, err_console, print_json
+from feederkit.errors import InputError
+from feederkit.importers import (
+    DEFAULT_FLATTEN_TOLERANCE,
+    DEFAULT_HULL_TOLERANCE,
+    DEFAULT_MAX_FILE_MB,
+    ImportOptions,
+)
+
+RICH_TABLE_ROWS = 200
+"""Longer tables are printed as plain columns."""
+
+catalog_app = typer.Typer(
+    name="catalog",
+    help="The parts catalog (SQLite): import CAD files, list, show, remove and export parts.",
+    no_args_is_help=True,
+)
+
+CatalogOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--catalog",
+        envvar=CATALOG_ENV,
+        help=f"Catalog file (default ${CATALOG_ENV}, else ./{DEFAULT_CATALOG}).",
+        show_envvar=True,
+    ),
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
+UnitsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--units", help="Units of the file's coordinates (mm, cm, m, in, ft): overrides the file."
+    ),
+]
+LayerOpt = Annotated[
+    list[str] | None,
+    typer.Option("--layer", help="DXF layer to read (repeat for several; default all)."),
+]
+FlattenOpt = Annotated[
+    float,
+    typer.Option("--flatten-tolerance", min=1e-6, help="Largest curve-to-chord distance (mm)."),
+]
+HullOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--hull-tolerance",
+        min=0.0,
+        help=f"Hull simplification (mm); default {DEFAULT_HULL_TOLERANCE} for CAD files, exact "
+        "for outline files.",
+    ),
+]
+AllPartsOpt = Annotated[
+    bool,
+    typer.Option(
+        "--all-parts", help="Import every separate part of a drawing, not only the largest."
+    ),
+]
+PoseOpt = Annotated[
+    int | None, typer.Option("--pose", min=0, help="Mesh resting pose K (0: the most probable).")
+]
+ComOpt = Annotated[
+    tuple[float, float] | None,
+    typer.Option("--com", help="Center of mass X Y (mm) in the outline's frame."),
+]
+AllowLargeOpt = Annotated[
+    bool, typer.Option("--allow-large", help=f"Read files over {DEFAULT_MAX_FILE_MB:g} MB.")
+]
+ReviseOpt = Annotated[
+    bool,
+    typer.Option(
+        "--revise", help="Make this file the next revision of an existing part of the same name."
+    ),
+]
+
+
+def catalog_path(option: Path | None) -> Path:
+    """The catalog file: the option (it includes the environment), else ./feederkit.db."""
+    return option if option is not None else Path(DEFAULT_CATALOG)
+
+
+def import_options(
+    units: str | None,
+    layer: list[str] | None,
+    flatten_tolerance: float,
+    hull_tolerance: float | None,
+    all_parts: bool,
+    pose: int | None,
+    com: tuple[float, float] | None,
+    allow_large: bool,
+) -> ImportOptions:
+    """The importer options from the command-line options."""
+    return ImportOptions(
+        units=units,
+        layers=tuple(layer or ()),
+        flatten_tolerance=flatten_tolerance,
+        hull_tolerance=hull_tolerance,
+        all_parts=all_parts,
+        pose=pose,
+        com=None if com is None else (float(com[0]), float(com[1])),
+        allow_large=allow_large,
+    )
+
+
+def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
+    return {
+        "name": o.name,
+        "revision": o.revision,
+        "status": o.status,
+        "source": o.source_path,
+        "orientable": o.orientable,
+        "warnings": list(o.warnings),
+    }
+
+
+def _warn(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
+    for o in outcomes:
+        for w in o.warnings:
+            err_console.print(f"[yellow]warning:[/] {o.name}: {w}", highlight=False, soft_wrap=True)
+
+
+def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
+    """The import summary: a rich table, or plain columns when it is long (rich is slow there)."""
+    headers = ("part", "revision", "status", "orientable", "warnings", "source")
+    rows = [
+        (
+            o.name,
+            str(o.revision),
+            o.status,
+            "yes" if o.orientable else "no",
+            str(len(o.warnings)),
+            o.source_path,
+        )
+        for o in outcomes
+    ]
+    if len(rows) > RICH_TABLE_ROWS:
+        sys.stdout.write(plain_table(headers, rows, right=(1, 4)))
+        return
+    table = Table(title="catalog import")
+    for col in headers:
+        table.add_column(col, overflow="fold")
+    for row in rows:
+        table.add_row(*row[:3], row[3] if row[3] == "yes" else "[red]no[/]", *row[4:])
+    console.print(table)
+
+
+def cmd_init(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
+    """Create the catalog (or bring an existing one to the current schema)."""
+    path = catalog_path(catalog)
+    existed = path.exists()
+    conn = connect(path, create=True)
+    conn.close()
+    if json_out:
+        print_json({"catalog": str(path), "created": not existed, "schema_version": SCHEMA_VERSION})
+    else:
+        verb = "ready" if existed else "created"
+        console.print(f"catalog {path} {verb} (schema version {SCHEMA_VERSION})", highlight=False)
+
+
+def cmd_add(
+    file: Annotated[Path, typer.Argument(help="Outline .json, .dxf, .stl, .obj or .ply file.")],
+    name: Annotated[
+        str | None, typer.Option("--name", help="Part name (default: from the file).")
+    ] = None,
+    revise: ReviseOpt = False,
+    units: UnitsOpt = None,
+    layer: LayerOpt = None,
+    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
+    hull_tolerance: HullOpt = None,
+    all_parts: AllPartsOpt = False,
+    pose: PoseOpt = None,
+    com: ComOpt = None,
+    allow_large: AllowLargeOpt = False,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Import one file as a part; a changed file makes a new revision, an unchanged one nothing."""
+    opts = import_options(
+        units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
+    )
+    outcomes = add_file(catalog_path(catalog), file, opts, name=name, revise=revise)
+    _warn(outcomes)
+    if json_out:
+        print_json([_outcome_dict(o) for o in outcomes])
+        return
+    for o in outcomes:
+        console.print(f"{o.name}: revision {o.revision} ({o.status})", highlight=False)
+
+
+def cmd_import(
+    directory: Annotated[
+        Path, typer.Argument(help="Folder searched recursively for source files.")
+    ],
+    revise: ReviseOpt = False,
+    units: UnitsOpt = None,
+    layer: LayerOpt = None,
+    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
+    hull_tolerance: HullOpt = None,
+    all_parts: AllPartsOpt = False,
+    pose: PoseOpt = None,
+    com: ComOpt = None,
+    allow_large: AllowLargeOpt = False,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Import every source file of a folder in one transaction: all files or none."""
+    opts = import_options(
+        units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
+    )
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TextColumn("{task.fields[item]}"),
+    )
+    with Progress(
+        *columns, console=err_console, transient=True, disable=not err_console.is_terminal
+    ) as bar:
+        tasks: dict[str, Any] = {}
+
+        def progress(phase: str, done: int, total: int, item: str) -> None:
+            if phase not in tasks:
+                label = "reading" if phase == "read" else "writing"
+                tasks[phase] = bar.add_task(label, total=total, item="")
+            bar.update(tasks[phase], completed=done, item=Path(item).name if item else "")
+
+        result = import_directory(
+            catalog_path(catalog), directory, opts, revise=revise, progress=progress
+        )
+    _warn(result.outcomes)
+    if json_out:
+        print_json(
+            {"parts": [_outcome_dict(o) for o in result.outcomes], "ignored": list(result.ignored)}
+        )
+        return
+    _print_summary(result.outcomes)
+    counts = {
+        s: sum(o.status == s for o in result.outcomes) for s in ("added", "revised", "unchanged")
+    }
+    console.print(
+        f"{counts['added']} added, {counts['revised']} revised, {counts['unchanged']} unchanged; "
+        f"{len(result.ignored)} other files ignored",
+        highlight=False,
+    )
+
+
+def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
+    """List the parts with their latest revision."""
+    parts = list_parts(catalog_path(catalog))
+    if json_out:
+        print_json(
+            [
+                {
+                    "name": p.name,
+                    "revision": p.revision,
+                    "revisions": p.revisions,
+                    "kind": p.source_kind,
+                    "source_units": p.source_units,
+                    "area": p.area,
+                    "holes": p.n_holes,
+                    "hull_vertices": p.n_hull,
+                    "orientable": p.orientable,
+                    "updated_at": p.updated_at,
+                }
+                for p in parts
+            ]
+        )
+        return
+    headers = ("part", "rev", "kind", "units", "area mm2", "holes", "hull", "orientable", "updated")
+    rows = [
+        (
+            p.name,
+            str(p.revision),
+            p.source_kind,
+            p.source_units,
+            f"{p.area:.1f}",
+            str(p.n_holes),
+            str(p.n_hull),
+            "yes" if p.orientable else "no",
+            p.updated_at,
+        )
+        for p in parts
+    ]
+    sys.stdout.write(plain_table(headers, rows, right=(1, 4, 5, 6)))
+    sys.stdout.write(f"{len(parts)} parts\n")
+    sys.stdout.flush()
+
+
+def plain_table(
+    headers: tuple[str, ...], rows: list[tuple[str, ...]], right: tuple[int, ...]
+) -> str:
+    """Columns padded to their widest cell: fast for catalogs of thousands of parts (rich's
+    Table takes seconds there) and never truncated, so it can be piped and grepped."""
+    widths = [max([len(h)] + [len(r[k]) for r in rows]) for k, h in enumerate(headers)]
+
+    def line(cells: tuple[str, ...]) -> str:
+        return "  ".join(
+            c.rjust(w) if k in right else c.ljust(w)
+            for k, (c, w) in enumerate(zip(cells, widths, strict=True))
+        ).rstrip()
+
+    rule = "  ".join("-" * w for w in widths)
+    return "\n".join([line(headers), rule, *(line(r) for r in rows)]) + "\n"
+
+
+def revision_dict(
+    rev: Revision, history: list[tuple[int, str, str, str]], changeovers: list[str]
+) -> dict[str, Any]:
+    """``catalog show --json``: everything stored about a revision."""
+    from feederkit.outline import outline_to_dict
+
+    return {
+        "name": rev.name,
+        "revision": rev.revision,
+        "units": "mm",
+        "source": {
+            "path": rev.source_path,
+            "sha256": rev.source_sha256,
+            "kind": rev.source_kind,
+            "units": rev.source_units,
+        },
+        "options": dict(rev.options),
+        "outline": outline_to_dict(rev.outline),
+        "area": rev.area,
+        "holes": len(rev.outline.holes),
+        "com": list(rev.com),
+        "hull": [list(p) for p in rev.hull],
+        "hull_tolerance": rev.hull_tolerance,
+        "mesh_pose": None if rev.mesh_pose is None else dict(rev.mesh_pose),
+        "orientable": rev.orientable,
+        "not_orientable_reason": rev.not_orientable_reason,
+        "warnings": list(rev.warnings),
+        "created_at": rev.created_at,
+        "created_by": rev.created_by,
+        "revisions": [
+            {"revision": r, "created_at": at, "created_by": by, "sha256": sha}
+            for r, at, by, sha in history
+        ],
+        "changeovers": changeovers,
+    }
+
+
+def _tol(value: float | None) -> str:
+    return "exact" if value is None else f"{value:g} mm"
+
+
+def cmd_show(
+    name: Annotated[str, typer.Argument(help="Part name.")],
+    revision: Annotated[
+        int | None, typer.Option("--revision", min=1, help="Revision (default latest).")
+    ] = None,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Show a part: source, units, outline, hull, COM, mesh pose, orientability, revisions."""
+    path = catalog_path(catalog)
+    conn = connect(path)
+    try:
+        rev = get_revision(conn, name, revision)
+        history = revision_history(conn, name)
+        users = [c.name for c in list_changeovers(conn) if any(n == name for n, _ in c.parts)]
+    finally:
+        conn.close()
+    data = revision_dict(rev, history, users)
+    if json_out:
+        print_json(data)
+        return
+    table = Table(show_header=False, title=f"{rev.name} revision {rev.revision}")
+    table.add_column("field")
+    table.add_column("value")
+    pose = rev.mesh_pose
+    rows = [
+        ("source", f"{rev.source_path} ({rev.source_kind}, {rev.source_units})"),
+        ("sha256", rev.source_sha256),
+        ("area", f"{rev.area:.3f} mm2, {len(rev.outline.holes)} holes"),
+        ("outline", f"{len(rev.outline.vertices)} vertices"),
+        (
+            "hull",
+            f"{len(rev.hull)} vertices (tolerance {_tol(rev.hull_tolerance)})",
+        ),
+        ("com", f"({rev.com[0]:.4f}, {rev.com[1]:.4f}) mm"),
+        (
+            "mesh pose",
+            "-"
+            if pose is None
+            else f"{pose['index']} of {pose['count']} (probability {pose['probability']:.3f})",
+        ),
+        ("orientable", "yes" if rev.orientable else f"no: {rev.not_orientable_reason}"),
+        ("created", f"{rev.created_at} by {rev.created_by}"),
+        ("revisions", ", ".join(f"{r} ({at})" for r, at, _, _ in history)),
+        ("changeovers", ", ".join(users) or "-"),
+    ]
+    rows += [("warning", w) for w in rev.warnings]
+    for k, v in rows:
+        table.add_row(k, v)
+    console.print(table)
+
+
+def cmd_remove(
+    name: Annotated[str, typer.Argument(help="Part name.")],
+    force: Annotated[
+        bool, typer.Option("--force", help="Also remove changeovers that use the part.")
+    ] = False,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Remove a part and all its revisions."""
+    removed = remove_part(catalog_path(catalog), name, force=force)
+    if json_out:
+        print_json({"removed": name, "changeovers_removed": removed})
+        return
+    extra = f" and changeover(s) {', '.join(removed)}" if removed else ""
+    console.print(f"removed {name}{extra}", highlight=False)
+
+
+def cmd_export(
+    name: Annotated[str, typer.Argument(help="Part name.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Outline file to write (.json).")],
+    revision: Annotated[
+        int | None, typer.Option("--revision", min=1, help="Revision (default latest).")
+    ] = None,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Write a part's outline file (design.md outline format)."""
+    if output.suffix.lower() != ".json":
+        raise InputError(f"{output}: the outline file must end in .json")
+    rev = export_part(catalog_path(catalog), name, output, revision)
+    if json_out:
+        print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
+        return
+    console.print(f"wrote {output} ({rev.name} revision {rev.revision})", highlight=False)
+
+
+catalog_app.command("init")(cmd_init)
+catalog_app.command("add")(cmd_add)
+catalog_app.command("import")(cmd_import)
+catalog_app.command("list")(cmd_list)
+catalog_app.command("show")(cmd_show)
+catalog_app.command("remove")(cmd_remove)
+catalog_app.command("export")(cmd_export)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``catalog`` command group (with ``analyze`` once it exists) to the app."""
+    try:
+        from feederkit.cli.catalog_analyze import analyze_command
+    except ModuleNotFoundError as exc:
+        if exc.name != "feederkit.cli.catalog_analyze":
+            raise
+    else:
+        catalog_app.command("analyze")(analyze_command)
+    app.add_typer(catalog_app, name="catalog")

@@ -1,0 +1,173 @@
+"""``feederkit catalog analyze``: behaviour classes of the catalog's parts and every pair no plan
+can tell apart under a sensor (section 8).
+
+The lead registers :func:`analyze_command` as ``analyze`` in the ``catalog`` group.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+from rich.progress import Progress
+from rich.table import Table
+
+from feederkit.catalog import CATALOG_ENV, default_catalog_path, list_parts, open_catalog
+from feederkit.catalog import get_part as catalog_get_part
+from feederkit.cli.common import console, err_console, print_json
+from feederkit.errors import InputError
+from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.mix.analyze import MixAnalysis, analyze_mix
+from feederkit.mix.pairs import PairWitness
+from feederkit.plans.render import sensor_text
+from feederkit.sensors import NoSensor, make_sensor, sensor_to_dict
+
+
+def catalog_file(option: Path | None) -> Path:
+    """The catalog file: option, else ``$FEEDERKIT_CATALOG``, else ./feederkit.db; it must exist."""
+    path = option if option is not None else default_catalog_path()
+    if not path.is_file():
+        raise InputError(f"no catalog at {path} (create one with: feederkit catalog init)")
+    return path
+
+
+def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str]]:
+    """Push functions of every orientable part's latest revision; a warning per part left out."""
+    conn = open_catalog(path)
+    try:
+        summaries = list_parts(conn)
+        pfs, skipped = [], []
+        with Progress(console=err_console, transient=True) as progress:
+            task = progress.add_task("reading parts", total=len(summaries))
+            for s in summaries:
+                progress.advance(task)
+                if not s.orientable:
+                    skipped.append(f"{s.name}: not orientable by pushing, left out")
+                    continue
+                part = catalog_get_part(conn, s.name, s.revision)
+                try:
+                    pfs.append(push_function(part))
+                except AssertionError as exc:
+                    skipped.append(f"{s.name}: no push function ({exc}), left out")
+    finally:
+        conn.close()
+    return pfs, skipped
+
+
+def analyze_command(
+    sensorless: Annotated[
+        bool, typer.Option("--sensorless", help="No sensor: classes only (the default).")
+    ] = False,
+    tolerance: Annotated[
+        float | None,
+        typer.Option("--tolerance", help="Diameter sensor: readings strictly within MM of d."),
+    ] = None,
+    led_pitch: Annotated[
+        float | None, typer.Option("--led-pitch", help="LED array with beams every MM.")
+    ] = None,
+    noise: Annotated[
+        float | None, typer.Option("--noise", help="The LED array's alignment noise (mm).")
+    ] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Machine-readable output on stdout.")
+    ] = False,
+    catalog: Annotated[
+        Path | None,
+        typer.Option(
+            "--catalog",
+            envvar=CATALOG_ENV,
+            help="Catalog file (default $FEEDERKIT_CATALOG, else ./feederkit.db).",
+            show_envvar=True,
+        ),
+    ] = None,
+) -> None:
+    """Behaviour classes (same push function, same push-diameter function: section 8.3) of the
+    catalog's parts, and with a sensor every pair of parts no plan can tell apart, with its
+    witness: the states that can never be told apart and why (decided exactly)."""
+    sensor = make_sensor(
+        sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
+    )
+    pfs, skipped = load_catalog_parts(catalog_file(catalog))
+    with err_console.status("analyzing ..."):
+        result = analyze_mix(pfs, sensor)
+    if json_out:
+        data = result.to_dict()
+        data["skipped"] = skipped
+        print_json(data)
+        return
+    for line in skipped:
+        err_console.print(f"warning: {line}", highlight=False, markup=False)
+    _print_report(result, pfs)
+
+
+def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
+    c = result.counts()
+    summary = Table(title="catalog analysis (section 8)", show_header=False)
+    summary.add_row("parts", str(c["parts"]))
+    summary.add_row("sensor", sensor_text(sensor_to_dict(result.sensor)))
+    summary.add_row(
+        "tolerances",
+        f"{result.angle_tol_deg:g} deg per resting-range side, "
+        f"{result.length_tol_mm:g} mm per diameter",
+    )
+    summary.add_row(
+        "push functions",
+        f"{c['push_classes']} distinct; {c['parts_sharing_a_push_function']} parts share one "
+        f"({len(result.shared_push)} classes)",
+    )
+    summary.add_row(
+        "push-diameter functions",
+        f"{c['push_diameter_classes']} distinct; "
+        f"{c['parts_sharing_a_push_diameter_function']} parts share one "
+        f"({len(result.shared_push_diameter)} classes)",
+    )
+    if result.pairs is None:
+        summary.add_row(
+            "unrecognizable pairs",
+            "all: without a sensor no part can be recognized (section 8.6); parts with one push "
+            "function share a sensorless plan (Corollary 5)",
+        )
+    else:
+        summary.add_row(
+            "unrecognizable pairs",
+            f"{c['unrecognizable_pairs']} (exact test on {c['candidate_pairs']} candidate pairs)",
+        )
+    console.print(summary)
+    for title, classes in (
+        ("parts with the same push function", result.shared_push),
+        ("parts with the same push-diameter function", result.shared_push_diameter),
+    ):
+        if not classes:
+            continue
+        t = Table(title=title)
+        t.add_column("class", justify="right")
+        t.add_column("parts (phase shift alpha from the first, deg)")
+        for k, cls in enumerate(classes, 1):
+            names = ", ".join(
+                f"{escape(result.names[m])} ({a:.4g})" if j else escape(result.names[m])
+                for j, (m, a) in enumerate(zip(cls.members, cls.phases_deg, strict=True))
+            )
+            t.add_row(str(k), names)
+        console.print(t)
+    if result.pairs:
+        console.print(_pairs_table(result.pairs, pfs))
+    elif result.pairs is not None and not isinstance(result.sensor, NoSensor):
+        console.print("every pair of parts can be told apart by some plan (Theorem 11)")
+
+
+def _pairs_table(pairs: tuple[PairWitness, ...], pfs: list[PushFunction]) -> Table:
+    t = Table(title="pairs no plan can tell apart (section 8.4)")
+    t.add_column("part A")
+    t.add_column("part B")
+    t.add_column("inseparable states (A ~ B: edge, diameter mm)")
+    t.add_column("why")
+    for w in pairs:
+        sa, sb = pfs[w.index_a].states, pfs[w.index_b].states
+        states = ", ".join(
+            f"{i}~{j} (e{sa[i].edge} {sa[i].diameter:.4g} / e{sb[j].edge} {sb[j].diameter:.4g})"
+            for i, j in w.pairs
+        )
+        t.add_row(escape(w.part_a), escape(w.part_b), states, escape(w.reason))
+    return t

@@ -1,0 +1,82 @@
+"""``feederkit lookalike SOURCE --keep push|push-diameter [-o OUT.json]`` (Theorems 4 and 6).
+
+Builds a non-similar convex polygon with the same push function or the same push-diameter
+function as SOURCE, checks it, writes its outline file (with the source's center of mass
+stated) and prints what was checked. Without ``-o`` the outline goes to stdout and the
+check to stderr.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from feederkit.cli.common import console, err_console
+from feederkit.errors import InputError
+from feederkit.mix.lookalike import build_lookalike
+from feederkit.outline import outline_to_dict, write_text_atomic
+from feederkit.sources import load_part
+
+
+def lookalike_command(
+    source: Annotated[str, typer.Argument(help="An outline file, CAD file or catalog part name.")],
+    keep: Annotated[
+        str, typer.Option("--keep", help="What the look-alike keeps: push or push-diameter.")
+    ],
+    output: Annotated[
+        Path | None, typer.Option("-o", "--output", help="Outline file (.json) to write.")
+    ] = None,
+    name: Annotated[str | None, typer.Option("--name", help="Name of the new part.")] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the construction's choices.")] = 0,
+    catalog: Annotated[
+        str | None, typer.Option("--catalog", help="Parts catalog for catalog part names.")
+    ] = None,
+) -> None:
+    """A non-similar part with the same push function (Theorem 4) or the same push-diameter
+    function (Theorem 6), checked numerically before it is written."""
+    if keep not in ("push", "push-diameter"):
+        raise InputError(f"--keep must be push or push-diameter, got {keep!r}")
+    if output is not None and output.suffix.lower() != ".json":
+        raise InputError(f"{output}: the look-alike is written as an outline file (.json)")
+    part = load_part(source, catalog=catalog)
+    result = build_lookalike(part, keep, seed)
+    data = outline_to_dict(result.part.outline)
+    if name:
+        data["name"] = name
+    text = json.dumps(data, indent=2) + "\n"
+    check = result.check
+    table = Table(title=f"look-alike of {part.name} (keep {keep})", show_header=False)
+    table.add_row("construction", result.construction)
+    table.add_row("hull vertices", f"{check.source_vertices} -> {check.vertices}")
+    table.add_row(
+        "same push function",
+        _yes(check.same_push) + f" (max error {check.angle_error_deg:.2g} deg)",
+    )
+    table.add_row(
+        "same push-diameter function",
+        _yes(check.same_push_diameter) + f" (max diameter error {check.diameter_error_mm:.2g} mm)",
+    )
+    table.add_row("similar to the source", _yes(check.similar))
+    table.add_row(
+        "center of mass", f"({part.com[0]:.6g}, {part.com[1]:.6g}) mm, stated in the file"
+    )
+    if output is None:
+        err_console.print(table)
+        typer.echo(text, nl=False)
+        return
+    write_text_atomic(output, text)
+    console.print(table)
+    console.print(f"wrote {output}", highlight=False, markup=False)
+
+
+def _yes(flag: bool) -> str:
+    return "yes" if flag else "no"
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``lookalike`` to the app."""
+    app.command("lookalike")(lookalike_command)

@@ -1,0 +1,185 @@
+"""``feederkit part``: analyse one or more parts (and, wired below, plot one).
+
+``part analyze SOURCE... [--com X Y] [--tolerance MM | --led-pitch MM [--noise MM]] [--json]``
+prints per part its stable states, symmetry and, with a sensor model, its Fig. 14 class and
+worst-case plan length. No logic of its own: :mod:`feederkit.mechanics.analysis` does the work.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+from rich import box
+from rich.markup import escape
+from rich.table import Table
+
+from feederkit.cli.common import console, err_console, print_json
+from feederkit.mechanics.analysis import PartAnalysis, analysis_to_dict, analyze_part
+from feederkit.sensors import make_sensor
+from feederkit.sources import load_part
+
+NEAR_LIST_MAX = 8
+"""At most this many near-metastable edges are named in a warning line; the rest are counted."""
+
+part_app = typer.Typer(
+    name="part",
+    help="Analyse a part's push-align mechanics, or plot them.",
+    no_args_is_help=True,
+)
+
+
+def _deg(x: float) -> str:
+    return f"{x:.2f}"
+
+
+def _near_list(a: PartAnalysis) -> str:
+    near = a.near_metastable
+    named = ", ".join(
+        f"edge {n.edge} ({n.kind}, foot {abs(n.margin_deg):.3g} deg from vertex {n.vertex})"
+        for n in near[:NEAR_LIST_MAX]
+    )
+    more = f" and {len(near) - NEAR_LIST_MAX} more" if len(near) > NEAR_LIST_MAX else ""
+    return named + more
+
+
+def near_metastable_warning(a: PartAnalysis) -> str | None:
+    """One line naming the part's near-metastable edges, or None when it has none."""
+    if not a.near_metastable:
+        return None
+    return (
+        f"{a.part.name}: near-metastable {_near_list(a)}; "
+        "in practice the part may rest on either neighbour"
+    )
+
+
+def _num(x: float, digits: int = 4, zero: float = 0.0) -> str:
+    return f"{(0.0 if abs(x) <= zero else x) + 0.0:.{digits}g}"
+
+
+def _print_analysis(a: PartAnalysis) -> None:
+    part, pf, sym = a.part, a.push, a.symmetry
+    rev = f" revision {part.revision}" if part.revision is not None else ""
+    tiny = 1e-9 * part.size
+    console.print(
+        f"[bold]{escape(part.name)}[/]{escape(rev)}: COM ({_num(part.com[0], 6, tiny)}, "
+        f"{_num(part.com[1], 6, tiny)}) mm, hull of {len(part.hull)} vertices, "
+        f"{pf.n} stable states",
+        highlight=False,
+    )
+    near_edges = set(pf.near_metastable_edges)
+    table = Table(
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        collapse_padding=True,
+        header_style="bold",
+        caption="angles in degrees (theta of design.md), lengths in mm"
+        + ("; * near-metastable" if near_edges else ""),
+        caption_justify="left",
+    )
+    for col in ("state", "edge", "normal", "resting range", "width", "diameter", "pose", "barrier"):
+        table.add_column(col, justify="right", no_wrap=True)
+    for s in pf.states:
+        lo, hi = s.resting_range_deg
+        table.add_row(
+            str(s.id),
+            f"{s.edge}*" if s.edge in near_edges else str(s.edge),
+            _deg(s.normal_deg),
+            f"{_deg(lo)} .. {_deg(hi)}",
+            _deg(hi - lo),
+            f"{s.diameter:.4f}",
+            _deg(s.pose_deg),
+            f"{s.barrier_mm:.3g}",
+        )
+    console.print(table)
+    kind = sym.kind
+    if kind in ("symmetric", "quasi-symmetric"):
+        kind = f"{kind}, period {_num(sym.period_deg, 6)}"
+    console.print(
+        f"symmetry: part {_num(sym.part_period_deg, 6)} deg, push function "
+        f"{_num(sym.push_period_deg, 6)} deg, push-diameter function {kind}",
+        highlight=False,
+    )
+    if a.near_metastable:
+        console.print(f"[yellow]near-metastable:[/] {escape(_near_list(a))}", highlight=False)
+    if a.polygon_class is not None:
+        c = a.polygon_class
+        console.print(
+            f"class {c.number} (Fig. 14): {c.description}; worst-case plan length {c.bound} "
+            f"(m = {c.m}, n = {c.n}, p = {c.p})",
+            highlight=False,
+        )
+    console.print()
+
+
+@part_app.command("analyze")
+def analyze_command(
+    sources: Annotated[
+        list[str],
+        typer.Argument(
+            help="Outline files, CAD files or catalog part names.",
+            metavar="SOURCE",
+            show_default=False,
+        ),
+    ],
+    com: Annotated[
+        tuple[float, float] | None,
+        typer.Option("--com", help="Center of mass X Y (mm) for every SOURCE, instead of its own."),
+    ] = None,
+    sensorless: Annotated[
+        bool, typer.Option("--sensorless", help="Classify for no sensor (Fig. 14 classes 7, 8).")
+    ] = False,
+    tolerance: Annotated[
+        float | None,
+        typer.Option("--tolerance", help="Sensor tolerance (mm): a reading lies within it."),
+    ] = None,
+    led_pitch: Annotated[
+        float | None, typer.Option("--led-pitch", help="LED array beam pitch (mm).")
+    ] = None,
+    noise: Annotated[
+        float | None, typer.Option("--noise", help="Alignment noise of the LED reading (mm).")
+    ] = None,
+    catalog: Annotated[
+        str | None, typer.Option("--catalog", help="Parts catalog for catalog part names.")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Stable states, resting ranges, diameters, symmetry and (with a sensor) the Fig. 14 class."""
+    given = sensorless or tolerance is not None or led_pitch is not None or noise is not None
+    sensor = (
+        make_sensor(sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise)
+        if given
+        else None
+    )
+    parts = [load_part(src, com=com, catalog=catalog) for src in sources]
+    analyses = [analyze_part(p, sensor) for p in parts]
+    for a in analyses:
+        warning = near_metastable_warning(a)
+        if warning is not None:
+            err_console.print(
+                f"[yellow]warning:[/] {escape(warning)}", highlight=False, soft_wrap=True
+            )
+    if json_out:
+        print_json([analysis_to_dict(a) for a in analyses])
+        return
+    for a in analyses:
+        _print_analysis(a)
+
+
+def _register_plot() -> None:
+    """``part plot``: wired here from :mod:`feederkit.cli.part_plot` when that module exists."""
+    try:
+        from feederkit.cli.part_plot import plot_command
+    except ModuleNotFoundError as exc:
+        if exc.name != "feederkit.cli.part_plot":
+            raise
+        return
+    part_app.command("plot")(plot_command)
+
+
+_register_plot()
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``part`` group (``analyze``, ``plot``) to the ``feederkit`` command."""
+    app.add_typer(part_app, name="part")

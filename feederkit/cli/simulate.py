@@ -1,0 +1,179 @@
+"""``feederkit simulate PLAN``: check a plan in MuJoCo over many trials (issue 7).
+
+Failures are data: the command exits 0 whatever the success rate, unless
+``--require-success`` names a rate the run must reach (then exit 1 below it).
+Without MuJoCo it exits 2 with one line saying to install ``feederkit[sim]``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from feederkit.cli.common import console, err_console, print_json
+from feederkit.errors import CheckFailed, InputError
+from feederkit.sim.api import (
+    DEFAULT_BELT_SPEED,
+    DEFAULT_FRICTION_BELT,
+    DEFAULT_FRICTION_FENCE,
+    simulate_plan,
+)
+from feederkit.sim.engine import require_mujoco
+from feederkit.sim.planfile import load_plan_json
+from feederkit.sim.summary import SimulationSummary
+
+SHOWN_ROWS = 20
+"""Failures and misses listed in the terminal (all of them are in ``--json``)."""
+
+
+def _print_summary(s: SimulationSummary) -> None:
+    st = s.settings
+    console.print(
+        f"[bold]simulated[/] {escape(', '.join(s.parts))}: {st.trials} trials, seed {st.seed}, "
+        f"rotation noise ±{st.rotation_noise_deg:g} deg, belt {st.belt_speed:g} m/s, "
+        f"friction belt {st.friction_belt:g} / fence {st.friction_fence:g}",
+        highlight=False,
+    )
+    table = Table(show_header=False, box=None, pad_edge=False)
+    table.add_row("successes", f"{s.successes} of {s.trials} ({100 * s.success_rate:.1f}%)")
+    if len(s.parts) > 1:
+        for name, t, k in zip(s.parts, s.part_trials, s.part_successes, strict=True):
+            table.add_row(f"  {escape(name)}", f"{k} of {t}")
+    table.add_row("failures", str(len(s.failures)))
+    table.add_row("never settled", str(len(s.unsettled)))
+    table.add_row(
+        "push agreement",
+        f"{s.push_agreements} of {s.settled_pushes} settled pushes "
+        f"({100 * s.push_agreement:.1f}%) end where the push function says",
+    )
+    margin = "none (no rotations)" if s.min_margin_deg is None else f"{s.min_margin_deg:.3g} deg"
+    table.add_row("plan's smallest margin", margin)
+    table.add_row("wall time", f"{s.wall_time_s:.2f} s ({s.pushes} push-align operations)")
+    console.print(table)
+    if s.min_margin_deg is not None and st.rotation_noise_deg > s.min_margin_deg:
+        console.print(
+            "[yellow]note:[/] the rotation noise exceeds the plan's smallest margin; "
+            "failures are expected",
+        )
+    rows = list(s.failures) + list(s.unsettled)
+    if rows:
+        t = Table(title="trials that went wrong", title_justify="left")
+        for col in ("trial", "part", "start deg", "step", "what happened"):
+            t.add_column(col, overflow="fold")
+        for r in rows[:SHOWN_ROWS]:
+            t.add_row(
+                str(r.index),
+                escape(r.part),
+                f"{r.start_deg:.2f}",
+                str(r.step),
+                escape(r.reason or ""),
+            )
+        console.print(t)
+        if len(rows) > SHOWN_ROWS:
+            console.print(f"... and {len(rows) - SHOWN_ROWS} more (see --json)")
+    if s.push_misses:
+        t = Table(title="pushes that disagree with the push function", title_justify="left")
+        cols = (
+            "trial",
+            "part",
+            "step",
+            "theta deg",
+            "from divergent",
+            "predicted",
+            "its margin",
+            "sim",
+        )
+        for col in cols:
+            t.add_column(col)
+        for m in s.push_misses[:SHOWN_ROWS]:
+            t.add_row(
+                str(m.trial),
+                escape(m.part),
+                str(m.step),
+                f"{m.theta_deg:.2f}",
+                f"{m.divergent_distance_deg:.2f} deg",
+                str(m.predicted_state),
+                f"{m.predicted_margin_deg:.2f} deg",
+                "-" if m.simulated_state is None else str(m.simulated_state),
+            )
+        console.print(t)
+
+
+def simulate_command(
+    plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
+    trials: Annotated[int, typer.Option("--trials", help="Number of trials.")] = 100,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts and errors.")] = 0,
+    rotation_noise: Annotated[
+        float,
+        typer.Option(
+            "--rotation-noise",
+            help="Robot rotation error, uniform in [-DEG, +DEG], on every rotation.",
+            metavar="DEG",
+        ),
+    ] = 0.0,
+    belt_speed: Annotated[
+        float, typer.Option("--belt-speed", help="Belt speed.", metavar="M/S")
+    ] = DEFAULT_BELT_SPEED,
+    friction_belt: Annotated[
+        float, typer.Option("--friction-belt", help="Part-belt friction.", metavar="MU")
+    ] = DEFAULT_FRICTION_BELT,
+    friction_fence: Annotated[
+        float, typer.Option("--friction-fence", help="Part-fence friction.", metavar="MU")
+    ] = DEFAULT_FRICTION_FENCE,
+    require_success: Annotated[
+        float | None,
+        typer.Option(
+            "--require-success",
+            help="Exit 1 when the success rate falls below this fraction (0-1).",
+            metavar="RATE",
+        ),
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+) -> None:
+    """Execute a plan in a MuJoCo conveyor, fence and robot and compare it with its claims."""
+    require_mujoco()  # InputError (exit 2): install feederkit[sim]
+    if require_success is not None and not 0.0 <= require_success <= 1.0:
+        raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
+    data = load_plan_json(plan)
+    columns = (
+        TextColumn("simulating"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("trials"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=err_console, transient=True) as bar:
+        task = bar.add_task("simulate", total=trials)
+
+        def advance(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        summary = simulate_plan(
+            data,
+            trials,
+            seed,
+            rotation_noise_deg=rotation_noise,
+            belt_speed=belt_speed,
+            friction_belt=friction_belt,
+            friction_fence=friction_fence,
+            progress=advance,
+        )
+    if json_out:
+        print_json(summary.to_dict())
+    else:
+        _print_summary(summary)
+    if require_success is not None and summary.success_rate < require_success:
+        raise CheckFailed(
+            f"{summary.successes} of {summary.trials} trials succeeded "
+            f"({100 * summary.success_rate:.1f}%), below the required {100 * require_success:g}%"
+        )
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``simulate`` command to the app."""
+    app.command("simulate")(simulate_command)

@@ -1,0 +1,144 @@
+"""Read any supported source file into outlines, then into parts with their orientability."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+
+from feederkit.errors import InputError
+from feederkit.importers.model import (
+    CAD_SUFFIXES,
+    DEFAULT_HULL_TOLERANCE,
+    MESH_SUFFIXES,
+    OUTLINE_SUFFIXES,
+    SUPPORTED_SUFFIXES,
+    ImportedOutline,
+    ImportOptions,
+    ImportResult,
+)
+from feederkit.importers.orientable import Orientability, orientability
+from feederkit.outline import load_outline_json
+from feederkit.part import Part, make_part
+
+NOT_ORIENTABLE = "not orientable by pushing"
+
+
+@dataclass(frozen=True)
+class ImportedPart:
+    """A part built from an imported outline, with its orientability and all warnings."""
+
+    part: Part
+    source: ImportedOutline
+    orientability: Orientability
+    hull_tolerance: float | None
+    warnings: tuple[str, ...]
+
+
+def file_sha256(path: Path, chunk: int = 1 << 20) -> str:
+    """SHA-256 of a file's bytes, hex."""
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def check_file(path: Path, options: ImportOptions) -> None:
+    """Refuse missing, empty, unsupported and (unless allowed) oversized files."""
+    suffix = path.suffix.lower()
+    if not path.exists():
+        raise InputError(f"{path}: no such file")
+    if not path.is_file():
+        raise InputError(f"{path}: not a file")
+    if suffix not in SUPPORTED_SUFFIXES:
+        known = ", ".join(SUPPORTED_SUFFIXES)
+        raise InputError(f"{path}: unsupported file type {path.suffix!r} (known: {known})")
+    size = path.stat().st_size
+    if size == 0:
+        raise InputError(f"{path}: the file is empty")
+    limit = options.max_file_mb * 1e6
+    if size > limit and not options.allow_large:
+        raise InputError(
+            f"{path}: the file is {size / 1e6:.1f} MB, over the {options.max_file_mb:g} MB limit "
+            "(use --allow-large to read it)"
+        )
+
+
+def read_source(path: str | Path, options: ImportOptions, name: str | None = None) -> ImportResult:
+    """Read an outline ``.json``, ``.dxf``, ``.stl``, ``.obj`` or ``.ply`` file.
+
+    ``name`` names the part (default: the outline file's name, else the file's stem).
+    Raises InputError, one line naming the file, for anything that is not a valid part.
+    """
+    p = Path(path)
+    check_file(p, options)
+    digest = file_sha256(p)
+    suffix = p.suffix.lower()
+    label = name or p.stem
+    others: list[str] = []
+    warnings: list[str] = []
+    if suffix in OUTLINE_SUFFIXES:
+        outline = load_outline_json(p)
+        if name:
+            outline = dataclasses.replace(outline, name=name)
+        if options.com is not None:
+            outline = dataclasses.replace(outline, com=options.com)
+        parts = [ImportedOutline(outline=outline, kind="outline", source_units="mm")]
+    elif suffix in CAD_SUFFIXES:
+        from feederkit.importers.dxf import read_dxf  # ezdxf loads slowly: only when needed
+
+        found, others, warnings = read_dxf(p, options, label)
+        parts = found
+    elif suffix in MESH_SUFFIXES:
+        from feederkit.importers.mesh import read_mesh  # trimesh loads slowly: only when needed
+
+        parts = [read_mesh(p, options, label)]
+    else:  # pragma: no cover - check_file refused it
+        raise InputError(f"{p}: unsupported file type")
+    return ImportResult(
+        path=str(p),
+        sha256=digest,
+        parts=tuple(parts),
+        others=tuple(others),
+        warnings=tuple(warnings),
+    )
+
+
+def effective_hull_tolerance(kind: str, options: ImportOptions) -> float | None:
+    """The user's hull tolerance, else 0.05 mm for CAD and meshes, exact for outline files."""
+    if options.hull_tolerance is not None:
+        if options.hull_tolerance < 0:
+            raise InputError(f"--hull-tolerance must be >= 0, got {options.hull_tolerance:g}")
+        return options.hull_tolerance
+    return None if kind == "outline" else DEFAULT_HULL_TOLERANCE
+
+
+def build_part(
+    imported: ImportedOutline, options: ImportOptions, extra_warnings: tuple[str, ...] = ()
+) -> ImportedPart:
+    """The part of an imported outline: simplified hull, COM check, and its orientability."""
+    tol = effective_hull_tolerance(imported.kind, options)
+    part = make_part(imported.outline, options.com, hull_tolerance=tol)
+    verdict = orientability(part, tol)
+    notes = list(extra_warnings) + list(imported.warnings)
+    if not verdict.orientable:
+        notes.append(f"{NOT_ORIENTABLE}: {verdict.reason}")
+    return ImportedPart(
+        part=part,
+        source=imported,
+        orientability=verdict,
+        hull_tolerance=tol,
+        warnings=tuple(notes),
+    )
+
+
+def import_parts(
+    path: str | Path, options: ImportOptions, name: str | None = None
+) -> tuple[ImportResult, list[ImportedPart]]:
+    """Read a source file and build its part(s) (several only with ``options.all_parts``)."""
+    result = read_source(path, options, name)
+    shared = result.warnings + tuple(f"left out: {o}" for o in result.others)
+    built = [build_part(imp, options, shared) for imp in result.parts]
+    return result, built

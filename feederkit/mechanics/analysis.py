@@ -1,0 +1,127 @@
+"""The analysis of one part: its push function, symmetry and, for a sensor, its Fig. 14 class.
+
+This is what ``feederkit part analyze`` prints; :func:`analysis_to_dict` is its JSON object
+(design.md: ``name``, ``units``, ``com``, ``hull``, ``stable_states``, ``symmetry_period_deg``
+and, with a sensor model, ``class`` and ``bound``; plus the extras documented in
+docs/analysis.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from feederkit.mechanics.classes import PolygonClass, polygon_class
+from feederkit.mechanics.push import (
+    PushFunction,
+    StableState,
+    edge_normals,
+    nearer_vertices,
+    push_function,
+)
+from feederkit.mechanics.symmetry import Symmetry, symmetry
+from feederkit.part import Part
+from feederkit.sensors import SensorModel, indistinguishable_sets, sensor_to_dict
+
+
+@dataclass(frozen=True)
+class NearMetastable:
+    """An edge whose COM foot lies within a small angle (seen from the COM) of ``vertex``.
+
+    ``margin_deg`` is signed: positive when the foot is on the edge (a stable edge that the
+    part may leave for its neighbour), negative when it is just past the vertex (an unstable
+    edge the part may still rest on), zero when exactly metastable.
+    """
+
+    edge: int
+    vertex: int
+    kind: str
+    margin_deg: float
+
+
+@dataclass(frozen=True)
+class PartAnalysis:
+    """A part with its push function, symmetry, and (when a sensor is given) its class."""
+
+    part: Part
+    push: PushFunction
+    symmetry: Symmetry
+    sensor: SensorModel | None
+    polygon_class: PolygonClass | None
+    indistinguishable_sets: tuple[tuple[int, ...], ...]
+    near_metastable: tuple[NearMetastable, ...]
+
+
+def analyze_part(part: Part, sensor: SensorModel | None = None) -> PartAnalysis:
+    """Analyse ``part``: exact push function and symmetry; its Fig. 14 class for ``sensor``."""
+    pf = push_function(part)
+    sym = symmetry(pf)
+    cls = None
+    sets: tuple[tuple[int, ...], ...] = ()
+    if sensor is not None:
+        diam = [s.diameter for s in pf.states]
+        sets = tuple(tuple(sorted(g)) for g in indistinguishable_sets(sensor, diam))
+        cls = polygon_class(pf, sensor, sets)
+    vertex = nearer_vertices(pf) if pf.near_metastable_edges else []
+    near = tuple(
+        NearMetastable(
+            edge=e,
+            vertex=vertex[e],
+            kind=pf.edge_kinds[e],
+            margin_deg=pf.edge_margin_deg[e],
+        )
+        for e in pf.near_metastable_edges
+    )
+    return PartAnalysis(part, pf, sym, sensor, cls, sets, near)
+
+
+def stable_state_to_dict(state: StableState) -> dict[str, object]:
+    """A stable state as the plan file writes it (design.md)."""
+    return {
+        "id": state.id,
+        "edge": state.edge,
+        "normal_deg": state.normal_deg,
+        "resting_range_deg": [state.resting_range_deg[0], state.resting_range_deg[1]],
+        "diameter": state.diameter,
+        "pose_deg": state.pose_deg,
+    }
+
+
+def analysis_to_dict(a: PartAnalysis) -> dict[str, object]:
+    """The JSON object of ``part analyze --json`` for one part."""
+    part, pf, sym = a.part, a.push, a.symmetry
+    out: dict[str, object] = {
+        "name": part.name,
+        "units": "mm",
+        "com": [part.com[0], part.com[1]],
+        "hull": [[x, y] for x, y in part.hull],
+        "stable_states": [stable_state_to_dict(s) for s in pf.states],
+        "symmetry_period_deg": sym.part_period_deg,
+    }
+    if part.revision is not None:
+        out["revision"] = part.revision
+    if a.sensor is not None and a.polygon_class is not None:
+        c = a.polygon_class
+        out["class"] = c.number
+        out["bound"] = c.bound
+        out["sensor"] = sensor_to_dict(a.sensor)
+        out["class_description"] = c.description
+        out["m"] = c.m
+        out["p"] = c.p
+        out["indistinguishable_sets"] = [list(g) for g in a.indistinguishable_sets]
+    out["push_period_deg"] = sym.push_period_deg
+    out["push_diameter_symmetry"] = {
+        "kind": sym.kind,
+        "period_deg": sym.period_deg,
+        "periods": sym.periods if sym.kind in ("symmetric", "quasi-symmetric") else 1,
+    }
+    out["divergent_deg"] = list(pf.divergent_deg)
+    out["resting_width_deg"] = [s.resting_range_deg[1] - s.resting_range_deg[0] for s in pf.states]
+    out["barrier_mm"] = [s.barrier_mm for s in pf.states]
+    out["edge_normals_deg"] = edge_normals(part.hull)
+    out["edge_kinds"] = list(pf.edge_kinds)
+    out["edge_margin_deg"] = list(pf.edge_margin_deg)
+    out["near_metastable_edges"] = [
+        {"edge": n.edge, "vertex": n.vertex, "kind": n.kind, "margin_deg": n.margin_deg}
+        for n in a.near_metastable
+    ]
+    return out

@@ -1,0 +1,115 @@
+"""A catalog's (or a mix's) analysis: behaviour classes, counts, unrecognizable pairs (section 8).
+
+Without a sensor no two parts can be recognized (section 8.6): the pairs are not listed, only
+the classes (parts with one push function share a sensorless plan, Corollary 5).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.classes import BehaviourClass, push_classes, push_diameter_classes
+from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
+from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
+from feederkit.sensors import NoSensor, SensorModel, sensor_to_dict
+
+
+@dataclass(frozen=True)
+class MixAnalysis:
+    """Classes of a set of parts and, with a sensor, every pair no plan can tell apart.
+
+    ``pairs`` is None without a sensor (every pair is unrecognizable). ``candidates`` is how
+    many pairs the diameter test left for the exact fixpoint. ``seconds`` times each stage.
+    """
+
+    names: tuple[str, ...]
+    sensor: SensorModel
+    angle_tol_deg: float
+    length_tol_mm: float
+    push_classes: tuple[BehaviourClass, ...]
+    push_diameter_classes: tuple[BehaviourClass, ...]
+    pairs: tuple[PairWitness, ...] | None
+    candidates: int
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def shared_push(self) -> list[BehaviourClass]:
+        """Push classes with more than one part."""
+        return [c for c in self.push_classes if c.size > 1]
+
+    @property
+    def shared_push_diameter(self) -> list[BehaviourClass]:
+        """Push-diameter classes with more than one part."""
+        return [c for c in self.push_diameter_classes if c.size > 1]
+
+    def counts(self) -> dict[str, int | None]:
+        """The numbers a summary shows."""
+        n = len(self.names)
+        return {
+            "parts": n,
+            "push_classes": len(self.push_classes),
+            "push_diameter_classes": len(self.push_diameter_classes),
+            "parts_sharing_a_push_function": sum(c.size for c in self.shared_push),
+            "parts_sharing_a_push_diameter_function": sum(
+                c.size for c in self.shared_push_diameter
+            ),
+            "candidate_pairs": self.candidates,
+            "unrecognizable_pairs": n * (n - 1) // 2 if self.pairs is None else len(self.pairs),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """As JSON: counts, classes with more than one member (by name), pairs with witnesses."""
+
+        def cls(c: BehaviourClass) -> dict[str, Any]:
+            return {
+                "members": [self.names[i] for i in c.members],
+                "phases_deg": [round(a, 9) for a in c.phases_deg],
+            }
+
+        return {
+            "sensor": sensor_to_dict(self.sensor),
+            "tolerances": {"angle_deg": self.angle_tol_deg, "diameter_mm": self.length_tol_mm},
+            "counts": self.counts(),
+            "push_classes": [cls(c) for c in self.shared_push],
+            "push_diameter_classes": [cls(c) for c in self.shared_push_diameter],
+            "all_pairs_unrecognizable": self.pairs is None and len(self.names) > 1,
+            "unrecognizable_pairs": [] if self.pairs is None else [w.to_dict() for w in self.pairs],
+        }
+
+
+def analyze_mix(
+    pfs: Sequence[PushFunction],
+    sensor: SensorModel,
+    *,
+    angle_tol: float = ANGLE_TOL_DEG,
+    length_tol: float = LENGTH_TOL_MM,
+) -> MixAnalysis:
+    """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs."""
+    t0 = time.perf_counter()
+    sigs = [signature(pf) for pf in pfs]
+    t1 = time.perf_counter()
+    pc = push_classes(sigs, angle_tol)
+    pdc = push_diameter_classes(sigs, angle_tol, length_tol)
+    t2 = time.perf_counter()
+    if isinstance(sensor, NoSensor):
+        pairs, cand = None, len(pfs) * (len(pfs) - 1) // 2
+    else:
+        todo = candidate_pairs(pfs, sensor)
+        cand = len(todo)
+        pairs = tuple(unrecognizable_pairs(pfs, sensor, todo))
+    t3 = time.perf_counter()
+    return MixAnalysis(
+        names=tuple(pf.part.name for pf in pfs),
+        sensor=sensor,
+        angle_tol_deg=angle_tol,
+        length_tol_mm=length_tol,
+        push_classes=tuple(pc),
+        push_diameter_classes=tuple(pdc),
+        pairs=pairs,
+        candidates=cand,
+        seconds={"signatures": t1 - t0, "classes": t2 - t1, "pairs": t3 - t2},
+    )

@@ -1,0 +1,309 @@
+"""Distinguishability of pairs of parts under a sensor model, decided exactly (section 8.4).
+
+Two parts are distinguishable (definition 11) when an action sequence makes their readings
+differ. Decided here exactly, not only by Theorem 9's sufficient condition: a state of part A
+and a state of part B are *inseparable* when their readings can agree and every action sends
+them to two states that are again inseparable (a greatest fixpoint over the pairs of the two
+parts' product machine, as :func:`feederkit.machine.inseparable` computes for any machine;
+two different parts' states are never merged into one). The parts are recognizable from any
+start iff no pair of their states is inseparable.
+
+If one pair is inseparable, every state of each part is in some inseparable pair: from any
+state some action reaches every resting range. The witness is therefore the list of
+inseparable pairs, with the reason in words. With noise the relation is not transitive
+(Lemma 10): it is reported for pairs of parts, never as classes.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections import defaultdict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from feederkit.mechanics.actions import action_ranges, merge_boundaries
+from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mix.signatures import (
+    ANGLE_TOL_DEG,
+    LENGTH_TOL_MM,
+    Signature,
+    matching_shifts,
+    signature,
+)
+from feederkit.sensors import LedSensor, NoSensor, SensorModel, ToleranceSensor, can_read_alike
+
+REASON_SAME_PDF = (
+    "same push-diameter function (Lemma 8): identical mechanical behaviour and diameters"
+)
+REASON_SENSORLESS = (
+    "no sensor: readings carry no information, parts cannot be recognized (section 8.6)"
+)
+REASON_SINGLE = "a single diameter value: every state of both parts reads alike (section 8.4)"
+REASON_SAME_DIAMETERS = (
+    "these states keep equal diameters under every action "
+    "(the push-diameter functions agree on them)"
+)
+REASON_TOLERANCE = (
+    "diameters within the sensor tolerance: every action keeps these states reading alike"
+)
+
+
+@dataclass(frozen=True)
+class PairWitness:
+    """Two parts that no plan can tell apart, and why.
+
+    ``states_a[k]`` (a stable state id of ``part_a``) and ``states_b[k]`` (of ``part_b``) are
+    the k-th inseparable pair: if the part is in one of them no action sequence ever makes
+    its readings differ from those of the other. ``kind`` names the reason in one word:
+    ``same-push-diameter``, ``sensorless``, ``single-diameter``, ``same-diameters`` or
+    ``tolerance``.
+    """
+
+    part_a: str
+    part_b: str
+    states_a: tuple[int, ...]
+    states_b: tuple[int, ...]
+    reason: str
+    kind: str = "tolerance"
+    index_a: int = 0
+    index_b: int = 1
+
+    @property
+    def pairs(self) -> tuple[tuple[int, int], ...]:
+        """The inseparable (state of a, state of b) pairs."""
+        return tuple(zip(self.states_a, self.states_b, strict=True))
+
+    def to_dict(self) -> dict[str, object]:
+        """``{"part_a", "part_b", "states_a", "states_b", "reason"}`` for reports and plans."""
+        return {
+            "part_a": self.part_a,
+            "part_b": self.part_b,
+            "states_a": list(self.states_a),
+            "states_b": list(self.states_b),
+            "reason": self.reason,
+        }
+
+
+def _ranges(pf: PushFunction) -> list[tuple[list[float], list[int]]]:
+    out = []
+    for s in pf.states:
+        rs = action_ranges(pf, s.id)
+        out.append(([r.lo for r in rs], [r.target for r in rs]))
+    return out
+
+
+def inseparable_cross_pairs(
+    pf_a: PushFunction,
+    pf_b: PushFunction,
+    sensor: SensorModel,
+    *,
+    _ranges_a: Sequence[tuple[list[float], list[int]]] | None = None,
+    _ranges_b: Sequence[tuple[list[float], list[int]]] | None = None,
+) -> list[tuple[int, int]]:
+    """The inseparable pairs (state of a, state of b): the greatest fixpoint of section 8.4.
+
+    Start from the pairs whose readings can agree; drop a pair when some action sends it to a
+    dropped pair (or to a pair whose readings cannot agree), until nothing changes. This is
+    :func:`feederkit.machine.inseparable` on the two-part machine, restricted to its cross
+    pairs (which are closed under actions and never merge).
+    """
+    ra = _ranges_a if _ranges_a is not None else _ranges(pf_a)
+    rb = _ranges_b if _ranges_b is not None else _ranges(pf_b)
+    eps = DIAMETER_REL_EPS * max(pf_a.part.size, pf_b.part.size)
+    da = [s.diameter for s in pf_a.states]
+    db = [s.diameter for s in pf_b.states]
+
+    def alike(i: int, j: int) -> bool:
+        return abs(da[i] - db[j]) <= eps or can_read_alike(sensor, da[i], db[j])
+
+    alive = {(i, j) for i in range(pf_a.n) for j in range(pf_b.n) if alike(i, j)}
+    if not alive:
+        return []
+    preds: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
+    dead: list[tuple[int, int]] = []
+    for i, j in alive:
+        (la, ta), (lb, tb) = ra[i], rb[j]
+        bounds = merge_boundaries([la, lb])
+        m = len(bounds)
+        for k in range(m):
+            hi = bounds[k + 1] if k + 1 < m else bounds[0] + 360.0
+            mid = (bounds[k] + hi) / 2.0
+            q = (_target(la, ta, mid), _target(lb, tb, mid))
+            if q not in alive:
+                dead.append((i, j))
+                break
+            preds[q].append((i, j))
+    while dead:
+        p = dead.pop()
+        if p not in alive:
+            continue
+        alive.discard(p)
+        dead.extend(q for q in preds.get(p, ()) if q in alive)
+    return sorted(alive)
+
+
+def _target(los: list[float], targets: list[int], action: float) -> int:
+    """The target of a state's action ranges (``los`` sorted) for a rotation inside one of them."""
+    k = bisect.bisect_right(los, action % 360.0) - 1
+    return targets[k if k >= 0 else len(los) - 1]
+
+
+def _reason(
+    pf_a: PushFunction,
+    pf_b: PushFunction,
+    sensor: SensorModel,
+    pairs: Sequence[tuple[int, int]],
+    sig_a: Signature | None,
+    sig_b: Signature | None,
+) -> tuple[str, str]:
+    if isinstance(sensor, NoSensor):
+        return "sensorless", REASON_SENSORLESS
+    sa = sig_a or signature(pf_a)
+    sb = sig_b or signature(pf_b)
+    if matching_shifts(sa, sb, angle_tol=ANGLE_TOL_DEG, length_tol=LENGTH_TOL_MM):
+        return "same-push-diameter", REASON_SAME_PDF
+    diams = [s.diameter for s in pf_a.states] + [s.diameter for s in pf_b.states]
+    if all(can_read_alike(sensor, x, y) for x in diams for y in diams):
+        return "single-diameter", REASON_SINGLE
+    da = [s.diameter for s in pf_a.states]
+    db = [s.diameter for s in pf_b.states]
+    if all(abs(da[i] - db[j]) <= LENGTH_TOL_MM for i, j in pairs):
+        return "same-diameters", REASON_SAME_DIAMETERS
+    return "tolerance", REASON_TOLERANCE + f" ({_sensor_words(sensor)})"
+
+
+def _sensor_words(sensor: SensorModel) -> str:
+    if isinstance(sensor, ToleranceSensor):
+        return f"tolerance {sensor.tolerance:g} mm"
+    if isinstance(sensor, LedSensor):
+        return f"LED pitch {sensor.pitch:g} mm, noise {sensor.noise:g} mm"
+    return "no sensor"
+
+
+def distinguishable(
+    pf_a: PushFunction,
+    pf_b: PushFunction,
+    sensor: SensorModel,
+    *,
+    index_a: int = 0,
+    index_b: int = 1,
+) -> PairWitness | None:
+    """None when some action sequence tells the two parts apart from any start (definition 11),
+    else the witness: the inseparable state pairs and the reason in words."""
+    pairs = inseparable_cross_pairs(pf_a, pf_b, sensor)
+    if not pairs:
+        return None
+    return _witness(pf_a, pf_b, sensor, pairs, None, None, index_a, index_b)
+
+
+def _witness(pf_a, pf_b, sensor, pairs, sig_a, sig_b, index_a, index_b) -> PairWitness:
+    kind, reason = _reason(pf_a, pf_b, sensor, pairs, sig_a, sig_b)
+    return PairWitness(
+        part_a=pf_a.part.name,
+        part_b=pf_b.part.name,
+        states_a=tuple(i for i, _ in pairs),
+        states_b=tuple(j for _, j in pairs),
+        reason=reason,
+        kind=kind,
+        index_a=index_a,
+        index_b=index_b,
+    )
+
+
+def reading_reach(sensor: SensorModel) -> float:
+    """The largest diameter difference (mm) two states can have and still read alike."""
+    if isinstance(sensor, ToleranceSensor):
+        return 2.0 * sensor.tolerance
+    if isinstance(sensor, LedSensor):
+        return 2.0 * sensor.noise + sensor.pitch
+    return math.inf
+
+
+def _covers(
+    xs: Sequence[float], ys: Sequence[float], alike: Callable[[float, float], bool]
+) -> bool:
+    return all(any(alike(x, y) for y in ys) for x in xs)
+
+
+def candidate_pairs(pfs: Sequence[PushFunction], sensor: SensorModel) -> list[tuple[int, int]]:
+    """Pairs of parts that may be unrecognizable, found without an all-pairs pass.
+
+    Necessary condition: every state of each part reads alike some state of the other (any
+    inseparable pair reaches every state, see the module docstring). In particular the two
+    smallest diameters read alike and so do the two largest: parts are hashed on a grid of
+    (smallest, largest diameter) with cells as wide as the sensor's reach and only
+    neighbouring cells are compared. A sensorless model gives every pair.
+    """
+    n = len(pfs)
+    if isinstance(sensor, NoSensor):
+        return [(i, j) for i in range(n) for j in range(i + 1, n)]
+    reach = reading_reach(sensor)
+    diams = [sorted(s.diameter for s in pf.states) for pf in pfs]
+    eps = [DIAMETER_REL_EPS * pf.part.size for pf in pfs]
+    cell = reach + max(eps, default=0.0) + 1e-12
+    grid: dict[tuple[int, int], list[int]] = defaultdict(list)
+    for i, d in enumerate(diams):
+        grid[(math.floor(d[0] / cell), math.floor(d[-1] / cell))].append(i)
+
+    def alike(x: float, y: float) -> bool:
+        return can_read_alike(sensor, x, y) or abs(x - y) <= cell - reach
+
+    out = []
+    for (cx, cy), here in grid.items():
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                there = grid.get((cx + dx, cy + dy))
+                if not there:
+                    continue
+                for i in here:
+                    for j in there:
+                        if (
+                            i < j
+                            and _covers(diams[i], diams[j], alike)
+                            and _covers(diams[j], diams[i], alike)
+                        ):
+                            out.append((i, j))
+    out.sort()
+    return out
+
+
+def unrecognizable_pairs(
+    pfs: Sequence[PushFunction],
+    sensor: SensorModel,
+    candidates: Sequence[tuple[int, int]] | None = None,
+) -> list[PairWitness]:
+    """Every pair of parts of a mix that no plan can tell apart, each with its witness.
+
+    Exact (the greatest fixpoint of :func:`inseparable_cross_pairs`) on the pairs that
+    :func:`candidate_pairs` leaves (or ``candidates``, if given, already computed by it);
+    the others cannot be unrecognizable. Sorted by part index.
+    """
+    ranges: dict[int, list] = {}
+    sigs: dict[int, Signature] = {}
+    out = []
+    todo = candidate_pairs(pfs, sensor) if candidates is None else candidates
+    for i, j in todo:
+        for k in (i, j):
+            if k not in ranges:
+                ranges[k] = _ranges(pfs[k])
+        pairs = inseparable_cross_pairs(
+            pfs[i], pfs[j], sensor, _ranges_a=ranges[i], _ranges_b=ranges[j]
+        )
+        if pairs:
+            for k in (i, j):
+                if k not in sigs:
+                    sigs[k] = signature(pfs[k])
+            out.append(_witness(pfs[i], pfs[j], sensor, pairs, sigs[i], sigs[j], i, j))
+    return out
+
+
+__all__ = [
+    "PairWitness",
+    "candidate_pairs",
+    "distinguishable",
+    "inseparable_cross_pairs",
+    "reading_reach",
+    "unrecognizable_pairs",
+]

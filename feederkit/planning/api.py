@@ -1,0 +1,188 @@
+"""The planners' public entry point: ``plan(machine, ...) -> PlanResult``.
+
+The root is the first alignment from an unknown orientation (``Step(action=None)``); its
+branches are the readings of the full set of states. Each branch is then oriented by a
+minimum worst-case plan (sections 4 and 6), ties broken by issue 3's order (see
+:mod:`feederkit.planning.refine`). ``length`` counts the first alignment (design.md).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from feederkit.errors import InputError, PlanningError
+from feederkit.machine import PushAlignMachine
+from feederkit.planning.andor import Deadline, Timeout, WorstCase
+from feederkit.planning.margins import largest_margin
+from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.problem import Problem
+from feederkit.planning.refine import EXPECTED_HORIZON, Refiner, child_masses
+from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
+from feederkit.planning.tree import PlanResult, Step
+
+Objective = Literal["worst", "expected"]
+Method = Literal["auto", "andor", "bottom-up", "bfs", "backchain"]
+METHODS = ("auto", "andor", "bottom-up", "bfs", "backchain")
+
+FALLBACK_SHARE = 0.3
+"""With a time limit, the share of it kept for finding some plan when the exact search fails."""
+
+
+def plan(
+    machine: PushAlignMachine,
+    *,
+    objective: Objective = "worst",
+    min_margin: float = 0.0,
+    grouping: str = "exact",
+    time_limit: float | None = None,
+    method: Method = "auto",
+) -> PlanResult:
+    """A plan orienting every state of ``machine`` (up to inseparable states), by issue 3's rules.
+
+    Raises InputError for bad arguments and PlanningError when no plan keeps ``min_margin``
+    (naming the largest margin that works) or none is found within ``time_limit``.
+    """
+    _check_args(machine, objective, min_margin, grouping, time_limit, method)
+    problem = Problem(
+        machine, grouping, min_margin, distinct_maps=objective == "expected"  # type: ignore[arg-type]
+    )
+    if method in ("bfs", "backchain") and not problem.sensorless:
+        raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
+    root_branches = problem.branches(problem.full)
+    roots = sorted({b.mask for b in root_branches})
+    start_mass = [s.weight for s in machine.states]
+    if min_margin > 0.0:
+        _check_margin(problem, roots, min_margin)
+
+    exact_deadline = Deadline(None if time_limit is None else time_limit * (1 - FALLBACK_SHARE))
+    worst = make_oracle(problem, method, exact_deadline)
+    try:
+        lengths = root_lengths(problem, worst, roots, method)
+    except Timeout:
+        return _fallback(problem, worst, roots, root_branches, start_mass, time_limit, objective)
+    length = 1 + max(lengths.values(), default=0)
+    budget = length - 1
+    children = _root_children(problem, root_branches, start_mass)
+    refiner = Refiner(problem, worst, exact_deadline)
+    try:
+        if objective == "worst":
+            refiner.floor = min((refiner.margin(r, budget) for r in roots), default=math.inf)
+            tie = "rotation" if problem.sensorless else "expected"
+            horizon = budget
+        else:
+            tie = "expected"
+            horizon = EXPECTED_HORIZON * budget
+        root = _build(refiner, children, horizon, tie)
+        complete = True
+    except Timeout:
+        # The lengths are proven; the tie-breaking stages ran out of time.
+        worst.deadline = refiner.deadline = Deadline(None)
+        refiner.floor = -math.inf
+        root = _build(refiner, children, budget, "first")
+        complete = objective == "worst"
+    if objective == "worst":
+        return _result(machine, root, complete, length, length, objective, grouping)
+    return _result(machine, root, complete, None, length, objective, grouping)
+
+
+def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
+    """The plan: the first alignment, then a subtree per root branch."""
+
+    def chooser(mask, masses, k):
+        return refiner.choose_worst(mask, masses, k, tie)
+
+    subs = [(b, refiner.build(b.mask, ms, horizon, chooser)) for b, _pb, ms in children]
+    return Step(None, tuple(subs))
+
+
+def _check_args(machine, objective, min_margin, grouping, time_limit, method) -> None:
+    if machine.n == 0:
+        raise InputError("the machine has no states")
+    if objective not in ("worst", "expected"):
+        raise InputError(f"objective must be 'worst' or 'expected', got {objective!r}")
+    if grouping not in ("exact", "components"):
+        raise InputError(f"grouping must be 'exact' or 'components', got {grouping!r}")
+    if method not in METHODS:
+        raise InputError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if not math.isfinite(min_margin) or min_margin < 0.0:
+        raise InputError(f"min_margin must be a non-negative number of degrees, got {min_margin}")
+    if time_limit is not None and (not math.isfinite(time_limit) or time_limit <= 0.0):
+        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
+
+
+def _check_margin(problem: Problem, roots: list[int], min_margin: float) -> None:
+    """Raise PlanningError when no plan keeps ``min_margin``, naming the largest that does."""
+    floored = largest_margin(problem, roots)
+    if floored >= min_margin:
+        return
+    best = largest_margin(problem.with_margin(0.0), roots)
+    raise PlanningError(
+        f"no plan keeps a margin of {min_margin:g} deg; the largest margin any plan keeps is "
+        f"{best:.6g} deg"
+    )
+
+
+def _root_children(problem: Problem, root_branches, start_mass):
+    """The root's branches with their probabilities and normalised masses."""
+    return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
+
+
+def _fallback(problem, worst, roots, root_branches, start_mass, time_limit, objective) -> PlanResult:
+    """Some plan when the exact search ran out of time, with the lower bound it proved."""
+    lower = 1 + max((_proven(worst, r) for r in roots), default=0)
+    deadline = Deadline(time_limit * FALLBACK_SHARE if time_limit else None)
+    cap = 2 * problem.n + 1
+    anytime = WorstCase(problem, deadline)
+    try:
+        budgets = {r: _first_found(anytime, r, cap) for r in roots}
+        anytime.deadline = Deadline(None)
+    except (Timeout, ValueError):
+        raise PlanningError(
+            f"no plan found within the time limit of {time_limit:g} s "
+            f"(a plan needs at least {lower} operations)"
+        ) from None
+    refiner = Refiner(problem, anytime)
+    children = _root_children(problem, root_branches, start_mass)
+
+    def chooser(mask, masses, k):
+        return refiner.choose_worst(mask, masses, k, "first")
+
+    subs = [(b, refiner.build(b.mask, ms, budgets[b.mask], chooser)) for b, _pb, ms in children]
+    root = Step(None, tuple(subs))
+    return _result(problem.machine, root, False, None, lower, objective, problem.grouping)
+
+
+def _proven(worst: WorstCase, mask: int) -> int:
+    if worst.p.is_goal(mask):
+        return 0
+    return worst.exact.get(mask, worst.lb.get(mask, 1))
+
+
+def _first_found(worst: WorstCase, mask: int, cap: int) -> int:
+    """A number of operations within which ``mask`` is proven orientable (not minimal)."""
+    if worst.p.is_goal(mask):
+        return 0
+    if not worst.within(mask, cap):
+        raise ValueError("no plan within the cap")
+    return cap
+
+
+def _result(
+    machine, root: Step, optimal: bool, length: int | None, lower: int, objective, grouping
+) -> PlanResult:
+    """The result with its statistics; ``length`` (when given) must be the tree's own."""
+    real = tree_length(root)
+    if length is not None and real != length:
+        raise AssertionError(f"plan length {real} differs from the proven optimum {length}")
+    return PlanResult(
+        machine=machine,
+        root=root,
+        length=real,
+        expected_length=expected_operations(machine, root),
+        min_margin=tree_min_margin(root),
+        optimal=optimal,
+        lower_bound=min(lower, real),
+        objective=objective,
+        grouping=grouping,
+    )

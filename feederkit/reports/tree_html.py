@@ -1,0 +1,167 @@
+"""The plan as a tree in HTML: each node the possible states drawn as parts in their poses.
+
+Markup contract (tests and scripts rely on it): every plan node is one element of class
+``tree-node`` with ``data-node-id`` (pre-order, root 0); operation nodes also have class ``op``,
+leaves class ``result``; each final pose of a leaf is one ``figure.final-pose`` with
+``data-part``, ``data-state`` and ``data-pose-deg``; each edge is one ``div.edge`` with
+``data-action-deg`` (empty at the root) and ``data-reading`` (``lo..hi``, empty when sensorless).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from feederkit.reports.planview import Branch, Node, OpNode, PlanView, ResultNode
+from feederkit.reports.svgkit import Ring, esc, num, part_colour, pose_svg, reach
+from feederkit.reports.trace import StateKey, Step, Trace
+
+STATE_PX = 56
+"""Drawn size of a possible state inside an operation node."""
+
+FINAL_PX = 72
+"""Drawn size of a final pose in a leaf."""
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """What the tree needs to draw a part: its rings (outline and holes, or hull), colour, scale."""
+
+    rings: Mapping[str, Sequence[Ring]]
+    colours: Mapping[str, str]
+    radius_mm: float
+
+
+def drawing_for(view: PlanView, rings: Mapping[str, Sequence[Ring]]) -> Drawing:
+    """One common scale for the whole mix, a colour per part in plan order."""
+    return Drawing(
+        rings=rings,
+        colours={p.name: part_colour(i) for i, p in enumerate(view.parts)},
+        radius_mm=max(reach(p.hull, p.com) for p in view.parts),
+    )
+
+
+def reading_text(reading: tuple[float, float] | None) -> str:
+    """A reading range for people: one value when the ends agree, ``lo-hi mm`` otherwise."""
+    if reading is None:
+        return "no reading (sensorless)"
+    lo, hi = reading
+    if num(lo) == num(hi):
+        return f"reads {num(lo)} mm"
+    return f"reads {num(lo)}\u2013{num(hi)} mm"
+
+
+def action_text(action_deg: float | None) -> str:
+    """An operation's rotation for people."""
+    if action_deg is None:
+        return "first alignment"
+    return f"rotate {num(action_deg, 2)}\u00b0 ccw"
+
+
+def path_text(path: Sequence[Step]) -> str:
+    """The operations and readings that lead to a node, as one line."""
+    if not path:
+        return "before the first alignment"
+    return " \u2192 ".join(f"{action_text(s.action_deg)}, {reading_text(s.reading)}" for s in path)
+
+
+def _state_figure(
+    view: PlanView, draw: Drawing, key: StateKey, cls: str, px: int, pose: float | None = None
+) -> str:
+    """A state drawn on the fence; ``pose`` (deg) overrides the state's own pose."""
+    name, sid = key
+    part = view.part(name)
+    state = part.state(sid)
+    pose_deg = state.pose_deg if pose is None else pose
+    title = f"{name}, state {sid} (edge {state.edge}) on the fence, pose {num(pose_deg, 1)} deg"
+    svg = pose_svg(
+        draw.rings.get(name, [part.hull]), part.hull, part.com, pose_deg,
+        radius_mm=draw.radius_mm, colour=draw.colours[name], px=px, title=title,
+    )
+    return (
+        f'<figure class="{cls}" data-part="{esc(name)}" data-state="{sid}" '
+        f'data-pose-deg="{num(pose_deg, 4)}">{svg}'
+        f'<figcaption>{esc(name)} s{sid}<span class="pose-deg"> {num(pose_deg, 1)}\u00b0</span>'
+        f"</figcaption></figure>"
+    )
+
+
+def _edge(parent: OpNode, branch: Branch) -> str:
+    action = "" if parent.action_deg is None else num(parent.action_deg, 6)
+    reading = ""
+    if branch.reading is not None:
+        reading = f"{num(branch.reading[0], 6)}..{num(branch.reading[1], 6)}"
+    return (
+        f'<div class="edge" data-action-deg="{action}" data-reading="{reading}">'
+        f'<span class="act">{esc(action_text(parent.action_deg))}</span>'
+        f'<span class="read">{esc(reading_text(branch.reading))}</span></div>'
+    )
+
+
+def _op_node(view: PlanView, trace: Trace, draw: Drawing, node: OpNode) -> str:
+    here = trace.states[node.node_id]
+    figures = "".join(_state_figure(view, draw, k, "state", STATE_PX) for k in here)
+    count = f"{len(here)} possible state{'s' if len(here) != 1 else ''}"
+    if node.node_id == 0:
+        count = f"any orientation: {len(here)} stable states after the first alignment"
+    margin = "" if node.margin_deg is None else f" (margin \u00b1{num(node.margin_deg, 2)}\u00b0)"
+    read = ", read" if any(b.reading is not None for b in node.branches) else ""
+    if node.action_deg is None:
+        step = f"next: align from an unknown orientation{read}"
+    else:
+        step = f"next: {action_text(node.action_deg)}{margin}, align{read}"
+    return (
+        f'<div class="tree-node op" data-node-id="{node.node_id}" data-depth="{node.depth}" '
+        f'data-states="{len(here)}"><div class="node-head">'
+        f"<strong>operation {node.depth + 1}</strong> "
+        f'<span class="muted">node {node.node_id} \u00b7 {esc(count)}</span></div>'
+        f'<div class="poses">{figures}</div>'
+        f'<div class="node-op">{esc(step)}</div></div>'
+    )
+
+
+def _result_node(view: PlanView, trace: Trace, draw: Drawing, node: ResultNode) -> str:
+    keys = [(r.part, r.state) for r in node.results]
+    figures = "".join(
+        _state_figure(view, draw, (r.part, r.state), "final-pose", FINAL_PX, r.pose_deg)
+        for r in node.results
+    )
+    parts = {r.part for r in node.results}
+    if len(node.results) == 1:
+        head = f"done: {node.results[0].part} in state {node.results[0].state}"
+        kind = "known"
+    elif len(parts) == 1:
+        head = f"done up to symmetry: {len(node.results)} poses that no plan tells apart"
+        kind = "symmetric"
+    else:
+        head = f"not recognized: {len(parts)} parts end here together"
+        kind = "confused"
+    note = ""
+    reached = set(trace.states[node.node_id])
+    if reached != set(keys):
+        got = ", ".join(f"{p} s{s}" for p, s in sorted(reached)) or "none"
+        note = (
+            f'<p class="warn">Following the plan, the states that reach this leaf are: '
+            f"{esc(got)}.</p>"
+        )
+    return (
+        f'<div class="tree-node result {kind}" data-node-id="{node.node_id}" '
+        f'data-depth="{node.depth}" data-states="{len(node.results)}">'
+        f'<div class="node-head"><strong>{esc(head)}</strong> '
+        f'<span class="muted">node {node.node_id}</span></div>'
+        f'<div class="poses">{figures}</div>{note}</div>'
+    )
+
+
+def _subtree(view: PlanView, trace: Trace, draw: Drawing, node: Node, edge: str) -> str:
+    if isinstance(node, ResultNode):
+        return f"<li>{edge}{_result_node(view, trace, draw, node)}</li>"
+    children = "".join(
+        _subtree(view, trace, draw, b.next, _edge(node, b)) for b in node.branches
+    )
+    return f"<li>{edge}{_op_node(view, trace, draw, node)}<ul>{children}</ul></li>"
+
+
+def tree_html(view: PlanView, trace: Trace, draw: Drawing) -> str:
+    """The whole plan as nested lists: operation nodes, labelled edges, leaves."""
+    return f'<ul class="tree">{_subtree(view, trace, draw, view.root, "")}</ul>'

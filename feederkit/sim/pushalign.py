@@ -1,0 +1,252 @@
+"""One simulated push-align operation in MuJoCo (paper, section 3; issue 7).
+
+The robot sets the part's yaw, zeroes its velocity and drops it a little upstream of the
+fence; the belt carries it into the fence, where it rotates until an edge lies flat; the
+operation ends when the part touches the fence, lies flush with one of its hull edges and
+its yaw has been still for a window. The LED array then reads the width across the belt.
+
+Conventions (design.md): ``theta`` is the fence's contact normal in the part frame; the
+part's world yaw is ``-90 - theta``; rotating the part by ``a`` counter-clockwise adds
+``a`` to its yaw, so ``theta' = theta - a``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from feederkit.angles import norm360
+from feederkit.mechanics.push import com_feet, edge_normals
+from feederkit.part import Part
+from feederkit.sim.engine import require_mujoco
+from feederkit.sim.scene import MM, SceneConfig, scene_geometry, scene_xml
+
+CHUNK_STEPS = 5
+"""Physics steps between two looks at the part (10 ms at the 2 ms step)."""
+
+
+@dataclass(frozen=True)
+class SettleRule:
+    """When a push-align operation has ended.
+
+    The part must touch the fence (come within ``touch_tol_mm`` of its face: contacts
+    flicker while the belt slides under a part held by the fence), rest flush on an edge
+    it can rest on (its fence orientation within ``align_tol_deg`` of the normal of an edge
+    whose COM foot lies on the edge: a part pivots through an unstable edge, however
+    slowly), and its orientation must have moved less than ``still_tol_deg`` while the belt
+    travelled ``window_sizes`` part sizes (at least ``min_window_s`` seconds). Lengths are
+    counted in belt travel because quasi-static rotation depends on how far the belt has
+    moved, not on how fast. A run not done after ``max_travel_sizes`` part sizes of belt
+    travel (at least ``min_max_time_s`` seconds) never settled.
+    """
+
+    window_sizes: float = 0.5
+    min_window_s: float = 0.1
+    still_tol_deg: float = 1.0
+    align_tol_deg: float = 1.0
+    touch_tol_mm: float = 0.3
+    max_travel_sizes: float = 20.0
+    min_max_time_s: float = 2.0
+
+    def window_s(self, size_m: float, belt_speed: float) -> float:
+        """Length (s) of the still window for a part of ``size_m`` metres."""
+        return max(self.min_window_s, self.window_sizes * size_m / belt_speed)
+
+    def max_time_s(self, size_m: float, belt_speed: float) -> float:
+        """Simulated time (s) after which a run never settled."""
+        return max(self.min_max_time_s, self.max_travel_sizes * size_m / belt_speed)
+
+
+@dataclass(frozen=True)
+class PushOutcome:
+    """The result of one simulated push-align operation.
+
+    ``theta_start_deg`` is the fence orientation (part frame) the part was dropped at;
+    ``theta_end_deg`` the one it came to rest at (averaged over the still window);
+    ``edge`` the hull edge flush with the fence (None when the run never settled);
+    ``width_mm`` the width across the belt the LED array reads, in the part's millimetres.
+    """
+
+    theta_start_deg: float
+    settled: bool
+    theta_end_deg: float
+    edge: int | None
+    width_mm: float
+    sim_time_s: float
+    steps: int
+
+
+def _signed_delta(a: float, b: float) -> float:
+    """b - a on the circle, in (-180, 180]."""
+    d = norm360(b - a)
+    return d - 360.0 if d > 180.0 else d
+
+
+def size_scale(part: Part, lo_mm: float = 20.0, hi_mm: float = 200.0) -> float:
+    """Factor applied to the part's lengths in the physics: 1 for parts of 20-200 mm.
+
+    Quasi-static pushing is scale free (the push function depends on shape and COM only),
+    so a part drawn in other units, e.g. the paper's unit triangle, is simulated at a
+    feeder-like size; widths are scaled back before they are read.
+    """
+    size = part.size
+    if size < lo_mm:
+        return lo_mm / size
+    if size > hi_mm:
+        return hi_mm / size
+    return 1.0
+
+
+class PushAligner:
+    """A MuJoCo model of the feeder with one part, reused across push-align operations.
+
+    Each operation starts from a fresh state (the robot picks the part up), so outcomes
+    depend only on the drop orientation and the settings.
+    """
+
+    def __init__(
+        self,
+        part: Part,
+        config: SceneConfig | None = None,
+        rule: SettleRule | None = None,
+        scale: float | None = None,
+    ) -> None:
+        mujoco = require_mujoco()
+        self._mj = mujoco
+        self.part = part
+        self.config = config or SceneConfig()
+        self.rule = rule or SettleRule()
+        self.scale = size_scale(part) if scale is None else scale
+        self.model = mujoco.MjModel.from_xml_string(scene_xml(part, self.config, self.scale))
+        self.data = mujoco.MjData(self.model)
+        geo = scene_geometry(part, self.config, self.scale)
+        self._geo = geo
+        half = geo.thickness / 2
+        hull = np.asarray(geo.hull)
+        self._verts = np.vstack(
+            [np.column_stack([hull, np.full(len(hull), z)]) for z in (-half, half)]
+        )
+        self._hull = hull
+        self._normals = np.asarray(edge_normals(part.hull))
+        # Edges the part can rest on: the COM's foot lies on the edge (stable or metastable).
+        self._restable = np.array([0.0 <= t <= 1.0 for t in com_feet(part.hull, part.com)])
+        m = self.model
+        part_joint = m.joint("part").id
+        belt_joint = m.joint("belt").id
+        self._pq = int(m.jnt_qposadr[part_joint])
+        self._pv = int(m.jnt_dofadr[part_joint])
+        self._bq = int(m.jnt_qposadr[belt_joint])
+        self._bv = int(m.jnt_dofadr[belt_joint])
+        self._body = m.body("part").id
+        self._size = float(np.max(np.linalg.norm(hull, axis=1)))
+        self._wrap = 0.5  # metres of belt travel before the slab is moved back
+
+    # -- reading the state ------------------------------------------------------------
+    def _theta(self) -> float:
+        xm = self.data.xmat[self._body]
+        yaw = math.degrees(math.atan2(xm[3], xm[0]))
+        return norm360(-90.0 - yaw)
+
+    def _extent_y(self) -> tuple[float, float]:
+        """Lowest and highest world y of the part (metres)."""
+        rot_y = self.data.xmat[self._body][3:6]
+        ys = self._verts @ rot_y + self.data.xpos[self._body][1]
+        return float(ys.min()), float(ys.max())
+
+    def _nearest_edge(self, theta: float) -> tuple[int, float]:
+        offs = np.abs((self._normals - theta + 180.0) % 360.0 - 180.0)
+        i = int(np.argmin(offs))
+        return i, float(offs[i])
+
+    @property
+    def size_m(self) -> float:
+        """The simulated part's size (larger bounding-box side), metres."""
+        return self.part.size * self.scale * MM
+
+    @property
+    def max_time_s(self) -> float:
+        """Simulated seconds after which an operation never settled."""
+        return self.rule.max_time_s(self.size_m, self.config.belt_speed)
+
+    # -- one operation ----------------------------------------------------------------
+    def _drop(self, theta_deg: float) -> None:
+        mj, d = self._mj, self.data
+        mj.mj_resetData(self.model, d)
+        yaw = math.radians(-90.0 - theta_deg)
+        c, s = math.cos(yaw), math.sin(yaw)
+        ys = s * self._hull[:, 0] + c * self._hull[:, 1]
+        gap = max(0.1 * self._size, 0.002)
+        drop = 0.0005
+        d.qpos[self._pq : self._pq + 3] = (
+            0.0,
+            gap - float(ys.min()),
+            self._geo.thickness / 2 + drop,
+        )
+        d.qpos[self._pq + 3 : self._pq + 7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+        d.qvel[self._pv : self._pv + 6] = 0.0
+        d.qvel[self._bv] = -self.config.belt_speed
+        mj.mj_forward(self.model, d)
+
+    def align(self, theta_deg: float) -> PushOutcome:
+        """Drop the part at fence orientation ``theta_deg`` and run until it settles."""
+        mj, m, d = self._mj, self.model, self.data
+        rule = self.rule
+        self._drop(theta_deg)
+        v = -self.config.belt_speed
+        bv, bq = self._bv, self._bq
+        dt = m.opt.timestep * CHUNK_STEPS
+        window = max(2, math.ceil(rule.window_s(self.size_m, self.config.belt_speed) / dt))
+        max_checks = math.ceil(self.max_time_s / dt)
+        to_mm = MM * self.scale
+        touch_tol = rule.touch_tol_mm * MM  # physical: the chatter does not scale with the part
+        thetas: list[float] = []  # unwrapped fence orientation at each look while touching
+        widths: list[float] = []
+        steps = 0
+        prev = theta_deg
+        unwrapped = theta_deg
+        for _ in range(max_checks):
+            for _ in range(CHUNK_STEPS):
+                d.qvel[bv] = v
+                mj.mj_step(m, d)
+            steps += CHUNK_STEPS
+            if d.qpos[bq] < -self._wrap:
+                d.qpos[bq] += self._wrap
+            theta = self._theta()
+            unwrapped += _signed_delta(prev, theta)
+            prev = theta
+            lo, hi = self._extent_y()
+            if lo > touch_tol:
+                thetas.clear()
+                widths.clear()
+                continue
+            thetas.append(unwrapped)
+            widths.append((hi - lo) / to_mm)
+            if len(thetas) < window:
+                continue
+            recent = thetas[-window:]
+            if max(recent) - min(recent) >= rule.still_tol_deg:
+                continue
+            mean = norm360(sum(recent) / window)
+            edge, off = self._nearest_edge(mean)
+            if off <= rule.align_tol_deg and self._restable[edge]:
+                return PushOutcome(
+                    theta_start_deg=norm360(theta_deg),
+                    settled=True,
+                    theta_end_deg=mean,
+                    edge=edge,
+                    width_mm=float(np.mean(widths[-window:])),
+                    sim_time_s=float(d.time),
+                    steps=steps,
+                )
+        lo, hi = self._extent_y()
+        return PushOutcome(
+            theta_start_deg=norm360(theta_deg),
+            settled=False,
+            theta_end_deg=self._theta(),
+            edge=None,
+            width_mm=(hi - lo) / to_mm,
+            sim_time_s=float(d.time),
+            steps=steps,
+        )

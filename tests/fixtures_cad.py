@@ -1,0 +1,254 @@
+"""CAD fixtures generated for the import tests (ezdxf drawings, trimesh solids), with hand figures.
+
+Each ``write_*`` function writes one file and returns its path; the docstrings and the
+``*_AREA`` constants give the values computed by hand that the tests check.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import ezdxf
+import numpy as np
+import shapely
+import trimesh
+
+BULGE_90 = math.tan(math.radians(90) / 4)
+
+# plate 60 x 40 with corner radius 5, a hole r = 5 and a slot 13 long (centres), r = 4
+PLATE_W, PLATE_H, PLATE_R = 60.0, 40.0, 5.0
+PLATE_AREA = (
+    PLATE_W * PLATE_H
+    - (4 - math.pi) * PLATE_R**2
+    - math.pi * 5.0**2
+    - (13.0 * 8.0 + math.pi * 4.0**2)
+)
+
+
+def _rounded_rect(w: float, h: float, r: float) -> list[tuple[float, float, float]]:
+    """LWPOLYLINE points (x, y, bulge) of a w x h rectangle with corner radius r, CCW."""
+    return [
+        (r, 0, 0),
+        (w - r, 0, BULGE_90),
+        (w, r, 0),
+        (w, h - r, BULGE_90),
+        (w - r, h, 0),
+        (r, h, BULGE_90),
+        (0, h - r, 0),
+        (0, r, BULGE_90),
+    ]
+
+
+def _plate_entities(msp, r12: bool = False) -> None:
+    pts = _rounded_rect(PLATE_W, PLATE_H, PLATE_R)
+    if r12:
+        msp.add_polyline2d([(x, y, 0, 0, b) for x, y, b in pts], format="xyseb", close=True)
+    else:
+        msp.add_lwpolyline(pts, format="xyb", close=True)
+    msp.add_circle((15, 20), 5)
+    msp.add_line((35, 16), (48, 16))
+    msp.add_line((48, 24), (35, 24))
+    msp.add_arc((48, 20), 4, -90, 90)
+    msp.add_arc((35, 20), 4, 90, 270)
+
+
+def write_plate(path: Path, *, version: str = "R2010", fmt: str = "asc") -> Path:
+    """Plate with bulged corners, a circular hole and a slot: area PLATE_AREA, 2 holes, mm."""
+    doc = ezdxf.new(version)
+    doc.header["$INSUNITS"] = 4
+    _plate_entities(doc.modelspace(), r12=version == "R12")
+    doc.saveas(path, fmt=fmt)
+    return path
+
+
+BLOCK_AREA_IN = (10 * 5 - math.pi * 1.0**2) * 2.0**2  # in square inches, scale 2
+
+
+def write_rotated_block(path: Path) -> Path:
+    """A 10 x 5 in rectangle with a r = 1 in hole, in a block inserted at (100, 50) in, 30 deg,
+    scale 2: area BLOCK_AREA_IN * 25.4**2 mm2, edges at 30 and 120 deg."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 1
+    blk = doc.blocks.new("PART")
+    blk.add_lwpolyline([(0, 0), (10, 0), (10, 5), (0, 5)], close=True)
+    blk.add_circle((5, 2.5), 1.0)
+    doc.modelspace().add_blockref(
+        "PART", (100, 50), dxfattribs={"rotation": 30, "xscale": 2, "yscale": 2}
+    )
+    doc.saveas(path)
+    return path
+
+
+def nested_mirrored_expected() -> set[tuple[float, float]]:
+    """Vertices of the nested/mirrored fixture: triangle (0,0),(4,0),(0,3) mirrored in x and
+    moved to (10, 0) in block OUTER, OUTER rotated 90 deg: (x, y) -> (-y, x)."""
+    inner = [(0, 0), (4, 0), (0, 3)]
+    mirrored = [(10 - x, y) for x, y in inner]
+    return {(-y, x) for x, y in mirrored}
+
+
+def write_nested_mirrored(path: Path) -> Path:
+    """Nested and mirrored inserts (see :func:`nested_mirrored_expected`), area 6."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    inner = doc.blocks.new("INNER")
+    inner.add_lwpolyline([(0, 0), (4, 0), (0, 3)], close=True)
+    outer = doc.blocks.new("OUTER")
+    outer.add_blockref("INNER", (10, 0), dxfattribs={"xscale": -1})
+    doc.modelspace().add_blockref("OUTER", (0, 0), dxfattribs={"rotation": 90})
+    doc.saveas(path)
+    return path
+
+
+SPLINE_AREA = 40 * 10 + 200 - 2 * 20**3 / 3 / 80  # box 40x10 + parabola cap 5 - (x-20)^2/80
+
+
+def write_fit_spline(path: Path) -> Path:
+    """A 40 x 10 box whose top is a fit-point spline through the parabola y = 15 - (x-20)^2/80:
+    area SPLINE_AREA = 533.33 mm2."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_line((0, 10), (0, 0))
+    msp.add_line((0, 0), (40, 0))
+    msp.add_line((40, 0), (40, 10))
+    xs = [40, 35, 30, 25, 20, 15, 10, 5, 0]
+    msp.add_spline([(x, 15 - (x - 20) ** 2 / 80) for x in xs])
+    doc.saveas(path)
+    return path
+
+
+ELLIPSE_AREA = 50 * 30 - math.pi * 10 * 5
+
+
+def write_ellipse_hole(path: Path) -> Path:
+    """A 50 x 30 rectangle with a rotated elliptic hole (semi-axes 10 and 5): ELLIPSE_AREA."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (50, 0), (50, 30), (0, 30)], close=True)
+    msp.add_ellipse((25, 15), major_axis=(6, 8), ratio=0.5)
+    doc.saveas(path)
+    return path
+
+
+FRAME_PART_AREA = 50 * 50 - math.pi * 10**2
+
+
+def write_framed(path: Path) -> Path:
+    """An A4 drawing frame with a title block around a 50 x 50 square with a r = 10 hole."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (297, 0), (297, 210), (0, 210)], close=True)
+    msp.add_line((200, 0), (200, 30))
+    msp.add_line((200, 30), (297, 30))
+    msp.add_line((200, 15), (297, 15))
+    msp.add_text("TITLE", dxfattribs={"height": 5}).set_placement((210, 20))
+    msp.add_lwpolyline([(100, 80), (150, 80), (150, 130), (100, 130)], close=True)
+    msp.add_circle((125, 105), 10)
+    doc.saveas(path)
+    return path
+
+
+def write_two_parts(path: Path) -> Path:
+    """Two separate parts: a 40 x 20 rectangle (the largest) and a 10 x 10 square."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (40, 0), (40, 20), (0, 20)], close=True)
+    msp.add_lwpolyline([(60, 0), (70, 0), (70, 10), (60, 10)], close=True)
+    doc.saveas(path)
+    return path
+
+
+def write_gear(path: Path, teeth: int = 12, tip: float = 30.0, root: float = 24.0) -> Path:
+    """A gear drawn with LINE and ARC entities: tip arcs of +-3 deg at radius ``tip``, root arcs
+    at ``root``, straight flanks. Tooth k is centred on angle k * 360 / teeth."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    pitch = 360.0 / teeth
+    half_tip, half_base = 3.0, 7.0
+
+    def at(r: float, a: float) -> tuple[float, float]:
+        return (r * math.cos(math.radians(a)), r * math.sin(math.radians(a)))
+
+    for k in range(teeth):
+        c = k * pitch
+        msp.add_arc((0, 0), tip, c - half_tip, c + half_tip)
+        msp.add_line(at(tip, c + half_tip), at(root, c + half_base))
+        msp.add_arc((0, 0), root, c + half_base, c + pitch - half_base)
+        msp.add_line(at(root, c + pitch - half_base), at(tip, c + pitch - half_tip))
+    doc.saveas(path)
+    return path
+
+
+def write_disk(path: Path, radius: float = 10.0) -> Path:
+    """A plain disk (CIRCLE): not orientable by pushing."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_circle((0, 0), radius)
+    doc.saveas(path)
+    return path
+
+
+def write_entities(path: Path, build, units: int = 4) -> Path:
+    """A drawing made by ``build(modelspace)``."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = units
+    build(doc.modelspace())
+    doc.saveas(path)
+    return path
+
+
+# ---- meshes -------------------------------------------------------------------------------
+
+
+def prism(vertices: list[tuple[float, float]], height: float) -> trimesh.Trimesh:
+    """A closed prism over a simple polygon (z from 0 to ``height``), built without a
+    triangulation engine: caps from shapely's constrained Delaunay triangles."""
+    poly = shapely.Polygon(vertices)
+    if not poly.exterior.is_ccw:
+        vertices = vertices[::-1]
+    n = len(vertices)
+    xy = np.asarray(vertices, dtype=float)
+    verts = np.vstack([np.c_[xy, np.zeros(n)], np.c_[xy, np.full(n, height)]])
+    index = {tuple(p): i for i, p in enumerate(map(tuple, xy))}
+    faces = []
+    for tri in shapely.get_parts(shapely.constrained_delaunay_triangles(poly)):
+        a, b, c = (index[tuple(p)] for p in np.asarray(tri.exterior.coords)[:3])
+        if shapely.Polygon(xy[[a, b, c]]).exterior.is_ccw:
+            a, b = b, a
+        faces.append([a, b, c])  # bottom faces point down
+        faces.append([n + b, n + a, n + c])  # top faces point up
+    for i in range(n):
+        j = (i + 1) % n
+        faces.append([i, j, n + j])
+        faces.append([i, n + j, n + i])
+    mesh = trimesh.Trimesh(verts, np.asarray(faces), process=True)
+    trimesh.repair.fix_normals(mesh)
+    return mesh
+
+
+L_VERTICES = [(0, 0), (40, 0), (40, 5), (5, 5), (5, 30), (0, 30)]
+L_DEPTH = 20.0
+L_HULL = [(0, 0), (40, 0), (40, 5), (5, 30), (0, 30)]
+L_HULL_AREA = 40 * 30 - 0.5 * 35 * 25  # 762.5
+L_COM = ((200 * 20 + 125 * 2.5) / 325, (200 * 2.5 + 125 * 17.5) / 325)
+L_SIDE_AREAS = (40 * L_DEPTH, 30 * L_DEPTH, 2150 / math.sqrt(1850) * L_DEPTH)
+"""Outlines of the three side poses: the L's stable hull edges (bottom, left, diagonal);
+the width of the L's hull along each edge times the depth."""
+
+
+def write_mesh(mesh: trimesh.Trimesh, path: Path) -> Path:
+    """Export a mesh (the format follows the suffix)."""
+    mesh.export(path)
+    return path
+
+
+def box_solid_angle_fraction(a: float, b: float, d: float) -> float:
+    """Solid angle of an a x b rectangle seen from distance d on its axis, over 4 pi."""
+    omega = 4 * math.asin(a * b / math.sqrt((a * a + 4 * d * d) * (b * b + 4 * d * d)))
+    return omega / (4 * math.pi)

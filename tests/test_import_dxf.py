@@ -1,0 +1,349 @@
+"""DXF import (ezdxf + shapely) and hull simplification, on drawings generated here."""
+
+from __future__ import annotations
+
+import math
+import random
+import sys
+from pathlib import Path
+
+import ezdxf
+import pytest
+import shapely
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import fixtures_cad as fx  # noqa: E402
+
+from feederkit.errors import InputError  # noqa: E402
+from feederkit.hull import clean_hull, contact_hull, convex_hull  # noqa: E402
+from feederkit.importers import ImportOptions, import_parts, read_source  # noqa: E402
+from feederkit.mechanics import push_function  # noqa: E402
+from feederkit.mechanics.push import edge_normals  # noqa: E402
+
+
+def one(path: Path, **options):
+    _, parts = import_parts(path, ImportOptions(**options))
+    return parts[0]
+
+
+def area(ip) -> float:
+    return ip.part.outline.polygon().area
+
+
+def test_plate_with_bulges_hole_and_slot(tmp_path):
+    ip = one(fx.write_plate(tmp_path / "plate.dxf"))
+    assert area(ip) == pytest.approx(fx.PLATE_AREA, rel=2e-4)
+    assert len(ip.part.outline.holes) == 2
+    assert ip.source.source_units == "mm"
+    # bulges are real arcs: the corners are flattened into many points
+    assert len(ip.part.outline.vertices) > 20
+    pf = push_function(ip.part)
+    # four straight sides are the only stable edges; widths 40 and 60 exactly
+    assert pf.n == 4
+    assert sorted(round(s.diameter, 9) for s in pf.states) == [40, 40, 60, 60]
+    assert ip.orientability.orientable
+    assert ip.warnings == ()
+
+
+@pytest.mark.parametrize(("version", "fmt"), [("R12", "asc"), ("R2000", "bin"), ("R2018", "bin")])
+def test_r12_and_binary_dxf(tmp_path, version, fmt):
+    ip = one(fx.write_plate(tmp_path / f"plate-{version}-{fmt}.dxf", version=version, fmt=fmt))
+    assert area(ip) == pytest.approx(fx.PLATE_AREA, rel=2e-4)
+    assert len(ip.part.outline.holes) == 2
+
+
+def test_block_rotated_scaled_in_inches(tmp_path):
+    ip = one(fx.write_rotated_block(tmp_path / "block.dxf"))
+    assert ip.source.source_units == "in"
+    assert area(ip) == pytest.approx(fx.BLOCK_AREA_IN * 25.4**2, rel=2e-4)
+    assert len(ip.part.outline.holes) == 1
+    normals = sorted(round(a, 6) % 360 for a in edge_normals(ip.part.hull))
+    assert normals == pytest.approx([30.0, 120.0, 210.0, 300.0])
+    # the hole's centre lands at insert point + R(30) * 2 * (5, 2.5), in mm
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    hx = (100 + 2 * (5 * c - 2.5 * s)) * 25.4
+    hy = (50 + 2 * (5 * s + 2.5 * c)) * 25.4
+    hole = shapely.Polygon(ip.part.outline.holes[0]).centroid
+    assert (hole.x, hole.y) == pytest.approx((hx, hy), abs=1e-3)
+
+
+def test_units_override(tmp_path):
+    ip = one(fx.write_rotated_block(tmp_path / "block.dxf"), units="mm")
+    assert area(ip) == pytest.approx(fx.BLOCK_AREA_IN, rel=1e-3)  # flattened at 0.01 "mm"
+    with pytest.raises(InputError, match="unknown unit"):
+        one(tmp_path / "block.dxf", units="furlong")
+
+
+def test_nested_and_mirrored_inserts(tmp_path):
+    ip = one(fx.write_nested_mirrored(tmp_path / "nested.dxf"))
+    got = {(round(x, 9) + 0.0, round(y, 9) + 0.0) for x, y in ip.part.outline.vertices}
+    assert got == {(float(x), float(y)) for x, y in fx.nested_mirrored_expected()}
+    assert area(ip) == pytest.approx(6.0)
+
+
+def test_fit_point_spline(tmp_path):
+    ip = one(fx.write_fit_spline(tmp_path / "spline.dxf"))
+    assert area(ip) == pytest.approx(fx.SPLINE_AREA, rel=2e-3)
+    top = [p for p in ip.part.outline.vertices if p[1] > 10.5]
+    assert len(top) >= 10  # the spline is flattened, not replaced by its fit points' polygon
+
+
+def test_ellipse_hole(tmp_path):
+    ip = one(fx.write_ellipse_hole(tmp_path / "ellipse.dxf"))
+    assert area(ip) == pytest.approx(fx.ELLIPSE_AREA, rel=2e-4)
+    (hole,) = ip.part.outline.holes
+    assert shapely.Polygon(hole).area == pytest.approx(math.pi * 50, rel=1e-3)
+
+
+def test_drawing_frame_is_skipped(tmp_path):
+    ip = one(fx.write_framed(tmp_path / "framed.dxf"))
+    assert area(ip) == pytest.approx(fx.FRAME_PART_AREA, rel=2e-4)
+    assert len(ip.part.outline.holes) == 1
+    assert any("frame" in w for w in ip.warnings)
+
+
+def test_several_parts_largest_or_all(tmp_path):
+    path = fx.write_two_parts(tmp_path / "two.dxf")
+    ip = one(path)
+    assert area(ip) == pytest.approx(800.0)
+    assert any("2 separate parts" in w for w in ip.warnings)
+    assert any("two-2" in w and "100.0 mm2" in w for w in ip.warnings)
+    _, parts = import_parts(path, ImportOptions(all_parts=True))
+    assert [p.part.name for p in parts] == ["two", "two-2"]
+    assert [round(area(p), 6) for p in parts] == [800.0, 100.0]
+
+
+def test_layers_select_geometry(tmp_path):
+    def build(msp):
+        msp.add_lwpolyline(
+            [(0, 0), (10, 0), (10, 10), (0, 10)], close=True, dxfattribs={"layer": "CUT"}
+        )
+        msp.add_lwpolyline(
+            [(-50, -50), (50, -50), (50, 50), (-50, 50)], close=True, dxfattribs={"layer": "NOTES"}
+        )
+
+    path = fx.write_entities(tmp_path / "layers.dxf", build)
+    assert area(one(path)) == pytest.approx(10000.0 - 100.0)
+    assert area(one(path, layers=("cut",))) == pytest.approx(100.0)
+    with pytest.raises(InputError, match="no geometry on layer nope"):
+        one(path, layers=("nope",))
+
+
+def test_text_dimensions_and_hatches_are_skipped(tmp_path):
+    def build(msp):
+        msp.add_lwpolyline([(0, 0), (20, 0), (20, 10), (0, 10)], close=True)
+        msp.add_text("PART 7")
+        msp.add_mtext("notes")
+        hatch = msp.add_hatch()
+        hatch.paths.add_polyline_path([(0, 0), (50, 0), (50, 50)], is_closed=True)
+        msp.add_linear_dim(base=(0, -20), p1=(0, 0), p2=(20, 0)).render()
+
+    ip = one(fx.write_entities(tmp_path / "annotated.dxf", build))
+    assert area(ip) == pytest.approx(200.0)
+
+
+def test_unitless_drawing_warns_and_reads_mm(tmp_path):
+    path = fx.write_entities(
+        tmp_path / "nounits.dxf",
+        lambda m: m.add_lwpolyline([(0, 0), (4, 0), (4, 3)], close=True),
+        units=0,
+    )
+    ip = one(path)
+    assert area(ip) == pytest.approx(6.0)
+    assert any("no units" in w for w in ip.warnings)
+
+
+def test_small_gaps_between_entities_are_closed(tmp_path):
+    def build(msp):
+        msp.add_line((0, 0), (10, 0))
+        msp.add_line((10.000001, 0), (10, 10))
+        msp.add_line((10, 10), (0, 10.000002))
+        msp.add_line((0, 10), (0, 0))
+
+    assert area(one(fx.write_entities(tmp_path / "gaps.dxf", build))) == pytest.approx(
+        100.0, rel=1e-5
+    )
+
+
+def test_crossing_centre_line_does_not_split_the_part(tmp_path):
+    def build(msp):
+        msp.add_lwpolyline([(0, 0), (30, 0), (30, 10), (0, 10)], close=True)
+        msp.add_line((15, -5), (15, 15))
+
+    assert area(one(fx.write_entities(tmp_path / "centre.dxf", build))) == pytest.approx(300.0)
+
+
+# ---- bad input: one clear line ----------------------------------------------------------
+
+
+def bad(path: Path, match: str, **options) -> str:
+    with pytest.raises(InputError, match=match) as info:
+        read_source(path, ImportOptions(**options))
+    message = str(info.value)
+    assert "\n" not in message and str(path.name) in message
+    return message
+
+
+def test_empty_and_corrupt_files(tmp_path):
+    empty = tmp_path / "empty.dxf"
+    empty.write_bytes(b"")
+    bad(empty, "empty")
+    corrupt = tmp_path / "corrupt.dxf"
+    corrupt.write_bytes(bytes(random.Random(1).randrange(256) for _ in range(4000)))
+    bad(corrupt, "not a DXF file")
+    truncated = tmp_path / "truncated.dxf"
+    full = fx.write_plate(tmp_path / "full.dxf").read_bytes()
+    truncated.write_bytes(full[: len(full) // 3])
+    with pytest.raises(InputError):
+        read_source(truncated, ImportOptions())
+
+
+def test_text_only(tmp_path):
+    path = fx.write_entities(tmp_path / "text.dxf", lambda m: m.add_text("hello"))
+    bad(path, "no outline geometry.*TEXT")
+
+
+def test_open_outline(tmp_path):
+    def build(msp):
+        msp.add_line((0, 0), (10, 0))
+        msp.add_line((10, 0), (10, 10))
+        msp.add_line((10, 10), (0, 10))
+
+    bad(fx.write_entities(tmp_path / "open.dxf", build), "no closed outline.*open ends")
+
+
+def test_zero_area_outline(tmp_path):
+    path = fx.write_entities(
+        tmp_path / "flat.dxf", lambda m: m.add_lwpolyline([(0, 0), (10, 0), (20, 0)], close=True)
+    )
+    bad(path, "zero area")
+
+
+def test_unknown_unit_code(tmp_path):
+    path = fx.write_entities(
+        tmp_path / "odd.dxf", lambda m: m.add_lwpolyline([(0, 0), (4, 0), (4, 3)], close=True)
+    )
+    doc = ezdxf.readfile(path)
+    doc.header["$INSUNITS"] = 99
+    doc.saveas(path)
+    bad(path, "unsupported drawing unit")
+
+
+def test_large_file_refused_unless_allowed(tmp_path):
+    path = fx.write_plate(tmp_path / "plate.dxf")
+    bad(path, "over the 0.001 MB limit.*--allow-large", max_file_mb=0.001)
+    result = read_source(path, ImportOptions(max_file_mb=0.001, allow_large=True))
+    assert result.parts[0].outline.polygon().area == pytest.approx(fx.PLATE_AREA, rel=2e-4)
+
+
+def test_missing_and_unsupported_files(tmp_path):
+    bad(tmp_path / "nope.dxf", "no such file")
+    other = tmp_path / "part.step"
+    other.write_text("ISO-10303-21;")
+    bad(other, "unsupported file type")
+
+
+# ---- hull simplification, gear and disk -------------------------------------------------
+
+
+def arc_points(r: float, a0: float, a1: float, n: int) -> list[tuple[float, float]]:
+    return [
+        (
+            r * math.cos(math.radians(a0 + (a1 - a0) * k / (n - 1))),
+            r * math.sin(math.radians(a0 + (a1 - a0) * k / (n - 1))),
+        )
+        for k in range(n)
+    ]
+
+
+def dist_to_polygon(p, ring) -> float:
+    return shapely.Polygon(ring).exterior.distance(shapely.Point(p))
+
+
+def test_simplification_is_measured_against_the_original_points():
+    # a finely flattened circle: neighbour-deviation cleaning would drift; ours stays within tol
+    pts = arc_points(50.0, 0.0, 360.0, 2001)[:-1]
+    tol = 0.05
+    ring = convex_hull(pts)
+    simple = clean_hull(ring, tol)
+    assert max(dist_to_polygon(p, simple) for p in pts) <= tol + 1e-9
+    # as few vertices as the tolerance allows: a chord of sagitta tol spans 2 acos(1 - tol/r)
+    best = math.ceil(360.0 / math.degrees(2 * math.acos(1 - tol / 50.0)))
+    assert best <= len(simple) <= 2 * best
+    assert set(simple) <= set(ring)
+
+
+def test_simplification_does_not_depend_on_the_start():
+    pts = arc_points(20.0, 0.0, 360.0, 361)[:-1] + [(25.0, 0.0)]
+    ring = convex_hull(pts)
+    base = set(clean_hull(ring, 0.05))
+    for shift in (1, 7, 100):
+        assert set(clean_hull(ring[shift:] + ring[:shift], 0.05)) == base
+
+
+def test_contact_hull_numbering_after_simplification():
+    pts = arc_points(10.0, 180.0, 360.0, 200) + [(10.0, 5.0), (-10.0, 5.0)]
+    hull = contact_hull(pts, 0.05)
+    ymin = min(p[1] for p in hull)
+    lowest = [p for p in hull if p[1] <= ymin + 0.05]
+    assert hull[0] == min(lowest)
+    assert shapely.Polygon(hull).exterior.is_ccw
+
+
+def test_exact_polygons_keep_their_vertices():
+    square = [(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0.0)]
+    assert contact_hull(square) == ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
+
+
+def test_gear_keeps_one_stable_edge_per_tooth_pair(tmp_path):
+    teeth = 12
+    path = fx.write_gear(tmp_path / "gear.dxf", teeth=teeth)
+    raw = one(path, hull_tolerance=0.0)
+    ip = one(path)
+    assert len(raw.part.hull) > 4 * teeth  # flattened tip arcs
+    assert len(ip.part.hull) == 2 * teeth  # each tip arc is one chord
+    assert ip.orientability.orientable
+    assert ip.orientability.useful_states == teeth
+    pf = push_function(ip.part)
+    wide = [s for s in pf.states if s.resting_range_deg[1] - s.resting_range_deg[0] > 10]
+    assert len(wide) == teeth
+    pitch = 360.0 / teeth
+    for s in wide:  # gap edges: their normals point between two teeth
+        assert (s.normal_deg - pitch / 2) % pitch == pytest.approx(0.0, abs=1e-6) or (
+            s.normal_deg - pitch / 2
+        ) % pitch == pytest.approx(pitch, abs=1e-6)
+        assert s.resting_range_deg[1] - s.resting_range_deg[0] == pytest.approx(
+            pitch - 6.0, abs=0.3
+        )
+    diameters = {round(s.diameter, 6) for s in wide}
+    assert len(diameters) == 1  # symmetric: every tooth pair alike
+
+
+def test_disk_is_not_orientable(tmp_path):
+    ip = one(fx.write_disk(tmp_path / "disk.dxf", radius=10.0))
+    assert not ip.orientability.orientable
+    assert "disk-like" in ip.orientability.reason
+    assert any(w.startswith("not orientable by pushing") for w in ip.warnings)
+    assert ip.orientability.deepest_well_mm <= 0.05
+
+
+def test_square_with_rounded_corners_is_orientable(tmp_path):
+    def build(msp):
+        msp.add_lwpolyline(fx._rounded_rect(20, 20, 8), format="xyb", close=True)
+
+    ip = one(fx.write_entities(tmp_path / "round-square.dxf", build))
+    assert ip.orientability.orientable
+    assert ip.orientability.useful_states == 4
+
+
+def test_minsert_grid_gives_separate_parts(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    blk = doc.blocks.new("SQ")
+    blk.add_lwpolyline([(0, 0), (5, 0), (5, 5), (0, 5)], close=True)
+    ref = doc.modelspace().add_blockref("SQ", (0, 0))
+    ref.grid(size=(1, 3), spacing=(20, 20))
+    path = tmp_path / "grid.dxf"
+    doc.saveas(path)
+    _, parts = import_parts(path, ImportOptions(all_parts=True))
+    assert len(parts) == 3 and all(area(p) == pytest.approx(25.0) for p in parts)

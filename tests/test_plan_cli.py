@@ -1,0 +1,212 @@
+"""``feederkit plan``: verified plans written atomically, exit codes, and ``run --all`` on them."""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+
+import pytest
+
+from feederkit.cli.app import main
+
+RECT = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
+TRI = [[0, 0], [1, 0], [0, 1]]
+
+
+def outline(tmp_path, name, vertices, com=None):
+    data = {"name": name, "units": "mm", "vertices": vertices}
+    if com is not None:
+        data["com"] = com
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+def random_convex(seed, n=9, radius=20.0):
+    rng = random.Random(seed)
+    angles = sorted(rng.uniform(0, 2 * math.pi) for _ in range(n))
+    return [
+        [radius * rng.uniform(0.6, 1.0) * math.cos(a), radius * rng.uniform(0.6, 1.0) * math.sin(a)]
+        for a in angles
+    ]
+
+
+def plan_file(tmp_path, capsys, args, name="plan.json", code=0):
+    out = tmp_path / name
+    rc = main(["plan", *args, "-o", str(out)])
+    captured = capsys.readouterr()
+    assert rc == code, captured.err
+    return json.loads(out.read_text()), captured
+
+
+def run_all(plan_path, sources, capsys):
+    rc = main(["run", str(plan_path), *sources, "--all"])
+    captured = capsys.readouterr()
+    assert rc == 0, captured.err
+    assert "paths end in their result" in captured.out
+
+
+def test_centred_rectangle_sensorless(tmp_path, capsys):
+    src = outline(tmp_path, "rect", RECT)
+    plan, cap = plan_file(tmp_path, capsys, [src])
+    assert "no sensor option given" in cap.out and "sensorless" in cap.out
+    assert plan["sensor"] == {"model": "none"}
+    assert plan["stats"]["length"] == 2 and plan["stats"]["optimal"]
+    leaves = []
+    stack = [plan["root"]]
+    while stack:
+        node = stack.pop()
+        if "result" in node:
+            leaves.append(node["result"])
+        else:
+            assert all(b["reading"] is None for b in node["branches"])
+            stack.extend(b["next"] for b in node["branches"])
+    (result,) = leaves
+    poses = sorted(e["pose_deg"] for e in result)
+    assert len(poses) == 2 and poses[1] - poses[0] == pytest.approx(180.0)
+    run_all(tmp_path / "plan.json", [src], capsys)
+
+
+def test_right_triangle_tolerance_and_sensorless(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    plan, cap = plan_file(tmp_path, capsys, [src, "--tolerance", "0.01"])
+    assert plan["stats"]["length"] == 2
+    assert plan["stats"]["class"] == 2 and plan["stats"]["meets_bound"] is True
+    assert "op 2: rotate" in cap.out and "statistics" in cap.out and "passed" in cap.out
+    run_all(tmp_path / "plan.json", [src], capsys)
+    plan, _ = plan_file(tmp_path, capsys, [src, "--sensorless"], name="sl.json")
+    assert plan["stats"]["length"] == 3
+    run_all(tmp_path / "sl.json", [src], capsys)
+
+
+def test_random_convex_part_led(tmp_path, capsys):
+    src = outline(tmp_path, "rnd", random_convex(7))
+    plan, _ = plan_file(tmp_path, capsys, [src, "--led-pitch", "1.0", "--noise", "0.2"])
+    assert plan["sensor"] == {"model": "led", "pitch_mm": 1.0, "noise_mm": 0.2}
+    assert plan["stats"]["meets_bound"] is True
+    run_all(tmp_path / "plan.json", [src], capsys)
+
+
+def test_two_part_mix(tmp_path, capsys):
+    octagon = [[math.cos(k * math.pi / 4), math.sin(k * math.pi / 4)] for k in range(8)]
+    a = outline(tmp_path, "tri", TRI)
+    b = outline(tmp_path, "octagon", octagon, com=[0.13, 0.05])
+    plan, _ = plan_file(tmp_path, capsys, [a, b, "--tolerance", "0.01"])
+    assert [p["name"] for p in plan["parts"]] == ["tri", "octagon"]
+    assert plan["stats"]["class"] is None
+    run_all(tmp_path / "plan.json", [a, b], capsys)
+    run_all(tmp_path / "plan.json", [b], capsys)
+
+
+def test_unrecognizable_pair_writes_the_plan_and_exits_1(tmp_path, capsys):
+    a = outline(tmp_path, "tri", TRI)
+    b = outline(tmp_path, "tri-copy", TRI)
+    plan, cap = plan_file(tmp_path, capsys, [a, b, "--tolerance", "0.01"], code=1)
+    assert "tri & tri-copy" in cap.err and len(cap.err.strip().splitlines()) == 1
+    assert any(len({e["part"] for e in leaf}) == 2 for leaf in _results(plan))
+    run_all(tmp_path / "plan.json", [a, b], capsys)
+
+
+def _results(plan):
+    stack, out = [plan["root"]], []
+    while stack:
+        node = stack.pop()
+        if "result" in node:
+            out.append(node["result"])
+        else:
+            stack.extend(b["next"] for b in node["branches"])
+    return out
+
+
+def test_json_output_is_the_plan_file(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    out = tmp_path / "p.json"
+    assert main(["plan", src, "--tolerance", "0.01", "--json", "-o", str(out)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed == json.loads(out.read_text())
+    assert printed["format"] == "feederkit-plan"
+
+
+def test_report_is_written(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    html = tmp_path / "r.html"
+    assert main(["plan", src, "--tolerance", "0.01", "--report", str(html)]) == 0
+    assert html.read_text().startswith("<!DOCTYPE html>")
+
+
+def test_options_reach_the_plan(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    plan, _ = plan_file(
+        tmp_path,
+        capsys,
+        [src, "--tolerance", "0.01", "--objective", "expected", "--grouping", "components"],
+    )
+    assert plan["stats"]["objective"] == "expected" and plan["stats"]["grouping"] == "components"
+    plan, _ = plan_file(
+        tmp_path, capsys, [src, "--sensorless", "--min-margin", "10"], name="m.json"
+    )
+    assert plan["stats"]["min_margin_deg"] >= 10
+
+
+def one_line_error(capsys, args, code=2):
+    rc = main(args)
+    err = capsys.readouterr().err
+    assert rc == code, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        ["--tolerance", "0"],
+        ["--tolerance", "-1"],
+        ["--noise", "0.1"],
+        ["--led-pitch", "0"],
+        ["--tolerance", "0.1", "--led-pitch", "1"],
+        ["--objective", "best"],
+        ["--grouping", "cliques"],
+        ["--min-margin", "-1"],
+        ["--time-limit", "0"],
+    ],
+)
+def test_impossible_settings(tmp_path, capsys, extra):
+    src = outline(tmp_path, "tri", TRI)
+    one_line_error(capsys, ["plan", src, *extra, "-o", str(tmp_path / "p.json")])
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_bad_sources(tmp_path, capsys):
+    err = one_line_error(capsys, ["plan", str(tmp_path / "nope.json")])
+    assert "nope.json" in err
+    src = outline(tmp_path, "tri", TRI)
+    one_line_error(capsys, ["plan", src, src])
+
+
+def test_disk_is_refused(tmp_path, capsys):
+    disk = [
+        [10 * math.cos(k * math.pi / 180), 10 * math.sin(k * math.pi / 180)] for k in range(360)
+    ]
+    src = outline(tmp_path, "disk", disk)
+    err = one_line_error(capsys, ["plan", src, "-o", str(tmp_path / "p.json")])
+    assert "not orientable" in err
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_unwritable_output(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    one_line_error(capsys, ["plan", src, "-o", str(tmp_path / "no" / "such" / "dir.json")])
+
+
+def test_catalog_names(tmp_path, capsys):
+    db = str(tmp_path / "parts.db")
+    src = outline(tmp_path, "tri", TRI)
+    assert main(["catalog", "init", "--catalog", db]) == 0
+    assert main(["catalog", "add", src, "--catalog", db]) == 0
+    capsys.readouterr()
+    plan, _ = plan_file(tmp_path, capsys, ["tri", "--catalog", db, "--tolerance", "0.01"])
+    assert plan["parts"][0]["revision"] == "1"
+    rc = main(["run", str(tmp_path / "plan.json"), "tri", "--catalog", db, "--all"])
+    assert rc == 0, capsys.readouterr().err
+    one_line_error(capsys, ["plan", "no-such-part", "--catalog", db])

@@ -1,0 +1,393 @@
+"""The planners of issue 3 on geometry and on hand-built machines.
+
+Every emitted plan is executed on its machine by ``check_plan`` below: from every start
+state, through every reading branch the state can follow, it must end in a leaf that lists
+the state it is really in, and only states inseparable from it.
+"""
+
+from __future__ import annotations
+
+import math
+from itertools import product
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from feederkit.errors import InputError, PlanningError
+from feederkit.machine import (
+    MachineState,
+    PushAlignMachine,
+    build_machine,
+    inseparable,
+    members,
+    successor,
+)
+from feederkit.mechanics import push_function
+from feederkit.mechanics.actions import ActionRange
+from feederkit.mechanics.classes import polygon_class
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.api import plan
+from feederkit.planning.stats import expected_operations
+from feederkit.planning.tree import Leaf, Step
+from feederkit.sensors import (
+    LedSensor,
+    NoSensor,
+    ToleranceSensor,
+    led_counts,
+    reading_consistent,
+)
+
+# ---------------------------------------------------------------- helpers
+
+
+def part(name, vertices, com=None):
+    return push_function(make_part(make_outline(name, vertices), com))
+
+
+def regular(n, com=(0.13, 0.05)):
+    pts = [(math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n)) for k in range(n)]
+    return part(f"regular-{n}", pts, com)
+
+
+RECT = [(0, 0), (2, 0), (2, 1), (0, 1)]
+TRIANGLE = [(0, 0), (1, 0), (0, 1)]
+
+
+def random_convex(seed, n):
+    import random
+
+    rng = random.Random(seed)
+    angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
+    radii = [rng.uniform(0.8, 1.0) for _ in angles]
+    pts = [(30 * r * math.cos(t), 20 * r * math.sin(t)) for r, t in zip(radii, angles, strict=True)]
+    return part(f"random-{seed}", pts)
+
+
+def _reading_points(machine, branch):
+    """Readings to try inside a closed branch interval: its ends and middle."""
+    if branch.lo is None:
+        return [None]
+    return [branch.lo, (branch.lo + branch.hi) / 2.0, branch.hi]
+
+
+def check_plan(result) -> int:
+    """Execute the plan from every start and every reading branch; return the longest run.
+
+    At each step the state must be in the branch it follows (its reading is possible
+    there), every branch a state can read into must exist, and the leaf must hold the
+    state and only states inseparable from it.
+    """
+    machine = result.machine
+    insep = inseparable(machine)
+    sensor = machine.sensor
+    longest = 0
+
+    def can_follow(state, branch):
+        if branch.lo is None:
+            return True
+        d = machine.states[state].diameter
+        # Some reading strictly inside the branch interval (or at an LED count) is possible.
+        if isinstance(sensor, ToleranceSensor):
+            e = sensor.tolerance
+            return max(branch.lo, d - e) < min(branch.hi, d + e)
+        return any(reading_consistent(sensor, d, r) for r in _reading_points(machine, branch))
+
+    def run(node, state, ops):
+        nonlocal longest
+        if isinstance(node, Leaf):
+            assert node.mask >> state & 1, "the leaf does not list the true state"
+            for j in members(node.mask):
+                assert j == state or insep[state] >> j & 1, "the leaf lists a separable state"
+            longest = max(longest, ops)
+            return
+        if node.action is not None:
+            a = node.action
+            assert a.lo < a.representative + (360 if a.representative < a.lo else 0) < a.hi + 1e-9
+            state = successor(machine, state, a.representative)
+        ops += 1
+        assert_covered(node, state)
+        for b, sub in node.branches:
+            if can_follow(state, b):
+                assert b.mask >> state & 1, "a branch the state can read into omits it"
+                run(sub, state, ops)
+
+    def assert_covered(node, state):
+        """Every reading the state can give lies in a branch that lists it."""
+        d = machine.states[state].diameter
+        mine = [b for b, _ in node.branches if b.mask >> state & 1]
+        if isinstance(sensor, NoSensor):
+            assert mine
+            return
+        if isinstance(sensor, ToleranceSensor):
+            e = sensor.tolerance
+            pts = sorted({d - e, d + e} | {x for b in mine for x in (b.lo, b.hi) if d - e < x < d + e})
+            probes = [(a + b) / 2 for a, b in zip(pts, pts[1:], strict=False)]
+        else:
+            c0, c1 = led_counts(sensor, d)
+            probes = [c * sensor.pitch for c in range(c0, c1 + 1)]
+        for x in probes:
+            assert any(b.lo - 1e-12 <= x <= b.hi + 1e-12 for b in mine), f"reading {x} uncovered"
+
+    for s in range(machine.n):
+        run(result.root, s, 0)
+    assert longest == result.length
+    return longest
+
+
+# ---------------------------------------------------------------- known cases
+
+
+def test_rectangle_sensorless_length_2_up_to_symmetry():
+    m = build_machine([part("rect", [(-1, -0.5), (1, -0.5), (1, 0.5), (-1, 0.5)])])
+    r = plan(m)
+    assert r.length == 2 and r.optimal
+    check_plan(r)
+    leaves = _leaves(r.root)
+    assert all(leaf.mask.bit_count() == 2 for leaf in leaves)
+    (leaf,) = leaves
+    a, b = members(leaf.mask)
+    normals = [s.normal_deg for s in push_function(make_part(make_outline("r", RECT))).states]
+    assert abs(abs(normals[a] - normals[b]) - 180.0) < 1e-9
+
+
+def test_isosceles_right_triangle():
+    pf = part("tri", TRIANGLE)
+    with_sensor = plan(build_machine([pf], ToleranceSensor(0.01)))
+    without = plan(build_machine([pf], NoSensor()))
+    assert (with_sensor.length, without.length) == (2, 3)
+    check_plan(with_sensor)
+    check_plan(without)
+    assert all(leaf.mask.bit_count() == 1 for leaf in _leaves(with_sensor.root))
+
+
+@pytest.mark.parametrize("n", range(5, 13))
+def test_offset_regular_polygon_needs_n(n):
+    m = build_machine([regular(n)])
+    r = plan(m)
+    assert r.length == n == 1 + shortest_synchronizing_word(m)
+    check_plan(r)
+
+
+def test_all_diameters_distinct_gives_length_1():
+    pf = part("scalene", [(0, 0), (4, 0), (1, 3)])
+    assert len({round(s.diameter, 6) for s in pf.states}) == pf.n
+    r = plan(build_machine([pf], ToleranceSensor(1e-3)))
+    assert r.length == 1
+    assert abs(r.expected_length - 1.0) < 1e-12
+    assert all(isinstance(sub, Leaf) for _, sub in r.root.branches)
+    check_plan(r)
+
+
+def _leaves(node):
+    if isinstance(node, Leaf):
+        return [node]
+    return [leaf for _, sub in node.branches for leaf in _leaves(sub)]
+
+
+def shortest_synchronizing_word(machine) -> int:
+    """Breadth-first search over subsets with this test's own representative rotations."""
+    n = machine.n
+    bounds = sorted({r.lo % 360.0 for rs in machine.action_maps for r in rs})
+    reps = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360.0], strict=True)]
+
+    def go(i, a):
+        a %= 360.0
+        for r in machine.action_maps[i]:
+            if r.lo < a < r.hi or r.lo < a + 360.0 < r.hi:
+                return r.target
+        raise AssertionError("rotation on a boundary")
+
+    start = frozenset(range(n))
+    seen, frontier, depth = {start}, [start], 0
+    while frontier:
+        if any(len(s) == 1 for s in frontier):
+            return depth
+        nxt = []
+        for s in frontier:
+            for a in reps:
+                t = frozenset(go(i, a) for i in s)
+                if t not in seen:
+                    seen.add(t)
+                    nxt.append(t)
+        frontier, depth = nxt, depth + 1
+    raise AssertionError("not synchronizing")
+
+
+# ---------------------------------------------------------------- methods agree
+
+
+PARTS = [
+    ("tri", TRIANGLE, None),
+    ("rect", RECT, None),
+    ("rect-off", RECT, (0.8, 0.45)),
+    ("quad", [(0, 0), (3, 0), (2.2, 1.6), (0.4, 1.1)], None),
+    ("penta", [(0, 0), (2, -0.3), (3, 1), (1.5, 2.2), (-0.4, 1.2)], None),
+    ("hexa", [(0, 0), (2, 0), (3, 1), (2, 2), (0, 2), (-1, 1)], (0.9, 1.05)),
+]
+SENSORS = [NoSensor(), ToleranceSensor(0.01), ToleranceSensor(0.2), LedSensor(0.25, 0.05)]
+
+
+@pytest.mark.parametrize(("name", "verts", "com"), PARTS)
+@pytest.mark.parametrize("sensor", SENSORS, ids=lambda s: repr(s))
+def test_methods_agree_and_bounds_hold(name, verts, com, sensor):
+    pf = part(name, verts, com)
+    m = build_machine([pf], sensor)
+    r = plan(m)
+    check_plan(r)
+    assert r.optimal and r.lower_bound == r.length
+    assert plan(m, method="andor").length == r.length
+    assert plan(m, method="bottom-up").length == r.length
+    sensorless = plan(build_machine([pf], NoSensor()))
+    assert r.length <= sensorless.length
+    assert plan(build_machine([pf], NoSensor()), method="bfs").length == sensorless.length
+    assert plan(build_machine([pf], NoSensor()), method="backchain").length == sensorless.length
+    assert r.length <= polygon_class(pf, sensor).bound
+    comp = plan(m, grouping="components")
+    check_plan(comp)
+    assert r.length <= comp.length
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10**6), st.integers(3, 9), st.sampled_from([0.0, 0.005, 0.02, 0.05]))
+def test_random_parts_methods_agree(seed, n, rel_tol):
+    pf = random_convex(seed, n)
+    sensor = NoSensor() if rel_tol == 0.0 else ToleranceSensor(rel_tol * pf.part.size)
+    m = build_machine([pf], sensor)
+    r = plan(m)
+    check_plan(r)
+    assert plan(m, method="andor").length == r.length
+    if pf.n <= 10:
+        assert plan(m, method="bottom-up").length == r.length
+    sensorless = build_machine([pf], NoSensor())
+    s = plan(sensorless)
+    assert r.length <= s.length
+    assert plan(sensorless, method="bfs").length == s.length == plan(sensorless, method="andor").length
+    assert r.length <= polygon_class(pf, sensor).bound
+    assert s.length <= polygon_class(pf, NoSensor()).bound
+
+
+# ---------------------------------------------------------------- ties and objectives
+
+
+@pytest.mark.parametrize(("name", "verts", "com"), PARTS)
+def test_no_plan_of_the_same_length_keeps_a_larger_margin(name, verts, com):
+    for sensor in (NoSensor(), ToleranceSensor(0.2)):
+        m = build_machine([part(name, verts, com)], sensor)
+        r = plan(m)
+        if r.length == 1:
+            assert r.min_margin == math.inf
+            continue
+        assert 0.0 < r.min_margin < 180.0
+        try:
+            assert plan(m, min_margin=r.min_margin * (1 + 1e-9)).length > r.length
+        except PlanningError:
+            pass
+
+
+def test_expected_objective_never_worse_and_statistics_consistent():
+    for name, verts, com in PARTS:
+        m = build_machine([part(name, verts, com)], ToleranceSensor(0.05))
+        w = plan(m)
+        e = plan(m, objective="expected")
+        check_plan(e)
+        assert e.expected_length <= w.expected_length + 1e-12
+        assert abs(expected_operations(m, e.root) - e.expected_length) < 1e-12
+        assert 1.0 - 1e-9 <= e.expected_length <= e.length + 1e-9
+
+
+def test_min_margin_respected_or_named():
+    pf = regular(7)
+    m = build_machine([pf])
+    r = plan(m)
+    floor = r.min_margin
+    same = plan(m, min_margin=floor)
+    assert same.min_margin >= floor and same.length == r.length
+    with pytest.raises(PlanningError) as err:
+        plan(m, min_margin=179.0)
+    assert "largest margin" in str(err.value)
+    best = float(str(err.value).split("is ")[-1].split(" deg")[0])
+    ok = plan(m, min_margin=best * 0.999)
+    check_plan(ok)
+    assert ok.min_margin >= best * 0.999
+
+
+def test_time_limit_returns_a_valid_plan_with_a_lower_bound():
+    m = build_machine([regular(9)])
+    r = plan(m, method="andor", time_limit=0.02)
+    check_plan(r)
+    assert r.lower_bound <= r.length
+    if not r.optimal:
+        assert r.lower_bound < 9 or r.length == 9
+
+
+def test_bad_arguments():
+    m = build_machine([part("tri", TRIANGLE)])
+    for kwargs in (
+        {"objective": "best"},
+        {"grouping": "pairs"},
+        {"method": "dfs"},
+        {"min_margin": -1.0},
+        {"min_margin": math.nan},
+        {"time_limit": 0.0},
+    ):
+        with pytest.raises(InputError):
+            plan(m, **kwargs)
+    with pytest.raises(InputError):
+        plan(build_machine([part("tri", TRIANGLE)], ToleranceSensor(0.01)), method="bfs")
+
+
+# ---------------------------------------------------------------- hand-built machines
+
+
+def hand_machine(n, maps, diameters=None, sensor=None):
+    """A machine from action maps given as lists of (lo, hi, target) per state."""
+    diameters = diameters or [1.0] * n
+    states = tuple(MachineState(0, i, diameters[i], 1.0 / n) for i in range(n))
+    action_maps = tuple(tuple(ActionRange(lo, hi, t) for lo, hi, t in rs) for rs in maps)
+    return PushAlignMachine(("hand",), states, action_maps, sensor or NoSensor())
+
+
+def test_hand_machine_two_states_merge_in_one_step():
+    # State 0 stays for rotations in (0, 180) and goes to 1 otherwise; state 1 always stays.
+    m = hand_machine(2, [[(0, 180, 0), (180, 360, 1)], [(0, 360, 1)]])
+    r = plan(m)
+    assert r.length == 2
+    check_plan(r)
+    (leaf,) = _leaves(r.root)
+    assert leaf.mask == 0b10
+    assert r.min_margin == 90.0
+
+
+def test_hand_machine_sensor_beats_sensorless():
+    # Three states; rotation in (0, 120) cycles them, (120, 360) keeps them: no merging at all.
+    cyc = [[(0, 120, (i + 1) % 3), (120, 360, i)] for i in range(3)]
+    blind = hand_machine(3, cyc)
+    assert inseparable(blind) == (0b110, 0b101, 0b011)
+    r = plan(blind)
+    assert r.length == 1 and _leaves(r.root)[0].mask == 0b111
+    sensed = hand_machine(3, cyc, [1.0, 1.0, 2.0], ToleranceSensor(0.1))
+    s = plan(sensed)
+    check_plan(s)
+    # Reading 1.0 leaves {0, 1}; cycling sends 0 -> 1 and 1 -> 2, which the reading tells apart.
+    assert s.length == 2
+    assert all(leaf.mask.bit_count() == 1 for leaf in _leaves(s.root))
+
+
+def test_hand_machine_equal_readings_are_sensorless():
+    maps = [[(0, 90, 0), (90, 360, 1)], [(0, 200, 2), (200, 360, 1)], [(0, 360, 2)]]
+    a = plan(hand_machine(3, maps))
+    b = plan(hand_machine(3, maps, [5.0] * 3, ToleranceSensor(0.5)))
+    check_plan(a)
+    check_plan(b)
+    assert a.length == b.length == 3
+
+
+def test_led_sensor_plans_are_valid():
+    for name, verts, com in PARTS:
+        for pitch, noise in product((0.1, 0.3), (0.0, 0.04)):
+            m = build_machine([part(name, verts, com)], LedSensor(pitch, noise))
+            r = plan(m)
+            check_plan(r)
+            assert plan(m, method="bottom-up").length == r.length

@@ -1,0 +1,109 @@
+"""``feederkit run``: execution on the kinematic model, bad input, corrupted plans."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from feederkit.cli.app import main
+
+TRI = [[0, 0], [1, 0], [0, 1]]
+
+
+@pytest.fixture()
+def tri(tmp_path, capsys):
+    src = tmp_path / "tri.json"
+    src.write_text(json.dumps({"name": "tri", "vertices": TRI}))
+    plan = tmp_path / "tri.plan.json"
+    assert main(["plan", str(src), "--tolerance", "0.01", "-o", str(plan)]) == 0
+    capsys.readouterr()
+    return str(src), plan
+
+
+def one_line_error(capsys, args, code=2):
+    rc = main(args)
+    err = capsys.readouterr().err
+    assert rc == code, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    return err
+
+
+def test_single_run_prints_steps_and_pose(tri, capsys):
+    src, plan = tri
+    assert main(["run", str(plan), src, "--start-deg", "200"]) == 0
+    out = capsys.readouterr().out
+    assert "align" in out and "oriented in 2 operations" in out and "pose 225 deg" in out
+
+
+def test_single_run_json(tri, capsys):
+    src, plan = tri
+    assert main(["run", str(plan), src, "--start-deg", "45", "--json"]) == 0
+    (trace,) = json.loads(capsys.readouterr().out)["runs"]
+    assert trace["success"] and trace["operations"] == 1
+    assert trace["steps"][0]["action_deg"] is None and trace["final_pose_deg"] == 225.0
+
+
+def test_all_json(tri, capsys):
+    src, plan = tri
+    assert main(["run", str(plan), src, "--all", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["ok"] and report["parts"][0]["starts"] == 9
+
+
+def _corrupt(plan_path, edit):
+    data = json.loads(plan_path.read_text())
+    edit(data)
+    plan_path.write_text(json.dumps(data))
+
+
+def test_corrupted_action_fails_all(tri, capsys):
+    src, plan = tri
+    _corrupt(plan, lambda d: d["root"]["branches"][1]["next"].update(action_deg=0.0))
+    err = one_line_error(capsys, ["run", str(plan), src, "--all"], code=1)
+    assert "the plan failed" in err
+
+
+def test_corrupted_interval_stops_the_run(tri, capsys):
+    src, plan = tri
+    _corrupt(plan, lambda d: d["root"]["branches"][0].update(reading=[0.8, 0.9]))
+    err = one_line_error(capsys, ["run", str(plan), src, "--start-deg", "45"], code=1)
+    assert "no branch" in err
+
+
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        ("{broken", "not valid JSON"),
+        ('{"format": "something-else"}', "not a feederkit plan"),
+        ('{"format": "feederkit-plan", "version": 1}', "conventions"),
+        ("[1, 2]", "not a feederkit plan"),
+    ],
+)
+def test_bad_plan_files(tmp_path, capsys, tri, content, message):
+    src, _ = tri
+    bad = tmp_path / "bad.json"
+    bad.write_text(content)
+    assert message in one_line_error(capsys, ["run", str(bad), src])
+
+
+def test_missing_plan(tmp_path, capsys, tri):
+    src, _ = tri
+    assert "no such plan file" in one_line_error(capsys, ["run", str(tmp_path / "x.json"), src])
+
+
+def test_unknown_part(tmp_path, capsys, tri):
+    _, plan = tri
+    other = tmp_path / "sq.json"
+    other.write_text(json.dumps({"name": "square", "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]}))
+    assert "not one of the plan's parts" in one_line_error(capsys, ["run", str(plan), str(other)])
+    moved = tmp_path / "tri2.json"
+    moved.write_text(json.dumps({"name": "tri", "vertices": TRI, "com": [0.3, 0.3]}))
+    assert "differs from the plan's part" in one_line_error(capsys, ["run", str(plan), str(moved)])
+    assert "no such file" in one_line_error(capsys, ["run", str(plan), str(tmp_path / "none.json")])
+
+
+def test_start_and_all_exclusive(tri, capsys):
+    src, plan = tri
+    one_line_error(capsys, ["run", str(plan), src, "--all", "--start-deg", "3"])
+    one_line_error(capsys, ["run", str(plan), src, "--start-deg", "nan"])
