@@ -1,7 +1,7 @@
 """Run every benchmark script in this folder, one after another, and print their figures.
 
-    python benchmarks/run_all.py            # all
-    python benchmarks/run_all.py planners   # those whose file name contains "planners"
+python benchmarks/run_all.py            # all
+python benchmarks/run_all.py planners   # those whose file name contains "planners"
 """
 
 from __future__ import annotations
@@ -15,7 +15,9 @@ HERE = Path(__file__).resolve().parent
 
 
 def main(argv: list[str]) -> int:
-    scripts = sorted(p for p in HERE.glob("bench_*.py") if not argv or any(a in p.name for a in argv))
+    scripts = sorted(
+        p for p in HERE.glob("bench_*.py") if not argv or any(a in p.name for a in argv)
+    )
     failed = 0
     for script in scripts:
         print(f"=== {script.name}", flush=True)

@@ -95,7 +95,10 @@ class SetAction:
 
 @dataclass(frozen=True)
 class Branch:
-    """States ``mask`` consistent with readings in the closed interval ``[lo, hi]`` (None: sensorless)."""
+    """States ``mask`` consistent with readings in the closed interval ``[lo, hi]``.
+
+    ``lo`` and ``hi`` are None when there is no sensor.
+    """
 
     lo: float | None
     hi: float | None
@@ -121,7 +124,7 @@ def members(mask: int) -> list[int]:
 
 
 def _snap(values: Sequence[float], eps: float) -> list[float]:
-    """Replace values equal within ``eps`` (chained in sorted order) by their cluster's first value."""
+    """Replace values equal within ``eps`` (chained in sorted order) by their cluster's first."""
     order = sorted(range(len(values)), key=lambda i: values[i])
     out = list(values)
     rep = None
@@ -132,7 +135,9 @@ def _snap(values: Sequence[float], eps: float) -> list[float]:
     return out
 
 
-def build_machine(parts: Sequence[PushFunction], sensor: SensorModel | None = None) -> PushAlignMachine:
+def build_machine(
+    parts: Sequence[PushFunction], sensor: SensorModel | None = None
+) -> PushAlignMachine:
     """The machine of one part or a mix (section 8.5): the parts' states side by side.
 
     Diameters equal within a relative 1e-9 of the largest part are made exactly equal, so
@@ -166,10 +171,18 @@ def build_machine(parts: Sequence[PushFunction], sensor: SensorModel | None = No
 
 def successor(machine: PushAlignMachine, state: int, action: float) -> int:
     """Where ``state`` goes under a rotation strictly inside one of its action ranges."""
-    ranges = machine.action_maps[state]
-    a = norm360(action)
-    k = bisect.bisect_right([r.lo for r in ranges], a) - 1
-    return ranges[k].target if k >= 0 else ranges[-1].target
+    los, targets = _lookup(machine)[state]
+    k = bisect.bisect_right(los, norm360(action)) - 1
+    return targets[k]  # k = -1 (before the first start) is the last range, which wraps
+
+
+def _lookup(machine: PushAlignMachine) -> list[tuple[list[float], list[int]]]:
+    """Per state, its range starts and targets (cached on the machine)."""
+    table = machine.__dict__.get("_lookup")
+    if table is None:
+        table = [([r.lo for r in rs], [r.target for r in rs]) for rs in machine.action_maps]
+        machine.__dict__["_lookup"] = table
+    return table
 
 
 def image(machine: PushAlignMachine, mask: int, action: float) -> int:
@@ -210,7 +223,9 @@ def _numpy_table(machine: PushAlignMachine):
 def _cells_sweep(machine: PushAlignMachine, mask: int, idx: list[int]) -> list[list]:
     """The cells ``[lo, hi, image]`` of a set, by a sweep in pure Python."""
     events = _cell_events(machine)
-    evs = sorted((lo, i, t) for i in idx for lo, t in events[i])
+    triples = _cell_triples(machine)
+    evs = [e for i in idx for e in triples[i]]
+    evs.sort()
     eps = ANGLE_EPS
     # Cluster the sorted boundaries exactly as merge_boundaries does.
     reps: list[float] = []
@@ -265,7 +280,7 @@ def _cells_sweep(machine: PushAlignMachine, mask: int, idx: list[int]) -> list[l
 
 
 def _cells_numpy(machine: PushAlignMachine, mask: int, idx: list[int], table) -> list[list] | None:
-    """The same cells as ``_cells_sweep`` with numpy (None: clusters too irregular, use the sweep)."""
+    """The cells of ``_cells_sweep`` by numpy (None: clusters too irregular, use the sweep)."""
     los, tgs = table
     k, r = len(idx), los.shape[1]
     sel = np.array(idx)
@@ -317,6 +332,17 @@ def _cells_numpy(machine: PushAlignMachine, mask: int, idx: list[int], table) ->
             reps[starts].tolist(), his[ends].tolist(), imgs[starts].tolist(), strict=True
         )
     ]
+
+
+def _cell_triples(machine: PushAlignMachine) -> tuple[tuple[tuple[float, int, int], ...], ...]:
+    """Per state ``i``, its action-range starts as ``(lo, i, target)`` (cached on the machine)."""
+    ev = machine.__dict__.get("_triples")
+    if ev is None:
+        ev = tuple(
+            tuple((r.lo, i, r.target) for r in rs) for i, rs in enumerate(machine.action_maps)
+        )
+        machine.__dict__["_triples"] = ev
+    return ev
 
 
 def overlap_ranges(machine: PushAlignMachine, mask: int) -> list[SetAction]:
@@ -378,8 +404,14 @@ def _tolerance_branches(machine: PushAlignMachine, mask: int, e: float) -> list[
     by diameter, so two pointers find them.
     """
     states = machine.states
-    order = sorted(members(mask), key=lambda i: states[i].diameter)
+    order = members(mask)
     ds = [states[i].diameter for i in order]
+    if any(ds[i] > ds[i + 1] for i in range(len(ds) - 1)):
+        order.sort(key=lambda i: states[i].diameter)
+        ds = [states[i].diameter for i in order]
+    prefix = [0]
+    for i in order:
+        prefix.append(prefix[-1] | 1 << i)
     points = sorted({d - e for d in ds} | {d + e for d in ds})
     k = len(ds)
     a = b = 0
@@ -398,10 +430,7 @@ def _tolerance_branches(machine: PushAlignMachine, mask: int, e: float) -> list[
         if last_run == (a, b):
             out[-1][1] = hi
             continue
-        m = 0
-        for i in order[a:b]:
-            m |= 1 << i
-        out.append([lo, hi, m])
+        out.append([lo, hi, prefix[b] ^ prefix[a]])
         last_run = (a, b)
     return [Branch(lo, hi, m) for lo, hi, m in out]
 
@@ -458,7 +487,4 @@ def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:
 
 def is_goal(insep: Sequence[int], mask: int) -> bool:
     """Whether every pair of states in ``mask`` is inseparable: the set is oriented."""
-    for i in members(mask):
-        if mask & ~insep[i] & ~(1 << i):
-            return False
-    return True
+    return all(not mask & ~insep[i] & ~(1 << i) for i in members(mask))

@@ -12,7 +12,6 @@ import json
 import math
 import numbers
 import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +21,7 @@ import shapely
 from shapely.geometry import Polygon
 
 from feederkit.errors import InputError
+from feederkit.jsonio import read_json, write_text_atomic
 
 Point = tuple[float, float]
 
@@ -217,35 +217,7 @@ def outline_to_dict(outline: Outline) -> dict[str, object]:
 
 def load_outline_json(path: str | os.PathLike[str]) -> Outline:
     """Load an outline file; unreadable or malformed files are bad input."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"{p}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: cannot read the file ({exc})") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    return outline_from_dict(data, default_name=p.stem)
-
-
-def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to ``path`` atomically: a temporary file beside it, then a rename."""
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    return outline_from_dict(read_json(path, "file"), default_name=Path(path).stem)
 
 
 def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:

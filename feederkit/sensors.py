@@ -1,4 +1,4 @@
-"""Sensor models: which readings each stable state can produce, and branching by reading (section 5).
+"""Sensor models: the readings each stable state can produce; branching by reading (section 5).
 
 The reading is the part's diameter (width across the belt, mm) after alignment (design.md).
 
@@ -34,7 +34,7 @@ class NoSensor:
 
 @dataclass(frozen=True)
 class ToleranceSensor:
-    """A diameter sensor whose reading lies strictly within ``tolerance`` mm of the true diameter."""
+    """A diameter sensor reading strictly within ``tolerance`` mm of the true diameter."""
 
     tolerance: float
     model: str = "tolerance"
@@ -54,7 +54,7 @@ SensorModel = NoSensor | ToleranceSensor | LedSensor
 
 @dataclass(frozen=True)
 class ReadingBranch:
-    """The states consistent with every reading in the closed interval ``[lo, hi]`` (None: sensorless)."""
+    """The states consistent with each reading in the closed ``[lo, hi]`` (None: sensorless)."""
 
     lo: float | None
     hi: float | None
@@ -108,7 +108,9 @@ def sensor_from_dict(data: object) -> SensorModel:
         if model == "tolerance":
             return make_sensor(tolerance=float(data["tolerance_mm"]))
         if model == "led":
-            return make_sensor(led_pitch=float(data["pitch_mm"]), noise=float(data.get("noise_mm", 0.0)))
+            return make_sensor(
+                led_pitch=float(data["pitch_mm"]), noise=float(data.get("noise_mm", 0.0))
+            )
     except (KeyError, TypeError, ValueError):
         raise InputError(f"the plan's {model!r} sensor lacks its parameters") from None
     raise InputError(f"unknown sensor model {model!r}")
@@ -145,7 +147,9 @@ def can_read_alike(sensor: SensorModel, d1: float, d2: float) -> bool:
     return a[0] <= b[1] and b[0] <= a[1]
 
 
-def indistinguishable_sets(sensor: SensorModel, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+def indistinguishable_sets(
+    sensor: SensorModel, diameters: Sequence[float]
+) -> list[tuple[int, ...]]:
     """Definition 10: connected components of the overlap relation, sorted by diameter."""
     order = sorted(range(len(diameters)), key=lambda i: diameters[i])
     if isinstance(sensor, NoSensor):
@@ -216,7 +220,11 @@ def split_by_reading(
     for a, b, members in cells:
         if not members:
             continue
-        if merged and merged[-1][2] == members and merged[-1][1] >= a - (1 if isinstance(sensor, LedSensor) else 0):
+        if (
+            merged
+            and merged[-1][2] == members
+            and merged[-1][1] >= a - (1 if isinstance(sensor, LedSensor) else 0)
+        ):
             merged[-1][1] = b
         else:
             merged.append([a, b, members])

@@ -10,6 +10,8 @@ from pathlib import Path
 import ezdxf
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import fixtures_cad as fx  # noqa: E402
@@ -347,3 +349,36 @@ def test_minsert_grid_gives_separate_parts(tmp_path):
     doc.saveas(path)
     _, parts = import_parts(path, ImportOptions(all_parts=True))
     assert len(parts) == 3 and all(area(p) == pytest.approx(25.0) for p in parts)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=3, max_size=12, unique=True
+    ),
+    st.floats(0.5, 20.0),
+    st.sampled_from([0.01, 0.05, 0.2]),
+    st.integers(0, 50),
+)
+def test_simplified_hull_properties(corners, radius, tol, shift):
+    # a polygon with rounded corners: corner points plus flattened arcs around each one
+    pts = []
+    for cx, cy in corners:
+        pts += [(cx + x, cy + y) for x, y in arc_points(radius, 0.0, 360.0, 73)]
+    ring = convex_hull(pts)
+    if len(ring) < 3 or shapely.Polygon(ring).area < 1.0:
+        return
+    simple = clean_hull(ring, tol)
+    poly = shapely.Polygon(simple)
+    assert poly.is_valid and poly.exterior.is_ccw and len(simple) <= len(ring)
+    n = len(simple)
+    for i in range(n):  # strictly convex
+        (ax, ay), (bx, by), (cx, cy) = simple[i - 1], simple[i], simple[(i + 1) % n]
+        assert (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0
+    assert shapely.Polygon(ring).exterior.hausdorff_distance(poly.exterior) <= 2 * tol + 1e-9
+    k = shift % len(ring)
+
+    def rounded(points):
+        return {(round(x, 9), round(y, 9)) for x, y in points}
+
+    assert rounded(clean_hull(ring[k:] + ring[:k], tol)) == rounded(simple)

@@ -7,6 +7,7 @@ import math
 import random
 
 import pytest
+from shared import one_line_error
 
 from feederkit.cli.app import main
 
@@ -147,14 +148,6 @@ def test_options_reach_the_plan(tmp_path, capsys):
         tmp_path, capsys, [src, "--sensorless", "--min-margin", "10"], name="m.json"
     )
     assert plan["stats"]["min_margin_deg"] >= 10
-
-
-def one_line_error(capsys, args, code=2):
-    rc = main(args)
-    err = capsys.readouterr().err
-    assert rc == code, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
-    return err
 
 
 @pytest.mark.parametrize(

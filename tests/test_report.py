@@ -10,11 +10,11 @@ from html.parser import HTMLParser
 
 import pytest
 import typer
+from shared import plan_part_entry
 from typer.testing import CliRunner
 
 from feederkit.cli.report import register
 from feederkit.errors import InputError
-from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.reports import read_plan_file, render_report
@@ -25,25 +25,7 @@ NASTY = '<b>&"x'
 
 
 def part_entry(name, vertices, com=None, holes=()):
-    part = make_part(make_outline(name, vertices, holes, com=com))
-    states = [
-        {
-            "id": s.id,
-            "edge": s.edge,
-            "normal_deg": s.normal_deg,
-            "resting_range_deg": list(s.resting_range_deg),
-            "diameter": s.diameter,
-            "pose_deg": s.pose_deg,
-        }
-        for s in push_function(part).states
-    ]
-    return {
-        "name": name,
-        "revision": "A",
-        "com": list(part.com),
-        "hull": [list(p) for p in part.hull],
-        "stable_states": states,
-    }
+    return plan_part_entry(make_part(make_outline(name, vertices, holes, com=com)), revision="A")
 
 
 def result(*entries):

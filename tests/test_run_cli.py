@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from shared import one_line_error
 
 from feederkit.cli.app import main
 
@@ -19,14 +20,6 @@ def tri(tmp_path, capsys):
     assert main(["plan", str(src), "--tolerance", "0.01", "-o", str(plan)]) == 0
     capsys.readouterr()
     return str(src), plan
-
-
-def one_line_error(capsys, args, code=2):
-    rc = main(args)
-    err = capsys.readouterr().err
-    assert rc == code, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
-    return err
 
 
 def test_single_run_prints_steps_and_pose(tri, capsys):

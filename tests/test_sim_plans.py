@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from shared import plan_part_entry as part_entry
 
 from feederkit.angles import norm360
 from feederkit.mechanics.push import PushFunction, push, push_function
@@ -111,28 +112,6 @@ def _margins(node: dict) -> list[float]:
         return []
     own = [node["margin_deg"]] if node.get("margin_deg") is not None else []
     return own + [m for b in node["branches"] for m in _margins(b["next"])]
-
-
-def part_entry(part: Part) -> dict:
-    """The plan file's entry for a part."""
-    pf = push_function(part)
-    return {
-        "name": part.name,
-        "revision": None,
-        "com": list(part.com),
-        "hull": [list(p) for p in part.hull],
-        "stable_states": [
-            {
-                "id": s.id,
-                "edge": s.edge,
-                "normal_deg": s.normal_deg,
-                "resting_range_deg": list(s.resting_range_deg),
-                "diameter": s.diameter,
-                "pose_deg": s.pose_deg,
-            }
-            for s in pf.states
-        ],
-    }
 
 
 def build_plan(part: Part, tolerance: float | None) -> dict:

@@ -6,6 +6,7 @@ Errors are one clear line on stderr, never a traceback.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import sys
 
@@ -39,16 +40,16 @@ COMMAND_MODULES = (
 
 def _register() -> None:
     for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(name)
-        except ModuleNotFoundError as exc:
-            if exc.name == name:
-                continue  # that command group is not built yet
-            raise
-        module.register(app)
+        importlib.import_module(name).register(app)
 
 
 _register()
+
+
+@functools.cache
+def _click_command() -> typer.core.TyperGroup:
+    """Typer's command tree, built once per process (building it costs tens of ms)."""
+    return typer.main.get_command(app)  # type: ignore[return-value]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -57,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     Usage errors (unknown options, missing arguments) exit with 2, as click does.
     """
     try:
-        app(args=argv, prog_name="feederkit")
+        _click_command().main(args=argv, prog_name="feederkit")
     except FeederkitError as exc:
         err_console.print(
             f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True, markup=True

@@ -11,11 +11,11 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.markup import escape
+from rich.progress import TextColumn
 from rich.table import Table
 
 from feederkit.catalog import (
-    CATALOG_ENV,
     DEFAULT_CATALOG,
     SCHEMA_VERSION,
     AddOutcome,
@@ -30,7 +30,14 @@ from feederkit.catalog import (
     remove_part,
     revision_history,
 )
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import (
+    CatalogOpt,
+    JsonOpt,
+    console,
+    err_console,
+    print_json,
+    progress_bar,
+)
 from feederkit.errors import InputError
 from feederkit.importers import (
     DEFAULT_FLATTEN_TOLERANCE,
@@ -48,16 +55,6 @@ catalog_app = typer.Typer(
     no_args_is_help=True,
 )
 
-CatalogOpt = Annotated[
-    Path | None,
-    typer.Option(
-        "--catalog",
-        envvar=CATALOG_ENV,
-        help=f"Catalog file (default ${CATALOG_ENV}, else ./{DEFAULT_CATALOG}).",
-        show_envvar=True,
-    ),
-]
-JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
 UnitsOpt = Annotated[
     str | None,
     typer.Option(
@@ -147,12 +144,26 @@ def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
 def _warn(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
     for o in outcomes:
         for w in o.warnings:
-            err_console.print(f"[yellow]warning:[/] {o.name}: {w}", highlight=False, soft_wrap=True)
+            err_console.print(
+                f"[yellow]warning:[/] {escape(o.name)}: {escape(w)}",
+                highlight=False,
+                soft_wrap=True,
+            )
 
 
-def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
-    """The import summary: a rich table, or plain columns when it is long (rich is slow there)."""
-    headers = ("part", "revision", "status", "orientable", "warnings", "source")
+def _relative(path: str, root: Path) -> str:
+    try:
+        return str(Path(path).relative_to(root.resolve()))
+    except ValueError:
+        return path
+
+
+def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Path) -> None:
+    """The import summary: a rich table, or plain columns when it is long (rich is slow there).
+
+    Sources are shown relative to the imported folder ``root``.
+    """
+    headers = ("part", "rev", "status", "orientable", "warnings", "file")
     rows = [
         (
             o.name,
@@ -160,7 +171,7 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
             o.status,
             "yes" if o.orientable else "no",
             str(len(o.warnings)),
-            o.source_path,
+            _relative(o.source_path, root),
         )
         for o in outcomes
     ]
@@ -171,7 +182,8 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
     for col in headers:
         table.add_column(col, overflow="fold")
     for row in rows:
-        table.add_row(*row[:3], row[3] if row[3] == "yes" else "[red]no[/]", *row[4:])
+        cells = [escape(c) for c in row]
+        table.add_row(*cells[:3], cells[3] if row[3] == "yes" else "[red]no[/]", *cells[4:])
     console.print(table)
 
 
@@ -185,7 +197,11 @@ def cmd_init(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
         print_json({"catalog": str(path), "created": not existed, "schema_version": SCHEMA_VERSION})
     else:
         verb = "ready" if existed else "created"
-        console.print(f"catalog {path} {verb} (schema version {SCHEMA_VERSION})", highlight=False)
+        console.print(
+            f"catalog {path} {verb} (schema version {SCHEMA_VERSION})",
+            highlight=False,
+            markup=False,
+        )
 
 
 def cmd_add(
@@ -215,7 +231,9 @@ def cmd_add(
         print_json([_outcome_dict(o) for o in outcomes])
         return
     for o in outcomes:
-        console.print(f"{o.name}: revision {o.revision} ({o.status})", highlight=False)
+        console.print(
+            f"{o.name}: revision {o.revision} ({o.status})", highlight=False, markup=False
+        )
 
 
 def cmd_import(
@@ -238,16 +256,8 @@ def cmd_import(
     opts = import_options(
         units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
     )
-    columns = (
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        TextColumn("{task.fields[item]}"),
-    )
-    with Progress(
-        *columns, console=err_console, transient=True, disable=not err_console.is_terminal
-    ) as bar:
+    item_column = TextColumn("{task.fields[item]}")
+    with progress_bar(item_column, disable=not err_console.is_terminal) as bar:
         tasks: dict[str, Any] = {}
 
         def progress(phase: str, done: int, total: int, item: str) -> None:
@@ -265,7 +275,7 @@ def cmd_import(
             {"parts": [_outcome_dict(o) for o in result.outcomes], "ignored": list(result.ignored)}
         )
         return
-    _print_summary(result.outcomes)
+    _print_summary(result.outcomes, directory)
     counts = {
         s: sum(o.status == s for o in result.outcomes) for s in ("added", "revised", "unchanged")
     }
@@ -397,9 +407,9 @@ def cmd_show(
     if json_out:
         print_json(data)
         return
-    table = Table(show_header=False, title=f"{rev.name} revision {rev.revision}")
+    table = Table(show_header=False, title=f"{escape(rev.name)} revision {rev.revision}")
     table.add_column("field")
-    table.add_column("value")
+    table.add_column("value", overflow="fold")
     pose = rev.mesh_pose
     rows = [
         ("source", f"{rev.source_path} ({rev.source_kind}, {rev.source_units})"),
@@ -424,7 +434,7 @@ def cmd_show(
     ]
     rows += [("warning", w) for w in rev.warnings]
     for k, v in rows:
-        table.add_row(k, v)
+        table.add_row(k, escape(v))
     console.print(table)
 
 
@@ -442,7 +452,7 @@ def cmd_remove(
         print_json({"removed": name, "changeovers_removed": removed})
         return
     extra = f" and changeover(s) {', '.join(removed)}" if removed else ""
-    console.print(f"removed {name}{extra}", highlight=False)
+    console.print(f"removed {name}{extra}", highlight=False, markup=False)
 
 
 def cmd_export(
@@ -461,7 +471,9 @@ def cmd_export(
     if json_out:
         print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
         return
-    console.print(f"wrote {output} ({rev.name} revision {rev.revision})", highlight=False)
+    console.print(
+        f"wrote {output} ({rev.name} revision {rev.revision})", highlight=False, markup=False
+    )
 
 
 catalog_app.command("init")(cmd_init)

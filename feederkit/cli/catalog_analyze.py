@@ -7,16 +7,24 @@ The lead registers :func:`analyze_command` as ``analyze`` in the ``catalog`` gro
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
 
-import typer
 from rich.markup import escape
-from rich.progress import Progress
 from rich.table import Table
 
-from feederkit.catalog import CATALOG_ENV, default_catalog_path, list_parts, open_catalog
+from feederkit.catalog import default_catalog_path, list_parts, open_catalog
 from feederkit.catalog import get_part as catalog_get_part
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import (
+    CatalogOpt,
+    JsonOpt,
+    LedPitchOpt,
+    NoiseOpt,
+    SensorlessOpt,
+    ToleranceOpt,
+    console,
+    err_console,
+    print_json,
+    progress_bar,
+)
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
@@ -39,7 +47,7 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str]]:
     try:
         summaries = list_parts(conn)
         pfs, skipped = [], []
-        with Progress(console=err_console, transient=True) as progress:
+        with progress_bar() as progress:
             task = progress.add_task("reading parts", total=len(summaries))
             for s in summaries:
                 progress.advance(task)
@@ -57,31 +65,12 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str]]:
 
 
 def analyze_command(
-    sensorless: Annotated[
-        bool, typer.Option("--sensorless", help="No sensor: classes only (the default).")
-    ] = False,
-    tolerance: Annotated[
-        float | None,
-        typer.Option("--tolerance", help="Diameter sensor: readings strictly within MM of d."),
-    ] = None,
-    led_pitch: Annotated[
-        float | None, typer.Option("--led-pitch", help="LED array with beams every MM.")
-    ] = None,
-    noise: Annotated[
-        float | None, typer.Option("--noise", help="The LED array's alignment noise (mm).")
-    ] = None,
-    json_out: Annotated[
-        bool, typer.Option("--json", help="Machine-readable output on stdout.")
-    ] = False,
-    catalog: Annotated[
-        Path | None,
-        typer.Option(
-            "--catalog",
-            envvar=CATALOG_ENV,
-            help="Catalog file (default $FEEDERKIT_CATALOG, else ./feederkit.db).",
-            show_envvar=True,
-        ),
-    ] = None,
+    sensorless: SensorlessOpt = False,
+    tolerance: ToleranceOpt = None,
+    led_pitch: LedPitchOpt = None,
+    noise: NoiseOpt = None,
+    json_out: JsonOpt = False,
+    catalog: CatalogOpt = None,
 ) -> None:
     """Behaviour classes (same push function, same push-diameter function: section 8.3) of the
     catalog's parts, and with a sensor every pair of parts no plan can tell apart, with its

@@ -8,25 +8,38 @@ them (Corollary 7), is still written and stored, and its results list each candi
 from __future__ import annotations
 
 import re
-from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.catalog import (
-    CATALOG_ENV,
-    get_changeover,
-    list_changeovers,
-)
+from feederkit.catalog import get_changeover, list_changeovers
 from feederkit.cli.catalog_analyze import catalog_file
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import (
+    CatalogOpt,
+    GroupingOpt,
+    JsonOpt,
+    LedPitchOpt,
+    MinMarginOpt,
+    NoiseOpt,
+    ObjectiveOpt,
+    PlanOutputOpt,
+    ReportOpt,
+    SensorlessOpt,
+    TimeLimitOpt,
+    ToleranceOpt,
+    check_planning_options,
+    console,
+    err_console,
+    print_json,
+)
+from feederkit.cli.plan import print_written, write_plan_and_report
 from feederkit.errors import CheckFailed, InputError
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import compile_changeover
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.fileformat import validate_plan, write_plan, write_text_checked
+from feederkit.plans.fileformat import validate_plan
 from feederkit.plans.render import plan_tree, sensor_text, stats_table
 from feederkit.sensors import make_sensor, sensor_to_dict
 
@@ -35,17 +48,6 @@ changeover_app = typer.Typer(
     help="Changeovers: one verified plan that orients and recognizes every part of a mix.",
     no_args_is_help=True,
 )
-
-CatalogOpt = Annotated[
-    Path | None,
-    typer.Option(
-        "--catalog",
-        envvar=CATALOG_ENV,
-        help="Catalog file (default $FEEDERKIT_CATALOG, else ./feederkit.db).",
-        show_envvar=True,
-    ),
-]
-JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
 
 _MEMBER_RE = re.compile(r"^(?P<name>.+)@(?P<rev>\d+)$")
 
@@ -91,38 +93,16 @@ def compile_command(
         str,
         typer.Option("--mix", help="Catalog parts, comma-separated: A,B,C (NAME@REV pins one)."),
     ],
-    sensorless: Annotated[
-        bool, typer.Option("--sensorless", help="No sensor (the default).")
-    ] = False,
-    tolerance: Annotated[
-        float | None,
-        typer.Option("--tolerance", help="Diameter sensor: readings strictly within MM of d."),
-    ] = None,
-    led_pitch: Annotated[
-        float | None, typer.Option("--led-pitch", help="LED array with beams every MM.")
-    ] = None,
-    noise: Annotated[
-        float | None, typer.Option("--noise", help="The LED array's alignment noise (mm).")
-    ] = None,
-    objective: Annotated[
-        str, typer.Option("--objective", help="worst (default) or expected number of operations.")
-    ] = "worst",
-    min_margin: Annotated[
-        float, typer.Option("--min-margin", help="Use only rotations keeping this margin (deg).")
-    ] = 0.0,
-    time_limit: Annotated[
-        float | None,
-        typer.Option("--time-limit", help="Seconds; then the best plan found, optimal: false."),
-    ] = None,
-    grouping: Annotated[
-        str, typer.Option("--grouping", help="exact (default) or components (the paper's rule).")
-    ] = "exact",
-    output: Annotated[
-        Path | None, typer.Option("-o", "--output", help="Also write the plan file here (atomic).")
-    ] = None,
-    report: Annotated[
-        Path | None, typer.Option("--report", help="Also write the HTML report here.")
-    ] = None,
+    sensorless: SensorlessOpt = False,
+    tolerance: ToleranceOpt = None,
+    led_pitch: LedPitchOpt = None,
+    noise: NoiseOpt = None,
+    objective: ObjectiveOpt = "worst",
+    min_margin: MinMarginOpt = 0.0,
+    time_limit: TimeLimitOpt = None,
+    grouping: GroupingOpt = "exact",
+    output: PlanOutputOpt = None,
+    report: ReportOpt = None,
     replace: Annotated[
         bool, typer.Option("--replace", help="Replace a stored changeover of the same name.")
     ] = False,
@@ -137,12 +117,7 @@ def compile_command(
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    if objective not in ("worst", "expected"):
-        raise InputError(f"--objective must be worst or expected, got {objective!r}")
-    if grouping not in ("exact", "components"):
-        raise InputError(f"--grouping must be exact or components, got {grouping!r}")
-    if not 0.0 <= min_margin < 180.0:
-        raise InputError(f"--min-margin must be at least 0 and below 180 degrees, got {min_margin}")
+    check_planning_options(objective, grouping, min_margin, time_limit)
     path = catalog_file(catalog)
     with err_console.status("planning and verifying ..."):
         compiled = compile_changeover(
@@ -156,25 +131,15 @@ def compile_command(
             time_limit=time_limit,
             replace=replace,
         )
+    for warning in compiled.warnings:
+        err_console.print(f"warning: {warning}", highlight=False, markup=False)
     plan, witnesses, pfs, revisions = (
         compiled.plan,
         list(compiled.witnesses),
         list(compiled.parts),
         list(compiled.revisions),
     )
-    html = None
-    if report is not None:
-        from feederkit.reports import render_report
-
-        html = render_report(
-            plan,
-            unrecognizable=[w.to_dict() for w in witnesses],
-            outlines={pf.part.name: pf.part.outline for pf in pfs},
-        )
-    if output is not None:
-        write_plan(output, plan)
-    if report is not None:
-        write_text_checked(report, html)
+    write_plan_and_report(plan, pfs, witnesses, output, report)
     if json_out:
         print_json(
             {
@@ -196,9 +161,7 @@ def compile_command(
         if witnesses:
             console.print(_pairs_table(witnesses, pfs))
         console.print(f"stored changeover {name!r} in {path}", highlight=False, markup=False)
-        for p, what in ((output, "plan"), (report, "report")):
-            if p is not None:
-                console.print(f"wrote the {what} to {p}", highlight=False, markup=False)
+        print_written(output, report)
     lumped = compiled.lumped
     if witnesses or lumped:
         named = "; ".join(f"{w.part_a} & {w.part_b} ({w.reason})" for w in witnesses)

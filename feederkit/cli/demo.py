@@ -17,17 +17,17 @@ from typing import Annotated, Any
 import typer
 from rich.box import SIMPLE_HEAD
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 from rich.table import Table
 
 import feederkit
 from feederkit.catalog import get_part, import_directory, list_parts, open_catalog
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import console, err_console, print_json, progress_bar
+from feederkit.cli.plan import report_html
 from feederkit.errors import InputError
+from feederkit.jsonio import write_text_atomic
 from feederkit.mechanics.analysis import analyze_part
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import CompiledChangeover, compile_changeover
-from feederkit.outline import write_text_atomic
 from feederkit.plans.fileformat import write_plan
 from feederkit.plans.make import make_plan
 from feederkit.plans.render import plan_tree, stats_table
@@ -70,13 +70,7 @@ def _margin(stats: dict[str, Any]) -> str:
 
 
 def _import(catalog: Path, source_dir: Path) -> None:
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        console=err_console,
-        transient=True,
-    ) as bar:
+    with progress_bar() as bar:
         task = bar.add_task("importing catalog/", total=None)
 
         def progress(phase: str, done: int, total: int, item: str) -> None:
@@ -132,13 +126,7 @@ def _analysis_table(
 
 def _plan_parts(pfs: list[PushFunction], percent: float, out: Path) -> list[DemoPlan]:
     plans = []
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        console=err_console,
-        transient=True,
-    ) as bar:
+    with progress_bar() as bar:
         task = bar.add_task("planning", total=len(pfs))
         for pf in pfs:
             bar.update(task, description=f"planning {pf.part.name}")
@@ -202,13 +190,7 @@ def _compile(
 
 
 def _write_report(compiled: CompiledChangeover, path: Path) -> None:
-    from feederkit.reports import render_report
-
-    html = render_report(
-        compiled.plan,
-        unrecognizable=[w.to_dict() for w in compiled.witnesses],
-        outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
-    )
+    html = report_html(compiled.plan, list(compiled.parts), list(compiled.witnesses))
     write_text_atomic(path, html)
 
 
@@ -249,9 +231,7 @@ def demo_command(
         _import(catalog, source_dir)
         summaries = list_parts(catalog)
         skipped = [s.name for s in summaries if not s.orientable]
-        pfs = [
-            analyze_part(get_part(catalog, s.name)).push for s in summaries if s.orientable
-        ]
+        pfs = [analyze_part(get_part(catalog, s.name)).push for s in summaries if s.orientable]
         head = f"[bold]feederkit demo[/]: {len(summaries)} parts from {escape(str(source_dir))}"
         if skipped:
             head += f"; not orientable by pushing: {escape(', '.join(skipped))}"
@@ -281,6 +261,8 @@ def demo_command(
             if name == "fig27-triangle-octagon":
                 say.print(plan_tree(compiled.plan))
             say.print(stats_table(compiled.plan, compiled.made.report))
+            for warning in compiled.warnings:
+                say.print(f"  warning: {escape(warning)}", highlight=False)
             for w in compiled.witnesses:
                 say.print(
                     f"  cannot be told apart: {escape(w.part_a)} & {escape(w.part_b)}: "

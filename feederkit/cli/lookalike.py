@@ -15,10 +15,11 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from feederkit.cli.common import console, err_console
+from feederkit.cli.common import CatalogOpt, console, err_console
 from feederkit.errors import InputError
+from feederkit.jsonio import write_text_atomic
 from feederkit.mix.lookalike import build_lookalike
-from feederkit.outline import outline_to_dict, write_text_atomic
+from feederkit.outline import outline_to_dict
 from feederkit.sources import load_part
 
 
@@ -32,9 +33,7 @@ def lookalike_command(
     ] = None,
     name: Annotated[str | None, typer.Option("--name", help="Name of the new part.")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the construction's choices.")] = 0,
-    catalog: Annotated[
-        str | None, typer.Option("--catalog", help="Parts catalog for catalog part names.")
-    ] = None,
+    catalog: CatalogOpt = None,
 ) -> None:
     """A non-similar part with the same push function (Theorem 4) or the same push-diameter
     function (Theorem 6), checked numerically before it is written."""

@@ -14,8 +14,22 @@ from rich import box
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.cli.common import console, err_console, print_json
-from feederkit.mechanics.analysis import PartAnalysis, analysis_to_dict, analyze_part
+from feederkit.cli.common import (
+    CatalogOpt,
+    JsonOpt,
+    LedPitchOpt,
+    NoiseOpt,
+    ToleranceOpt,
+    console,
+    err_console,
+    print_json,
+)
+from feederkit.mechanics.analysis import (
+    PartAnalysis,
+    analysis_to_dict,
+    analyze_part,
+    fragile_warning,
+)
 from feederkit.sensors import make_sensor
 from feederkit.sources import load_part
 
@@ -129,20 +143,11 @@ def analyze_command(
     sensorless: Annotated[
         bool, typer.Option("--sensorless", help="Classify for no sensor (Fig. 14 classes 7, 8).")
     ] = False,
-    tolerance: Annotated[
-        float | None,
-        typer.Option("--tolerance", help="Sensor tolerance (mm): a reading lies within it."),
-    ] = None,
-    led_pitch: Annotated[
-        float | None, typer.Option("--led-pitch", help="LED array beam pitch (mm).")
-    ] = None,
-    noise: Annotated[
-        float | None, typer.Option("--noise", help="Alignment noise of the LED reading (mm).")
-    ] = None,
-    catalog: Annotated[
-        str | None, typer.Option("--catalog", help="Parts catalog for catalog part names.")
-    ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    tolerance: ToleranceOpt = None,
+    led_pitch: LedPitchOpt = None,
+    noise: NoiseOpt = None,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
 ) -> None:
     """Stable states, resting ranges, diameters, symmetry and (with a sensor) the Fig. 14 class."""
     given = sensorless or tolerance is not None or led_pitch is not None or noise is not None
@@ -154,11 +159,11 @@ def analyze_command(
     parts = [load_part(src, com=com, catalog=catalog) for src in sources]
     analyses = [analyze_part(p, sensor) for p in parts]
     for a in analyses:
-        warning = near_metastable_warning(a)
-        if warning is not None:
-            err_console.print(
-                f"[yellow]warning:[/] {escape(warning)}", highlight=False, soft_wrap=True
-            )
+        for warning in (near_metastable_warning(a), fragile_warning(a.push)):
+            if warning is not None:
+                err_console.print(
+                    f"[yellow]warning:[/] {escape(warning)}", highlight=False, soft_wrap=True
+                )
     if json_out:
         print_json([analysis_to_dict(a) for a in analyses])
         return

@@ -12,23 +12,38 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import (
+    CatalogOpt,
+    GroupingOpt,
+    LedPitchOpt,
+    MinMarginOpt,
+    NoiseOpt,
+    ObjectiveOpt,
+    PlanOutputOpt,
+    ReportOpt,
+    SensorlessOpt,
+    TimeLimitOpt,
+    ToleranceOpt,
+    check_planning_options,
+    console,
+    err_console,
+    print_json,
+)
 from feederkit.errors import CheckFailed, InputError
+from feederkit.jsonio import write_text_atomic
+from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
-from feederkit.plans.fileformat import write_plan, write_text_checked
+from feederkit.plans.fileformat import write_plan
 from feederkit.plans.make import make_plan
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.render import plan_tree, sensor_text, stats_table
 from feederkit.sensors import make_sensor
 from feederkit.sources import load_part_with_warnings
 
-OBJECTIVES = ("worst", "expected")
-GROUPINGS = ("exact", "components")
 
-
-def _load(sources: list[str], catalog: str | None) -> tuple[list[PushFunction], list[str]]:
-    """The parts' push functions and the imports' warnings; a disk-like part is refused."""
+def _load(sources: list[str], catalog: Path | None) -> tuple[list[PushFunction], list[str]]:
+    """The parts' push functions and warnings (import, fragile states); disk-like parts refused."""
     pfs, warnings = [], []
     for source in sources:
         loaded = load_part_with_warnings(source, catalog=catalog)
@@ -36,22 +51,14 @@ def _load(sources: list[str], catalog: str | None) -> tuple[list[PushFunction], 
             raise InputError(f"{source}: not orientable by pushing: {loaded.orientability.reason}")
         warnings += [f"{source}: {w}" for w in loaded.warnings]
         pfs.append(push_function(loaded.part))
+        fragile = fragile_warning(pfs[-1])
+        if fragile is not None:
+            warnings.append(fragile)
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:
             raise InputError(f"two SOURCEs are both the part {name!r}: a mix names each part once")
     return pfs, warnings
-
-
-def _check_options(objective: str, grouping: str, min_margin: float, time_limit: float | None):
-    if objective not in OBJECTIVES:
-        raise InputError(f"--objective must be worst or expected, got {objective!r}")
-    if grouping not in GROUPINGS:
-        raise InputError(f"--grouping must be exact or components, got {grouping!r}")
-    if not 0.0 <= min_margin < 180.0:
-        raise InputError(f"--min-margin must be at least 0 and below 180 degrees, got {min_margin}")
-    if time_limit is not None and not time_limit > 0.0:
-        raise InputError(f"--time-limit must be a positive number of seconds, got {time_limit}")
 
 
 def _pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -> str:
@@ -72,9 +79,7 @@ def _pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) 
     return msg
 
 
-def _report_html(
-    plan: dict[str, Any], pfs: list[PushFunction], witnesses: list[PairWitness]
-) -> str:
+def report_html(plan: dict[str, Any], pfs: list[PushFunction], witnesses: list[PairWitness]) -> str:
     """The HTML report (another module's, imported only when asked for)."""
     from feederkit.reports import render_report
 
@@ -83,6 +88,29 @@ def _report_html(
         unrecognizable=[w.to_dict() for w in witnesses],
         outlines={pf.part.name: pf.part.outline for pf in pfs},
     )
+
+
+def write_plan_and_report(
+    plan: dict[str, Any],
+    pfs: list[PushFunction],
+    witnesses: list[PairWitness],
+    output: Path | None,
+    report: Path | None,
+) -> None:
+    """Write the plan file and the HTML report where asked (both atomic; the report is
+    rendered first, so a report that cannot be made leaves no plan file behind)."""
+    html = None if report is None else report_html(plan, pfs, witnesses)
+    if output is not None:
+        write_plan(output, plan)
+    if report is not None and html is not None:
+        write_text_atomic(report, html)
+
+
+def print_written(output: Path | None, report: Path | None) -> None:
+    """Say which files were written."""
+    for path, what in ((output, "plan"), (report, "report")):
+        if path is not None:
+            console.print(f"wrote the {what} to {path}", highlight=False, markup=False)
 
 
 def _header(plan: dict[str, Any], sensor_given: bool) -> str:
@@ -105,69 +133,20 @@ def plan_command(
             metavar="SOURCE", help="Outline or CAD files, or catalog names; several: a mix."
         ),
     ],
-    sensorless: Annotated[
-        bool, typer.Option("--sensorless", help="No sensor (the default when none is given).")
-    ] = False,
-    tolerance: Annotated[
-        float | None,
-        typer.Option(
-            "--tolerance", metavar="MM", help="Diameter sensor: readings strictly within MM of d."
-        ),
-    ] = None,
-    led_pitch: Annotated[
-        float | None,
-        typer.Option("--led-pitch", metavar="MM", help="LED array with beams every MM."),
-    ] = None,
-    noise: Annotated[
-        float | None,
-        typer.Option("--noise", metavar="MM", help="The LED array's alignment noise (mm)."),
-    ] = None,
-    objective: Annotated[
-        str,
-        typer.Option(
-            "--objective",
-            metavar="worst|expected",
-            help="worst: fewest operations in the worst case; "
-            "expected: fewest on average (uniform start).",
-        ),
-    ] = "worst",
-    min_margin: Annotated[
-        float,
-        typer.Option(
-            "--min-margin", metavar="DEG", help="Use only rotations keeping this margin (deg)."
-        ),
-    ] = 0.0,
-    time_limit: Annotated[
-        float | None,
-        typer.Option(
-            "--time-limit", metavar="S", help="Seconds; then the best plan found, optimal: false."
-        ),
-    ] = None,
-    grouping: Annotated[
-        str,
-        typer.Option(
-            "--grouping",
-            metavar="exact|components",
-            help="exact (default) or components (the paper's rule).",
-        ),
-    ] = "exact",
-    output: Annotated[
-        Path | None,
-        typer.Option(
-            "-o", "--output", metavar="PLAN.json", help="Write the plan file here (atomic)."
-        ),
-    ] = None,
+    sensorless: SensorlessOpt = False,
+    tolerance: ToleranceOpt = None,
+    led_pitch: LedPitchOpt = None,
+    noise: NoiseOpt = None,
+    objective: ObjectiveOpt = "worst",
+    min_margin: MinMarginOpt = 0.0,
+    time_limit: TimeLimitOpt = None,
+    grouping: GroupingOpt = "exact",
+    output: PlanOutputOpt = None,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the plan file's JSON on stdout.")
     ] = False,
-    report: Annotated[
-        Path | None,
-        typer.Option("--report", metavar="REPORT.html", help="Also write the HTML report here."),
-    ] = None,
-    catalog: Annotated[
-        str | None,
-        typer.Option("--catalog", metavar="DB", help="The parts catalog for catalog names."),
-    ] = None,
+    report: ReportOpt = None,
+    catalog: CatalogOpt = None,
 ) -> None:
     """Plan the shortest conditional sequence of push-align operations that orients the part(s).
 
@@ -178,7 +157,7 @@ def plan_command(
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    _check_options(objective, grouping, min_margin, time_limit)
+    check_planning_options(objective, grouping, min_margin, time_limit)
     pfs, warnings = _load(sources, catalog)
     for w in warnings:
         err_console.print(f"warning: {w}", highlight=False, markup=False)
@@ -193,11 +172,7 @@ def plan_command(
         )
         witnesses = unrecognizable_pairs(pfs, sensor) if len(pfs) > 1 else []
     plan = made.plan
-    html = None if report is None else _report_html(plan, pfs, witnesses)
-    if output is not None:
-        write_plan(output, plan)
-    if report is not None and html is not None:
-        write_text_checked(report, html)
+    write_plan_and_report(plan, pfs, witnesses, output, report)
     if json_out:
         print_json(plan)
     else:
@@ -205,9 +180,7 @@ def plan_command(
         console.print(_header(plan, sensor_given), highlight=False)
         console.print(plan_tree(plan))
         console.print(stats_table(plan, made.report))
-        for path, what in ((output, "plan"), (report, "report")):
-            if path is not None:
-                console.print(f"wrote the {what} to {path}", highlight=False, markup=False)
+        print_written(output, report)
     lumped = leaf_part_pairs(plan)
     if witnesses or lumped:
         raise CheckFailed(_pairs_message(witnesses, lumped))

@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from feederkit.cli.common import console, print_json
+from feederkit.cli.common import CatalogOpt, JsonOpt, console, print_json
 from feederkit.errors import CheckFailed, InputError
 from feederkit.plans.execute import execute, kinematic_model
 from feederkit.plans.fileformat import read_plan
@@ -43,11 +43,8 @@ def run_command(
         bool,
         typer.Option("--all", help="Every stable start, every reading extreme, every branch."),
     ] = False,
-    json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
-    catalog: Annotated[
-        str | None,
-        typer.Option("--catalog", metavar="DB", help="The parts catalog for catalog names."),
-    ] = None,
+    json_out: JsonOpt = False,
+    catalog: CatalogOpt = None,
 ) -> None:
     """Execute a plan for the given part(s): each step's rotation, reading and branch, the pose."""
     if start_deg is not None and all_starts:

@@ -103,9 +103,7 @@ def explode(
         eff = layer if (own == "0" and layer) else own
         if kind == "INSERT":
             if depth >= MAX_BLOCK_DEPTH:
-                raise InputError(
-                    f"block references nested deeper than {MAX_BLOCK_DEPTH}"
-                )
+                raise InputError(f"block references nested deeper than {MAX_BLOCK_DEPTH}")
             try:
                 subs = (
                     list(entity.multi_insert())

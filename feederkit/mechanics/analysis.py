@@ -38,6 +38,36 @@ class NearMetastable:
     margin_deg: float
 
 
+FRAGILE_BARRIER_REL = 1e-3
+"""A stable state whose barrier is below this fraction of the part's size is fragile."""
+
+
+def fragile_states(pf: PushFunction, rel: float = FRAGILE_BARRIER_REL) -> tuple[int, ...]:
+    """Stable states the part leaves for a neighbour at the slightest disturbance.
+
+    A state's barrier (``StableState.barrier_mm``) is how far the radius function rises
+    before the part tips out of it. Below ``rel`` times the part's size (0.06 mm on a 60 mm
+    part) the kinematic model's state is real but a belt's vibration, a pick-up's offset or
+    the flattened facets of a CAD arc decide where the part actually rests; plans that rely
+    on such states deserve a physics check (``feederkit simulate``).
+    """
+    limit = rel * pf.part.size
+    return tuple(s.id for s in pf.states if s.barrier_mm < limit)
+
+
+def fragile_warning(pf: PushFunction) -> str | None:
+    """One line naming a part's fragile states, or None when it has none."""
+    ids = fragile_states(pf)
+    if not ids:
+        return None
+    limit = FRAGILE_BARRIER_REL * pf.part.size
+    named = ", ".join(str(i) for i in ids[:8]) + (f" (+{len(ids) - 8})" if len(ids) > 8 else "")
+    return (
+        f"{pf.part.name}: fragile states {named} (barrier below {limit:.3g} mm): the part may "
+        "settle on a neighbour; check the plan with feederkit simulate"
+    )
+
+
 @dataclass(frozen=True)
 class PartAnalysis:
     """A part with its push function, symmetry, and (when a sensor is given) its class."""
@@ -117,6 +147,7 @@ def analysis_to_dict(a: PartAnalysis) -> dict[str, object]:
     out["divergent_deg"] = list(pf.divergent_deg)
     out["resting_width_deg"] = [s.resting_range_deg[1] - s.resting_range_deg[0] for s in pf.states]
     out["barrier_mm"] = [s.barrier_mm for s in pf.states]
+    out["fragile_states"] = list(fragile_states(pf))
     out["edge_normals_deg"] = edge_normals(part.hull)
     out["edge_kinds"] = list(pf.edge_kinds)
     out["edge_margin_deg"] = list(pf.edge_margin_deg)

@@ -17,6 +17,7 @@ from feederkit.catalog import (
     save_changeover,
 )
 from feederkit.errors import InputError
+from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.plans.fileformat import plan_json
@@ -39,6 +40,11 @@ class CompiledChangeover:
     def plan(self) -> dict[str, Any]:
         """The plan file's object."""
         return self.made.plan
+
+    @property
+    def warnings(self) -> list[str]:
+        """One line per part with fragile states (the plan may rely on them)."""
+        return [w for pf in self.parts if (w := fragile_warning(pf)) is not None]
 
     @property
     def lumped(self) -> list[tuple[str, str]]:

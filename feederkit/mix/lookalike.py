@@ -130,10 +130,10 @@ class _Splice:
     ft: float | None  # None: cut the corner by one edge
 
 
-def _splice_points(
-    hull: Sequence[Point], com: Point, sp: _Splice, t_abs: float | None = None
-) -> list[np.ndarray]:
-    """The points replacing hull vertex ``sp.vertex``: Q_i, (T,) Q_j."""
+def _corner(
+    hull: Sequence[Point], com: Point, sp: _Splice
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """Vertex V, C, Q_i and Q_j of a splice, and the largest T parameter Theorem 4 allows."""
     n = len(hull)
     v, ei, ej, c = (
         _v(hull[sp.vertex]),
@@ -145,28 +145,25 @@ def _splice_points(
     uj = (ej - v) / np.hypot(*(ej - v))
     qi = v + sp.fi * _edge_limit(v, ei, c) * ui
     qj = v + sp.fj * _edge_limit(v, ej, c) * uj
+    t_max = min(_t_perp(v, qi, c), _t_perp(v, qj, c), _t_chord(v, qi, qj, c), 1.0)
+    return v, c, qi, qj, t_max
+
+
+def _splice_points(
+    hull: Sequence[Point], com: Point, sp: _Splice, t_abs: float | None = None
+) -> list[np.ndarray]:
+    """The points replacing hull vertex ``sp.vertex``: Q_i, (T,) Q_j."""
+    v, c, qi, qj, t_max = _corner(hull, com, sp)
     if sp.ft is None and t_abs is None:
         return [qi, qj]
     if t_abs is None:
-        t_max = min(_t_perp(v, qi, c), _t_perp(v, qj, c), _t_chord(v, qi, qj, c), 1.0)
         t_abs = sp.ft * t_max
     return [qi, v + t_abs * (c - v), qj]
 
 
 def _t_limit(hull: Sequence[Point], com: Point, sp: _Splice) -> float:
     """The largest T parameter Theorem 4 allows at this vertex for these Q fractions."""
-    n = len(hull)
-    v, ei, ej, c = (
-        _v(hull[sp.vertex]),
-        _v(hull[sp.vertex - 1]),
-        _v(hull[(sp.vertex + 1) % n]),
-        _v(com),
-    )
-    ui = (ei - v) / np.hypot(*(ei - v))
-    uj = (ej - v) / np.hypot(*(ej - v))
-    qi = v + sp.fi * _edge_limit(v, ei, c) * ui
-    qj = v + sp.fj * _edge_limit(v, ej, c) * uj
-    return min(_t_perp(v, qi, c), _t_perp(v, qj, c), _t_chord(v, qi, qj, c), 1.0)
+    return _corner(hull, com, sp)[4]
 
 
 def _apply(

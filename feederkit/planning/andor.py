@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 
-from feederkit.planning.problem import Problem
+from feederkit.planning.problem import Act, Problem
 
 
 class Timeout(Exception):
@@ -19,7 +19,7 @@ class Timeout(Exception):
 
 
 class Deadline:
-    """A wall-clock limit checked every few hundred search nodes."""
+    """A wall-clock limit checked every few search nodes."""
 
     def __init__(self, seconds: float | None) -> None:
         self.end = None if seconds is None else time.perf_counter() + seconds
@@ -30,7 +30,7 @@ class Deadline:
         if self.end is None:
             return
         self._count += 1
-        if self._count & 255 == 0 and time.perf_counter() > self.end:
+        if self._count & 7 == 0 and time.perf_counter() > self.end:
             raise Timeout
 
     @property
@@ -40,12 +40,17 @@ class Deadline:
 
 
 class WorstCase:
-    """Exact minimum worst-case lengths of sets, memoised (``lb``: proven lower bounds)."""
+    """Exact minimum worst-case lengths of sets, memoised.
+
+    ``lb`` and ``ub`` are proven bounds per set; ``choice`` keeps, per set, the action that
+    first proved the smallest bound (with that bound), so some plan can always be rebuilt.
+    """
 
     def __init__(self, problem: Problem, deadline: Deadline | None = None) -> None:
         self.p = problem
         self.lb: dict[int, int] = {}
         self.ub: dict[int, int] = {}
+        self.choice: dict[int, tuple[int, Act]] = {}
         self.exact: dict[int, int] = {}
         self.deadline = deadline or Deadline(None)
 
@@ -63,14 +68,16 @@ class WorstCase:
         if self.ub.get(mask, k + 1) <= k:
             return True
         self.deadline.check()
-        for act in self.p.actions(mask):
+        for act in self.p.search_actions(mask):
             ok = True
-            for c in sorted(act.children, key=lambda c: -c.bit_count()):
+            for c in act.children:  # largest first: the likeliest to fail
                 if not self.within(c, k - 1):
                     ok = False
                     break
             if ok:
                 self.ub[mask] = k
+                if mask not in self.choice or self.choice[mask][0] > k:
+                    self.choice[mask] = (k, act)
                 return True
         self.lb[mask] = k + 1
         return False

@@ -16,10 +16,11 @@ from feederkit.machine import PushAlignMachine
 from feederkit.planning.andor import Deadline, Timeout, WorstCase
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
-from feederkit.planning.problem import Problem
+from feederkit.planning.problem import Problem, maximal_sets
 from feederkit.planning.refine import EXPECTED_HORIZON, Refiner, child_masses
+from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
-from feederkit.planning.tree import PlanResult, Step
+from feederkit.planning.tree import Leaf, PlanResult, Step
 
 Objective = Literal["worst", "expected"]
 Method = Literal["auto", "andor", "bottom-up", "bfs", "backchain"]
@@ -44,13 +45,36 @@ def plan(
     (naming the largest margin that works) or none is found within ``time_limit``.
     """
     _check_args(machine, objective, min_margin, grouping, time_limit, method)
+    # Plan with the states numbered by diameter (readings then pick runs of bits).
+    sorted_machine, old = by_diameter(machine)
+    root, optimal, length, lower = _plan(
+        sorted_machine, objective, min_margin, grouping, time_limit, method
+    )
+    if sorted_machine is not machine:
+        root = remap_tree(root, old)
+    return _result(machine, root, optimal, length, lower, objective, grouping)
+
+
+def _plan(machine, objective, min_margin, grouping, time_limit, method):
+    """``plan`` on a machine whose states are numbered by diameter.
+
+    Returns the plan tree, whether it is proven optimal, its proven length (None when the
+    tree's own length is the answer) and a proven lower bound.
+    """
     problem = Problem(
-        machine, grouping, min_margin, distinct_maps=objective == "expected"  # type: ignore[arg-type]
+        machine,
+        grouping,
+        min_margin,
+        distinct_maps=objective == "expected",  # type: ignore[arg-type]
     )
     if method in ("bfs", "backchain") and not problem.sensorless:
         raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
     root_branches = problem.branches(problem.full)
-    roots = sorted({b.mask for b in root_branches})
+    # Without a margin floor a reading set inside another is oriented by its rotations in no
+    # more operations, so the length depends on the maximal ones only. Margins are not
+    # monotone that way (Problem.exact_actions): the floor below looks at every branch.
+    every = sorted({b.mask for b in root_branches})
+    roots = sorted(maximal_sets(every)) if min_margin == 0.0 else every
     start_mass = [s.weight for s in machine.states]
     if min_margin > 0.0:
         _check_margin(problem, roots, min_margin)
@@ -60,14 +84,18 @@ def plan(
     try:
         lengths = root_lengths(problem, worst, roots, method)
     except Timeout:
-        return _fallback(problem, worst, roots, root_branches, start_mass, time_limit, objective)
+        return _fallback(problem, worst, roots, root_branches, time_limit)
     length = 1 + max(lengths.values(), default=0)
     budget = length - 1
     children = _root_children(problem, root_branches, start_mass)
     refiner = Refiner(problem, worst, exact_deadline)
     try:
         if objective == "worst":
-            refiner.floor = min((refiner.margin(r, budget) for r in roots), default=math.inf)
+            # The smallest margin over the root branches; each only has to beat the least so far.
+            floor = math.inf
+            for r in sorted(every, key=lambda r: -r.bit_count()):
+                floor = refiner.margin(r, budget, floor)
+            refiner.floor = floor
             tie = "rotation" if problem.sensorless else "expected"
             horizon = budget
         else:
@@ -81,9 +109,7 @@ def plan(
         refiner.floor = -math.inf
         root = _build(refiner, children, budget, "first")
         complete = objective == "worst"
-    if objective == "worst":
-        return _result(machine, root, complete, length, length, objective, grouping)
-    return _result(machine, root, complete, None, length, objective, grouping)
+    return root, complete, length if objective == "worst" else None, length
 
 
 def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
@@ -128,44 +154,44 @@ def _root_children(problem: Problem, root_branches, start_mass):
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
 
 
-def _fallback(problem, worst, roots, root_branches, start_mass, time_limit, objective) -> PlanResult:
-    """Some plan when the exact search ran out of time, with the lower bound it proved."""
+def _fallback(problem, worst, roots, root_branches, time_limit):
+    """Some plan when the exact search ran out of time, with the lower bound it proved.
+
+    A depth-first search with a generous budget (the greedy action order of
+    ``Problem.actions``) finds a plan; the tree follows the actions that proved it.
+    """
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
-    deadline = Deadline(time_limit * FALLBACK_SHARE if time_limit else None)
+    anytime = WorstCase(problem, Deadline(time_limit * FALLBACK_SHARE))
     cap = 2 * problem.n + 1
-    anytime = WorstCase(problem, deadline)
     try:
-        budgets = {r: _first_found(anytime, r, cap) for r in roots}
-        anytime.deadline = Deadline(None)
-    except (Timeout, ValueError):
+        for r in roots:
+            if not anytime.within(r, cap):
+                raise Timeout
+    except Timeout:
         raise PlanningError(
             f"no plan found within the time limit of {time_limit:g} s "
             f"(a plan needs at least {lower} operations)"
         ) from None
-    refiner = Refiner(problem, anytime)
-    children = _root_children(problem, root_branches, start_mass)
 
-    def chooser(mask, masses, k):
-        return refiner.choose_worst(mask, masses, k, "first")
+    anytime.deadline = Deadline(None)
 
-    subs = [(b, refiner.build(b.mask, ms, budgets[b.mask], chooser)) for b, _pb, ms in children]
-    root = Step(None, tuple(subs))
-    return _result(problem.machine, root, False, None, lower, objective, problem.grouping)
+    def build(mask: int, k: int) -> Step | Leaf:
+        if problem.is_goal(mask):
+            return Leaf(mask)
+        if mask not in anytime.choice or anytime.choice[mask][0] > k:
+            # A branch inside a searched one: a subset is solvable within the same budget.
+            assert anytime.within(mask, k)
+        k, act = anytime.choice[mask]
+        return Step(act.action, tuple((b, build(b.mask, k - 1)) for b in problem.act_branches(act)))
+
+    root = Step(None, tuple((b, build(b.mask, cap)) for b in root_branches))
+    return root, False, None, lower
 
 
 def _proven(worst: WorstCase, mask: int) -> int:
     if worst.p.is_goal(mask):
         return 0
     return worst.exact.get(mask, worst.lb.get(mask, 1))
-
-
-def _first_found(worst: WorstCase, mask: int, cap: int) -> int:
-    """A number of operations within which ``mask`` is proven orientable (not minimal)."""
-    if worst.p.is_goal(mask):
-        return 0
-    if not worst.within(mask, cap):
-        raise ValueError("no plan within the cap")
-    return cap
 
 
 def _result(

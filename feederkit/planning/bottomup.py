@@ -21,7 +21,9 @@ MAX_SUBSETS = 1 << 20
 """The most subsets the bottom-to-top algorithm will enumerate."""
 
 
-def bottom_up_lengths(problem: Problem, roots: list[int], deadline: Deadline | None = None) -> dict[int, int]:
+def bottom_up_lengths(
+    problem: Problem, roots: list[int], deadline: Deadline | None = None
+) -> dict[int, int]:
     """Minimum worst-case number of operations of each root set, by the bottom-to-top algorithm."""
     deadline = deadline or Deadline(None)
     total = sum(1 << r.bit_count() for r in roots)
@@ -55,7 +57,7 @@ def bottom_up_lengths(problem: Problem, roots: list[int], deadline: Deadline | N
             for s in todo:
                 deadline.check()
                 best = value[s]
-                for act in problem.actions(s):
+                for act in problem.search_actions(s):
                     v = 1 + max(value.get(c, math.inf) for c in act.children)
                     if v < best:
                         best = v

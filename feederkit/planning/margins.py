@@ -20,7 +20,9 @@ from feederkit.planning.problem import Problem
 
 
 def largest_margin(problem: Problem, roots: list[int], deadline: Deadline | None = None) -> float:
-    """Largest ``t`` with a plan for every root using actions of margin >= ``t`` (inf: no action needed).
+    """Largest ``t`` with a plan for every root using only actions of margin >= ``t``.
+
+    inf when no root needs an action; -inf when some root has no plan at all.
 
     ``problem`` should have no margin floor of its own.
     """
@@ -41,7 +43,7 @@ def largest_margin(problem: Problem, roots: list[int], deadline: Deadline | None
         if problem.is_goal(mask):
             solved.add(mask)
             return
-        for act in problem.actions(mask):
+        for act in problem.exact_actions(mask):
             heapq.heappush(heap, (-act.action.margin, next(tick), mask, act.children))
 
     for r in open_roots:

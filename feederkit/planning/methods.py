@@ -34,7 +34,9 @@ def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
     return WorstCase(problem, deadline)
 
 
-def root_lengths(problem: Problem, worst: WorstCase, roots: list[int], method: str) -> dict[int, int]:
+def root_lengths(
+    problem: Problem, worst: WorstCase, roots: list[int], method: str
+) -> dict[int, int]:
     """Minimum worst-case operations after the first alignment, per root branch mask.
 
     Lengths found by another algorithm are recorded in ``worst`` as exact values.

@@ -138,7 +138,8 @@ class Backchain:
         d = [0.0, max(circle.left[a] + circle.right[a] for a in range(k))]
         while d[-1] <= t + ANGLE_EPS:
             nxt = max(
-                circle.left[a] + self._best[a][bisect.bisect_left(self._arcs[a], d[-1] - ANGLE_EPS) - 1]
+                circle.left[a]
+                + self._best[a][bisect.bisect_left(self._arcs[a], d[-1] - ANGLE_EPS) - 1]
                 for a in range(k)
             )
             if nxt <= d[-1] + ANGLE_EPS:
@@ -168,7 +169,9 @@ class Backchain:
 class BackchainWorst(WorstCase):
     """The worst-case oracle of a sensorless push machine, answered by backchaining."""
 
-    def __init__(self, problem: Problem, chain: Backchain, deadline: Deadline | None = None) -> None:
+    def __init__(
+        self, problem: Problem, chain: Backchain, deadline: Deadline | None = None
+    ) -> None:
         super().__init__(problem, deadline)
         self.chain = chain
 
@@ -194,7 +197,7 @@ def bfs_length(problem: Problem, mask: int, deadline: Deadline | None = None) ->
     while frontier:
         deadline.check()
         cur, d = frontier.popleft()
-        for act in problem.actions(cur):
+        for act in problem.search_actions(cur):
             img = act.children[0]
             if problem.is_goal(img):
                 return d + 1

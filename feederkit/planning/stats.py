@@ -36,10 +36,15 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
     times the probability that its reading falls in the branch.
     """
     start = {i: s.weight for i, s in enumerate(machine.states)}
-    return _expected(machine, root, start)
+    return _expected(machine, root, start, {})
 
 
-def _expected(machine: PushAlignMachine, node: PlanTree, masses: dict[int, float]) -> float:
+def _expected(
+    machine: PushAlignMachine,
+    node: PlanTree,
+    masses: dict[int, float],
+    memo: dict[tuple[float | None, float | None, int], float],
+) -> float:
     if isinstance(node, Leaf):
         return 0.0
     if node.action is not None:
@@ -54,6 +59,10 @@ def _expected(machine: PushAlignMachine, node: PlanTree, masses: dict[int, float
         kept = {}
         for s, w in masses.items():
             if b.mask >> s & 1:
-                kept[s] = w * reading_probability(machine.sensor, b, machine.states[s].diameter)
-        total += _expected(machine, sub, kept)
+                p = memo.get((b.lo, b.hi, s))
+                if p is None:
+                    d = machine.states[s].diameter
+                    p = memo[(b.lo, b.hi, s)] = reading_probability(machine.sensor, b, d)
+                kept[s] = w * p
+        total += _expected(machine, sub, kept, memo)
     return total

@@ -49,10 +49,8 @@ class KinematicModel:
 
 def rebuild_part(entry: dict[str, Any]) -> PushFunction:
     """The push function of a plan file's part, from its hull and COM only."""
-    name = entry["name"]
-    com = (float(entry["com"][0]), float(entry["com"][1]))
-    outline = make_outline(name, entry["hull"], com=com)
-    return push_function(make_part(outline, com, revision=entry.get("revision")))
+    outline = make_outline(entry["name"], entry["hull"], com=entry["com"])
+    return push_function(make_part(outline, revision=entry.get("revision")))
 
 
 def kinematic_model(plan: dict[str, Any] | KinematicModel) -> KinematicModel:

@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import Any
 
 from feederkit.errors import InputError
+from feederkit.jsonio import read_json, write_text_atomic
 from feederkit.machine import Branch, PushAlignMachine, members
 from feederkit.mechanics.push import PushFunction
-from feederkit.outline import write_text_atomic
 from feederkit.planning.tree import Leaf, PlanResult, Step
 from feederkit.plans.stats import plan_stats
 from feederkit.sensors import NoSensor, sensor_from_dict, sensor_to_dict, split_by_reading
@@ -195,7 +195,7 @@ def _check_part(c: _Checker, raw: object, index: int) -> tuple[str, set[int]]:
     c.pair(c.key(d, "com", where), f"{where} com")
     hull = c.lst(c.key(d, "hull", where), f"{where} hull")
     if len(hull) < 3:
-        raise c.fail(f"{where} hull needs at least three vertices")
+        raise c.fail(f"{where} hull has fewer than three vertices")
     for v in hull:
         c.pair(v, f"{where} hull vertex")
     states = c.lst(c.key(d, "stable_states", where), f"{where} stable_states")
@@ -354,33 +354,9 @@ def plan_json(plan: Mapping[str, Any]) -> str:
 
 def read_plan(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Load and check a plan file; a missing, unreadable or malformed file is bad input."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"{p}: no such plan file") from None
-    except IsADirectoryError:
-        raise InputError(f"{p}: is a directory, not a plan file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: cannot read the plan file ({type(exc).__name__})") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    except RecursionError:
-        raise InputError(f"{p}: not a plan (nested too deeply)") from None
-    return validate_plan(data, str(p))
-
-
-def write_text_checked(path: str | os.PathLike[str], text: str) -> None:
-    """Write a file atomically; a path that cannot be written is bad input (one line)."""
-    try:
-        write_text_atomic(path, text)
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise InputError(f"{path}: cannot write the file ({reason})") from None
+    return validate_plan(read_json(path, "plan file"), str(Path(path)))
 
 
 def write_plan(path: str | os.PathLike[str], plan: Mapping[str, Any]) -> None:
     """Write a plan file atomically (a temporary file beside it, then a rename)."""
-    write_text_checked(path, plan_json(plan))
+    write_text_atomic(path, plan_json(plan))

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 from feederkit.errors import InputError
+from feederkit.jsonio import write_bytes_atomic, write_text_atomic
 from feederkit.mechanics.push import push_function
-from feederkit.outline import write_text_atomic
 from feederkit.part import Part
 from feederkit.reports.partplot import FORMATS, part_plot_bytes
 
@@ -21,29 +20,6 @@ def plot_format(path: str | os.PathLike[str]) -> str:
     return fmt
 
 
-def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file beside it and a rename.
-
-    An unwritable destination is bad input.
-    """
-    target = Path(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    except OSError as exc:
-        raise InputError(f"{target}: cannot write the file ({exc.strerror})") from None
-    try:
-        os.fchmod(fd, 0o644)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def write_part_plot(part: Part, path: str | os.PathLike[str]) -> None:
     """Draw ``part``'s plot and write it as PNG or SVG, chosen by the file's suffix."""
     fmt = plot_format(path)
@@ -52,7 +28,4 @@ def write_part_plot(part: Part, path: str | os.PathLike[str]) -> None:
 
 def write_report(path: str | os.PathLike[str], html_text: str) -> None:
     """Write the HTML report atomically; an unwritable destination is bad input."""
-    try:
-        write_text_atomic(path, html_text)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot write the report ({exc.strerror})") from None
+    write_text_atomic(path, html_text, what="report")

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 from itertools import combinations
 
 from feederkit.angles import norm360
+from feederkit.mechanics.push import StableState, rotation_after
 from feederkit.reports.planview import (
     Node,
     OpNode,
     PartEntry,
     PlanView,
     ResultNode,
-    StateEntry,
     leaves,
 )
 from feederkit.sensors import NoSensor, SensorModel, ToleranceSensor, led_counts, sensor_from_dict
@@ -59,9 +59,10 @@ class Confusion:
     path: tuple[Step, ...]
 
 
-def pushed(part: PartEntry, state: StateEntry, action_deg: float) -> StateEntry:
-    """The state ``state`` settles into after a counter-clockwise rotation by ``action_deg``."""
-    theta = norm360(state.normal_deg - action_deg)
+def pushed(part: PartEntry, state: StableState, action_deg: float) -> StableState:
+    """The state ``state`` settles into after a counter-clockwise rotation by ``action_deg``:
+    the push function (section 3.1) read off the plan's resting ranges."""
+    theta = rotation_after(state.normal_deg, action_deg)
     for s in part.states:
         lo, hi = s.resting_range_deg
         if norm360(theta - lo) < hi - lo:

@@ -1,14 +1,14 @@
 """Read a plan file (design.md, ``feederkit-plan`` version 1) into what the simulator executes.
 
-Only the plan JSON is used: each part is rebuilt from its ``hull`` and ``com`` with
-``make_part(make_outline(...))``, and the plan's stable-state ids are matched to the
-rebuilt part's push function by their normal direction, so a plan whose states do not
-belong to its hull is refused. Bad plans raise InputError with one line.
+Only the plan JSON is used: each part is rebuilt from its ``hull`` and ``com`` by
+:func:`feederkit.plans.execute.rebuild_part` (as ``feederkit run`` does), and the plan's
+stable-state ids are matched to the rebuilt part's push function by their normal direction,
+so a plan whose states do not belong to its hull is refused. Bad plans raise InputError with
+one line.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass
@@ -16,9 +16,10 @@ from pathlib import Path
 
 from feederkit.angles import norm360
 from feederkit.errors import InputError
-from feederkit.mechanics.push import PushFunction, StableState, push_function
-from feederkit.outline import make_outline
-from feederkit.part import Part, make_part
+from feederkit.jsonio import read_json
+from feederkit.mechanics.push import PushFunction, StableState
+from feederkit.part import Part
+from feederkit.plans.execute import rebuild_part
 from feederkit.sensors import SensorModel, sensor_from_dict
 
 NORMAL_MATCH_DEG = 1e-4
@@ -111,19 +112,9 @@ class SimPlan:
 
 def load_plan_json(path: str | os.PathLike[str]) -> dict:
     """Read a plan file's JSON object; unreadable or malformed files are bad input."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"{p}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: cannot read the plan ({exc})") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    data = read_json(path, "file")
     if not isinstance(data, dict):
-        raise InputError(f"{p}: a plan file holds a JSON object")
+        raise InputError(f"{Path(path)}: a plan file holds a JSON object")
     return data
 
 
@@ -142,8 +133,7 @@ def _plan_part(entry: object, index: int) -> PlanPart:
     hull, com, states = entry.get("hull"), entry.get("com"), entry.get("stable_states")
     if not isinstance(hull, list) or not isinstance(com, list) or not isinstance(states, list):
         raise InputError(f"plan: part {name!r} needs 'hull', 'com' and 'stable_states'")
-    part = make_part(make_outline(name, hull, com=com))
-    pf = push_function(part)
+    pf = rebuild_part(entry)
     state_of_edge: dict[int, int] = {}
     by_id: dict[int, StableState] = {}
     for s in states:
@@ -174,7 +164,7 @@ def _plan_part(entry: object, index: int) -> PlanPart:
         raise InputError(
             f"plan: part {name!r} lists {len(by_id)} stable states but its hull has {pf.n}"
         )
-    return PlanPart(name=name, part=part, pf=pf, state_of_edge=state_of_edge, states=by_id)
+    return PlanPart(name=name, part=pf.part, pf=pf, state_of_edge=state_of_edge, states=by_id)
 
 
 def _node(data: object, parts: dict[str, PlanPart], where: str, root: bool) -> Node:

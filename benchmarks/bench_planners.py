@@ -1,0 +1,169 @@
+"""Planner performance against issue 3's and issue 5's targets, with the plain search as baseline.
+
+    python benchmarks/bench_planners.py           # everything (a few minutes: the baseline)
+    python benchmarks/bench_planners.py --quick   # skip the slowest baseline runs
+
+For each case: the time of ``feederkit.planning.plan`` (proven optimal, default options),
+the time of the plain exhaustive AND/OR search over sets (``baseline_length`` below: iterative
+deepening, every overlap range, readings branching exactly, a memo of (set, depth) results
+and nothing else), their ratio, and the target. Times are wall-clock seconds (the best of a
+few runs for fast cases) and CPU seconds, since other work on the machine inflates wall
+time. Peak memory is the process's maximum resident set size. Exit code 1 when a target is
+missed.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import resource
+import sys
+import time
+from pathlib import Path
+
+from feederkit.machine import (
+    build_machine,
+    branches,
+    inseparable,
+    is_goal,
+    overlap_ranges,
+)
+from feederkit.mechanics import push_function
+from feederkit.outline import load_outline_json, make_outline
+from feederkit.part import make_part
+from feederkit.planning.api import plan
+from feederkit.sensors import NoSensor, ToleranceSensor
+
+HERE = Path(__file__).resolve().parent
+BASELINE_LIMIT_S = 60.0
+"""The baseline gives up after this long (its time is then reported as '>')."""
+
+
+class GaveUp(Exception):
+    pass
+
+
+def baseline_length(machine, limit_s: float = BASELINE_LIMIT_S) -> int:
+    """The plain exhaustive AND/OR search (section 6.1): the first alignment counted."""
+    insep = inseparable(machine)
+    memo: dict[tuple[int, int], bool] = {}
+    end = time.perf_counter() + limit_s
+
+    def within(mask: int, k: int) -> bool:
+        if is_goal(insep, mask):
+            return True
+        if k == 0:
+            return False
+        key = (mask, k)
+        if key in memo:
+            return memo[key]
+        if time.perf_counter() > end:
+            raise GaveUp
+        ok = any(
+            all(within(b.mask, k - 1) for b in branches(machine, a.image))
+            for a in overlap_ranges(machine, mask)
+        )
+        memo[key] = ok
+        return ok
+
+    worst = 0
+    for b in branches(machine, machine.all_states):
+        k = 0
+        while not within(b.mask, k):
+            k += 1
+        worst = max(worst, k)
+    return 1 + worst
+
+
+def regular(n: int, com: tuple[float, float]):
+    pts = [(math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n)) for k in range(n)]
+    return push_function(make_part(make_outline(f"regular-{n}", pts, com=com)))
+
+
+def random_convex(n: int, seed: int, name: str):
+    """Random angles on a 60 x 40 mm ellipse: every point is a hull vertex."""
+    rng = random.Random(seed)
+    angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
+    pts = [(30 * math.cos(t), 20 * math.sin(t)) for t in angles]
+    return push_function(make_part(make_outline(name, pts)))
+
+
+def mix(count: int):
+    return [
+        random_convex(random.Random(s).randint(6, 10), 100 + s, f"mix-{s}") for s in range(count)
+    ]
+
+
+def timed(fn, repeats: int):
+    """Best wall and CPU seconds over ``repeats`` runs, and the last result."""
+    wall, cpu, out = math.inf, math.inf, None
+    for _ in range(repeats):
+        t, c = time.perf_counter(), time.process_time()
+        out = fn()
+        cpu = min(cpu, time.process_time() - c)
+        wall = min(wall, time.perf_counter() - t)
+    return wall, cpu, out
+
+
+def cases(quick: bool):
+    """(name, machine, target seconds, run the baseline?)"""
+    for path in sorted((HERE.parent / "catalog").glob("*.json")):
+        pf = push_function(make_part(load_outline_json(path)))
+        yield f"sample {path.stem}, sensorless", build_machine([pf]), 0.01, True
+        sensor = ToleranceSensor(0.03 * pf.part.size)
+        yield f"sample {path.stem}, tolerance 3%", build_machine([pf], sensor), 0.01, True
+    for n, target in ((12, 0.1), (32, 2.0), (64, 30.0)):
+        m = build_machine([regular(n, (0.13, 0.05))])
+        yield f"regular {n}-gon, COM (0.13, 0.05) [{m.n} states]", m, target, not quick or n == 12
+    m = build_machine([regular(32, (0.02, 0.008))])
+    yield f"regular 32-gon, COM (0.02, 0.008) [{m.n} states]", m, 2.0, not quick
+    for seed in range(10):
+        pf = random_convex(64, seed, f"random-64-{seed}")
+        m = build_machine([pf], ToleranceSensor(0.03 * pf.part.size))
+        yield f"random convex 64-gon #{seed}, 3% [{m.n} states]", m, 0.2, seed < 3
+    for count, rel, target in ((20, 0.02, 0.5), (50, 0.01, 5.0)):
+        parts = mix(count)
+        size = max(pf.part.size for pf in parts)
+        m = build_machine(parts, ToleranceSensor(rel * size))
+        yield f"{count}-part mix of 6-10-gons, {rel:.0%} [{m.n} states]", m, target, not quick
+
+
+def main(argv: list[str]) -> int:
+    quick = "--quick" in argv
+    missed = 0
+    print(f"{'case':52} {'plan s':>8} {'cpu s':>8} {'target':>7} {'base s':>8} {'ratio':>7} {'len':>4}")
+    for name, machine, target, with_baseline in cases(quick):
+        wall, cpu, result = timed(lambda m=machine: plan(m), 3 if target <= 0.5 else 1)
+        assert result.optimal
+        base = ""
+        ratio = ""
+        if with_baseline:
+            try:
+                bw, _, blen = timed(lambda m=machine: baseline_length(m), 1)
+                assert blen == result.length, (name, blen, result.length)
+                base, ratio = f"{bw:8.3f}", f"{bw / max(wall, 1e-9):7.0f}"
+            except GaveUp:
+                base, ratio = f">{BASELINE_LIMIT_S:7.0f}", f">{BASELINE_LIMIT_S / wall:6.0f}"
+        ok = min(wall, cpu) <= target
+        missed += not ok
+        flag = "" if ok else "  <-- MISSED"
+        print(
+            f"{name:52} {wall:8.4f} {cpu:8.4f} {target:7.2f} {base:>8} {ratio:>7} "
+            f"{result.length:4d}{flag}",
+            flush=True,
+        )
+    for count, rel in ((20, 0.02), (50, 0.01)):
+        parts = mix(count)
+        size = max(pf.part.size for pf in parts)
+        m = build_machine(parts, ToleranceSensor(rel * size))
+        wall, cpu, _ = timed(lambda m=m: inseparable(m), 3)
+        print(f"inseparable() on the {count}-part mix [{m.n} states]: {wall:.4f} s ({cpu:.4f} CPU)")
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    ok = peak < 500.0
+    missed += not ok
+    print(f"peak memory: {peak:.0f} MB (target 500 MB){'' if ok else '  <-- MISSED'}")
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,59 @@
+"""Renumbering a machine's states by diameter, and plans back to the original numbering.
+
+With states numbered in diameter order, the states a reading can come from are a run of
+consecutive bits, so the planners find reading branches with a few mask operations.
+Nothing else depends on the numbering.
+"""
+
+from __future__ import annotations
+
+from feederkit.machine import Branch, PushAlignMachine, SetAction, members
+from feederkit.mechanics.actions import ActionRange
+from feederkit.planning.tree import Leaf, PlanTree, Step
+
+
+def by_diameter(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[int]]:
+    """The machine with states sorted by diameter, and ``old[new_index]``."""
+    old = sorted(range(machine.n), key=lambda i: (machine.states[i].diameter, i))
+    if old == list(range(machine.n)):
+        return machine, old
+    new = [0] * machine.n
+    for k, i in enumerate(old):
+        new[i] = k
+    maps = tuple(
+        tuple(ActionRange(r.lo, r.hi, new[r.target]) for r in machine.action_maps[i]) for i in old
+    )
+    states = tuple(machine.states[i] for i in old)
+    return PushAlignMachine(machine.part_names, states, maps, machine.sensor), old
+
+
+def remap_mask(mask: int, old: list[int]) -> int:
+    """A mask over the renumbered states as a mask over the original ones."""
+    out = 0
+    for k in members(mask):
+        out |= 1 << old[k]
+    return out
+
+
+def remap_tree(node: PlanTree, old: list[int], cache: dict[int, int] | None = None) -> PlanTree:
+    """A plan over the renumbered machine as a plan over the original one."""
+    cache = {} if cache is None else cache
+
+    def mask(m: int) -> int:
+        out = cache.get(m)
+        if out is None:
+            out = cache[m] = remap_mask(m, old)
+        return out
+
+    if isinstance(node, Leaf):
+        return Leaf(mask(node.mask))
+    action = node.action
+    if action is not None:
+        action = SetAction(action.lo, action.hi, mask(action.image))
+    return Step(
+        action,
+        tuple(
+            (Branch(b.lo, b.hi, mask(b.mask)), remap_tree(sub, old, cache))
+            for b, sub in node.branches
+        ),
+    )
