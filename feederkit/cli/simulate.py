@@ -25,6 +25,7 @@ from feederkit.sim.api import (
 )
 from feederkit.sim.engine import require_mujoco
 from feederkit.sim.planfile import load_plan_json
+from feederkit.sim.planfile import read_plan as read_sim_plan
 from feederkit.sim.summary import SimulationSummary
 
 SHOWN_ROWS = 20
@@ -140,6 +141,10 @@ def simulate_command(
     if require_success is not None and not 0.0 <= require_success <= 1.0:
         raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
     data = load_plan_json(plan)
+    try:
+        read_sim_plan(data)  # check it before the progress bar starts
+    except InputError as exc:
+        raise InputError(f"{plan}: {str(exc).removeprefix('plan: ')}") from None
     columns = (
         TextColumn("simulating"),
         BarColumn(),
