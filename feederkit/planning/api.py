@@ -12,13 +12,14 @@ import math
 from typing import Literal
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import PushAlignMachine
+from feederkit.machine import PushAlignMachine, SetAction, overlap_cells
 from feederkit.planning.andor import Deadline, Timeout, WorstCase
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.problem import Problem, maximal_sets
 from feederkit.planning.refine import EXPECTED_HORIZON, Refiner, child_masses
 from feederkit.planning.reindex import by_diameter, remap_tree
+from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.tree import Leaf, PlanResult, Step
 
@@ -61,12 +62,13 @@ def _plan(machine, objective, min_margin, grouping, time_limit, method):
     Returns the plan tree, whether it is proven optimal, its proven length (None when the
     tree's own length is the answer) and a proven lower bound.
     """
-    problem = Problem(
-        machine,
-        grouping,
-        min_margin,
-        distinct_maps=objective == "expected",  # type: ignore[arg-type]
-    )
+    problem = Problem(machine, grouping, min_margin)  # type: ignore[arg-type]
+    if problem.sensorless:
+        # One path for every start: the expected number of operations is the length, so
+        # the plans of minimum length are exactly those of minimum expected length.
+        objective = "worst"
+    elif objective == "expected":
+        problem = Problem(machine, grouping, min_margin, problem.insep, distinct_maps=True)  # type: ignore[arg-type]
     if method in ("bfs", "backchain") and not problem.sensorless:
         raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
     root_branches = problem.branches(problem.full)
@@ -158,34 +160,97 @@ def _fallback(problem, worst, roots, root_branches, time_limit):
     """Some plan when the exact search ran out of time, with the lower bound it proved.
 
     A depth-first search with a generous budget (the greedy action order of
-    ``Problem.actions``) finds a plan; the tree follows the actions that proved it.
+    ``Problem.lazy_actions``) finds a plan; the tree follows the actions that proved it. A
+    reading set the search never met lies inside one it did (its "witness"), and without a
+    margin floor it follows the witness's rotations.
     """
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
+    blind = _sensorless_plan(problem, root_branches)
     anytime = WorstCase(problem, Deadline(time_limit * FALLBACK_SHARE))
     cap = 2 * problem.n + 1
+    if blind is not None:
+        cap = tree_length(blind) - 2  # look only for something shorter
     try:
         for r in roots:
             if not anytime.within(r, cap):
                 raise Timeout
     except Timeout:
+        if blind is not None:
+            return blind, False, None, lower
         raise PlanningError(
             f"no plan found within the time limit of {time_limit:g} s "
             f"(a plan needs at least {lower} operations)"
         ) from None
 
-    anytime.deadline = Deadline(None)
+    choice = anytime.choice
 
-    def build(mask: int, k: int) -> Step | Leaf:
+    def witness_of(mask: int, supersets) -> int:
+        if problem.is_goal(mask) or mask in choice:
+            return mask
+        return next(c for c in supersets if mask & c == mask)
+
+    made: dict[tuple[int, int], Step | Leaf] = {}  # equal cases share their subtree
+
+    def build(mask: int, witness: int) -> Step | Leaf:
+        if (mask, witness) not in made:
+            made[(mask, witness)] = make(mask, witness)
+        return made[(mask, witness)]
+
+    def make(mask: int, witness: int) -> Step | Leaf:
         if problem.is_goal(mask):
             return Leaf(mask)
-        if mask not in anytime.choice or anytime.choice[mask][0] > k:
-            # A branch inside a searched one: a subset is solvable within the same budget.
-            assert anytime.within(mask, k)
-        k, act = anytime.choice[mask]
-        return Step(act.action, tuple((b, build(b.mask, k - 1)) for b in problem.act_branches(act)))
+        k, act = choice[witness]
+        if witness != mask:
+            # Follow the witness's rotation: the set's range holding it (any rotation in it
+            # sends the set inside the witness's image).
+            r = act.action.representative
+            lo, hi, img = next(
+                c
+                for c in overlap_cells(problem.machine, mask)
+                if c[0] < r < c[1] or c[0] < r + 360.0 < c[1]
+            )
+            action = SetAction(lo, hi, img)
+        else:
+            action = act.action
+        subs = []
+        for b in problem.image_branches(action.image):
+            subs.append((b, build(b.mask, witness_of(b.mask, act.children))))
+        return Step(action, tuple(subs))
 
-    root = Step(None, tuple((b, build(b.mask, cap)) for b in root_branches))
+    root = Step(None, tuple((b, build(b.mask, witness_of(b.mask, roots))) for b in root_branches))
     return root, False, None, lower
+
+
+def _sensorless_plan(problem: Problem, root_branches) -> Step | None:
+    """A plan that takes the readings but chooses rotations by backchaining, or None.
+
+    For one part's push machine (no margin floor), Goldberg's table says how many
+    operations collapse any set with no sensor; each step takes a rotation that lowers
+    that number, and a reading only leaves a subset, which needs no more. Instant, and
+    never longer than the sensorless plan.
+    """
+    if problem.min_margin > 0.0:
+        return None
+    circle = push_circle(problem.machine, problem.insep)
+    if circle is None:
+        return None
+    chain = Backchain(circle)
+    made: dict[int, Step | Leaf] = {}  # equal sets share their subtree
+
+    def build(mask: int) -> Step | Leaf:
+        if mask in made:
+            return made[mask]
+        if problem.is_goal(mask):
+            node: Step | Leaf = Leaf(mask)
+        else:
+            k = chain.length(mask)
+            lo, hi, img = next(c for c in problem.cells(mask, False) if chain.length(c[2]) < k)
+            subs = tuple((b, build(b.mask)) for b in problem.image_branches(img))
+            node = Step(SetAction(lo, hi, img), subs)
+        made[mask] = node
+        return node
+
+    return Step(None, tuple((b, build(b.mask)) for b in root_branches))
 
 
 def _proven(worst: WorstCase, mask: int) -> int:

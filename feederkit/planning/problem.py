@@ -237,7 +237,7 @@ class Problem:
         floor = 2.0 * self.min_margin
         for cell in overlap_cells(self.machine, mask):
             lo, hi, img = cell
-            if hi - lo < floor or (useful and img & mask == mask):
+            if hi - lo < floor:
                 continue
             key: object = img
             if self.distinct_maps:
@@ -248,8 +248,10 @@ class Problem:
         keyed = [(lo - hi, norm360((lo + hi) / 2.0), img, lo, hi) for lo, hi, img in best.values()]
         keyed.sort()
         cells = [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
-        self._cells[(mask, useful)] = cells
-        return cells
+        self._cells[(mask, False)] = cells
+        # The useful ones: without those whose image contains the set.
+        self._cells[(mask, True)] = [c for c in cells if c[2] & mask != mask]
+        return self._cells[(mask, useful)]
 
     def act(self, mask: int, cell: tuple[float, float, int], exact: bool = False) -> Act | None:
         """The action of one cell with its branch sets.

@@ -35,25 +35,33 @@ def remap_mask(mask: int, old: list[int]) -> int:
     return out
 
 
-def remap_tree(node: PlanTree, old: list[int], cache: dict[int, int] | None = None) -> PlanTree:
-    """A plan over the renumbered machine as a plan over the original one."""
-    cache = {} if cache is None else cache
+def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
+    """A plan over the renumbered machine as a plan over the original one.
+
+    Shared subtrees stay shared (each node is converted once).
+    """
+    masks: dict[int, int] = {}
+    nodes: dict[int, PlanTree] = {}
 
     def mask(m: int) -> int:
-        out = cache.get(m)
+        out = masks.get(m)
         if out is None:
-            out = cache[m] = remap_mask(m, old)
+            out = masks[m] = remap_mask(m, old)
         return out
 
-    if isinstance(node, Leaf):
-        return Leaf(mask(node.mask))
-    action = node.action
-    if action is not None:
-        action = SetAction(action.lo, action.hi, mask(action.image))
-    return Step(
-        action,
-        tuple(
-            (Branch(b.lo, b.hi, mask(b.mask)), remap_tree(sub, old, cache))
-            for b, sub in node.branches
-        ),
-    )
+    def convert(n: PlanTree) -> PlanTree:
+        hit = nodes.get(id(n))
+        if hit is not None:
+            return hit
+        if isinstance(n, Leaf):
+            out: PlanTree = Leaf(mask(n.mask))
+        else:
+            action = n.action
+            if action is not None:
+                action = SetAction(action.lo, action.hi, mask(action.image))
+            subs = tuple((Branch(b.lo, b.hi, mask(b.mask)), convert(s)) for b, s in n.branches)
+            out = Step(action, subs)
+        nodes[id(n)] = out
+        return out
+
+    return convert(node)

@@ -2,6 +2,8 @@
 
 The expected number of operations uses the distribution of :mod:`feederkit.planning.readings`
 (uniform initial orientation, uniform reading error), the same one the planners minimise.
+Subtrees may be shared (a plan is then a DAG in memory); every statistic is memoised per
+node, so shared subtrees cost once.
 """
 
 from __future__ import annotations
@@ -13,19 +15,29 @@ from feederkit.planning.readings import reading_probability
 from feederkit.planning.tree import Leaf, PlanTree, Step
 
 
-def tree_length(node: PlanTree) -> int:
+def tree_length(node: PlanTree, _memo: dict[int, int] | None = None) -> int:
     """Worst-case number of operations of a subtree (each Step is one operation)."""
     if isinstance(node, Leaf):
         return 0
-    return 1 + max((tree_length(sub) for _, sub in node.branches), default=0)
+    memo = {} if _memo is None else _memo
+    hit = memo.get(id(node))
+    if hit is None:
+        hit = 1 + max((tree_length(sub, memo) for _, sub in node.branches), default=0)
+        memo[id(node)] = hit
+    return hit
 
 
-def tree_min_margin(node: PlanTree) -> float:
+def tree_min_margin(node: PlanTree, _memo: dict[int, float] | None = None) -> float:
     """Smallest margin of the subtree's actions (inf when it has none)."""
     if isinstance(node, Leaf):
         return math.inf
-    here = math.inf if node.action is None else node.action.margin
-    return min([here] + [tree_min_margin(sub) for _, sub in node.branches])
+    memo = {} if _memo is None else _memo
+    hit = memo.get(id(node))
+    if hit is None:
+        here = math.inf if node.action is None else node.action.margin
+        hit = min([here] + [tree_min_margin(sub, memo) for _, sub in node.branches])
+        memo[id(node)] = hit
+    return hit
 
 
 def expected_operations(machine: PushAlignMachine, root: Step) -> float:
@@ -33,36 +45,31 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
 
     Masses start at each state's weight; an action moves a state's mass to its successor
     under the action's representative rotation; a reading branch keeps each state's mass
-    times the probability that its reading falls in the branch.
+    times the probability that its reading falls in the branch. By linearity this is the
+    weighted sum, over start states, of the expected operations of a part in that state.
     """
-    start = {i: s.weight for i, s in enumerate(machine.states)}
-    return _expected(machine, root, start, {})
+    memo: dict[tuple[int, int], float] = {}
+    probs: dict[tuple[float | None, float | None, int], float] = {}
 
-
-def _expected(
-    machine: PushAlignMachine,
-    node: PlanTree,
-    masses: dict[int, float],
-    memo: dict[tuple[float | None, float | None, int], float],
-) -> float:
-    if isinstance(node, Leaf):
-        return 0.0
-    if node.action is not None:
-        moved: dict[int, float] = {}
-        rep = node.action.representative
-        for s, w in masses.items():
-            t = successor(machine, s, rep)
-            moved[t] = moved.get(t, 0.0) + w
-        masses = moved
-    total = sum(masses.values())
-    for b, sub in node.branches:
-        kept = {}
-        for s, w in masses.items():
-            if b.mask >> s & 1:
-                p = memo.get((b.lo, b.hi, s))
+    def ops(node: PlanTree, state: int) -> float:
+        if isinstance(node, Leaf):
+            return 0.0
+        key = (id(node), state)
+        hit = memo.get(key)
+        if hit is not None:
+            return hit
+        if node.action is not None:
+            state = successor(machine, state, node.action.representative)
+        total = 1.0
+        for b, sub in node.branches:
+            if b.mask >> state & 1:
+                p = probs.get((b.lo, b.hi, state))
                 if p is None:
-                    d = machine.states[s].diameter
-                    p = memo[(b.lo, b.hi, s)] = reading_probability(machine.sensor, b, d)
-                kept[s] = w * p
-        total += _expected(machine, sub, kept, memo)
-    return total
+                    d = machine.states[state].diameter
+                    p = probs[(b.lo, b.hi, state)] = reading_probability(machine.sensor, b, d)
+                if p > 0.0:
+                    total += p * ops(sub, state)
+        memo[key] = total
+        return total
+
+    return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
