@@ -23,7 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.angles import ANGLE_EPS, norm360
-from feederkit.mechanics.actions import ActionRange, action_ranges, merge_boundaries
+from feederkit.mechanics.actions import (
+    ActionRange,
+    RotationRange,
+    action_ranges,
+    merge_boundaries,
+)
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.sensors import (
@@ -75,22 +80,14 @@ class PushAlignMachine:
 
 
 @dataclass(frozen=True)
-class SetAction:
-    """An overlap range of a set of states: rotations in ``(lo, hi)`` send the set to ``image``."""
+class SetAction(RotationRange):
+    """An overlap range of a set of states: rotations in ``(lo, hi)`` send the set to ``image``.
 
-    lo: float
-    hi: float
+    ``representative`` (the middle) is the rotation a plan uses; ``margin`` (the half-width)
+    the rotation error it tolerates.
+    """
+
     image: int
-
-    @property
-    def representative(self) -> float:
-        """The middle of the range in [0, 360): the rotation a plan uses."""
-        return norm360((self.lo + self.hi) / 2.0)
-
-    @property
-    def margin(self) -> float:
-        """Half-width of the range (deg): the rotation error the action tolerates."""
-        return (self.hi - self.lo) / 2.0
 
 
 @dataclass(frozen=True)
@@ -435,6 +432,24 @@ def _tolerance_branches(machine: PushAlignMachine, mask: int, e: float) -> list[
     return [Branch(lo, hi, m) for lo, hi, m in out]
 
 
+def prune_pairs(
+    alive: set[tuple[int, int]],
+    dead: list[tuple[int, int]],
+    preds: dict[tuple[int, int], list[tuple[int, int]]],
+) -> None:
+    """The worklist step of a greatest fixpoint over state pairs, in place.
+
+    Removes the ``dead`` pairs from ``alive`` and, transitively, every alive pair that some
+    action sends to a removed one (``preds[q]``: the pairs that lead to ``q``).
+    """
+    while dead:
+        p = dead.pop()
+        if p not in alive:
+            continue
+        alive.discard(p)
+        dead.extend(q for q in preds.get(p, ()) if q in alive)
+
+
 def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:
     """For each state, the mask of states it is inseparable from (see the module docstring).
 
@@ -472,12 +487,7 @@ def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:
             if q not in alive:
                 dead.append(p)
             preds.setdefault(q, []).append(p)
-    while dead:
-        p = dead.pop()
-        if p not in alive:
-            continue
-        alive.discard(p)
-        dead.extend(q for q in preds.get(p, ()) if q in alive)
+    prune_pairs(alive, dead, preds)
     out = [0] * n
     for i, j in alive:
         out[i] |= 1 << j

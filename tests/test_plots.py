@@ -25,14 +25,14 @@ SVG_NS = "{http://www.w3.org/2000/svg}"
 SHAPES = {
     # name: (vertices, holes, com)
     "rectangle": (
-        [(0, 0), (2, 0), (2, 1), (0, 1)], [[(0.2, 0.2), (0.6, 0.2), (0.6, 0.6)]], (1, 0.5)
+        [(0, 0), (2, 0), (2, 1), (0, 1)],
+        [[(0.2, 0.2), (0.6, 0.2), (0.6, 0.6)]],
+        (1, 0.5),
     ),
     "triangle": ([(0, 0), (1, 0), (0, 1)], [], None),
     # a quadrilateral with an unstable edge: fewer stable states than edges
     "kite": ([(0, 0), (4, 0), (4.5, 0.6), (0.3, 3)], [], None),
-    "octagon": (
-        [(1, 0), (2, 0), (3, 1), (3, 2), (2, 3), (1, 3), (0, 2), (0, 1)], [], (1.2, 1.4)
-    ),
+    "octagon": ([(1, 0), (2, 0), (3, 1), (3, 2), (2, 3), (1, 3), (0, 2), (0, 1)], [], (1.2, 1.4)),
 }
 
 
@@ -73,8 +73,15 @@ def test_svg_shows_the_states_numbers_and_titles_as_paths():
     svg = part_plot_bytes(push_function(make("rectangle")), "svg").decode()
     assert "<script" not in svg and "<image" not in svg
     # fonts are drawn as paths; the texts appear as comments matplotlib writes beside them
-    for label in ("s0 e0", "s1 e1", "s2 e2", "s3 e3", "radius function", "push function",
-                  "push-diameter function"):
+    for label in (
+        "s0 e0",
+        "s1 e1",
+        "s2 e2",
+        "s3 e3",
+        "radius function",
+        "push function",
+        "push-diameter function",
+    ):
         assert label in svg
 
 
@@ -116,8 +123,15 @@ def test_plot_format_by_suffix(tmp_path):
 
 def test_plot_command(tmp_path):
     src = tmp_path / "bracket.json"
-    src.write_text(json.dumps({"name": "bracket", "vertices": [[0, 0], [3, 0], [3, 1], [0, 2]],
-                               "holes": [[[1, 0.5], [2, 0.5], [2, 0.8]]]}))
+    src.write_text(
+        json.dumps(
+            {
+                "name": "bracket",
+                "vertices": [[0, 0], [3, 0], [3, 1], [0, 2]],
+                "holes": [[[1, 0.5], [2, 0.5], [2, 0.8]]],
+            }
+        )
+    )
     out = tmp_path / "bracket.svg"
     plot_command(str(src), out)
     assert re.search(rb'id="stable-orientation-0"', out.read_bytes())
@@ -162,7 +176,9 @@ def test_plot_command_as_a_typer_command(tmp_path):
 @settings(max_examples=8, deadline=None)
 @given(
     st.lists(
-        st.tuples(st.floats(0, 359.9), st.floats(5.0, 40.0)), min_size=3, max_size=9,
+        st.tuples(st.floats(0, 359.9), st.floats(5.0, 40.0)),
+        min_size=3,
+        max_size=9,
         unique_by=lambda p: round(p[0]),
     )
 )

@@ -68,8 +68,13 @@ def rectangle_plan(name="rect"):
     """
     rect = part_entry(name, RECT, com=(1, 0.5))
     root = op(None, None, (None, op(45.0, 18.43, (None, result((rect, 0), (rect, 2))))))
-    stats = {"length": 2, "expected_length": 2.0, "min_margin_deg": 18.43, "optimal": True,
-             "lower_bound": 2}
+    stats = {
+        "length": 2,
+        "expected_length": 2.0,
+        "min_margin_deg": 18.43,
+        "optimal": True,
+        "lower_bound": 2,
+    }
     return plan_file([rect], {"model": "none"}, root, stats)
 
 
@@ -91,8 +96,13 @@ def triangle_plan(name=NASTY, e=0.01):
         (rd(hyp), result((tri, 1))),
         (rd(1.0), op(90.0, 18.43, (rd(1.0), result((tri, 2))), (rd(hyp), result((tri, 1))))),
     )
-    stats = {"length": 2, "expected_length": 5 / 3, "min_margin_deg": 18.43, "optimal": True,
-             "lower_bound": 2}
+    stats = {
+        "length": 2,
+        "expected_length": 5 / 3,
+        "min_margin_deg": 18.43,
+        "optimal": True,
+        "lower_bound": 2,
+    }
     return plan_file([tri], {"model": "tolerance", "tolerance_mm": e}, root, stats)
 
 
@@ -120,8 +130,13 @@ def twin_plan():
             ),
         ),
     )
-    stats = {"length": 2, "expected_length": 5 / 3, "min_margin_deg": 18.43, "optimal": True,
-             "lower_bound": 2}
+    stats = {
+        "length": 2,
+        "expected_length": 5 / 3,
+        "min_margin_deg": 18.43,
+        "optimal": True,
+        "lower_bound": 2,
+    }
     return plan_file([a, b], {"model": "tolerance", "tolerance_mm": e}, root, stats)
 
 
@@ -209,8 +224,15 @@ def test_a_leaf_that_disagrees_with_the_trace_is_flagged():
 def test_part_names_are_escaped_everywhere():
     html = render_report(
         triangle_plan(),
-        unrecognizable=[{"part_a": NASTY, "part_b": "<i>y", "states_a": [0], "states_b": [1],
-                         "reason": "<script>same</script>"}],
+        unrecognizable=[
+            {
+                "part_a": NASTY,
+                "part_b": "<i>y",
+                "states_a": [0],
+                "states_b": [1],
+                "reason": "<script>same</script>",
+            }
+        ],
         simulation={"trials": 3, "successes": 2, "note": "<u>"},
     )
     assert NASTY not in html and "<i>y" not in html and "<script" not in html and "<u>" not in html
@@ -237,8 +259,9 @@ def test_the_page_is_self_contained_and_prints_on_a4(make):
 
 
 def test_statistics_cycle_time_and_simulation():
-    html = render_report(triangle_plan(), seconds_per_op=4.5,
-                         simulation={"trials": 20, "successes": 19})
+    html = render_report(
+        triangle_plan(), seconds_per_op=4.5, simulation={"trials": 20, "successes": 19}
+    )
     text = "".join(parse(html).text)
     assert "2 push-align operations" in text
     assert "1.667 operations" in text
@@ -272,15 +295,21 @@ def test_symmetric_leaves_and_twins_are_reported():
 
 
 def test_unrecognizable_pairs_from_the_mix_analysis():
-    given = [{"part_a": "a", "part_b": "b", "states_a": [0, 1], "states_b": [2],
-              "reason": "same push-diameter function"}]
+    given = [
+        {
+            "part_a": "a",
+            "part_b": "b",
+            "states_a": [0, 1],
+            "states_b": [2],
+            "reason": "same push-diameter function",
+        }
+    ]
     doc = parse(render_report(triangle_plan(), unrecognizable=given))
     assert [p["data-source"] for p in doc.with_class("pair")] == ["mix"]
     text = "".join(doc.text)
     assert "same push-diameter function" in text
     assert "a: s0, s1; b: s2" in text  # unequal lists are shown side by side
-    paired = [{"part_a": "a", "part_b": "b", "states_a": [0, 1], "states_b": [2, 0],
-               "reason": "r"}]
+    paired = [{"part_a": "a", "part_b": "b", "states_a": [0, 1], "states_b": [2, 0], "reason": "r"}]
     assert "a s0 ~ b s2, a s1 ~ b s0" in "".join(
         parse(render_report(triangle_plan(), unrecognizable=paired)).text
     )
@@ -288,8 +317,9 @@ def test_unrecognizable_pairs_from_the_mix_analysis():
 
 def test_outlines_draw_holes():
     plan = rectangle_plan()
-    outline = make_outline("rect", RECT, [[(0.2, 0.2), (0.6, 0.2), (0.6, 0.6), (0.2, 0.6)]],
-                           com=(1, 0.5))
+    outline = make_outline(
+        "rect", RECT, [[(0.2, 0.2), (0.6, 0.2), (0.6, 0.6), (0.2, 0.6)]], com=(1, 0.5)
+    )
     with_holes = render_report(plan, outlines={"rect": outline})
     paths = re.findall(r'<path d="([^"]*)" fill="#', with_holes)
     assert paths and all(d.count("M ") == 2 for d in paths)
@@ -351,8 +381,9 @@ def test_report_command_writes_the_page(tmp_path):
     plan = tmp_path / "plan.json"
     plan.write_text(json.dumps(triangle_plan()))
     out = tmp_path / "report.html"
-    res = CliRunner().invoke(cli_app(), ["report", str(plan), "-o", str(out),
-                                         "--seconds-per-op", "3"])
+    res = CliRunner().invoke(
+        cli_app(), ["report", str(plan), "-o", str(out), "--seconds-per-op", "3"]
+    )
     assert res.exit_code == 0, res.output
     assert str(out) in res.output
     assert out.read_text().startswith("<!DOCTYPE html>")
@@ -371,10 +402,15 @@ def test_report_command_through_the_feederkit_entry_point(tmp_path):
     plan = tmp_path / "plan.json"
     plan.write_text("not json")
     code = subprocess.run(
-        [sys.executable, "-c",
-         "import sys; from feederkit.cli.app import main; "
-         f"sys.exit(main(['report', {str(plan)!r}, '-o', {str(tmp_path / 'r.html')!r}]))"],
-        capture_output=True, text=True, timeout=120,
+        [
+            sys.executable,
+            "-c",
+            "import sys; from feederkit.cli.app import main; "
+            f"sys.exit(main(['report', {str(plan)!r}, '-o', {str(tmp_path / 'r.html')!r}]))",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert code.returncode == 2
     assert "not valid JSON" in code.stderr and "Traceback" not in code.stderr

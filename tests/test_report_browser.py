@@ -72,8 +72,14 @@ def no_network_prefix() -> tuple[str, ...]:
 def chromium(tmp_path: Path, page: Path, *args: str) -> subprocess.CompletedProcess[str]:
     profile = tmp_path / f"profile-{len(list(tmp_path.iterdir()))}"
     profile.mkdir()
-    cmd = [*no_network_prefix(), CHROMIUM, *FLAGS, f"--user-data-dir={profile}", *args,
-           page.resolve().as_uri()]
+    cmd = [
+        *no_network_prefix(),
+        CHROMIUM,
+        *FLAGS,
+        f"--user-data-dir={profile}",
+        *args,
+        page.resolve().as_uri(),
+    ]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
     assert done.returncode == 0, done.stderr[-2000:]
     return done

@@ -1,6 +1,6 @@
 """``feederkit plan SOURCE...``: a verified orienting plan for one part or a product mix.
 
-A thin layer: resolve the parts, choose the sensor, call :func:`feederkit.plans.make.make_plan`
+A thin layer: resolve the parts, choose the sensor, call :func:`feederkit.mix.changeover.plan_mix`
 (planner, plan file, verification), write the plan and the report, print the tree.
 """
 
@@ -33,9 +33,9 @@ from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import write_text_atomic
 from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
-from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
+from feederkit.mix.changeover import plan_mix
+from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import write_plan
-from feederkit.plans.make import make_plan
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.render import plan_tree, sensor_text, stats_table
 from feederkit.sensors import make_sensor
@@ -162,7 +162,7 @@ def plan_command(
     for w in warnings:
         err_console.print(f"warning: {w}", highlight=False, markup=False)
     with err_console.status("planning and verifying ..."):
-        made = make_plan(
+        made, witnesses = plan_mix(
             pfs,
             sensor,
             objective=objective,
@@ -170,7 +170,6 @@ def plan_command(
             grouping=grouping,
             time_limit=time_limit,
         )
-        witnesses = unrecognizable_pairs(pfs, sensor) if len(pfs) > 1 else []
     plan = made.plan
     write_plan_and_report(plan, pfs, witnesses, output, report)
     if json_out:

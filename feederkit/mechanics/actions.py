@@ -31,17 +31,15 @@ class ActionRange:
 
 
 @dataclass(frozen=True)
-class OverlapRange:
-    """A cell of the overlap of several states' action ranges (section 3.2.2).
+class RotationRange:
+    """Rotations ``lo < a < hi`` (deg; ``hi`` may pass 360) that all have the same result.
 
-    ``targets[k]`` is where the k-th state of the set goes for any rotation in ``(lo, hi)``;
-    ``representative`` is the middle of the range and ``margin`` its half-width: the rotation
-    error the action tolerates.
+    A plan rotates by the ``representative``, the middle; the ``margin``, the half-width, is
+    the rotation error the action tolerates.
     """
 
     lo: float
     hi: float
-    targets: tuple[int, ...]
 
     @property
     def representative(self) -> float:
@@ -52,6 +50,16 @@ class OverlapRange:
     def margin(self) -> float:
         """Half the width of the range (deg)."""
         return (self.hi - self.lo) / 2.0
+
+
+@dataclass(frozen=True)
+class OverlapRange(RotationRange):
+    """A cell of the overlap of several states' action ranges (section 3.2.2).
+
+    ``targets[k]`` is where the k-th state of the set goes for any rotation in ``(lo, hi)``.
+    """
+
+    targets: tuple[int, ...]
 
 
 def action_ranges(pf: PushFunction, state: int) -> tuple[ActionRange, ...]:

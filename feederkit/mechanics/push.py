@@ -103,9 +103,7 @@ def _normals(hull: Hull) -> np.ndarray:
     return out
 
 
-def _foot_angles(
-    hull: Hull, com: tuple[float, float]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _foot_angles(hull: Hull, com: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per edge: the angles (deg), seen from the COM, from the edge's normal to its start and end.
 
     Positive when the COM's foot lies on the edge's side of that end, zero when metastable

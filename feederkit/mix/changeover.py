@@ -75,6 +75,30 @@ def load_mix(
     return pfs, revisions
 
 
+def plan_mix(
+    parts: Sequence[PushFunction],
+    sensor: SensorModel,
+    *,
+    objective: str = "worst",
+    min_margin: float = 0.0,
+    grouping: str = "exact",
+    time_limit: float | None = None,
+) -> tuple[MadePlan, list[PairWitness]]:
+    """A verified plan for one part or a mix (section 8.5), and the pairs of parts no plan
+    can tell apart (section 8.4), each with its witness.
+    """
+    made = make_plan(
+        parts,
+        sensor,
+        objective=objective,
+        min_margin=min_margin,
+        grouping=grouping,
+        time_limit=time_limit,
+    )
+    witnesses = unrecognizable_pairs(parts, sensor) if len(parts) > 1 else []
+    return made, witnesses
+
+
 def compile_changeover(
     catalog: Path,
     name: str,
@@ -95,7 +119,7 @@ def compile_changeover(
     if not replace and any(c.name == name for c in list_changeovers(catalog)):
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
     pfs, revisions = load_mix(catalog, members)
-    made = make_plan(
+    made, witnesses = plan_mix(
         pfs,
         sensor,
         objective=objective,
@@ -103,7 +127,6 @@ def compile_changeover(
         grouping=grouping,
         time_limit=time_limit,
     )
-    witnesses = unrecognizable_pairs(pfs, sensor) if len(pfs) > 1 else []
     save_changeover(
         catalog, name, revisions, sensor_to_dict(sensor), plan_json(made.plan), replace=replace
     )

@@ -22,6 +22,7 @@ from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from feederkit.machine import prune_pairs
 from feederkit.mechanics.actions import action_ranges, merge_boundaries
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
@@ -135,12 +136,7 @@ def inseparable_cross_pairs(
                 dead.append((i, j))
                 break
             preds[q].append((i, j))
-    while dead:
-        p = dead.pop()
-        if p not in alive:
-            continue
-        alive.discard(p)
-        dead.extend(q for q in preds.get(p, ()) if q in alive)
+    prune_pairs(alive, dead, preds)
     return sorted(alive)
 
 

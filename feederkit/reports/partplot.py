@@ -63,8 +63,14 @@ def _shade_ranges(ax: Axes, pf: PushFunction, label: bool) -> None:
             ax.axvspan(a, b, color=state_colour(s.id), alpha=0.10, lw=0)
             if label and b - a > 12.0:
                 ax.text(
-                    (a + b) / 2, 1.0, f"s{s.id}", transform=ax.get_xaxis_transform(),
-                    ha="center", va="bottom", fontsize=8, color=state_colour(s.id),
+                    (a + b) / 2,
+                    1.0,
+                    f"s{s.id}",
+                    transform=ax.get_xaxis_transform(),
+                    ha="center",
+                    va="bottom",
+                    fontsize=8,
+                    color=state_colour(s.id),
                 )
     for d in pf.divergent_deg:
         ax.axvline(d, color="#555", lw=0.8, ls=":")
@@ -105,8 +111,14 @@ def _draw_outline(ax: Axes, pf: PushFunction) -> None:
         u = np.array([np.cos(np.radians(normals[s.edge])), np.sin(np.radians(normals[s.edge]))])
         tx, ty = mid + 0.09 * size * u
         ax.text(
-            tx, ty, f"s{s.id} e{s.edge}", ha="center", va="center", fontsize=8,
-            color=state_colour(s.id), fontweight="bold",
+            tx,
+            ty,
+            f"s{s.id} e{s.edge}",
+            ha="center",
+            va="center",
+            fontsize=8,
+            color=state_colour(s.id),
+            fontweight="bold",
         )
     stable_edges = {s.edge for s in pf.states}
     for e in range(n):
@@ -114,8 +126,15 @@ def _draw_outline(ax: Axes, pf: PushFunction) -> None:
             mid = (np.array(part.hull[e]) + np.array(part.hull[(e + 1) % n])) / 2
             u = np.array([np.cos(np.radians(normals[e])), np.sin(np.radians(normals[e]))])
             tx, ty = mid + 0.07 * size * u
-            ax.text(tx, ty, f"e{e} {pf.edge_kinds[e]}", ha="center", va="center", fontsize=7,
-                    color="#777")
+            ax.text(
+                tx,
+                ty,
+                f"e{e} {pf.edge_kinds[e]}",
+                ha="center",
+                va="center",
+                fontsize=7,
+                color="#777",
+            )
     ax.plot([part.com[0]], [part.com[1]], "o", color="black", ms=5, label="COM")
     xs = [p[0] for p in part.hull]
     ys = [p[1] for p in part.hull]
@@ -160,8 +179,13 @@ def _draw_push(ax: Axes, pf: PushFunction) -> None:
 def _draw_push_diameter(ax: Axes, pf: PushFunction) -> None:
     for s in pf.states:
         for a, b in _arcs(*s.resting_range_deg):
-            ax.plot([a, b], [s.diameter, s.diameter], color=state_colour(s.id), lw=2.2,
-                    solid_capstyle="butt")
+            ax.plot(
+                [a, b],
+                [s.diameter, s.diameter],
+                color=state_colour(s.id),
+                lw=2.2,
+                solid_capstyle="butt",
+            )
         (m,) = ax.plot([norm360(s.normal_deg)], [s.diameter], "x", color="black", ms=7, mew=1.6)
         m.set_gid(f"stable-orientation-{s.id}")
     _shade_ranges(ax, pf, label=False)

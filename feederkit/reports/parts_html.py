@@ -33,8 +33,13 @@ def _states_table(entry: PartEntry, draw: Drawing) -> str:
     rows = []
     for s in entry.states:
         svg = pose_svg(
-            draw.rings.get(entry.name, [entry.hull]), entry.hull, entry.com, s.pose_deg,
-            radius_mm=draw.radius_mm, colour=draw.colours[entry.name], px=POSE_PX,
+            draw.rings.get(entry.name, [entry.hull]),
+            entry.hull,
+            entry.com,
+            s.pose_deg,
+            radius_mm=draw.radius_mm,
+            colour=draw.colours[entry.name],
+            px=POSE_PX,
             title=f"{entry.name}, state {s.id} on the fence",
         )
         lo, hi = s.resting_range_deg

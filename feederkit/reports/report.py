@@ -43,7 +43,7 @@ def _tree_section(view: PlanView, tree: str) -> str:
     n_leaves = len(leaves(view.root))
     return (
         f'<section id="plan-tree" data-nodes="{n_nodes}" data-leaves="{n_leaves}">'
-        "<h2>The plan</h2><p class=\"muted\">Each box is a plan node with the states the part "
+        '<h2>The plan</h2><p class="muted">Each box is a plan node with the states the part '
         "may be in, drawn on the fence. Each edge says the rotation the robot applies and the "
         "reading that leads there. Shaded boxes are the final poses: green one known pose, blue "
         "poses alike up to symmetry, red parts the plan cannot tell apart.</p>"

@@ -31,6 +31,7 @@ CONVENTIONS = (
 )
 """The conventions paragraph (design.md), used when the plan file carries none."""
 
+
 def sensor_text(sensor: Mapping[str, Any]) -> str:
     """The sensor model and its parameters, for people."""
     model = sensor_from_dict(dict(sensor))
@@ -135,9 +136,7 @@ def _states(ids: Sequence[object]) -> str:
 def _pairing(a: str, b: str, states_a: Sequence[object], states_b: Sequence[object]) -> str:
     """``a s0 ~ b s2, ...`` when the states pair up one to one, else both lists."""
     if states_a and len(states_a) == len(states_b):
-        return ", ".join(
-            f"{a} s{i} ~ {b} s{j}" for i, j in zip(states_a, states_b, strict=True)
-        )
+        return ", ".join(f"{a} s{i} ~ {b} s{j}" for i, j in zip(states_a, states_b, strict=True))
     return f"{a}: {_states(states_a)}; {b}: {_states(states_b)}"
 
 
@@ -149,9 +148,7 @@ def _plan_rows(confusions: Sequence[Confusion]) -> list[str]:
     rows = []
     for (a, b), cs in grouped.items():
         states = "; ".join(_pairing(a, b, c.states_a, c.states_b) for c in cs)
-        paths = "".join(
-            f"<li>leaf {c.node_id}: {esc(path_text(c.path))}</li>" for c in cs
-        )
+        paths = "".join(f"<li>leaf {c.node_id}: {esc(path_text(c.path))}</li>" for c in cs)
         rows.append(
             f'<tr class="pair" data-source="plan"><td>{esc(a)}</td><td>{esc(b)}</td>'
             f"<td>{esc(states)}</td><td>the plan ends with both at<ul>{paths}</ul></td></tr>"
@@ -169,7 +166,7 @@ def _given_rows(given: Sequence[Mapping[str, Any]]) -> list[str]:
         states = _pairing(a, b, list(pair.get("states_a") or []), list(pair.get("states_b") or []))
         rows.append(
             f'<tr class="pair" data-source="mix"><td>{esc(a)}</td><td>{esc(b)}</td>'
-            f'<td>{esc(states)}</td><td>{esc(pair.get("reason", ""))}</td></tr>'
+            f"<td>{esc(states)}</td><td>{esc(pair.get('reason', ''))}</td></tr>"
         )
     return rows
 
@@ -190,8 +187,11 @@ def lookalike_section(
         body = "<p>Every part of the mix is recognized: no leaf of the plan holds two parts.</p>"
     else:
         body = "<p>One part only: nothing to recognize.</p>"
-    sym = [leaf for leaf in leaves(view.root) if len({r.part for r in leaf.results}) == 1
-           and len(leaf.results) > 1]
+    sym = [
+        leaf
+        for leaf in leaves(view.root)
+        if len({r.part for r in leaf.results}) == 1 and len(leaf.results) > 1
+    ]
     if sym:
         items = "".join(
             f"<li>{esc(leaf.results[0].part)}: states "

@@ -75,8 +75,14 @@ def _state_figure(
     pose_deg = state.pose_deg if pose is None else pose
     title = f"{name}, state {sid} (edge {state.edge}) on the fence, pose {num(pose_deg, 1)} deg"
     svg = pose_svg(
-        draw.rings.get(name, [part.hull]), part.hull, part.com, pose_deg,
-        radius_mm=draw.radius_mm, colour=draw.colours[name], px=px, title=title,
+        draw.rings.get(name, [part.hull]),
+        part.hull,
+        part.com,
+        pose_deg,
+        radius_mm=draw.radius_mm,
+        colour=draw.colours[name],
+        px=px,
+        title=title,
     )
     return (
         f'<figure class="{cls}" data-part="{esc(name)}" data-state="{sid}" '
@@ -156,9 +162,7 @@ def _result_node(view: PlanView, trace: Trace, draw: Drawing, node: ResultNode) 
 def _subtree(view: PlanView, trace: Trace, draw: Drawing, node: Node, edge: str) -> str:
     if isinstance(node, ResultNode):
         return f"<li>{edge}{_result_node(view, trace, draw, node)}</li>"
-    children = "".join(
-        _subtree(view, trace, draw, b.next, _edge(node, b)) for b in node.branches
-    )
+    children = "".join(_subtree(view, trace, draw, b.next, _edge(node, b)) for b in node.branches)
     return f"<li>{edge}{_op_node(view, trace, draw, node)}<ul>{children}</ul></li>"
 
 
