@@ -15,7 +15,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from feederkit.errors import InputError
+from feederkit.errors import InputError, PlanningError
 from feederkit.jsonio import read_json, write_text_atomic
 from feederkit.machine import Branch, PushAlignMachine, members
 from feederkit.mechanics.push import PushFunction
@@ -111,12 +111,38 @@ def _node_dict(machine: PushAlignMachine, parts: Sequence[PushFunction], node: S
     }
 
 
+MAX_FILE_NODES = 100_000
+"""A plan whose file would hold more nodes than this is refused: no controller wants it."""
+
+
+def file_nodes(root: Step | Leaf) -> int:
+    """How many nodes the plan file holds once shared subtrees are written out in full.
+
+    Counted on the planner's shared structure (each distinct node once), so a plan whose
+    written tree would be astronomically large is measured without being built.
+    """
+    memo: dict[int, int] = {}
+
+    def count(node: Step | Leaf) -> int:
+        key = id(node)
+        if key not in memo:
+            memo[key] = (
+                1 if isinstance(node, Leaf) else 1 + sum(count(nxt) for _b, nxt in node.branches)
+            )
+        return memo[key]
+
+    return count(root)
+
+
 def plan_to_dict(result: PlanResult, parts: Sequence[PushFunction]) -> dict[str, Any]:
     """The plan file's JSON object for a planner's result on the machine of ``parts`` (in order).
 
     ``parts`` are the push functions the machine was built from (``build_machine``): the file
     records each part's hull and COM, so the plan can be checked on the geometry alone.
-    Raises InputError when two parts share a name (results name their part).
+    Raises InputError when two parts share a name (results name their part) and
+    PlanningError when the written tree would exceed MAX_FILE_NODES nodes (a plan found
+    under a time limit for a part whose states nearly all read alike can share subtrees
+    that would expand beyond any file).
     """
     machine = result.machine
     names = [pf.part.name for pf in parts]
@@ -125,6 +151,15 @@ def plan_to_dict(result: PlanResult, parts: Sequence[PushFunction]) -> dict[str,
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise InputError(f"two parts of the mix are both named {dup!r}: a plan names its parts")
+    size = file_nodes(result.root)
+    if size > MAX_FILE_NODES:
+        found = f"the plan found ({result.length} operations"
+        if not result.optimal:
+            found += f", not proven optimal; a plan needs at least {result.lower_bound}"
+        raise PlanningError(
+            f"{found}) would write {size:.3g} nodes, more than {MAX_FILE_NODES:,}: give the "
+            "planner more --time-limit, use a finer sensor, or set a --min-margin"
+        )
     return {
         "format": FORMAT,
         "version": VERSION,
