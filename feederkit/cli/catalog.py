@@ -30,6 +30,7 @@ from feederkit.catalog import (
     remove_part,
     revision_history,
 )
+from feederkit.cli.catalog_analyze import analyze_command
 from feederkit.cli.common import (
     CatalogOpt,
     JsonOpt,
@@ -486,12 +487,6 @@ catalog_app.command("export")(cmd_export)
 
 
 def register(app: typer.Typer) -> None:
-    """Add the ``catalog`` command group (with ``analyze`` once it exists) to the app."""
-    try:
-        from feederkit.cli.catalog_analyze import analyze_command
-    except ModuleNotFoundError as exc:
-        if exc.name != "feederkit.cli.catalog_analyze":
-            raise
-    else:
-        catalog_app.command("analyze")(analyze_command)
+    """Add the ``catalog`` command group to the app."""
+    catalog_app.command("analyze")(analyze_command)
     app.add_typer(catalog_app, name="catalog")

@@ -24,6 +24,7 @@ from feederkit.cli.common import (
     err_console,
     print_json,
 )
+from feederkit.cli.part_plot import plot_command
 from feederkit.mechanics.analysis import (
     PartAnalysis,
     analysis_to_dict,
@@ -171,18 +172,7 @@ def analyze_command(
         _print_analysis(a)
 
 
-def _register_plot() -> None:
-    """``part plot``: wired here from :mod:`feederkit.cli.part_plot` when that module exists."""
-    try:
-        from feederkit.cli.part_plot import plot_command
-    except ModuleNotFoundError as exc:
-        if exc.name != "feederkit.cli.part_plot":
-            raise
-        return
-    part_app.command("plot")(plot_command)
-
-
-_register_plot()
+part_app.command("plot")(plot_command)
 
 
 def register(app: typer.Typer) -> None:
