@@ -97,6 +97,9 @@ def test_overlap_ranges_match_the_reference(machine):
             mid = ((lo + hi) / 2.0) % 360.0
             (a,) = [a for a in got if a.lo <= mid < a.hi or a.lo <= mid + 360.0 < a.hi]
             assert image(machine, mask, mid) == a.image
+        # Merged as far as it goes: neighbouring ranges (cyclically) differ in image.
+        if len(got) > 1:
+            assert all(got[k].image != got[k - 1].image for k in range(len(got)))
 
 
 def test_successor_follows_the_action_maps():
