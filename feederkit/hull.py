@@ -209,14 +209,13 @@ def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
     return refit if refit is not None else [ring[i] for i in kept]
 
 
-def number_hull(hull: Sequence[Point], length_tol: float = 0.0) -> tuple[Point, ...]:
+def number_hull(hull: Sequence[Point]) -> tuple[Point, ...]:
     """Rotate a counter-clockwise ring so vertex 0 is the lowest-then-leftmost vertex.
 
-    Vertices whose y is within ``length_tol`` of the lowest count as lowest.
+    Exact, as design.md states it (no tolerance): so a hull read back from a plan file is
+    numbered as it was written.
     """
-    ymin = min(p[1] for p in hull)
-    candidates = [i for i, p in enumerate(hull) if p[1] <= ymin + length_tol]
-    start = min(candidates, key=lambda i: (hull[i][0], hull[i][1]))
+    start = min(range(len(hull)), key=lambda i: (hull[i][1], hull[i][0]))
     return tuple(hull[start:]) + tuple(hull[:start])
 
 
@@ -232,7 +231,7 @@ def contact_hull(
     if len(raw) < 3:
         return tuple(raw)
     tol = REL_LENGTH_TOL * size_of(raw) if length_tol is None else length_tol
-    return number_hull(clean_hull(raw, tol), tol)
+    return number_hull(clean_hull(raw, tol))
 
 
 def point_in_convex(hull: Sequence[Point], p: Point, margin: float = 0.0) -> bool:

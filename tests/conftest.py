@@ -1,0 +1,22 @@
+"""Test-wide settings: hypothesis profiles (derandomized under CI) and the ``slow`` marker.
+
+The test directory is on ``sys.path`` through pytest's rootdir import mode, so helper modules
+(``shared``, ``fixtures_cad``, ``mix_oracle``) are imported by name. ``pytest`` runs the
+default suite; ``pytest -m slow`` the long end-to-end checks (``.ci/run`` runs both).
+"""
+
+from __future__ import annotations
+
+import os
+
+from hypothesis import HealthCheck, settings
+
+settings.register_profile(
+    "ci",
+    derandomize=True,
+    deadline=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile("dev", deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if os.environ.get("CI") else "dev"))

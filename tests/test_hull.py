@@ -1,0 +1,53 @@
+"""The contact hull is a fixpoint: a hull read back from a plan file is the hull written.
+
+A plan file carries each part's contact hull; whoever rebuilds the part from it (the
+verifier, the executor, reports) re-hulls it with tolerance 0, and must get the same
+vertices in the same numbering (design.md: vertex 0 is the lowest-then-leftmost, exactly).
+"""
+
+from __future__ import annotations
+
+import math
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from feederkit.hull import contact_hull, number_hull
+
+
+def _bulged_rectangle(bulge: float, points: int = 41) -> list[tuple[float, float]]:
+    """A 2 x 1 rectangle whose bottom edge sags by ``bulge`` mm over ``points`` points."""
+    bottom = [
+        (2.0 * i / (points - 1), -bulge * math.sin(math.pi * i / (points - 1)))
+        for i in range(points)
+    ]
+    return [*bottom, (2.0, 1.0), (0.0, 1.0)]
+
+
+def test_vertex_zero_is_the_lowest_then_leftmost_exactly() -> None:
+    ring = [(1.0, 1e-12), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0), (0.0, 1e-12)]
+    assert number_hull(ring)[0] == (2.0, 0.0)
+    assert number_hull([(0.0, 1.0), (0.0, 0.0), (1.0, 0.0)])[0] == (0.0, 0.0)
+
+
+def test_a_cleaned_hull_rehulled_with_tolerance_zero_is_unchanged() -> None:
+    hull = contact_hull(_bulged_rectangle(1e-8))
+    assert contact_hull(hull, 0.0) == hull
+
+
+@settings(max_examples=60)
+@given(
+    st.lists(
+        st.tuples(st.floats(-50, 50, allow_nan=False), st.floats(-50, 50, allow_nan=False)),
+        min_size=3,
+        max_size=40,
+    ),
+    st.sampled_from([None, 0.0, 1e-6, 1e-3, 0.05]),
+)
+def test_contact_hull_is_a_fixpoint_at_tolerance_zero(points, tol) -> None:
+    hull = contact_hull(points, tol)
+    if len(hull) < 3:
+        return
+    assert contact_hull(hull, 0.0) == hull
+    start = min(range(len(hull)), key=lambda i: (hull[i][1], hull[i][0]))
+    assert start == 0
