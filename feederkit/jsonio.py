@@ -9,8 +9,10 @@ a rename).
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 from feederkit.errors import InputError
@@ -24,24 +26,107 @@ def _reason(exc: BaseException) -> str:
     return type(exc).__name__
 
 
-def read_json(path: str | os.PathLike[str], what: str = "file") -> object:
+MAX_JSON_DEPTH = 512
+"""Arrays and objects nested deeper than this are refused: no feederkit file needs it (a plan
+node costs three levels), and deeper input would exhaust Python's recursion limit."""
+
+MAX_NUMBER_DIGITS = 400
+"""Integers with more digits than this are refused before Python converts them (its own limit
+is 4300 digits, and anything beyond 309 digits overflows a float anyway)."""
+
+
+class _BadNumber(ValueError):
+    """A JSON number feederkit cannot use: too large, not finite, or NaN."""
+
+
+def _parse_int(text: str) -> int | float:
+    digits = len(text.lstrip("-"))
+    if digits > MAX_NUMBER_DIGITS:
+        raise _BadNumber(f"an integer of {digits} digits is too large")
+    value = int(text)
+    if abs(value) > 1.7976931348623157e308:
+        raise _BadNumber(f"the integer {_clip(text)} is too large for a number")
+    return value
+
+
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise _BadNumber(f"the number {_clip(text)} is too large: NaN or infinite as a float")
+    return value
+
+
+def _parse_constant(text: str) -> float:
+    raise _BadNumber(f"{text}: a NaN or infinite number, which JSON does not allow")
+
+
+def _clip(text: str, n: int = 24) -> str:
+    return text if len(text) <= n else text[:n] + "..."
+
+
+def json_depth(value: object, limit: int) -> int:
+    """The nesting depth of a parsed JSON value (a scalar is 0), counted without recursion;
+    the count stops once it passes ``limit``."""
+    deepest = 0
+    stack: list[tuple[object, int]] = [(value, 0)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict):
+            children = item.values()
+        elif isinstance(item, list):
+            children = item
+        else:
+            continue
+        depth += 1
+        deepest = max(deepest, depth)
+        if deepest > limit:
+            return deepest
+        stack.extend((child, depth) for child in children if isinstance(child, dict | list))
+    return deepest
+
+
+def parse_json(text: str, where: str, max_depth: int = MAX_JSON_DEPTH) -> object:
+    """The JSON value of ``text``; invalid JSON, numbers no float can hold (over 400 digits,
+    1e400), ``NaN``/``Infinity`` and nesting deeper than ``max_depth`` are bad input naming
+    ``where`` on one line."""
+    try:
+        value = json.loads(
+            text,
+            parse_int=_parse_int,
+            parse_float=_parse_float,
+            parse_constant=_parse_constant,
+        )
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{where}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    except _BadNumber as exc:
+        raise InputError(f"{where}: not valid JSON for feederkit ({exc})") from None
+    except RecursionError:
+        raise InputError(f"{where}: not valid JSON (nested deeper than {max_depth})") from None
+    except (ValueError, OverflowError) as exc:  # int() refusing a number, float overflow
+        raise InputError(f"{where}: not valid JSON for feederkit ({exc})") from None
+    if json_depth(value, max_depth) > max_depth:
+        raise InputError(f"{where}: not valid JSON for feederkit (nested deeper than {max_depth})")
+    return value
+
+
+def read_json(
+    path: str | os.PathLike[str], what: str = "file", *, max_depth: int = MAX_JSON_DEPTH
+) -> object:
     """The JSON value in ``path``; a missing, unreadable or invalid file is bad input.
 
-    ``what`` names the file in the message: ``<path>: no such <what>``.
+    ``what`` names the file in the message: ``<path>: no such <what>``. Numbers must fit a
+    float and be finite, and nesting is limited to ``max_depth`` (see :func:`parse_json`).
     """
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputError(f"{p}: no such {what}") from None
+    except IsADirectoryError:
+        raise InputError(f"{p}: cannot read the {what} (a folder, not a file)") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{p}: cannot read the {what} ({_reason(exc)})") from None
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    except RecursionError:
-        raise InputError(f"{p}: not valid JSON (nested too deeply)") from None
+    return parse_json(text, str(p), max_depth)
 
 
 def _umask() -> int:
@@ -87,3 +172,43 @@ def write_bytes_atomic(
 def write_text_atomic(path: str | os.PathLike[str], text: str, *, what: str = "file") -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically; an unwritable path is bad input."""
     write_bytes_atomic(path, text.encode("utf-8"), what=what)
+
+
+def write_all_atomic(files: Sequence[tuple[str | os.PathLike[str], bytes, str]]) -> None:
+    """Write several files as one effect: each ``(path, data, what)`` goes to a temporary file
+    beside its target first; only when all were written are they renamed, in order.
+
+    A failure while writing (disk full, unwritable folder) removes every temporary and leaves
+    every target as it was; that covers ``plan -o PLAN --report REPORT`` writing both or
+    neither. Errors are bad input naming the file: ``<path>: cannot write the <what> (...)``.
+    """
+    mode = 0o666 & ~_umask()
+    staged: list[tuple[str, Path]] = []
+    try:
+        for path, data, what in files:
+            target = Path(path)
+            if target.is_dir():
+                raise InputError(f"{path}: cannot write the {what} (a folder is there)")
+            directory = target.parent if str(target.parent) else Path(".")
+            try:
+                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+            except OSError as exc:
+                raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
+            staged.append((tmp, target))
+            try:
+                with os.fdopen(fd, "wb") as fh:
+                    os.fchmod(fh.fileno(), mode)
+                    fh.write(data)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+            except OSError as exc:
+                raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
+        for tmp, target in staged:
+            try:
+                os.replace(tmp, target)
+            except OSError as exc:
+                raise InputError(f"{target}: cannot write the file ({_reason(exc)})") from None
+    finally:
+        for tmp, _ in staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)

@@ -187,7 +187,7 @@ def bad_files(tmp_path: Path) -> dict[str, tuple[Path, list[str], str]]:
         "open": (fx.write_entities(tmp_path / "open.dxf", open_square), [], "no closed outline"),
         "zero area": (fx.write_entities(tmp_path / "zero.dxf", zero_area), [], "zero area"),
         "unit": (fx.write_plate(tmp_path / "plate.dxf"), ["--units", "furlong"], "unknown unit"),
-        "leaky mesh": (leaky, [], "not a closed volume"),
+        "leaky mesh": (leaky, [], "not a closed"),
         "over 50 MB": (big, [], "over the 50 MB limit"),
         "missing": (tmp_path / "missing.dxf", [], "no such file"),
     }

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from feederkit.errors import InputError
-from feederkit.jsonio import read_json, write_text_atomic
+from feederkit.jsonio import read_json, write_all_atomic, write_text_atomic
 
 
 def test_atomic_write_gives_the_permissions_of_a_plain_write(tmp_path: Path) -> None:
@@ -31,3 +31,86 @@ def test_unwritable_and_unreadable_paths_are_one_line_input_errors(tmp_path: Pat
     with pytest.raises(InputError) as exc:
         read_json(bad)
     assert "\n" not in str(exc.value) and "not valid JSON" in str(exc.value)
+
+
+@pytest.mark.parametrize(
+    ("text", "why"),
+    [
+        ('{"vertices": [[0, ' + "9" * 5000 + "]]}", "5000 digits"),
+        ('{"vertices": [[0, ' + "9" * 400 + "]]}", "too large for a number"),
+        ('{"x": 1e400}', "1e400 is too large"),
+        ('{"x": -1e400}', "-1e400 is too large"),
+        ('{"x": NaN}', "NaN: a NaN or infinite number"),
+        ('{"x": Infinity}', "Infinity: a NaN or infinite number"),
+        ("[" * 600 + "]" * 600, "nested deeper than 512"),
+        ("[" * 100_000 + "]" * 100_000, "nested deeper than 512"),
+    ],
+    ids=["4300-digit limit", "400 digits", "1e400", "-1e400", "NaN", "Infinity", "600", "1e5"],
+)
+def test_numbers_no_float_holds_and_deep_nesting_name_the_file(
+    tmp_path: Path, text: str, why: str
+) -> None:
+    bad = tmp_path / "part.json"
+    bad.write_text(text)
+    with pytest.raises(InputError) as exc:
+        read_json(bad)
+    message = str(exc.value)
+    assert "\n" not in message and message.startswith(f"{bad}: ") and why in message
+
+
+def test_ordinary_numbers_and_a_custom_depth(tmp_path: Path) -> None:
+    good = tmp_path / "ok.json"
+    good.write_text('{"a": [1, -2.5e3, 1e308, ' + "9" * 300 + "]}")
+    assert read_json(good) == {"a": [1, -2500.0, 1e308, int("9" * 300)]}
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 40 + "]" * 40)
+    assert read_json(deep, max_depth=40) == read_json(deep)
+    with pytest.raises(InputError, match=r"deep\.json: .*nested deeper than 32"):
+        read_json(deep, max_depth=32)
+
+
+def test_unreadable_files_are_named(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no such plan file"):
+        read_json(tmp_path / "none.json", "plan file")
+    with pytest.raises(InputError, match="a folder, not a file"):
+        read_json(tmp_path)
+    with pytest.raises(InputError, match="File name too long"):
+        read_json(tmp_path / ("p" * 300 + ".json"))
+    latin = tmp_path / "latin.json"
+    latin.write_bytes(b'{"name": "\xe9"}')
+    with pytest.raises(InputError, match="not UTF-8 text"):
+        read_json(latin)
+
+
+def test_several_files_are_written_together_or_not_at_all(tmp_path: Path) -> None:
+    plan, report = tmp_path / "plan.json", tmp_path / "report.html"
+    plan.write_text("old plan")
+    with pytest.raises(InputError) as exc:
+        write_all_atomic(
+            [(plan, b"new plan", "plan file"), (tmp_path / "gone" / "r.html", b"x", "report")]
+        )
+    assert "gone" in str(exc.value) and "cannot write the report" in str(exc.value)
+    (tmp_path / "folder.html").mkdir()
+    with pytest.raises(InputError, match="a folder is there"):
+        write_all_atomic([(plan, b"new plan", "plan file"), (tmp_path / "folder.html", b"x", "r")])
+    assert plan.read_text() == "old plan"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.html", "plan.json"]
+    write_all_atomic([(plan, b"new plan", "plan file"), (report, b"<html>", "report")])
+    assert plan.read_text() == "new plan" and report.read_text() == "<html>"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.html", "plan.json", "report.html"]
+
+
+def test_a_failed_write_in_the_middle_leaves_no_temporaries(tmp_path: Path, monkeypatch) -> None:
+    calls = []
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:
+        calls.append(fd)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    with pytest.raises(InputError, match=r"b\.json: cannot write the file \(No space left"):
+        write_all_atomic([(tmp_path / "a.json", b"1", "file"), (tmp_path / "b.json", b"2", "file")])
+    assert list(tmp_path.iterdir()) == []

@@ -18,8 +18,18 @@ from feederkit.catalog.model import (
     PartSummary,
     Revision,
     check_name,
+    could_be_part_name,
+    is_valid_name,
 )
-from feederkit.catalog.schema import SCHEMA_VERSION, connect, migrate, schema_version
+from feederkit.catalog.schema import (
+    DEFAULT_WAIT,
+    SCHEMA_VERSION,
+    connect,
+    migrate,
+    schema_version,
+    set_busy_notifier,
+    transaction,
+)
 from feederkit.catalog.store import (
     CATALOG_ENV,
     DEFAULT_CATALOG,
@@ -27,6 +37,7 @@ from feederkit.catalog.store import (
     add_file,
     add_outline,
     default_catalog_path,
+    did_you_mean,
     export_part,
     get_part,
     get_revision,
@@ -35,12 +46,15 @@ from feederkit.catalog.store import (
     part_from_revision,
     part_names,
     remove_part,
+    resolve_catalog_path,
     revision_history,
+    similar_names,
 )
 
 __all__ = [
     "CATALOG_ENV",
     "DEFAULT_CATALOG",
+    "DEFAULT_WAIT",
     "SCHEMA_VERSION",
     "AddOutcome",
     "CatalogLike",
@@ -53,12 +67,15 @@ __all__ = [
     "add_outline",
     "check_name",
     "connect",
+    "could_be_part_name",
     "default_catalog_path",
+    "did_you_mean",
     "export_part",
     "get_changeover",
     "get_part",
     "get_revision",
     "import_directory",
+    "is_valid_name",
     "list_changeovers",
     "list_parts",
     "migrate",
@@ -67,8 +84,12 @@ __all__ = [
     "part_names",
     "remove_changeover",
     "remove_part",
+    "resolve_catalog_path",
     "revision_history",
     "save_changeover",
     "schema_version",
+    "set_busy_notifier",
+    "similar_names",
     "source_files",
+    "transaction",
 ]

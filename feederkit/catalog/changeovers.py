@@ -4,13 +4,28 @@ from __future__ import annotations
 
 import json
 import sqlite3
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from feederkit.catalog.model import Changeover, ChangeoverInfo, check_name
+from feederkit.catalog.model import (
+    Changeover,
+    ChangeoverInfo,
+    check_name,
+    is_valid_name,
+    is_valid_text,
+    shown_name,
+)
 from feederkit.catalog.schema import transaction
-from feederkit.catalog.store import CatalogLike, _conn, current_user, now_utc
+from feederkit.catalog.store import (
+    CatalogLike,
+    _conn,
+    _similar,
+    current_user,
+    did_you_mean,
+    now_utc,
+)
 from feederkit.errors import InputError
+from feederkit.jsonio import parse_json
 
 
 def _revision_id(conn: sqlite3.Connection, name: str, revision: int) -> int:
@@ -33,11 +48,15 @@ def save_changeover(
     *,
     replace: bool = False,
     created_by: str | None = None,
+    before_commit: Callable[[], None] | None = None,
 ) -> ChangeoverInfo:
     """Store a changeover in one transaction: the mix's exact revisions, sensor, and plan JSON.
 
-    An existing name is refused unless ``replace``. Raises InputError for unknown parts or
-    revisions, an empty mix, a part listed twice, or a plan that is not JSON.
+    ``before_commit`` runs inside that transaction once the rows are written: write the plan
+    and report files there, so that the changeover is committed only when they were written
+    and nothing is stored when writing them raises. An existing name is refused unless
+    ``replace``. Raises InputError for unknown parts or revisions, an empty mix, a part listed
+    twice, a plan that is not JSON, or a catalog error (busy, read-only, disk full).
     """
     check_name(name, "changeover")
     mix = [(str(n), int(r)) for n, r in part_revisions]
@@ -54,7 +73,7 @@ def save_changeover(
             f"changeover {name!r}: the sensor or plan is not valid JSON ({exc})"
         ) from None
     who, when = created_by or current_user(), now_utc()
-    with _conn(catalog) as conn, transaction(conn):
+    with _conn(catalog) as conn, transaction(conn, before_commit=before_commit):
         ids = [_revision_id(conn, n, r) for n, r in mix]
         old = conn.execute("SELECT id FROM changeovers WHERE name = ?", (name,)).fetchone()
         if old is not None:
@@ -75,18 +94,38 @@ def save_changeover(
 
 
 def _info(conn: sqlite3.Connection, row: Sequence[Any]) -> ChangeoverInfo:
+    """A stored changeover's info, checked: a damaged row is one InputError naming it."""
     parts = conn.execute(
         "SELECT p.name, r.revision FROM changeover_parts cp JOIN revisions r "
         "ON r.id = cp.revision_id JOIN parts p ON p.id = r.part_id "
         "WHERE cp.changeover_id = ? ORDER BY cp.position",
         (row[0],),
     ).fetchall()
+    name = row[1]
+    try:
+        if not is_valid_name(name):
+            raise InputError("the name is not a valid changeover name")
+        for text in (row[2], row[3]):
+            if not isinstance(text, str) or not is_valid_text(text):
+                raise InputError("created_at or created_by is not UTF-8 text")
+        if not all(is_valid_name(n) and isinstance(r, int) for n, r in parts):
+            raise InputError("a part of its mix has a damaged name or revision")
+        if not isinstance(row[4], str) or not is_valid_text(row[4]):
+            raise InputError("sensor_json is not UTF-8 text")
+        sensor = parse_json(row[4], "sensor_json")
+        if not isinstance(sensor, dict):
+            raise InputError("sensor_json is not a JSON object")
+    except InputError as exc:
+        raise InputError(
+            f"changeover {shown_name(name)}: the stored data is damaged ({exc}); remove it "
+            "with 'feederkit changeover remove NAME' and compile it again"
+        ) from None
     return ChangeoverInfo(
-        name=row[1],
+        name=name,
         created_at=row[2],
         created_by=row[3],
         parts=tuple((n, int(r)) for n, r in parts),
-        sensor=json.loads(row[4]),
+        sensor=sensor,
     )
 
 
@@ -99,8 +138,16 @@ def get_changeover(catalog: CatalogLike, name: str) -> Changeover:
             (name,),
         ).fetchone()
         if row is None:
-            raise InputError(f"no changeover named {name!r} in the catalog")
-        return Changeover(info=_info(conn, row), plan_json=row[5])
+            names = [r[0] for r in conn.execute("SELECT name FROM changeovers")]
+            hint = did_you_mean(_similar([n for n in names if is_valid_name(n)], name))
+            raise InputError(f"no changeover named {name!r} in the catalog{hint}")
+        info = _info(conn, row)
+        if not isinstance(row[5], str) or not is_valid_text(row[5]):
+            raise InputError(
+                f"changeover {name!r}: the stored plan is not UTF-8 text; remove it with "
+                "'feederkit changeover remove NAME' and compile it again"
+            )
+        return Changeover(info=info, plan_json=row[5])
 
 
 def list_changeovers(catalog: CatalogLike) -> list[ChangeoverInfo]:

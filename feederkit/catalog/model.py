@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import unicodedata
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -16,15 +17,87 @@ NAME_RE = re.compile(r"^[^\s@/\\\-\x00-\x1f][^@/\\\x00-\x1f]{0,199}$")
 """Part and changeover names: 1-200 characters, no '@', '/', '\\' or control characters,
 not starting with '-' or a space ('@' separates a revision: ``bracket@2``)."""
 
+MAX_NAME_BYTES = 240
+"""A name's UTF-8 bytes: names become file names (``NAME.json``, ``NAME.plan.json``) and file
+systems hold 255 bytes per name, so 240 leaves room for the suffix."""
+
+_INVISIBLE_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
+"""Control, format (bidi overrides, zero-width), surrogate, private, unassigned, line and
+paragraph separators: characters that hide or reorder what a name shows."""
+
+
+def _name_problem(name: object) -> str | None:
+    """Why ``name`` is not a valid catalog name, or None."""
+    if not isinstance(name, str):
+        return "not text"
+    if name in (".", ".."):
+        return "'.' and '..' name folders"
+    if name != name.strip():
+        return "surrounding spaces"
+    for ch in name:
+        category = unicodedata.category(ch)
+        if category in _INVISIBLE_CATEGORIES:
+            return f"the invisible or control character U+{ord(ch):04X} ({category})"
+        if category == "Zs" and ch != " ":
+            return f"the space character U+{ord(ch):04X} (only plain spaces are allowed)"
+    if not NAME_RE.match(name):
+        return "1-200 characters, no '@', '/', '\\', no leading '-'"
+    size = len(name.encode("utf-8"))
+    if size > MAX_NAME_BYTES:
+        return (
+            f"{size} bytes in UTF-8, more than the {MAX_NAME_BYTES} a file name can hold "
+            "(file systems allow 255 bytes)"
+        )
+    return None
+
 
 def check_name(name: str, what: str = "part") -> str:
-    """Return ``name`` when it is a valid catalog name, else raise InputError."""
-    if not isinstance(name, str) or not NAME_RE.match(name) or name != name.strip():
-        raise InputError(
-            f"invalid {what} name {name!r}: 1-200 characters, no '@', '/', '\\', "
-            "no leading '-' or surrounding spaces"
-        )
+    """Return ``name`` when it is a valid catalog name, else raise InputError.
+
+    Valid: 1-200 characters and at most 240 UTF-8 bytes (names are used as file names), no
+    '@', '/', '\\', no leading '-', no surrounding spaces, not '.' or '..', and no control,
+    bidi-override or zero-width characters.
+    """
+    problem = _name_problem(name)
+    if problem is not None:
+        shown = repr(_clip(name)) if isinstance(name, str) else type(name).__name__
+        raise InputError(f"invalid {what} name {shown}: {problem}")
     return name
+
+
+def is_valid_name(name: object) -> bool:
+    """Whether ``name`` could name a catalog part or changeover (see :func:`check_name`)."""
+    return _name_problem(name) is None
+
+
+FILE_SUFFIXES = (".json", ".dxf", ".stl", ".obj", ".ply")
+"""Suffixes of source files (docs/import.md): a SOURCE ending so names a file."""
+
+
+def could_be_part_name(source: str) -> bool:
+    """Whether a SOURCE that is not an existing file could be a catalog name (``NAME`` or
+    ``NAME@REV``); when not (a path with '/', a file suffix, an invalid name) it is a missing
+    file and should be reported as one."""
+    name = re.sub(r"@[0-9]+$", "", source)
+    return is_valid_name(name) and not name.lower().endswith(FILE_SUFFIXES)
+
+
+def is_valid_text(text: str) -> bool:
+    """Whether ``text`` read from the catalog is UTF-8 (bad bytes come back as surrogates)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def shown_name(name: object) -> str:
+    """A name as it is safe to print on one line: itself when valid, else its ``repr``."""
+    return name if isinstance(name, str) and is_valid_name(name) else repr(name)
+
+
+def _clip(text: str, n: int = 40) -> str:
+    return text if len(text) <= n else text[:n] + "..."
 
 
 @dataclass(frozen=True)
@@ -77,6 +150,8 @@ class AddOutcome:
     source_path: str
     orientable: bool
     warnings: tuple[str, ...]
+    changes: tuple[str, ...] = ()
+    """For ``revised``: what changed against the previous latest revision (file, options)."""
 
 
 @dataclass(frozen=True)

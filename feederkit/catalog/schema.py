@@ -6,9 +6,10 @@ transaction and bumps ``user_version``, so a catalog is always at one known vers
 
 from __future__ import annotations
 
+import os
 import sqlite3
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 from feederkit.errors import InputError
@@ -75,16 +76,162 @@ MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1,)
 SCHEMA_VERSION = len(MIGRATIONS)
 
 
+DEFAULT_WAIT = 10.0
+"""Seconds a command waits for another process's write transaction (``--wait``)."""
+
+_FIRST_TRY_MS = 200
+"""A busy catalog is retried silently this long (at most a quarter of the wait) before the
+wait is announced."""
+
+_busy_notifier: Callable[[str], None] | None = None
+
+
+def set_busy_notifier(notify: Callable[[str], None] | None) -> None:
+    """Who hears "the catalog is busy, waiting": the command line prints it on stderr.
+
+    The library itself never prints; without a notifier the wait is silent.
+    """
+    global _busy_notifier
+    _busy_notifier = notify
+
+
+class CatalogConnection(sqlite3.Connection):
+    """A catalog connection that knows its file and how long to wait for a busy catalog."""
+
+    path: Path = Path("?")
+    wait: float = DEFAULT_WAIT
+
+
+def catalog_file_of(conn: sqlite3.Connection) -> Path:
+    """The file behind a connection (for messages)."""
+    if isinstance(conn, CatalogConnection):
+        return conn.path
+    try:
+        return Path(conn.execute("PRAGMA database_list").fetchone()[2] or "?")
+    except sqlite3.Error:
+        return Path("?")
+
+
+def _writable_dir(p: Path) -> bool:
+    return os.access(p.parent if str(p.parent) else Path("."), os.W_OK)
+
+
+def describe_sqlite_error(exc: sqlite3.Error, path: Path) -> str:
+    """One line for an SQLite error on the catalog ``path``: what happened and what to do.
+
+    Classified by SQLite's result code (busy, read-only, full, damaged, cannot open).
+    """
+    code = getattr(exc, "sqlite_errorname", "") or ""
+    folder = path.parent if str(path.parent) else Path(".")
+    if code.startswith(("SQLITE_BUSY", "SQLITE_LOCKED")):
+        return (
+            f"{path}: the catalog is busy (another process is writing it); try again when it "
+            "is done, or wait longer with --wait SECONDS"
+        )
+    if code.startswith("SQLITE_FULL") or "disk is full" in str(exc):
+        return (
+            f"{path}: the disk is full; nothing was written and the catalog is as it was; "
+            "free some space and try again"
+        )
+    if code.startswith(("SQLITE_READONLY", "SQLITE_CANTOPEN", "SQLITE_PERM", "SQLITE_AUTH")):
+        if path.exists() and not os.access(path, os.R_OK):
+            return f"{path}: cannot read the catalog (permission denied)"
+        if not folder.is_dir():
+            return f"{path}: cannot open the catalog (the folder {folder} does not exist)"
+        if not _writable_dir(path):
+            return (
+                f"{path}: the catalog's folder {folder} is not writable (SQLite keeps its "
+                "-wal and -shm files beside the catalog); use a writable folder or a copy"
+            )
+        if path.exists() and not os.access(path, os.W_OK) or code.startswith("SQLITE_READONLY"):
+            return (
+                f"{path}: the catalog is read-only; ask for write permission or work on a "
+                "writable copy"
+            )
+        return f"{path}: cannot open the catalog ({exc})"
+    if code.startswith(("SQLITE_CORRUPT", "SQLITE_NOTADB")):
+        return (
+            f"{path}: the catalog file is damaged ({exc}); restore it from a backup (or "
+            "salvage it with: sqlite3 CATALOG .recover)"
+        )
+    if code.startswith("SQLITE_IOERR"):
+        return f"{path}: input/output error on the catalog ({exc}); check the disk and try again"
+    return f"{path}: catalog error ({exc})"
+
+
+def catalog_error(exc: sqlite3.Error, path: Path) -> InputError:
+    """The :class:`InputError` for an SQLite error on the catalog ``path``."""
+    return InputError(describe_sqlite_error(exc, path))
+
+
+def _is_busy(exc: sqlite3.Error) -> bool:
+    code = getattr(exc, "sqlite_errorname", "") or ""
+    return code.startswith(("SQLITE_BUSY", "SQLITE_LOCKED"))
+
+
+def _begin(conn: sqlite3.Connection, path: Path) -> None:
+    """``BEGIN IMMEDIATE``; a busy catalog is announced, then waited for up to ``conn.wait``."""
+    wait = conn.wait if isinstance(conn, CatalogConnection) else DEFAULT_WAIT
+    first = min(_FIRST_TRY_MS, int(wait * 250))
+    conn.execute(f"PRAGMA busy_timeout = {first}")
+    try:
+        conn.execute("BEGIN IMMEDIATE")
+        return
+    except sqlite3.OperationalError as exc:
+        if not _is_busy(exc):
+            raise catalog_error(exc, path) from None
+        if first == 0:
+            raise InputError(
+                f"{path}: the catalog is busy (another process is writing it); try again when "
+                "it is done, or wait longer with --wait SECONDS"
+            ) from None
+    finally:
+        conn.execute(f"PRAGMA busy_timeout = {int(wait * 1000)}")
+    if _busy_notifier is not None:
+        _busy_notifier(
+            f"{path}: the catalog is busy (another process is writing it); waiting up to {wait:g} s"
+        )
+    try:
+        conn.execute("BEGIN IMMEDIATE")
+    except sqlite3.OperationalError as exc:
+        if _is_busy(exc):
+            raise InputError(
+                f"{path}: the catalog is still busy after {wait:g} s (another process is "
+                "writing it); try again when it is done, or wait longer with --wait SECONDS"
+            ) from None
+        raise catalog_error(exc, path) from None
+
+
+def _rollback(conn: sqlite3.Connection) -> None:
+    if conn.in_transaction:
+        # SQLite may have rolled back already (e.g. after a full disk); nothing is committed.
+        with suppress(sqlite3.Error):
+            conn.execute("ROLLBACK")
+
+
 @contextmanager
-def transaction(conn: sqlite3.Connection) -> Iterator[sqlite3.Connection]:
-    """One write transaction: all of it is committed, or (on any exception or kill) none."""
-    conn.execute("BEGIN IMMEDIATE")
+def transaction(
+    conn: sqlite3.Connection, *, before_commit: Callable[[], None] | None = None
+) -> Iterator[sqlite3.Connection]:
+    """One write transaction: all of it is committed, or (on any exception or kill) none.
+
+    ``before_commit`` runs after the body, inside the transaction: when it raises, nothing is
+    committed (used to write a changeover's files only together with its row). SQLite errors
+    (busy, read-only, full disk at ``COMMIT``, damaged file) become one-line InputErrors.
+    """
+    path = catalog_file_of(conn)
+    _begin(conn, path)
     try:
         yield conn
+        if before_commit is not None:
+            before_commit()
+        conn.execute("COMMIT")
+    except sqlite3.Error as exc:
+        _rollback(conn)
+        raise catalog_error(exc, path) from None
     except BaseException:
-        conn.execute("ROLLBACK")
+        _rollback(conn)
         raise
-    conn.execute("COMMIT")
 
 
 def schema_version(conn: sqlite3.Connection) -> int:
@@ -108,23 +255,42 @@ def migrate(conn: sqlite3.Connection) -> int:
     return version
 
 
-def connect(path: str | Path, *, create: bool = False) -> sqlite3.Connection:
+def connect(
+    path: str | Path, *, create: bool = False, wait: float = DEFAULT_WAIT
+) -> CatalogConnection:
     """Open (and with ``create`` make) a catalog, migrated to the current schema.
 
-    Raises InputError when the file is missing (without ``create``) or not a catalog.
+    ``wait`` is how many seconds a write waits for another process's transaction. Raises
+    InputError, one line naming the file, when it is missing (without ``create``), cannot be
+    created or opened, is read-only where a write is needed, or is not a catalog.
     """
     p = Path(path)
-    if not create and not p.exists():
-        raise InputError(f"{p}: no catalog there (create one with 'feederkit catalog init')")
-    if p.exists() and p.is_dir():
-        raise InputError(f"{p}: is a directory, not a catalog file")
+    if not wait >= 0.0 or wait > 86400.0:
+        raise InputError(f"--wait must be between 0 and 86400 seconds, got {wait}")
     try:
-        conn = sqlite3.connect(p, isolation_level=None, timeout=10.0)
+        exists = p.exists()
+        if exists and p.is_dir():
+            raise InputError(f"{p}: is a directory, not a catalog file")
+    except OSError as exc:
+        raise InputError(f"{p}: cannot open the catalog ({exc.strerror})") from None
+    if not exists:
+        if not create:
+            raise InputError(f"{p}: no catalog there (create one with 'feederkit catalog init')")
+        folder = p.parent if str(p.parent) else Path(".")
+        if not folder.is_dir():
+            raise InputError(f"{p}: cannot create the catalog: the folder {folder} does not exist")
+        if not _writable_dir(p):
+            raise InputError(f"{p}: cannot create the catalog: the folder {folder} is not writable")
+    try:
+        conn = sqlite3.connect(p, isolation_level=None, timeout=wait, factory=CatalogConnection)
     except sqlite3.Error as exc:
-        raise InputError(f"{p}: cannot open the catalog ({exc})") from None
+        raise catalog_error(exc, p) from None
+    conn.path, conn.wait = p, wait
+    # Text that is not UTF-8 is read with surrogate escapes, so each row's check can name it.
+    conn.text_factory = lambda raw: raw.decode("utf-8", "surrogateescape")
     try:
         conn.execute("PRAGMA foreign_keys = ON")
-        conn.execute("PRAGMA busy_timeout = 10000")
+        conn.execute(f"PRAGMA busy_timeout = {int(wait * 1000)}")
         mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
         if str(mode).lower() != "wal":
             raise InputError(f"{p}: the catalog cannot use WAL journaling (got {mode})")
@@ -136,7 +302,10 @@ def connect(path: str | Path, *, create: bool = False) -> sqlite3.Connection:
         migrate(conn)
     except sqlite3.DatabaseError as exc:
         conn.close()
-        raise InputError(f"{p}: not a feederkit catalog ({exc})") from None
+        code = getattr(exc, "sqlite_errorname", "") or ""
+        if code.startswith("SQLITE_NOTADB"):
+            raise InputError(f"{p}: not a feederkit catalog ({exc})") from None
+        raise catalog_error(exc, p) from None
     except BaseException:
         conn.close()
         raise

@@ -7,9 +7,11 @@ write is one transaction: a killed process leaves the catalog as it was.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import getpass
 import hashlib
 import json
+import math
 import os
 import sqlite3
 from collections.abc import Iterator, Sequence
@@ -18,8 +20,21 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from feederkit.catalog.model import AddOutcome, PartSummary, Revision, check_name
-from feederkit.catalog.schema import connect, transaction
+from feederkit.catalog.model import (
+    AddOutcome,
+    PartSummary,
+    Revision,
+    check_name,
+    is_valid_name,
+    shown_name,
+)
+from feederkit.catalog.schema import (
+    DEFAULT_WAIT,
+    catalog_error,
+    catalog_file_of,
+    connect,
+    transaction,
+)
 from feederkit.errors import InputError
 from feederkit.importers import (
     ImportedOutline,
@@ -28,7 +43,14 @@ from feederkit.importers import (
     build_part,
     import_parts,
 )
-from feederkit.outline import Outline, outline_from_dict, outline_to_dict, write_text_atomic
+from feederkit.jsonio import parse_json
+from feederkit.outline import (
+    MAX_COORD_MM,
+    Outline,
+    outline_from_dict,
+    outline_to_dict,
+    write_text_atomic,
+)
 from feederkit.part import Part
 
 CatalogLike = sqlite3.Connection | str | os.PathLike[str]
@@ -37,26 +59,49 @@ DEFAULT_CATALOG = "feederkit.db"
 CATALOG_ENV = "FEEDERKIT_CATALOG"
 
 
-def default_catalog_path() -> Path:
-    """``$FEEDERKIT_CATALOG`` if set, else ``./feederkit.db``."""
+def resolve_catalog_path(path: str | os.PathLike[str] | None = None) -> Path:
+    """The catalog file: ``path`` when given, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.db``.
+
+    The one rule every command uses (docs/catalog.md); an empty string counts as not given.
+    """
+    if path is not None and str(path):
+        return Path(path)
     return Path(os.environ.get(CATALOG_ENV) or DEFAULT_CATALOG)
 
 
+def default_catalog_path() -> Path:
+    """``$FEEDERKIT_CATALOG`` if set, else ``./feederkit.db`` (:func:`resolve_catalog_path`)."""
+    return resolve_catalog_path(None)
+
+
 def open_catalog(
-    path: str | os.PathLike[str] | None = None, *, create: bool = False
+    path: str | os.PathLike[str] | None = None,
+    *,
+    create: bool = False,
+    wait: float = DEFAULT_WAIT,
 ) -> sqlite3.Connection:
-    """Open the catalog at ``path`` (default :func:`default_catalog_path`), migrated."""
-    return connect(Path(path) if path is not None else default_catalog_path(), create=create)
+    """Open the catalog at ``path`` (default :func:`resolve_catalog_path`), migrated.
+
+    ``wait``: seconds a write waits for another process's transaction before giving up.
+    """
+    return connect(resolve_catalog_path(path), create=create, wait=wait)
 
 
 @contextmanager
 def _conn(catalog: CatalogLike, create: bool = False) -> Iterator[sqlite3.Connection]:
+    """The connection for a catalog argument; SQLite errors become one-line InputErrors."""
     if isinstance(catalog, sqlite3.Connection):
-        yield catalog
+        try:
+            yield catalog
+        except sqlite3.Error as exc:
+            raise catalog_error(exc, catalog_file_of(catalog)) from None
         return
-    conn = connect(Path(catalog), create=create)
+    path = Path(catalog)
+    conn = connect(path, create=create)
     try:
         yield conn
+    except sqlite3.Error as exc:
+        raise catalog_error(exc, path) from None
     finally:
         conn.close()
 
@@ -113,6 +158,7 @@ def write_revision(
     when = now_utc()
     options_json = _dumps(options_key)
     pid = _part_id(conn, name)
+    changes: tuple[str, ...] = ()
     if pid is None:
         cur = conn.execute(
             "INSERT INTO parts (name, created_at, created_by) VALUES (?, ?, ?)", (name, when, who)
@@ -136,6 +182,7 @@ def write_revision(
                 imported.warnings,
             )
         revision, status = int(rev) + 1, "revised"
+        changes = _changes(int(rev), old_sha, sha256, old_options, options_key)
     src = imported.source
     pose = None
     if src.pose is not None:
@@ -176,8 +223,39 @@ def write_revision(
         ),
     )
     return AddOutcome(
-        name, revision, status, source_path, imported.orientability.orientable, imported.warnings
+        name,
+        revision,
+        status,
+        source_path,
+        imported.orientability.orientable,
+        imported.warnings,
+        changes,
     )
+
+
+def _changes(
+    old_rev: int, old_sha: str, new_sha: str, old_options: str, new_options: dict[str, Any]
+) -> tuple[str, ...]:
+    """What differs from revision ``old_rev``: the file's SHA-256 and each import option."""
+    out = []
+    if old_sha != new_sha:
+        out.append(
+            f"file changed since revision {old_rev} (sha256 {old_sha[:12]} -> {new_sha[:12]})"
+        )
+    try:
+        before = json.loads(old_options)
+    except ValueError:
+        before = {}
+    before = before if isinstance(before, dict) else {}
+    after = json.loads(_dumps(new_options))
+    for key in sorted(set(before) | set(after)):
+        if before.get(key) != after.get(key):
+            out.append(f"{key}: {_opt(before.get(key))} -> {_opt(after.get(key))}")
+    return tuple(out)
+
+
+def _opt(value: Any) -> str:
+    return "default" if value is None or value == [] else json.dumps(value)
 
 
 def add_file(
@@ -248,31 +326,144 @@ WHERE r.revision = (SELECT max(m.revision) FROM revisions m WHERE m.part_id = p.
 """
 
 
+class _Damaged(Exception):
+    """A stored value fails its check; turned into one InputError naming the part revision."""
+
+
+def _damaged(name: Any, revision: Any, why: str) -> InputError:
+    label = f"{shown_name(name)}@{revision}"
+    if isinstance(name, str) and is_valid_name(name) and isinstance(revision, int):
+        fix = (
+            f"remove it with 'feederkit catalog remove {label}' or re-import its file with --revise"
+        )
+    else:
+        fix = "restore the catalog from a backup or fix the row with sqlite3"
+    return InputError(f"catalog part {label}: the stored data is damaged ({why}); {fix}")
+
+
+def _text(value: Any, what: str, *, optional: bool = False) -> str | None:
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise _Damaged(f"{what} is {type(value).__name__}, not text")
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise _Damaged(f"{what} is not UTF-8 text") from None
+    return value
+
+
+def _int(value: Any, what: str, lo: int = 0) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
+        raise _Damaged(f"{what} is {value!r}, not a whole number of at least {lo}")
+    return value
+
+
+def _real(value: Any, what: str, *, optional: bool = False) -> float | None:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise _Damaged(f"{what} is {type(value).__name__}, not a number")
+    x = float(value)
+    if not math.isfinite(x) or abs(x) > MAX_COORD_MM:
+        raise _Damaged(f"{what} is {value!r}, not a finite number within 1e9")
+    return x
+
+
+def _json(value: Any, what: str, kind: type | tuple[type, ...], *, optional: bool = False) -> Any:
+    text = _text(value, what, optional=optional)
+    if text is None:
+        return None
+    try:
+        data = parse_json(text, what)
+    except InputError as exc:
+        raise _Damaged(str(exc)) from None
+    if not isinstance(data, kind):
+        raise _Damaged(f"{what} is not a JSON {getattr(kind, '__name__', 'value')}")
+    return data
+
+
+def _hull(raw: list[Any]) -> tuple[tuple[float, float], ...]:
+    """The stored contact hull: at least 3 finite points, convex, counter-clockwise."""
+    pts = []
+    for q in raw:
+        if not isinstance(q, list) or len(q) != 2:
+            raise _Damaged("hull_json is not a list of [x, y] points")
+        pts.append((_real(q[0], "a hull_json coordinate"), _real(q[1], "a hull_json coordinate")))
+    if len(pts) < 3:
+        raise _Damaged(f"hull_json has {len(pts)} vertices, fewer than 3")
+    scale = max(max(abs(x), abs(y)) for x, y in pts) or 1.0
+    n = len(pts)
+    for k in range(n):
+        (ax, ay), (bx, by), (cx, cy) = pts[k], pts[(k + 1) % n], pts[(k + 2) % n]
+        if (bx - ax) * (cy - by) - (by - ay) * (cx - bx) < -1e-9 * scale * scale:
+            raise _Damaged("hull_json is not convex and counter-clockwise")
+    return tuple(pts)  # type: ignore[arg-type]
+
+
+def _inside(com: tuple[float, float], hull: tuple[tuple[float, float], ...]) -> bool:
+    """Whether ``com`` lies strictly inside the convex CCW ``hull`` (pushing needs it there)."""
+    scale = max(max(abs(x), abs(y)) for x, y in hull) or 1.0
+    n = len(hull)
+    for k in range(n):
+        (ax, ay), (bx, by) = hull[k], hull[(k + 1) % n]
+        if (bx - ax) * (com[1] - ay) - (by - ay) * (com[0] - ax) <= 1e-12 * scale * scale:
+            return False
+    return True
+
+
+def _summary_from_row(r: Sequence[Any]) -> PartSummary:
+    """A ``catalog list`` row, checked: a damaged row is one InputError naming the part."""
+    try:
+        name = _text(r[0], "the name")
+        if not is_valid_name(name):
+            raise _Damaged("the name is not a valid part name")
+        return PartSummary(
+            name=name,  # type: ignore[arg-type]
+            revision=_int(r[1], "revision", 1),
+            revisions=_int(r[2], "the revision count", 1),
+            source_kind=_text(r[3], "source_kind"),  # type: ignore[arg-type]
+            source_units=_text(r[4], "source_units"),  # type: ignore[arg-type]
+            area=_real(r[5], "area"),  # type: ignore[arg-type]
+            n_holes=_int(r[6], "n_holes"),
+            n_hull=_int(r[7], "n_hull", 3),
+            orientable=bool(_int(r[8], "orientable")),
+            updated_at=_text(r[9], "created_at"),  # type: ignore[arg-type]
+        )
+    except _Damaged as exc:
+        raise _damaged(r[0], r[1], str(exc)) from None
+
+
 def list_parts(catalog: CatalogLike) -> list[PartSummary]:
-    """Every part with its latest revision, sorted by name."""
+    """Every part with its latest revision, sorted by name; each row checked."""
     with _conn(catalog) as conn:
         rows = conn.execute(_SUMMARY_SQL + " ORDER BY p.name").fetchall()
-    return [
-        PartSummary(
-            name=r[0],
-            revision=int(r[1]),
-            revisions=int(r[2]),
-            source_kind=r[3],
-            source_units=r[4],
-            area=float(r[5]),
-            n_holes=int(r[6]),
-            n_hull=int(r[7]),
-            orientable=bool(r[8]),
-            updated_at=r[9],
-        )
-        for r in rows
-    ]
+    return [_summary_from_row(r) for r in rows]
 
 
 def part_names(catalog: CatalogLike) -> list[str]:
-    """Names of all parts, sorted."""
+    """Names of all parts, sorted (names that are not valid text are left out)."""
     with _conn(catalog) as conn:
-        return [r[0] for r in conn.execute("SELECT name FROM parts ORDER BY name")]
+        names = [r[0] for r in conn.execute("SELECT name FROM parts ORDER BY name")]
+    return [n for n in names if isinstance(n, str) and is_valid_name(n)]
+
+
+def similar_names(catalog: CatalogLike, name: str, n: int = 3) -> list[str]:
+    """Up to ``n`` catalog part names closest to ``name`` (for "did you mean ...?")."""
+    return _similar(part_names(catalog), name, n)
+
+
+def _similar(names: list[str], name: str, n: int = 3) -> list[str]:
+    folded = {k.casefold(): k for k in names}
+    close = difflib.get_close_matches(name.casefold(), list(folded), n=n, cutoff=0.6)
+    return [folded[c] for c in close]
+
+
+def did_you_mean(names: list[str]) -> str:
+    """`` (did you mean 'a' or 'b'?)`` for the suggestions, or nothing when there are none."""
+    if not names:
+        return ""
+    return " (did you mean " + " or ".join(repr(x) for x in names) + "?)"
 
 
 _REVISION_SQL = """
@@ -285,35 +476,69 @@ FROM parts p JOIN revisions r ON r.part_id = p.id WHERE p.name = ?
 
 
 def _revision_from_row(row: Sequence[Any]) -> Revision:
-    outline = outline_from_dict(json.loads(row[7]), default_name=row[0])
-    return Revision(
-        name=row[0],
-        revision=int(row[1]),
-        source_path=row[2],
-        source_sha256=row[3],
-        source_kind=row[4],
-        source_units=row[5],
-        options=json.loads(row[6]),
-        outline=outline,
-        hull=tuple((float(x), float(y)) for x, y in json.loads(row[8])),
-        com=(float(row[9]), float(row[10])),
-        hull_tolerance=row[11],
-        mesh_pose=None if row[12] is None else json.loads(row[12]),
-        orientable=bool(row[13]),
-        not_orientable_reason=row[14],
-        warnings=tuple(json.loads(row[15])),
-        area=float(row[16]),
-        created_at=row[17],
-        created_by=row[18],
+    """A stored revision, every field checked (types, UTF-8, JSON, hull convex, COM inside).
+
+    Anything wrong (an edited or corrupted row) is one InputError naming the part and
+    revision and saying how to get rid of it.
+    """
+    try:
+        name = _text(row[0], "the name")
+        revision = _int(row[1], "revision", 1)
+        data = _json(row[7], "outline_json", dict)
+        try:
+            outline = outline_from_dict(data, default_name=name)  # type: ignore[arg-type]
+        except InputError as exc:
+            raise _Damaged(f"outline_json: {exc}") from None
+        hull = _hull(_json(row[8], "hull_json", list))
+        com = (_real(row[9], "com_x"), _real(row[10], "com_y"))
+        if not _inside(com, hull):  # type: ignore[arg-type]
+            raise _Damaged(f"the center of mass {com} is not inside the hull")
+        warnings = _json(row[15], "warnings_json", list)
+        if not all(isinstance(w, str) for w in warnings):
+            raise _Damaged("warnings_json is not a list of text")
+        orientable = _int(row[13], "orientable")
+        if orientable > 1:
+            raise _Damaged(f"orientable is {orientable}, not 0 or 1")
+        hull_tolerance = _real(row[11], "hull_tolerance", optional=True)
+        if hull_tolerance is not None and hull_tolerance < 0:
+            raise _Damaged(f"hull_tolerance is {hull_tolerance}, negative")
+        return Revision(
+            name=name,  # type: ignore[arg-type]
+            revision=revision,
+            source_path=_text(row[2], "source_path"),  # type: ignore[arg-type]
+            source_sha256=_text(row[3], "source_sha256"),  # type: ignore[arg-type]
+            source_kind=_text(row[4], "source_kind"),  # type: ignore[arg-type]
+            source_units=_text(row[5], "source_units"),  # type: ignore[arg-type]
+            options=_json(row[6], "options_json", dict),
+            outline=outline,
+            hull=hull,
+            com=com,  # type: ignore[arg-type]
+            hull_tolerance=hull_tolerance,
+            mesh_pose=_json(row[12], "mesh_pose_json", dict, optional=True),
+            orientable=bool(orientable),
+            not_orientable_reason=_text(row[14], "not_orientable_reason", optional=True),
+            warnings=tuple(warnings),
+            area=_real(row[16], "area"),  # type: ignore[arg-type]
+            created_at=_text(row[17], "created_at"),  # type: ignore[arg-type]
+            created_by=_text(row[18], "created_by"),  # type: ignore[arg-type]
+        )
+    except _Damaged as exc:
+        raise _damaged(row[0], row[1], str(exc)) from None
+
+
+def _unknown(conn: sqlite3.Connection, name: str) -> InputError:
+    names = [r[0] for r in conn.execute("SELECT name FROM parts")]
+    valid = [n for n in names if isinstance(n, str) and is_valid_name(n)]
+    return InputError(
+        f"no part named {shown_name(name)!s} in the catalog{did_you_mean(_similar(valid, name))}"
+        if not is_valid_name(name)
+        else f"no part named {name!r} in the catalog{did_you_mean(_similar(valid, name))}"
     )
 
 
-def _unknown(name: str) -> InputError:
-    return InputError(f"no part named {name!r} in the catalog")
-
-
 def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -> Revision:
-    """A stored revision of a part (default: the latest); InputError when there is none."""
+    """A stored revision of a part (default: the latest), checked; InputError when there is
+    none (suggesting the nearest names) or when its row is damaged."""
     with _conn(catalog) as conn:
         if revision is None:
             row = conn.execute(
@@ -326,7 +551,7 @@ def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -
         if row is None:
             if revision is not None and _part_id(conn, name) is not None:
                 raise InputError(f"part {name!r} has no revision {revision}")
-            raise _unknown(name)
+            raise _unknown(conn, name)
     return _revision_from_row(row)
 
 
@@ -338,9 +563,22 @@ def revision_history(catalog: CatalogLike, name: str) -> list[tuple[int, str, st
             "JOIN parts p ON p.id = r.part_id WHERE p.name = ? ORDER BY r.revision",
             (name,),
         ).fetchall()
-    if not rows:
-        raise InputError(f"no part named {name!r} in the catalog")
-    return [(int(r[0]), r[1], r[2], r[3]) for r in rows]
+        if not rows:
+            raise _unknown(conn, name)
+    out = []
+    for r in rows:
+        try:
+            out.append(
+                (
+                    _int(r[0], "revision", 1),
+                    _text(r[1], "created_at"),
+                    _text(r[2], "created_by"),
+                    _text(r[3], "source_sha256"),
+                )
+            )
+        except _Damaged as exc:
+            raise _damaged(name, r[0], str(exc)) from None
+    return out  # type: ignore[return-value]
 
 
 def part_from_revision(rev: Revision) -> Part:
@@ -355,32 +593,53 @@ def get_part(catalog: CatalogLike, name: str, revision: int | None = None) -> Pa
     return part_from_revision(get_revision(catalog, name, revision))
 
 
-def remove_part(catalog: CatalogLike, name: str, *, force: bool = False) -> list[str]:
-    """Delete a part with all its revisions; returns the changeovers removed with it.
+def _users(conn: sqlite3.Connection, where: str, arg: int) -> list[str]:
+    return [
+        r[0]
+        for r in conn.execute(
+            "SELECT DISTINCT c.name FROM changeovers c JOIN changeover_parts cp "
+            "ON cp.changeover_id = c.id JOIN revisions r ON r.id = cp.revision_id "
+            f"WHERE {where} = ? ORDER BY c.name",
+            (arg,),
+        )
+    ]
 
-    A part used by a changeover is refused unless ``force``, which removes those changeovers too.
+
+def remove_part(
+    catalog: CatalogLike, name: str, *, force: bool = False, revision: int | None = None
+) -> list[str]:
+    """Delete a part with all its revisions, or only ``revision``; returns the changeovers
+    removed with it.
+
+    A revision used by a changeover is refused unless ``force``, which removes those
+    changeovers too. Removing a part's only revision removes the part.
     """
     with _conn(catalog) as conn, transaction(conn):
         pid = _part_id(conn, name)
         if pid is None:
-            raise _unknown(name)
-        users = [
-            r[0]
-            for r in conn.execute(
-                "SELECT DISTINCT c.name FROM changeovers c JOIN changeover_parts cp "
-                "ON cp.changeover_id = c.id JOIN revisions r ON r.id = cp.revision_id "
-                "WHERE r.part_id = ? ORDER BY c.name",
-                (pid,),
-            )
-        ]
+            raise _unknown(conn, name)
+        rid = None
+        if revision is not None:
+            row = conn.execute(
+                "SELECT id FROM revisions WHERE part_id = ? AND revision = ?", (pid, int(revision))
+            ).fetchone()
+            if row is None:
+                raise InputError(f"part {name!r} has no revision {revision}")
+            rid = int(row[0])
+        users = _users(conn, "r.part_id", pid) if rid is None else _users(conn, "r.id", rid)
+        label = name if revision is None else f"{name}@{revision}"
         if users and not force:
             raise InputError(
-                f"part {name!r} is used by changeover(s) {', '.join(users)}; "
+                f"part {label!r} is used by changeover(s) {', '.join(users)}; "
                 "use --force to remove them too"
             )
         for changeover in users:
             conn.execute("DELETE FROM changeovers WHERE name = ?", (changeover,))
-        conn.execute("DELETE FROM parts WHERE id = ?", (pid,))
+        left = conn.execute("SELECT count(*) FROM revisions WHERE part_id = ?", (pid,)).fetchone()
+        if rid is None or int(left[0]) <= 1:
+            conn.execute("DELETE FROM parts WHERE id = ?", (pid,))
+        else:
+            conn.execute("DELETE FROM revisions WHERE id = ?", (rid,))
     return users
 
 
@@ -390,7 +649,11 @@ def export_part(
     """Write a part's outline file (design.md format) atomically; returns the revision written."""
     rev = get_revision(catalog, name, revision)
     target = Path(out)
-    if target.parent and not target.parent.exists():
+    try:
+        missing = bool(str(target.parent)) and not target.parent.is_dir()
+    except OSError as exc:
+        raise InputError(f"{target}: cannot write the file ({exc.strerror})") from None
+    if missing:
         raise InputError(f"{target}: the folder {target.parent} does not exist")
     write_text_atomic(target, json.dumps(outline_to_dict(rev.outline), indent=2) + "\n")
     return rev

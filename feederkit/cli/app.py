@@ -1,20 +1,41 @@
-"""The ``feederkit`` command: registers each command group's module and maps errors to exit codes.
+"""The ``feederkit`` command: registers each command group's module and is the one error boundary.
 
-Exit codes (design.md): 0 success, 1 a result the user must act on, 2 bad input or usage.
-Errors are one clear line on stderr, never a traceback.
+Exit codes (design.md): 0 success, 1 a result the user must act on, 2 bad input or usage,
+130 interrupted (Ctrl-C), 70 a bug in feederkit. Errors are one clear line on stderr, never
+a traceback: feederkit's own errors carry their message; errors from the system (SQLite,
+files, numbers too large, input nested too deeply) are named with what to do. Anything else
+is a bug: one line says so and names the log file that holds the traceback.
 """
 
 from __future__ import annotations
 
-import functools
-import importlib
 import sys
 
-import typer
-from rich.markup import escape
+try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one line, too.
+    import errno
+    import functools
+    import importlib
+    import os
+    import sqlite3
+    import tempfile
+    import traceback
+    from datetime import UTC, datetime
+    from typing import Annotated
 
-from feederkit.cli.common import err_console
-from feederkit.errors import FeederkitError
+    import typer
+    from rich.markup import escape
+
+    import feederkit
+    from feederkit.catalog import set_busy_notifier
+    from feederkit.cli.common import err_console
+    from feederkit.errors import FeederkitError
+except KeyboardInterrupt:
+    sys.stderr.write("error: interrupted\n")
+    raise SystemExit(130) from None
+
+EXIT_INTERRUPTED = 130
+EXIT_BUG = 70
+"""``EX_SOFTWARE`` of sysexits.h: an internal error."""
 
 app = typer.Typer(
     name="feederkit",
@@ -38,12 +59,44 @@ COMMAND_MODULES = (
 )
 
 
+def version_text() -> str:
+    """``feederkit X.Y.Z``: the installed distribution's version, else the package's."""
+    try:
+        from importlib.metadata import PackageNotFoundError, version
+
+        return f"feederkit {version('feederkit')}"
+    except PackageNotFoundError:
+        return f"feederkit {feederkit.__version__}"
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(version_text())
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_version, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
+) -> None:
+    """Orient and recognize flat parts on a flexible parts feeder (Akella & Mason 1999)."""
+
+
 def _register() -> None:
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(app)
 
 
-_register()
+try:
+    _register()
+except KeyboardInterrupt:
+    sys.stderr.write("error: interrupted\n")
+    raise SystemExit(EXIT_INTERRUPTED) from None
 
 
 @functools.cache
@@ -52,28 +105,120 @@ def _click_command() -> typer.core.TyperGroup:
     return typer.main.get_command(app)  # type: ignore[return-value]
 
 
+def _say(message: str) -> None:
+    """One line on stderr, ``error: ...`` (markup in the message is shown as typed)."""
+    err_console.print(
+        f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True, markup=True
+    )
+
+
+def _notify_busy(message: str) -> None:
+    err_console.print(f"{message} ...", highlight=False, soft_wrap=True, markup=False)
+
+
+def _oneline(text: object) -> str:
+    return " ".join(str(text).split())
+
+
+_OS_ADVICE = {
+    errno.ENOSPC: "the disk is full; free some space and try again",
+    errno.EDQUOT: "the disk quota is exceeded; free some space and try again",
+    errno.EACCES: "permission denied; check the file's and its folder's permissions",
+    errno.EPERM: "operation not permitted; check the file's and its folder's permissions",
+    errno.EROFS: "the file system is read-only; write somewhere else",
+    errno.ENAMETOOLONG: "the file name is too long (file systems allow 255 bytes per name)",
+    errno.ENOENT: "no such file or folder",
+    errno.ENOTDIR: "a part of the path is not a folder",
+    errno.EISDIR: "a folder, not a file",
+    errno.EMFILE: "too many open files; raise the limit (ulimit -n) and try again",
+    errno.EIO: "input/output error; check the disk",
+}
+
+
+def system_error_message(exc: BaseException) -> str | None:
+    """The one line for an error from the system or the input, or None when it is not one.
+
+    SQLite errors (busy, read-only, disk full, damaged file), file errors (disk full,
+    permission, name too long), numbers too large, input nested too deeply, text that is
+    not UTF-8.
+    """
+    if isinstance(exc, sqlite3.Error):
+        code = getattr(exc, "sqlite_errorname", None) or type(exc).__name__
+        return (
+            f"catalog error ({_oneline(exc)}, {code}); check the catalog file given by "
+            "--catalog or $FEEDERKIT_CATALOG"
+        )
+    if isinstance(exc, OSError):
+        what = _OS_ADVICE.get(exc.errno or -1) or _oneline(exc.strerror or exc)
+        name = exc.filename if exc.filename is not None else "a file"
+        return f"{_oneline(os.fsdecode(name))}: {what}"
+    if isinstance(exc, OverflowError):
+        return f"a number is too large to compute with ({_oneline(exc)}); check the input's values"
+    if isinstance(exc, RecursionError):
+        return "the input is nested too deeply to process; check the input file"
+    if isinstance(exc, UnicodeDecodeError):
+        return f"an input is not UTF-8 text ({_oneline(exc.reason)} at byte {exc.start})"
+    if isinstance(exc, MemoryError):
+        return "out of memory; the input is too large for this machine"
+    return None
+
+
+def write_crash_log(exc: BaseException, argv: list[str] | None) -> str | None:
+    """Write the traceback of an unexpected exception to a log file in the system temp dir;
+    its path, or None when even that fails."""
+    stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
+    try:
+        fd, path = tempfile.mkstemp(prefix=f"feederkit-{stamp}-", suffix=".log")
+        with os.fdopen(fd, "w", encoding="utf-8", errors="backslashreplace") as fh:
+            fh.write(f"{version_text()}\nargv: {argv if argv is not None else sys.argv}\n\n")
+            fh.write("".join(traceback.format_exception(exc)))
+    except OSError:
+        return None
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the app; feederkit errors become one line on stderr and their exit code.
+    """Entry point: run the app and turn every error into one line on stderr and an exit code.
 
     Usage errors (unknown options, missing arguments) exit with 2, as click does.
     """
+    set_busy_notifier(_notify_busy)
     try:
         _click_command().main(args=argv, prog_name="feederkit")
     except FeederkitError as exc:
-        err_console.print(
-            f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True, markup=True
-        )
+        _say(_oneline(exc))
         return exc.exit_code
     except SystemExit as exc:
         if exc.code is None:
             return 0
+        if exc.code == EXIT_INTERRUPTED:  # typer turns Ctrl-C in a command into Exit(130)
+            _say("interrupted")
         return exc.code if isinstance(exc.code, int) else 2
     except KeyboardInterrupt:
-        err_console.print("error: interrupted")
-        return 130
+        _say("interrupted")
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - the boundary: every error becomes one line
+        message = system_error_message(exc)
+        log = write_crash_log(exc, argv)
+        where = f"; details in {log}" if log else ""
+        if message is not None:
+            _say(f"{message}{where}")
+            return 2
+        _say(
+            f"this is a bug in feederkit ({type(exc).__name__}: {_oneline(exc)[:200]}); "
+            f"please report it with the log{where}"
+        )
+        return EXIT_BUG
+    finally:
+        set_busy_notifier(None)
     return 0
 
 
 def run() -> None:
     """Console-script wrapper around :func:`main`."""
-    sys.exit(main())
+    try:
+        code = main()
+    except KeyboardInterrupt:  # Ctrl-C while printing the error itself
+        sys.stderr.write("error: interrupted\n")
+        code = EXIT_INTERRUPTED
+    sys.exit(code)

@@ -6,8 +6,12 @@ catalog is ``--catalog PATH``, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.d
 
 from __future__ import annotations
 
+import re
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from sqlite3 import Connection
 from typing import Annotated, Any
 
 import typer
@@ -16,18 +20,19 @@ from rich.progress import TextColumn
 from rich.table import Table
 
 from feederkit.catalog import (
-    DEFAULT_CATALOG,
+    DEFAULT_WAIT,
     SCHEMA_VERSION,
     AddOutcome,
     Revision,
     add_file,
-    connect,
     export_part,
     get_revision,
     import_directory,
     list_changeovers,
     list_parts,
+    open_catalog,
     remove_part,
+    resolve_catalog_path,
     revision_history,
 )
 from feederkit.cli.catalog_analyze import analyze_command
@@ -103,9 +108,31 @@ ReviseOpt = Annotated[
 ]
 
 
+WaitOpt = Annotated[
+    float,
+    typer.Option(
+        "--wait",
+        metavar="S",
+        min=0.0,
+        max=86400.0,
+        help=f"Seconds to wait while another process writes the catalog ({DEFAULT_WAIT:g}).",
+    ),
+]
+
+
 def catalog_path(option: Path | None) -> Path:
-    """The catalog file: the option (it includes the environment), else ./feederkit.db."""
-    return option if option is not None else Path(DEFAULT_CATALOG)
+    """The catalog file: the option, else ``$FEEDERKIT_CATALOG``, else ./feederkit.db."""
+    return resolve_catalog_path(option)
+
+
+@contextmanager
+def opened(option: Path | None, wait: float, *, create: bool = False) -> Iterator[Connection]:
+    """The catalog connection of a command, waiting up to ``wait`` s for a busy catalog."""
+    conn = open_catalog(catalog_path(option), create=create, wait=wait)
+    try:
+        yield conn
+    finally:
+        conn.close()
 
 
 def import_options(
@@ -139,6 +166,7 @@ def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
         "source": o.source_path,
         "orientable": o.orientable,
         "warnings": list(o.warnings),
+        "changes": list(o.changes),
     }
 
 
@@ -188,12 +216,14 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Pa
     console.print(table)
 
 
-def cmd_init(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
+def cmd_init(
+    catalog: CatalogOpt = None, wait: WaitOpt = DEFAULT_WAIT, json_out: JsonOpt = False
+) -> None:
     """Create the catalog (or bring an existing one to the current schema)."""
     path = catalog_path(catalog)
     existed = path.exists()
-    conn = connect(path, create=True)
-    conn.close()
+    with opened(catalog, wait, create=True):
+        pass
     if json_out:
         print_json({"catalog": str(path), "created": not existed, "schema_version": SCHEMA_VERSION})
     else:
@@ -220,21 +250,39 @@ def cmd_add(
     com: ComOpt = None,
     allow_large: AllowLargeOpt = False,
     catalog: CatalogOpt = None,
+    wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
-    """Import one file as a part; a changed file makes a new revision, an unchanged one nothing."""
+    """Import one file as a part; a changed file or changed options make a new revision (and
+    say what changed), an unchanged one nothing."""
     opts = import_options(
         units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
     )
-    outcomes = add_file(catalog_path(catalog), file, opts, name=name, revise=revise)
+    _check_source_file(file)
+    with opened(catalog, wait, create=True) as conn:
+        outcomes = add_file(conn, file, opts, name=name, revise=revise)
     _warn(outcomes)
     if json_out:
         print_json([_outcome_dict(o) for o in outcomes])
         return
     for o in outcomes:
+        changed = f": {'; '.join(o.changes)}" if o.changes else ""
         console.print(
-            f"{o.name}: revision {o.revision} ({o.status})", highlight=False, markup=False
+            f"{o.name}: revision {o.revision} ({o.status}{changed})",
+            highlight=False,
+            markup=False,
         )
+
+
+def _check_source_file(file: Path) -> None:
+    """A FILE argument that is missing or not a file is named as such, before the catalog."""
+    try:
+        if not file.exists():
+            raise InputError(f"{file}: no such file")
+        if not file.is_file():
+            raise InputError(f"{file}: not a file")
+    except OSError as exc:
+        raise InputError(f"{file}: cannot read the file ({exc.strerror})") from None
 
 
 def cmd_import(
@@ -251,6 +299,7 @@ def cmd_import(
     com: ComOpt = None,
     allow_large: AllowLargeOpt = False,
     catalog: CatalogOpt = None,
+    wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
     """Import every source file of a folder in one transaction: all files or none."""
@@ -267,9 +316,8 @@ def cmd_import(
                 tasks[phase] = bar.add_task(label, total=total, item="")
             bar.update(tasks[phase], completed=done, item=Path(item).name if item else "")
 
-        result = import_directory(
-            catalog_path(catalog), directory, opts, revise=revise, progress=progress
-        )
+        with opened(catalog, wait, create=True) as conn:
+            result = import_directory(conn, directory, opts, revise=revise, progress=progress)
     _warn(result.outcomes)
     if json_out:
         print_json(
@@ -289,7 +337,8 @@ def cmd_import(
 
 def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
     """List the parts with their latest revision."""
-    parts = list_parts(catalog_path(catalog))
+    with opened(catalog, DEFAULT_WAIT) as conn:
+        parts = list_parts(conn)
     if json_out:
         print_json(
             [
@@ -388,7 +437,7 @@ def _tol(value: float | None) -> str:
 
 
 def cmd_show(
-    name: Annotated[str, typer.Argument(help="Part name.")],
+    name: Annotated[str, typer.Argument(help="Part name (NAME@REV for one revision).")],
     revision: Annotated[
         int | None, typer.Option("--revision", min=1, help="Revision (default latest).")
     ] = None,
@@ -396,14 +445,13 @@ def cmd_show(
     json_out: JsonOpt = False,
 ) -> None:
     """Show a part: source, units, outline, hull, COM, mesh pose, orientability, revisions."""
-    path = catalog_path(catalog)
-    conn = connect(path)
-    try:
-        rev = get_revision(conn, name, revision)
-        history = revision_history(conn, name)
-        users = [c.name for c in list_changeovers(conn) if any(n == name for n, _ in c.parts)]
-    finally:
-        conn.close()
+    part, at = split_revision(name)
+    if at is not None and revision is not None and at != revision:
+        raise InputError(f"{name}: the revision is given twice ({at} and --revision {revision})")
+    with opened(catalog, DEFAULT_WAIT) as conn:
+        rev = get_revision(conn, part, at if at is not None else revision)
+        history = revision_history(conn, part)
+        users = [c.name for c in list_changeovers(conn) if any(n == part for n, _ in c.parts)]
     data = revision_dict(rev, history, users)
     if json_out:
         print_json(data)
@@ -439,21 +487,39 @@ def cmd_show(
     console.print(table)
 
 
+_REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>[0-9]+)$")
+
+
+def split_revision(text: str) -> tuple[str, int | None]:
+    """``NAME@REV`` as (name, revision); plain ``NAME`` as (name, None)."""
+    found = _REVISION_RE.match(text)
+    if found is None:
+        return text, None
+    rev = int(found["rev"])
+    if rev < 1:
+        raise InputError(f"{text}: revisions are numbered from 1")
+    return found["name"], rev
+
+
 def cmd_remove(
-    name: Annotated[str, typer.Argument(help="Part name.")],
+    name: Annotated[str, typer.Argument(help="Part name, or NAME@REV for one revision.")],
     force: Annotated[
         bool, typer.Option("--force", help="Also remove changeovers that use the part.")
     ] = False,
     catalog: CatalogOpt = None,
+    wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
-    """Remove a part and all its revisions."""
-    removed = remove_part(catalog_path(catalog), name, force=force)
+    """Remove a part and all its revisions, or one revision (NAME@REV)."""
+    part, revision = split_revision(name)
+    with opened(catalog, wait) as conn:
+        removed = remove_part(conn, part, force=force, revision=revision)
     if json_out:
-        print_json({"removed": name, "changeovers_removed": removed})
+        print_json({"removed": part, "revision": revision, "changeovers_removed": removed})
         return
     extra = f" and changeover(s) {', '.join(removed)}" if removed else ""
-    console.print(f"removed {name}{extra}", highlight=False, markup=False)
+    what = part if revision is None else f"{part} revision {revision}"
+    console.print(f"removed {what}{extra}", highlight=False, markup=False)
 
 
 def cmd_export(
@@ -468,7 +534,9 @@ def cmd_export(
     """Write a part's outline file (design.md outline format)."""
     if output.suffix.lower() != ".json":
         raise InputError(f"{output}: the outline file must end in .json")
-    rev = export_part(catalog_path(catalog), name, output, revision)
+    part, at = split_revision(name)
+    with opened(catalog, DEFAULT_WAIT) as conn:
+        rev = export_part(conn, part, output, at if at is not None else revision)
     if json_out:
         print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
         return

@@ -11,8 +11,8 @@ from pathlib import Path
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.catalog import default_catalog_path, list_parts, open_catalog
 from feederkit.catalog import get_part as catalog_get_part
+from feederkit.catalog import list_parts, open_catalog, resolve_catalog_path
 from feederkit.cli.common import (
     CatalogOpt,
     JsonOpt,
@@ -25,7 +25,7 @@ from feederkit.cli.common import (
     print_json,
     progress_bar,
 )
-from feederkit.errors import InputError
+from feederkit.errors import CheckFailed, InputError
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
 from feederkit.mix.pairs import PairWitness
@@ -34,10 +34,13 @@ from feederkit.sensors import NoSensor, make_sensor, sensor_to_dict
 
 
 def catalog_file(option: Path | None) -> Path:
-    """The catalog file: option, else ``$FEEDERKIT_CATALOG``, else ./feederkit.db; it must exist."""
-    path = option if option is not None else default_catalog_path()
-    if not path.is_file():
-        raise InputError(f"no catalog at {path} (create one with: feederkit catalog init)")
+    """The catalog file (:func:`feederkit.catalog.resolve_catalog_path`); it must exist."""
+    path = resolve_catalog_path(option)
+    try:
+        if not path.is_file():
+            raise InputError(f"no catalog at {path} (create one with: feederkit catalog init)")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot open the catalog ({exc.strerror})") from None
     return path
 
 
@@ -74,7 +77,9 @@ def analyze_command(
 ) -> None:
     """Behaviour classes (same push function, same push-diameter function: section 8.3) of the
     catalog's parts, and with a sensor every pair of parts no plan can tell apart, with its
-    witness: the states that can never be told apart and why (decided exactly)."""
+    witness: the states that can never be told apart and why (decided exactly).
+
+    Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
@@ -85,10 +90,18 @@ def analyze_command(
         data = result.to_dict()
         data["skipped"] = skipped
         print_json(data)
-        return
-    for line in skipped:
-        err_console.print(f"warning: {line}", highlight=False, markup=False)
-    _print_report(result, pfs)
+    else:
+        for line in skipped:
+            err_console.print(f"warning: {line}", highlight=False, markup=False)
+        _print_report(result, pfs)
+    if result.pairs:
+        n = len(result.pairs)
+        named = "; ".join(f"{w.part_a} & {w.part_b}" for w in result.pairs[:5])
+        more = f" and {n - 5} more" if n > 5 else ""
+        raise CheckFailed(
+            f"{n} pair(s) of parts no plan can tell apart with this sensor: {named}{more}; "
+            "keep them out of one mix or use a finer sensor"
+        )
 
 
 def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
