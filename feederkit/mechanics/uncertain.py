@@ -1,0 +1,831 @@
+"""Push-align mechanics under uncertainty: physical resting states, bands and outcome sets.
+
+The ideal model (section 3) knows the part exactly. Here (design.md, "Uncertainty") every hull
+vertex may lie within ``t`` mm of its drawn position, the COM within ``c`` mm, and the robot's
+rotation is off by up to ``r`` degrees. Everything rests on three facts, with ``eps = t + c``:
+
+* (F1) the perturbed radius function is within ``eps`` of the drawn one at every orientation;
+* (F2) its local maxima lie in the directions from the perturbed COM to perturbed vertices, so
+  within ``asin(eps / rho_j)`` of the drawn direction to vertex ``j`` (``rho_j`` its distance
+  from the COM), and only vertices with ``rho_j >= R - 2 eps`` can hold the highest point of a
+  hill of height ``R``;
+* (F3) the part rests on a perturbed hull edge: a chord of drawn vertices ``a .. b`` whose
+  intermediate vertices lie within ``2 t`` of it (they may fall inside), whose normal is within
+  ``asin(2 t / |v_b - v_a|)`` of the chord's, and on which the COM's foot can fall.
+
+A push descends the perturbed radius function and can never pass one of its local maxima, so
+from a fence orientation it ends on a rest candidate (F3) between the nearest sure hilltops on
+either side (F1, F2). At ``t = c = 0`` every set here is the ideal one exactly; otherwise each
+is a superset of what the perturbed parts can do (provably conservative), and the docstrings
+say which. docs/uncertainty.md gives the derivations and the measured price of conservatism.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from feederkit.angles import norm360
+from feederkit.errors import InputError
+from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
+from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.part import Part
+from feederkit.uncertainty import Uncertainty, check_for_part
+from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
+
+_BISECT_STEPS = 48
+BOUNDARY_EPS_DEG = 1e-9
+"""Fence orientations this close to a cell's end count as on it (both sides' outcomes)."""
+
+
+@dataclass(frozen=True)
+class RestCandidate:
+    """A perturbed edge the part may rest on (F3): the chord from hull vertex ``start`` to ``end``.
+
+    Its normal lies within ``half_width_deg`` of ``normal_deg`` for every shape in the tolerance
+    zone; ``basin`` is the ideal stable state whose resting range holds ``normal_deg``;
+    ``height_mm`` the COM's distance from the drawn chord (the radius function at its normal is
+    within ``[height, height + 2 t]``: intermediate vertices lie at most ``2 t`` outside it).
+    """
+
+    start: int
+    end: int
+    normal_deg: float
+    half_width_deg: float
+    basin: int
+    height_mm: float
+
+
+@dataclass(frozen=True)
+class Band:
+    """The band around the divergent orientation ``divergent_deg`` (a hilltop of the radius
+    function between ideal states ``left`` and ``right``, counter-clockwise).
+
+    Every perturbed shape has a local maximum of its radius function in ``[lo_deg, hi_deg]``
+    (``lo <= divergent <= hi``, ``hi`` may pass 360): a push starting inside may end on either
+    side, one starting outside never crosses it. At ``t = c = 0`` the band is the point.
+    """
+
+    divergent_deg: float
+    lo_deg: float
+    hi_deg: float
+    left: int
+    right: int
+
+    @property
+    def half_width_deg(self) -> float:
+        """The larger distance from the divergent orientation to an end of the band."""
+        return max(self.divergent_deg - self.lo_deg, self.hi_deg - self.divergent_deg)
+
+
+@dataclass(frozen=True)
+class PhysicalState:
+    """A physical resting state: a cluster of adjacent ideal stable states (``members``, CCW).
+
+    ``rest_deg`` ``(lo, hi)``, ``hi`` may pass 360: where the resting edge's normal can lie
+    (a point, the ideal normal, at zero uncertainty). ``capture_deg``: the union of the members'
+    ideal resting ranges. ``diameter`` ``(lo, hi)``: every reading of the part resting here,
+    the min and max of the width over ``rest_deg`` widened by ``2 t`` (exact at zero
+    uncertainty: the ideal state's diameter).
+    """
+
+    id: int
+    members: tuple[int, ...]
+    rest_deg: tuple[float, float]
+    capture_deg: tuple[float, float]
+    diameter: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class FenceCell:
+    """Fence orientations from ``lo`` to ``hi`` (deg, ``hi`` may pass 360) all settling into
+    ``targets`` (physical state ids) for every shape in the tolerance zone.
+
+    ``closed`` cells are bands (ends included); open cells lie between two bands.
+    """
+
+    lo: float
+    hi: float
+    closed: bool
+    targets: frozenset[int]
+
+
+@dataclass(frozen=True)
+class UncertainMechanics:
+    """The mechanics of one part under one declared uncertainty (what a machine is built from).
+
+    ``state_of[i]`` is the physical state holding ideal stable state ``i``, None for a
+    transient state (one the part surely leaves for a neighbour: its barrier is below the
+    vibration for every shape); ``destinations[i]`` are the physical states a part coming to
+    rest in ideal state ``i`` may end in (its own, and those vibration may carry it to over a
+    barrier below ``merge_threshold_mm``, vibration plus ``2 (t + c)``).
+    ``cells`` tile the circle of fence orientations, starting at the first band.
+    """
+
+    push: PushFunction
+    uncertainty: Uncertainty
+    vibration_mm: float
+    merge_threshold_mm: float
+    candidates: tuple[RestCandidate, ...]
+    bands: tuple[Band, ...]
+    states: tuple[PhysicalState, ...]
+    state_of: tuple[int | None, ...]
+    destinations: tuple[frozenset[int], ...]
+    cells: tuple[FenceCell, ...]
+    cell_los: tuple[float, ...] = ()
+    """The cells' ``lo`` over two turns (sorted, for bisection)."""
+
+    @property
+    def part(self) -> Part:
+        """The part."""
+        return self.push.part
+
+    @property
+    def n(self) -> int:
+        """Number of physical states."""
+        return len(self.states)
+
+
+# --- geometry helpers ---------------------------------------------------------------------
+
+
+def _radius(hull: np.ndarray, com: np.ndarray, phi_deg: np.ndarray) -> np.ndarray:
+    phi = np.radians(np.atleast_1d(np.asarray(phi_deg, dtype=float)))
+    u = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
+    return (u @ (hull - com).T).max(axis=-1)
+
+
+def _normals(hull: np.ndarray) -> np.ndarray:
+    d = np.roll(hull, -1, axis=0) - hull
+    return np.mod(np.degrees(np.arctan2(-d[:, 0], d[:, 1])), 360.0)
+
+
+def _support_index(unwrapped: np.ndarray, phi_deg: np.ndarray) -> np.ndarray:
+    """The hull vertex supporting direction ``phi``: the first edge normal at or past it."""
+    n = len(unwrapped)
+    x = unwrapped[0] + np.mod(np.asarray(phi_deg, dtype=float) - unwrapped[0], 360.0)
+    return np.searchsorted(unwrapped, x, side="left") % n
+
+
+def width_range(
+    hull: Sequence[Sequence[float]], lo_deg: float, hi_deg: float
+) -> tuple[float, float]:
+    """Exact min and max of the width (diameter function) over fence orientations [lo, hi].
+
+    The width is piecewise sinusoidal with breaks at the edge normals and their opposites; on
+    each piece it is ``<v_a - v_b, u(phi)>`` for the two supporting vertices, so its minimum is
+    at an end or a break and its maximum also where a piece peaks (the direction of
+    ``v_a - v_b``). Supporting vertices are found by binary search on the unwrapped normals:
+    O(k log n) for k breaks in the arc.
+    """
+    h = np.asarray(hull, dtype=float)
+    span = min(hi_deg - lo_deg, 360.0)
+    nrm = _normals(h)
+    unwrapped = nrm[0] + np.concatenate([[0.0], np.cumsum(np.mod(np.diff(nrm), 360.0))])
+    breaks = np.mod(np.concatenate([nrm, nrm + 180.0]) - lo_deg, 360.0)
+    pts = np.unique(np.concatenate([[0.0, span], breaks[breaks < span]]))
+    phi = lo_deg + pts
+    ends = np.concatenate([phi, lo_deg + (pts[:-1] + pts[1:]) / 2.0])
+    a = _support_index(unwrapped, ends)
+    b = _support_index(unwrapped, ends + 180.0)
+    gap = h[a] - h[b]
+    rad = np.radians(ends)
+    w = gap[:, 0] * np.cos(rad) + gap[:, 1] * np.sin(rad)
+    k = len(pts)
+    lo_w, hi_w = float(w[:k].min()), float(w[:k].max())
+    if k > 1:
+        piece = gap[k:]
+        peak = np.mod(np.degrees(np.arctan2(piece[:, 1], piece[:, 0])) - lo_deg, 360.0)
+        inside = (peak > pts[:-1]) & (peak < pts[1:])
+        if inside.any():
+            hi_w = max(hi_w, float(np.hypot(piece[inside, 0], piece[inside, 1]).max()))
+    return lo_w, hi_w
+
+
+def _rest_candidates(pf: PushFunction, t: float, c: float) -> list[RestCandidate]:
+    """Every chord the perturbed part may rest on (F3); the ideal stable edges when t = c = 0."""
+    if t == 0.0 and c == 0.0:
+        n = len(pf.part.hull)
+        heights = _radius(
+            np.asarray(pf.part.hull, dtype=float),
+            np.asarray(pf.part.com, dtype=float),
+            np.asarray([s.normal_deg for s in pf.states]),
+        ).tolist()
+        return [
+            RestCandidate(s.edge, (s.edge + 1) % n, s.normal_deg, 0.0, s.id, hh)
+            for s, hh in zip(pf.states, heights, strict=True)
+        ]
+    h = np.asarray(pf.part.hull, dtype=float)
+    com = np.asarray(pf.part.com, dtype=float)
+    n = len(h)
+    idx = np.arange(n)
+    div = np.asarray(pf.divergent_deg, dtype=float)
+    out: list[RestCandidate] = []
+    valid = np.ones(n, dtype=bool)
+    for m in range(1, n - 1):
+        b = (idx + m) % n
+        d = h[b] - h
+        length = np.hypot(d[:, 0], d[:, 1])
+        if m > 1:
+            for k in range(1, m):
+                rel = h[(idx + k) % n] - h
+                dist = np.abs(d[:, 0] * rel[:, 1] - d[:, 1] * rel[:, 0]) / length
+                valid &= dist <= 2.0 * t
+            if not valid.any():
+                break
+        ratio = np.minimum(1.0, 2.0 * t / length)
+        turn = np.where(ratio < 1.0, np.arcsin(ratio), math.pi)
+        chord_slack = 2.0 * np.sin(turn / 2.0)
+        unit = d / length[:, None]
+        along = np.einsum("ij,ij->i", com - h, unit)
+        ahead = np.einsum("ij,ij->i", h[b] - com, unit)
+        slack_a = np.hypot(*(com - h).T) * chord_slack + t + c
+        slack_b = np.hypot(*(h[b] - com).T) * chord_slack + t + c
+        possible = valid & (along + slack_a > 0.0) & (ahead + slack_b > 0.0)
+        normal = np.mod(np.degrees(np.arctan2(-d[:, 0], d[:, 1])), 360.0)
+        normal[normal >= 360.0] = 0.0
+        height = unit[:, 0] * (com[1] - h[:, 1]) - unit[:, 1] * (com[0] - h[:, 0])
+        sel = np.flatnonzero(possible)
+        k = (np.searchsorted(div, normal[sel], side="right") - 1) % len(div)
+        basin = np.asarray(pf.range_state)[k]
+        out.extend(
+            RestCandidate(a, bb, nd, hw, bs, hh)
+            for a, bb, nd, hw, bs, hh in zip(
+                sel.tolist(),
+                b[sel].tolist(),
+                normal[sel].tolist(),
+                np.degrees(turn[sel]).tolist(),
+                basin.tolist(),
+                height[sel].tolist(),
+                strict=True,
+            )
+        )
+    return out
+
+
+def _level_crossing(
+    hull: np.ndarray, com: np.ndarray, low: np.ndarray, high: np.ndarray, level: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bisection brackets of where r, monotone on [low, high], crosses ``level`` (vectorized).
+
+    Returns ``(below, above)``: r(below) < level <= r(above) when r rises from low to high.
+    """
+    rising = _radius(hull, com, high) >= _radius(hull, com, low)
+    a, b = low.copy(), high.copy()
+    for _ in range(_BISECT_STEPS):
+        mid = (a + b) / 2.0
+        up = _radius(hull, com, mid) >= level
+        go_low = up == rising  # the crossing lies between a and mid
+        b = np.where(go_low, mid, b)
+        a = np.where(go_low, a, mid)
+    return a, b
+
+
+def _bands(pf: PushFunction, eps: float, sure: np.ndarray, peaks: np.ndarray) -> list[Band]:
+    """Bands around the sure hilltops (F1, F2); the divergent orientations when eps = 0."""
+    div = np.asarray(pf.divergent_deg, dtype=float)
+    m = len(div)
+    rs = pf.range_state
+    psi = np.asarray([s.normal_deg for s in pf.states])
+    ks = np.flatnonzero(sure)
+    if len(ks) == 0:
+        return []
+    left = np.asarray([rs[(k - 1) % m] for k in ks])
+    right = np.asarray([rs[k] for k in ks])
+    d = div[ks]
+    if eps == 0.0:
+        lo, hi = d.copy(), d.copy()
+    else:
+        h = np.asarray(pf.part.hull, dtype=float)
+        com = np.asarray(pf.part.com, dtype=float)
+        level = peaks[ks] - 2.0 * eps
+        lpsi = d - np.mod(d - psi[left], 360.0)
+        rpsi = d + np.mod(psi[right] - d, 360.0)
+        lo, _ = _level_crossing(h, com, lpsi, d, level)
+        _, hi = _level_crossing(h, com, d, rpsi, level)
+        rho = np.hypot(*(h - com).T)
+        alpha = np.degrees(np.arctan2(h[:, 1] - com[1], h[:, 0] - com[0]))
+        spread = np.degrees(np.arcsin(np.minimum(1.0, eps / rho)))
+        for j in range(len(ks)):
+            # F2: the highest point of the perturbed hill is near a vertex almost as far out.
+            far = rho >= peaks[ks[j]] - 2.0 * eps
+            off = np.mod(alpha[far] - d[j] + 180.0, 360.0) - 180.0
+            a_lo = np.maximum(off - spread[far], lo[j] - d[j])
+            a_hi = np.minimum(off + spread[far], hi[j] - d[j])
+            keep = a_lo <= a_hi
+            if keep.any():
+                lo[j] = d[j] + min(float(a_lo[keep].min()), 0.0)
+                hi[j] = d[j] + max(float(a_hi[keep].max()), 0.0)
+    return [
+        Band(float(d[j]), float(lo[j]), float(hi[j]), int(left[j]), int(right[j]))
+        for j in range(len(ks))
+    ]
+
+
+def _strong_components(edges: Sequence[set[int]]) -> list[int]:
+    """Strong component id of every node of a small directed graph (iterative Kosaraju)."""
+    n = len(edges)
+    order: list[int] = []
+    seen = [False] * n
+    for root in range(n):
+        if seen[root]:
+            continue
+        seen[root] = True
+        stack = [(root, iter(sorted(edges[root])))]
+        while stack:
+            node, it = stack[-1]
+            nxt = next(it, None)
+            if nxt is None:
+                stack.pop()
+                order.append(node)
+            elif not seen[nxt]:
+                seen[nxt] = True
+                stack.append((nxt, iter(sorted(edges[nxt]))))
+    back: list[list[int]] = [[] for _ in range(n)]
+    for i, out in enumerate(edges):
+        for j in out:
+            back[j].append(i)
+    comp = [-1] * n
+    label = 0
+    for root in reversed(order):
+        if comp[root] >= 0:
+            continue
+        comp[root] = label
+        todo = [root]
+        while todo:
+            node = todo.pop()
+            for j in back[node]:
+                if comp[j] < 0:
+                    comp[j] = label
+                    todo.append(j)
+        label += 1
+    return comp
+
+
+def _destinations(
+    edges: Sequence[set[int]], comp: Sequence[int], pid_of: Mapping[int, int]
+) -> list[frozenset[int]]:
+    """For each ideal state, the physical states it may stay in or vibration may take it to.
+
+    Kosaraju numbers the components in topological order, so the last ones are done first.
+    """
+    labels = max(comp) + 1
+    succ: list[set[int]] = [set() for _ in range(labels)]
+    for i, out in enumerate(edges):
+        for j in out:
+            if comp[j] != comp[i]:
+                succ[comp[i]].add(comp[j])
+    reach: list[frozenset[int]] = [frozenset()] * labels
+    for cc in range(labels - 1, -1, -1):
+        got = {pid_of[cc]} if cc in pid_of else set()
+        for nxt in succ[cc]:
+            got |= reach[nxt]
+        reach[cc] = frozenset(got)
+    return [reach[comp[i]] for i in range(len(edges))]
+
+
+def _arc_hull(arcs: Sequence[tuple[float, float]], ref: float) -> tuple[float, float]:
+    """Smallest arc ``(lo, hi)`` near ``ref`` holding every ``(centre, half_width)`` arc.
+
+    ``lo`` is in [0, 360) and ``hi >= lo``; the ends are computed from the extreme arcs
+    themselves, so zero-width arcs give their centres exactly.
+    """
+    offs = [norm360(cn - ref + 180.0) - 180.0 for cn, _ in arcs]
+    first = min(range(len(arcs)), key=lambda i: offs[i] - arcs[i][1])
+    last = max(range(len(arcs)), key=lambda i: offs[i] + arcs[i][1])
+    lo = norm360(arcs[first][0] - arcs[first][1])
+    span = (offs[last] + arcs[last][1]) - (offs[first] - arcs[first][1])
+    hi = arcs[last][0] + arcs[last][1]
+    while hi < lo:
+        hi += 360.0
+    while hi - lo > span + 1e-6:
+        hi -= 360.0
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class _CandidateArrays:
+    """Candidates' normals, half-widths and basins; ``ext_*`` sorted over three turns."""
+
+    normal: np.ndarray
+    half: np.ndarray
+    basin: np.ndarray
+    ext_normal: np.ndarray
+    ext_half: np.ndarray
+    ext_basin: np.ndarray
+    widest: float
+
+
+def _candidate_arrays(cands: Sequence[RestCandidate]) -> _CandidateArrays:
+    normal = np.mod(np.asarray([x.normal_deg for x in cands], dtype=float), 360.0)
+    half = np.asarray([x.half_width_deg for x in cands], dtype=float)
+    basin = np.asarray([x.basin for x in cands], dtype=int)
+    order = np.argsort(normal, kind="stable")
+    ext = np.concatenate([normal[order] - 360.0, normal[order], normal[order] + 360.0])
+    return _CandidateArrays(
+        normal,
+        half,
+        basin,
+        ext,
+        np.tile(half[order], 3),
+        np.tile(basin[order], 3),
+        float(half.max()) if len(half) else 0.0,
+    )
+
+
+def _cell_targets(
+    arr: _CandidateArrays, dest: Sequence[frozenset[int]], lo: float, hi: float
+) -> frozenset[int]:
+    """Physical states of the candidates whose normal arc meets the open arc (lo, hi)."""
+    if hi - lo >= 360.0:
+        basins = np.unique(arr.basin).tolist()
+    else:
+        x = norm360(lo)
+        y = x + (hi - lo)
+        a = int(np.searchsorted(arr.ext_normal, x - arr.widest, side="left"))
+        b = int(np.searchsorted(arr.ext_normal, y + arr.widest, side="right"))
+        nrm, half = arr.ext_normal[a:b], arr.ext_half[a:b]
+        hit = (nrm - half < y) & (nrm + half > x)
+        basins = set(arr.ext_basin[a:b][hit].tolist())
+    out: set[int] = set()
+    for bs in basins:
+        out |= dest[bs]
+    return frozenset(out)
+
+
+def uncertain_mechanics(
+    part: Part, uncertainty: Uncertainty, *, vibration_mm: float | None = None
+) -> UncertainMechanics:
+    """The physical states, bands and fence cells of ``part`` under ``uncertainty``.
+
+    Merge rule: the part resting in ideal state ``i`` can cross to the neighbour beyond a hill
+    when a rest candidate of ``i``'s basin lies less than ``vibration + 2 (t + c)`` below the
+    hilltop (F1: a barrier that high survives every shape and still holds against the
+    vibration). The physical states are the strong components of that crossing graph (states
+    the part may wander between), except single states it surely leaves (transient: their
+    barrier plus ``2 (t + c)`` is below the vibration); a push that ends in a component may
+    also end in any component it can reach. ``vibration_mm`` defaults to the fragile
+    threshold (1e-3 of the part's size, a breath of vibration) unless the uncertainty is ideal,
+    where it is 0 and every physical state is one ideal state. Raises InputError for a shape
+    tolerance of half the smallest hull edge or more.
+    """
+    check_for_part(uncertainty, part)
+    pf = push_function(part)
+    t, c = uncertainty.shape_tolerance_mm, uncertainty.com_tolerance_mm
+    eps = t + c
+    if vibration_mm is None:
+        vibration_mm = 0.0 if uncertainty.is_ideal else FRAGILE_BARRIER_REL * part.size
+    if vibration_mm < 0.0 or math.isnan(vibration_mm):
+        raise InputError(f"vibration must be a nonnegative length in mm, got {vibration_mm!r}")
+    h = np.asarray(part.hull, dtype=float)
+    com = np.asarray(part.com, dtype=float)
+    div = np.asarray(pf.divergent_deg, dtype=float)
+    m = len(div)
+    rs = pf.range_state
+    heights = _radius(h, com, np.asarray([s.normal_deg for s in pf.states]))
+    peaks = _radius(h, com, div)
+    left = np.asarray([rs[(k - 1) % m] for k in range(m)])
+    right = np.asarray(rs)
+    barrier = peaks - np.maximum(heights[left], heights[right])
+    sure = np.ones(m, dtype=bool) if eps == 0.0 else barrier > 2.0 * eps
+    if m == 1:
+        sure[:] = False
+    threshold = vibration_mm + 2.0 * eps
+
+    cands = _rest_candidates(pf, t, c)
+    rho_max = float(np.hypot(*(h - com).T).max())
+    # Crossing graph: ideal state i -> its neighbour across a hill when some rest candidate in
+    # i's basin may lie less than the vibration below that hilltop for some shape (F1: its
+    # resting height is within r(normal) +- rho_max * half-width, r's slope bound, +- eps).
+    # i must leave when every candidate surely lies that close below one of its hilltops.
+    edges: list[set[int]] = [set() for _ in range(pf.n)]
+    must_leave = [threshold > 0.0] * pf.n
+    if threshold > 0.0 and cands:
+        arr = _candidate_arrays(cands)
+        slack = rho_max * np.radians(arr.half)
+        height = np.asarray([x.height_mm for x in cands])
+        top, bottom = height + 2.0 * t + slack, height - slack
+        range_of = np.empty(pf.n, dtype=int)
+        range_of[np.asarray(rs)] = np.arange(m)
+        k = range_of[arr.basin]
+        leaves = np.zeros(len(cands), dtype=bool)
+        for hill, beyond in ((k, left[k]), ((k + 1) % m, right[(k + 1) % m])):
+            other = beyond != arr.basin
+            cross = other & (peaks[hill] - top < threshold)
+            for i, j in set(zip(arr.basin[cross].tolist(), beyond[cross].tolist(), strict=True)):
+                edges[i].add(j)
+            leaves |= other & (peaks[hill] - bottom + 2.0 * eps < vibration_mm)
+        stays = np.unique(arr.basin[~leaves]).tolist()
+        for i in stays:
+            must_leave[i] = False
+    comp = _strong_components(edges)
+    size: dict[int, int] = {}
+    for cc in comp:
+        size[cc] = size.get(cc, 0) + 1
+    transient = [size[comp[i]] == 1 and must_leave[i] and bool(edges[i]) for i in range(pf.n)]
+    first_member: dict[int, int] = {}
+    for i in range(pf.n):
+        first_member.setdefault(comp[i], i)
+    kept = sorted({comp[i] for i in range(pf.n) if not transient[i]}, key=first_member.__getitem__)
+    pid_of = {cc: p for p, cc in enumerate(kept)}
+    state_of = [pid_of.get(comp[i]) for i in range(pf.n)]
+    destinations = _destinations(edges, comp, pid_of)
+
+    states: list[PhysicalState] = []
+    by_basin: dict[int, list[RestCandidate]] = {}
+    for x in cands:
+        by_basin.setdefault(x.basin, []).append(x)
+    ranges_of: dict[int, list[int]] = {}
+    for k in range(m):
+        ranges_of.setdefault(comp[rs[k]], []).append(k)
+    for pid, cc in enumerate(kept):
+        ks = ranges_of[cc]
+        if len(ks) == m:
+            order = list(range(m))
+        else:
+            # A strong component of this ring graph is a run of ranges: start after its gap.
+            inside = set(ks)
+            start = next(k for k in ks if (k - 1) % m not in inside)
+            order = [(start + i) % m for i in range(len(ks))]
+        members = tuple(rs[k] for k in order)
+        cap_lo = float(div[order[0]])
+        if len(ks) == m:
+            cap_hi = cap_lo + 360.0
+            rest = (cap_lo, cap_lo + 360.0)
+        else:
+            cap_hi = cap_lo + norm360(div[(order[-1] + 1) % m] - cap_lo)
+            if cap_hi <= cap_lo:
+                cap_hi += 360.0
+            own = [x for s in members for x in by_basin.get(s, [])]
+            rest = _arc_hull([(x.normal_deg, x.half_width_deg) for x in own], (cap_lo + cap_hi) / 2)
+        if eps == 0.0 and len(members) == 1:
+            d = pf.states[members[0]].diameter
+            diam = (d, d)
+        else:
+            w_lo, w_hi = width_range(part.hull, rest[0], rest[1])
+            exact = [pf.states[i].diameter for i in members]  # the same widths, rounded apart
+            diam = (max(min(w_lo, *exact) - 2.0 * t, 0.0), max(w_hi, *exact) + 2.0 * t)
+        states.append(PhysicalState(pid, members, rest, (cap_lo, cap_hi), diam))
+
+    bands = _bands(pf, eps, sure, peaks)
+    cells = _fence_cells(bands, cands, destinations)
+    return UncertainMechanics(
+        push=pf,
+        uncertainty=uncertainty,
+        vibration_mm=float(vibration_mm),
+        merge_threshold_mm=float(threshold),
+        candidates=tuple(cands),
+        bands=tuple(bands),
+        states=tuple(states),
+        state_of=tuple(state_of),
+        destinations=tuple(destinations),
+        cells=cells,
+        cell_los=tuple([cl.lo for cl in cells] + [cl.lo + 360.0 for cl in cells]),
+    )
+
+
+def _fence_cells(
+    bands: Sequence[Band], cands: Sequence[RestCandidate], dest: Sequence[frozenset[int]]
+) -> tuple[FenceCell, ...]:
+    """The circle of fence orientations cut at the band ends, each cell with its targets.
+
+    From a gap between bands ``j`` and ``j + 1`` the push stays between them (it cannot pass a
+    local maximum); from inside band ``j`` it stays between bands ``j - 1`` and ``j + 1``.
+    """
+    arr = _candidate_arrays(cands)
+    if not bands:
+        return (FenceCell(0.0, 360.0, False, _cell_targets(arr, dest, 0.0, 360.0)),)
+    base = bands[0].lo_deg
+    lo = [base + norm360(b.lo_deg - base) for b in bands]
+    hi = [lo[j] + (b.hi_deg - b.lo_deg) for j, b in enumerate(bands)]
+    q = len(bands)
+
+    def at(j: int) -> tuple[float, float]:
+        turn = 360.0 * (j // q)
+        return lo[j % q] + turn, hi[j % q] + turn
+
+    cells: list[FenceCell] = []
+    for j in range(q):
+        b_lo, b_hi = at(j)
+        prev_lo, _ = at(j - 1)
+        _, next_hi = at(j + 1)
+        region = (b_lo, b_lo + 360.0) if q == 1 else (prev_lo, next_hi)
+        cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
+        n_lo, _ = at(j + 1)
+        gap_region = (b_lo, b_lo + 360.0) if q == 1 else (b_lo, next_hi)
+        cells.append(FenceCell(b_hi, n_lo, False, _cell_targets(arr, dest, *gap_region)))
+    return tuple(cells)
+
+
+# --- outcome sets ---------------------------------------------------------------------------
+
+
+def fence_outcomes(mech: UncertainMechanics, lo_deg: float, hi_deg: float) -> frozenset[int]:
+    """Physical states a push can end in from any fence orientation in the closed [lo, hi].
+
+    Exact at zero uncertainty (the ideal push, both neighbours exactly at a divergent
+    orientation, closed to within ``BOUNDARY_EPS_DEG`` so rounding cannot lose a side); a
+    superset otherwise. O(log cells + cells met).
+    """
+    lo_deg, hi_deg = lo_deg - BOUNDARY_EPS_DEG, hi_deg + BOUNDARY_EPS_DEG
+    cells = mech.cells
+    q = len(cells)
+    if hi_deg - lo_deg >= 360.0 or q == 1:
+        return frozenset(t for cell in cells for t in cell.targets)
+    los = mech.cell_los
+    base = los[0]
+    x = base + norm360(lo_deg - base)
+    y = x + (hi_deg - lo_deg)
+    i = bisect.bisect_right(los, x) - 1
+    if i > 0 and not cells[i].closed and x <= cells[i - 1].hi:
+        i -= 1  # x closes the band before this open cell
+    j = bisect.bisect_right(los, y) - 1
+    if j >= 0 and j < len(los) and not cells[j % q].closed and y <= los[j]:
+        j -= 1  # an open cell starting at y does not hold it
+    out: set[int] = set()
+    for k in range(i, j + 1):
+        out |= cells[k % q].targets
+    return frozenset(out)
+
+
+def _window(mech: UncertainMechanics, state: int, action: float, err: float) -> tuple[float, float]:
+    rest_lo, rest_hi = mech.states[state].rest_deg
+    return rest_lo - action - err, rest_hi - action + err
+
+
+def outcome_set(
+    mech: UncertainMechanics, state: int, action_deg: float, rotation_error_deg: float | None = None
+) -> frozenset[int]:
+    """Physical states the part can end in from physical ``state`` after the rotation ``action``.
+
+    The robot turns by ``action +- rotation_error`` (closed; default the declared error) and
+    the part rests anywhere in its rest interval; ``theta' = theta - a`` (design.md).
+    """
+    err = mech.uncertainty.rotation_error_deg if rotation_error_deg is None else rotation_error_deg
+    return fence_outcomes(mech, *_window(mech, state, action_deg, err))
+
+
+def action_map(
+    mech: UncertainMechanics, state: int, rotation_error_deg: float | None = None
+) -> tuple[tuple[float, float, frozenset[int]], ...]:
+    """The piecewise-constant outcome sets of every rotation from physical ``state``.
+
+    Sorted ``(lo, hi, targets)``: every rotation strictly inside ``(lo, hi)`` (``lo`` in
+    [0, 360), ``hi`` may pass 360) has the outcome set ``targets``; together they cover the
+    circle. At zero uncertainty these are the ideal action ranges (definition 9) with
+    singleton targets; at a boundary itself :func:`outcome_set` gives the union of both sides.
+    """
+    err = mech.uncertainty.rotation_error_deg if rotation_error_deg is None else rotation_error_deg
+    x, y = _window(mech, state, 0.0, err)
+    if y - x >= 360.0 or len(mech.cells) == 1:
+        return ((0.0, 360.0, fence_outcomes(mech, 0.0, 360.0)),)
+    ends = sorted({v for cell in mech.cells for v in (cell.lo, cell.hi)})
+    cuts = sorted({norm360(x - e) for e in ends} | {norm360(y - e) for e in ends})
+    merged: list[float] = []
+    for v in cuts:
+        if not merged or v - merged[-1] > 1e-12:
+            merged.append(v)
+    if len(merged) > 1 and merged[0] + 360.0 - merged[-1] <= 1e-12:
+        merged.pop()
+    out: list[tuple[float, float, frozenset[int]]] = []
+    for k, lo in enumerate(merged):
+        hi = merged[k + 1] if k + 1 < len(merged) else merged[0] + 360.0
+        mid = (lo + hi) / 2.0
+        targets = fence_outcomes(mech, x - mid, y - mid)
+        if out and out[-1][2] == targets:
+            out[-1] = (out[-1][0], hi, targets)
+        else:
+            out.append((lo, hi, targets))
+    if len(out) > 1 and out[0][2] == out[-1][2]:
+        first = out.pop(0)
+        out[-1] = (out[-1][0], first[1] + 360.0, first[2])
+    return tuple(out)
+
+
+def outcome_at(
+    amap: Sequence[tuple[float, float, frozenset[int]]], action_deg: float
+) -> frozenset[int]:
+    """The outcome set of a rotation strictly inside one of ``amap``'s ranges."""
+    a = norm360(action_deg)
+    los = [lo for lo, _, _ in amap]
+    k = bisect.bisect_right(los, a) - 1
+    return amap[k][2] if k >= 0 else amap[-1][2]
+
+
+# --- certificates ---------------------------------------------------------------------------
+
+
+def max_rotation_error(
+    mech: UncertainMechanics,
+    states: Iterable[int],
+    action_deg: float,
+    assumed: Mapping[int, frozenset[int]] | None = None,
+) -> float:
+    """The largest rotation error (deg, a supremum) keeping every outcome within the plan's sets.
+
+    For each physical state ``s`` in ``states`` the plan assumes outcomes ``assumed[s]``
+    (default: the outcome set at the declared error). Every error strictly below the result
+    keeps ``outcome_set(s, action, err)`` within it: the distance from the action's window to
+    the nearest cell whose targets leave the assumed set (bands included). Exact for the model
+    (the cells); 0 when even an exact rotation leaves the set; at most 90.
+    """
+    best = 90.0
+    for s in states:
+        allowed = assumed[s] if assumed is not None else outcome_set(mech, s, action_deg)
+        x0, y0 = _window(mech, s, action_deg, 0.0)
+        ends = {v for cell in mech.cells for v in (cell.lo, cell.hi)}
+        dist = sorted({norm360(e - y0) for e in ends} | {norm360(x0 - e) for e in ends} | {0.0})
+        dist = [d for d in dist if d < best] + [best]
+        limit = best
+        for k, d in enumerate(dist[:-1]):
+            nxt = dist[k + 1]
+            if not fence_outcomes(mech, x0 - d, y0 + d) <= allowed:
+                limit = d
+                break
+            mid = (d + nxt) / 2.0
+            if not fence_outcomes(mech, x0 - mid, y0 + mid) <= allowed:
+                limit = d
+                break
+        best = min(best, limit)
+    return best
+
+
+def max_shape_tolerance(
+    part: Part,
+    base: Uncertainty,
+    checks: Sequence[tuple[int, float, frozenset[int]]],
+    *,
+    rel_tol: float = 1e-3,
+) -> float:
+    """The largest shape tolerance (mm) under which every ``(ideal state, action, allowed)`` holds.
+
+    A check holds when every ideal member of every outcome of the physical state holding the
+    ideal state, after ``action`` at ``base``'s rotation error and COM tolerance, is in the
+    ``allowed`` ideal ids. Found by bisection on :func:`uncertain_mechanics` (outcome sets grow
+    with the tolerance) to ``rel_tol`` of the bound, half the smallest hull edge; returns the
+    lower end of the final bracket, so the checks hold there; 0 when they fail at t = 0.
+    """
+
+    def holds(t: float) -> bool:
+        unc = Uncertainty(base.rotation_error_deg, t, base.com_tolerance_mm)
+        mech = uncertain_mechanics(part, unc)
+        for ideal, action, allowed in checks:
+            for start in mech.destinations[ideal]:
+                out = outcome_set(mech, start, action)
+                if any(mm not in allowed for p in out for mm in mech.states[p].members):
+                    return False
+        return True
+
+    limit = shape_tolerance_limit(part)
+    if not holds(0.0):
+        return 0.0
+    lo, hi = 0.0, limit * (1.0 - 1e-9)
+    if holds(hi):
+        return hi
+    while hi - lo > rel_tol * limit:
+        mid = (lo + hi) / 2.0
+        lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+    return lo
+
+
+def mechanics_to_dict(mech: UncertainMechanics) -> dict[str, object]:
+    """The physical states and bands as JSON-ready lists (for ``part analyze`` and plan files)."""
+    return {
+        "uncertainty": mech.uncertainty.to_dict(),
+        "merge_threshold_mm": mech.merge_threshold_mm,
+        "physical_states": [
+            {
+                "id": s.id,
+                "members": list(s.members),
+                "rest_deg": list(s.rest_deg),
+                "capture_deg": list(s.capture_deg),
+                "diameter": list(s.diameter),
+            }
+            for s in mech.states
+        ],
+        "bands": [
+            {"divergent_deg": b.divergent_deg, "band_deg": [b.lo_deg, b.hi_deg]} for b in mech.bands
+        ],
+    }
+
+
+__all__ = [
+    "Band",
+    "FenceCell",
+    "PhysicalState",
+    "RestCandidate",
+    "UncertainMechanics",
+    "action_map",
+    "fence_outcomes",
+    "max_rotation_error",
+    "max_shape_tolerance",
+    "mechanics_to_dict",
+    "outcome_at",
+    "outcome_set",
+    "uncertain_mechanics",
+    "width_range",
+]

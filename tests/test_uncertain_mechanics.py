@@ -1,0 +1,393 @@
+"""The uncertainty value and the mechanics under uncertainty on known parts.
+
+Zero uncertainty must give back the ideal model exactly (states, diameters, action ranges);
+the default uncertainty must merge the wrench's two bottom edges and the d-washer's arc facets;
+bands, outcome sets and certificates must follow their definitions.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from feederkit.angles import norm360
+from feederkit.errors import InputError
+from feederkit.mechanics import action_ranges, diameter, push, push_function
+from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
+from feederkit.mechanics.uncertain import (
+    action_map,
+    fence_outcomes,
+    max_rotation_error,
+    max_shape_tolerance,
+    mechanics_to_dict,
+    outcome_at,
+    outcome_set,
+    uncertain_mechanics,
+    width_range,
+)
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.sources import load_part
+from feederkit.uncertainty import (
+    IDEAL,
+    Uncertainty,
+    check_for_part,
+)
+from feederkit.uncertainty import (
+    max_shape_tolerance as tolerance_limit,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+CATALOG = ROOT / "catalog"
+WRENCH = ROOT.parent / "shared" / "samples" / "trimesh__wrench.dxf"
+CATALOG_PARTS = sorted(p.stem for p in CATALOG.glob("*.json"))
+
+
+def catalog_part(name: str):  # noqa: ANN201
+    return load_part(str(CATALOG / f"{name}.json"))
+
+
+def circ(a: float, b: float) -> float:
+    d = (a - b) % 360.0
+    return min(d, 360.0 - d)
+
+
+# --- the Uncertainty value --------------------------------------------------------------------
+
+
+def test_defaults_and_round_trip() -> None:
+    u = Uncertainty()
+    assert (u.rotation_error_deg, u.shape_tolerance_mm, u.com_tolerance_mm) == (1.0, 0.0, 0.0)
+    assert not u.is_ideal and IDEAL.is_ideal
+    v = Uncertainty(0.5, 0.02, 0.1)
+    assert v.to_dict() == {
+        "rotation_error_deg": 0.5,
+        "shape_tolerance_mm": 0.02,
+        "com_tolerance_mm": 0.1,
+    }
+    assert Uncertainty.from_dict(v.to_dict()) == v
+    assert Uncertainty.from_dict({}) == Uncertainty()
+    assert v.radius_error_mm == pytest.approx(0.12)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"rotation_error_deg": -1.0}, "rotation error"),
+        ({"rotation_error_deg": float("nan")}, "rotation error"),
+        ({"rotation_error_deg": 90.0}, "[0, 90)"),
+        ({"rotation_error_deg": 120.0}, "[0, 90)"),
+        ({"shape_tolerance_mm": -0.1}, "shape tolerance"),
+        ({"shape_tolerance_mm": float("inf")}, "shape tolerance"),
+        ({"com_tolerance_mm": float("nan")}, "COM tolerance"),
+        ({"com_tolerance_mm": "abc"}, "COM tolerance"),
+    ],
+)
+def test_bad_values_are_one_line_input_errors(kwargs: dict, words: str) -> None:
+    with pytest.raises(InputError) as err:
+        Uncertainty(**kwargs)
+    assert words in str(err.value) and "\n" not in str(err.value)
+
+
+def test_bad_dicts_are_input_errors() -> None:
+    with pytest.raises(InputError, match="unknown key"):
+        Uncertainty.from_dict({"rotation_error": 1.0})
+    with pytest.raises(InputError, match="must be an object"):
+        Uncertainty.from_dict([1.0])
+
+
+def test_shape_tolerance_is_checked_against_the_smallest_edge() -> None:
+    part = catalog_part("rectangle-2x1")  # 2 x 1: smallest edge 1 mm
+    assert tolerance_limit(part) == pytest.approx(0.5)
+    assert check_for_part(Uncertainty(1.0, 0.49), part).shape_tolerance_mm == 0.49
+    with pytest.raises(InputError, match="half the smallest hull edge"):
+        check_for_part(Uncertainty(1.0, 0.5), part)
+    with pytest.raises(InputError, match="rectangle-2x1"):
+        uncertain_mechanics(part, Uncertainty(1.0, 0.7))
+
+
+# --- zero uncertainty is the ideal model -------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", CATALOG_PARTS)
+def test_zero_uncertainty_is_the_ideal_model(name: str) -> None:
+    part = catalog_part(name)
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, IDEAL)
+    assert mech.n == pf.n and mech.state_of == tuple(range(pf.n))
+    for ps, s in zip(mech.states, pf.states, strict=True):
+        assert ps.members == (s.id,)
+        assert ps.rest_deg == (s.normal_deg, s.normal_deg)
+        assert ps.diameter == (s.diameter, s.diameter)
+        ideal = action_ranges(pf, s.id)
+        amap = action_map(mech, ps.id)
+        assert len(amap) == len(ideal)
+        for (lo, hi, targets), r in zip(amap, ideal, strict=True):
+            assert circ(lo, r.lo) < 1e-9 and abs((hi - lo) - (r.hi - r.lo)) < 1e-9
+            assert targets == {r.target}
+        # Exactly at a boundary the push may end on either side.
+        lo, _, left = amap[0]
+        _, _, right = amap[-1]
+        assert outcome_set(mech, ps.id, lo) == left | right
+
+
+def test_zero_uncertainty_fence_outcomes_are_the_push_function() -> None:
+    part = catalog_part("heptagon-fig17")
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, IDEAL)
+    for theta in np.linspace(0.0, 360.0, 721)[:-1].tolist():
+        if min(circ(theta, d) for d in pf.divergent_deg) < 1e-6:
+            continue
+        assert fence_outcomes(mech, theta, theta) == {push(pf, theta).id}
+    for d in pf.divergent_deg:
+        assert len(fence_outcomes(mech, d, d)) == 2
+
+
+def test_rotation_error_alone_unions_the_ideal_outcomes() -> None:
+    # No vibration, no tolerances: the outcome set is the ideal push over a - r .. a + r.
+    part = catalog_part("quadrilateral")
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, Uncertainty(2.0), vibration_mm=0.0)
+    assert mech.n == pf.n
+    rng = np.random.default_rng(5)
+    for s in pf.states:
+        for a in rng.uniform(0.0, 360.0, 40).tolist():
+            want = {push(pf, s.normal_deg - a - e).id for e in np.linspace(-2.0, 2.0, 801)}
+            assert want <= outcome_set(mech, s.id, a)
+            got = outcome_set(mech, s.id, a)
+            bounds = [norm360(s.normal_deg - d) for d in pf.divergent_deg]
+            if min(abs(circ(a, b) - 2.0) for b in bounds) > 0.01:
+                assert got == want
+
+
+# --- physical states on known parts ------------------------------------------------------------
+
+
+def bent_bar():  # noqa: ANN201
+    """An 80 x 20 bar whose bottom is two edges 3 degrees apart, the bend just under the COM."""
+    sag = 40.0 * math.tan(math.radians(1.5))
+    pts = [(0, 0), (40.1, -sag), (80, 0), (80, 20), (0, 20)]
+    return make_part(make_outline("bent-bar", pts), (40.0, 10.0))
+
+
+def test_a_bar_rests_across_its_two_bottom_edges() -> None:
+    part = bent_bar()
+    pf = push_function(part)
+    bottom = sorted(s.id for s in pf.states if circ(s.normal_deg, 270.0) < 2.0)
+    assert len(bottom) == 2
+    assert uncertain_mechanics(part, IDEAL).n == pf.n
+    mech = uncertain_mechanics(part, Uncertainty())
+    merged = mech.states[mech.state_of[bottom[0]]]
+    assert merged.members == tuple(sorted(bottom, key=lambda i: pf.states[i].normal_deg))
+    lo, hi = merged.rest_deg
+    normals = [pf.states[i].normal_deg for i in bottom]
+    assert hi - lo == pytest.approx(circ(*normals), abs=1e-9) and 2.9 < hi - lo < 3.1
+    assert merged.diameter == pytest.approx(width_range(part.hull, lo, hi))
+    widths = [pf.states[i].diameter for i in bottom]
+    assert merged.diameter[0] <= min(widths) < max(widths) <= merged.diameter[1]
+    # Away from the bottom nothing merges: the bar's ends and top keep their own states.
+    assert mech.n == pf.n - 1
+
+
+@pytest.mark.slow
+def test_the_wrench_rests_across_its_two_bottom_edges() -> None:
+    part = load_part(str(WRENCH))
+    pf = push_function(part)
+    bottom = sorted(s.id for s in pf.states if circ(s.normal_deg, 268.5) < 3.0)
+    assert len(bottom) == 2
+    assert uncertain_mechanics(part, IDEAL).n == pf.n
+    mech = uncertain_mechanics(part, Uncertainty())
+    merged = mech.states[mech.state_of[bottom[0]]]
+    assert set(merged.members) == set(bottom)
+    lo, hi = merged.rest_deg
+    assert hi - lo == pytest.approx(circ(*(pf.states[i].normal_deg for i in bottom)), abs=1e-9)
+    widths = [pf.states[i].diameter for i in bottom]
+    # It reads anything between (and including) the two states' diameters.
+    assert merged.diameter[0] <= min(widths) and merged.diameter[1] >= max(widths)
+    assert merged.diameter == pytest.approx(width_range(part.hull, lo, hi))
+    assert float(diameter(part, (lo + hi) / 2.0)) <= merged.diameter[1]
+    # The fragile side state is transient: the part always leaves it.
+    side = next(s.id for s in pf.states if s.barrier_mm < 0.01 and s.id not in bottom)
+    assert mech.state_of[side] is None and len(mech.destinations[side]) >= 1
+
+
+def test_the_d_washer_arc_facets_merge_and_the_flat_stays() -> None:
+    part = catalog_part("d-washer")
+    pf = push_function(part)
+    flat = next(s.id for s in pf.states if circ(s.normal_deg, 270.0) < 1e-6)
+    mech = uncertain_mechanics(part, Uncertainty())
+    assert mech.n == 2
+    assert mech.states[mech.state_of[flat]].members == (flat,)
+    arc = mech.states[1 - mech.state_of[flat]]
+    assert set(arc.members) == set(range(pf.n)) - {flat}
+    d = [pf.states[i].diameter for i in arc.members]
+    assert arc.diameter[0] <= min(d) and arc.diameter[1] >= max(d)
+    data = mechanics_to_dict(mech)
+    assert data["uncertainty"] == Uncertainty().to_dict() and len(data["physical_states"]) == 2
+
+
+def test_plain_shapes_keep_their_states_at_the_default() -> None:
+    for name in ("rectangle-2x1", "octagon", "equilateral-triangle"):
+        part = catalog_part(name)
+        assert uncertain_mechanics(part, Uncertainty()).n == push_function(part).n
+
+
+def test_bands_are_asin_of_the_tolerance_at_a_sharp_vertex() -> None:
+    part = make_part(make_outline("tri", [(0, 0), (40, 0), (10, 30)]))
+    pf = push_function(part)
+    unc = Uncertainty(1.0, 0.01, 0.02)
+    mech = uncertain_mechanics(part, unc)
+    assert len(mech.bands) == pf.n == 3
+    com = np.asarray(part.com)
+    for band in mech.bands:
+        v = min(
+            part.hull,
+            key=lambda p: circ(
+                math.degrees(math.atan2(p[1] - com[1], p[0] - com[0])), band.divergent_deg
+            ),
+        )
+        rho = math.dist(v, part.com)
+        spread = math.degrees(math.asin(unc.radius_error_mm / rho))
+        assert band.lo_deg <= band.divergent_deg <= band.hi_deg
+        assert band.divergent_deg - band.lo_deg == pytest.approx(spread, rel=1e-6)
+        assert band.hi_deg - band.divergent_deg == pytest.approx(spread, rel=1e-6)
+
+
+def test_outcome_sets_grow_with_the_uncertainty() -> None:
+    part = catalog_part("l-bracket")
+    rng = np.random.default_rng(2)
+    actions = rng.uniform(0.0, 360.0, 60).tolist()
+    levels = [
+        Uncertainty(0.0),
+        Uncertainty(0.5),
+        Uncertainty(1.0),
+        Uncertainty(2.0, 0.01, 0.01),
+        Uncertainty(4.0, 0.05, 0.05),
+    ]
+    # The same vibration at every level (the ideal model has none: its states are exact).
+    vibration = FRAGILE_BARRIER_REL * part.size
+    mechs = [uncertain_mechanics(part, u, vibration_mm=vibration) for u in levels]
+
+    def ideal_members(mech, i: int, a: float) -> set[int]:  # noqa: ANN001
+        return {
+            m
+            for start in mech.destinations[i]
+            for p in outcome_set(mech, start, a)
+            for m in mech.states[p].members
+        }
+
+    for i in range(push_function(part).n):
+        for a in actions:
+            sets = [ideal_members(m, i, a) for m in mechs]
+            for small, large in zip(sets, sets[1:], strict=False):
+                assert small <= large
+
+
+# --- certificates ------------------------------------------------------------------------------
+
+
+def test_max_rotation_error_is_the_distance_to_the_nearest_boundary() -> None:
+    part = catalog_part("rectangle-2x1")
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, Uncertainty(0.0), vibration_mm=0.0)
+    for s in pf.states:
+        for r in action_ranges(pf, s.id):
+            mid = (r.lo + r.hi) / 2.0
+            got = max_rotation_error(mech, [s.id], mid, {s.id: frozenset({r.target})})
+            assert got == pytest.approx(min((r.hi - r.lo) / 2.0, 90.0), abs=1e-9)
+    # The certificate of a set is the smallest; just above it some outcome leaves the set.
+    states = [0, 1]
+    a = 100.0
+    assumed = {s: outcome_set(mech, s, a, 0.0) for s in states}
+    cert = max_rotation_error(mech, states, a, assumed)
+    assert all(outcome_set(mech, s, a, cert * 0.999) <= assumed[s] for s in states)
+    assert any(not outcome_set(mech, s, a, cert + 1e-6) <= assumed[s] for s in states)
+
+
+def test_max_rotation_error_is_at_least_the_declared_error_for_the_declared_sets() -> None:
+    part = catalog_part("l-bracket")
+    mech = uncertain_mechanics(part, Uncertainty(1.0))
+    for s in range(mech.n):
+        for a in (10.0, 95.0, 200.0, 300.0):
+            assert max_rotation_error(mech, [s], a) >= 1.0
+
+
+def test_max_shape_tolerance_bisection_brackets_the_change() -> None:
+    part = catalog_part("rectangle-2x1")
+    pf = push_function(part)
+    base = Uncertainty(1.0)
+    checks = [
+        (s.id, r.lo + 0.3 * (r.hi - r.lo), frozenset({r.target}))
+        for s in pf.states
+        for r in action_ranges(pf, s.id)[:1]
+    ]
+    t = max_shape_tolerance(part, base, checks, rel_tol=1e-3)
+    assert 0.0 < t < tolerance_limit(part)
+
+    def holds(tol: float) -> bool:
+        mech = uncertain_mechanics(part, Uncertainty(1.0, tol))
+        return all(
+            {
+                m
+                for st in mech.destinations[i]
+                for p in outcome_set(mech, st, a)
+                for m in mech.states[p].members
+            }
+            <= allowed
+            for i, a, allowed in checks
+        )
+
+    assert holds(t)
+    assert not holds(t + 2e-3 * tolerance_limit(part))
+
+
+# --- exactness of helpers and speed ------------------------------------------------------------
+
+
+def test_width_range_is_exact() -> None:
+    part = catalog_part("l-bracket")
+    for lo, hi in ((10.0, 50.0), (200.0, 200.5), (300.0, 420.0), (0.0, 360.0)):
+        grid = np.linspace(lo, hi, 20001)
+        w = diameter(part, grid)
+        got = width_range(part.hull, lo, hi)
+        assert got[0] <= w.min() + 1e-12 and got[1] >= w.max() - 1e-12
+        assert got[0] == pytest.approx(w.min(), abs=1e-6) and got[1] == pytest.approx(
+            w.max(), abs=1e-6
+        )
+
+
+def test_action_map_covers_the_circle_and_agrees_with_outcome_set() -> None:
+    part = bent_bar()
+    mech = uncertain_mechanics(part, Uncertainty(1.0, 0.01, 0.02))
+    for s in range(mech.n):
+        amap = action_map(mech, s)
+        assert amap[0][0] >= 0.0 and amap[0][0] < 360.0
+        assert sum(hi - lo for lo, hi, _ in amap) == pytest.approx(360.0)
+        for (_, hi, _), (lo, _, _) in zip(amap, amap[1:], strict=False):
+            assert hi == pytest.approx(lo)
+        for lo, hi, targets in amap:
+            mid = (lo + hi) / 2.0
+            assert outcome_set(mech, s, mid) == targets == outcome_at(amap, mid)
+
+
+def test_a_thousand_vertex_outline_is_fast() -> None:
+    n = 1000
+    pts = [
+        (
+            30 * math.cos(2 * math.pi * k / n) * (1 + 0.02 * math.sin(14 * math.pi * k / n)),
+            30 * math.sin(2 * math.pi * k / n),
+        )
+        for k in range(n)
+    ]
+    part = make_part(make_outline("big", pts))
+    assert len(part.hull) == n
+    uncertain_mechanics(part, Uncertainty())  # warm up
+    start = time.perf_counter()
+    mech = uncertain_mechanics(part, Uncertainty())
+    elapsed = time.perf_counter() - start
+    assert mech.n >= 1
+    assert elapsed < 0.25, elapsed  # typically ~40 ms; the margin absorbs a loaded machine
