@@ -56,6 +56,7 @@ COMMAND_MODULES = (
     "feederkit.cli.report",
     "feederkit.cli.simulate",
     "feederkit.cli.demo",
+    "feederkit.cli.design",
 )
 
 

@@ -1,0 +1,420 @@
+"""The cell profile: the feeder described once (design.md, "Cell profile"; docs/cell.md).
+
+A TOML file, ``feederkit.toml`` in the working directory or ``--cell FILE``::
+
+    [sensor]  model = "tolerance"   # "tolerance" | "led" | "none"
+              tolerance_mm = 0.2    # with model = "tolerance"
+              pitch_mm = 0.5        # with model = "led"
+              noise_mm = 0.05       # with model = "led" (default 0)
+    [robot]   rotation_error_deg = 1.0
+              pick_place_s = 1.2
+              rotation_speed_deg_s = 180
+    [belt]    speed_m_s = 0.1
+              drop_to_fence_mm = 150
+
+Every section and key is optional; unknown sections and keys are refused, and every bad
+field is named on its own line (:class:`CellProfileError`). Command-line options override
+the profile (:func:`resolve_settings`); every output names the profile it used
+(:attr:`CellProfile.source`).
+
+The cycle time of a plan (:func:`cycle_time`) follows the paper's operation (section 3.3):
+the first alignment is the drop from the feeder and the drift to the fence; every later
+operation is a pick, a rotation through the plan's angle, a place, and again the drift to
+the fence, where the part aligns and is read.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from feederkit.errors import InputError
+from feederkit.machine import successor
+from feederkit.sensors import SensorModel, make_sensor
+
+DEFAULT_CELL_FILE = "feederkit.toml"
+"""The profile read from the working directory when no ``--cell FILE`` is given."""
+
+BUILT_IN = "built-in defaults"
+"""The :attr:`CellProfile.source` when no profile file was read."""
+
+SENSOR_MODELS = ("none", "tolerance", "led")
+
+
+class CellProfileError(InputError):
+    """A profile with bad fields; ``problems`` holds one line per bad field."""
+
+    def __init__(self, source: str, problems: list[str]) -> None:
+        self.problems = tuple(problems)
+        super().__init__(f"{source}: " + "; ".join(problems))
+
+
+@dataclass(frozen=True)
+class SensorSection:
+    """``[sensor]``: the model and its parameters (mm); see :mod:`feederkit.sensors`."""
+
+    model: str = "none"
+    tolerance_mm: float | None = None
+    pitch_mm: float | None = None
+    noise_mm: float = 0.0
+
+    def sensor(self) -> SensorModel:
+        """The sensor this section describes."""
+        if self.model == "tolerance":
+            return make_sensor(tolerance=self.tolerance_mm)
+        if self.model == "led":
+            return make_sensor(led_pitch=self.pitch_mm, noise=self.noise_mm)
+        return make_sensor(sensorless=True)
+
+
+@dataclass(frozen=True)
+class RobotSection:
+    """``[robot]``: rotation error (deg, design.md's "Uncertainty"), pick-and-place time (s),
+    rotation speed (deg/s). The timing fields are None when the profile does not give them."""
+
+    rotation_error_deg: float = 1.0
+    pick_place_s: float | None = None
+    rotation_speed_deg_s: float | None = None
+
+
+@dataclass(frozen=True)
+class BeltSection:
+    """``[belt]``: belt speed (m/s) and the travel (mm) from the drop point to the fence."""
+
+    speed_m_s: float | None = None
+    drop_to_fence_mm: float | None = None
+
+
+@dataclass(frozen=True)
+class CellProfile:
+    """A feeder cell: sensor, robot and belt, and where the description came from."""
+
+    sensor: SensorSection = field(default_factory=SensorSection)
+    robot: RobotSection = field(default_factory=RobotSection)
+    belt: BeltSection = field(default_factory=BeltSection)
+    source: str = BUILT_IN
+
+    def missing_timing(self) -> tuple[str, ...]:
+        """The fields a cycle time needs that the profile does not give."""
+        wanted = {
+            "robot.pick_place_s": self.robot.pick_place_s,
+            "robot.rotation_speed_deg_s": self.robot.rotation_speed_deg_s,
+            "belt.speed_m_s": self.belt.speed_m_s,
+            "belt.drop_to_fence_mm": self.belt.drop_to_fence_mm,
+        }
+        return tuple(k for k, v in wanted.items() if v is None)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The profile as its three sections and ``source``, for JSON output."""
+        return {
+            "source": self.source,
+            "sensor": {
+                "model": self.sensor.model,
+                "tolerance_mm": self.sensor.tolerance_mm,
+                "pitch_mm": self.sensor.pitch_mm,
+                "noise_mm": self.sensor.noise_mm,
+            },
+            "robot": {
+                "rotation_error_deg": self.robot.rotation_error_deg,
+                "pick_place_s": self.robot.pick_place_s,
+                "rotation_speed_deg_s": self.robot.rotation_speed_deg_s,
+            },
+            "belt": {
+                "speed_m_s": self.belt.speed_m_s,
+                "drop_to_fence_mm": self.belt.drop_to_fence_mm,
+            },
+        }
+
+
+# Per section, per key: (what the value must be, its check).
+_POSITIVE = ("a positive number", lambda v: v > 0.0)
+_NONNEGATIVE = ("zero or a positive number", lambda v: v >= 0.0)
+_ROTATION = ("a number in [0, 180)", lambda v: 0.0 <= v < 180.0)
+_FIELDS: dict[str, dict[str, tuple[str, Any] | None]] = {
+    "sensor": {"model": None, "tolerance_mm": _POSITIVE, "pitch_mm": _POSITIVE,
+               "noise_mm": _NONNEGATIVE},
+    "robot": {"rotation_error_deg": _ROTATION, "pick_place_s": _NONNEGATIVE,
+              "rotation_speed_deg_s": _POSITIVE},
+    "belt": {"speed_m_s": _POSITIVE, "drop_to_fence_mm": _NONNEGATIVE},
+}  # fmt: skip
+_UNITS = {"mm": "mm", "deg": "degrees", "s": "seconds", "deg_s": "deg/s", "m_s": "m/s"}
+
+
+def _unit(key: str) -> str:
+    for suffix in ("deg_s", "m_s", "mm", "deg", "s"):
+        if key.endswith("_" + suffix):
+            return " " + _UNITS[suffix]
+    return ""
+
+
+def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
+    """A profile from the parsed TOML tables; CellProfileError names every bad field."""
+    problems: list[str] = []
+    bad_model = False
+    values: dict[str, dict[str, Any]] = {name: {} for name in _FIELDS}
+    for section, table in data.items():
+        if section not in _FIELDS:
+            problems.append(f"unknown section [{section}] (the sections are {', '.join(_FIELDS)})")
+            continue
+        if not isinstance(table, dict):
+            problems.append(f"{section} must be a table ([{section}])")
+            continue
+        for key, value in table.items():
+            name = f"{section}.{key}"
+            if key not in _FIELDS[section]:
+                known = ", ".join(_FIELDS[section])
+                problems.append(f"unknown key {name} (the keys of [{section}] are {known})")
+                continue
+            check = _FIELDS[section][key]
+            if check is None:  # sensor.model
+                if value not in SENSOR_MODELS:
+                    bad_model = True
+                    problems.append(
+                        f"{name} must be one of {', '.join(map(repr, SENSOR_MODELS))}, "
+                        f"got {value!r}"
+                    )
+                    continue
+                values[section][key] = value
+                continue
+            what, ok = check
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not math.isfinite(value)
+                or not ok(float(value))
+            ):
+                problems.append(f"{name} must be {what} of{_unit(key)}, got {value!r}")
+                continue
+            values[section][key] = float(value)
+    sensor = values["sensor"]
+    model = sensor.get("model", "none")
+    needs = {"tolerance": "tolerance_mm", "led": "pitch_mm"}
+    if model in needs and needs[model] not in sensor and not bad_model:
+        problems.append(f"sensor.{needs[model]} is required with model = {model!r}")
+    for key, owner in (("tolerance_mm", "tolerance"), ("pitch_mm", "led"), ("noise_mm", "led")):
+        if key in sensor and model != owner and not bad_model:
+            problems.append(f"sensor.{key} goes with model = {owner!r}, but the model is {model!r}")
+    if problems:
+        raise CellProfileError(source, problems)
+    return CellProfile(
+        sensor=SensorSection(**sensor),
+        robot=RobotSection(**values["robot"]),
+        belt=BeltSection(**values["belt"]),
+        source=source,
+    )
+
+
+def read_cell(path: str | Path) -> CellProfile:
+    """Read and validate a profile file; InputError when it is missing or not TOML."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{p}: no such cell profile")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{p}: not a valid TOML file ({exc})") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{p}: not a UTF-8 text file") from None
+    return parse_cell(data, str(p))
+
+
+def load_cell(path: str | Path | None = None, *, directory: str | Path = ".") -> CellProfile:
+    """The profile of ``--cell FILE`` if given, else ``feederkit.toml`` in ``directory`` if it
+    exists, else the built-in defaults (no sensor, 1 deg rotation error, no timing)."""
+    if path is not None:
+        return read_cell(path)
+    default = Path(directory) / DEFAULT_CELL_FILE
+    if default.is_file():
+        return read_cell(default)
+    return CellProfile()
+
+
+@dataclass(frozen=True)
+class CellSettings:
+    """What a planning command uses: the profile with the command line's overrides applied.
+
+    ``overrides`` names the command-line options that replaced profile fields.
+    """
+
+    profile: CellProfile
+    sensor: SensorModel
+    rotation_error_deg: float
+    overrides: tuple[str, ...] = ()
+
+    def describe(self) -> str:
+        """One line naming the profile and the overrides, for every output."""
+        text = f"cell profile: {self.profile.source}"
+        if self.overrides:
+            text += f" (overridden: {', '.join(self.overrides)})"
+        return text
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"profile", "overrides", "sensor", "rotation_error_deg"}`` for JSON output."""
+        return {
+            "profile": self.profile.source,
+            "overrides": list(self.overrides),
+            "sensor": self.sensor.to_dict(),
+            "rotation_error_deg": self.rotation_error_deg,
+        }
+
+
+def resolve_settings(
+    profile: CellProfile,
+    *,
+    sensorless: bool = False,
+    tolerance: float | None = None,
+    led_pitch: float | None = None,
+    noise: float | None = None,
+    rotation_error: float | None = None,
+) -> CellSettings:
+    """The sensor and settings of ``profile`` with the command line's options on top.
+
+    Any of ``--sensorless``, ``--tolerance`` and ``--led-pitch`` replaces the profile's
+    sensor (``--noise`` with it, else the profile's LED noise); ``--noise`` alone changes
+    the noise of the profile's LED array. InputError for impossible values.
+    """
+    overrides: list[str] = []
+    if sensorless or tolerance is not None or led_pitch is not None:
+        overrides += [
+            name
+            for name, given in (
+                ("--sensorless", sensorless),
+                ("--tolerance", tolerance is not None),
+                ("--led-pitch", led_pitch is not None),
+                ("--noise", noise is not None),
+            )
+            if given
+        ]
+        if noise is None and led_pitch is not None and profile.sensor.model == "led":
+            noise = profile.sensor.noise_mm
+        sensor = make_sensor(
+            sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
+        )
+    elif noise is not None:
+        if profile.sensor.model != "led":
+            raise InputError(
+                f"--noise goes with --led-pitch or a profile whose sensor is an LED array "
+                f"({profile.source} has model = {profile.sensor.model!r})"
+            )
+        overrides.append("--noise")
+        sensor = make_sensor(led_pitch=profile.sensor.pitch_mm, noise=noise)
+    else:
+        sensor = profile.sensor.sensor()
+    r = profile.robot.rotation_error_deg
+    if rotation_error is not None:
+        if not (math.isfinite(rotation_error) and 0.0 <= rotation_error < 180.0):
+            raise InputError(f"--rotation-error must be in [0, 180) degrees, got {rotation_error}")
+        r = float(rotation_error)
+        overrides.append("--rotation-error")
+    return CellSettings(profile, sensor, r, tuple(overrides))
+
+
+@dataclass(frozen=True)
+class CycleTime:
+    """Seconds per part of a plan in a cell, expected (uniform start, as the plan's
+    expected length) and in the worst case, and the parts per minute they give."""
+
+    expected_s: float
+    worst_s: float
+
+    @property
+    def parts_per_minute(self) -> float | None:
+        """60 / expected seconds (None when a part takes no time)."""
+        return 60.0 / self.expected_s if self.expected_s > 0.0 else None
+
+    @property
+    def worst_parts_per_minute(self) -> float | None:
+        """60 / worst seconds (None when a part takes no time)."""
+        return 60.0 / self.worst_s if self.worst_s > 0.0 else None
+
+    def to_dict(self) -> dict[str, float | None]:
+        """``{"expected_s", "worst_s", "parts_per_minute", "worst_parts_per_minute"}``."""
+        return {
+            "expected_s": self.expected_s,
+            "worst_s": self.worst_s,
+            "parts_per_minute": self.parts_per_minute,
+            "worst_parts_per_minute": self.worst_parts_per_minute,
+        }
+
+
+def rotation_deg(action_deg: float) -> float:
+    """How far the robot turns for a plan's rotation: the shorter way round (deg).
+
+    A rotation by ``a`` and by ``a - 360`` leave the part in the same pose.
+    """
+    a = action_deg % 360.0
+    return min(a, 360.0 - a)
+
+
+def operation_seconds(action_deg: float | None, profile: CellProfile) -> float:
+    """Seconds of one push-align operation: the first (``action_deg`` None) is the drift
+    from the drop to the fence; a later one adds the pick and place and the rotation."""
+    missing = profile.missing_timing()
+    if missing:
+        raise InputError(
+            f"{profile.source}: a cycle time needs {', '.join(missing)} in the cell profile"
+        )
+    drift = profile.belt.drop_to_fence_mm / (profile.belt.speed_m_s * 1000.0)  # type: ignore[operator]
+    if action_deg is None:
+        return drift
+    turn = rotation_deg(action_deg) / profile.robot.rotation_speed_deg_s  # type: ignore[operator]
+    return profile.robot.pick_place_s + turn + drift  # type: ignore[operator]
+
+
+def cycle_time(plan: Any, profile: CellProfile) -> CycleTime:
+    """The expected and worst seconds per part of a plan in the cell ``profile``.
+
+    ``plan`` is a planner's result (``machine`` and ``root``) or anything with such a
+    ``result`` (a made plan). Expected: start states weighted as the machine says (its
+    ``MachineState.weight``), readings uniform over the sensor's reading set, as the plan's
+    expected length (:mod:`feederkit.planning.stats`); worst: the slowest path of the tree.
+    """
+    result = getattr(plan, "result", plan)
+    machine, root = result.machine, result.root
+    sensor = machine.sensor
+    cost: dict[int, float] = {}
+
+    def seconds(node: Any) -> float:
+        key = id(node)
+        if key not in cost:
+            action = None if node.action is None else node.action.representative
+            cost[key] = operation_seconds(action, profile)
+        return cost[key]
+
+    worst_memo: dict[int, float] = {}
+
+    def worst(node: Any) -> float:
+        if not hasattr(node, "branches"):
+            return 0.0
+        key = id(node)
+        if key not in worst_memo:
+            worst_memo[key] = seconds(node) + max(
+                (worst(sub) for _, sub in node.branches), default=0.0
+            )
+        return worst_memo[key]
+
+    memo: dict[tuple[int, int], float] = {}
+
+    def expected(node: Any, state: int) -> float:
+        if not hasattr(node, "branches"):
+            return 0.0
+        key = (id(node), state)
+        if key not in memo:
+            if node.action is not None:
+                state = successor(machine, state, node.action.representative)
+            d = machine.states[state].diameter
+            total = seconds(node)
+            for b, sub in node.branches:
+                if b.mask >> state & 1:
+                    p = sensor.reading_probability(d, b.lo, b.hi)
+                    if p > 0.0:
+                        total += p * expected(sub, state)
+            memo[key] = total
+        return memo[key]
+
+    mean = sum(s.weight for s in machine.states)
+    exp = sum(s.weight * expected(root, i) for i, s in enumerate(machine.states)) / mean
+    return CycleTime(exp, worst(root))

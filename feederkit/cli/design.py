@@ -1,0 +1,231 @@
+"""``feederkit design sensor SOURCE... | --mix A,B,...``: which sensor a product mix needs.
+
+A thin layer over :mod:`feederkit.design`: read the cell profile (``--cell FILE`` or
+``./feederkit.toml``) and the command line's overrides, load the parts, decide the critical
+tolerances (or each LED pitch), print the tables, the one-line answer and the profile used,
+and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from feederkit.cell import load_cell
+from feederkit.cli.common import CatalogOpt, JsonOpt, console, fail, print_json
+from feederkit.design.pitches import parse_pitches
+from feederkit.design.sensor import (
+    MODEL_NOTE,
+    PitchDesign,
+    ToleranceDesign,
+    design_pitches,
+    design_tolerance,
+)
+from feederkit.errors import InputError
+from feederkit.loading import load_parts
+
+design_app = typer.Typer(
+    name="design",
+    help="Choose the cell: which sensor a product mix needs.",
+    no_args_is_help=True,
+)
+
+SHOWN_PAIRS = 10
+"""Pairs listed on the terminal (the lowest critical tolerances); --json lists every pair."""
+
+
+def parse_mix(text: str) -> list[str]:
+    """``--mix A,B,...``: catalog part names, each once; InputError for an empty name."""
+    names = [t.strip() for t in text.split(",")]
+    if not names or any(not n for n in names):
+        raise InputError(f"--mix must list part names separated by commas, got {text!r}")
+    for n in names:
+        if ":" in n:
+            raise InputError(
+                f"--mix {n}: design sensor takes part names only; mix shares weigh expected "
+                "figures, which it computes for equal shares"
+            )
+    return names
+
+
+@design_app.command("sensor")
+def sensor_command(
+    sources: Annotated[
+        list[str] | None,
+        typer.Argument(help="Outline or CAD files or catalog part names (or use --mix)."),
+    ] = None,
+    mix: Annotated[
+        str | None, typer.Option("--mix", metavar="A,B,...", help="Catalog part names.")
+    ] = None,
+    pitches: Annotated[
+        str | None,
+        typer.Option(
+            "--pitches",
+            metavar="P,...|START:STOP:STEP",
+            help="Design an LED array: these pitches (mm), each evaluated on its own.",
+        ),
+    ] = None,
+    noise: Annotated[
+        float | None,
+        typer.Option("--noise", metavar="MM", help="The LED array's alignment noise (mm)."),
+    ] = None,
+    max_tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--max-tolerance",
+            metavar="MM",
+            help="Tabulate lengths up to this tolerance (default: the critical tolerance).",
+        ),
+    ] = None,
+    rotation_error: Annotated[
+        float | None,
+        typer.Option(
+            "--rotation-error",
+            metavar="DEG",
+            help="Robot rotation error, reported (the figures are for the ideal model).",
+        ),
+    ] = None,
+    cell: Annotated[
+        Path | None,
+        typer.Option("--cell", metavar="FILE", help="Cell profile (default ./feederkit.toml)."),
+    ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", metavar="FILE.png|svg", help="Also draw the lengths here."),
+    ] = None,
+    catalog: CatalogOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """The exact critical tolerance (or LED pitch) of a mix and its pairs (Theorem 9), and
+    the optimal plan length as a step function of the tolerance."""
+    names = list(sources or [])
+    if mix is not None:
+        if names:
+            raise InputError("give the parts as SOURCE... or as --mix, not both")
+        names = parse_mix(mix)
+    if not names:
+        raise InputError("no parts: give SOURCE... or --mix A,B,...")
+    profile = load_cell(cell)
+    r = profile.robot.rotation_error_deg if rotation_error is None else rotation_error
+    if not 0.0 <= r < 180.0:
+        raise InputError(f"--rotation-error must be in [0, 180) degrees, got {r}")
+    led = pitches is not None or profile.sensor.model == "led"
+    if not led and noise is not None:
+        raise InputError("--noise goes with --pitches (or a profile with an LED array)")
+    if led:
+        default = (float(profile.sensor.pitch_mm or 0.0),)  # a profile's LED array has one
+        values = parse_pitches(pitches) if pitches is not None else default
+        e = noise if noise is not None else profile.sensor.noise_mm
+        if not e >= 0.0:
+            raise InputError(f"--noise must be zero or a positive number of mm, got {e}")
+    if plot is not None and plot.suffix.lower() not in (".png", ".svg"):
+        raise InputError(f"{plot}: the plot is written as .png or .svg")
+
+    loaded = load_parts(names, catalog=catalog)
+    pfs = list(loaded.push_functions)
+    design: ToleranceDesign | PitchDesign
+    if led:
+        design = design_pitches(pfs, values, noise=e, rotation_error_deg=r)
+    else:
+        design = design_tolerance(pfs, max_tolerance=max_tolerance, rotation_error_deg=r)
+    if plot is not None:
+        from feederkit.design.plot import plot_design
+
+        plot_design(design, plot)
+
+    if json_out:
+        data = design.to_dict()
+        data["cell_profile"] = profile.source
+        if plot is not None:
+            data["plot"] = str(plot)
+        print_json(data)
+    else:
+        for line in loaded.warnings:
+            console.print(f"warning: {line}", highlight=False, markup=False)
+        if isinstance(design, ToleranceDesign):
+            _print_tolerance(design)
+        else:
+            _print_pitches(design)
+        console.print(
+            f"cell profile: {profile.source}; rotation error {r:g} deg ({MODEL_NOTE})",
+            highlight=False,
+            markup=False,
+        )
+        if plot is not None:
+            console.print(f"wrote {plot}", highlight=False, markup=False)
+        console.print(design.answer(), highlight=False, markup=False)
+    if not design.recognizable:
+        fail(design.answer(), code=1)
+
+
+def _mm(x: float | None) -> str:
+    return "none" if x is None else f"{x:.6g}"
+
+
+def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
+    pairs = sorted(
+        design.critical.pairs,
+        key=lambda p: -1.0 if p.critical_tolerance is None else p.critical_tolerance,
+    )
+    shown = pairs[:SHOWN_PAIRS]
+    more = len(pairs) - len(shown)
+    title = "critical tolerance of each pair (the largest that still tells them apart)"
+    if more > 0:
+        title += f"; the {len(shown)} lowest of {len(pairs)}"
+    table = Table(title=title)
+    table.add_column("part a")
+    table.add_column("part b")
+    table.add_column("critical tolerance (mm)", justify="right")
+    table.add_column("why not", overflow="fold")
+    for p in shown:
+        why = p.witness.reason if p.witness is not None else ""
+        table.add_row(p.a, p.b, _mm(p.critical_tolerance), why)
+    return table
+
+
+def _print_tolerance(design: ToleranceDesign) -> None:
+    console.print(_pairs_table(design))
+    table = Table(title="optimal plan length by tolerance (each step holds on (lo, hi])")
+    table.add_column("tolerance (mm)")
+    table.add_column("length", justify="right")
+    table.add_column("expected (at hi)", justify="right")
+    for s in design.steps:
+        hi = "..." if s.hi is None else f"{s.hi:.6g}"
+        table.add_row(f"({s.lo:.6g}, {hi}]", str(s.length), f"{s.expected:.4f}")
+    if design.steps:
+        console.print(table)
+
+
+def _print_pitches(design: PitchDesign) -> None:
+    table = Table(title=f"LED pitches, each on its own (noise {design.noise:g} mm)")
+    table.add_column("pitch (mm)", justify="right")
+    table.add_column("recognizable")
+    table.add_column("length", justify="right")
+    table.add_column("expected", justify="right")
+    table.add_column("pairs it cannot tell apart", overflow="fold")
+    for row in design.rows:
+        bad = ", ".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])
+        if len(row.unrecognizable) > 3:
+            bad += f" and {len(row.unrecognizable) - 3} more"
+        table.add_row(
+            f"{row.pitch:.6g}",
+            "yes" if row.recognizable else "no",
+            "-" if row.length is None else str(row.length),
+            "-" if row.expected is None else f"{row.expected:.4f}",
+            bad,
+        )
+    console.print(table)
+    console.print(
+        f"for comparison, an exact diameter sensor: critical tolerance "
+        f"{_mm(design.critical.critical_tolerance)} mm",
+        highlight=False,
+        markup=False,
+    )
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``design sensor`` to the app."""
+    app.add_typer(design_app, name="design")

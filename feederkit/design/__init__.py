@@ -1,0 +1,43 @@
+"""Sensor design: which sensor a product mix needs, and the plan it then gets.
+
+- :mod:`~feederkit.design.critical`: exact critical tolerances of pairs and mixes (binary
+  search over the breakpoints ``|d - d'| / 2`` with the exact pair test, Theorem 9);
+- :mod:`~feederkit.design.steps`: the optimal plan length as a step function of the
+  tolerance, with its exact breakpoints;
+- :mod:`~feederkit.design.pitches`: LED arrays, pitch by pitch;
+- :mod:`~feederkit.design.sensor`: the ``design sensor`` answer (docs/design.md).
+"""
+
+from feederkit.design.critical import (
+    MixCritical,
+    PairCritical,
+    mix_critical_tolerance,
+    pair_breakpoints,
+    pair_critical_tolerance,
+)
+from feederkit.design.pitches import PitchRow, parse_pitches, pitch_rows
+from feederkit.design.sensor import (
+    PitchDesign,
+    ToleranceDesign,
+    design_pitches,
+    design_tolerance,
+)
+from feederkit.design.steps import LengthStep, length_steps, mix_breakpoints
+
+__all__ = [
+    "LengthStep",
+    "MixCritical",
+    "PairCritical",
+    "PitchDesign",
+    "PitchRow",
+    "ToleranceDesign",
+    "design_pitches",
+    "design_tolerance",
+    "length_steps",
+    "mix_breakpoints",
+    "mix_critical_tolerance",
+    "pair_breakpoints",
+    "pair_critical_tolerance",
+    "parse_pitches",
+    "pitch_rows",
+]

@@ -1,0 +1,170 @@
+"""Critical tolerances: the largest sensor tolerance at which parts can still be told apart.
+
+With a tolerance sensor of tolerance ``e`` two states of diameters ``d`` and ``d'`` read
+alike iff ``|d - d'| < 2e`` (design.md's open interval). The read-alike relation, and so
+everything decided from it (distinguishability, definition 11 and Theorem 9; the plan
+length), changes only at the *breakpoints* ``e = |d - d'| / 2``: it is the same for every
+``e`` in ``(b_k, b_{k+1}]``. Between breakpoints nothing changes, so the exact answer is
+reached by a binary search over the sorted breakpoints with the exact pair test
+(:func:`feederkit.mix.pairs.distinguishable`), not by bisection on floats.
+
+Distinguishability is monotone in ``e``: a larger tolerance only adds read-alike pairs, so
+the greatest fixpoint of inseparable pairs only grows (the tests check it exhaustively on
+random pairs). Diameters equal within the library's relative ``DIAMETER_REL_EPS`` always
+read alike and give no breakpoint.
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mix.pairs import PairWitness, distinguishable
+from feederkit.sensors import ToleranceSensor
+
+
+def _eps(pfs: Sequence[PushFunction]) -> float:
+    """Diameters closer than this are the same diameter (as the machine and pair test say)."""
+    return DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
+
+
+def breakpoints_of(diameters_a: Sequence[float], diameters_b: Sequence[float], eps: float):
+    """The sorted distinct ``|d - d'| / 2`` over ``d`` in a and ``d'`` in b above ``eps / 2``."""
+    return tuple(
+        sorted({abs(x - y) / 2.0 for x in diameters_a for y in diameters_b if abs(x - y) > eps})
+    )
+
+
+def pair_breakpoints(pf_a: PushFunction, pf_b: PushFunction) -> tuple[float, ...]:
+    """The tolerances at which two parts' cross read-alike relation changes."""
+    return breakpoints_of(
+        [s.diameter for s in pf_a.states], [s.diameter for s in pf_b.states], _eps([pf_a, pf_b])
+    )
+
+
+def interval_probe(breaks: Sequence[float], k: int) -> float:
+    """A tolerance inside interval ``k``: ``(b_{k-1}, b_k]`` (``b_{-1} = 0``), or past the last.
+
+    The closed right end ``b_k`` itself for ``k < len(breaks)``; twice the last breakpoint
+    (or 1 mm without breakpoints) for the unbounded last interval.
+    """
+    if k < len(breaks):
+        return breaks[k]
+    return 2.0 * breaks[-1] if breaks else 1.0
+
+
+def last_true(count: int, test: Callable[[int], bool]) -> int:
+    """The largest ``k`` in ``[0, count)`` with ``test(k)``, for a test true then false; -1 if none.
+
+    Binary search: ``ceil(log2(count + 1))`` calls of ``test``.
+    """
+    lo, hi = -1, count  # test(lo) is true (or lo = -1), test(hi) false (or hi = count)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if test(mid):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@dataclass(frozen=True)
+class PairCritical:
+    """A pair of parts and its critical tolerance (mm): the largest ``e`` still distinguishable.
+
+    None when no tolerance tells them apart (then ``witness`` says why, e.g. the same
+    push-diameter function, Lemma 8). At exactly ``critical_tolerance`` the pair reads apart
+    (the open interval); at any larger tolerance it does not.
+    """
+
+    a: str
+    b: str
+    critical_tolerance: float | None
+    witness: PairWitness | None = None
+
+    def to_dict(self) -> dict[str, object]:
+        """``{"a", "b", "critical_tolerance_mm"}`` and, when none works, the ``reason``."""
+        out: dict[str, object] = {
+            "a": self.a,
+            "b": self.b,
+            "critical_tolerance_mm": self.critical_tolerance,
+        }
+        if self.witness is not None:
+            out["reason"] = self.witness.reason
+        return out
+
+
+def pair_critical_tolerance(pf_a: PushFunction, pf_b: PushFunction) -> PairCritical:
+    """The exact critical tolerance of two parts, by binary search over their breakpoints.
+
+    Interval ``k`` of the breakpoints is tested at its right end with the exact pair test
+    (definition 11); the largest distinguishable interval's right end is the answer. Past the
+    last breakpoint every cross pair reads alike, so the pair is never distinguishable there.
+    A Hausdorff bound starts the search: while some state of one part is farther than ``2e``
+    from every state of the other, no inseparable pair can exist (every state of each part
+    is in one, see :mod:`feederkit.mix.pairs`).
+    """
+    breaks = pair_breakpoints(pf_a, pf_b)
+    da = [s.diameter for s in pf_a.states]
+    db = [s.diameter for s in pf_b.states]
+    eps = _eps([pf_a, pf_b])
+    hausdorff = max(
+        max(min(abs(x - y) for y in db) for x in da),
+        max(min(abs(x - y) for y in da) for x in db),
+    )
+    # Intervals whose right end is at most half the Hausdorff distance are distinguishable.
+    sure = bisect.bisect_right(breaks, hausdorff / 2.0) - 1 if hausdorff > eps else -1
+
+    def ok(k: int) -> bool:
+        return k <= sure or distinguishable(pf_a, pf_b, ToleranceSensor(breaks[k])) is None
+
+    k = last_true(len(breaks), ok)
+    name_a, name_b = pf_a.part.name, pf_b.part.name
+    if k < 0:
+        why = distinguishable(pf_a, pf_b, ToleranceSensor(interval_probe(breaks, 0)))
+        return PairCritical(name_a, name_b, None, why)
+    return PairCritical(name_a, name_b, breaks[k])
+
+
+@dataclass(frozen=True)
+class MixCritical:
+    """The critical tolerance of a mix and of each of its pairs of parts.
+
+    The mix is recognizable (section 8.5) iff every pair of its parts is distinguishable,
+    so its critical tolerance is the smallest of the pairs' (None when one pair has none:
+    no tolerance works; a single part has no pair and is recognizable with any).
+    """
+
+    pairs: tuple[PairCritical, ...]
+
+    @property
+    def critical_tolerance(self) -> float | None:
+        """The largest tolerance (mm) at which the mix is recognizable (inf for one part)."""
+        values = [p.critical_tolerance for p in self.pairs]
+        if any(v is None for v in values):
+            return None
+        return min((v for v in values if v is not None), default=float("inf"))
+
+    @property
+    def inseparable(self) -> tuple[PairCritical, ...]:
+        """The pairs that no tolerance can tell apart."""
+        return tuple(p for p in self.pairs if p.critical_tolerance is None)
+
+    @property
+    def limiting(self) -> tuple[PairCritical, ...]:
+        """The pairs whose critical tolerance is the mix's (the ones that set it)."""
+        c = self.critical_tolerance
+        return tuple(p for p in self.pairs if p.critical_tolerance == c)
+
+
+def mix_critical_tolerance(pfs: Sequence[PushFunction]) -> MixCritical:
+    """Every pair's exact critical tolerance, in part order, and so the mix's."""
+    pairs = [
+        pair_critical_tolerance(pfs[i], pfs[j])
+        for i in range(len(pfs))
+        for j in range(i + 1, len(pfs))
+    ]
+    return MixCritical(tuple(pairs))

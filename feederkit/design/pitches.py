@@ -1,0 +1,107 @@
+"""LED arrays: which beam pitches make a mix recognizable, evaluated one pitch at a time.
+
+Beam grids of different pitches are not nested (beams at multiples of 0.3 mm are not a subset
+of those at multiples of 0.2 mm), so recognizability and plan length need not be monotone in
+the pitch: each pitch in the list is decided on its own with the exact pair test
+(:func:`feederkit.mix.pairs.unrecognizable_pairs`) and, when the mix is recognizable, a
+verified optimal plan (:func:`feederkit.plans.make.make_plan`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from feederkit.errors import InputError
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.pairs import unrecognizable_pairs
+from feederkit.plans.make import make_plan
+from feederkit.sensors import LedSensor
+
+
+@dataclass(frozen=True)
+class PitchRow:
+    """One LED pitch (mm): whether the mix is recognizable with it and, if so, its plan.
+
+    ``unrecognizable``: the pairs of parts (names) that this pitch cannot tell apart.
+    """
+
+    pitch: float
+    noise: float
+    unrecognizable: tuple[tuple[str, str], ...]
+    length: int | None = None
+    expected: float | None = None
+
+    @property
+    def recognizable(self) -> bool:
+        """Whether every pair of parts is distinguishable with this pitch."""
+        return not self.unrecognizable
+
+    def to_dict(self) -> dict[str, object]:
+        """``{"pitch_mm", "noise_mm", "recognizable", "length", "expected", "unrecognizable"}``."""
+        return {
+            "pitch_mm": self.pitch,
+            "noise_mm": self.noise,
+            "recognizable": self.recognizable,
+            "length": self.length,
+            "expected": self.expected,
+            "unrecognizable": [list(p) for p in self.unrecognizable],
+        }
+
+
+def pitch_row(pfs: Sequence[PushFunction], pitch: float, noise: float) -> PitchRow:
+    """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix."""
+    sensor = LedSensor(pitch, noise)
+    bad = tuple((w.part_a, w.part_b) for w in unrecognizable_pairs(list(pfs), sensor))
+    if bad:
+        return PitchRow(pitch, noise, bad)
+    result = make_plan(list(pfs), sensor).result
+    return PitchRow(pitch, noise, (), result.length, result.expected_length)
+
+
+def pitch_rows(
+    pfs: Sequence[PushFunction], pitches: Sequence[float], noise: float
+) -> tuple[PitchRow, ...]:
+    """Every pitch of the list, ascending, each decided on its own."""
+    return tuple(pitch_row(pfs, p, noise) for p in sorted(set(pitches)))
+
+
+def parse_pitches(text: str) -> tuple[float, ...]:
+    """``--pitches``: a list ``0.1,0.2,0.5`` or a range ``START:STOP:STEP`` (STOP included).
+
+    InputError for an empty list, a value that is not a positive number, or a bad range.
+    """
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    if not items:
+        raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5 or 0.1:1:0.1")
+    out: list[float] = []
+    for item in items:
+        if ":" in item:
+            out.extend(_range(item))
+            continue
+        out.append(_positive(item))
+    return tuple(sorted(set(out)))
+
+
+def _positive(item: str) -> float:
+    try:
+        v = float(item)
+    except ValueError:
+        raise InputError(f"--pitches: {item!r} is not a number of mm") from None
+    if not math.isfinite(v) or v <= 0.0:
+        raise InputError(f"--pitches: a pitch must be a positive number of mm, got {item}")
+    return v
+
+
+def _range(item: str) -> list[float]:
+    parts = item.split(":")
+    if len(parts) != 3:
+        raise InputError(f"--pitches: a range is START:STOP:STEP, got {item!r}")
+    start, stop, step = (_positive(p) for p in parts)
+    if stop < start:
+        raise InputError(f"--pitches: the range {item!r} ends before it starts")
+    count = math.floor((stop - start) / step + 1e-9) + 1
+    if count > 1000:
+        raise InputError(f"--pitches: the range {item!r} has {count} pitches (at most 1000)")
+    return [round(start + k * step, 12) for k in range(count)]

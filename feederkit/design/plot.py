@@ -1,0 +1,77 @@
+"""The plot of ``design sensor``: plan length (and expected length) against the sensor.
+
+matplotlib (Agg) is imported only to draw. A tolerance design is drawn as the step function
+of its exact breakpoints; an LED design as one point per pitch (pitches are not ordered in
+what they can tell apart, :mod:`feederkit.design.pitches`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from feederkit.design.sensor import PitchDesign, ToleranceDesign
+from feederkit.errors import InputError
+
+PLOT_SUFFIXES = (".png", ".svg")
+
+
+def plot_design(design: ToleranceDesign | PitchDesign, path: str | Path) -> Path:
+    """Draw the design's lengths to ``path`` (.png or .svg); InputError for another suffix."""
+    out = Path(path)
+    if out.suffix.lower() not in PLOT_SUFFIXES:
+        raise InputError(f"{out}: the plot is written as .png or .svg")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    try:
+        if isinstance(design, ToleranceDesign):
+            _tolerance(ax, design)
+        else:
+            _pitches(ax, design)
+        ax.set_ylabel("operations")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper left")
+        fig.tight_layout()
+        fig.savefig(out)
+    finally:
+        plt.close(fig)
+    return out
+
+
+def _tolerance(ax, design: ToleranceDesign) -> None:
+    steps = design.steps
+    if not steps:
+        ax.text(0.5, 0.5, "no tolerance makes this mix recognizable", ha="center",
+                transform=ax.transAxes)  # fmt: skip
+        return
+    top = steps[-1].hi if steps[-1].hi is not None else 2.0 * steps[-1].lo
+    for k, s in enumerate(steps):
+        hi = s.hi if s.hi is not None else top
+        ax.hlines(s.length, s.lo, hi, colors="C0", label="length (worst case)" if k == 0 else None)
+        ax.plot([hi], [s.length], "o", color="C0")  # the closed right end
+        ax.plot([hi], [s.expected], "x", color="C1", label="expected, at the step's end"
+                if k == 0 else None)  # fmt: skip
+    x = design.critical_tolerance
+    if x is not None:
+        ax.axvline(x, color="C3", linestyle="--", label=f"critical tolerance {x:.4g} mm")
+    ax.set_xlabel("sensor tolerance (mm)")
+    ax.set_title("optimal plan length by sensor tolerance (" + ", ".join(design.parts[:4])
+                 + (", ..." if len(design.parts) > 4 else "") + ")")  # fmt: skip
+
+
+def _pitches(ax, design: PitchDesign) -> None:
+    ok = [r for r in design.rows if r.recognizable]
+    bad = [r for r in design.rows if not r.recognizable]
+    if ok:
+        ax.plot([r.pitch for r in ok], [r.length for r in ok], "o", color="C0",
+                label="length (worst case)")  # fmt: skip
+        ax.plot([r.pitch for r in ok], [r.expected for r in ok], "x", color="C1",
+                label="expected")  # fmt: skip
+    if bad:
+        ax.plot([r.pitch for r in bad], [0 for _ in bad], "s", color="C3",
+                label="not recognizable")  # fmt: skip
+    ax.set_xlabel(f"LED pitch (mm), noise {design.noise:.4g} mm")
+    ax.set_title("optimal plan length by LED pitch")

@@ -1,0 +1,140 @@
+"""``feederkit design sensor`` through ``main``: JSON, the one-line answer, exit codes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from shared import one_line_error
+
+import feederkit.cli.app as app_module
+from feederkit.cli import design as design_cli
+from feederkit.cli.app import main
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+MIX = [str(CATALOG / f"{n}.json") for n in ("quadrilateral", "rectangle-2x1", "l-bracket")]
+
+
+@pytest.fixture(autouse=True)
+def design_registered(tmp_path, monkeypatch):
+    """The command on the app (until the lead lists it in COMMAND_MODULES); no stray profile."""
+    group = app_module._click_command()
+    if "design" not in getattr(group, "commands", {}):
+        design_cli.register(app_module.app)
+        app_module._click_command.cache_clear()
+    monkeypatch.chdir(tmp_path)
+
+
+def run_json(capsys, args, code=0):
+    rc = main(args)
+    captured = capsys.readouterr()
+    assert rc == code, captured.err
+    return json.loads(captured.out), captured.err
+
+
+def test_tolerance_design_json(capsys):
+    data, _ = run_json(capsys, ["design", "sensor", *MIX, "--json"])
+    x = data["critical_tolerance_mm"]
+    assert data["sensor_model"] == "tolerance" and x > 0
+    assert data["cell_profile"] == "built-in defaults"
+    assert [(p["a"], p["b"]) for p in data["pairs"]] == [
+        ("quadrilateral", "rectangle-2x1"),
+        ("quadrilateral", "l-bracket"),
+        ("rectangle-2x1", "l-bracket"),
+    ]
+    assert x == min(p["critical_tolerance_mm"] for p in data["pairs"])
+    rows = data["lengths"]
+    assert rows[0]["tolerance_mm"][0] == 0.0 and rows[-1]["tolerance_mm"][1] == x
+    for a, b in zip(rows, rows[1:], strict=False):
+        assert a["tolerance_mm"][1] == b["tolerance_mm"][0] and a["length"] < b["length"]
+    assert all(r["recognizable"] and 1.0 <= r["expected"] <= r["length"] for r in rows)
+    assert data["uncertainty"] == {"rotation_error_deg": 1.0, "applied": False}
+    assert data["answer"].startswith(f"this mix is recognizable with a tolerance up to {x:.6g} mm")
+
+
+def test_terminal_output_names_the_answer_and_the_profile(capsys):
+    assert main(["design", "sensor", *MIX, "--rotation-error", "0"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "this mix is recognizable with a tolerance up to" in out
+    assert "the plan takes" in out and "cell profile: built-in defaults" in out
+    assert "rotation error 0 deg" in out
+
+
+@pytest.mark.parametrize("pitches", [None, "0.5,1"])
+def test_the_plot_is_written(capsys, tmp_path, pitches):
+    plot = tmp_path / "steps.svg"
+    extra = [] if pitches is None else ["--pitches", pitches]
+    assert main(["design", "sensor", *MIX[:2], "--plot", str(plot), *extra]) == 0
+    assert f"wrote {plot}" in " ".join(capsys.readouterr().out.split())
+    assert plot.read_text().lstrip().startswith("<?xml") and "<svg" in plot.read_text()
+
+
+def test_led_pitches_one_by_one(capsys):
+    data, _ = run_json(capsys, ["design", "sensor", *MIX, "--pitches", "5,0.2,1", "--json"])
+    assert [r["pitch_mm"] for r in data["pitches"]] == [0.2, 1.0, 5.0]
+    ok = [r["pitch_mm"] for r in data["pitches"] if r["recognizable"]]
+    assert data["critical_pitch_mm"] == max(ok)
+    for r in data["pitches"]:
+        assert (r["length"] is not None) == r["recognizable"] == (not r["unrecognizable"])
+    assert "LED pitch of" in data["answer"]
+
+
+def test_the_profile_chooses_the_led_array(capsys, tmp_path):
+    cell = tmp_path / "cell.toml"
+    cell.write_text('[sensor]\nmodel = "led"\npitch_mm = 0.25\nnoise_mm = 0.01\n')
+    data, _ = run_json(capsys, ["design", "sensor", *MIX, "--cell", str(cell), "--json"])
+    assert data["cell_profile"] == str(cell) and data["noise_mm"] == 0.01
+    assert [r["pitch_mm"] for r in data["pitches"]] == [0.25]
+
+
+def test_a_lookalike_pair_exits_1_naming_lemma_8(capsys, tmp_path):
+    twin = tmp_path / "twin.json"
+    src = MIX[0]
+    assert (
+        main(["lookalike", src, "--keep", "push-diameter", "--name", "twin", "-o", str(twin)]) == 0
+    )
+    capsys.readouterr()
+    data, err = run_json(capsys, ["design", "sensor", src, str(twin), "--json"], code=1)
+    assert data["critical_tolerance_mm"] is None and data["lengths"] == []
+    assert "Lemma 8" in data["pairs"][0]["reason"]
+    assert len(err.strip().splitlines()) == 1 and "Lemma 8" in err
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--pitches", ""], "--pitches is empty"),
+        (["--pitches", " , "], "--pitches is empty"),
+        (["--pitches", "0.2,-1"], "positive"),
+        (["--pitches", "0.2,wide"], "not a number"),
+        (["--pitches", "1:0.5:0.1"], "ends before"),
+        (["--noise", "0.1"], "--noise goes with"),
+        (["--plot", "steps.pdf"], ".png or .svg"),
+        (["--max-tolerance", "0"], "--max-tolerance"),
+        (["--rotation-error", "-1"], "--rotation-error"),
+    ],
+)
+def test_bad_options_are_one_line_exit_2(capsys, args, needle):
+    assert needle in one_line_error(capsys, ["design", "sensor", *MIX, *args])
+
+
+def test_bad_mixes_and_profiles_are_one_line_exit_2(capsys, tmp_path):
+    assert "at least two parts" in one_line_error(capsys, ["design", "sensor", MIX[0]])
+    assert "SOURCE" in one_line_error(capsys, ["design", "sensor"])
+    assert "not both" in one_line_error(capsys, ["design", "sensor", MIX[0], "--mix", "a,b"])
+    assert "part names only" in one_line_error(capsys, ["design", "sensor", "--mix", "a:0.7,b"])
+    assert "commas" in one_line_error(capsys, ["design", "sensor", "--mix", "a,,b"])
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[robot]\npick_place_s = -1\nspeed = 3\n")
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--cell", str(bad)])
+    assert "robot.pick_place_s" in err and "unknown key robot.speed" in err
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--cell", str(tmp_path / "no.toml")])
+    assert "no such cell profile" in err
+
+
+def test_a_shorter_table_says_where_it_stops(capsys):
+    data, _ = run_json(capsys, ["design", "sensor", *MIX, "--max-tolerance", "0.1", "--json"])
+    top = data["lengths"][-1]["tolerance_mm"][1]
+    assert 0.1 <= top < data["critical_tolerance_mm"]
+    assert f"tabulated up to {top:.6g} mm only" in data["answer"]
