@@ -298,7 +298,8 @@ def test_max_rotation_error_is_the_distance_to_the_nearest_boundary() -> None:
         for r in action_ranges(pf, s.id):
             mid = (r.lo + r.hi) / 2.0
             got = max_rotation_error(mech, [s.id], mid, {s.id: frozenset({r.target})})
-            assert got == pytest.approx(min((r.hi - r.lo) / 2.0, 90.0), abs=1e-9)
+            # The supremum stops BOUNDARY_EPS_DEG short of the boundary (touching counts).
+            assert got == pytest.approx(min((r.hi - r.lo) / 2.0, 90.0), abs=2e-9)
     # The certificate of a set is the smallest; just above it some outcome leaves the set.
     states = [0, 1]
     a = 100.0

@@ -730,8 +730,9 @@ def max_rotation_error(
     For each physical state ``s`` in ``states`` the plan assumes outcomes ``assumed[s]``
     (default: the outcome set at the declared error). Every error strictly below the result
     keeps ``outcome_set(s, action, err)`` within it: the distance from the action's window to
-    the nearest cell whose targets leave the assumed set (bands included). Exact for the model
-    (the cells); 0 when even an exact rotation leaves the set; at most 90.
+    the nearest cell whose targets leave the assumed set (bands included), less
+    ``BOUNDARY_EPS_DEG`` (closer than that counts as touching). Exact for the model (the
+    cells); 0 when even an exact rotation leaves the set; at most 90.
     """
     best = 90.0
     for s in states:
@@ -750,7 +751,9 @@ def max_rotation_error(
             if not fence_outcomes(mech, x0 - mid, y0 + mid) <= allowed:
                 limit = d
                 break
-        best = min(best, limit)
+        # A window within BOUNDARY_EPS_DEG of a cell's end counts as on it (both sides'
+        # outcomes), so the supremum the model can honour stops that far short.
+        best = min(best, limit if limit >= 90.0 else max(0.0, limit - BOUNDARY_EPS_DEG))
     return best
 
 
