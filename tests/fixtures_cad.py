@@ -252,3 +252,229 @@ def box_solid_angle_fraction(a: float, b: float, d: float) -> float:
     """Solid angle of an a x b rectangle seen from distance d on its axis, over 4 pi."""
     omega = 4 * math.asin(a * b / math.sqrt((a * a + 4 * d * d) * (b * b + 4 * d * d)))
     return omega / (4 * math.pi)
+
+
+# ---- real-drawing patterns: frames and cut sheets, gaps, units, paper space ----------------
+
+
+def _rect(msp, x0: float, y0: float, x1: float, y1: float, **attribs) -> None:
+    msp.add_lwpolyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], close=True, dxfattribs=attribs)
+
+
+def _title_block(msp, x1: float, y0: float) -> None:
+    """A title block in the lower right corner of a frame, its lines touching the frame."""
+    msp.add_line((x1 - 120, y0), (x1 - 120, y0 + 40))
+    msp.add_line((x1 - 120, y0 + 40), (x1, y0 + 40))
+    msp.add_line((x1 - 120, y0 + 20), (x1, y0 + 20))
+    msp.add_line((x1 - 60, y0), (x1 - 60, y0 + 20))
+    msp.add_text("FRAME PLATE", dxfattribs={"height": 5}).set_placement((x1 - 110, y0 + 28))
+
+
+CUT_PLATE_HOLE_R = 3.0
+CUT_PLATE_AREA = 200 * 150 - 120 * 80 - 4 * math.pi * CUT_PLATE_HOLE_R**2
+"""The plate of :func:`write_cut_sheet`: 200 x 150, a 120 x 80 window, four r = 3 holes."""
+CUT_PIECE_AREAS = (50 * 30 - math.pi * 4.0**2, 30 * 30)
+
+
+def _cut_sheet(msp, ox: float, oy: float) -> None:
+    """A 200 x 150 printer frame plate with a 120 x 80 window and four mounting holes; two
+    pieces cut from the window lie in it (a 50 x 30 bar with a r = 4 hole, a 30 x 30 square)."""
+    _rect(msp, ox, oy, ox + 200, oy + 150)
+    _rect(msp, ox + 40, oy + 35, ox + 160, oy + 115)
+    for dx, dy in ((15, 15), (185, 15), (185, 135), (15, 135)):
+        msp.add_circle((ox + dx, oy + dy), CUT_PLATE_HOLE_R)
+    _rect(msp, ox + 50, oy + 45, ox + 100, oy + 75)
+    msp.add_circle((ox + 75, oy + 60), 4.0)
+    _rect(msp, ox + 120, oy + 70, ox + 150, oy + 100)
+
+
+def write_cut_sheet(path: Path, *, frame: str | None = "title") -> Path:
+    """The cut sheet of :func:`_cut_sheet`, alone (``frame=None``), inside an A3 drawing frame
+    with a title block (``"title"``), or inside a double-line frame border (``"double"``)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    if frame == "title":
+        _rect(msp, 0, 0, 420, 297)
+        _title_block(msp, 420, 0)
+    elif frame == "double":
+        _rect(msp, 0, 0, 420, 297)
+        _rect(msp, 10, 10, 410, 287)
+    _cut_sheet(msp, 60, 70)
+    doc.saveas(path)
+    return path
+
+
+def gap_spline_points(gap: float) -> list[tuple[float, float]]:
+    """Fit points of a 100 x 60 oval sketched as one open spline whose end stops ``gap`` short
+    of its start (the start at (50, 0), the end at (50 - gap, 0))."""
+    pts = []
+    for k in range(33):
+        t = 2 * math.pi * k / 32
+        pts.append((50 * math.cos(t), 30 * math.sin(t)))
+    pts[0] = (50.0, 0.0)
+    pts[-1] = (50.0 - gap * math.cos(0.05), -gap * math.sin(0.05))
+    return pts
+
+
+GAP_HOLE_AREA = math.pi * 15 * 8
+
+
+def write_gap_spline(path: Path, gap: float) -> Path:
+    """An oval outline drawn as an open fit-point spline missing closing by ``gap`` mm, with a
+    15 x 8 elliptical hole: the part is the oval minus the hole, never the hole."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_spline(gap_spline_points(gap))
+    msp.add_ellipse((0, 0), major_axis=(15, 0), ratio=8 / 15)
+    doc.saveas(path)
+    return path
+
+
+def write_wrong_header(path: Path, insunits: int = 6, measurement: int | None = 0) -> Path:
+    """An 8 x 5 inch plate with a r = 0.5 in hole, drawn in inch numbers, whose header says
+    ``$INSUNITS`` ``insunits`` (6: metres) and ``$MEASUREMENT`` ``measurement`` (0: imperial)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = insunits
+    if measurement is not None:
+        doc.header["$MEASUREMENT"] = measurement
+    msp = doc.modelspace()
+    _rect(msp, 0, 0, 8, 5)
+    msp.add_circle((2, 2.5), 0.5)
+    doc.saveas(path)
+    return path
+
+
+WRONG_HEADER_AREA_IN2 = 8 * 5 - math.pi * 0.25
+
+
+def write_paper_space(path: Path) -> Path:
+    """A 40 x 20 rectangle with a r = 5 hole drawn in paper space only (model space empty)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    paper = doc.paperspace()
+    _rect(paper, 0, 0, 40, 20)
+    paper.add_circle((10, 10), 5)
+    doc.saveas(path)
+    return path
+
+
+def hollow_box(outer: float, inner: float, offset: tuple[float, float, float]) -> trimesh.Trimesh:
+    """A cube of side ``outer`` with a cubic cavity of side ``inner`` centred at ``offset``:
+    the cavity's shell faces inward, as CAD programs export a solid with a void."""
+    shell = trimesh.creation.box((outer,) * 3)
+    void = trimesh.creation.box((inner,) * 3)
+    void.apply_translation(offset)
+    void.invert()
+    return trimesh.util.concatenate([shell, void])
+
+
+# ---- hostile files: each must be answered (imported or refused) within its budget ---------
+
+
+def write_nested_blocks(path: Path, depth: int, fanout: int) -> Path:
+    """Blocks nested ``depth`` deep, each inserting the next ``fanout`` times: fanout**depth
+    squares after expansion."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    leaf = doc.blocks.new("B0")
+    leaf.add_lwpolyline([(0, 0), (1, 0), (1, 1), (0, 1)], close=True)
+    for d in range(1, depth + 1):
+        blk = doc.blocks.new(f"B{d}")
+        for k in range(fanout):
+            blk.add_blockref(f"B{d - 1}", (k * 2.0 * (2.0 * fanout) ** (d - 1), 0))
+    doc.modelspace().add_blockref(f"B{depth}", (0, 0))
+    doc.saveas(path)
+    return path
+
+
+def write_block_cycle(path: Path) -> Path:
+    """Block A inserts B, B inserts A: a reference cycle."""
+    doc = ezdxf.new("R2010")
+    a, b = doc.blocks.new("A"), doc.blocks.new("B")
+    a.add_lwpolyline([(0, 0), (1, 0), (1, 1)], close=True)
+    a.add_blockref("B", (2, 0))
+    b.add_blockref("A", (2, 0))
+    doc.modelspace().add_blockref("A", (0, 0))
+    doc.saveas(path)
+    return path
+
+
+def write_minsert(path: Path, rows: int, cols: int, block: str = "CELL") -> Path:
+    """A MINSERT grid of ``rows`` x ``cols`` unit squares (``block`` may be left undefined)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    cell = doc.blocks.new("CELL")
+    cell.add_lwpolyline([(0, 0), (1, 0), (1, 1), (0, 1)], close=True)
+    ref = doc.modelspace().add_blockref("CELL", (0, 0))
+    ref.grid(size=(rows, cols), spacing=(2, 2))
+    if block != "CELL":
+        ref.dxf.name = block
+    doc.saveas(path)
+    return path
+
+
+def write_holes_plate(path: Path, n: int) -> Path:
+    """A plate with an n x n grid of r = 0.3 holes (n * n holes)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    _rect(msp, 0, 0, n + 1, n + 1)
+    for i in range(n):
+        for j in range(n):
+            msp.add_circle((i + 1, j + 1), 0.3)
+    doc.saveas(path)
+    return path
+
+
+def write_crossing_lines(path: Path, n: int, seed: int = 0) -> Path:
+    """``n`` random lines across a 100 mm square: about n * n / 4 crossings."""
+    rng = np.random.default_rng(seed)
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    for a, b in rng.uniform(0, 100, size=(n, 2, 2)):
+        msp.add_line(tuple(a), tuple(b))
+    doc.saveas(path)
+    return path
+
+
+def write_big_polyline(path: Path, n: int) -> Path:
+    """A closed LWPOLYLINE with ``n`` vertices on a circle of radius 50."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline(np.c_[50 * np.cos(t), 50 * np.sin(t)], close=True)
+    doc.saveas(path)
+    return path
+
+
+def write_circle(path: Path, radius: float, insunits: int = 6) -> Path:
+    """One circle of ``radius`` drawing units (default in metres)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = insunits
+    doc.modelspace().add_circle((0, 0), radius)
+    doc.saveas(path)
+    return path
+
+
+def write_with_coordinate(path: Path, value: str) -> Path:
+    """The plate of :func:`write_plate` with one line whose end x is the text ``value``
+    (``1e20``, ``1e300``, ``inf``, ``nan``, ``1e400``), written into the DXF as is."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    _plate_entities(doc.modelspace())
+    doc.modelspace().add_line((0, 0), (123456.789, 0))
+    doc.saveas(path)
+    text = path.read_text().replace("123456.789", value)
+    path.write_text(text)
+    return path
+
+
+def write_obj_repeated_face(path: Path, repeats: int) -> Path:
+    """A tetrahedron OBJ whose last face lists its vertices ``repeats`` times."""
+    lines = ["v 0 0 0", "v 10 0 0", "v 0 10 0", "v 0 0 10", "f 1 3 2", "f 1 2 4", "f 2 3 4"]
+    lines.append("f " + " ".join(["1", "4", "3"] * repeats))
+    path.write_text("\n".join(lines) + "\n")
+    return path

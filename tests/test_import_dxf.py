@@ -4,23 +4,20 @@ from __future__ import annotations
 
 import math
 import random
-import sys
 from pathlib import Path
 
 import ezdxf
+import fixtures_cad as fx
 import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.errors import InputError  # noqa: E402
-from feederkit.hull import clean_hull, contact_hull, convex_hull  # noqa: E402
-from feederkit.importers import ImportOptions, import_parts, read_source  # noqa: E402
-from feederkit.mechanics import push_function  # noqa: E402
-from feederkit.mechanics.push import edge_normals  # noqa: E402
+from feederkit.errors import InputError
+from feederkit.hull import clean_hull, contact_hull, convex_hull
+from feederkit.importers import ImportOptions, import_parts, read_source
+from feederkit.mechanics import push_function
+from feederkit.mechanics.push import edge_normals
 
 
 def one(path: Path, **options):
@@ -286,9 +283,8 @@ def test_simplification_does_not_depend_on_the_start():
 def test_contact_hull_numbering_after_simplification():
     pts = arc_points(10.0, 180.0, 360.0, 200) + [(10.0, 5.0), (-10.0, 5.0)]
     hull = contact_hull(pts, 0.05)
-    ymin = min(p[1] for p in hull)
-    lowest = [p for p in hull if p[1] <= ymin + 0.05]
-    assert hull[0] == min(lowest)
+    # vertex 0 is exactly the lowest, then leftmost (design.md), not within the tolerance
+    assert hull[0] == min(hull, key=lambda p: (p[1], p[0]))
     assert shapely.Polygon(hull).exterior.is_ccw
 
 

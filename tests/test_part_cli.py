@@ -176,3 +176,41 @@ def test_part_group_lists_analyze_and_plot(capsys) -> None:
     out = capsys.readouterr().out
     assert "analyze" in out
     assert "plot" in out
+
+
+def _unitless_plate(tmp_path: Path) -> str:
+    import ezdxf
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 0
+    doc.modelspace().add_lwpolyline([(0, 0), (40, 0), (40, 20), (0, 20)], close=True)
+    doc.modelspace().add_lwpolyline([(60, 0), (70, 0), (70, 10), (60, 10)], close=True)
+    path = tmp_path / "sheet.dxf"
+    doc.saveas(path)
+    return str(path)
+
+
+def test_analyze_prints_the_importers_warnings(capsys, tmp_path: Path) -> None:
+    src = _unitless_plate(tmp_path)
+    assert main(["part", "analyze", src, "--json"]) == 0
+    err = capsys.readouterr().err
+    assert f"warning: {src}: the drawing has no units" in err
+    assert "left out: sheet-2" in err
+
+
+def test_analyze_takes_the_import_options(capsys, tmp_path: Path) -> None:
+    src = _unitless_plate(tmp_path)
+    (d,) = run_json(capsys, src, "--units", "cm")
+    xs = [p[0] for p in d["hull"]]
+    assert max(xs) - min(xs) == pytest.approx(400.0)
+    fails_with(capsys, ["part", "analyze", src, "--max-entities", "1"], "--max-entities")
+    fails_with(capsys, ["part", "analyze", src, "--space", "nope"], "--space must be")
+
+
+def test_plot_and_lookalike_print_the_importers_warnings(capsys, tmp_path: Path) -> None:
+    src = _unitless_plate(tmp_path)
+    out = tmp_path / "p.png"
+    assert main(["part", "plot", src, "-o", str(out), "--units", "mm"]) == 0
+    assert "the drawing has no units" not in capsys.readouterr().err  # --units given
+    assert main(["lookalike", src, "--keep", "push", "-o", str(tmp_path / "l.json")]) == 0
+    assert "the drawing has no units" in capsys.readouterr().err

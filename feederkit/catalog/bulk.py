@@ -1,11 +1,14 @@
-"""Import a directory of source files into the catalog: all files or none.
+"""Import a directory of source files into the catalog: all files or none (or, asked, the good).
 
 Every file is read and checked first; only then are all parts written, in one transaction.
-A bad file, a duplicate name or a killed process leaves the catalog as it was.
+A bad file, a duplicate name or a killed process leaves the catalog as it was; every bad
+file is named with its path and reason. With ``skip_bad`` the good files are imported (one
+transaction) and the bad ones reported.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -13,9 +16,10 @@ from pathlib import Path
 
 from feederkit.catalog.model import AddOutcome, check_name
 from feederkit.catalog.schema import transaction
-from feederkit.catalog.store import CatalogLike, _conn, write_revision
+from feederkit.catalog.store import CatalogLike, _conn, landings_for, options_key, write_revision
 from feederkit.errors import InputError
 from feederkit.importers import SUPPORTED_SUFFIXES, ImportedPart, ImportOptions, import_parts
+from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing
 
 Progress = Callable[[str, int, int, str], None]
 """Called as ``progress(phase, done, total, item)``; phase is ``read`` or ``write``."""
@@ -23,14 +27,44 @@ Progress = Callable[[str, int, int, str], None]
 
 @dataclass(frozen=True)
 class DirectoryImport:
-    """The outcome of a directory import: one outcome per part, and files that were not sources."""
+    """The outcome of a directory import: one outcome per part, files that were not sources,
+    and (with ``skip_bad``) the bad files skipped, each ``path: reason``."""
 
     outcomes: tuple[AddOutcome, ...]
     ignored: tuple[str, ...]
+    bad: tuple[str, ...] = ()
+
+
+OUTLINE_PEEK_BYTES = 1 << 20
+"""An outline file is recognised from at most its first megabyte (it must parse as one)."""
+
+
+def is_outline_file(path: Path) -> bool:
+    """Whether a ``.json`` file is an outline file (design.md): a JSON object with "vertices".
+
+    A folder of parts often holds other JSON (plans, settings, a package.json): those are
+    not parts and are left alone instead of being refused as broken outlines.
+    """
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(OUTLINE_PEEK_BYTES + 1)
+    except OSError:
+        return True  # unreadable: let the import name the reason
+    if len(head) > OUTLINE_PEEK_BYTES:
+        return b'"vertices"' in head
+    try:
+        data = json.loads(head.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        return b'"vertices"' in head  # broken JSON that meant to be an outline is reported
+    return isinstance(data, dict) and "vertices" in data
 
 
 def source_files(directory: Path) -> tuple[list[Path], list[Path]]:
-    """Supported source files under ``directory`` (recursive, sorted) and the other files."""
+    """Supported source files under ``directory`` (recursive, sorted) and the other files.
+
+    Only supported extensions count; a ``.json`` file counts when it is an outline file
+    (:func:`is_outline_file`).
+    """
     if not directory.exists():
         raise InputError(f"{directory}: no such directory")
     if not directory.is_dir():
@@ -42,7 +76,9 @@ def source_files(directory: Path) -> tuple[list[Path], list[Path]]:
             p = Path(root) / f
             if f.startswith("."):
                 continue
-            (found if p.suffix.lower() in SUPPORTED_SUFFIXES else ignored).append(p)
+            suffix = p.suffix.lower()
+            source = suffix in SUPPORTED_SUFFIXES and (suffix != ".json" or is_outline_file(p))
+            (found if source else ignored).append(p)
     return found, ignored
 
 
@@ -54,33 +90,52 @@ def import_directory(
     revise: bool = False,
     created_by: str | None = None,
     progress: Progress | None = None,
+    skip_bad: bool = False,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
 ) -> DirectoryImport:
     """Import every source file under ``directory`` in one transaction (all files or none).
 
     Part names come from the files (outline name or file stem); two files giving the same
-    name are refused. Raises InputError naming the first bad file; nothing is written then.
+    name are refused. Every file is read; a bad one raises InputError naming every bad file
+    with its path and reason, and nothing is written; with ``skip_bad`` the good files are
+    written and the bad ones listed in :attr:`DirectoryImport.bad`.
     """
+    key = options_key(options, side_probability)
     root = Path(directory)
     files, ignored = source_files(root)
     if not files:
         raise InputError(f"{root}: no source files (.json, .dxf, .stl, .obj, .ply) in it")
-    batch: list[tuple[Path, str, ImportedPart]] = []
+    batch: list[tuple[Path, str, ImportedPart, tuple[Landing, ...]]] = []
     seen: dict[str, Path] = {}
+    bad: list[str] = []
     for k, path in enumerate(files):
         if progress:
             progress("read", k, len(files), str(path))
-        result, parts = import_parts(path, options)
-        for p in parts:
-            name = check_name(p.part.name)
+        try:
+            result, parts = import_parts(path, options)
+            names = [check_name(p.part.name) for p in parts]
+            landings = [landings_for(p, options, path, side_probability) for p in parts]
+        except InputError as exc:
+            reason = str(exc)
+            bad.append(reason if str(path) in reason else f"{path}: {reason}")
+            continue
+        for name, p, lands in zip(names, parts, landings, strict=True):
             if name in seen:
-                raise InputError(f"duplicate name {name!r}: from {seen[name]} and {path}")
+                bad.append(f"{path}: duplicate name {name!r} (also from {seen[name]})")
+                continue
             seen[name] = path
-            batch.append((path, result.sha256, p))
+            batch.append((path, result.sha256, p, lands))
     if progress:
         progress("read", len(files), len(files), "")
+    if bad and not skip_bad:
+        listed = "; ".join(bad)
+        raise InputError(
+            f"{len(bad)} of {len(files)} files in {root} are bad, nothing imported "
+            f"(--skip-bad imports the rest): {listed}"
+        )
     outcomes = []
     with _conn(catalog, create=True) as conn, transaction(conn):
-        for k, (path, sha, p) in enumerate(batch):
+        for k, (path, sha, p, lands) in enumerate(batch):
             if progress:
                 progress("write", k, len(batch), p.part.name)
             outcomes.append(
@@ -89,11 +144,14 @@ def import_directory(
                     p,
                     source_path=str(path.resolve()),
                     sha256=sha,
-                    options_key=options.as_key(),
+                    options_key=key,
                     revise=revise,
                     created_by=created_by,
+                    landings=lands,
                 )
             )
         if progress:
             progress("write", len(batch), len(batch), "")
-    return DirectoryImport(outcomes=tuple(outcomes), ignored=tuple(str(p) for p in ignored))
+    return DirectoryImport(
+        outcomes=tuple(outcomes), ignored=tuple(str(p) for p in ignored), bad=tuple(bad)
+    )

@@ -8,6 +8,7 @@ hatches and other annotation are skipped. The loops are built in :mod:`.loops`.
 from __future__ import annotations
 
 import logging
+import warnings
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
@@ -21,8 +22,10 @@ from ezdxf.entities import DXFGraphic
 from ezdxf.lldxf.const import DXFError
 
 from feederkit.errors import InputError
+from feederkit.importers.budget import MAX_COORD_MM, Budget
 from feederkit.importers.loops import Region, drawing_from_lines
 from feederkit.importers.model import ImportedOutline, ImportOptions
+from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
 from feederkit.outline import make_outline, unit_scale
 
 logging.getLogger("ezdxf").addHandler(logging.NullHandler())  # a library never prints
@@ -32,6 +35,9 @@ CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", 
 
 MAX_BLOCK_DEPTH = 32
 """Deeper block nesting is taken as a reference cycle."""
+
+REL_FLATTEN = 1e-5
+"""The flatten tolerance is at least this share of the drawing's size (0.002 mm at 200 mm)."""
 
 INSUNITS: dict[int, tuple[str, float]] = {
     1: ("in", 25.4),
@@ -48,6 +54,41 @@ INSUNITS: dict[int, tuple[str, float]] = {
     14: ("dm", 100.0),
 }
 """``$INSUNITS`` codes and millimetres per unit (0, unitless, is read as mm with a warning)."""
+
+
+DRAWN_SECTIONS = frozenset({b"ENTITIES", b"BLOCKS"})
+"""Sections whose entities are drawn (the others hold tables, classes and objects)."""
+
+
+def prescan(path: Path, budget: Budget) -> None:
+    """Count an ASCII DXF's entities and points from its raw tags, before ezdxf parses it.
+
+    Parsing costs about a millisecond per entity, so a file with 200,000 entities or a
+    million-vertex polyline is refused here, in a fraction of that time. Binary DXF files
+    are left to the parser (the file size limit bounds them).
+    """
+    with path.open("rb") as fh:
+        if fh.read(22) == b"AutoCAD Binary DXF\r\n\x1a\x00":
+            return
+        fh.seek(0)
+        data = fh.read()
+    lines = data.splitlines()
+    entities = points = 0
+    drawn = False
+    codes, values = lines[0::2], lines[1::2]
+    for k in range(min(len(codes), len(values))):
+        code = codes[k].strip()
+        if code == b"0":
+            value = values[k].strip()
+            if value == b"SECTION" and k + 1 < len(values):
+                drawn = values[k + 1].strip() in DRAWN_SECTIONS
+            elif drawn:
+                entities += 1
+        elif drawn and code == b"10":
+            points += 1
+    budget.need("entities", entities, "entities in the file")
+    budget.need("vertices", points, "points in the file")
+    budget.check_time()
 
 
 def read_document(path: Path) -> DxfDocument:
@@ -85,8 +126,63 @@ def drawing_units(
     raise InputError(f"{label}: unsupported drawing unit $INSUNITS {code}; give --units")
 
 
+def space_layouts(doc: DxfDocument, space: str) -> list[object]:
+    """The layouts to read: the model space, or every paper-space layout."""
+    if space == "model":
+        return [doc.modelspace()]
+    if space == "paper":
+        return [lay for lay in doc.layouts if lay.is_any_paperspace]
+    raise InputError(f"--space must be model or paper, got {space!r}")
+
+
+def _count_expanded(doc: DxfDocument, layouts: list[object], budget: Budget) -> int:
+    """Curve entities the layouts hold once every block reference is expanded (exact count).
+
+    Counted per block definition (memoised), so nesting depth 32 with fan-out 10 or a MINSERT
+    grid of 1e9 x 1e9 is refused before anything is expanded; reference cycles, references to
+    undefined blocks and nesting deeper than :data:`MAX_BLOCK_DEPTH` are bad input.
+    """
+    memo: dict[str, int] = {}
+    active: list[str] = []
+
+    def block(name: str) -> int:
+        if name in memo:
+            return memo[name]
+        if name in active:
+            raise InputError(f"{budget.label}: block {name!r} contains a reference to itself")
+        if len(active) >= MAX_BLOCK_DEPTH:
+            raise InputError(
+                f"{budget.label}: block references nested deeper than {MAX_BLOCK_DEPTH}"
+            )
+        definition = doc.blocks.get(name)
+        if definition is None:
+            raise InputError(f"{budget.label}: a reference to the undefined block {name!r}")
+        active.append(name)
+        memo[name] = count(definition)
+        active.pop()
+        return memo[name]
+
+    def count(entities: object) -> int:
+        total = 0
+        for entity in entities:  # type: ignore[attr-defined]
+            kind = entity.dxftype()
+            if kind == "INSERT":
+                rows = max(1, int(entity.dxf.get("row_count", 1) or 1))
+                cols = max(1, int(entity.dxf.get("column_count", 1) or 1))
+                total += rows * cols * block(str(entity.dxf.get("name", "")))
+            elif kind in CURVES:
+                total += 1
+            if total > budget.limits.entities:
+                break  # already too many: the exact figure does not matter
+        return total
+
+    total = sum(count(layout) for layout in layouts)
+    budget.need("entities", total, "entities after block expansion")
+    return total
+
+
 def explode(
-    entities: object, layer: str, depth: int, skipped: Counter[str]
+    entities: object, layer: str, depth: int, skipped: Counter[str], budget: Budget
 ) -> Iterator[tuple[DXFGraphic, str]]:
     """Curve entities in world coordinates with their effective layer, block references exploded.
 
@@ -105,69 +201,138 @@ def explode(
             if depth >= MAX_BLOCK_DEPTH:
                 raise InputError(f"block references nested deeper than {MAX_BLOCK_DEPTH}")
             try:
-                subs = (
-                    list(entity.multi_insert())
-                    if entity.mcount > 1
-                    else list(entity.virtual_entities())
-                )
+                with warnings.catch_warnings(), np.errstate(all="ignore"):
+                    warnings.simplefilter("ignore")
+                    subs = (
+                        list(entity.multi_insert())
+                        if entity.mcount > 1
+                        else list(entity.virtual_entities())
+                    )
             except Exception as exc:  # noqa: BLE001 - broken block definitions
                 raise InputError(
                     f"cannot explode block {entity.dxf.get('name', '?')!r} ({exc})"
                 ) from None
-            yield from explode(subs, eff, depth + 1, skipped)
+            yield from explode(subs, eff, depth + 1, skipped, budget)
         else:
+            budget.entities()
             yield entity, eff
 
 
-def flatten(entity: DXFGraphic, distance: float) -> list[np.ndarray]:
-    """The entity as polylines (drawing units, x y), curves within ``distance`` of their chords."""
+def _point_count(entity: DXFGraphic) -> int:
+    """Defining points of an entity, counted without building geometry (for the budget)."""
     kind = entity.dxftype()
-    if kind == "LINE":
-        s, e = entity.dxf.start, entity.dxf.end
-        return [np.array([[s.x, s.y], [e.x, e.y]])]
-    if kind == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline):
-        return []  # polyface and polygon meshes are surfaces, not outlines
+    if kind == "LWPOLYLINE":
+        return len(entity)
+    if kind == "POLYLINE":
+        return len(entity.vertices)
+    if kind == "SPLINE":
+        return entity.control_point_count() + entity.fit_point_count()
+    return 2
+
+
+def curve_path(entity: DXFGraphic) -> dxfpath.Path | None:
+    """The entity as an ezdxf path (cubic Bezier pieces), None for surfaces (polyface meshes)."""
+    if entity.dxftype() == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline):
+        return None  # polyface and polygon meshes are surfaces, not outlines
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")
+        return dxfpath.make_path(entity)
+
+
+def flatten(path: dxfpath.Path, distance: float) -> list[np.ndarray]:
+    """The path as polylines (drawing units, x y), curves within ``distance`` of their chords."""
     out = []
-    for sub in dxfpath.make_path(entity).sub_paths():
+    for sub in path.sub_paths():
         pts = np.array([(v.x, v.y) for v in sub.flattening(distance)], dtype=float)
         if len(pts) >= 2:
             out.append(pts)
     return out
 
 
-def dxf_lines(
-    doc: DxfDocument, layers: tuple[str, ...], scale: float, flatten_mm: float, label: str
-) -> tuple[list[np.ndarray], Counter[str]]:
-    """All outline polylines of the model space in millimetres, and the skipped entity types.
+def _label(entity: DXFGraphic) -> str:
+    return f"{entity.dxftype()} {entity.dxf.get('handle', '?')}"
 
-    With ``layers``, only entities on those layers (case-insensitive; block contents on
-    layer "0" count on their reference's layer) are read.
+
+def dxf_lines(
+    doc: DxfDocument,
+    options: ImportOptions,
+    scale: float,
+    label: str,
+    budget: Budget,
+) -> tuple[list[np.ndarray], Counter[str], list[str], float]:
+    """Outline polylines of the chosen space (mm), skipped types, warnings, flatten tolerance.
+
+    With ``options.layers``, only entities on those layers (case-insensitive; block contents
+    on layer "0" count on their reference's layer) are read. Every coordinate is checked as
+    it is read: NaN, infinity or a magnitude beyond :data:`MAX_COORD_MM` is refused before
+    any geometry runs. The flatten tolerance is at least :data:`REL_FLATTEN` of the
+    drawing's size, so a huge circle cannot ask for millions of segments.
     """
+    layers = options.layers
     skipped: Counter[str] = Counter()
     wanted = {name.lower() for name in layers}
     seen: set[str] = set()
-    distance = flatten_mm / scale
-    lines: list[np.ndarray] = []
-    for entity, layer in explode(doc.modelspace(), "", 0, skipped):
-        seen.add(layer)
-        if wanted and layer.lower() not in wanted:
-            continue
-        try:
-            pieces = flatten(entity, distance)
-        except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
-            kind, handle = entity.dxftype(), entity.dxf.handle
-            raise InputError(f"{label}: cannot flatten {kind} {handle} ({exc})") from None
-        for pts in pieces:
-            if not np.isfinite(pts).all():
-                kind, handle = entity.dxftype(), entity.dxf.handle
-                raise InputError(f"{label}: {kind} {handle} has NaN or infinite coordinates")
-            lines.append(pts * scale)
-    if wanted and not lines and seen:
+    layouts = space_layouts(doc, options.space)
+    _count_expanded(doc, layouts, budget)
+    paths: list[tuple[DXFGraphic, dxfpath.Path]] = []
+    lo = np.full(2, np.inf)
+    hi = np.full(2, -np.inf)
+    for layout in layouts:
+        for entity, layer in explode(layout, "", 0, skipped, budget):
+            seen.add(layer)
+            if wanted and layer.lower() not in wanted:
+                continue
+            budget.need("vertices", _point_count(entity), "points in one entity")
+            try:
+                path = curve_path(entity)
+                if path is None:
+                    continue
+                cv = np.array([(v.x, v.y) for v in path.control_vertices()], dtype=float)
+            except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
+                raise InputError(f"{label}: cannot read {_label(entity)} ({exc})") from None
+            if len(cv) == 0:
+                continue
+            if not np.isfinite(cv).all():
+                raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates")
+            far = float(np.abs(cv).max()) * scale
+            if far > MAX_COORD_MM:
+                raise InputError(
+                    f"{label}: {_label(entity)} has a coordinate of {far:.3g} mm, beyond any "
+                    f"part a feeder can hold ({MAX_COORD_MM:g} mm; check the units)"
+                )
+            lo, hi = np.minimum(lo, cv.min(axis=0)), np.maximum(hi, cv.max(axis=0))
+            paths.append((entity, path))
+    notes: list[str] = []
+    if wanted and not paths and seen:
         names = ", ".join(sorted(seen))
         raise InputError(
             f"{label}: no geometry on layer {', '.join(sorted(layers))} (layers: {names})"
         )
-    return lines, skipped
+    if not paths:
+        return [], skipped, notes, options.flatten_tolerance
+    size_mm = float((hi - lo).max()) * scale
+    flatten_mm = options.flatten_tolerance
+    if REL_FLATTEN * size_mm > flatten_mm:
+        flatten_mm = REL_FLATTEN * size_mm
+        notes.append(
+            f"flatten tolerance raised to {flatten_mm:.3g} mm ({REL_FLATTEN:g} of the "
+            f"drawing's size, {size_mm:.4g} mm)"
+        )
+    distance = flatten_mm / scale
+    lines: list[np.ndarray] = []
+    for entity, path in paths:
+        try:
+            with warnings.catch_warnings(), np.errstate(all="ignore"):
+                warnings.simplefilter("ignore")
+                pieces = flatten(path, distance)
+        except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
+            raise InputError(f"{label}: cannot flatten {_label(entity)} ({exc})") from None
+        for pts in pieces:
+            budget.vertices(len(pts))
+            if not np.isfinite(pts).all():
+                raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates")
+            lines.append(pts * scale)
+    return lines, skipped, notes, flatten_mm
 
 
 def _describe(region: Region) -> str:
@@ -178,34 +343,57 @@ def _describe(region: Region) -> str:
 
 
 def read_dxf(
-    path: Path, options: ImportOptions, name: str
+    path: Path, options: ImportOptions, name: str, budget: Budget | None = None
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
     """Parts of a DXF file: (imported outlines, descriptions of parts left out, warnings).
 
     The part is the largest closed loop with the loops inside it as holes; with
     ``options.all_parts`` every separate part is returned, named ``name``, ``name-2``, ...
     """
+    budget = budget or Budget(options.limits, str(path))
+    prescan(path, budget)
     doc = read_document(path)
+    budget.check_time()
     try:
-        return _read_doc(doc, path, options, name)
+        return _read_doc(doc, path, options, name, budget)
     except DXFError as exc:  # malformed entities that ezdxf loaded but cannot interpret
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputError(f"{path}: malformed DXF ({reason})") from None
 
 
+def _paper_space_hint(doc: DxfDocument, options: ImportOptions) -> str:
+    """Why a model space without outline geometry may still hold a part: it is in paper space."""
+    if options.space != "model":
+        return ""
+    names = [
+        lay.name
+        for lay in doc.layouts
+        if lay.is_any_paperspace and any(e.dxftype() in CURVES | {"INSERT"} for e in lay)
+    ]
+    if not names:
+        return ""
+    return (
+        f"; the drawing's geometry is in paper space (layout {', '.join(map(repr, names))}): "
+        "use --space paper"
+    )
+
+
 def _read_doc(
-    doc: DxfDocument, path: Path, options: ImportOptions, name: str
+    doc: DxfDocument, path: Path, options: ImportOptions, name: str, budget: Budget
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
-    unit_name, scale, warnings = drawing_units(doc, options.units, str(path))
-    lines, skipped = dxf_lines(doc, options.layers, scale, options.flatten_tolerance, str(path))
+    unit_name, scale, warnings_ = drawing_units(doc, options.units, str(path))
+    lines, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
+    warnings_ += notes
     if not lines:
         what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
         raise InputError(
-            f"{path}: no outline geometry (lines, arcs, curves) in the drawing: {what}"
+            f"{path}: no outline geometry (lines, arcs, curves) in the "
+            f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing = drawing_from_lines(lines, options.flatten_tolerance, str(path))
+    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget)
+    warnings_ += list(drawing.warnings)
     if drawing.frames:
-        warnings.append(f"skipped {drawing.frames} drawing frame(s) around the part")
+        warnings_.append(f"skipped {drawing.frames} drawing frame(s) around the part")
     regions = list(drawing.regions)
     chosen = regions if options.all_parts else regions[:1]
     others = (
@@ -213,16 +401,27 @@ def _read_doc(
         if options.all_parts
         else [f"{name}-{k + 2}: {_describe(r)}" for k, r in enumerate(regions[1:])]
     )
+    if drawing.nested:
+        warnings_.append(
+            f"the part's holes hold {drawing.nested} other part(s), as in a cut sheet: imported "
+            "the outer part (if the outer loop is a drawing frame, leave its layer out with "
+            "--layer)"
+        )
     if others:
-        warnings.append(
+        warnings_.append(
             f"the drawing holds {len(regions)} separate parts; imported the largest "
             "(use --all-parts for all)"
         )
+    if options.units is None:
+        warnings_ += measurement_warnings(doc, unit_name)
     outlines = []
     for k, region in enumerate(chosen):
         label = name if k == 0 else f"{name}-{k + 1}"
         outline = make_outline(label, region.shell, region.holes, options.com, "mm")
+        size_notes = size_warnings(outline_size(outline), unit_name, options.units is not None)
         outlines.append(
-            ImportedOutline(outline=outline, kind="dxf", source_units=unit_name, warnings=())
+            ImportedOutline(
+                outline=outline, kind="dxf", source_units=unit_name, warnings=tuple(size_notes)
+            )
         )
-    return outlines, others, warnings
+    return outlines, others, warnings_

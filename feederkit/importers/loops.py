@@ -16,14 +16,25 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
-from shapely.geometry import Polygon
+from shapely.geometry import LineString, Polygon
 
 from feederkit.errors import InputError
+from feederkit.importers.budget import Budget
 
 Point = tuple[float, float]
 
 FRAME_FILL = 0.9
 """A drawing frame fills at least this share of its bounding box (it is a rectangle)."""
+
+FRAME_MATERIAL = 0.2
+"""A double-line frame border (outer minus inner rectangle) is at most this share of its box."""
+
+TITLE_BLOCK_SHARE = 0.7
+"""In a single-line frame the empty sheet is at least this share of the loop; the rest are
+title-block cells (faces made by lines touching the border)."""
+
+HEAL_GAP_REL = 0.002
+"""Gaps between open line ends up to this share of the drawing's size are closed (0.2 %)."""
 
 
 @dataclass(frozen=True)
@@ -38,10 +49,16 @@ class Region:
 
 @dataclass(frozen=True)
 class Drawing:
-    """The parts of a drawing, largest loop first, and how many drawing frames were skipped."""
+    """The parts of a drawing, largest loop first, what was skipped, and notes for the user.
+
+    ``frames`` counts the drawing frames skipped; ``nested`` counts the parts lying in the
+    first region's holes (a cut sheet); ``warnings`` say what was healed or guessed.
+    """
 
     regions: tuple[Region, ...]
     frames: int
+    nested: int = 0
+    warnings: tuple[str, ...] = ()
 
 
 def snap_endpoints(lines: Sequence[np.ndarray], gap: float) -> list[np.ndarray]:
@@ -84,42 +101,86 @@ def _components(pieces: np.ndarray) -> np.ndarray:
     return connected_components(graph, directed=False)[1]
 
 
-def closed_loops(lines: Sequence[np.ndarray]) -> tuple[list[Polygon], int]:
-    """The closed loops the lines form (filled polygons, no holes) and the number of open ends."""
+def face_count(pieces: np.ndarray, labels: np.ndarray) -> int:
+    """Faces the noded line pieces enclose, by Euler's formula: edges - nodes + components.
+
+    Counted before polygonizing, so a plate with 20,000 holes or 2,000 crossing lines is
+    refused in a moment instead of after minutes of polygonizing.
+    """
+    ends = np.concatenate([shapely.get_coordinates(shapely.get_point(pieces, k)) for k in (0, -1)])
+    nodes = len(np.unique(ends, axis=0))
+    return max(0, len(pieces) - nodes + len(np.unique(labels)))
+
+
+@dataclass(frozen=True)
+class Loop:
+    """A closed loop of a drawing (filled, no holes) and how many faces it was merged from.
+
+    ``faces`` above 1 means lines inside the loop touch its boundary: title-block cells in a
+    drawing frame, or a centre line across a part.
+    """
+
+    polygon: Polygon
+    faces: int
+    largest_face: float
+
+
+def closed_loops(
+    lines: Sequence[np.ndarray], budget: Budget | None = None
+) -> tuple[list[Loop], list[LineString]]:
+    """The closed loops the lines form, and the open lines (dangles) left over."""
     lines = [ln for ln in lines if len(ln) >= 2]
     if not lines:
-        return [], 0
+        return [], []
     sizes = [len(ln) for ln in lines]
     geoms = shapely.get_parts(
         shapely.linestrings(np.concatenate(lines), indices=np.repeat(np.arange(len(lines)), sizes))
     )
     geoms = geoms[shapely.length(geoms) > 0.0]
     if len(geoms) == 0:
-        return [], 0
+        return [], []
+    if budget is not None:  # noding costs grow with the crossings: count them first (cheap)
+        left, right = shapely.STRtree(geoms).query(geoms)
+        budget.crossings(int((left < right).sum()))
     noded = shapely.union_all(geoms)
     pieces = np.array(shapely.get_parts(noded))
     pieces = pieces[shapely.get_type_id(pieces) == 1]  # LineStrings only
     if len(pieces) == 0:
-        return [], 0
+        return [], []
+    if budget is not None:
+        budget.segments(int(shapely.get_num_coordinates(pieces).sum()) - len(pieces))
     labels = _components(pieces)
-    loops: list[Polygon] = []
-    dangles = 0
+    if budget is not None:
+        budget.need("loops", face_count(pieces, labels), "closed loops (parts and holes)")
+    loops: list[Loop] = []
+    dangles: list[LineString] = []
     for lab in np.unique(labels):
+        if budget is not None:
+            budget.check_time()
         group = pieces[labels == lab]
         faces, _cuts, dangle_geoms, _invalid = shapely.polygonize_full(group)
-        dangles += len(shapely.get_parts(dangle_geoms))
+        dangles.extend(shapely.get_parts(dangle_geoms))
         parts = shapely.get_parts(faces)
         if len(parts) == 0:
             continue
+        if budget is not None:
+            budget.loops(len(parts))
         merged = shapely.union_all(parts)
         for poly in shapely.get_parts(merged):
             if isinstance(poly, Polygon) and poly.area > 0.0:
-                loops.append(Polygon(poly.exterior))
+                inside = [f for f in parts if poly.contains(f.representative_point())]
+                loops.append(
+                    Loop(
+                        polygon=Polygon(poly.exterior),
+                        faces=len(inside),
+                        largest_face=max((f.area for f in inside), default=poly.area),
+                    )
+                )
     return loops, dangles
 
 
-def _is_frame(loop: Polygon) -> bool:
-    """Whether a loop is shaped like a drawing frame: close to its bounding box."""
+def _is_rectangle(loop: Polygon) -> bool:
+    """Whether a loop is close to its bounding box (a drawing frame or a rectangular plate)."""
     x0, y0, x1, y1 = loop.bounds
     box = (x1 - x0) * (y1 - y0)
     return box > 0.0 and loop.area >= FRAME_FILL * box
@@ -148,65 +209,172 @@ def _ring(poly: Polygon) -> tuple[Point, ...]:
     return tuple((float(x), float(y)) for x, y in coords)
 
 
-def regions_from_loops(loops: Sequence[Polygon]) -> Drawing:
+def _children(loops: Sequence[Polygon]) -> dict[int, list[int]]:
+    children: dict[int, list[int]] = {}
+    for i, p in enumerate(nest(loops)):
+        children.setdefault(p, []).append(i)
+    return children
+
+
+def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
+    """How many loops (from the largest) a drawing frame takes: 0 (not a frame), 1 or 2.
+
+    A frame is a thin border, not a part: either a double line whose border (outer minus the
+    inner rectangle) is a small share of its box (2 loops), or a single rectangle whose
+    title-block lines touch it (1 loop: its sheet is one large face beside small cells).
+    A rectangle whose holes hold parts but which has neither mark is a plate: a cut sheet
+    keeps its material.
+    """
+    if not kids or not _is_rectangle(top.polygon):
+        return 0
+    inner = loops[kids[0]]
+    if _is_rectangle(inner.polygon) and inner.polygon.area >= (1.0 - FRAME_MATERIAL) * (
+        top.polygon.area
+    ):
+        return 2
+    if top.faces >= 2 and top.largest_face >= TITLE_BLOCK_SHARE * top.polygon.area:
+        return 1
+    return 0
+
+
+def regions_from_loops(found: Sequence[Loop | Polygon]) -> Drawing:
     """Parts (largest loop first) from closed loops; skips drawing frames.
 
-    A loop at even nesting depth is a part, the loops directly inside it are its holes. The
-    largest top-level loop is a drawing frame when it is a rectangle that holds a loop that
-    itself holds loops (the real part and its holes); it is dropped. Title-block lines touch
-    the frame, so they belong to its loop (see :func:`closed_loops`).
+    A loop at even nesting depth is a part, the loops directly inside it are its holes; parts
+    inside a part's holes (a cut sheet: pieces cut from a plate's window) are separate parts.
+    Drawing frames (:func:`frame_kind`) around the parts are dropped.
     """
-    loops = sorted(loops, key=lambda p: -p.area)
+    loops = sorted(
+        (lp if isinstance(lp, Loop) else Loop(lp, 1, lp.area) for lp in found),
+        key=lambda p: -p.polygon.area,
+    )
     frames = 0
     while loops:
-        parent = nest(loops)
-        children: dict[int, list[int]] = {}
-        for i, p in enumerate(parent):
-            children.setdefault(p, []).append(i)
-        grand = any(children.get(c) for c in children.get(0, []))
-        if not (grand and _is_frame(loops[0])):
+        kids = _children([lp.polygon for lp in loops]).get(0, [])
+        drop = frame_kind(loops[0], loops, kids)
+        if not drop:
             break
-        loops = loops[1:]
+        loops = [lp for k, lp in enumerate(loops) if k != 0 and (drop == 1 or k != kids[0])]
         frames += 1
-    parent = nest(loops)
-    depth = [0] * len(loops)
+    polys = [lp.polygon for lp in loops]
+    parent = nest(polys)
+    depth = [0] * len(polys)
     for i, p in enumerate(parent):
         depth[i] = 0 if p < 0 else depth[p] + 1
     holes: dict[int, list[int]] = {}
     for i, p in enumerate(parent):
         if depth[i] % 2 == 1:
             holes.setdefault(p, []).append(i)
-    regions = []
-    for i, loop in enumerate(loops):
+    regions: list[tuple[int, Region]] = []
+    for i, loop in enumerate(polys):
         if depth[i] % 2:
             continue
-        hole_loops = [loops[h] for h in holes.get(i, [])]
+        hole_loops = [polys[h] for h in holes.get(i, [])]
         area = loop.area - sum(h.area for h in hole_loops)
-        regions.append(
-            Region(
-                shell=_ring(loop),
-                holes=tuple(_ring(h) for h in hole_loops),
-                area=float(area),
-                loop_area=float(loop.area),
-            )
+        region = Region(
+            shell=_ring(loop),
+            holes=tuple(_ring(h) for h in hole_loops),
+            area=float(area),
+            loop_area=float(loop.area),
         )
-    regions.sort(key=lambda r: -r.loop_area)
-    return Drawing(regions=tuple(regions), frames=frames)
+        regions.append((i, region))
+    regions.sort(key=lambda r: -r[1].loop_area)
+    nested = 0
+    if regions:
+        first = regions[0][0]
+        for i, _ in regions[1:]:
+            k = parent[i]
+            while k >= 0 and k != first:
+                k = parent[k]
+            nested += k == first
+    return Drawing(regions=tuple(r for _, r in regions), frames=frames, nested=nested)
 
 
-def drawing_from_lines(lines: Sequence[np.ndarray], gap: float, label: str) -> Drawing:
-    """Parts of a drawing from its flattened lines (mm); InputError without a closed loop."""
+def open_ends(lines: Sequence[np.ndarray], tol: float) -> np.ndarray:
+    """Indices (into the 2n polyline ends) of ends that meet no other end nor any line."""
+    n = len(lines)
+    ends = np.empty((2 * n, 2))
+    for k, ln in enumerate(lines):
+        ends[2 * k], ends[2 * k + 1] = ln[0], ln[-1]
+    closed = [float(np.hypot(*(ln[0] - ln[-1]))) <= tol for ln in lines]
+    counts = [len(c) for c in cKDTree(ends).query_ball_point(ends, tol)]
+    candidates = [e for e in range(2 * n) if counts[e] == 1 and not closed[e // 2]]
+    if not candidates:
+        return np.zeros(0, dtype=np.int64)
+    geoms = np.array([shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines])
+    hit_p, hit_g = shapely.STRtree(geoms).query(
+        shapely.points(ends[candidates]), predicate="dwithin", distance=tol
+    )
+    touching = {int(p) for p, g in zip(hit_p, hit_g, strict=True) if int(g) != candidates[p] // 2}
+    return np.array([e for k, e in enumerate(candidates) if k not in touching], dtype=np.int64)
+
+
+def heal_gaps(
+    lines: Sequence[np.ndarray], snap: float, max_gap: float
+) -> tuple[list[np.ndarray], list[str]]:
+    """Bridge gaps of at most ``max_gap`` between open line ends (mutually nearest pairs).
+
+    A CAD user's outline often misses closing by a hair more than the flatten tolerance
+    (a spline ending 0.09 mm short of its start); unhealed, the outline is dropped and its
+    hole taken for the part. Each gap closed is a straight bridge, and the user is told.
+    """
+    if max_gap <= snap or not lines:
+        return list(lines), []
+    ends_idx = open_ends(lines, snap)
+    if len(ends_idx) < 2:
+        return list(lines), []
+    ends = np.array([lines[e // 2][0 if e % 2 == 0 else -1] for e in ends_idx], dtype=float)
+    dist, nearest = cKDTree(ends).query(ends, k=2)
+    bridges: list[np.ndarray] = []
+    gaps: list[tuple[float, np.ndarray]] = []
+    for a in range(len(ends)):
+        b = int(nearest[a, 1])
+        if a < b and int(nearest[b, 1]) == a and snap < dist[a, 1] <= max_gap:
+            bridges.append(np.array([ends[a], ends[b]]))
+            gaps.append((float(dist[a, 1]), (ends[a] + ends[b]) / 2))
+    if not bridges:
+        return list(lines), []
+    worst, where = max(gaps, key=lambda g: g[0])
+    note = (
+        f"closed {len(bridges)} gap(s) between open line ends (largest {worst:.3g} mm, at "
+        f"({where[0]:.1f}, {where[1]:.1f})); check the drawing"
+    )
+    return list(lines) + bridges, [note]
+
+
+def drawing_from_lines(
+    lines: Sequence[np.ndarray], gap: float, label: str, budget: Budget | None = None
+) -> Drawing:
+    """Parts of a drawing from its flattened lines (mm); InputError without a closed loop.
+
+    Line ends closer than ``gap`` (the flatten tolerance) are joined; open ends up to
+    :data:`HEAL_GAP_REL` of the drawing's size apart are bridged, with a warning, before the
+    loops and holes are chosen.
+    """
     if not lines:
         raise InputError(f"{label}: the drawing has no lines, arcs or curves")
     pts = np.concatenate([np.asarray(ln, dtype=float) for ln in lines])
     extent = pts.max(axis=0) - pts.min(axis=0)
     if float(extent.max()) == 0.0 or float(extent.min()) <= 1e-12 * float(extent.max()):
         raise InputError(f"{label}: the outline has zero area (all geometry lies on a line)")
-    loops, dangles = closed_loops(snap_endpoints(lines, gap))
+    snapped = snap_endpoints(lines, gap)
+    healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
+    if budget is not None:
+        budget.check_time()
+    loops, dangles = closed_loops(healed, budget)
     if not loops:
-        detail = f" ({dangles} open ends)" if dangles else ""
+        detail = f" ({len(dangles)} open ends)" if dangles else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
     drawing = regions_from_loops(loops)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
-    return drawing
+    x0, y0, x1, y1 = Polygon(drawing.regions[0].shell).bounds
+    for d in dangles:
+        dx0, dy0, dx1, dy1 = d.bounds
+        if dx0 < x0 and dy0 < y0 and dx1 > x1 and dy1 > y1:
+            notes.append(
+                "an open outline (its gap too large to close) surrounds the imported part: "
+                "the drawing's real outer outline may be open"
+            )
+            break
+    return Drawing(drawing.regions, drawing.frames, drawing.nested, tuple(notes))

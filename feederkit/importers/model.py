@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from feederkit.errors import InputError
+from feederkit.importers.budget import ImportLimits
 from feederkit.outline import Outline
 
 Point = tuple[float, float]
@@ -12,7 +14,13 @@ DEFAULT_FLATTEN_TOLERANCE = 0.01
 """Largest distance (mm) between a curve and the chords that replace it."""
 
 DEFAULT_HULL_TOLERANCE = 0.05
-"""Hull simplification (mm) for CAD files: flattened arcs give the edges a fence feels."""
+"""Hull simplification (mm) for CAD files: flattened arcs give the edges a fence feels.
+
+It is a cap: the tolerance used is :data:`REL_HULL_TOLERANCE` of the part's size when that
+is smaller, so a 3 mm part's hull is not shrunk by 2 %."""
+
+REL_HULL_TOLERANCE = 0.002
+"""Default hull simplification as a share of the part's size (0.05 mm from 25 mm up)."""
 
 DEFAULT_MAX_FILE_MB = 50.0
 """Files larger than this are refused unless the user allows them."""
@@ -31,8 +39,10 @@ class ImportOptions:
     ``all_parts`` imports every separate part of a drawing, not only the largest; ``pose``
     chooses a mesh's resting pose (index into the poses sorted by probability; default the
     most probable); ``com`` gives the center of mass in the outline frame; ``hull_tolerance``
-    ``None`` means :data:`DEFAULT_HULL_TOLERANCE` for CAD and mesh files and an exact hull for
-    outline files.
+    ``None`` means :data:`REL_HULL_TOLERANCE` of the part's size, at most
+    :data:`DEFAULT_HULL_TOLERANCE`, for CAD and mesh files and an exact hull for outline
+    files; ``space`` is the DXF space read (``model`` or ``paper``); ``limits`` are the
+    import budgets (:mod:`.budget`).
     """
 
     units: str | None = None
@@ -44,6 +54,14 @@ class ImportOptions:
     com: Point | None = None
     max_file_mb: float = DEFAULT_MAX_FILE_MB
     allow_large: bool = False
+    space: str = "model"
+    limits: ImportLimits = field(default_factory=ImportLimits)
+
+    def __post_init__(self) -> None:
+        if self.space not in ("model", "paper"):
+            raise InputError(f"--space must be model or paper, got {self.space!r}")
+        if not self.flatten_tolerance > 0.0:
+            raise InputError(f"--flatten-tolerance must be > 0, got {self.flatten_tolerance:g}")
 
     def as_key(self) -> dict[str, object]:
         """The options that change the imported part (stored with a revision, compared later)."""
@@ -54,7 +72,7 @@ class ImportOptions:
             "hull_tolerance": self.hull_tolerance,
             "pose": self.pose,
             "com": list(self.com) if self.com is not None else None,
-        }
+        } | ({"space": self.space} if self.space != "model" else {})
 
 
 @dataclass(frozen=True)

@@ -8,17 +8,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from feederkit.errors import InputError
+from feederkit.importers.budget import Budget
 from feederkit.importers.model import (
     CAD_SUFFIXES,
     DEFAULT_HULL_TOLERANCE,
     MESH_SUFFIXES,
     OUTLINE_SUFFIXES,
+    REL_HULL_TOLERANCE,
     SUPPORTED_SUFFIXES,
     ImportedOutline,
     ImportOptions,
     ImportResult,
 )
 from feederkit.importers.orientable import Orientability, orientability
+from feederkit.importers.plausible import outline_size
 from feederkit.outline import load_outline_json
 from feederkit.part import Part, make_part
 
@@ -74,6 +77,7 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     """
     p = Path(path)
     check_file(p, options)
+    budget = Budget(options.limits, str(p))
     digest = file_sha256(p)
     suffix = p.suffix.lower()
     label = name or p.stem
@@ -81,6 +85,8 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     warnings: list[str] = []
     if suffix in OUTLINE_SUFFIXES:
         outline = load_outline_json(p)
+        budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
+        budget.loops(1 + len(outline.holes))
         if name:
             outline = dataclasses.replace(outline, name=name)
         if options.com is not None:
@@ -89,12 +95,12 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     elif suffix in CAD_SUFFIXES:
         from feederkit.importers.dxf import read_dxf  # ezdxf loads slowly: only when needed
 
-        found, others, warnings = read_dxf(p, options, label)
+        found, others, warnings = read_dxf(p, options, label, budget)
         parts = found
     elif suffix in MESH_SUFFIXES:
         from feederkit.importers.mesh import read_mesh  # trimesh loads slowly: only when needed
 
-        parts = [read_mesh(p, options, label)]
+        parts = [read_mesh(p, options, label, budget)]
     else:  # pragma: no cover - check_file refused it
         raise InputError(f"{p}: unsupported file type")
     return ImportResult(
@@ -106,21 +112,43 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     )
 
 
-def effective_hull_tolerance(kind: str, options: ImportOptions) -> float | None:
-    """The user's hull tolerance, else 0.05 mm for CAD and meshes, exact for outline files."""
+def effective_hull_tolerance(
+    kind: str, options: ImportOptions, size_mm: float | None = None
+) -> float | None:
+    """The user's hull tolerance; else, for CAD files and meshes, a share of the part's size.
+
+    The default is :data:`REL_HULL_TOLERANCE` of ``size_mm`` capped by
+    :data:`DEFAULT_HULL_TOLERANCE` (0.05 mm from 25 mm up; 0.006 mm for a 3 mm part), and
+    exact (``None``) for outline files.
+    """
     if options.hull_tolerance is not None:
-        if options.hull_tolerance < 0:
+        if not options.hull_tolerance >= 0:
             raise InputError(f"--hull-tolerance must be >= 0, got {options.hull_tolerance:g}")
         return options.hull_tolerance
-    return None if kind == "outline" else DEFAULT_HULL_TOLERANCE
+    if kind == "outline":
+        return None
+    if size_mm is None:
+        return DEFAULT_HULL_TOLERANCE
+    return min(DEFAULT_HULL_TOLERANCE, REL_HULL_TOLERANCE * size_mm)
 
 
 def build_part(
     imported: ImportedOutline, options: ImportOptions, extra_warnings: tuple[str, ...] = ()
 ) -> ImportedPart:
-    """The part of an imported outline: simplified hull, COM check, and its orientability."""
-    tol = effective_hull_tolerance(imported.kind, options)
-    part = make_part(imported.outline, options.com, hull_tolerance=tol)
+    """The part of an imported outline: simplified hull, COM check, and its orientability.
+
+    When the part cannot be built and its size was found implausible (a unit mistake is the
+    likely cause), the error says so.
+    """
+    size = outline_size(imported.outline)
+    tol = effective_hull_tolerance(imported.kind, options, size)
+    try:
+        part = make_part(imported.outline, options.com, hull_tolerance=tol)
+    except InputError as exc:
+        doubts = [w for w in imported.warnings if "check the units" in w]
+        if not doubts:
+            raise
+        raise InputError(f"{exc} ({doubts[0]})") from None
     verdict = orientability(part, tol)
     notes = list(extra_warnings) + list(imported.warnings)
     if not verdict.orientable:

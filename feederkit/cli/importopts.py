@@ -1,0 +1,155 @@
+"""The import options every command that takes a SOURCE shares, and how it prints import warnings.
+
+One place for the typer option types (``--units --layer --all-parts --pose --space`` and the
+import budgets, docs/import.md), the builder of :class:`~feederkit.importers.ImportOptions`
+and the printing of the importer's warnings (parts left out, frames skipped, gaps closed,
+units in doubt), so ``part analyze``, ``part plot``, ``lookalike``, ``plan`` and ``catalog``
+say the same thing about the same file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Annotated
+
+import typer
+
+from feederkit.importers import (
+    DEFAULT_FLATTEN_TOLERANCE,
+    DEFAULT_HULL_TOLERANCE,
+    DEFAULT_MAX_FILE_MB,
+    ImportOptions,
+)
+from feederkit.importers.budget import (
+    DEFAULT_MAX_CROSSINGS,
+    DEFAULT_MAX_ENTITIES,
+    DEFAULT_MAX_FACES,
+    DEFAULT_MAX_HULL_FACES,
+    DEFAULT_MAX_LOOPS,
+    DEFAULT_MAX_VERTICES,
+    DEFAULT_TIME_LIMIT_S,
+    ImportLimits,
+)
+from feederkit.importers.model import REL_HULL_TOLERANCE
+
+UnitsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--units",
+        help="Units of the file's coordinates (mm, cm, m, in, ft, um): overrides the file.",
+    ),
+]
+LayerOpt = Annotated[
+    list[str] | None,
+    typer.Option("--layer", help="DXF layer to read (repeat for several; default all)."),
+]
+SpaceOpt = Annotated[
+    str,
+    typer.Option("--space", help="DXF space to read: model (default) or paper."),
+]
+FlattenOpt = Annotated[
+    float,
+    typer.Option("--flatten-tolerance", min=1e-6, help="Largest curve-to-chord distance (mm)."),
+]
+HullOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--hull-tolerance",
+        min=0.0,
+        help=f"Hull simplification (mm); default {REL_HULL_TOLERANCE:g} of the part's size, at "
+        f"most {DEFAULT_HULL_TOLERANCE}, for CAD files; exact for outline files.",
+    ),
+]
+AllPartsOpt = Annotated[
+    bool,
+    typer.Option(
+        "--all-parts", help="Import every separate part of a drawing, not only the largest."
+    ),
+]
+PoseOpt = Annotated[
+    int | None, typer.Option("--pose", min=0, help="Mesh resting pose K (0: the most probable).")
+]
+AllowLargeOpt = Annotated[
+    bool, typer.Option("--allow-large", help=f"Read files over {DEFAULT_MAX_FILE_MB:g} MB.")
+]
+MaxEntitiesOpt = Annotated[
+    int,
+    typer.Option(
+        "--max-entities", min=1, help="Import budget: DXF entities after block expansion."
+    ),
+]
+MaxVerticesOpt = Annotated[
+    int,
+    typer.Option("--max-vertices", min=1, help="Import budget: vertices after flattening."),
+]
+MaxLoopsOpt = Annotated[
+    int, typer.Option("--max-loops", min=1, help="Import budget: closed loops (parts and holes).")
+]
+MaxCrossingsOpt = Annotated[
+    int,
+    typer.Option(
+        "--max-crossings", min=1, help="Import budget: pairs of DXF lines that may cross."
+    ),
+]
+MaxFacesOpt = Annotated[
+    int, typer.Option("--max-faces", min=1, help="Import budget: mesh triangles.")
+]
+MaxHullFacesOpt = Annotated[
+    int,
+    typer.Option(
+        "--max-hull-faces", min=1, help="Import budget: faces of a mesh's convex hull (poses)."
+    ),
+]
+ImportTimeOpt = Annotated[
+    float,
+    typer.Option("--import-time-limit", min=0.001, help="Import budget: wall time (s) per file."),
+]
+
+
+def import_options(
+    units: str | None = None,
+    layer: list[str] | None = None,
+    flatten_tolerance: float = DEFAULT_FLATTEN_TOLERANCE,
+    hull_tolerance: float | None = None,
+    all_parts: bool = False,
+    pose: int | None = None,
+    com: tuple[float, float] | None = None,
+    allow_large: bool = False,
+    *,
+    space: str = "model",
+    max_entities: int = DEFAULT_MAX_ENTITIES,
+    max_vertices: int = DEFAULT_MAX_VERTICES,
+    max_loops: int = DEFAULT_MAX_LOOPS,
+    max_crossings: int = DEFAULT_MAX_CROSSINGS,
+    max_faces: int = DEFAULT_MAX_FACES,
+    max_hull_faces: int = DEFAULT_MAX_HULL_FACES,
+    import_time_limit: float = DEFAULT_TIME_LIMIT_S,
+) -> ImportOptions:
+    """The importer options from the command-line options (bad values: InputError)."""
+    return ImportOptions(
+        units=units,
+        layers=tuple(layer or ()),
+        flatten_tolerance=flatten_tolerance,
+        hull_tolerance=hull_tolerance,
+        all_parts=all_parts,
+        pose=pose,
+        com=None if com is None else (float(com[0]), float(com[1])),
+        allow_large=allow_large,
+        space=space,
+        limits=ImportLimits(
+            entities=max_entities,
+            vertices=max_vertices,
+            loops=max_loops,
+            crossings=max_crossings,
+            faces=max_faces,
+            hull_faces=max_hull_faces,
+            seconds=import_time_limit,
+        ),
+    )
+
+
+def print_import_warnings(source: str, warnings: Iterable[str]) -> None:
+    """Each import warning as ``warning: SOURCE: ...`` on stderr (plain text, as ``plan`` does)."""
+    from feederkit.cli.common import print_warnings  # the console lives there
+
+    print_warnings(f"{source}: {w}" for w in warnings)

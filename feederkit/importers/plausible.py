@@ -1,0 +1,77 @@
+"""Plausibility of an imported part's size and units: say so when the scale looks wrong.
+
+A header that says metres on a 200 mm plate gives a 200 m part; a housing modelled in
+metres read as millimetres gives a 0.04 mm part. Either way the plan that follows would be
+verified and wrong, so an import outside :data:`MIN_PLAUSIBLE_MM` .. :data:`MAX_PLAUSIBLE_MM`
+is told what the part would measure in the other likely units, and how to choose one.
+"""
+
+from __future__ import annotations
+
+from feederkit.outline import Outline, unit_scale
+
+MIN_PLAUSIBLE_MM = 1.0
+"""A feeder part smaller than 1 mm across is more likely a unit mistake."""
+
+MAX_PLAUSIBLE_MM = 2000.0
+"""A feeder part larger than 2 m across is more likely a unit mistake."""
+
+LIKELY_UNITS = ("mm", "in", "m")
+"""The units a CAD file is usually drawn in."""
+
+METRIC = frozenset({"mm", "cm", "m", "km", "um", "dm"})
+IMPERIAL = frozenset({"in", "ft", "mi", "yd", "mil", "microinch"})
+
+
+def outline_size(outline: Outline) -> float:
+    """The larger side of the outline's bounding box (mm)."""
+    xs = [p[0] for p in outline.vertices]
+    ys = [p[1] for p in outline.vertices]
+    return max(max(xs) - min(xs), max(ys) - min(ys))
+
+
+def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
+    """A warning when a part of ``size_mm`` (read in ``unit_name``) is implausibly small or large.
+
+    It names the size the part would have in the other likely units and the ``--units``
+    option; ``given`` says the user chose the unit (the warning then says so).
+    """
+    if MIN_PLAUSIBLE_MM <= size_mm <= MAX_PLAUSIBLE_MM:
+        return []
+    try:
+        scale = unit_scale(unit_name)
+    except Exception:  # noqa: BLE001 - units outside the table (miles, ...): the size alone
+        scale = None
+    how = "as you chose with --units" if given else "from the file"
+    what = "smaller than 1 mm" if size_mm < MIN_PLAUSIBLE_MM else "larger than 2 m"
+    alt = ""
+    if scale is not None:
+        drawn = size_mm / scale
+        others = [f"{drawn * unit_scale(u):.4g} mm in {u}" for u in LIKELY_UNITS if u != unit_name]
+        alt = f"; drawn in other units it would be {', '.join(others)}"
+    return [
+        f"the part is {size_mm:.4g} mm across ({what}), read in {unit_name} {how}{alt}: "
+        "check the units (use --units)"
+    ]
+
+
+def measurement_warnings(doc: object, unit_name: str) -> list[str]:
+    """A warning when ``$INSUNITS`` contradicts ``$MEASUREMENT`` (0 imperial, 1 metric)."""
+    header = doc.header  # type: ignore[attr-defined]
+    if "$MEASUREMENT" not in header:
+        return []
+    try:
+        code = int(header.get("$MEASUREMENT"))
+    except (TypeError, ValueError):
+        return []
+    system = {0: "imperial", 1: "metric"}.get(code)
+    if system is None:
+        return []
+    if (system == "imperial" and unit_name in METRIC) or (
+        system == "metric" and unit_name in IMPERIAL
+    ):
+        return [
+            f"the drawing's unit ({unit_name}, $INSUNITS) contradicts its measurement system "
+            f"({system}, $MEASUREMENT {code}): check the units (use --units)"
+        ]
+    return []

@@ -1,0 +1,160 @@
+"""Import budgets and coordinate checks: hostile files are refused in one line, quickly.
+
+Each case is made here, names what was too large and the option that raises it, and must be
+answered well within a second or two (docs/import.md, budgets).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import trimesh
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import fixtures_cad as fx  # noqa: E402
+
+from feederkit.errors import InputError  # noqa: E402
+from feederkit.importers import ImportOptions, import_parts  # noqa: E402
+from feederkit.importers.budget import ImportLimits  # noqa: E402
+
+QUICK_S = 2.0
+
+
+def refused(path: Path, match: str, **options) -> str:
+    start = time.monotonic()
+    with pytest.raises(InputError, match=match) as info:
+        import_parts(path, ImportOptions(**options))
+    assert time.monotonic() - start < QUICK_S
+    message = str(info.value)
+    assert "\n" not in message and str(path) in message
+    return message
+
+
+@pytest.mark.parametrize(
+    ("depth", "fanout", "match"),
+    [
+        (5, 10, r"more than 10,000 entities after block expansion .*--max-entities"),
+        (20, 2, r"more than 10,000 entities after block expansion .*--max-entities"),
+        (33, 10, r"nested deeper than 32"),
+    ],
+)
+def test_block_explosions_are_refused_before_expansion(tmp_path, depth, fanout, match):
+    refused(fx.write_nested_blocks(tmp_path / "nest.dxf", depth, fanout), match)
+
+
+def test_small_nesting_within_the_budget_imports(tmp_path):
+    path = fx.write_nested_blocks(tmp_path / "nest.dxf", 2, 3)  # 9 unit squares
+    _, parts = import_parts(path, ImportOptions(all_parts=True))
+    assert len(parts) == 9
+    assert all(p.part.outline.polygon().area == pytest.approx(1.0) for p in parts)
+
+
+def test_block_cycle_is_refused(tmp_path):
+    refused(
+        fx.write_block_cycle(tmp_path / "cycle.dxf"), "block 'A' contains a reference to itself"
+    )
+
+
+@pytest.mark.parametrize("size", [1000, 10**9])
+def test_minsert_grids_are_counted_before_expansion(tmp_path, size):
+    refused(fx.write_minsert(tmp_path / "grid.dxf", size, size), "more than 10,000 entities")
+
+
+def test_minsert_of_an_undefined_block(tmp_path):
+    refused(fx.write_minsert(tmp_path / "grid.dxf", 10, 10, "NOPE"), "undefined block 'NOPE'")
+
+
+def test_vertex_budget_and_its_option(tmp_path):
+    path = fx.write_big_polyline(tmp_path / "poly.dxf", 5000)
+    refused(
+        path,
+        r"more than 1,000 points in the file .*--max-vertices",
+        limits=ImportLimits(vertices=1000),
+    )
+    _, (ip,) = import_parts(path, ImportOptions(limits=ImportLimits(vertices=10_000)))
+    assert len(ip.part.outline.vertices) == 5000
+
+
+def test_loop_budget_counts_holes_before_polygonizing(tmp_path):
+    path = fx.write_holes_plate(tmp_path / "holes.dxf", 15)  # 225 holes
+    refused(path, r"more than 100 closed loops .*--max-loops", limits=ImportLimits(loops=100))
+    _, (ip,) = import_parts(path, ImportOptions())
+    assert len(ip.part.outline.holes) == 225
+
+
+def test_crossing_lines_are_counted_before_noding(tmp_path):
+    path = fx.write_crossing_lines(tmp_path / "cross.dxf", 300)
+    refused(path, r"more than 5,000 pairs of lines that may cross .*--max-crossings",
+            limits=ImportLimits(crossings=5000))  # fmt: skip
+
+
+def test_wall_time_budget(tmp_path):
+    path = fx.write_holes_plate(tmp_path / "holes.dxf", 15)
+    refused(
+        path, r"took longer than 0.001 s .*--import-time-limit", limits=ImportLimits(seconds=0.001)
+    )
+
+
+@pytest.mark.parametrize("value", ["1e20", "1e300", "1.8e308", "1e400", "inf", "-inf", "nan"])
+def test_coordinates_are_checked_as_they_are_read(tmp_path, value):
+    path = fx.write_with_coordinate(tmp_path / "coord.dxf", value)
+    refused(path, "beyond any part a feeder can hold|NaN or infinite coordinates")
+
+
+@pytest.mark.parametrize(("radius", "units"), [(1e6, 6), (1e300, 6), (2e7, 4)])
+def test_huge_circles_are_refused(tmp_path, radius, units):
+    path = fx.write_circle(tmp_path / "circle.dxf", radius, units)
+    refused(path, "beyond any part a feeder can hold|NaN or infinite")
+
+
+def test_flatten_tolerance_follows_the_drawing_size(tmp_path):
+    start = time.monotonic()
+    path = fx.write_circle(tmp_path / "circle.dxf", 1000.0)  # a 2 km disk in metres
+    _, (ip,) = import_parts(path, ImportOptions())
+    assert time.monotonic() - start < QUICK_S
+    assert len(ip.part.outline.vertices) < 2000  # 0.01 mm chords would need ~10**6
+    assert any("flatten tolerance raised to 20 mm" in w for w in ip.warnings)
+    assert any("larger than 2 m" in w for w in ip.warnings)
+
+
+def test_mesh_with_a_huge_convex_hull_is_refused_quickly(tmp_path):
+    mesh = trimesh.creation.cylinder(radius=10, height=4, sections=5000)
+    path = fx.write_mesh(mesh, tmp_path / "cyl.stl")
+    refused(path, r"more than 4,000 faces of the mesh's convex hull .*--max-hull-faces")
+
+
+def test_mesh_face_budget(tmp_path):
+    path = fx.write_mesh(trimesh.creation.icosphere(subdivisions=3), tmp_path / "ball.stl")
+    refused(path, r"more than 100 mesh faces .*--max-faces", limits=ImportLimits(faces=100))
+
+
+def test_obj_face_with_a_repeated_vertex_list(tmp_path):
+    path = fx.write_obj_repeated_face(tmp_path / "rep.obj", 400_000)
+    refused(path, r"more than 1,000,000 mesh faces in the file .*--max-faces")
+
+
+def test_mesh_coordinates_beyond_any_part(tmp_path):
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((1e8, 0, 0))
+    refused(fx.write_mesh(box, tmp_path / "far.stl"), "beyond any part a feeder can hold")
+
+
+def test_bad_limits_are_refused():
+    with pytest.raises(InputError, match="--max-loops must be at least 1"):
+        ImportLimits(loops=0)
+    with pytest.raises(InputError, match="--import-time-limit must be > 0"):
+        ImportLimits(seconds=float("nan"))
+
+
+def test_outline_json_counts_against_the_budget(tmp_path):
+    path = tmp_path / "many.json"
+    pts = ",".join(f"[{x}, {y}]" for x, y in [(0, 0), (10, 0), (10, 10), (5, 12), (0, 10)])
+    path.write_text('{"name": "many", "vertices": [' + pts + "]}")
+    refused(
+        path,
+        r"more than 4 vertices after flattening .*--max-vertices",
+        limits=ImportLimits(vertices=4),
+    )
