@@ -12,7 +12,12 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from feederkit.catalog import default_catalog_path, get_revision, part_from_revision
+from feederkit.catalog import (
+    could_be_part_name,
+    default_catalog_path,
+    get_revision,
+    part_from_revision,
+)
 from feederkit.errors import InputError
 from feederkit.importers import (
     NOT_ORIENTABLE,
@@ -76,12 +81,18 @@ def load_part_with_warnings(
     if com is not None:
         opts = dataclasses.replace(opts, com=(float(com[0]), float(com[1])))
     path = Path(source)
-    if path.is_file():
+    try:
+        is_file, exists = path.is_file(), path.exists()
+    except OSError as exc:  # e.g. a name longer than the file system holds
+        raise InputError(f"{source[:80]}: cannot be a file ({exc.strerror or exc})") from None
+    if is_file:
         _, parts = import_parts(path, opts)
         first = parts[0]
         return LoadedPart(first.part, first.warnings, first.orientability, str(path))
-    if path.exists():
+    if exists:
         raise InputError(f"{source}: not a file")
+    if not could_be_part_name(source):
+        raise InputError(f"{source}: no such file")
     return _from_catalog(source, opts.com, catalog)
 
 

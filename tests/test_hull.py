@@ -51,3 +51,18 @@ def test_contact_hull_is_a_fixpoint_at_tolerance_zero(points, tol) -> None:
     assert contact_hull(hull, 0.0) == hull
     start = min(range(len(hull)), key=lambda i: (hull[i][1], hull[i][0]))
     assert start == 0
+
+
+def test_a_plan_for_a_bulged_rectangle_passes_its_own_verification() -> None:
+    """The verifier rebuilds the part from the file's hull: it must not simplify it again
+    (a 1e-8 mm bulge over 41 points used to give 'the file says edge 2 ... gives edge 1')."""
+    from feederkit.mechanics.push import push_function
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+    from feederkit.plans.make import make_plan
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    part = make_part(make_outline("bulge", _bulged_rectangle(1e-8)))
+    made = make_plan([push_function(part)], ToleranceSensor(0.1), uncertainty=Uncertainty(0.0))
+    assert made.result.length >= 1
