@@ -11,16 +11,14 @@ import sys
 import textwrap
 from pathlib import Path
 
+import fixtures_cad as fx
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit import catalog as cat  # noqa: E402
-from feederkit.errors import InputError  # noqa: E402
-from feederkit.importers import ImportOptions  # noqa: E402
-from feederkit.outline import load_outline_json, make_outline, save_outline_json  # noqa: E402
-from feederkit.sources import load_part, load_part_with_warnings  # noqa: E402
+from feederkit import catalog as cat
+from feederkit.errors import InputError
+from feederkit.importers import ImportOptions
+from feederkit.outline import load_outline_json, make_outline, save_outline_json
+from feederkit.sources import load_part, load_part_with_warnings
 
 
 def snapshot(db: Path) -> list[str]:

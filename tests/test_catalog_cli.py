@@ -8,14 +8,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import fixtures_cad as fx
 import pytest
 import trimesh
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.cli.app import main  # noqa: E402
-from feederkit.outline import make_outline, save_outline_json  # noqa: E402
+from feederkit.cli.app import main
+from feederkit.outline import make_outline, save_outline_json
 
 
 @pytest.fixture

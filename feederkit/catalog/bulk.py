@@ -19,7 +19,7 @@ from feederkit.catalog.schema import transaction
 from feederkit.catalog.store import CatalogLike, _conn, landings_for, options_key, write_revision
 from feederkit.errors import InputError
 from feederkit.importers import SUPPORTED_SUFFIXES, ImportedPart, ImportOptions, import_parts
-from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing
+from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
 
 Progress = Callable[[str, int, int, str], None]
 """Called as ``progress(phase, done, total, item)``; phase is ``read`` or ``write``."""
@@ -100,7 +100,7 @@ def import_directory(
     with its path and reason, and nothing is written; with ``skip_bad`` the good files are
     written and the bad ones listed in :attr:`DirectoryImport.bad`.
     """
-    key = options_key(options, side_probability)
+    check_side_probability(side_probability)
     root = Path(directory)
     files, ignored = source_files(root)
     if not files:
@@ -144,7 +144,7 @@ def import_directory(
                     p,
                     source_path=str(path.resolve()),
                     sha256=sha,
-                    options_key=key,
+                    options_key=options_key(options, side_probability, p.source.kind),
                     revise=revise,
                     created_by=created_by,
                     landings=lands,

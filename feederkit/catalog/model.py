@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from feederkit.errors import InputError
+from feederkit.landing.model import Landing
 from feederkit.outline import Outline
 
 Point = tuple[float, float]
@@ -118,7 +119,12 @@ class PartSummary:
 
 @dataclass(frozen=True)
 class Revision:
-    """A stored part revision with everything needed to rebuild the part exactly."""
+    """A stored part revision with everything needed to rebuild the part exactly.
+
+    ``landings`` are the ways the part lands (docs/landings.md), each with its own outline,
+    hull and COM; ``landings_note`` says when they were not stored but computed on read (a
+    revision stored before catalog schema 2), and what that means.
+    """
 
     name: str
     revision: int
@@ -138,6 +144,8 @@ class Revision:
     area: float
     created_at: str
     created_by: str
+    landings: tuple[Landing, ...] = ()
+    landings_note: str | None = None
 
 
 @dataclass(frozen=True)

@@ -70,7 +70,36 @@ def _v1(conn: sqlite3.Connection) -> None:
             conn.execute(statement)
 
 
-MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1,)
+SCHEMA_V2 = """
+CREATE TABLE landings (
+    revision_id  INTEGER NOT NULL REFERENCES revisions(id) ON DELETE CASCADE,
+    position     INTEGER NOT NULL CHECK (position >= 0),
+    name         TEXT NOT NULL,
+    probability  REAL NOT NULL CHECK (probability > 0),
+    outline_json TEXT NOT NULL,
+    hull_json    TEXT NOT NULL,
+    com_x        REAL NOT NULL,
+    com_y        REAL NOT NULL,
+    merged_json  TEXT NOT NULL,
+    PRIMARY KEY (revision_id, position),
+    UNIQUE (revision_id, name)
+);
+"""
+
+
+def _v2(conn: sqlite3.Connection) -> None:
+    """Landings (docs/landings.md): each revision's ways to land, one row each.
+
+    Revisions stored before this version have no rows; reading them computes their landings
+    and says so (:func:`feederkit.catalog.store.get_revision`), so old catalogs stay readable
+    without the source files.
+    """
+    for statement in SCHEMA_V2.split(";"):
+        if statement.strip():
+            conn.execute(statement)
+
+
+MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2)
 """Migration ``k`` brings a catalog from version ``k`` to ``k + 1``."""
 
 SCHEMA_VERSION = len(MIGRATIONS)

@@ -44,6 +44,14 @@ from feederkit.importers import (
     import_parts,
 )
 from feederkit.jsonio import parse_json
+from feederkit.landing.mesh import landings_of_mesh, pose_name
+from feederkit.landing.model import (
+    DEFAULT_SIDE_PROBABILITY,
+    Landing,
+    check_landing_name,
+    check_side_probability,
+    landings_of_outline,
+)
 from feederkit.outline import (
     MAX_COORD_MM,
     Outline,
@@ -128,12 +136,84 @@ def _part_id(conn: sqlite3.Connection, name: str) -> int | None:
     return None if row is None else int(row[0])
 
 
-def _latest(conn: sqlite3.Connection, part_id: int) -> tuple[int, str, str, str]:
+def _latest(conn: sqlite3.Connection, part_id: int) -> tuple[int, str, str, str, int]:
     return conn.execute(
-        "SELECT revision, source_path, source_sha256, options_json FROM revisions "
+        "SELECT revision, source_path, source_sha256, options_json, id FROM revisions "
         "WHERE part_id = ? ORDER BY revision DESC LIMIT 1",
         (part_id,),
     ).fetchone()
+
+
+def options_key(
+    options: ImportOptions,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
+    kind: str = "outline",
+) -> dict[str, Any]:
+    """The import options that make a revision: ``options.as_key()`` and, for a flat part
+    (``kind`` not ``mesh``) when not the default 0.5, ``side_probability`` (so older
+    revisions compare equal, and a mesh, which has no sides, is not revised by it)."""
+    key = dict(options.as_key())
+    p = check_side_probability(side_probability)
+    if p != DEFAULT_SIDE_PROBABILITY and kind != "mesh":
+        key["side_probability"] = p
+    return key
+
+
+def _imported_pose(imported: ImportedPart) -> tuple[Landing, ...]:
+    """The one landing known without the mesh file: the imported pose."""
+    part = imported.part
+    pose = imported.source.pose
+    k = 0 if pose is None else pose.index
+    prob = 1.0 if pose is None else float(pose.probability)
+    named = Part(part.name + f"/{pose_name(k)}", part.outline, part.com, part.hull, part.revision)
+    return (Landing(part.name, pose_name(k), prob, named),)
+
+
+def landings_for(
+    imported: ImportedPart,
+    options: ImportOptions = ImportOptions(),
+    source: str | os.PathLike[str] | None = None,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
+) -> tuple[Landing, ...]:
+    """The landings to store with an imported part (docs/landings.md).
+
+    A flat part: ``up`` and ``down`` (one when mirror-symmetric), ``up`` with
+    ``side_probability``. A mesh: every resting pose of the ``source`` file, congruent ones
+    merged (without the file, only the imported pose).
+    """
+    if imported.source.kind != "mesh":
+        return landings_of_outline(imported.part, side_probability)
+    if source is None:
+        return _imported_pose(imported)
+    return landings_of_mesh(
+        Path(source), options, name=imported.part.name, hull_tolerance=imported.hull_tolerance
+    )
+
+
+def _has_landings(conn: sqlite3.Connection, revision_id: int) -> bool:
+    row = conn.execute("SELECT 1 FROM landings WHERE revision_id = ? LIMIT 1", (revision_id,))
+    return row.fetchone() is not None
+
+
+def _write_landings(
+    conn: sqlite3.Connection, revision_id: int, landings: Sequence[Landing]
+) -> None:
+    for position, x in enumerate(landings):
+        conn.execute(
+            "INSERT INTO landings (revision_id, position, name, probability, outline_json, "
+            "hull_json, com_x, com_y, merged_json) VALUES (?,?,?,?,?,?,?,?,?)",
+            (
+                revision_id,
+                position,
+                check_landing_name(x.name),
+                float(x.probability),
+                _dumps(outline_to_dict(x.part.outline)),
+                _dumps([list(p) for p in x.part.hull]),
+                x.part.com[0],
+                x.part.com[1],
+                _dumps(list(x.merged)),
+            ),
+        )
 
 
 def write_revision(
@@ -145,13 +225,18 @@ def write_revision(
     options_key: dict[str, Any],
     revise: bool = False,
     created_by: str | None = None,
+    landings: Sequence[Landing] | None = None,
 ) -> AddOutcome:
-    """Store one imported part inside the caller's transaction.
+    """Store one imported part and its landings inside the caller's transaction.
 
     A new name is added as revision 1. For an existing name, the same source path (or
     ``revise``) with the same SHA-256 and options is a no-op; with a changed file or options
-    it becomes the next revision. Another source file under an existing name is refused.
+    it becomes the next revision, and so does a mesh whose latest revision was stored before
+    landings (to store all its resting poses). Another source file under an existing name is
+    refused. ``landings`` default to :func:`landings_for` without the source file.
     """
+    if landings is None:
+        landings = landings_for(imported)
     part = imported.part
     name = check_name(part.name)
     who = created_by or current_user()
@@ -166,13 +251,16 @@ def write_revision(
         pid = int(cur.lastrowid)
         revision, status = 1, "added"
     else:
-        rev, old_path, old_sha, old_options = _latest(conn, pid)
+        rev, old_path, old_sha, old_options, old_id = _latest(conn, pid)
         if old_path != source_path and not revise:
             raise InputError(
                 f"duplicate name: part {name!r} already exists from {old_path}; choose another "
                 "--name, or use --revise to make this file its next revision"
             )
-        if old_sha == sha256 and old_options == options_json:
+        poses_missing = (
+            imported.source.kind == "mesh" and len(landings) > 1 and not _has_landings(conn, old_id)
+        )
+        if old_sha == sha256 and old_options == options_json and not poses_missing:
             return AddOutcome(
                 name,
                 int(rev),
@@ -183,6 +271,11 @@ def write_revision(
             )
         revision, status = int(rev) + 1, "revised"
         changes = _changes(int(rev), old_sha, sha256, old_options, options_key)
+        if poses_missing:
+            changes += (
+                f"landings: all {len(landings)} resting poses stored (revision {rev} was "
+                "stored before landings)",
+            )
     src = imported.source
     pose = None
     if src.pose is not None:
@@ -193,7 +286,7 @@ def write_revision(
             "transform": [list(r) for r in src.pose.transform],
         }
     outline = part.outline
-    conn.execute(
+    cur = conn.execute(
         "INSERT INTO revisions (part_id, revision, source_path, source_sha256, source_kind, "
         "source_units, options_json, outline_json, hull_json, com_x, com_y, hull_tolerance, "
         "mesh_pose_json, orientable, not_orientable_reason, warnings_json, area, n_holes, "
@@ -222,6 +315,7 @@ def write_revision(
             who,
         ),
     )
+    _write_landings(conn, int(cur.lastrowid), landings)
     return AddOutcome(
         name,
         revision,
@@ -266,11 +360,15 @@ def add_file(
     name: str | None = None,
     revise: bool = False,
     created_by: str | None = None,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
 ) -> list[AddOutcome]:
-    """Import one file and store its part(s) in one transaction (several with ``all_parts``)."""
+    """Import one file and store its part(s) with their landings in one transaction (several
+    parts with ``all_parts``); ``side_probability`` is a flat part's probability of ``up``."""
     if name is not None:
         check_name(name)
+    check_side_probability(side_probability)
     result, parts = import_parts(path, options, name)
+    landings = [landings_for(p, options, path, side_probability) for p in parts]
     source = str(Path(path).resolve())
     with _conn(catalog, create=True) as conn, transaction(conn):
         return [
@@ -279,11 +377,12 @@ def add_file(
                 p,
                 source_path=source,
                 sha256=result.sha256,
-                options_key=options.as_key(),
+                options_key=options_key(options, side_probability, p.source.kind),
                 revise=revise,
                 created_by=created_by,
+                landings=lands,
             )
-            for p in parts
+            for p, lands in zip(parts, landings, strict=True)
         ]
 
 
@@ -296,25 +395,30 @@ def add_outline(
     source_path: str | None = None,
     revise: bool = False,
     created_by: str | None = None,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
 ) -> AddOutcome:
-    """Store an outline made in Python; its SHA-256 is that of its outline-file JSON."""
+    """Store an outline made in Python with its landings (``up`` with ``side_probability``);
+    its SHA-256 is that of its outline-file JSON."""
     if name is not None:
         outline = dataclasses.replace(outline, name=check_name(name))
     text = _dumps(outline_to_dict(outline))
     sha = hashlib.sha256(text.encode()).hexdigest()
     options = ImportOptions(hull_tolerance=hull_tolerance)
+    key = options_key(options, side_probability)
     imported = build_part(
         ImportedOutline(outline=outline, kind="outline", source_units="mm"), options
     )
+    landings = landings_of_outline(imported.part, side_probability)
     with _conn(catalog, create=True) as conn, transaction(conn):
         return write_revision(
             conn,
             imported,
             source_path=source_path or f"<python:{outline.name}>",
             sha256=sha,
-            options_key=options.as_key(),
+            options_key=key,
             revise=revise,
             created_by=created_by,
+            landings=landings,
         )
 
 
@@ -470,13 +574,69 @@ _REVISION_SQL = """
 SELECT p.name, r.revision, r.source_path, r.source_sha256, r.source_kind, r.source_units,
        r.options_json, r.outline_json, r.hull_json, r.com_x, r.com_y, r.hull_tolerance,
        r.mesh_pose_json, r.orientable, r.not_orientable_reason, r.warnings_json, r.area,
-       r.created_at, r.created_by
+       r.created_at, r.created_by, r.id
 FROM parts p JOIN revisions r ON r.part_id = p.id WHERE p.name = ?
 """
 
+_LANDINGS_SQL = """
+SELECT position, name, probability, outline_json, hull_json, com_x, com_y, merged_json
+FROM landings WHERE revision_id = ? ORDER BY position
+"""
 
-def _revision_from_row(row: Sequence[Any]) -> Revision:
-    """A stored revision, every field checked (types, UTF-8, JSON, hull convex, COM inside).
+NOTE_FLAT = (
+    "landings computed on read: this revision was stored before landings (catalog schema 1), "
+    "so up and down have probability 0.5 each"
+)
+NOTE_MESH = (
+    "only the imported pose is known: this revision was stored before landings (catalog "
+    "schema 1); add the mesh file again to store all its resting poses"
+)
+
+
+def _stored_landing(name: str, revision: int, row: Sequence[Any]) -> Landing:
+    """One stored landing, checked like the revision (name, probability, outline, hull, COM)."""
+    lname = _text(row[1], "a landing's name")
+    try:
+        check_landing_name(lname)  # type: ignore[arg-type]
+    except InputError as exc:
+        raise _Damaged(str(exc)) from None
+    prob = _real(row[2], f"landing {lname}'s probability")
+    if not 0.0 < prob <= 1.0 + 1e-9:  # type: ignore[operator]
+        raise _Damaged(f"landing {lname}'s probability is {prob}, not in (0, 1]")
+    data = _json(row[3], f"landing {lname}'s outline_json", dict)
+    try:
+        outline = outline_from_dict(data, default_name=name)
+    except InputError as exc:
+        raise _Damaged(f"landing {lname}'s outline_json: {exc}") from None
+    hull = _hull(_json(row[4], f"landing {lname}'s hull_json", list))
+    com = (_real(row[5], f"landing {lname}'s com_x"), _real(row[6], f"landing {lname}'s com_y"))
+    if not _inside(com, hull):  # type: ignore[arg-type]
+        raise _Damaged(f"landing {lname}'s center of mass {com} is not inside its hull")
+    merged = _json(row[7], f"landing {lname}'s merged_json", list)
+    if not all(isinstance(m, str) for m in merged):
+        raise _Damaged(f"landing {lname}'s merged_json is not a list of text")
+    part = Part(f"{name}/{lname}", outline, com, hull, str(revision))  # type: ignore[arg-type]
+    return Landing(name, lname, prob, part, tuple(merged))  # type: ignore[arg-type]
+
+
+def _computed_landings(
+    name: str, revision: int, kind: str, part: Part, pose: Any
+) -> tuple[tuple[Landing, ...], str]:
+    """The landings of a revision stored before landings, and the note saying so."""
+    if kind != "mesh":
+        return landings_of_outline(part), NOTE_FLAT
+    k, prob = 0, 1.0
+    if isinstance(pose, dict):
+        k = _int(pose.get("index", 0), "mesh_pose_json's index")
+        p = _real(pose.get("probability", 1.0), "mesh_pose_json's probability")
+        prob = p if 0.0 < p <= 1.0 else 1.0  # type: ignore[operator]
+    named = Part(f"{name}/{pose_name(k)}", part.outline, part.com, part.hull, str(revision))
+    return (Landing(name, pose_name(k), prob, named),), NOTE_MESH
+
+
+def _revision_from_row(row: Sequence[Any], landing_rows: Sequence[Sequence[Any]] = ()) -> Revision:
+    """A stored revision, every field checked (types, UTF-8, JSON, hull convex, COM inside),
+    with its landings (computed, and noted, for a revision stored before landings).
 
     Anything wrong (an edited or corrupted row) is one InputError naming the part and
     revision and saying how to get rid of it.
@@ -502,25 +662,35 @@ def _revision_from_row(row: Sequence[Any]) -> Revision:
         hull_tolerance = _real(row[11], "hull_tolerance", optional=True)
         if hull_tolerance is not None and hull_tolerance < 0:
             raise _Damaged(f"hull_tolerance is {hull_tolerance}, negative")
+        kind = _text(row[4], "source_kind")
+        mesh_pose = _json(row[12], "mesh_pose_json", dict, optional=True)
+        note = None
+        if landing_rows:
+            landings = tuple(_stored_landing(name, revision, r) for r in landing_rows)  # type: ignore[arg-type]
+        else:
+            part = Part(name, outline, com, hull, str(revision))  # type: ignore[arg-type]
+            landings, note = _computed_landings(name, revision, kind, part, mesh_pose)  # type: ignore[arg-type]
         return Revision(
             name=name,  # type: ignore[arg-type]
             revision=revision,
             source_path=_text(row[2], "source_path"),  # type: ignore[arg-type]
             source_sha256=_text(row[3], "source_sha256"),  # type: ignore[arg-type]
-            source_kind=_text(row[4], "source_kind"),  # type: ignore[arg-type]
+            source_kind=kind,  # type: ignore[arg-type]
             source_units=_text(row[5], "source_units"),  # type: ignore[arg-type]
             options=_json(row[6], "options_json", dict),
             outline=outline,
             hull=hull,
             com=com,  # type: ignore[arg-type]
             hull_tolerance=hull_tolerance,
-            mesh_pose=_json(row[12], "mesh_pose_json", dict, optional=True),
+            mesh_pose=mesh_pose,
             orientable=bool(orientable),
             not_orientable_reason=_text(row[14], "not_orientable_reason", optional=True),
             warnings=tuple(warnings),
             area=_real(row[16], "area"),  # type: ignore[arg-type]
             created_at=_text(row[17], "created_at"),  # type: ignore[arg-type]
             created_by=_text(row[18], "created_by"),  # type: ignore[arg-type]
+            landings=landings,
+            landings_note=note,
         )
     except _Damaged as exc:
         raise _damaged(row[0], row[1], str(exc)) from None
@@ -552,7 +722,8 @@ def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -
             if revision is not None and _part_id(conn, name) is not None:
                 raise InputError(f"part {name!r} has no revision {revision}")
             raise _unknown(conn, name)
-    return _revision_from_row(row)
+        landing_rows = conn.execute(_LANDINGS_SQL, (row[19],)).fetchall()
+    return _revision_from_row(row, landing_rows)
 
 
 def revision_history(catalog: CatalogLike, name: str) -> list[tuple[int, str, str, str]]:

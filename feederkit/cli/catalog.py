@@ -44,13 +44,36 @@ from feederkit.cli.common import (
     print_json,
     progress_bar,
 )
-from feederkit.errors import InputError
-from feederkit.importers import (
-    DEFAULT_FLATTEN_TOLERANCE,
-    DEFAULT_HULL_TOLERANCE,
-    DEFAULT_MAX_FILE_MB,
-    ImportOptions,
+from feederkit.cli.importopts import (
+    AllowLargeOpt,
+    AllPartsOpt,
+    FlattenOpt,
+    HullOpt,
+    ImportTimeOpt,
+    LayerOpt,
+    MaxCrossingsOpt,
+    MaxEntitiesOpt,
+    MaxFacesOpt,
+    MaxHullFacesOpt,
+    MaxLoopsOpt,
+    MaxVerticesOpt,
+    PoseOpt,
+    SpaceOpt,
+    UnitsOpt,
+    import_options,
 )
+from feederkit.errors import InputError
+from feederkit.importers import DEFAULT_FLATTEN_TOLERANCE
+from feederkit.importers.budget import (
+    DEFAULT_MAX_CROSSINGS,
+    DEFAULT_MAX_ENTITIES,
+    DEFAULT_MAX_FACES,
+    DEFAULT_MAX_HULL_FACES,
+    DEFAULT_MAX_LOOPS,
+    DEFAULT_MAX_VERTICES,
+    DEFAULT_TIME_LIMIT_S,
+)
+from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
 
 RICH_TABLE_ROWS = 200
 """Longer tables are printed as plain columns."""
@@ -61,44 +84,9 @@ catalog_app = typer.Typer(
     no_args_is_help=True,
 )
 
-UnitsOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--units", help="Units of the file's coordinates (mm, cm, m, in, ft): overrides the file."
-    ),
-]
-LayerOpt = Annotated[
-    list[str] | None,
-    typer.Option("--layer", help="DXF layer to read (repeat for several; default all)."),
-]
-FlattenOpt = Annotated[
-    float,
-    typer.Option("--flatten-tolerance", min=1e-6, help="Largest curve-to-chord distance (mm)."),
-]
-HullOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--hull-tolerance",
-        min=0.0,
-        help=f"Hull simplification (mm); default {DEFAULT_HULL_TOLERANCE} for CAD files, exact "
-        "for outline files.",
-    ),
-]
-AllPartsOpt = Annotated[
-    bool,
-    typer.Option(
-        "--all-parts", help="Import every separate part of a drawing, not only the largest."
-    ),
-]
-PoseOpt = Annotated[
-    int | None, typer.Option("--pose", min=0, help="Mesh resting pose K (0: the most probable).")
-]
 ComOpt = Annotated[
     tuple[float, float] | None,
     typer.Option("--com", help="Center of mass X Y (mm) in the outline's frame."),
-]
-AllowLargeOpt = Annotated[
-    bool, typer.Option("--allow-large", help=f"Read files over {DEFAULT_MAX_FILE_MB:g} MB.")
 ]
 ReviseOpt = Annotated[
     bool,
@@ -107,6 +95,14 @@ ReviseOpt = Annotated[
     ),
 ]
 
+SideOpt = Annotated[
+    float,
+    typer.Option(
+        "--side-probability",
+        metavar="P",
+        help="Probability (0 < P < 1) that a flat part lands up, as drawn; down gets 1 - P.",
+    ),
+]
 
 WaitOpt = Annotated[
     float,
@@ -133,29 +129,6 @@ def opened(option: Path | None, wait: float, *, create: bool = False) -> Iterato
         yield conn
     finally:
         conn.close()
-
-
-def import_options(
-    units: str | None,
-    layer: list[str] | None,
-    flatten_tolerance: float,
-    hull_tolerance: float | None,
-    all_parts: bool,
-    pose: int | None,
-    com: tuple[float, float] | None,
-    allow_large: bool,
-) -> ImportOptions:
-    """The importer options from the command-line options."""
-    return ImportOptions(
-        units=units,
-        layers=tuple(layer or ()),
-        flatten_tolerance=flatten_tolerance,
-        hull_tolerance=hull_tolerance,
-        all_parts=all_parts,
-        pose=pose,
-        com=None if com is None else (float(com[0]), float(com[1])),
-        allow_large=allow_large,
-    )
 
 
 def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
@@ -249,18 +222,45 @@ def cmd_add(
     pose: PoseOpt = None,
     com: ComOpt = None,
     allow_large: AllowLargeOpt = False,
+    space: SpaceOpt = "model",
+    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
+    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
+    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
+    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
+    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
+    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
+    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
+    side_probability: SideOpt = DEFAULT_SIDE_PROBABILITY,
     catalog: CatalogOpt = None,
     wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
-    """Import one file as a part; a changed file or changed options make a new revision (and
-    say what changed), an unchanged one nothing."""
+    """Import one file as a part with its landings; a changed file or changed options make a
+    new revision (and say what changed), an unchanged one nothing."""
     opts = import_options(
-        units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
+        units,
+        layer,
+        flatten_tolerance,
+        hull_tolerance,
+        all_parts,
+        pose,
+        com,
+        allow_large,
+        space=space,
+        max_entities=max_entities,
+        max_vertices=max_vertices,
+        max_loops=max_loops,
+        max_crossings=max_crossings,
+        max_faces=max_faces,
+        max_hull_faces=max_hull_faces,
+        import_time_limit=import_time_limit,
     )
+    check_side_probability(side_probability)
     _check_source_file(file)
     with opened(catalog, wait, create=True) as conn:
-        outcomes = add_file(conn, file, opts, name=name, revise=revise)
+        outcomes = add_file(
+            conn, file, opts, name=name, revise=revise, side_probability=side_probability
+        )
     _warn(outcomes)
     if json_out:
         print_json([_outcome_dict(o) for o in outcomes])
@@ -298,14 +298,44 @@ def cmd_import(
     pose: PoseOpt = None,
     com: ComOpt = None,
     allow_large: AllowLargeOpt = False,
+    space: SpaceOpt = "model",
+    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
+    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
+    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
+    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
+    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
+    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
+    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
+    side_probability: SideOpt = DEFAULT_SIDE_PROBABILITY,
+    skip_bad: Annotated[
+        bool,
+        typer.Option("--skip-bad", help="Import the good files and name each bad one."),
+    ] = False,
     catalog: CatalogOpt = None,
     wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
-    """Import every source file of a folder in one transaction: all files or none."""
+    """Import every source file of a folder, with landings, in one transaction: all files or
+    none (with --skip-bad: every good file, and each bad one named)."""
     opts = import_options(
-        units, layer, flatten_tolerance, hull_tolerance, all_parts, pose, com, allow_large
+        units,
+        layer,
+        flatten_tolerance,
+        hull_tolerance,
+        all_parts,
+        pose,
+        com,
+        allow_large,
+        space=space,
+        max_entities=max_entities,
+        max_vertices=max_vertices,
+        max_loops=max_loops,
+        max_crossings=max_crossings,
+        max_faces=max_faces,
+        max_hull_faces=max_hull_faces,
+        import_time_limit=import_time_limit,
     )
+    check_side_probability(side_probability)
     item_column = TextColumn("{task.fields[item]}")
     with progress_bar(item_column, disable=not err_console.is_terminal) as bar:
         tasks: dict[str, Any] = {}
@@ -317,11 +347,25 @@ def cmd_import(
             bar.update(tasks[phase], completed=done, item=Path(item).name if item else "")
 
         with opened(catalog, wait, create=True) as conn:
-            result = import_directory(conn, directory, opts, revise=revise, progress=progress)
+            result = import_directory(
+                conn,
+                directory,
+                opts,
+                revise=revise,
+                progress=progress,
+                skip_bad=skip_bad,
+                side_probability=side_probability,
+            )
     _warn(result.outcomes)
+    for line in result.bad:
+        err_console.print(f"[yellow]skipped:[/] {escape(line)}", highlight=False, soft_wrap=True)
     if json_out:
         print_json(
-            {"parts": [_outcome_dict(o) for o in result.outcomes], "ignored": list(result.ignored)}
+            {
+                "parts": [_outcome_dict(o) for o in result.outcomes],
+                "ignored": list(result.ignored),
+                "skipped": list(result.bad),
+            }
         )
         return
     _print_summary(result.outcomes, directory)
@@ -330,7 +374,8 @@ def cmd_import(
     }
     console.print(
         f"{counts['added']} added, {counts['revised']} revised, {counts['unchanged']} unchanged; "
-        f"{len(result.ignored)} other files ignored",
+        f"{len(result.ignored)} other files ignored"
+        + (f"; {len(result.bad)} bad files skipped" if result.bad else ""),
         highlight=False,
     )
 
@@ -422,6 +467,8 @@ def revision_dict(
         "orientable": rev.orientable,
         "not_orientable_reason": rev.not_orientable_reason,
         "warnings": list(rev.warnings),
+        "landings": [landing_dict(x) for x in rev.landings],
+        "landings_note": rev.landings_note,
         "created_at": rev.created_at,
         "created_by": rev.created_by,
         "revisions": [
@@ -430,6 +477,28 @@ def revision_dict(
         ],
         "changeovers": changeovers,
     }
+
+
+def landing_dict(x: Landing) -> dict[str, Any]:
+    """One landing of ``catalog show --json``: name, probability, outline, hull, COM."""
+    from feederkit.outline import outline_to_dict
+
+    return {
+        "landing": x.name,
+        "probability": x.probability,
+        "merged": list(x.merged),
+        "outline": outline_to_dict(x.part.outline),
+        "com": list(x.part.com),
+        "hull": [list(p) for p in x.part.hull],
+    }
+
+
+def _landing_line(x: Landing) -> str:
+    same = f", same shape as {', '.join(x.merged)}" if x.merged else ""
+    return (
+        f"{x.name}: probability {x.probability:.3f}, {len(x.part.hull)} hull vertices, "
+        f"com ({x.part.com[0]:.4f}, {x.part.com[1]:.4f}) mm{same}"
+    )
 
 
 def _tol(value: float | None) -> str:
@@ -444,7 +513,8 @@ def cmd_show(
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
-    """Show a part: source, units, outline, hull, COM, mesh pose, orientability, revisions."""
+    """Show a part: source, units, outline, hull, COM, mesh pose, landings, orientability,
+    revisions."""
     part, at = split_revision(name)
     if at is not None and revision is not None and at != revision:
         raise InputError(f"{name}: the revision is given twice ({at} and --revision {revision})")
@@ -476,6 +546,8 @@ def cmd_show(
             if pose is None
             else f"{pose['index']} of {pose['count']} (probability {pose['probability']:.3f})",
         ),
+        *[("landing", _landing_line(x)) for x in rev.landings],
+        *([("landings", rev.landings_note)] if rev.landings_note else []),
         ("orientable", "yes" if rev.orientable else f"no: {rev.not_orientable_reason}"),
         ("created", f"{rev.created_at} by {rev.created_by}"),
         ("revisions", ", ".join(f"{r} ({at})" for r, at, _, _ in history)),

@@ -1,0 +1,66 @@
+"""Landings of a mesh: its resting poses with their probabilities, congruent ones merged.
+
+The poses, their probabilities (trimesh's stable poses: the share of random drops that end
+on each face) and each pose's outline seen from above come from
+:mod:`feederkit.importers.mesh` unchanged; ``pose-K`` is its K-th pose (0 the most probable).
+Poses whose outlines are congruent (:func:`feederkit.landing.model.congruent`: the same
+outline and COM up to a rotation, such as opposite faces of a box) are one landing whose
+probability is their sum, named after its most probable pose.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from feederkit.errors import InputError
+from feederkit.importers.budget import Budget
+from feederkit.importers.mesh import load_mesh, pose_outline, resting_poses, solid
+from feederkit.importers.model import ImportOptions
+from feederkit.landing.model import Landing, merge_congruent, renamed
+from feederkit.outline import make_outline
+from feederkit.part import Part, make_part
+
+
+def pose_name(k: int) -> str:
+    """The landing name of mesh pose ``k``."""
+    return f"pose-{k}"
+
+
+def landings_of_mesh(
+    path: str | Path,
+    options: ImportOptions = ImportOptions(),
+    name: str | None = None,
+    hull_tolerance: float | None = None,
+) -> tuple[Landing, ...]:
+    """Every resting pose of the mesh file as a landing, congruent poses merged.
+
+    ``hull_tolerance`` simplifies each pose's hull as the import does (default: exact). With
+    ``options.com`` (a COM given for one pose) the other poses' COMs are unknown: the only
+    landing is then the imported pose (``options.pose``, default 0).
+    """
+    p = Path(path)
+    label = name or p.stem
+    mesh, _units, _notes = load_mesh(p, options.units, Budget(options.limits, str(p)))
+    s = solid(mesh, options.com is not None, str(p))
+    try:
+        poses = resting_poses(s)
+    except InputError as exc:
+        raise InputError(f"{p}: {exc}") from None
+    if not poses:
+        raise InputError(f"{p}: no resting pose found for the mesh")
+    if options.com is not None:
+        k = options.pose or 0
+        if not 0 <= k < len(poses):
+            raise InputError(f"{p}: no pose {k}: the mesh has {len(poses)} resting poses")
+        part = _pose_part(s, poses[k], options.com, label, hull_tolerance)
+        return (Landing(label, pose_name(k), 1.0, renamed(part, f"{label}/{pose_name(k)}")),)
+    candidates = [
+        (pose_name(k), pose.probability, _pose_part(s, pose, None, label, hull_tolerance))
+        for k, pose in enumerate(poses)
+    ]
+    return merge_congruent(label, candidates)
+
+
+def _pose_part(s, pose, com2d, label: str, hull_tolerance: float | None) -> Part:
+    ring, com, _transform = pose_outline(s, pose, com2d)
+    return make_part(make_outline(label, ring, (), com, "mm"), hull_tolerance=hull_tolerance)
