@@ -118,9 +118,9 @@ class FenceCell:
 class UncertainMechanics:
     """The mechanics of one part under one declared uncertainty (what a machine is built from).
 
-    ``state_of[i]`` is the physical state holding ideal stable state ``i``, None for a
-    transient state (one the part surely leaves for a neighbour: its barrier is below the
-    vibration for every shape); ``destinations[i]`` are the physical states a part coming to
+    ``state_of[i]`` is the physical state holding ideal stable state ``i`` (the type admits
+    None, but every state is kept: see :func:`uncertain_mechanics`); ``destinations[i]`` are
+    the physical states a part coming to
     rest in ideal state ``i`` may end in (its own, and those vibration may carry it to over a
     barrier below ``merge_threshold_mm``, vibration plus ``2 (t + c)``).
     ``cells`` tile the circle of fence orientations, starting at the first band.
@@ -466,9 +466,10 @@ def uncertain_mechanics(
     when a rest candidate of ``i``'s basin lies less than ``vibration + 2 (t + c)`` below the
     hilltop (F1: a barrier that high survives every shape and still holds against the
     vibration). The physical states are the strong components of that crossing graph (states
-    the part may wander between), except single states it surely leaves (transient: their
-    barrier plus ``2 (t + c)`` is below the vibration); a push that ends in a component may
-    also end in any component it can reach. ``vibration_mm`` defaults to the fragile
+    the part may wander between); a push that ends in a component may also end in any
+    component it can reach. A state the part *should* leave (its barrier below the vibration)
+    is kept as one it may stay in: the feeder's vibration is not known, and the physics check
+    shows parts resting on such edges. ``vibration_mm`` defaults to the fragile
     threshold (1e-3 of the part's size, a breath of vibration) unless the uncertainty is ideal,
     where it is 0 and every physical state is one ideal state. Raises InputError for a shape
     tolerance of half the smallest hull edge or more.
@@ -501,36 +502,29 @@ def uncertain_mechanics(
     # Crossing graph: ideal state i -> its neighbour across a hill when some rest candidate in
     # i's basin may lie less than the vibration below that hilltop for some shape (F1: its
     # resting height is within r(normal) +- rho_max * half-width, r's slope bound, +- eps).
-    # i must leave when every candidate surely lies that close below one of its hilltops.
     edges: list[set[int]] = [set() for _ in range(pf.n)]
-    must_leave = [threshold > 0.0] * pf.n
     if threshold > 0.0 and cands:
         arr = _candidate_arrays(cands)
         slack = rho_max * np.radians(arr.half)
         height = np.asarray([x.height_mm for x in cands])
-        top, bottom = height + 2.0 * t + slack, height - slack
+        top = height + 2.0 * t + slack
         range_of = np.empty(pf.n, dtype=int)
         range_of[np.asarray(rs)] = np.arange(m)
         k = range_of[arr.basin]
-        leaves = np.zeros(len(cands), dtype=bool)
         for hill, beyond in ((k, left[k]), ((k + 1) % m, right[(k + 1) % m])):
             other = beyond != arr.basin
             cross = other & (peaks[hill] - top < threshold)
             for i, j in set(zip(arr.basin[cross].tolist(), beyond[cross].tolist(), strict=True)):
                 edges[i].add(j)
-            leaves |= other & (peaks[hill] - bottom + 2.0 * eps < vibration_mm)
-        stays = np.unique(arr.basin[~leaves]).tolist()
-        for i in stays:
-            must_leave[i] = False
     comp = _strong_components(edges)
-    size: dict[int, int] = {}
-    for cc in comp:
-        size[cc] = size.get(cc, 0) + 1
-    transient = [size[comp[i]] == 1 and must_leave[i] and bool(edges[i]) for i in range(pf.n)]
     first_member: dict[int, int] = {}
     for i in range(pf.n):
         first_member.setdefault(comp[i], i)
-    kept = sorted({comp[i] for i in range(pf.n) if not transient[i]}, key=first_member.__getitem__)
+    # No state is transient: one the part *should* leave (its barrier below the vibration) is
+    # kept as a state it may stay in, since how hard a feeder vibrates is not known and the
+    # physics check shows parts resting on such edges; a push ending there may end in it or in
+    # any state it can cross to (``destinations``).
+    kept = sorted(set(comp), key=first_member.__getitem__)
     pid_of = {cc: p for p, cc in enumerate(kept)}
     state_of = [pid_of.get(comp[i]) for i in range(pf.n)]
     destinations = _destinations(edges, comp, pid_of)
