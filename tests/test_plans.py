@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from feederkit.errors import CheckFailed, InputError
+from feederkit.errors import CheckFailed, InputError, PlanningError
 from feederkit.machine import branches, build_machine, inseparable, is_goal, overlap_ranges
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
@@ -22,6 +22,7 @@ from feederkit.plans import (
     CONVENTIONS,
     check_plan,
     execute,
+    plan_from_dict,
     plan_json,
     plan_to_dict,
     read_plan,
@@ -31,7 +32,9 @@ from feederkit.plans import (
 )
 from feederkit.plans.make import make_plan
 from feederkit.plans.match import leaf_part_pairs
+from feederkit.plans.verify import verify_declared
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 RECT = [(0, 0), (2, 0), (2, 1), (0, 1)]
 TRI = [(0, 0), (1, 0), (0, 1)]
@@ -95,7 +98,8 @@ def rect_plan():
 
 def test_plan_dict_has_design_md_fields(tri_plan):
     d = tri_plan
-    assert d["format"] == "feederkit-plan" and d["version"] == 1
+    assert d["format"] == "feederkit-plan" and d["version"] == 2
+    assert list(d)[list(d).index("sensor") + 1] == "uncertainty"
     assert d["conventions"] == CONVENTIONS
     assert d["sensor"] == {"model": "tolerance", "tolerance_mm": 0.01}
     (part,) = d["parts"]
@@ -129,9 +133,10 @@ def test_actions_in_range_and_sensorless_readings_null(rect_plan):
 
 def test_json_round_trip(tmp_path, tri_plan):
     path = tmp_path / "p.json"
-    write_plan(path, tri_plan)
-    assert read_plan(path) == tri_plan
+    write_plan(plan_from_dict(tri_plan), path)
+    assert plan_to_dict(read_plan(path)) == tri_plan
     assert json.loads(plan_json(tri_plan)) == tri_plan
+    assert plan_json(read_plan(path)) == path.read_text()
 
 
 def test_mix_has_no_class_and_lists_parts():
@@ -165,7 +170,7 @@ def _broken(plan, edit):
 
 BROKEN = {
     "not a plan": lambda d: d.update(format="other"),
-    "version": lambda d: d.update(version=2),
+    "version": lambda d: d.update(version=3),
     "conventions": lambda d: d.pop("conventions"),
     "sensor": lambda d: d.update(sensor={"model": "sonar"}),
     "no parts": lambda d: d.update(parts=[]),
@@ -183,6 +188,15 @@ BROKEN = {
     "empty result": lambda d: d["root"]["branches"][0]["next"].update(result=[]),
     "stats": lambda d: d.pop("stats"),
     "length": lambda d: d["stats"].update(length=0),
+    "length inflated": lambda d: d["stats"].update(length=3),
+    "length deflated": lambda d: d["stats"].update(length=1),
+    "version float": lambda d: d.update(version=1.0),
+    "version true": lambda d: d.update(version=True),
+    "part a list": lambda d: d["root"]["branches"][0]["next"]["result"][0].update(part=["tri"]),
+    "margin 180": lambda d: d["root"]["branches"][1]["next"].update(margin_deg=180.0),
+    "margin stats": lambda d: d["stats"].update(min_margin_deg=1.0),
+    "margin removed": lambda d: d["root"]["branches"][1]["next"].pop("margin_deg"),
+    "tolerance a string": lambda d: d["sensor"].update(tolerance_mm="0.01"),
 }
 
 
@@ -264,7 +278,7 @@ def test_hand_plans_pass(tri_plan, rect_plan):
         report = check_plan(plan)
         assert report.ok and report.first_problem() is None
         (part,) = report.parts
-        assert part.starts == 3 * len(plan["parts"][0]["stable_states"])
+        assert part.starts == len(plan["parts"][0]["stable_states"])  # every stable start
         assert part.worst_operations == plan["stats"]["length"]
 
 
@@ -272,15 +286,24 @@ def _op2(d):
     return d["root"]["branches"][1]["next"]
 
 
+def _inflate_margin(d, margin):
+    """Widen the second operation's margin, keeping ``stats`` consistent with the tree."""
+    _op2(d).update(margin_deg=margin)
+    d["stats"]["min_margin_deg"] = min(
+        b["next"]["margin_deg"] for b in d["root"]["branches"] if "margin_deg" in b["next"]
+    )
+
+
 CORRUPT = {
     "action": lambda d: _op2(d).update(action_deg=0.0),
-    "margin": lambda d: _op2(d).update(margin_deg=170.0),
+    "margin": lambda d: _inflate_margin(d, 170.0),
     "interval shifted": lambda d: d["root"]["branches"][0].update(reading=[0.71, 0.8]),
     "interval narrowed": lambda d: _op2(d)["branches"][-1].update(reading=[1.0, 1.01]),
     "result": lambda d: d["root"]["branches"][0]["next"]["result"][0].update(state=0, pose_deg=0.0),
     "pose": lambda d: d["root"]["branches"][0]["next"]["result"][0].update(pose_deg=1.0),
-    "length": lambda d: d["stats"].update(length=1),
-    "length too long": lambda d: d["stats"].update(length=3),
+    "diameter": lambda d: d["parts"][0]["stable_states"][0].update(
+        diameter=d["parts"][0]["stable_states"][0]["diameter"] * 1.01
+    ),
     "state normal": lambda d: d["parts"][0]["stable_states"][0].update(normal_deg=271.0),
     "com": lambda d: d["parts"][0].update(com=[0.2, 0.2]),
 }
@@ -371,16 +394,22 @@ def test_emitted_plans_of_random_parts_verify(pts, kind):
         "tol": ToleranceSensor(0.03 * size),
         "led": LedSensor(0.05 * size, 0.01 * size),
     }[kind]
-    made = make_plan([pf], sensor, time_limit=5.0)
+    made = make_plan([pf], sensor, time_limit=5.0, uncertainty=IDEAL)
     assert made.report.ok
     if made.plan["stats"]["meets_bound"] is not None and made.plan["stats"]["optimal"]:
         assert made.plan["stats"]["meets_bound"]
+    try:  # at design.md's default rotation error: a strong plan that verifies, or none at all
+        strong = make_plan([pf], sensor, time_limit=5.0, uncertainty=Uncertainty(1.0))
+    except PlanningError as exc:
+        assert "no strong plan" in str(exc)
+    else:
+        assert verify_declared(strong.plan).ok
 
 
 def test_plan_files_from_disk_match_memory(tmp_path):
     pf = pf_of("rect", RECT, com=(1.2, 0.45))
     made = make_plan([pf], ToleranceSensor(0.05))
     path = Path(tmp_path / "r.json")
-    write_plan(path, made.plan)
+    write_plan(plan_from_dict(made.plan), path)
     report = verify_plan(read_plan(path))
     assert report.ok and report.paths == made.report.paths

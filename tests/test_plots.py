@@ -193,3 +193,22 @@ def test_random_parts_have_one_marker_per_stable_orientation(polar):
     pf = push_function(part)
     ids = svg_ids(part_plot_bytes(pf, "svg"))
     assert len([i for i in ids if i.startswith("stable-orientation-")]) == pf.n
+
+
+def test_a_part_with_arcs_labels_only_its_stable_edges_and_marks_fragile_ones():
+    """The d-washer's flattened arc has many short edges: only stable ones get a label."""
+    from pathlib import Path
+
+    from feederkit.mechanics.analysis import fragile_states
+    from feederkit.sources import load_part
+
+    washer = Path(__file__).resolve().parents[1] / "catalog" / "d-washer.json"
+    pf = push_function(load_part(str(washer)))
+    assert len(pf.edge_kinds) > pf.n  # edges that are no stable state
+    svg = part_plot_bytes(pf, "svg").decode()
+    assert "unstable" not in svg and "metastable" not in svg
+    fragile = fragile_states(pf)
+    assert fragile  # the arc's states have barriers below 10 micrometres
+    for s in pf.states:
+        label = f"s{s.id} e{s.edge}" + (" fragile" if s.id in fragile else "")
+        assert f"<!-- {label} -->" in svg

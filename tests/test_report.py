@@ -17,7 +17,8 @@ from feederkit.cli.report import register
 from feederkit.errors import InputError
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.reports import read_plan_file, render_report
+from feederkit.plans import plan_json, read_plan
+from feederkit.reports import render_report
 
 NASTY = '<b>&"x'
 
@@ -290,7 +291,8 @@ def test_symmetric_leaves_and_twins_are_reported():
     assert len(pairs) == 1 and pairs[0]["data-source"] == "plan"  # one row, three witnesses
     assert len(doc.with_class("confused")) == 3
     text = "".join(doc.text)
-    assert "tri-a s1 ~ tri-b s1; tri-a s2 ~ tri-b s2; tri-a s1 ~ tri-b s1" in text
+    assert "tri-a s1 ~ tri-b s1; tri-a s2 ~ tri-b s2" in text  # each pairing once
+    assert "tri-b s2; tri-a s1" not in text
     assert "leaf 3: first alignment, reads 0.99\u20131.01 mm \u2192 rotate 90\u00b0 ccw" in text
 
 
@@ -331,7 +333,7 @@ def test_outlines_draw_holes():
     "mutate, message",
     [
         (lambda p: p.update(format="other"), "not a feederkit plan"),
-        (lambda p: p.update(version=2), "unsupported plan version"),
+        (lambda p: p.update(version=3), "unsupported plan version"),
         (lambda p: p.pop("root"), "no 'root'"),
         (lambda p: p["root"]["branches"][0]["next"]["result"][0].update(part="ghost"), "ghost"),
         (lambda p: p["root"]["branches"][0]["next"]["result"][0].update(state=9), "state 9"),
@@ -353,17 +355,108 @@ def test_seconds_per_op_must_be_positive(bad):
         render_report(triangle_plan(), seconds_per_op=bad)
 
 
-def test_read_plan_file_errors(tmp_path):
-    with pytest.raises(InputError, match="no such file"):
-        read_plan_file(tmp_path / "none.json")
+def test_read_plan_errors(tmp_path):
+    with pytest.raises(InputError, match="no such plan file"):
+        read_plan(tmp_path / "none.json")
     broken = tmp_path / "broken.json"
     broken.write_text("{not json")
     with pytest.raises(InputError, match="not valid JSON"):
-        read_plan_file(broken)
+        read_plan(broken)
     other = tmp_path / "outline.json"
     other.write_text(json.dumps({"name": "x", "vertices": [[0, 0], [1, 0], [0, 1]]}))
     with pytest.raises(InputError, match="not a feederkit plan"):
-        read_plan_file(other)
+        read_plan(other)
+
+
+def test_a_plan_that_fails_verification_gets_a_red_banner():
+    good = parse(render_report(triangle_plan()))
+    assert not good.with_class("banner")
+    plan = triangle_plan()
+    plan["root"]["branches"][1]["next"]["action_deg"] = 0.0  # now the rotation does nothing
+    doc = parse(render_report(plan))
+    (banner,) = [a for a in doc.with_class("banner") if a.get("id") == "verification"]
+    assert banner["data-ok"] == "false"
+    assert "FAILED verification" in "".join(doc.text)
+
+
+def test_a_small_margin_is_warned_about():
+    plan = triangle_plan()
+    plan["root"]["branches"][1]["next"]["margin_deg"] = 0.04
+    plan["stats"]["min_margin_deg"] = 0.04
+    doc = parse(render_report(plan))
+    assert [a["id"] for a in doc.with_class("caution")] == ["low-margin"]
+    text = "".join(doc.text)
+    assert "below \u00b11\u00b0" in text and "\u00b10.04\u00b0" in text  # never "0.0"
+    assert not parse(render_report(triangle_plan())).with_class("caution")
+
+
+def test_the_simulation_row_is_in_words():
+    sim = {
+        "trials": 10,
+        "successes": 8,
+        "failures": [{}, {}],
+        "unsettled": [],
+        "settled_pushes": 19,
+        "push_agreements": 18,
+        "success_rate": 0.8,
+        "min_margin_deg": 18.43,
+    }
+    text = "".join(parse(render_report(triangle_plan(), simulation=sim)).text)
+    assert "8 of 10 trials oriented correctly (80%)" in text
+    assert "2 ended in a wrong pose, 0 never settled" in text
+    assert "18 of 19 settled pushes ended where the push function says" in text
+    assert "success_rate" not in text and "min_margin_deg" not in text
+
+
+def test_a_pair_named_by_the_plan_and_the_mix_is_one_row():
+    given = [
+        {"part_a": "tri-b", "part_b": "tri-a", "states_a": [1], "states_b": [1], "reason": "twins"}
+    ]
+    doc = parse(render_report(twin_plan(), unrecognizable=given))
+    assert len(doc.with_class("pair")) == 1
+    text = "".join(doc.text)
+    assert "twins" in text and text.count("tri-a s1 ~ tri-b s1") == 1
+
+
+def test_a_plan_325_operations_deep_is_reported():
+    from test_plan_model import deep_plan
+
+    doc = parse(render_report(deep_plan(325)))
+    assert len(doc.with_class("tree-node")) == 326
+
+
+def test_the_part_plot_is_the_plans_part():
+    """The plot is drawn from the plan's hull and COM: its stable edges are the table's."""
+    import base64
+
+    from test_plan_model import golden
+
+    doc = parse(render_report(golden("d-washer.tolerance.json")))
+    (img,) = [a for t, a in doc.tags if t == "img"]
+    svg = base64.b64decode(img["src"].split(",", 1)[1]).decode()
+    edges = sorted(re.findall(r'id="stable-edge-(\d+)"', svg), key=int)
+    table = [a["data-state"] for a in doc.with_class("stable-state")]
+    assert edges == table
+    assert "unstable" not in svg
+
+
+def test_report_command_refuses_a_pdf(tmp_path):
+    plan = tmp_path / "plan.json"
+    plan.write_text(json.dumps(triangle_plan()))
+    res = CliRunner().invoke(cli_app(), ["report", str(plan), "-o", str(tmp_path / "r.pdf")])
+    assert isinstance(res.exception, InputError) and "HTML" in str(res.exception)
+    assert not (tmp_path / "r.pdf").exists()
+
+
+def test_report_command_refuses_a_file_over_the_size_limit(tmp_path):
+    plan = tmp_path / "plan.json"
+    plan.write_text(plan_json(triangle_plan()))
+    out = tmp_path / "r.html"
+    res = CliRunner().invoke(
+        cli_app(), ["report", str(plan), "-o", str(out), "--max-plan-mb", "0.001"]
+    )
+    assert isinstance(res.exception, InputError) and "--max-plan-mb" in str(res.exception)
+    assert not out.exists()
 
 
 def cli_app():

@@ -41,7 +41,8 @@ def test_all_json(tri, capsys):
     src, plan = tri
     assert main(["run", str(plan), src, "--all", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
-    assert report["ok"] and report["parts"][0]["starts"] == 9
+    assert report["ok"] and report["parts"][0]["starts"] == 3  # one per stable state
+    assert report["warnings"] == []
 
 
 def _corrupt(plan_path, edit):
@@ -100,3 +101,54 @@ def test_start_and_all_exclusive(tri, capsys):
     src, plan = tri
     one_line_error(capsys, ["run", str(plan), src, "--all", "--start-deg", "3"])
     one_line_error(capsys, ["run", str(plan), src, "--start-deg", "nan"])
+
+
+def test_run_without_source_runs_every_part_of_the_plan(tri, capsys):
+    _, plan = tri
+    assert main(["run", str(plan), "--start-deg", "200", "--json"]) == 0
+    (trace,) = json.loads(capsys.readouterr().out)["runs"]
+    assert trace["part"] == "tri" and trace["success"]
+    assert main(["run", str(plan), "--all"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: d.update(version=1.0), "version"),
+        (lambda d: d.update(version=True), "version"),
+        (lambda d: d["stats"].update(length=d["stats"]["length"] + 1), "stats length"),
+        (lambda d: d["root"]["branches"][1]["next"].pop("margin_deg"), "margin_deg"),
+    ],
+)
+def test_structurally_wrong_plans_exit_2_even_for_one_part(tri, capsys, edit, words):
+    src, plan = tri
+    _corrupt(plan, edit)
+    assert words in one_line_error(capsys, ["run", str(plan), src, "--all"])
+
+
+def test_a_wrong_plan_fails_a_single_run_too(tri, capsys):
+    src, plan = tri
+    state = lambda d: d["parts"][0]["stable_states"][0]  # noqa: E731
+    _corrupt(plan, lambda d: state(d).update(diameter=state(d)["diameter"] + 0.05))
+    err = one_line_error(capsys, ["run", str(plan), "--start-deg", "200"], code=1)
+    assert "failed verification" in err and "diameter" in err
+
+
+def test_a_small_margin_is_warned_about(tri, capsys):
+    src, plan = tri
+
+    def shrink(d):
+        d["root"]["branches"][1]["next"]["margin_deg"] = 0.5
+        d["stats"]["min_margin_deg"] = 0.5
+
+    _corrupt(plan, shrink)
+    assert main(["run", str(plan), "--start-deg", "200"]) == 0
+    assert "below" in capsys.readouterr().out
+    assert main(["run", str(plan), "--start-deg", "200", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["warnings"]
+
+
+def test_a_plan_file_over_the_size_limit_is_refused(tri, capsys):
+    _, plan = tri
+    err = one_line_error(capsys, ["run", str(plan), "--max-plan-mb", "0.0001"])
+    assert "more than the limit" in err and "--max-plan-mb" in err

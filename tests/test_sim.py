@@ -26,6 +26,7 @@ from test_sim_plans import (  # noqa: E402
     right_triangle,
 )
 
+from feederkit.errors import CheckFailed  # noqa: E402
 from feederkit.mechanics.push import push_function  # noqa: E402
 from feederkit.outline import make_outline  # noqa: E402
 from feederkit.part import make_part  # noqa: E402
@@ -84,7 +85,9 @@ def test_rotation_noise_beyond_the_smallest_margin_makes_failures_appear() -> No
     assert rough.failures
     for f in rough.failures:
         assert f.step == 2  # the first alignment cannot go wrong; the rotation can
-        assert "rotation error" in f.reason
+        # the plan declares the ideal model: errors beyond it are outcomes it did not predict
+        assert f.predicted is False and f.cause == "wrong result"
+        assert "a model error" in f.reason and ("error +" in f.reason or "error -" in f.reason)
         bad = f.pushes[1]
         assert abs(bad.rotation_error_deg) > margin
         assert bad.simulated_state != bad.expected_state
@@ -103,7 +106,9 @@ def test_a_reading_in_no_branch_stops_the_trial_and_says_so() -> None:
     plan = build_plan(pentagon(), 0.5)
     for b in plan["root"]["branches"]:
         b["reading"] = [b["reading"][0] + 3.0, b["reading"][1] + 3.0]
-    s = simulate_plan(plan, 3, seed=0)
+    with pytest.raises(CheckFailed):
+        simulate_plan(plan, 3, seed=0)  # the kinematic model already says it is wrong
+    s = simulate_plan(plan, 3, seed=0, check=False)
     assert s.successes == 0 and len(s.failures) == 3
     assert all(f.step == 1 and "no branch" in f.reason for f in s.failures)
 
@@ -115,7 +120,7 @@ def test_a_plan_claiming_the_wrong_result_fails_at_its_last_step() -> None:
     results = [b["next"]["result"] for b in branches]
     for b, r in zip(branches, results[1:] + results[:1], strict=True):
         b["next"]["result"] = r
-    s = simulate_plan(wrong, 3, seed=0)
+    s = simulate_plan(wrong, 3, seed=0, check=False)
     assert s.successes == 0
     assert all(f.step == 1 and "result" in f.reason for f in s.failures)
 

@@ -96,7 +96,7 @@ def _node(pf: PushFunction, name: str, states: list[int], tolerance, depth: int)
     _, a, margin, outs = best
     return {
         "action_deg": round(a, 4),
-        "margin_deg": round(margin, 4),
+        "margin_deg": math.floor(margin * 1e4) / 1e4,  # rounded down: never claim more
         "branches": _branches(pf, name, sorted(set(outs)), tolerance, depth),
     }
 
@@ -136,7 +136,7 @@ def build_plan(part: Part, tolerance: float | None) -> dict:
         "root": root,
         "stats": {
             "length": _depth(root),
-            "expected_length": None,
+            "expected_length": float(_depth(root)),  # an upper bound: not computed here
             "min_margin_deg": min(margins) if margins else None,
             "optimal": False,
             "lower_bound": 1,

@@ -10,11 +10,11 @@ from pathlib import Path
 import pytest
 from test_sim_plans import build_plan, pentagon, rectangle
 
-from feederkit.errors import InputError
+from feederkit.errors import CheckFailed, InputError
+from feederkit.plans.fileformat import plan_from_dict
+from feederkit.plans.model import Leaf, Step, push_function_of
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 from feederkit.sim.massprops import plate_inertia, region_moments
-from feederkit.sim.planfile import Leaf, Step, read_plan
-from feederkit.sim.readings import reading_of
 from feederkit.sim.scene import SceneConfig, scene_xml
 
 RUN = "from feederkit.cli.app import run; run()"
@@ -41,10 +41,10 @@ def test_plate_inertia_moves_to_the_users_com() -> None:
 
 
 def test_readings_follow_the_plans_sensor_model() -> None:
-    assert reading_of(NoSensor(), 20.3) is None
-    assert reading_of(ToleranceSensor(0.5), 20.3) == 20.3
-    assert reading_of(LedSensor(2.0), 20.3) == pytest.approx(20.0)  # beams at 2, 4, ..., 20
-    assert reading_of(LedSensor(2.0), 19.9) == pytest.approx(18.0)
+    assert NoSensor().read(20.3) is None
+    assert ToleranceSensor(0.5).read(20.3) == 20.3
+    assert LedSensor(2.0).read(20.3) == pytest.approx(20.0)  # beams at 2, 4, ..., 20
+    assert LedSensor(2.0).read(19.9) == pytest.approx(18.0)
 
 
 def test_scene_has_priority_belt_and_fence_a_free_part_and_a_2ms_step() -> None:
@@ -57,19 +57,19 @@ def test_scene_has_priority_belt_and_fence_a_free_part_and_a_2ms_step() -> None:
     assert len(mesh) == 3 * 2 * len(part.hull)
 
 
-def test_read_plan_rebuilds_parts_and_the_tree() -> None:
-    plan = read_plan(build_plan(rectangle(), 1.0))
+def test_the_plan_model_rebuilds_parts_and_the_tree() -> None:
+    plan = plan_from_dict(build_plan(rectangle(), 1.0))
     assert [p.name for p in plan.parts] == ["rect-2x1"]
     assert isinstance(plan.root, Step) and plan.root.action_deg is None
-    assert plan.min_margin_deg == pytest.approx(4.68, abs=0.01)
+    assert plan.stats.min_margin_deg == pytest.approx(4.68, abs=0.01)
     first = plan.root.branches[0].next
     assert isinstance(first, Step) and first.action_deg is not None
     assert all(isinstance(b.next, Leaf) for b in first.branches)
-    assert set(plan.parts[0].state_of_edge.values()) == {0, 1, 2, 3}
+    assert {s.id for s in push_function_of(plan.parts[0]).states} == {0, 1, 2, 3}
 
 
 def test_branches_hold_closed_intervals_and_shared_endpoints() -> None:
-    root = read_plan(build_plan(rectangle(), 1.0)).root
+    root = plan_from_dict(build_plan(rectangle(), 1.0)).root
     assert root.follow(19.0) == 0 and root.follow(21.0) == 0
     assert root.follow(39.0) == 1
     assert root.follow(30.0) is None
@@ -86,16 +86,19 @@ def _broken(mutate) -> dict:
     ("mutate", "words"),
     [
         (lambda p: p.update(format="other"), "not a feederkit plan"),
-        (lambda p: p.update(version=2), "version"),
+        (lambda p: p.update(version=3), "version"),
+        (lambda p: p.update(version=1.0), "version"),
+        (lambda p: p.update(version=True), "version"),
         (lambda p: p.update(parts=[]), "parts"),
-        (lambda p: p["parts"][0]["stable_states"][0].update(normal_deg=13.0), "not a stable edge"),
-        (lambda p: p["parts"][0]["stable_states"].pop(), "lists 3 stable states"),
         (lambda p: p["parts"][0].update(com=[99, 99]), "outside the contact hull"),
-        (lambda p: p["root"]["branches"][0]["next"].update(action_deg=None), "no action_deg"),
-        (lambda p: p["root"].update(branches=[]), "non-empty list of branches"),
+        (lambda p: p["root"]["branches"][0]["next"].update(action_deg=None), "action_deg"),
+        (lambda p: p["root"].update(branches=[]), "no branches"),
         (lambda p: p["root"]["branches"][0].update(reading=[5, 1]), "lo > hi"),
-        (lambda p: p["root"]["branches"][0].update(reading="x"), "a pair lo, hi or null"),
+        (lambda p: p["root"]["branches"][0].update(reading="x"), "a pair"),
         (lambda p: p.update(sensor={"model": "laser"}), "unknown sensor model"),
+        (lambda p: p["stats"].update(length=7), "stats length"),
+        (lambda p: p["stats"].pop("min_margin_deg"), "min_margin_deg"),
+        (lambda p: p.pop("stats"), "stats"),
         (
             lambda p: p["root"]["branches"][0]["next"]["branches"][0]["next"].update(
                 result=[{"part": "rect-2x1", "state": 9}]
@@ -105,10 +108,40 @@ def _broken(mutate) -> dict:
     ],
 )
 def test_bad_plans_are_one_line_input_errors(mutate, words: str) -> None:
+    from feederkit.sim import simulate_plan
+
     with pytest.raises(InputError) as exc:
-        read_plan(_broken(mutate))
+        simulate_plan(_broken(mutate), trials=1, seed=0)
     assert words in str(exc.value)
     assert "\n" not in str(exc.value)
+
+
+def _inflate_first_margin(plan: dict) -> None:
+    """Widen the first rotation's margin to ±170 degrees, the stats kept consistent."""
+    step = plan["root"]["branches"][0]["next"]
+    step["margin_deg"] = 170.0
+    plan["stats"]["min_margin_deg"] = min(
+        b["next"]["margin_deg"] for b in plan["root"]["branches"] if "margin_deg" in b["next"]
+    )
+
+
+@pytest.mark.parametrize(
+    "mutate",
+    [
+        lambda p: p["parts"][0]["stable_states"][0].update(
+            normal_deg=p["parts"][0]["stable_states"][0]["normal_deg"] + 0.01
+        ),
+        lambda p: p["parts"][0]["stable_states"][0].update(diameter=20.5),
+        lambda p: p["parts"][0]["stable_states"].pop(),
+        _inflate_first_margin,
+    ],
+)
+def test_plans_wrong_for_their_geometry_fail_before_any_trial(mutate) -> None:
+    from feederkit.sim import simulate_plan
+
+    with pytest.raises(CheckFailed) as exc:
+        simulate_plan(_broken(mutate), trials=1, seed=0)
+    assert "failed verification" in str(exc.value) and "\n" not in str(exc.value)
 
 
 def test_simulate_plan_refuses_impossible_settings() -> None:
@@ -153,3 +186,21 @@ def test_bad_plan_files_exit_2_with_one_line(tmp_path: Path) -> None:
         assert out.returncode == 2
         lines = [line for line in out.stderr.splitlines() if line.strip()]
         assert len(lines) == 1 and str(path.name) in lines[0]
+
+
+@pytest.mark.parametrize(
+    ("mutate", "code", "words"),
+    [
+        (lambda p: p.pop("stats"), 2, "stats"),
+        (lambda p: p["root"]["branches"][0]["next"].pop("margin_deg"), 2, "margin_deg"),
+        (lambda p: p["parts"][0]["stable_states"][0].update(diameter=20.5), 1, "diameter"),
+    ],
+)
+def test_simulate_checks_plan_files_as_run_and_report_do(tmp_path: Path, mutate, code, words):
+    pytest.importorskip("mujoco", reason="MuJoCo is not installed: the command stops before")
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(_broken(mutate)), encoding="utf-8")
+    out = _cli(["simulate", str(path), "--trials", "1"])
+    lines = [line for line in out.stderr.splitlines() if line.strip()]
+    assert out.returncode == code, out.stderr
+    assert len(lines) == 1 and words in lines[0] and "Traceback" not in out.stderr

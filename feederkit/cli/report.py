@@ -1,4 +1,9 @@
-"""``feederkit report PLAN -o REPORT.html``: the self-contained HTML changeover report."""
+"""``feederkit report PLAN -o REPORT.html``: the self-contained HTML changeover report.
+
+The plan is loaded and checked as ``run`` and ``simulate`` load it; a plan that fails
+verification is still drawn, under a red banner that says so (docs/reports.md). The report
+is HTML only: ``-o`` must end in .html (print it to PDF from a browser).
+"""
 
 from __future__ import annotations
 
@@ -8,12 +13,14 @@ from typing import Annotated, Any
 import typer
 
 from feederkit.cli.common import console, progress_bar
+from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import InputError
-from feederkit.reports import read_plan_file, render_report, write_report
+from feederkit.plans.model import Plan
+from feederkit.reports import check_report_path, render_report, write_report
 
 
-def _simulate(plan: dict[str, Any], trials: int, seed: int) -> dict[str, Any]:
-    """Run the plan in the MuJoCo model (issue 7) and return its summary for the page."""
+def _simulate(plan: Plan, trials: int, seed: int) -> dict[str, Any]:
+    """Run the plan in the MuJoCo model (docs/simulation.md) and return its summary."""
     from feederkit.sim import require_mujoco, simulate_plan
 
     require_mujoco()
@@ -42,9 +49,11 @@ def report_command(
         ),
     ] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed of --simulate.")] = 0,
+    max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
     """Write one self-contained HTML page: the mix, the plan as a tree, statistics, part plots."""
-    data = read_plan_file(plan)
+    check_report_path(output)
+    data = load_plan(plan, max_plan_mb)
     if simulate is not None and simulate < 1:
         raise InputError(f"--simulate must be a positive number of trials, got {simulate}")
     simulation = None if simulate is None else _simulate(data, simulate, seed)

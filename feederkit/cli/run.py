@@ -1,36 +1,48 @@
-"""``feederkit run PLAN SOURCE...``: execute a plan file on the kinematic model.
+"""``feederkit run PLAN [SOURCE...]``: execute a plan on the kinematic model.
 
-A thin layer over :mod:`feederkit.plans`: the parts named by SOURCE must be the plan's parts
-(same hull and COM); one run from ``--start-deg`` step by step, or ``--all`` for the full
-verification of those parts. Exit 1 when anything fails.
+A thin layer over :mod:`feederkit.plans`: the plan file holds each part's hull and COM, so
+without SOURCE every part of the plan is run; a SOURCE names a part that must be one of the
+plan's (same hull and COM: the plan is checked against the current part). One run from
+``--start-deg`` step by step, or ``--all`` for the full verification at the plan's declared
+uncertainty (a strong plan: every outcome and reading; the ideal model: the kinematic model).
+Exit 1 when anything fails, including a plan that fails verification.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from feederkit.cli.common import CatalogOpt, JsonOpt, console, print_json
+from feederkit.cli.plan_render import (
+    DEFAULT_MAX_PLAN_MB,
+    MaxPlanMbOpt,
+    load_plan,
+    trace_table,
+    verification_table,
+)
 from feederkit.errors import CheckFailed, InputError
-from feederkit.plans.execute import execute, kinematic_model
-from feederkit.plans.fileformat import read_plan
+from feederkit.plans.execute import execute
 from feederkit.plans.match import match_part
-from feederkit.plans.render import trace_table, verification_table
-from feederkit.plans.verify import verify_plan
+from feederkit.plans.model import Plan
+from feederkit.plans.verify import verify_declared
 from feederkit.sources import load_part
 
 
 def run_command(
     plan_path: Annotated[Path, typer.Argument(metavar="PLAN", help="A plan file (JSON).")],
     sources: Annotated[
-        list[str],
+        list[str] | None,
         typer.Argument(
-            metavar="SOURCE", help="The part(s) to run: outline or CAD files, catalog names."
+            metavar="[SOURCE]...",
+            help="Check and run these parts (outline or CAD files, catalog names); "
+            "default: every part of the plan, from the hull and COM it records.",
+            show_default=False,
         ),
-    ],
+    ] = None,
     start_deg: Annotated[
         float | None,
         typer.Option(
@@ -41,38 +53,55 @@ def run_command(
     ] = None,
     all_starts: Annotated[
         bool,
-        typer.Option("--all", help="Every stable start, every reading extreme, every branch."),
+        typer.Option("--all", help="Every stable start, every reading, every rotation."),
     ] = False,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
+    max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
-    """Execute a plan for the given part(s): each step's rotation, reading and branch, the pose."""
+    """Execute a plan for its parts: each step's rotation, reading and branch, the pose."""
     if start_deg is not None and all_starts:
         raise InputError("choose one of --start-deg and --all")
     if start_deg is not None and not math.isfinite(start_deg):
         raise InputError(f"--start-deg must be a finite angle in degrees, got {start_deg}")
-    plan = read_plan(plan_path)
-    model = kinematic_model(plan)
-    indices = []
-    for source in sources:
+    plan = load_plan(plan_path, max_plan_mb)
+    indices: list[int] = []
+    for source in sources or []:
         k = match_part(plan, load_part(source, catalog=catalog), source)
         if k not in indices:
             indices.append(k)
+    if not sources:
+        indices = list(range(len(plan.parts)))
+    warnings = [w for w in (plan.low_margin_warning(),) if w]
+    if not json_out:
+        for w in warnings:
+            console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)
+    if not json_out:
+        console.print(
+            f"declared uncertainty: {plan.uncertainty_words()}",
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )
+        cert = plan.certificate_words()
+        if cert is not None:
+            console.print(f"certificate: {cert}", highlight=False, markup=False, soft_wrap=True)
+    report = verify_declared(plan, None if not sources else indices)
     if all_starts:
-        report = verify_plan(model, indices)
         if json_out:
-            print_json(report.to_dict())
+            print_json({**report.to_dict(), **_declared(plan), "warnings": warnings})
         else:
-            console.print(verification_table(report))
+            console.print(verification_table(report, plan))
             if report.ok:
                 console.print(f"all {report.paths} paths end in their result", highlight=False)
         if not report.ok:
             raise CheckFailed(f"the plan failed: {report.first_problem()}")
         return
     start = 0.0 if start_deg is None else start_deg
-    traces = [execute(model, k, start) for k in indices]
+    traces = [execute(plan, k, start) for k in indices]
     if json_out:
-        print_json({"plan": str(plan_path), "runs": [t.to_dict() for t in traces]})
+        runs = [t.to_dict() for t in traces]
+        print_json({"plan": str(plan_path), "runs": runs, **_declared(plan), "warnings": warnings})
     else:
         for t in traces:
             console.print(trace_table(t))
@@ -81,6 +110,18 @@ def run_command(
     failed = [t for t in traces if not t.success]
     if failed:
         raise CheckFailed(failed[0].message)
+    if not report.ok:
+        raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
+
+
+def _declared(plan: Plan) -> dict[str, Any]:
+    """The declared uncertainty and the certificate, for ``--json``."""
+    cert = plan.stats.certificate
+    return {
+        "uncertainty": plan.uncertainty.to_dict(),
+        "uncertainty_declared": plan.uncertainty_declared,
+        "certificate": None if cert is None else cert.to_dict(),
+    }
 
 
 def register(app: typer.Typer) -> None:

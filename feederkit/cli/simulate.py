@@ -1,6 +1,10 @@
-"""``feederkit simulate PLAN``: check a plan in MuJoCo over many trials (issue 7).
+"""``feederkit simulate PLAN``: check a plan in MuJoCo over many trials (docs/simulation.md).
 
-Failures are data: the command exits 0 whatever the success rate, unless
+The plan is loaded and checked as ``run`` and ``report`` load it, and verified at its declared
+uncertainty first (a strong plan: every outcome and reading): a plan that fails verification
+exits 1 before any trial. Each trial samples the declared uncertainty and the friction ranges
+(``--ideal``: nothing sampled); a trial the plan's model did not predict is listed first. Trial
+failures are data: the command exits 0 whatever the success rate, unless
 ``--require-success`` names a rate the run must reach (then exit 1 below it).
 Without MuJoCo it exits 2 with one line saying to install ``feederkit[sim]``.
 """
@@ -16,29 +20,38 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
 from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
-    DEFAULT_FRICTION_BELT,
-    DEFAULT_FRICTION_FENCE,
+    DEFAULT_FRICTION_BELT_RANGE,
+    DEFAULT_FRICTION_FENCE_RANGE,
     simulate_plan,
 )
 from feederkit.sim.engine import require_mujoco
-from feederkit.sim.planfile import load_plan_json
-from feederkit.sim.planfile import read_plan as read_sim_plan
 from feederkit.sim.summary import SimulationSummary
 
 SHOWN_ROWS = 20
 """Failures and misses listed in the terminal (all of them are in ``--json``)."""
 
 
-def _print_summary(s: SimulationSummary) -> None:
+def _print_summary(s: SimulationSummary, declared: str) -> None:
     st = s.settings
+    fb, ff = st.friction_belt_range, st.friction_fence_range
+    sampled = (
+        "nothing sampled (--ideal)"
+        if st.ideal
+        else f"sampled: rotation error ±{st.rotation_noise_deg:g} deg per rotation, vertices "
+        f"within {st.sampled.shape_tolerance_mm:g} mm, COM within "
+        f"{st.sampled.com_tolerance_mm:g} mm, friction belt {fb.text() if fb else '-'} / fence "
+        f"{ff.text() if ff else '-'}"
+    )
     console.print(
         f"[bold]simulated[/] {escape(', '.join(s.parts))}: {st.trials} trials, seed {st.seed}, "
-        f"rotation noise ±{st.rotation_noise_deg:g} deg, belt {st.belt_speed:g} m/s, "
-        f"friction belt {st.friction_belt:g} / fence {st.friction_fence:g}",
+        f"belt {st.belt_speed:g} m/s; declared uncertainty: {escape(declared)}; "
+        f"{escape(sampled)}; contact: {escape(st.contact)}",
         highlight=False,
+        soft_wrap=True,
     )
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_row("successes", f"{s.successes} of {s.trials} ({100 * s.success_rate:.1f}%)")
@@ -47,6 +60,9 @@ def _print_summary(s: SimulationSummary) -> None:
             table.add_row(f"  {escape(name)}", f"{k} of {t}")
     table.add_row("failures", str(len(s.failures)))
     table.add_row("never settled", str(len(s.unsettled)))
+    table.add_row("model errors (not predicted)", str(s.model_errors))
+    for cause, n in s.by_cause().items():
+        table.add_row(f"  {escape(cause)}", str(n))
     table.add_row(
         "push agreement",
         f"{s.push_agreements} of {s.settled_pushes} settled pushes "
@@ -56,15 +72,19 @@ def _print_summary(s: SimulationSummary) -> None:
     table.add_row("plan's smallest margin", margin)
     table.add_row("wall time", f"{s.wall_time_s:.2f} s ({s.pushes} push-align operations)")
     console.print(table)
-    if s.min_margin_deg is not None and st.rotation_noise_deg > s.min_margin_deg:
+    if (
+        s.min_margin_deg is not None
+        and st.sampled.is_ideal
+        and st.rotation_noise_deg > s.min_margin_deg
+    ):
         console.print(
             "[yellow]note:[/] the rotation noise exceeds the plan's smallest margin; "
             "failures are expected",
         )
-    rows = list(s.failures) + list(s.unsettled)
+    rows = s.went_wrong
     if rows:
-        t = Table(title="trials that went wrong", title_justify="left")
-        for col in ("trial", "part", "start deg", "step", "what happened"):
+        t = Table(title="trials that went wrong (model errors first)", title_justify="left")
+        for col in ("trial", "part", "start deg", "step", "cause", "model predicted", "what"):
             t.add_column(col, overflow="fold")
         for r in rows[:SHOWN_ROWS]:
             t.add_row(
@@ -72,6 +92,8 @@ def _print_summary(s: SimulationSummary) -> None:
                 escape(r.part),
                 f"{r.start_deg:.2f}",
                 str(r.step),
+                escape(r.cause or ""),
+                "yes" if r.predicted else "[bold red]no: model error[/]",
                 escape(r.reason or ""),
             )
         console.print(t)
@@ -109,23 +131,41 @@ def simulate_command(
     plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
     trials: Annotated[int, typer.Option("--trials", help="Number of trials.")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts and errors.")] = 0,
+    ideal: Annotated[
+        bool,
+        typer.Option(
+            "--ideal", help="Sample nothing: the drawn part, nominal friction, exact rotations."
+        ),
+    ] = False,
     rotation_noise: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--rotation-noise",
-            help="Robot rotation error, uniform in [-DEG, +DEG], on every rotation.",
+            help="Draw rotation errors in [-DEG, +DEG] instead of the plan's declared error "
+            "(a stress test beyond what the plan claims).",
             metavar="DEG",
+            show_default=False,
         ),
-    ] = 0.0,
+    ] = None,
     belt_speed: Annotated[
         float, typer.Option("--belt-speed", help="Belt speed.", metavar="M/S")
     ] = DEFAULT_BELT_SPEED,
     friction_belt: Annotated[
-        float, typer.Option("--friction-belt", help="Part-belt friction.", metavar="MU")
-    ] = DEFAULT_FRICTION_BELT,
+        str,
+        typer.Option(
+            "--friction-belt",
+            help="Part-belt friction, drawn per trial from LO:HI (or one value).",
+            metavar="LO:HI",
+        ),
+    ] = DEFAULT_FRICTION_BELT_RANGE.text(),
     friction_fence: Annotated[
-        float, typer.Option("--friction-fence", help="Part-fence friction.", metavar="MU")
-    ] = DEFAULT_FRICTION_FENCE,
+        str,
+        typer.Option(
+            "--friction-fence",
+            help="Part-fence friction, drawn per trial from LO:HI (or one value).",
+            metavar="LO:HI",
+        ),
+    ] = DEFAULT_FRICTION_FENCE_RANGE.text(),
     require_success: Annotated[
         float | None,
         typer.Option(
@@ -135,16 +175,16 @@ def simulate_command(
         ),
     ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+    max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
     """Execute a plan in a MuJoCo conveyor, fence and robot and compare it with its claims."""
     require_mujoco()  # InputError (exit 2): install feederkit[sim]
     if require_success is not None and not 0.0 <= require_success <= 1.0:
         raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
-    data = load_plan_json(plan)
-    try:
-        read_sim_plan(data)  # check it before the progress bar starts
-    except InputError as exc:
-        raise InputError(f"{plan}: {str(exc).removeprefix('plan: ')}") from None
+    data = load_plan(plan, max_plan_mb)  # the one loader and validator
+    warning = data.low_margin_warning()
+    if warning:
+        err_console.print(f"warning: {warning}", style="yellow", highlight=False, markup=False)
     columns = (
         TextColumn("simulating"),
         BarColumn(),
@@ -167,11 +207,18 @@ def simulate_command(
             friction_belt=friction_belt,
             friction_fence=friction_fence,
             progress=advance,
+            ideal=ideal,
         )
     if json_out:
-        print_json(summary.to_dict())
+        print_json(
+            {
+                **summary.to_dict(),
+                "uncertainty": data.uncertainty.to_dict(),
+                "uncertainty_declared": data.uncertainty_declared,
+            }
+        )
     else:
-        _print_summary(summary)
+        _print_summary(summary, data.uncertainty_words())
     if require_success is not None and summary.success_rate < require_success:
         raise CheckFailed(
             f"{summary.successes} of {summary.trials} trials succeeded "

@@ -1,21 +1,28 @@
 """Plans as files a controller can run: JSON version 1, execution and verification on geometry.
 
-- :mod:`~feederkit.plans.fileformat`: ``plan_to_dict``, ``validate_plan``, ``read_plan``,
-  ``write_plan`` (atomic), ``plan_json``.
+- :mod:`~feederkit.plans.model`: the one immutable :class:`Plan` (parts, sensor, tree, stats).
+- :mod:`~feederkit.plans.fileformat`: the only maker and writer of a Plan:
+  ``plan_from_result``, ``plan_from_dict``, ``read_plan`` (size and depth limits),
+  ``plan_to_dict``, ``plan_json``, ``write_plan`` (atomic).
 - :mod:`~feederkit.plans.stats`: the ``stats`` object (length, margins, Fig. 14 class bound).
 - :mod:`~feederkit.plans.execute`: ``execute`` a plan on the kinematic model rebuilt from
-  the file's hulls and COMs, giving a ``Trace``.
+  the plan's hulls and COMs, giving a ``Trace``.
 - :mod:`~feederkit.plans.verify`: ``verify_plan`` / ``check_plan``: every start, reading and
-  branch.
+  rotation, by interval arithmetic.
 - :mod:`~feederkit.plans.match`: which plan part a loaded part is; parts a plan lumps together.
 - :mod:`~feederkit.plans.render`: rich tree and tables.
 """
 
-from feederkit.plans.execute import KinematicModel, Trace, TraceStep, execute, kinematic_model
+from feederkit.plans.execute import Trace, TraceStep, execute
 from feederkit.plans.fileformat import (
     CONVENTIONS,
     FORMAT,
+    MAX_PLAN_BYTES,
+    MAX_PLAN_DEPTH,
     VERSION,
+    as_plan,
+    plan_from_dict,
+    plan_from_result,
     plan_json,
     plan_to_dict,
     read_plan,
@@ -23,26 +30,47 @@ from feederkit.plans.fileformat import (
     write_plan,
 )
 from feederkit.plans.match import leaf_part_pairs, match_part
+from feederkit.plans.model import (
+    Branch,
+    Leaf,
+    Plan,
+    PlanPart,
+    PlanStats,
+    ResultEntry,
+    Step,
+    push_function_of,
+)
 from feederkit.plans.stats import plan_stats
 from feederkit.plans.verify import PartCheck, VerificationReport, check_plan, verify_plan
 
 __all__ = [
     "CONVENTIONS",
     "FORMAT",
+    "MAX_PLAN_BYTES",
+    "MAX_PLAN_DEPTH",
     "VERSION",
-    "KinematicModel",
+    "Branch",
+    "Leaf",
     "PartCheck",
+    "Plan",
+    "PlanPart",
+    "PlanStats",
+    "ResultEntry",
+    "Step",
     "Trace",
     "TraceStep",
     "VerificationReport",
+    "as_plan",
     "check_plan",
     "execute",
-    "kinematic_model",
     "leaf_part_pairs",
     "match_part",
+    "plan_from_dict",
+    "plan_from_result",
     "plan_json",
     "plan_stats",
     "plan_to_dict",
+    "push_function_of",
     "read_plan",
     "validate_plan",
     "verify_plan",

@@ -1,102 +1,48 @@
-"""Execute a plan file on the kinematic model: the part rebuilt from the file's hull and COM.
+"""Execute a plan on the kinematic model: each part rebuilt from the plan's hull and COM.
 
 This is an independent check of the planner: it never looks at the push-align machine the
 plan was made on, only at geometry (the push function of section 3.1, computed from the hull
-and COM the file records) and at the plan file itself. A controller does the same steps: rotate
+and COM the plan records) and at the plan itself. A controller does the same steps: rotate
 by ``action_deg``, let the part align (the push function), read the diameter, follow the
-branch whose closed interval holds the reading.
+branch whose closed interval holds the reading (:meth:`~feederkit.plans.model.Branch.holds`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from feederkit.mechanics.push import PushFunction, StableState, push, push_function, rotation_after
-from feederkit.outline import make_outline
-from feederkit.part import make_part
-from feederkit.plans.fileformat import validate_plan
-from feederkit.sensors import (
-    LedSensor,
-    NoSensor,
-    SensorModel,
-    ToleranceSensor,
-    led_count,
-    led_counts,
-    sensor_from_dict,
-)
+from feederkit.mechanics.push import StableState, push, rotation_after
+from feederkit.plans.fileformat import as_plan
+from feederkit.plans.model import Leaf, Plan, Step, push_function_of
+from feederkit.sensors import Sensor
 
 ReadingChoice = Literal["nominal", "low", "high"] | Sequence[float | None]
 
 
-@dataclass(frozen=True)
-class KinematicModel:
-    """A checked plan with its parts rebuilt from their hulls and COMs, and its sensor."""
+def reading_inset(sensor: Sensor, size: float) -> float:
+    """How far inside an open reading interval its extreme readings are taken (mm).
 
-    plan: dict[str, Any]
-    sensor: SensorModel
-    names: tuple[str, ...]
-    parts: tuple[PushFunction, ...]
-
-    def tiny_reading(self, part_index: int) -> float:
-        """How far inside a tolerance's open reading interval its extreme readings are taken."""
-        if not isinstance(self.sensor, ToleranceSensor):
-            return 0.0
-        e = self.sensor.tolerance
-        return min(max(e * 1e-6, 2e-9 * self.parts[part_index].part.size), e / 4.0)
-
-
-def rebuild_part(entry: dict[str, Any]) -> PushFunction:
-    """The push function of a plan file's part, from its hull and COM only."""
-    outline = make_outline(entry["name"], entry["hull"], com=entry["com"])
-    return push_function(make_part(outline, revision=entry.get("revision")))
-
-
-def kinematic_model(plan: dict[str, Any] | KinematicModel) -> KinematicModel:
-    """Check a plan's structure and rebuild its parts (InputError for a broken plan)."""
-    if isinstance(plan, KinematicModel):
-        return plan
-    validate_plan(plan)
-    parts = tuple(rebuild_part(p) for p in plan["parts"])
-    return KinematicModel(
-        plan=plan,
-        sensor=sensor_from_dict(plan["sensor"]),
-        names=tuple(p["name"] for p in plan["parts"]),
-        parts=parts,
-    )
-
-
-def nominal_reading(sensor: SensorModel, diameter: float) -> float | None:
-    """The reading an exact sensor gives: the diameter, or the LED array's count times its pitch."""
-    if isinstance(sensor, NoSensor):
-        return None
-    if isinstance(sensor, LedSensor):
-        return led_count(sensor.pitch, diameter) * sensor.pitch
-    return diameter
+    A tolerance sensor never reads its interval's ends (design.md); a millionth of the
+    tolerance, at least a few ulps of the part's size, keeps a run's extremes inside it.
+    """
+    reach = sensor.reading_reach()
+    if not math.isfinite(reach):
+        return 0.0
+    e = reach / 2.0
+    return min(max(e * 1e-6, 2e-9 * size), e / 4.0)
 
 
 def extreme_readings(
-    sensor: SensorModel, diameter: float, tiny: float
+    sensor: Sensor, diameter: float, inset: float
 ) -> tuple[float | None, float | None]:
-    """The smallest and largest reading a state gives (``tiny`` inside a tolerance's interval)."""
-    if isinstance(sensor, NoSensor):
+    """The smallest and largest reading a state gives (``inset`` inside an open interval)."""
+    probes = sensor.probe_readings(diameter, inset)
+    if not probes:
         return None, None
-    if isinstance(sensor, LedSensor):
-        c0, c1 = led_counts(sensor, diameter)
-        return c0 * sensor.pitch, c1 * sensor.pitch
-    e = sensor.tolerance
-    return diameter - e + tiny, diameter + e - tiny
-
-
-def branches_holding(node: dict[str, Any], reading: float | None) -> list[int]:
-    """The branches whose closed reading interval holds ``reading`` (all when sensorless)."""
-    out = []
-    for k, b in enumerate(node["branches"]):
-        r = b["reading"]
-        if r is None or (reading is not None and r[0] <= reading <= r[1]):
-            out.append(k)
-    return out
+    return min(probes), max(probes)
 
 
 @dataclass(frozen=True)
@@ -173,9 +119,9 @@ def _ops(k: int) -> str:
     return f"{k} operation" if k == 1 else f"{k} operations"
 
 
-def leaf_entries(node: dict[str, Any]) -> tuple[tuple[str, int, float], ...]:
-    """A result node's entries as ``(part, state, pose_deg)``."""
-    return tuple((e["part"], e["state"], float(e["pose_deg"])) for e in node["result"])
+def leaf_entries(leaf: Leaf) -> tuple[tuple[str, int, float], ...]:
+    """A leaf's entries as ``(part, state, pose_deg)``."""
+    return tuple((e.part, e.state, e.pose_deg) for e in leaf.results)
 
 
 def path_text(steps: Sequence[TraceStep]) -> str:
@@ -196,7 +142,7 @@ def finish(
     start: float,
     steps: Sequence[TraceStep],
     state: StableState,
-    leaf: dict[str, Any] | None,
+    leaf: Leaf | None,
 ) -> Trace:
     """The trace of a run that ended in ``state`` at ``leaf`` (None: on an unheld reading).
 
@@ -230,12 +176,13 @@ def finish(
 
 
 def _pick_reading(
-    model: KinematicModel, part_index: int, choice: ReadingChoice, step: int, diameter: float
+    plan: Plan, part_index: int, choice: ReadingChoice, step: int, diameter: float
 ) -> float | None:
     if isinstance(choice, str):
         if choice == "nominal":
-            return nominal_reading(model.sensor, diameter)
-        low, high = extreme_readings(model.sensor, diameter, model.tiny_reading(part_index))
+            return plan.sensor.nominal_reading(diameter)
+        inset = reading_inset(plan.sensor, plan.parts[part_index].size)
+        low, high = extreme_readings(plan.sensor, diameter, inset)
         if choice == "low":
             return low
         if choice == "high":
@@ -247,7 +194,7 @@ def _pick_reading(
 
 
 def execute(
-    plan: dict[str, Any] | KinematicModel,
+    plan: Plan | Mapping[str, Any],
     part_index: int,
     start_theta_deg: float,
     reading_choice: ReadingChoice = "nominal",
@@ -259,32 +206,26 @@ def execute(
     reading that several branches hold (a shared endpoint) the first is followed; a reading
     that no branch holds stops the run (``success`` False, the message says so).
     """
-    model = kinematic_model(plan)
-    if not 0 <= part_index < len(model.parts):
+    plan = as_plan(plan)
+    if not 0 <= part_index < len(plan.parts):
         raise ValueError(f"the plan has no part {part_index}")
-    pf = model.parts[part_index]
-    name = model.names[part_index]
-    node: dict[str, Any] = model.plan["root"]
+    pf = push_function_of(plan.parts[part_index])
+    name = plan.parts[part_index].name
+    node: Step | Leaf = plan.root
     state = push(pf, start_theta_deg)
     theta = float(start_theta_deg)
     steps: list[TraceStep] = []
-    while "result" not in node:
-        action = node["action_deg"]
-        if action is not None:
-            theta = rotation_after(state.normal_deg, action)
+    while isinstance(node, Step):
+        if node.action_deg is not None:
+            theta = rotation_after(state.normal_deg, node.action_deg)
             state = push(pf, theta)
-        reading = _pick_reading(model, part_index, reading_choice, len(steps), state.diameter)
-        held = branches_holding(node, reading)
-        b = held[0] if held else None
-        interval = (
-            None
-            if b is None or node["branches"][b]["reading"] is None
-            else tuple(node["branches"][b]["reading"])
-        )
+        reading = _pick_reading(plan, part_index, reading_choice, len(steps), state.diameter)
+        b = node.follow(reading)
+        interval = None if b is None else node.branches[b].reading
         steps.append(
             TraceStep(
                 len(steps) + 1,
-                action,
+                node.action_deg,
                 theta,
                 state.id,
                 state.edge,
@@ -296,5 +237,5 @@ def execute(
         )
         if b is None:
             return finish(name, start_theta_deg, steps, state, None)
-        node = node["branches"][b]["next"]
+        node = node.branches[b].next
     return finish(name, start_theta_deg, steps, state, node)

@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from feederkit.mechanics.classes import polygon_class
 from feederkit.mechanics.push import PushFunction
-from feederkit.planning.tree import PlanResult
+
+if TYPE_CHECKING:
+    from feederkit.planning.tree import PlanResult
 
 
 def plan_stats(result: PlanResult, parts: Sequence[PushFunction]) -> dict[str, Any]:

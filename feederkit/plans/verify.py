@@ -1,39 +1,42 @@
-"""Verify a plan file on the kinematic model: every start, every reading, every branch.
+"""Verify a plan on the kinematic model: every start, every reading, every rotation.
 
-For every part and every stable start (each stable orientation, and fence orientations just
-inside both ends of each resting range), the plan is executed with every reading the sensor
-model allows at each operation (both extremes of a tolerance's open interval and every branch
-endpoint inside it; every LED count) along every branch whose closed interval holds the
-reading (on a shared endpoint each must be right), and with rotations at the middle and just
-inside both ends of each action's margin. Every run must end in a result that lists the
-part's final state, and the longest run must take exactly the plan's stated length. The
-file's stable states must also be the ones its hulls and COMs give. Paths that share a
-(node, state) share their future, so the search is memoised and linear in plan size times
-states.
+For every part, every stable state it can start in, the plan is followed exactly, by
+interval arithmetic rather than by sampling:
+
+- a rotation ``action ± margin`` (the step's overlap range, section 6) from a state reaches
+  every state whose resting range meets the rotated interval of fence orientations, so the
+  whole range is checked, not a few rotations in it;
+- a state of diameter ``d`` can give every reading of its reading set (the sensor model,
+  section 5): for a tolerance sensor the open interval, split at every branch endpoint inside
+  it, each piece and each endpoint tried once; for an LED array every beam count. Each
+  reading must be held by some branch, and every branch that holds one (on a shared endpoint
+  both) must be right.
+
+Every path must end in a result that lists the part's final state, and the longest must take
+exactly the plan's stated length. The plan's listed stable states must be the ones its hulls
+and COMs give. Paths that share a (node, state) share their future, so the search is
+memoised and linear in plan size times states.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+import sys
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from feederkit.angles import angle_close
+from feederkit.angles import angle_close, norm360
 from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
-from feederkit.plans.execute import (
-    KinematicModel,
-    Trace,
-    TraceStep,
-    branches_holding,
-    extreme_readings,
-    finish,
-    kinematic_model,
-)
-from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor, led_counts
+from feederkit.plans.execute import Trace, TraceStep, finish
+from feederkit.plans.fileformat import as_plan
+from feederkit.plans.model import Leaf, Plan, Step, push_function_of
+from feederkit.sensors import Sensor
 
-START_INSIDE_DEG = 1e-6
-"""How far inside a resting range's ends the extreme starts are taken (deg)."""
+ANGLE_EPS_DEG = 1e-7
+"""An overlap range is taken this much inside its ends (deg): the planner's ranges end exactly
+on resting-range boundaries, which rebuilding the push function reproduces to about 1e-12."""
 
 
 @dataclass(frozen=True)
@@ -101,7 +104,7 @@ class _Failure:
     interval: tuple[float, float] | None
     rest: tuple[TraceStep, ...]
     final: StableState
-    leaf: dict[str, Any] | None
+    leaf: Leaf | None
 
 
 @dataclass(frozen=True)
@@ -111,77 +114,107 @@ class _Outcome:
     failure: _Failure | None
 
 
-def _candidate_readings(
-    model: KinematicModel, p: int, node: dict[str, Any], d: float
-) -> list[float | None]:
-    """Every reading that can lead a state of diameter ``d`` down a different set of branches."""
-    sensor = model.sensor
-    if isinstance(sensor, NoSensor):
+def _discrete(sensor: Sensor, diameter: float) -> bool:
+    """Whether the sensor's readings of this state are a finite set (an LED array's counts)
+    rather than a continuum (a tolerance's interval): a single reading then has a positive
+    probability."""
+    r = sensor.nominal_reading(diameter)
+    return r is not None and sensor.reading_probability(diameter, r, r) > 0.0
+
+
+def candidate_readings(sensor: Sensor, step: Step, diameter: float) -> list[float | None]:
+    """Readings that together meet every branch a state of this diameter can follow.
+
+    Which branches hold a reading changes only at branch endpoints, so the endpoints inside
+    the state's reading interval and one reading between each two neighbours cover the whole
+    interval however narrow a branch is.
+    """
+    if not sensor.informative:
         return [None]
-    if isinstance(sensor, LedSensor):
-        c0, c1 = led_counts(sensor, d)
-        return [c * sensor.pitch for c in range(c0, c1 + 1)]
-    assert isinstance(sensor, ToleranceSensor)
-    e = sensor.tolerance
-    t = model.tiny_reading(p)
-    low, high = extreme_readings(sensor, d, t)
-    out = {low, high, d}
-    for b in node["branches"]:
-        for x in b["reading"]:
-            # readings within t/2 of the open interval's ends count as its ends: rounding
-            out.update(r for r in (x - t, x, x + t) if abs(r - d) < e - t / 2)
-    return sorted(out)
+    if _discrete(sensor, diameter):
+        return sorted(set(sensor.probe_readings(diameter, 0.0)))
+    interval = sensor.reading_interval(diameter)
+    assert interval is not None
+    lo, hi = interval
+    inner = sorted(
+        {x for b in step.branches if b.reading is not None for x in b.reading if lo < x < hi}
+    )
+    points = [lo, *inner, hi]
+    mids = [(a + b) / 2.0 for a, b in zip(points, points[1:], strict=False) if a < b]
+    out = sorted({*inner, *mids})
+    return [r for r in out if sensor.consistent(diameter, r)]
 
 
-def _margin_errors(margin: float) -> tuple[float, ...]:
-    """Rotation errors tried for an action of this margin: none, and just inside both ends."""
-    inside = margin - max(1e-6, 1e-3 * margin)
-    return (0.0, -inside, inside) if inside > 0.0 else (0.0,)
+def _arcs_meet(t0: float, width: float, rng: tuple[float, float]) -> bool:
+    """Whether the open arc ``(t0, t0 + width)`` meets the open range ``(lo, hi)`` (deg)."""
+    lo = norm360(rng[0])
+    hi = lo + (rng[1] - rng[0])
+    t0 = norm360(t0)
+    return any(max(t0, lo + 360.0 * k) < min(t0 + width, hi + 360.0 * k) for k in (-1, 0, 1))
+
+
+def rotation_outcomes(pf: PushFunction, normal_deg: float, step: Step) -> list[StableState]:
+    """Every state a rotation in the step's overlap range leads the state of ``normal_deg`` to.
+
+    The rotated fence orientations ``normal - (action ± margin)`` form one arc; the part
+    settles in every state whose resting range meets it (section 3.1).
+    """
+    assert step.action_deg is not None and step.margin_deg is not None
+    nominal = push(pf, rotation_after(normal_deg, step.action_deg))
+    width = 2.0 * (step.margin_deg - ANGLE_EPS_DEG)
+    if width <= 0.0:
+        return [nominal]
+    t0 = normal_deg - step.action_deg - step.margin_deg + ANGLE_EPS_DEG
+    met = [s for s in pf.states if _arcs_meet(t0, width, s.resting_range_deg)]
+    return met if nominal in met else [nominal, *met]
 
 
 class _PartSearch:
     """The memoised search over (node, state) for one part."""
 
-    def __init__(self, model: KinematicModel, p: int) -> None:
-        self.model = model
-        self.p = p
-        self.pf: PushFunction = model.parts[p]
-        self.name = model.names[p]
+    def __init__(self, plan: Plan, p: int) -> None:
+        self.plan = plan
+        self.sensor = plan.sensor
+        self.pf: PushFunction = push_function_of(plan.parts[p])
+        self.name = plan.parts[p].name
+        listed = {s.id: s.diameter for s in plan.parts[p].states}
+        # readings are those of the diameters the plan was made on (checked against geometry)
+        self.diameter = {s.id: listed.get(s.id, s.diameter) for s in self.pf.states}
         self.memo: dict[tuple[int, int], _Outcome] = {}
 
-    def after_push(self, node: dict[str, Any], number: int, state: StableState) -> _Outcome:
+    def after_push(self, node: Step, number: int, state: StableState) -> _Outcome:
         """Outcome of every continuation once operation ``number`` of ``node`` left ``state``."""
         key = (id(node), state.id)
         if key in self.memo:
             return self.memo[key]
         paths, worst, failure = 0, number, None
-        for reading in _candidate_readings(self.model, self.p, node, state.diameter):
-            held = branches_holding(node, reading)
+        explored: set[int] = set()
+        for reading in candidate_readings(self.sensor, node, self.diameter[state.id]):
+            held = node.held_by(reading)
             if not held and failure is None:
                 failure = _Failure(reading, None, None, (), state, None)
             for b in held:
-                branch = node["branches"][b]
-                interval = None if branch["reading"] is None else tuple(branch["reading"])
-                nxt = branch["next"]
-                if "result" in nxt:
-                    paths += 1
-                    ok = any(
-                        e["part"] == self.name and e["state"] == state.id for e in nxt["result"]
-                    )
-                    if not ok and failure is None:
-                        failure = _Failure(reading, b, interval, (), state, nxt)
+                if b in explored:
                     continue
-                for err in _margin_errors(nxt["margin_deg"]):
-                    theta = rotation_after(state.normal_deg, nxt["action_deg"] + err)
-                    s2 = push(self.pf, theta)
+                explored.add(b)
+                branch = node.branches[b]
+                nxt = branch.next
+                if isinstance(nxt, Leaf):
+                    paths += 1
+                    if not nxt.accepts(self.name, state.id) and failure is None:
+                        failure = _Failure(reading, b, branch.reading, (), state, nxt)
+                    continue
+                assert nxt.action_deg is not None
+                for s2 in rotation_outcomes(self.pf, state.normal_deg, nxt):
                     sub = self.after_push(nxt, number + 1, s2)
                     paths += sub.paths
                     worst = max(worst, sub.worst)
                     if sub.failure is not None and failure is None:
                         f = sub.failure
+                        theta = _theta_into(state.normal_deg, nxt, s2)
                         step = TraceStep(
                             number + 1,
-                            nxt["action_deg"],
+                            nxt.action_deg,
                             theta,
                             s2.id,
                             s2.edge,
@@ -189,32 +222,25 @@ class _PartSearch:
                             f.reading,
                             f.branch,
                             f.interval,
-                            err,
+                            norm360(state.normal_deg - nxt.action_deg - theta + 180.0) - 180.0,
                         )
-                        failure = _Failure(reading, b, interval, (step, *f.rest), f.final, f.leaf)
+                        failure = _Failure(
+                            reading, b, branch.reading, (step, *f.rest), f.final, f.leaf
+                        )
         out = _Outcome(paths, worst, failure)
         self.memo[key] = out
         return out
 
-    def starts(self) -> list[float]:
-        """Each stable orientation, and just inside both ends of its resting range."""
-        out = []
-        for s in self.pf.states:
-            lo, hi = s.resting_range_deg
-            out += [s.normal_deg, lo + START_INSIDE_DEG, hi - START_INSIDE_DEG]
-        return out
-
     def run(self) -> tuple[PartCheck, list[Trace]]:
-        root = self.model.plan["root"]
         paths, worst, failed = 0, 0, []
-        starts = self.starts()
-        for theta in starts:
-            s0 = push(self.pf, theta)
-            o = self.after_push(root, 1, s0)
+        starts = self.pf.states
+        for s0 in starts:
+            o = self.after_push(self.plan.root, 1, s0)
             paths += o.paths
             worst = max(worst, o.worst)
             if o.failure is not None:
                 f = o.failure
+                theta = s0.normal_deg
                 first = TraceStep(
                     1, None, theta, s0.id, s0.edge, s0.diameter, f.reading, f.branch, f.interval
                 )
@@ -222,95 +248,150 @@ class _PartSearch:
         return PartCheck(self.name, len(starts), paths, worst, len(failed)), failed
 
 
-def _state_problems(model: KinematicModel, p: int) -> list[str]:
-    """Differences between the file's stable states and those its hull and COM give."""
-    entry = model.plan["parts"][p]
-    pf = model.parts[p]
-    name = entry["name"]
-    listed = {s["id"]: s for s in entry["stable_states"]}
+def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
+    """A fence orientation inside the step's overlap range that settles in ``target``: the
+    nominal one when it does, else the nearest point of the target's resting range."""
+    assert step.action_deg is not None and step.margin_deg is not None
+    nominal = rotation_after(normal_deg, step.action_deg)
+    lo, hi = target.resting_range_deg
+    mid = (lo + hi) / 2.0
+    offset = norm360(nominal - mid + 180.0) - 180.0  # nominal relative to the range's middle
+    half = (hi - lo) / 2.0
+    if abs(offset) < half:
+        return nominal
+    inside = math.copysign(half - min(ANGLE_EPS_DEG, half / 2.0), offset)
+    return norm360(mid + inside)
+
+
+def _state_problems(plan: Plan, p: int) -> list[str]:
+    """Differences between the plan's stable states and those its hull and COM give."""
+    part = plan.parts[p]
+    pf = push_function_of(part)
+    listed = {s.id: s for s in part.states}
     if set(listed) != {s.id for s in pf.states}:
         return [
-            f"part {name!r}: the file lists stable states {sorted(listed)}, but its hull and COM "
-            f"give {pf.n}"
+            f"part {part.name!r}: the plan lists stable states {sorted(listed)}, but its hull "
+            f"and COM give {pf.n}"
         ]
     eps_d = 1e-9 * pf.part.size + 1e-12
     out = []
     for s in pf.states:
         f = listed[s.id]
-        lo, hi = f["resting_range_deg"]
         same = (
-            f["edge"] == s.edge
-            and angle_close(f["normal_deg"], s.normal_deg, 1e-6)
-            and angle_close(lo, s.resting_range_deg[0], 1e-6)
-            and angle_close(hi, s.resting_range_deg[1], 1e-6)
-            and abs(f["diameter"] - s.diameter) <= eps_d
-            and angle_close(f["pose_deg"], s.pose_deg, 1e-6)
+            f.edge == s.edge
+            and angle_close(f.normal_deg, s.normal_deg, 1e-6)
+            and angle_close(f.resting_range_deg[0], s.resting_range_deg[0], 1e-6)
+            and angle_close(f.resting_range_deg[1], s.resting_range_deg[1], 1e-6)
+            and abs(f.diameter - s.diameter) <= eps_d
+            and angle_close(f.pose_deg, s.pose_deg, 1e-6)
         )
         if not same:
             out.append(
-                f"part {name!r} state {s.id}: the file says edge {f['edge']}, normal "
-                f"{f['normal_deg']:.6g} deg, diameter {f['diameter']:.6g}, but its hull and COM "
-                f"give edge {s.edge}, normal {s.normal_deg:.6g} deg, diameter {s.diameter:.6g}"
+                f"part {part.name!r} state {s.id}: the plan says edge {f.edge}, normal "
+                f"{f.normal_deg:.6g} deg, diameter {f.diameter:.10g}, but its hull and COM "
+                f"give edge {s.edge}, normal {s.normal_deg:.6g} deg, diameter {s.diameter:.10g}"
             )
     return out
 
 
-def _pose_problems(model: KinematicModel) -> list[str]:
+def _pose_problems(plan: Plan) -> list[str]:
     """Result entries whose pose is not the pose of the state they name."""
-    poses = {
-        (p["name"], s["id"]): s["pose_deg"] for p in model.plan["parts"] for s in p["stable_states"]
-    }
+    poses = {(p.name, s.id): s.pose_deg for p in plan.parts for s in p.states}
     out = []
-    stack = [model.plan["root"]]
-    while stack:
-        node = stack.pop()
-        if "result" in node:
-            for e in node["result"]:
-                want = poses[(e["part"], e["state"])]
-                if not angle_close(e["pose_deg"], want, 1e-6):
-                    out.append(
-                        f"a result gives {e['part']} state {e['state']} the pose "
-                        f"{e['pose_deg']:.6g} deg, but that state's pose is {want:.6g} deg"
-                    )
-        else:
-            stack.extend(b["next"] for b in node["branches"])
+    for leaf in plan.leaves():
+        for e in leaf.results:
+            want = poses[(e.part, e.state)]
+            if not angle_close(e.pose_deg, want, 1e-6):
+                out.append(
+                    f"a result gives {e.part} state {e.state} the pose {e.pose_deg:.6g} deg, "
+                    f"but that state's pose is {want:.6g} deg"
+                )
     return out
 
 
 def verify_plan(
-    plan: dict[str, Any] | KinematicModel, part_indices: Sequence[int] | None = None
+    plan: Plan | Mapping[str, Any], part_indices: Sequence[int] | None = None
 ) -> VerificationReport:
-    """Execute the plan on the kinematic model: every start, reading and branch (see the module).
+    """Follow the plan on the kinematic model: every start, reading and rotation (see the
+    module).
 
-    ``part_indices`` restricts the check to some of the plan's parts (default: all).
-    Raises InputError when the plan is structurally broken.
+    ``part_indices`` restricts the check to some of the plan's parts (default: all); the
+    plan's stated length is checked against its tree when it is made (plan_from_dict), so
+    it holds either way. Raises InputError when the plan is structurally broken.
     """
-    model = kinematic_model(plan)
-    indices = range(len(model.parts)) if part_indices is None else part_indices
-    problems = _pose_problems(model)
+    plan = as_plan(plan)
+    indices = range(len(plan.parts)) if part_indices is None else part_indices
+    problems = _pose_problems(plan)
     checks, failures = [], []
-    length = model.plan["stats"]["length"]
-    for p in indices:
-        problems += _state_problems(model, p)
-        check, failed = _PartSearch(model, p).run()
-        if check.worst_operations > length:
-            problems.append(
-                f"part {check.part!r}: a run takes {check.worst_operations} operations, but the "
-                f"plan's length is {length}"
-            )
-        checks.append(check)
-        failures += failed
+    length = plan.stats.length
+    old = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(old, 4 * length + 200))  # the search recurses once per operation
+    try:
+        for p in indices:
+            problems += _state_problems(plan, p)
+            check, failed = _PartSearch(plan, p).run()
+            if check.worst_operations > length:
+                problems.append(
+                    f"part {check.part!r}: a run takes {check.worst_operations} operations, but "
+                    f"the plan's length is {length}"
+                )
+            checks.append(check)
+            failures += failed
+    finally:
+        sys.setrecursionlimit(old)
     longest = max(c.worst_operations for c in checks)
     if part_indices is None and not failures and longest < length:
         # every node is reachable (its states are images of every start), so some path is as
-        # long as the tree: a shorter longest path means the stated length is wrong
+        # long as the tree: a shorter longest path means a branch no part can reach
         problems.append(f"the plan's length is {length}, but no path takes more than {longest}")
     return VerificationReport(tuple(checks), tuple(failures), tuple(problems))
 
 
-def check_plan(plan: dict[str, Any] | KinematicModel) -> VerificationReport:
+def check_plan(plan: Plan | Mapping[str, Any]) -> VerificationReport:
     """Verify a plan; a failure raises CheckFailed with the first counterexample in one line."""
     report = verify_plan(plan)
+    if not report.ok:
+        raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
+    return report
+
+
+def verify_declared(
+    plan: Plan | Mapping[str, Any], part_indices: Sequence[int] | None = None
+) -> VerificationReport:
+    """Verify a plan at the uncertainty it declares: the one check every consumer calls.
+
+    A plan declaring the ideal model (or a version-1 file declaring none) is followed on the
+    kinematic model (:func:`verify_plan`); any other is a strong plan (design.md,
+    "Uncertainty"), checked for every outcome the declared uncertainty allows and every
+    reading (:func:`feederkit.plans.strong.verify_strong`), together with the file's own
+    consistency (listed states and poses against the hulls and COMs). A failure is in the
+    report (``ok`` False, ``first_problem``), not raised; structural breakage is InputError.
+    """
+    plan = as_plan(plan)
+    if plan.uncertainty.is_ideal:
+        return verify_plan(plan, part_indices)
+    from feederkit.plans.fileformat import plan_to_dict
+    from feederkit.plans.strong import verify_strong
+
+    indices = range(len(plan.parts)) if part_indices is None else part_indices
+    problems = _pose_problems(plan)
+    for p in indices:
+        problems += _state_problems(plan, p)
+    names = {plan.parts[p].name for p in indices}
+    try:
+        strong = verify_strong(plan_to_dict(plan))
+    except CheckFailed as exc:
+        unc = plan.uncertainty_words()
+        problems.append(f"at the declared uncertainty ({unc}): {exc}")
+        checks = tuple(PartCheck(plan.parts[p].name, 0, 0, 0, 0) for p in indices)
+        return VerificationReport(checks, (), tuple(problems))
+    checks = tuple(c for c in strong.parts if c.part in names)
+    return VerificationReport(checks, (), tuple(problems))
+
+
+def check_declared(plan: Plan | Mapping[str, Any]) -> VerificationReport:
+    """:func:`verify_declared`; a failure raises CheckFailed with the first problem."""
+    report = verify_declared(plan)
     if not report.ok:
         raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
     return report

@@ -26,6 +26,20 @@ def write_part_plot(part: Part, path: str | os.PathLike[str]) -> None:
     write_bytes_atomic(path, part_plot_bytes(push_function(part), fmt))
 
 
+REPORT_SUFFIXES = (".html", ".htm")
+"""The report is one HTML page; a PDF is printed from a browser (the page prints on A4)."""
+
+
+def check_report_path(path: str | os.PathLike[str]) -> None:
+    """A report file must end in .html (or .htm): a .pdf would hold HTML, so it is refused."""
+    if Path(path).suffix.lower() not in REPORT_SUFFIXES:
+        raise InputError(
+            f"{path}: the report is an HTML page: name it .html (a browser prints it to PDF on A4)"
+        )
+
+
 def write_report(path: str | os.PathLike[str], html_text: str) -> None:
-    """Write the HTML report atomically; an unwritable destination is bad input."""
+    """Write the HTML report atomically; an unwritable destination or a name that does not
+    end in .html is bad input."""
+    check_report_path(path)
     write_text_atomic(path, html_text, what="report")

@@ -20,6 +20,7 @@ import numpy as np
 
 from feederkit.angles import norm360
 from feederkit.mechanics.push import PushFunction, edge_normals, radius
+from feederkit.outline import Outline
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -83,13 +84,22 @@ def _oriented(ring: tuple[tuple[float, float], ...], ccw: bool) -> list[tuple[fl
     return list(ring) if (area2 > 0) == ccw else list(reversed(ring))
 
 
-def _draw_outline(ax: Axes, pf: PushFunction) -> None:
+def _draw_outline(ax: Axes, pf: PushFunction, outline: Outline | None = None) -> None:
+    """The outline (``outline`` when given, for its holes; else the part's), its contact hull,
+    and the stable edges labelled by state and edge, fragile ones marked.
+
+    Only stable edges are labelled: a CAD arc flattened into many short edges would otherwise
+    bury the part under "unstable" labels.
+    """
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MplPath
 
+    from feederkit.mechanics.analysis import fragile_states
+
     part = pf.part
-    rings = [_oriented(part.outline.vertices, True)]
-    rings += [_oriented(h, False) for h in part.outline.holes]
+    shape = outline if outline is not None else part.outline
+    rings = [_oriented(shape.vertices, True)]
+    rings += [_oriented(h, False) for h in shape.holes]
     verts: list[tuple[float, float]] = []
     codes: list[int] = []
     for ring in rings:
@@ -101,10 +111,16 @@ def _draw_outline(ax: Axes, pf: PushFunction) -> None:
     normals = edge_normals(part.hull)
     size = part.size
     n = len(part.hull)
+    fragile = set(fragile_states(pf))
     for s in pf.states:
         p0, p1 = np.array(part.hull[s.edge]), np.array(part.hull[(s.edge + 1) % n])
         (line,) = ax.plot(
-            [p0[0], p1[0]], [p0[1], p1[1]], color=state_colour(s.id), lw=3.2, solid_capstyle="butt"
+            [p0[0], p1[0]],
+            [p0[1], p1[1]],
+            color=state_colour(s.id),
+            lw=3.2,
+            solid_capstyle="butt",
+            ls=":" if s.id in fragile else "-",
         )
         line.set_gid(f"stable-edge-{s.id}")
         mid = (p0 + p1) / 2
@@ -113,28 +129,13 @@ def _draw_outline(ax: Axes, pf: PushFunction) -> None:
         ax.text(
             tx,
             ty,
-            f"s{s.id} e{s.edge}",
+            f"s{s.id} e{s.edge}" + (" fragile" if s.id in fragile else ""),
             ha="center",
             va="center",
             fontsize=8,
             color=state_colour(s.id),
             fontweight="bold",
         )
-    stable_edges = {s.edge for s in pf.states}
-    for e in range(n):
-        if e not in stable_edges:
-            mid = (np.array(part.hull[e]) + np.array(part.hull[(e + 1) % n])) / 2
-            u = np.array([np.cos(np.radians(normals[e])), np.sin(np.radians(normals[e]))])
-            tx, ty = mid + 0.07 * size * u
-            ax.text(
-                tx,
-                ty,
-                f"e{e} {pf.edge_kinds[e]}",
-                ha="center",
-                va="center",
-                fontsize=7,
-                color="#777",
-            )
     ax.plot([part.com[0]], [part.com[1]], "o", color="black", ms=5, label="COM")
     xs = [p[0] for p in part.hull]
     ys = [p[1] for p in part.hull]
@@ -198,8 +199,14 @@ def _draw_push_diameter(ax: Axes, pf: PushFunction) -> None:
     ax.set_title("push-diameter function: the sensor's reading", fontsize=9, loc="left")
 
 
-def part_figure(pf: PushFunction, title: str | None = None) -> Figure:
-    """The part plot of a push function's part as a matplotlib figure (Agg canvas)."""
+def part_figure(
+    pf: PushFunction, title: str | None = None, outline: Outline | None = None
+) -> Figure:
+    """The part plot of a push function's part as a matplotlib figure (Agg canvas).
+
+    Every state, edge and function is the push function's; ``outline`` only draws the plate
+    (its holes) around that part's hull.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -207,7 +214,7 @@ def part_figure(pf: PushFunction, title: str | None = None) -> Figure:
     FigureCanvasAgg(fig)
     grid = fig.add_gridspec(4, 1, height_ratios=[3.2, 1.5, 1.5, 1.5])
     ax0 = fig.add_subplot(grid[0])
-    _draw_outline(ax0, pf)
+    _draw_outline(ax0, pf, outline)
     label = title if title is not None else pf.part.name
     ax0.set_title(
         f"{label}: {pf.n} stable state{'s' if pf.n != 1 else ''}", fontsize=11, parse_math=False
@@ -233,15 +240,17 @@ def _stable_clip_ids(svg: str) -> str:
     return svg
 
 
-def part_plot_bytes(pf: PushFunction, fmt: str, title: str | None = None) -> bytes:
+def part_plot_bytes(
+    pf: PushFunction, fmt: str, title: str | None = None, outline: Outline | None = None
+) -> bytes:
     """The part plot encoded as ``png`` or ``svg`` (SVG: UTF-8, fonts drawn as paths, the same
-    bytes on every run)."""
+    bytes on every run); ``outline`` as in :func:`part_figure`."""
     import matplotlib
 
     if fmt not in FORMATS:
         raise ValueError(f"unsupported plot format {fmt!r}")
     with matplotlib.rc_context({"svg.hashsalt": "feederkit", "svg.fonttype": "path"}):
-        fig = part_figure(pf, title)
+        fig = part_figure(pf, title, outline)
         buf = io.BytesIO()
         meta = {"Date": None} if fmt == "svg" else {"Software": "feederkit"}
         fig.savefig(buf, format=fmt, dpi=120, metadata=meta)

@@ -1,8 +1,10 @@
 """The per-part section of the report: stable states drawn on the fence, and the part plot.
 
-The part is rebuilt from its plan entry (hull and COM), or from the caller's outline when one is
-given so holes show. The plot is embedded as an SVG data URI: self-contained, vector for print,
-and its element ids cannot clash with the rest of the page.
+One part model: the table and the plot both show the plan's part, its push function rebuilt
+from the hull and COM the plan records (:func:`feederkit.plans.model.push_function_of`); a
+caller's outline only draws the plate's holes around that hull. The plot is embedded as an
+SVG data URI: self-contained, vector for print, and its element ids cannot clash with the
+rest of the page.
 """
 
 from __future__ import annotations
@@ -10,26 +12,16 @@ from __future__ import annotations
 import base64
 from collections.abc import Mapping
 
-from feederkit.mechanics.push import push_function
-from feederkit.outline import Outline, make_outline
-from feederkit.part import Part, make_part
+from feederkit.outline import Outline
+from feederkit.plans.model import PlanPart, push_function_of
 from feederkit.reports.partplot import part_plot_bytes
-from feederkit.reports.planview import PartEntry
 from feederkit.reports.svgkit import esc, num, pose_svg
 from feederkit.reports.tree_html import Drawing
 
 POSE_PX = 64
 
 
-def part_of(entry: PartEntry, outlines: Mapping[str, Outline] | None) -> Part:
-    """The part a plan entry describes, with the caller's outline (and its holes) when given."""
-    outline = (outlines or {}).get(entry.name)
-    if outline is None:
-        outline = make_outline(entry.name, entry.hull, com=entry.com)
-    return make_part(outline, entry.com, name=entry.name, revision=entry.revision)
-
-
-def _states_table(entry: PartEntry, draw: Drawing) -> str:
+def _states_table(entry: PlanPart, draw: Drawing) -> str:
     rows = []
     for s in entry.states:
         svg = pose_svg(
@@ -56,32 +48,22 @@ def _states_table(entry: PartEntry, draw: Drawing) -> str:
     )
 
 
-def _numbering_note(entry: PartEntry, part: Part) -> str:
-    computed = {(s.id, s.edge) for s in push_function(part).states}
-    if computed == {(s.id, s.edge) for s in entry.states}:
-        return ""
-    return (
-        '<p class="warn">The stable states recomputed from this hull are numbered differently '
-        "from the plan's; the table follows the plan, the plot the recomputation.</p>"
-    )
-
-
 def part_section(
-    index: int, entry: PartEntry, draw: Drawing, outlines: Mapping[str, Outline] | None
+    index: int, entry: PlanPart, draw: Drawing, outlines: Mapping[str, Outline] | None
 ) -> str:
     """One part: name, stable-state table with poses, and its radius/push/push-diameter plot."""
-    part = part_of(entry, outlines)
-    svg = part_plot_bytes(push_function(part), "svg")
+    pf = push_function_of(entry)
+    outline = (outlines or {}).get(entry.name)
+    svg = part_plot_bytes(pf, "svg", outline=outline)
     uri = "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
-    rev = f' <span class="muted">rev {esc(entry.revision)}</span>' if entry.revision else ""
+    rev = f' <span class="muted">rev {esc(str(entry.revision))}</span>' if entry.revision else ""
     return (
         f'<section class="part" id="part-{index}" data-part="{esc(entry.name)}">'
         f'<h3><span class="swatch" style="background:{draw.colours[entry.name]}"></span>'
         f"{esc(entry.name)}{rev}</h3>"
-        f'<div class="part-grid"><div>{_states_table(entry, draw)}{_numbering_note(entry, part)}'
-        "</div>"
+        f'<div class="part-grid"><div>{_states_table(entry, draw)}</div>'
         f'<figure class="plot"><img src="{uri}" alt="{esc(entry.name)}: outline, radius, push '
         'and push-diameter functions"><figcaption>Outline with hull (dashed), COM and numbered '
-        "stable edges; below, over the fence orientation theta: radius, push and push-diameter "
-        "functions, resting ranges shaded.</figcaption></figure></div></section>"
+        "stable edges (dotted: fragile); below, over the fence orientation theta: radius, push "
+        "and push-diameter functions, resting ranges shaded.</figcaption></figure></div></section>"
     )

@@ -5,16 +5,14 @@ Each function returns an HTML fragment; every value that comes from outside is e
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from feederkit.errors import InputError
-from feederkit.reports.planview import PlanView, leaves
+from feederkit.plans.model import Leaf, Plan
 from feederkit.reports.svgkit import esc, num
-from feederkit.reports.trace import Confusion, plan_depth
+from feederkit.reports.trace import Confusion
 from feederkit.reports.tree_html import Drawing, path_text
-from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 
 CONVENTIONS = (
     "Part frame: the outline's own coordinates, in millimetres; the contact polygon is the "
@@ -32,39 +30,19 @@ CONVENTIONS = (
 """The conventions paragraph (design.md), used when the plan file carries none."""
 
 
-def sensor_text(sensor: Mapping[str, Any]) -> str:
-    """The sensor model and its parameters, for people."""
-    model = sensor_from_dict(dict(sensor))
-    if isinstance(model, ToleranceSensor):
-        return f"diameter sensor: a reading lies within \u00b1{num(model.tolerance, 4)} mm of it"
-    if isinstance(model, LedSensor):
-        return (
-            f"LED array: beams every {num(model.pitch, 4)} mm, alignment noise "
-            f"{num(model.noise, 4)} mm; the reading is the blocked beams times the pitch"
-        )
-    return "no sensor: a sensorless plan"
-
-
-def mix_section(view: PlanView, draw: Drawing) -> str:
+def mix_section(plan: Plan, draw: Drawing) -> str:
     """The parts of the mix (with their colours), the sensor and the plan's verdict in brief."""
     items = "".join(
         f'<li><span class="swatch" style="background:{draw.colours[p.name]}"></span>'
         f'<a href="#part-{i}">{esc(p.name)}</a>'
-        + (f' <span class="muted">rev {esc(p.revision)}</span>' if p.revision else "")
+        + (f' <span class="muted">rev {esc(str(p.revision))}</span>' if p.revision else "")
         + f' <span class="muted">\u00b7 {len(p.states)} stable states</span></li>'
-        for i, p in enumerate(view.parts)
+        for i, p in enumerate(plan.parts)
     )
     return (
         f'<section id="mix"><h2>Mix and sensor</h2><ul class="mix">{items}</ul>'
-        f"<p><strong>Sensor:</strong> {esc(sensor_text(view.sensor))}</p></section>"
+        f"<p><strong>Sensor:</strong> {esc(plan.sensor.describe())}</p></section>"
     )
-
-
-def _stat(stats: Mapping[str, Any], key: str) -> float | None:
-    v = stats.get(key)
-    if isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v):
-        return float(v)
-    return None
 
 
 def _row(label: str, value: str) -> str:
@@ -72,33 +50,47 @@ def _row(label: str, value: str) -> str:
 
 
 def stats_section(
-    view: PlanView,
+    plan: Plan,
     seconds_per_op: float | None,
     simulation: Mapping[str, Any] | None,
 ) -> str:
-    """Length, expected length, smallest margin, optimality, cycle time, simulation results."""
-    stats = view.stats
-    length = _stat(stats, "length")
-    if length is None:
-        length = float(plan_depth(view.root))
-    expected = _stat(stats, "expected_length")
-    margin = _stat(stats, "min_margin_deg")
-    bound = _stat(stats, "lower_bound")
-    optimal = stats.get("optimal")
+    """Length, expected length, smallest margin, the declared uncertainty and the certificate
+    (design.md, "Uncertainty"), optimality, cycle time, simulation results."""
+    stats = plan.stats
+    length = float(stats.length)
+    expected = stats.expected_length
+    margin = stats.min_margin_deg
+    shown_margin = "none (no rotation)" if margin is None else f"\u00b1{num(margin, 2)}\u00b0"
+    if margin is not None and margin < 0.005:
+        shown_margin = f"\u00b1{margin:.2g}\u00b0"  # never round a tiny margin to 0
     rows = [
         _row("worst-case length", f"{num(length)} push-align operations"),
-        _row("expected length", "not given" if expected is None else f"{num(expected)} operations"),
-        _row("smallest margin", "none" if margin is None else f"\u00b1{num(margin, 2)}\u00b0"),
+        _row("expected length", f"{num(expected)} operations"),
+        _row("smallest margin", esc(shown_margin)),
+        _row("declared uncertainty", esc(plan.uncertainty_words())),
     ]
-    opt = {True: "yes: no shorter plan exists", False: "not proven"}.get(optimal, "not stated")
-    if bound is not None:
-        opt += f" (lower bound {num(bound)})"
+    cert = stats.certificate
+    if cert is not None:
+        ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
+        rows += [
+            _row(
+                "certified rotation error",
+                f"up to \u00b1{num(cert.max_rotation_error_deg, 3)}\u00b0",
+            ),
+            _row("certified shape tolerance", f"up to {num(cert.max_shape_tolerance_mm, 4)} mm"),
+            _row(
+                "length: robust / ideal model",
+                f"{stats.length} / {esc(ideal)} push-align operations",
+            ),
+        ]
+    opt = "yes: no shorter plan exists" if stats.optimal else "not proven"
+    opt += f" (lower bound {stats.lower_bound})"
     rows.append(_row("optimal", esc(opt)))
     if seconds_per_op is None:
         rows.append(_row("cycle time", "give seconds per operation to see it"))
     else:
         worst = f"{num(length * seconds_per_op, 2)} s worst case"
-        mean = "" if expected is None else f"{num(expected * seconds_per_op, 2)} s expected, "
+        mean = f"{num(expected * seconds_per_op, 2)} s expected, "
         rows.append(
             _row("cycle time", f"{mean}{worst} at {num(seconds_per_op, 3)} s per operation")
         )
@@ -108,8 +100,17 @@ def stats_section(
     return f'<section id="stats"><h2>Statistics</h2>{table}</section>'
 
 
+def _count(value: object) -> int | None:
+    if isinstance(value, list | tuple):
+        return len(value)
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    return None
+
+
 def simulation_text(simulation: Mapping[str, Any]) -> str:
-    """``successes of trials (rate)`` and any other plain values the simulator reported."""
+    """The simulator's result in words: successes of trials, then what went wrong, per part
+    and how often a simulated push ended where the push function says (docs/simulation.md)."""
     trials, successes = simulation.get("trials"), simulation.get("successes")
     if (
         not isinstance(trials, int)
@@ -119,14 +120,26 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     ):
         raise InputError("simulation results need integer 'trials' and 'successes'")
     rate = f" ({num(100.0 * successes / trials, 1)}%)" if trials > 0 else ""
-    extra = [
-        f"{k} {num(v, 4) if isinstance(v, float) else v}"
-        for k, v in simulation.items()
-        if k not in ("trials", "successes") and isinstance(v, str | int | float | bool)
-    ]
-    return f"{successes} of {trials} trials oriented correctly{rate}" + (
-        f"; {', '.join(extra)}" if extra else ""
-    )
+    words = [f"{successes} of {trials} trials oriented correctly{rate}"]
+    failed, unsettled = _count(simulation.get("failures")), _count(simulation.get("unsettled"))
+    if failed is not None or unsettled is not None:
+        words.append(f"{failed or 0} ended in a wrong pose, {unsettled or 0} never settled")
+    model_errors = simulation.get("model_errors")
+    if isinstance(model_errors, int) and not isinstance(model_errors, bool):
+        words.append(f"{model_errors} went where the plan's model did not predict (model errors)")
+    per_part = simulation.get("per_part")
+    if isinstance(per_part, list) and len(per_part) > 1:
+        words.append(
+            ", ".join(
+                f"{p.get('part')}: {p.get('successes')} of {p.get('trials')}"
+                for p in per_part
+                if isinstance(p, Mapping)
+            )
+        )
+    agree, settled = simulation.get("push_agreements"), simulation.get("settled_pushes")
+    if isinstance(agree, int) and isinstance(settled, int) and settled > 0:
+        words.append(f"{agree} of {settled} settled pushes ended where the push function says")
+    return "; ".join(words)
 
 
 def _states(ids: Sequence[object]) -> str:
@@ -140,42 +153,63 @@ def _pairing(a: str, b: str, states_a: Sequence[object], states_b: Sequence[obje
     return f"{a}: {_states(states_a)}; {b}: {_states(states_b)}"
 
 
-def _plan_rows(confusions: Sequence[Confusion]) -> list[str]:
-    """One row per pair of parts the plan's leaves hold together, every such leaf a witness."""
-    grouped: dict[tuple[str, str], list[Confusion]] = {}
+def _unique(items: Sequence[str]) -> list[str]:
+    return list(dict.fromkeys(items))
+
+
+def _rows(confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]) -> list[str]:
+    """One row per pair of parts, whichever order they are named in: the plan's leaves that
+    hold both (each a witness) and the mix analysis's reason; no pairing listed twice."""
+    rows: dict[frozenset[str], dict[str, Any]] = {}
+
+    def row(a: str, b: str, source: str) -> dict[str, Any]:
+        key = frozenset((a, b))
+        if key not in rows:
+            rows[key] = {"a": a, "b": b, "source": source, "states": [], "paths": [], "why": []}
+        return rows[key]
+
     for c in confusions:
-        grouped.setdefault((c.part_a, c.part_b), []).append(c)
-    rows = []
-    for (a, b), cs in grouped.items():
-        states = "; ".join(_pairing(a, b, c.states_a, c.states_b) for c in cs)
-        paths = "".join(f"<li>leaf {c.node_id}: {esc(path_text(c.path))}</li>" for c in cs)
-        rows.append(
-            f'<tr class="pair" data-source="plan"><td>{esc(a)}</td><td>{esc(b)}</td>'
-            f"<td>{esc(states)}</td><td>the plan ends with both at<ul>{paths}</ul></td></tr>"
-        )
-    return rows
-
-
-def _given_rows(given: Sequence[Mapping[str, Any]]) -> list[str]:
-    """Rows for the pairs the mix analysis found, with its reason."""
-    rows = []
+        r = row(c.part_a, c.part_b, "plan")
+        r["states"].append(_pairing(c.part_a, c.part_b, c.states_a, c.states_b))
+        r["paths"].append(f"leaf {c.node_id}: {path_text(c.path)}")
     for i, pair in enumerate(given):
         if not isinstance(pair, Mapping):
             raise InputError(f"unrecognizable pair {i} must be a mapping")
         a, b = str(pair.get("part_a", "?")), str(pair.get("part_b", "?"))
-        states = _pairing(a, b, list(pair.get("states_a") or []), list(pair.get("states_b") or []))
-        rows.append(
-            f'<tr class="pair" data-source="mix"><td>{esc(a)}</td><td>{esc(b)}</td>'
-            f"<td>{esc(states)}</td><td>{esc(pair.get('reason', ''))}</td></tr>"
+        r = row(a, b, "mix")
+        if r["a"] != a:  # named the other way round: keep the row's order
+            a, b = b, a
+            sa, sb = pair.get("states_b"), pair.get("states_a")
+        else:
+            sa, sb = pair.get("states_a"), pair.get("states_b")
+        if r["source"] == "mix":
+            r["states"].append(_pairing(a, b, list(sa or []), list(sb or [])))
+        if pair.get("reason"):
+            r["why"].append(str(pair["reason"]))
+    out = []
+    for r in rows.values():
+        witness = ""
+        if r["paths"]:
+            items = "".join(f"<li>{esc(p)}</li>" for p in _unique(r["paths"]))
+            witness = f"the plan ends with both at<ul>{items}</ul>"
+        why = "; ".join(_unique(r["why"]))
+        out.append(
+            f'<tr class="pair" data-source="{r["source"]}"><td>{esc(r["a"])}</td>'
+            f"<td>{esc(r['b'])}</td><td>{esc('; '.join(_unique(r['states'])))}</td>"
+            f"<td>{esc(why)}{' ' if why and witness else ''}{witness}</td></tr>"
         )
-    return rows
+    return out
 
 
 def lookalike_section(
-    view: PlanView, confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]
+    plan: Plan,
+    confusions: Sequence[Confusion],
+    given: Sequence[Mapping[str, Any]],
+    symmetric: Sequence[tuple[int, Leaf]] = (),
 ) -> str:
-    """Pairs of parts that cannot be told apart, with their witnesses, and symmetric leaves."""
-    rows = _plan_rows(confusions) + _given_rows(given)
+    """Pairs of parts that cannot be told apart, with their witnesses, and symmetric leaves
+    (``symmetric``: the numbered leaves)."""
+    rows = _rows(confusions, given)
     if rows:
         body = (
             "<p>These parts behave alike under every push-align operation the sensor can "
@@ -183,20 +217,18 @@ def lookalike_section(
             '<table class="grid"><tr><th>part</th><th>look-alike</th>'
             f"<th>inseparable states</th><th>witness</th></tr>{''.join(rows)}</table>"
         )
-    elif len(view.parts) > 1:
+    elif len(plan.parts) > 1:
         body = "<p>Every part of the mix is recognized: no leaf of the plan holds two parts.</p>"
     else:
         body = "<p>One part only: nothing to recognize.</p>"
     sym = [
-        leaf
-        for leaf in leaves(view.root)
-        if len({r.part for r in leaf.results}) == 1 and len(leaf.results) > 1
+        c for c in symmetric if len({r.part for r in c[1].results}) == 1 and len(c[1].results) > 1
     ]
     if sym:
         items = "".join(
             f"<li>{esc(leaf.results[0].part)}: states "
-            f"{esc(_states([r.state for r in leaf.results]))} at leaf {leaf.node_id}</li>"
-            for leaf in sym
+            f"{esc(_states([r.state for r in leaf.results]))} at leaf {node_id}</li>"
+            for node_id, leaf in sym
         )
         body += (
             "<p>Oriented up to symmetry (poses no plan tells apart; each is a correct answer):"
@@ -205,9 +237,9 @@ def lookalike_section(
     return f'<section id="lookalikes"><h2>Parts the plan cannot tell apart</h2>{body}</section>'
 
 
-def conventions_section(view: PlanView) -> str:
+def conventions_section(plan: Plan) -> str:
     """The conventions in one paragraph, and how the drawings show them."""
-    text = view.conventions or CONVENTIONS
+    text = plan.conventions or CONVENTIONS
     return (
         f'<section id="conventions"><h2>Conventions</h2><p>{esc(text)}</p>'
         "<p>Drawings: each part is seen from above, resting on the fence (the dark bar) with the "

@@ -12,6 +12,9 @@ h2 { font-size: 1.2rem; margin: 1.6rem 0 .5rem; padding-bottom: .2rem;
 h3 { font-size: 1.05rem; margin: 1.2rem 0 .4rem; }
 .muted { color: var(--muted); font-weight: normal; }
 .warn { color: var(--warn); }
+.banner { border: 2px solid var(--warn); background: #fbeaea; color: var(--warn);
+  padding: 0.5em 0.8em; margin: 0.6em 0; font-weight: bold; }
+.banner.caution { border-color: #b7791f; background: #fdf6e3; color: #8a5a00; }
 .lead { font-size: 1.05rem; margin: .2rem 0 .8rem; }
 .swatch { display: inline-block; width: .9em; height: .9em; border-radius: 2px;
   margin-right: .4em; vertical-align: -0.1em; border: 1px solid #0003; }

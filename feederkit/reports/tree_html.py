@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from feederkit.reports.planview import Branch, Node, OpNode, PlanView, ResultNode
+from feederkit.plans.model import Branch, Leaf, Plan, Step
 from feederkit.reports.svgkit import Ring, esc, num, part_colour, pose_svg, reach
-from feederkit.reports.trace import StateKey, Step, Trace
+from feederkit.reports.trace import Place, StateKey, Trace, TraceStep
 
 STATE_PX = 56
 """Drawn size of a possible state inside an operation node."""
@@ -32,12 +32,12 @@ class Drawing:
     radius_mm: float
 
 
-def drawing_for(view: PlanView, rings: Mapping[str, Sequence[Ring]]) -> Drawing:
+def drawing_for(plan: Plan, rings: Mapping[str, Sequence[Ring]]) -> Drawing:
     """One common scale for the whole mix, a colour per part in plan order."""
     return Drawing(
         rings=rings,
-        colours={p.name: part_colour(i) for i, p in enumerate(view.parts)},
-        radius_mm=max(reach(p.hull, p.com) for p in view.parts),
+        colours={p.name: part_colour(i) for i, p in enumerate(plan.parts)},
+        radius_mm=max(reach(p.hull, p.com) for p in plan.parts),
     )
 
 
@@ -58,7 +58,7 @@ def action_text(action_deg: float | None) -> str:
     return f"rotate {num(action_deg, 2)}\u00b0 ccw"
 
 
-def path_text(path: Sequence[Step]) -> str:
+def path_text(path: Sequence[TraceStep]) -> str:
     """The operations and readings that lead to a node, as one line."""
     if not path:
         return "before the first alignment"
@@ -66,11 +66,11 @@ def path_text(path: Sequence[Step]) -> str:
 
 
 def _state_figure(
-    view: PlanView, draw: Drawing, key: StateKey, cls: str, px: int, pose: float | None = None
+    plan: Plan, draw: Drawing, key: StateKey, cls: str, px: int, pose: float | None = None
 ) -> str:
     """A state drawn on the fence; ``pose`` (deg) overrides the state's own pose."""
     name, sid = key
-    part = view.part(name)
+    part = plan.part(name)
     state = part.state(sid)
     pose_deg = state.pose_deg if pose is None else pose
     title = f"{name}, state {sid} (edge {state.edge}) on the fence, pose {num(pose_deg, 1)} deg"
@@ -92,7 +92,7 @@ def _state_figure(
     )
 
 
-def _edge(parent: OpNode, branch: Branch) -> str:
+def _edge(parent: Step, branch: Branch) -> str:
     action = "" if parent.action_deg is None else num(parent.action_deg, 6)
     reading = ""
     if branch.reading is not None:
@@ -104,11 +104,13 @@ def _edge(parent: OpNode, branch: Branch) -> str:
     )
 
 
-def _op_node(view: PlanView, trace: Trace, draw: Drawing, node: OpNode) -> str:
-    here = trace.states[node.node_id]
-    figures = "".join(_state_figure(view, draw, k, "state", STATE_PX) for k in here)
+def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place) -> str:
+    node = place.node
+    assert isinstance(node, Step)
+    here = trace.states[place.node_id]
+    figures = "".join(_state_figure(plan, draw, k, "state", STATE_PX) for k in here)
     count = f"{len(here)} possible state{'s' if len(here) != 1 else ''}"
-    if node.node_id == 0:
+    if place.node_id == 0:
         count = f"any orientation: {len(here)} stable states after the first alignment"
     margin = "" if node.margin_deg is None else f" (margin \u00b1{num(node.margin_deg, 2)}\u00b0)"
     read = ", read" if any(b.reading is not None for b in node.branches) else ""
@@ -117,19 +119,21 @@ def _op_node(view: PlanView, trace: Trace, draw: Drawing, node: OpNode) -> str:
     else:
         step = f"next: {action_text(node.action_deg)}{margin}, align{read}"
     return (
-        f'<div class="tree-node op" data-node-id="{node.node_id}" data-depth="{node.depth}" '
+        f'<div class="tree-node op" data-node-id="{place.node_id}" data-depth="{place.depth}" '
         f'data-states="{len(here)}"><div class="node-head">'
-        f"<strong>operation {node.depth + 1}</strong> "
-        f'<span class="muted">node {node.node_id} \u00b7 {esc(count)}</span></div>'
+        f"<strong>operation {place.depth + 1}</strong> "
+        f'<span class="muted">node {place.node_id} \u00b7 {esc(count)}</span></div>'
         f'<div class="poses">{figures}</div>'
         f'<div class="node-op">{esc(step)}</div></div>'
     )
 
 
-def _result_node(view: PlanView, trace: Trace, draw: Drawing, node: ResultNode) -> str:
+def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place) -> str:
+    node = place.node
+    assert isinstance(node, Leaf)
     keys = [(r.part, r.state) for r in node.results]
     figures = "".join(
-        _state_figure(view, draw, (r.part, r.state), "final-pose", FINAL_PX, r.pose_deg)
+        _state_figure(plan, draw, (r.part, r.state), "final-pose", FINAL_PX, r.pose_deg)
         for r in node.results
     )
     parts = {r.part for r in node.results}
@@ -143,7 +147,7 @@ def _result_node(view: PlanView, trace: Trace, draw: Drawing, node: ResultNode) 
         head = f"not recognized: {len(parts)} parts end here together"
         kind = "confused"
     note = ""
-    reached = set(trace.states[node.node_id])
+    reached = set(trace.states[place.node_id])
     if reached != set(keys):
         got = ", ".join(f"{p} s{s}" for p, s in sorted(reached)) or "none"
         note = (
@@ -151,21 +155,35 @@ def _result_node(view: PlanView, trace: Trace, draw: Drawing, node: ResultNode) 
             f"{esc(got)}.</p>"
         )
     return (
-        f'<div class="tree-node result {kind}" data-node-id="{node.node_id}" '
-        f'data-depth="{node.depth}" data-states="{len(node.results)}">'
+        f'<div class="tree-node result {kind}" data-node-id="{place.node_id}" '
+        f'data-depth="{place.depth}" data-states="{len(node.results)}">'
         f'<div class="node-head"><strong>{esc(head)}</strong> '
-        f'<span class="muted">node {node.node_id}</span></div>'
+        f'<span class="muted">node {place.node_id}</span></div>'
         f'<div class="poses">{figures}</div>{note}</div>'
     )
 
 
-def _subtree(view: PlanView, trace: Trace, draw: Drawing, node: Node, edge: str) -> str:
-    if isinstance(node, ResultNode):
-        return f"<li>{edge}{_result_node(view, trace, draw, node)}</li>"
-    children = "".join(_subtree(view, trace, draw, b.next, _edge(node, b)) for b in node.branches)
-    return f"<li>{edge}{_op_node(view, trace, draw, node)}<ul>{children}</ul></li>"
-
-
-def tree_html(view: PlanView, trace: Trace, draw: Drawing) -> str:
-    """The whole plan as nested lists: operation nodes, labelled edges, leaves."""
-    return f'<ul class="tree">{_subtree(view, trace, draw, view.root, "")}</ul>'
+def tree_html(plan: Plan, numbered: Sequence[Place], trace: Trace, draw: Drawing) -> str:
+    """The whole plan as nested lists: operation nodes, labelled edges, leaves (no recursion)."""
+    out: list[str] = ['<ul class="tree">']
+    stack: list[str | tuple[int, str]] = [(0, "")]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            out.append(item)
+            continue
+        number, edge = item
+        place = numbered[number]
+        if isinstance(place.node, Leaf):
+            out.append(f"<li>{edge}{_result_node(plan, trace, draw, place)}</li>")
+            continue
+        out.append(f"<li>{edge}{_op_node(plan, trace, draw, place)}<ul>")
+        stack.append("</ul></li>")
+        step = place.node
+        stack.extend(
+            reversed(
+                [(k, _edge(step, b)) for b, k in zip(step.branches, place.children, strict=True)]
+            )
+        )
+    out.append("</ul>")
+    return "".join(out)

@@ -1,35 +1,54 @@
 """The simulator's library API: one push-align operation, and a plan over many trials.
 
 ``simulate_push`` drops one part at one fence orientation and compares the outcome with
-the push function (section 3.1). ``simulate_plan`` executes a plan file's tree (design.md)
-trial by trial, each trial a part of the plan's mix at a uniformly random orientation.
+the push function (section 3.1). ``simulate_plan`` executes a plan's tree (design.md)
+trial by trial, each trial a part of the plan's mix at a uniformly random orientation,
+sampling the plan's declared uncertainty and the friction (:mod:`feederkit.sim.sampling`).
 
 A run with failures is data, not an error: ``simulate_plan`` returns the summary whatever
-the success rate; only bad input raises (InputError).
+the success rate. Bad input raises InputError; a plan that fails verification at its
+declared uncertainty (``feederkit.plans.verify.check_declared``) raises CheckFailed before
+any trial runs, as ``run`` and ``report`` refuse it too.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
 from feederkit.errors import InputError
 from feederkit.mechanics.push import StableState, push, push_function
 from feederkit.part import Part
-from feederkit.sim.planfile import read_plan
+from feederkit.plans.fileformat import as_plan, plan_to_dict
+from feederkit.plans.model import Plan, push_function_of
+from feederkit.plans.verify import check_declared
 from feederkit.sim.pushalign import PushAligner, PushOutcome, SettleRule
+from feederkit.sim.sampling import (
+    FrictionRange,
+    draw_rotation_error,
+    draw_trial,
+    friction_range,
+    nature_rng,
+    perturbed_part,
+)
 from feederkit.sim.scene import SceneConfig
 from feederkit.sim.summary import PushMiss, SimSettings, SimulationSummary, TrialResult
-from feederkit.sim.trial import divergent_distance, run_trial
+from feederkit.sim.trial import TrialModel, divergent_distance, run_trial
+from feederkit.uncertainty import IDEAL
 
 DEFAULT_BELT_SPEED = 0.1
 DEFAULT_FRICTION_BELT = 0.5
 DEFAULT_FRICTION_FENCE = 0.2
+DEFAULT_FRICTION_BELT_RANGE = FrictionRange(0.4, 0.6)
+"""Belt friction drawn per trial: a rubber or PU belt on a delrin part, ±20 % about 0.5."""
+DEFAULT_FRICTION_FENCE_RANGE = FrictionRange(0.1, 0.3)
+"""Fence friction drawn per trial: a polished steel or UHMW fence, 0.2 ± 0.1."""
 
 Progress = Callable[[int, int], None]
 """Called as ``progress(done, total)`` after each trial."""
@@ -101,37 +120,82 @@ def simulate_push(
     return PushCheck(out, state, push(pf, theta_deg), divergent_distance(pf, theta_deg))
 
 
+def _models(plan: Plan) -> dict[str, TrialModel]:
+    """Each part's model at the plan's declared uncertainty (the one it was verified on)."""
+    from feederkit.plans.strong import strong_model
+
+    model = strong_model(plan_to_dict(plan))
+    return {
+        name: TrialModel(mech, diam, plan.sensor)
+        for name, mech, diam in zip(model.names, model.mechanics, model.diameters, strict=True)
+    }
+
+
 def simulate_plan(
-    plan: dict,
+    plan: Plan | Mapping[str, Any],
     trials: int,
     seed: int,
-    rotation_noise_deg: float = 0.0,
+    rotation_noise_deg: float | None = None,
     belt_speed: float = DEFAULT_BELT_SPEED,
-    friction_belt: float = DEFAULT_FRICTION_BELT,
-    friction_fence: float = DEFAULT_FRICTION_FENCE,
+    friction_belt: float | str | tuple[float, float] | FrictionRange | None = None,
+    friction_fence: float | str | tuple[float, float] | FrictionRange | None = None,
     progress: Progress | None = None,
     *,
+    ideal: bool = False,
     rule: SettleRule | None = None,
+    check: bool = True,
+    config: SceneConfig | None = None,
 ) -> SimulationSummary:
-    """Simulate a plan file's JSON object over ``trials`` trials.
+    """Simulate a plan (or a plan file's JSON object, checked) over ``trials`` trials.
 
     Each trial draws a part of the mix uniformly and a start orientation uniformly on the
-    circle; every robot rotation gets an error drawn uniformly from
-    ``[-rotation_noise_deg, +rotation_noise_deg]``. Trial ``i`` uses its own generator
-    seeded with ``(seed, i)``, so a trial's outcome does not depend on the others.
+    circle, and (unless ``ideal``) nature's draw (:mod:`feederkit.sim.sampling`): a part
+    perturbed within the declared shape and COM tolerances, the friction coefficients from
+    their ranges (``friction_*``: a number, ``LO:HI`` or a pair; default
+    ``DEFAULT_FRICTION_*_RANGE``), and per rotation an error uniform in ``[-r, +r]``, ``r``
+    the declared rotation error (``rotation_noise_deg`` overrides it, to stress a plan beyond
+    its claim). Trial ``i`` draws from generators seeded with ``(seed, i)``, so a trial's
+    outcome does not depend on the others. Every operation is judged by the plan's model.
+
+    The plan is verified at its declared uncertainty first (CheckFailed when it fails);
+    ``check=False`` skips that, to watch how a plan known to be wrong fails physically.
     """
     if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
         raise InputError(f"--trials must be a positive integer, got {trials!r}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"--seed must be a non-negative integer, got {seed!r}")
-    if not (math.isfinite(rotation_noise_deg) and 0.0 <= rotation_noise_deg <= 180.0):
+    if rotation_noise_deg is not None and not (
+        math.isfinite(rotation_noise_deg) and 0.0 <= rotation_noise_deg <= 180.0
+    ):
         raise InputError(
             f"--rotation-noise must be in [0, 180] degrees, got {rotation_noise_deg:g}"
         )
-    config = scene_config(belt_speed, friction_belt, friction_fence)
+    fb = _range(friction_belt, DEFAULT_FRICTION_BELT_RANGE, "--friction-belt")
+    ff = _range(friction_fence, DEFAULT_FRICTION_FENCE_RANGE, "--friction-fence")
+    if fb.lo <= 0.0:
+        raise InputError(
+            "--friction-belt must be positive: a frictionless belt cannot carry the part"
+        )
+    base = scene_config(belt_speed, fb.nominal, ff.hi if ff.hi > 0.0 else 0.0)
+    if config is not None:
+        base = replace(config, belt_speed=base.belt_speed)
     rule = rule or SettleRule()
-    sim_plan = read_plan(plan)
-    aligners = {pp.name: PushAligner(pp.part, config, rule) for pp in sim_plan.parts}
+    sim_plan = as_plan(plan)
+    if check:
+        check_declared(sim_plan)
+    sampled = IDEAL if ideal else sim_plan.uncertainty
+    noise = (
+        0.0
+        if ideal
+        else (
+            sampled.rotation_error_deg if rotation_noise_deg is None else float(rotation_noise_deg)
+        )
+    )
+    shapes = sampled.shape_tolerance_mm > 0.0 or sampled.com_tolerance_mm > 0.0
+    aligners = {
+        pp.name: PushAligner(push_function_of(pp).part, base, rule) for pp in sim_plan.parts
+    }
+    models = _models(sim_plan)
     names = [pp.name for pp in sim_plan.parts]
     t0 = time.perf_counter()
     results: list[TrialResult] = []
@@ -139,13 +203,38 @@ def simulate_plan(
         rng = np.random.default_rng([seed, i])
         name = names[int(rng.integers(len(names)))]
         start = float(rng.uniform(0.0, 360.0))
+        pp = sim_plan.part(name)
+        aligner, edges = aligners[name], None
+        if ideal:
+            draw = None
+            aligner.set_friction(fb.nominal, ff.nominal)
 
-        def error(rng: np.random.Generator = rng) -> float:
-            if rotation_noise_deg == 0.0:
+            def error() -> float:
                 return 0.0
-            return float(rng.uniform(-rotation_noise_deg, rotation_noise_deg))
 
-        results.append(run_trial(sim_plan, name, aligners[name], start, error, index=i))
+        else:
+            nature = nature_rng(seed, i)
+            draw = draw_trial(nature, len(pp.hull), sampled, fb, ff)
+            if shapes:
+                perturbed = perturbed_part(pp, push_function_of(pp), draw)
+                aligner = PushAligner(perturbed.part, base, rule, scale=aligners[name].scale)
+                edges = perturbed.basin_of_edge
+            aligner.set_friction(draw.friction_belt, draw.friction_fence)
+
+            def error(nature: np.random.Generator = nature) -> float:
+                return draw_rotation_error(nature, noise)
+
+        result = run_trial(
+            sim_plan,
+            name,
+            aligner,
+            start,
+            error,
+            index=i,
+            model=models[name],
+            state_of_edge=edges,
+        )
+        results.append(replace(result, draw=draw))
         if progress is not None:
             progress(i + 1, trials)
     wall = time.perf_counter() - t0
@@ -165,15 +254,25 @@ def simulate_plan(
         for r, p in settled
         if not p.agrees
     )
+
+    def wrong(outcome: str) -> tuple[TrialResult, ...]:
+        rows = [r for r in results if r.outcome == outcome]
+        return tuple(sorted(rows, key=lambda r: (bool(r.predicted), r.index)))
+
     return SimulationSummary(
         settings=SimSettings(
             trials=trials,
             seed=seed,
-            rotation_noise_deg=float(rotation_noise_deg),
-            belt_speed=config.belt_speed,
-            friction_belt=config.friction_belt,
-            friction_fence=config.friction_fence,
-            timestep=config.timestep,
+            rotation_noise_deg=noise,
+            belt_speed=base.belt_speed,
+            friction_belt=fb.nominal,
+            friction_fence=ff.nominal,
+            timestep=base.timestep,
+            sampled=sampled,
+            ideal=ideal,
+            friction_belt_range=fb,
+            friction_fence_range=ff,
+            contact=contact_words(base),
         ),
         parts=tuple(names),
         part_trials=tuple(sum(r.part == n for r in results) for n in names),
@@ -181,14 +280,34 @@ def simulate_plan(
             sum(r.part == n and r.outcome == "success" for r in results) for n in names
         ),
         scales=tuple(aligners[n].scale for n in names),
-        min_margin_deg=sim_plan.min_margin_deg,
+        min_margin_deg=sim_plan.stats.min_margin_deg,
         successes=sum(r.outcome == "success" for r in results),
-        failures=tuple(r for r in results if r.outcome == "failure"),
-        unsettled=tuple(r for r in results if r.outcome == "unsettled"),
+        failures=wrong("failure"),
+        unsettled=wrong("unsettled"),
         pushes=len(pushes),
         settled_pushes=len(settled),
         push_agreements=len(settled) - len(misses),
         push_misses=misses,
         wall_time_s=wall,
         sim_time_s=sum(p.sim_time_s for _, p in pushes),
+    )
+
+
+def _range(
+    value: float | str | tuple[float, float] | FrictionRange | None,
+    default: FrictionRange,
+    label: str,
+) -> FrictionRange:
+    if value is None:
+        return default
+    if isinstance(value, FrictionRange):
+        return friction_range((value.lo, value.hi), label)
+    return friction_range(value, label)
+
+
+def contact_words(config: SceneConfig) -> str:
+    """The contact settings in words (docs/simulation.md says why these)."""
+    return (
+        f"{config.cone} cones, impratio {config.impratio:g}, "
+        f"{config.iterations} iterations, noslip_iterations {config.noslip_iterations}"
     )

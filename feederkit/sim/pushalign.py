@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.angles import norm360
+from feederkit.errors import InputError
 from feederkit.mechanics.push import com_feet, edge_normals
 from feederkit.part import Part
 from feederkit.sim.engine import require_mujoco
@@ -142,6 +143,43 @@ class PushAligner:
         self._body = m.body("part").id
         self._size = float(np.max(np.linalg.norm(hull, axis=1)))
         self._wrap = 0.5  # metres of belt travel before the slab is moved back
+
+    def set_friction(self, belt: float, fence: float) -> None:
+        """Set the belt's and the fence's friction coefficients for the next operations (the
+        belt and fence carry ``priority``, so theirs are the contacts' coefficients)."""
+        m = self.model
+        m.geom_friction[m.geom("belt").id][0] = belt
+        m.geom_friction[m.geom("fence").id][0] = fence
+
+    def resting_drift(self, theta_deg: float, seconds: float) -> tuple[float, float, float]:
+        """Creep of a settled part: align at ``theta_deg``, then keep the belt running for
+        ``seconds`` and return how far the part turned (deg) and slid along the fence and
+        away from it (mm, in the part's own units). A quasi-static part held by the fence
+        should not move at all; what it does is MuJoCo's soft-contact creep
+        (docs/simulation.md compares contact settings by it). Raises InputError when the
+        part never settles."""
+        out = self.align(theta_deg)
+        if not out.settled:
+            raise InputError(f"the part never settled from {theta_deg:g} deg: no drift to measure")
+        mj, m, d = self._mj, self.model, self.data
+        to_mm = MM * self.scale
+        yaw0, x0 = self._theta(), float(d.xpos[self._body][0])
+        lo0, _ = self._extent_y()
+        unwrapped, prev = 0.0, yaw0
+        for _ in range(math.ceil(seconds / m.opt.timestep)):
+            d.qvel[self._bv] = -self.config.belt_speed
+            mj.mj_step(m, d)
+            if d.qpos[self._bq] < -self._wrap:
+                d.qpos[self._bq] += self._wrap
+            theta = self._theta()
+            unwrapped += _signed_delta(prev, theta)
+            prev = theta
+        lo, _ = self._extent_y()
+        return (
+            abs(unwrapped),
+            abs(float(d.xpos[self._body][0]) - x0) / to_mm,
+            abs(lo - lo0) / to_mm,
+        )
 
     # -- reading the state ------------------------------------------------------------
     def _theta(self) -> float:

@@ -45,6 +45,8 @@ class SceneConfig:
     solref: tuple[float, float] = (0.02, 1.0)
     cone: str = "elliptic"
     iterations: int = 50
+    impratio: float = 1.0
+    noslip_iterations: int = 0
 
     def thickness_for(self, size_mm: float) -> float:
         """Plate thickness (mm) used for a part whose larger bounding-box side is ``size_mm``."""
@@ -93,7 +95,8 @@ def scene_xml(part: Part, config: SceneConfig, scale: float = 1.0) -> str:
     return f"""<mujoco model="feederkit-push-align">
   <compiler angle="radian" boundmass="1e-9" boundinertia="1e-15"/>
   <option timestep="{config.timestep:.10g}" gravity="0 0 -9.81" integrator="implicitfast"
-          cone="{config.cone}" iterations="{config.iterations}">
+          cone="{config.cone}" iterations="{config.iterations}" impratio="{config.impratio:.6g}"
+          noslip_iterations="{config.noslip_iterations}">
     <flag multiccd="enable"/>
   </option>
   <asset>

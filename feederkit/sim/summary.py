@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from feederkit.sim.sampling import FrictionRange, TrialDraw
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 
 def _r(x: float | None, nd: int = 4) -> float | None:
@@ -39,6 +42,7 @@ class PushRecord:
     reading: float | None
     branch: int | None
     sim_time_s: float
+    in_model: bool = True
 
     @property
     def agrees(self) -> bool:
@@ -63,6 +67,7 @@ class PushRecord:
             "reading": _r(self.reading),
             "branch": self.branch,
             "sim_time_s": _r(self.sim_time_s),
+            "in_model": self.in_model,
         }
 
 
@@ -71,7 +76,10 @@ class TrialResult:
     """One trial: a part of the plan's mix dropped at ``start_deg`` and the plan executed.
 
     ``outcome`` is ``success``, ``failure`` or ``unsettled``; for the last two ``step`` is
-    the push-align operation that went wrong (1 = the first alignment) and ``reason`` says how.
+    the push-align operation that went wrong (1 = the first alignment), ``reason`` says how,
+    ``cause`` is what broke (``feederkit.sim.trial.CAUSES``) and ``predicted`` whether the
+    plan's model allowed everything that happened (False: a model error). ``draw`` is nature's
+    draw for the trial (None under ``--ideal``: nothing drawn).
     """
 
     index: int
@@ -82,6 +90,9 @@ class TrialResult:
     reason: str | None
     final_state: int | None
     pushes: tuple[PushRecord, ...]
+    cause: str | None = None
+    predicted: bool | None = None
+    draw: TrialDraw | None = None
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
@@ -91,7 +102,10 @@ class TrialResult:
             "start_deg": _r(self.start_deg),
             "outcome": self.outcome,
             "step": self.step,
+            "cause": self.cause,
+            "predicted": self.predicted,
             "reason": self.reason,
+            "draw": None if self.draw is None else self.draw.to_dict(),
             "final_state": self.final_state,
             "pushes": [p.to_dict() for p in self.pushes],
         }
@@ -126,7 +140,13 @@ class PushMiss:
 
 @dataclass(frozen=True)
 class SimSettings:
-    """The settings of a simulation run (SI units, degrees)."""
+    """The settings of a simulation run (SI units, degrees).
+
+    ``sampled`` is the uncertainty drawn from (the plan's declared one, IDEAL under
+    ``--ideal``); ``rotation_noise_deg`` the rotation error actually drawn (the declared one
+    unless overridden); ``friction_belt`` and ``friction_fence`` the nominal coefficients and
+    ``*_range`` the ranges drawn from.
+    """
 
     trials: int
     seed: int
@@ -135,17 +155,29 @@ class SimSettings:
     friction_belt: float
     friction_fence: float
     timestep: float
+    sampled: Uncertainty = IDEAL
+    ideal: bool = False
+    friction_belt_range: FrictionRange | None = None
+    friction_fence_range: FrictionRange | None = None
+    contact: str = field(default="")
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
+        fb = self.friction_belt_range or FrictionRange(self.friction_belt, self.friction_belt)
+        ff = self.friction_fence_range or FrictionRange(self.friction_fence, self.friction_fence)
         return {
             "trials": self.trials,
             "seed": self.seed,
+            "ideal": self.ideal,
+            "sampled_uncertainty": self.sampled.to_dict(),
             "rotation_noise_deg": self.rotation_noise_deg,
             "belt_speed_m_s": self.belt_speed,
             "friction_belt": self.friction_belt,
             "friction_fence": self.friction_fence,
+            "friction_belt_range": [fb.lo, fb.hi],
+            "friction_fence_range": [ff.lo, ff.hi],
             "timestep_s": self.timestep,
+            "contact": self.contact,
         }
 
 
@@ -190,12 +222,36 @@ class SimulationSummary:
         """Fraction of settled pushes that agree with the push function (1.0 when none)."""
         return self.push_agreements / self.settled_pushes if self.settled_pushes else 1.0
 
+    @property
+    def went_wrong(self) -> tuple[TrialResult, ...]:
+        """Every failed or unsettled trial, those the model did not predict (model errors)
+        first, then by trial."""
+        rows = list(self.failures) + list(self.unsettled)
+        return tuple(sorted(rows, key=lambda r: (bool(r.predicted), r.index)))
+
+    @property
+    def model_errors(self) -> int:
+        """Trials that went wrong where the plan's model did not predict what happened."""
+        return sum(not r.predicted for r in self.went_wrong)
+
+    def by_cause(self) -> dict[str, int]:
+        """How many trials went wrong by each cause (``feederkit.sim.trial.CAUSES``)."""
+        out: dict[str, int] = {}
+        for r in self.went_wrong:
+            key = r.cause or "unknown"
+            out[key] = out.get(key, 0) + 1
+        return out
+
     def to_dict(self) -> dict[str, object]:
-        """JSON-ready form (``--json``): integers ``trials`` and ``successes``, the failures."""
+        """JSON-ready form (``--json``): integers ``trials`` and ``successes``, the failures
+        (model errors first)."""
         return {
             "trials": self.trials,
             "successes": self.successes,
             "success_rate": _r(self.success_rate, 6),
+            "model_errors": self.model_errors,
+            "by_cause": self.by_cause(),
+            "went_wrong": [r.to_dict() for r in self.went_wrong],
             "failures": [f.to_dict() for f in self.failures],
             "unsettled": [u.to_dict() for u in self.unsettled],
             "pushes": self.pushes,

@@ -4,18 +4,29 @@ A controller executes a node by rotating the part by ``action_deg`` (none at the
 letting it align, reading the width and following the branch whose closed interval holds
 the reading (design.md). Here the rotation starts from where the part really rests in the
 simulation, the robot adds its rotation error, and MuJoCo does the aligning.
+
+Every operation is compared with the plan's own model (:class:`TrialModel`: the mechanics of
+the declared uncertainty, :mod:`feederkit.mechanics.uncertain`): the outcome set the model
+allows after the rotation from where the part rested, and the readings it allows there. A
+failed trial names its step, its cause and whether the model predicted what happened; an
+outcome the model did not predict is a model error, not a fault of the plan.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 from feederkit.angles import norm360
 from feederkit.mechanics.push import PushFunction, push
-from feederkit.sim.planfile import Leaf, PlanPart, SimPlan, Step
+from feederkit.mechanics.uncertain import UncertainMechanics, outcome_set
+from feederkit.plans.model import Leaf, Plan, PlanPart, Step, push_function_of
+from feederkit.sensors import Sensor
 from feederkit.sim.pushalign import PushAligner
-from feederkit.sim.readings import reading_of
 from feederkit.sim.summary import PushRecord, TrialResult
+
+CAUSES = ("never settled", "unstable edge", "reading in no branch", "wrong result")
+"""What broke in a failed trial (the summary groups failures by these)."""
 
 
 def divergent_distance(pf: PushFunction, theta_deg: float) -> float:
@@ -24,50 +35,116 @@ def divergent_distance(pf: PushFunction, theta_deg: float) -> float:
     return min(min(norm360(t - d), norm360(d - t)) for d in pf.divergent_deg)
 
 
-def _state_id(pp: PlanPart, theta_deg: float) -> int:
+@dataclass(frozen=True)
+class _SimPart:
+    """A plan's part with its push function and the plan's state id of each resting edge."""
+
+    part: PlanPart
+    pf: PushFunction
+    state_of_edge: dict[int, int]
+
+
+def _sim_part(part: PlanPart) -> _SimPart:
+    return _SimPart(part, push_function_of(part), {s.edge: s.id for s in part.states})
+
+
+def _state_id(pp: _SimPart, theta_deg: float) -> int:
     return pp.state_of_edge[push(pp.pf, theta_deg).edge]
 
 
-def _mismatch_reason(rec: PushRecord) -> str:
-    if rec.simulated_state is None:
-        return f"the part came to rest on hull edge {rec.edge}, which is no stable state"
-    if rec.simulated_state == rec.predicted_state:
-        return (
-            f"the rotation error ({rec.rotation_error_deg:+.2f} deg) carried the part into the "
-            f"resting range of state {rec.simulated_state} instead of {rec.expected_state}"
-        )
-    return (
-        f"the simulated push settled in state {rec.simulated_state} where the push function "
-        f"gives {rec.predicted_state} (dropped {rec.divergent_distance_deg:.2f} deg from a "
-        "divergent orientation)"
-    )
+@dataclass(frozen=True)
+class TrialModel:
+    """The plan's model of one part: its mechanics under the declared uncertainty and the
+    diameter interval of each physical state (as :func:`feederkit.plans.strong.strong_model`
+    builds them, so the simulator judges by the model the plan was verified on)."""
+
+    mechanics: UncertainMechanics
+    diameters: tuple[tuple[float, float], ...]
+    sensor: Sensor
+
+    def physical(self, state: int) -> frozenset[int]:
+        """The physical states a part resting in ideal ``state`` is in (a transient state:
+        those it surely moves on to)."""
+        x = self.mechanics.state_of[state]
+        return frozenset({x}) if x is not None else self.mechanics.destinations[state]
+
+    def outcomes(self, before: int | None, action_deg: float | None) -> frozenset[int] | None:
+        """The physical states the model allows after the rotation from ideal state
+        ``before`` (None at the root: every state)."""
+        if action_deg is None or before is None:
+            return None
+        out: set[int] = set()
+        for x in self.physical(before):
+            out |= outcome_set(self.mechanics, x, action_deg)
+        return frozenset(out)
+
+    def transient(self, state: int) -> bool:
+        """Whether the model says a part never stays in ideal ``state`` (its barrier is below
+        the vibration the model assumes)."""
+        return self.mechanics.state_of[state] is None
+
+    def allows(self, before: int | None, action_deg: float | None, after: int) -> bool:
+        """Whether resting in ideal state ``after`` is an outcome the model allows (never a
+        transient state: the model says the part moves on)."""
+        if self.transient(after):
+            return False
+        allowed = self.outcomes(before, action_deg)
+        return allowed is None or bool(self.physical(after) & allowed)
+
+    def reads(self, state: int, reading: float | None) -> bool:
+        """Whether the model allows ``reading`` of a part resting in ideal ``state``."""
+        if reading is None or not self.sensor.informative:
+            return True
+        return any(self.sensor.consistent(self.diameters[x], reading) for x in self.physical(state))
 
 
 def run_trial(
-    plan: SimPlan,
+    plan: Plan,
     part_name: str,
     aligner: PushAligner,
     start_deg: float,
     rotation_error: Callable[[], float],
     index: int = 0,
+    *,
+    model: TrialModel | None = None,
+    state_of_edge: Sequence[int | None] | None = None,
 ) -> TrialResult:
     """Execute ``plan`` on ``part_name`` dropped first at fence orientation ``start_deg``.
 
     ``rotation_error()`` gives the robot's error (deg, counter-clockwise) for each rotation.
-    The step that went wrong is the first push whose simulated state differs from the state
-    the plan expects from the part's actual previous state; failing that, the step whose
-    reading no branch holds, or the last one when the plan's result is wrong.
+    ``state_of_edge`` maps the simulated part's hull edges to the plan's stable states (a
+    perturbed part's basins; default the drawn part's stable edges). Each operation is
+    judged by ``model`` (the plan's, see :class:`TrialModel`; None: the push function at the
+    nominal orientation). A failed trial's step is the first operation the model did not
+    predict (``predicted`` False: a model error), else the one where the plan broke (its
+    cause one of :data:`CAUSES`). Branches are followed by the plan's one rule
+    (:meth:`~feederkit.plans.model.Branch.holds`).
     """
-    pp = plan.part(part_name)
-    node = plan.root
+    pp = _sim_part(plan.part(part_name))
+    edges = dict(pp.state_of_edge) if state_of_edge is None else dict(enumerate(state_of_edge))
+    node: Step | Leaf = plan.root
     records: list[PushRecord] = []
-    first_wrong: tuple[int, str] | None = None
+    unpredicted: tuple[int, str] | None = None
     rest_theta = start_deg
     state: int | None = None
 
-    def finish(outcome: str, step: int | None, reason: str | None) -> TrialResult:
+    def finish(outcome: str, step: int | None, cause: str | None, why: str | None) -> TrialResult:
+        predicted = None
+        if outcome != "success":
+            predicted = unpredicted is None and outcome != "unsettled"
+            if unpredicted is not None:
+                step, why = unpredicted[0], f"{unpredicted[1]}; then {why}"
         return TrialResult(
-            index, part_name, norm360(start_deg), outcome, step, reason, state, tuple(records)
+            index,
+            part_name,
+            norm360(start_deg),
+            outcome,
+            step,
+            why,
+            state,
+            tuple(records),
+            cause=cause,
+            predicted=predicted,
         )
 
     while isinstance(node, Step):
@@ -78,9 +155,16 @@ def run_trial(
             nominal, err = norm360(rest_theta - node.action_deg), rotation_error()
         theta = norm360(nominal - err)
         out = aligner.align(theta)
-        sim_state = pp.state_of_edge.get(out.edge) if out.edge is not None else None
-        reading = reading_of(plan.sensor, out.width_mm) if out.settled else None
+        sim_state = edges.get(out.edge) if out.edge is not None else None
+        reading = plan.sensor.read(out.width_mm) if out.settled else None
         branch = node.follow(reading) if out.settled and sim_state is not None else None
+        expected = _state_id(pp, nominal)
+        if model is None:
+            in_model = sim_state == expected
+            reads = True
+        else:
+            in_model = sim_state is not None and model.allows(state, node.action_deg, sim_state)
+            reads = sim_state is None or model.reads(sim_state, reading)
         rec = PushRecord(
             step=step,
             action_deg=node.action_deg,
@@ -88,7 +172,7 @@ def run_trial(
             theta_drop_deg=theta,
             divergent_distance_deg=divergent_distance(pp.pf, theta),
             predicted_margin_deg=divergent_distance(pp.pf, push(pp.pf, theta).normal_deg),
-            expected_state=_state_id(pp, nominal),
+            expected_state=expected,
             predicted_state=_state_id(pp, theta),
             simulated_state=sim_state,
             edge=out.edge,
@@ -97,31 +181,67 @@ def run_trial(
             reading=reading,
             branch=branch,
             sim_time_s=out.sim_time_s,
+            in_model=in_model and reads,
         )
         records.append(rec)
-        state = sim_state
         if not out.settled:
+            state = None
             return finish(
-                "unsettled", step, f"the part never settled within {aligner.max_time_s:.3g} s"
+                "unsettled",
+                step,
+                "never settled",
+                f"the part never settled within {aligner.max_time_s:.3g} s",
             )
-        if first_wrong is None and sim_state != rec.expected_state:
-            first_wrong = (step, _mismatch_reason(rec))
+        if unpredicted is None and not in_model:
+            unpredicted = (step, _unpredicted_reason(rec, state, model))
+        elif unpredicted is None and not reads:
+            unpredicted = (step, f"the reading {reading:.4f} mm is outside what the model allows")
+        state = sim_state
         if sim_state is None:
-            return finish("failure", *(first_wrong or (step, _mismatch_reason(rec))))
+            return finish(
+                "failure",
+                step,
+                "unstable edge",
+                f"the part came to rest on hull edge {rec.edge}, which is no stable state",
+            )
         if branch is None:
-            msg = f"the reading {reading:.3f} mm lies in no branch of the plan"
-            if first_wrong is not None:
-                return finish("failure", first_wrong[0], f"{first_wrong[1]}; then {msg}")
-            return finish("failure", step, msg)
+            return finish(
+                "failure",
+                step,
+                "reading in no branch",
+                f"the reading {reading:.4f} mm lies in no branch of step {step}",
+            )
         rest_theta = out.theta_end_deg
         node = node.branches[branch].next
     assert isinstance(node, Leaf)
     if state is not None and node.accepts(part_name, state):
-        return finish("success", None, None)
-    if first_wrong is not None:
-        return finish("failure", *first_wrong)
+        return finish("success", None, None, None)
     return finish(
         "failure",
         len(records),
-        f"every push went as the plan expects but its result does not hold state {state}",
+        "wrong result",
+        f"the plan's result does not hold state {state}",
+    )
+
+
+def _unpredicted_reason(rec: PushRecord, before: int | None, model: TrialModel | None) -> str:
+    """Why an operation is outside the model, in words."""
+    if model is None:
+        return (
+            f"the rotation error ({rec.rotation_error_deg:+.2f} deg) or the physics sent the part "
+            f"to state {rec.simulated_state} instead of {rec.expected_state}"
+        )
+    if rec.simulated_state is not None and model.transient(rec.simulated_state):
+        return (
+            f"the part stayed in state {rec.simulated_state}, which the plan's model says it "
+            "always leaves (a barrier below the vibration it assumes): a model error"
+        )
+    allowed = model.outcomes(before, rec.action_deg)
+    if allowed is None:
+        return f"the part rested in state {rec.simulated_state}, which the model does not allow"
+    ideal = sorted({m for x in allowed for m in model.mechanics.states[x].members})
+    return (
+        f"the part rested in state {rec.simulated_state} after rotation {rec.action_deg:.4g} deg "
+        f"(error {rec.rotation_error_deg:+.2f} deg), which the plan's model does not allow "
+        f"(it allows states {ideal}): a model error"
     )

@@ -1,0 +1,198 @@
+"""The command line's view of plans: rich renderables, and loading a plan file with its limits.
+
+Renderables are built here, never in the library (``feederkit.plans`` does not import rich):
+the plan as a tree, its statistics, one run, the verification. Every function takes a
+:class:`~feederkit.plans.model.Plan`; a plan file's JSON object is accepted (and checked)
+while callers move to the model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+from rich.text import Text
+from rich.tree import Tree
+
+from feederkit.errors import InputError
+from feederkit.mechanics.classes import CLASS_NAMES
+from feederkit.plans.execute import Trace
+from feederkit.plans.fileformat import MAX_PLAN_BYTES, as_plan, read_plan
+from feederkit.plans.model import Leaf, Plan, Step
+from feederkit.plans.verify import VerificationReport
+from feederkit.sensors import Sensor, sensor_from_dict
+
+MaxPlanMbOpt = Annotated[
+    float,
+    typer.Option(
+        "--max-plan-mb",
+        metavar="MB",
+        help="Refuse plan files larger than this many megabytes (read before parsing).",
+    ),
+]
+DEFAULT_MAX_PLAN_MB = MAX_PLAN_BYTES / 1e6
+
+
+def load_plan(path: Path, max_plan_mb: float = DEFAULT_MAX_PLAN_MB) -> Plan:
+    """Read and check a plan file for a command; the size limit is ``--max-plan-mb``."""
+    if not max_plan_mb > 0.0:
+        raise InputError(f"--max-plan-mb must be a positive number, got {max_plan_mb:g}")
+    try:
+        return read_plan(path, max_bytes=int(max_plan_mb * 1e6))
+    except InputError as exc:
+        if "more than the limit" in str(exc) and "MB" in str(exc):
+            raise InputError(f"{exc} (raise it with --max-plan-mb)") from None
+        raise
+
+
+def sensor_text(sensor: Sensor | Mapping[str, Any]) -> str:
+    """The plan's sensor in words (:meth:`Sensor.describe`)."""
+    if isinstance(sensor, Mapping):
+        sensor = sensor_from_dict(dict(sensor))
+    return sensor.describe()
+
+
+def _interval(r: tuple[float, float] | None) -> str:
+    if r is None:
+        return "any reading"
+    return f"reads {r[0]:.6g} mm" if r[0] == r[1] else f"reads {r[0]:.6g} .. {r[1]:.6g} mm"
+
+
+def _result_text(leaf: Leaf, plan: Plan) -> Text:
+    parts = []
+    for e in leaf.results:
+        s = plan.part(e.part).state(e.state)
+        parts.append(f"{e.part} state {e.state} (edge {s.edge}), pose {e.pose_deg:.6g}°")
+    lead = "done: " if len(leaf.results) == 1 else "done, one of: "
+    return Text(lead + "; ".join(parts), style="bold green")
+
+
+def _op_text(step: Step, number: int) -> Text:
+    if step.action_deg is None:
+        return Text(f"op {number}: align (first push from an unknown orientation)", style="bold")
+    t = Text(f"op {number}: rotate {step.action_deg:.4f}°", style="bold")
+    t.append(f"  margin ±{step.margin_deg:.4f}°", style="cyan")
+    return t
+
+
+def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
+    """The plan as a tree: operations, rotations and margins, reading intervals, results.
+
+    A chain of single-branch operations stays flat; built without recursion.
+    """
+    plan = as_plan(plan)
+    tree = Tree(Text(f"plan: at most {plan.stats.length} push-align operations", style="bold"))
+    stack: list[tuple[Tree, Step, int]] = [(tree, plan.root, 1)]
+    while stack:
+        parent, step, number = stack.pop()
+        while len(step.branches) == 1:  # a chain of single-branch operations
+            (b,) = step.branches
+            label = _op_text(step, number)
+            if b.reading is not None:
+                label.append(f", {_interval(b.reading)}", style="yellow")
+            parent.add(label)
+            if isinstance(b.next, Leaf):
+                parent.add(_result_text(b.next, plan))
+                break
+            step, number = b.next, number + 1
+        else:
+            op = parent.add(_op_text(step, number))
+            later = []
+            for b in step.branches:
+                line = Text(_interval(b.reading), style="yellow")
+                if isinstance(b.next, Leaf):
+                    line.append(" → ")
+                    line.append_text(_result_text(b.next, plan))
+                    op.add(line)
+                else:
+                    later.append((op.add(line), b.next, number + 1))
+            stack.extend(reversed(later))
+    return tree
+
+
+def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | None = None) -> Table:
+    """The plan's statistics, and the verification's summary when given."""
+    plan = as_plan(plan)
+    s = plan.stats
+    t = Table(title="statistics", show_header=False)
+    t.add_column("what")
+    t.add_column("value")
+    t.add_row("length (worst case, first alignment counted)", str(s.length))
+    t.add_row("expected operations (uniform start)", f"{s.expected_length:.4f}")
+    margin = s.min_margin_deg
+    shown = "no rotation" if margin is None else f"±{margin:.4f}°"
+    if plan.low_margin_warning():
+        shown += " (below ±1°: no robot holds it)"
+    t.add_row("smallest margin", shown)
+    t.add_row("declared uncertainty", plan.uncertainty_words())
+    cert = s.certificate
+    if cert is not None:
+        t.add_row("certified rotation error (largest)", f"±{cert.max_rotation_error_deg:.4g}°")
+        t.add_row("certified shape tolerance (largest)", f"{cert.max_shape_tolerance_mm:.4g} mm")
+        ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
+        t.add_row("length: robust / ideal model", f"{s.length} / {ideal}")
+    optimal = "yes" if s.optimal else f"not proven (lower bound {s.lower_bound})"
+    t.add_row(f"optimal ({s.objective or 'worst'} objective)", optimal)
+    if s.grouping:
+        t.add_row("reading branching", str(s.grouping))
+    if s.polygon_class is not None:
+        t.add_row("polygon class (Fig. 14)", f"{s.polygon_class}: {CLASS_NAMES[s.polygon_class]}")
+        meets = "meets it" if s.meets_bound else "EXCEEDS it"
+        t.add_row("class bound", f"{s.class_bound} ({meets})")
+    if report is not None:
+        verdict = "passed" if report.ok else "FAILED"
+        t.add_row(verification_title(plan), f"{verdict}, {report.paths} paths")
+    return t
+
+
+def trace_table(trace: Trace) -> Table:
+    """One run, step by step: rotation, where the part rests, reading and branch."""
+    t = Table(title=f"{trace.part} from theta {trace.start_theta_deg:.6g}°")
+    for col in ("op", "rotation", "theta", "state (edge)", "diameter", "reading", "branch"):
+        t.add_column(col)
+    for s in trace.steps:
+        rot = "align" if s.action_deg is None else f"{s.action_deg:.4f}°"
+        if s.rotation_error_deg:
+            rot += f" {s.rotation_error_deg:+.4f}°"
+        reading = "-" if s.reading is None else f"{s.reading:.6g}"
+        if s.branch is None:
+            branch: str | Text = Text("none holds it", style="bold red")
+        else:
+            branch = f"{s.branch}" + (
+                "" if s.interval is None else f" [{s.interval[0]:.6g}, {s.interval[1]:.6g}]"
+            )
+        t.add_row(
+            str(s.number),
+            rot,
+            f"{s.theta_deg:.4f}°",
+            f"{s.state} ({s.edge})",
+            f"{s.diameter:.6g}",
+            reading,
+            branch,
+        )
+    return t
+
+
+def verification_title(plan: Plan) -> str:
+    """What the verification of ``plan`` checked: the kinematic model, or (under a declared
+    uncertainty) every outcome and reading of a strong plan."""
+    if plan.uncertainty.is_ideal:
+        return "verified on the kinematic model"
+    return "verified as a strong plan (every outcome, every reading)"
+
+
+def verification_table(report: VerificationReport, plan: Plan | None = None) -> Table:
+    """Per part: starts, paths, the most operations a path took, failed starts."""
+    title = "verification"
+    if plan is not None:
+        title += " " + verification_title(plan).removeprefix("verified ")
+    t = Table(title=title)
+    for col in ("part", "starts", "paths", "worst operations", "failed starts"):
+        t.add_column(col)
+    for p in report.parts:
+        failed = Text(str(p.failed_starts), style="bold red" if p.failed_starts else "green")
+        t.add_row(p.part, str(p.starts), str(p.paths), str(p.worst_operations), failed)
+    return t

@@ -1,0 +1,287 @@
+"""The plan as one immutable value: parts, sensor, a tree of steps, results and statistics.
+
+A plan (sections 4, 6 and 8.5 of Akella & Mason 1999; the file is design.md's
+``feederkit-plan``) is a tree: each :class:`Step` rotates the part by ``action_deg`` within its
+overlap range ``action_deg ± margin_deg`` (none at the root, the first alignment from an
+unknown orientation), lets it align on the fence and reads its diameter; each
+:class:`Branch` is followed when its closed reading interval holds the reading; a
+:class:`Leaf` lists the (part, state) pairs the part may then be in, every one a correct
+answer.
+
+Only :mod:`feederkit.plans.fileformat` makes a :class:`Plan` (from a file, a dict or a
+planner's result) and writes one; everything else reads it. Every value here is a frozen
+dataclass; a part's push function (section 3.1) is rebuilt from the hull and COM the plan
+records, by :func:`push_function_of`, an explicit cache keyed by the part.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from feederkit.errors import InputError
+from feederkit.mechanics.push import PushFunction, StableState, push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.sensors import Sensor
+from feederkit.uncertainty import IDEAL, Uncertainty
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class PlanPart:
+    """A part of the plan's mix as the plan records it: hull and COM (part frame), states.
+
+    ``states`` are the stable states the plan lists (the diameters it was planned on); the
+    push function the hull and COM give is :func:`push_function_of`.
+    """
+
+    name: str
+    revision: str | int | None
+    com: Point
+    hull: tuple[Point, ...]
+    states: tuple[StableState, ...]
+
+    def state(self, sid: int) -> StableState:
+        """The listed state with id ``sid``; an unknown id is bad input."""
+        for s in self.states:
+            if s.id == sid:
+                return s
+        raise InputError(f"plan: part {self.name!r} lists no stable state {sid}")
+
+    @property
+    def size(self) -> float:
+        """The hull's largest extent (mm): the scale of geometric tolerances."""
+        xs = [p[0] for p in self.hull]
+        ys = [p[1] for p in self.hull]
+        return max(max(xs) - min(xs), max(ys) - min(ys))
+
+
+@functools.lru_cache(maxsize=256)
+def push_function_of(part: PlanPart) -> PushFunction:
+    """The push function of a plan's part, rebuilt from its hull and COM only (section 3.1).
+
+    Cached by the (frozen, hashable) part: execution, verification, reports and the simulator
+    of one plan share one rebuild.
+    """
+    outline = make_outline(part.name, [list(p) for p in part.hull], com=list(part.com))
+    revision = None if part.revision is None else str(part.revision)
+    # The file's hull is the contact polygon as planned: re-hull it exactly (tolerance 0),
+    # never simplify it again, so it is numbered and shaped as it was written.
+    return push_function(make_part(outline, hull_tolerance=0.0, revision=revision))
+
+
+@dataclass(frozen=True)
+class ResultEntry:
+    """One correct answer of a leaf: part ``part`` resting in its state ``state``."""
+
+    part: str
+    state: int
+    pose_deg: float
+
+
+@dataclass(frozen=True)
+class Leaf:
+    """The end of a plan: the part rests in one of ``results`` (several: no plan tells them
+    apart)."""
+
+    results: tuple[ResultEntry, ...]
+
+    def accepts(self, part: str, state: int) -> bool:
+        """Whether ``part`` resting in ``state`` is one of the answers."""
+        return any(r.part == part and r.state == state for r in self.results)
+
+
+@dataclass(frozen=True)
+class Branch:
+    """Follow ``next`` when the reading lies in the closed interval ``reading``.
+
+    ``reading`` is None only in a sensorless plan, whose single branch holds every reading.
+    """
+
+    reading: tuple[float, float] | None
+    next: Node
+
+    def holds(self, reading: float | None) -> bool:
+        """Whether this branch may be followed on ``reading`` (design.md: closed ``[lo, hi]``).
+
+        This is the one rule every consumer follows: no slack, so a reading on a shared
+        endpoint is held by both branches (each must be right for it).
+        """
+        if self.reading is None:
+            return True
+        return reading is not None and self.reading[0] <= reading <= self.reading[1]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One push-align operation: rotate by ``action_deg`` (None at the root), align, read.
+
+    ``margin_deg`` is the half-width of the action's overlap range (section 6): every
+    rotation in ``action_deg ± margin_deg`` must lead every state to the same outcome.
+    """
+
+    action_deg: float | None
+    margin_deg: float | None
+    branches: tuple[Branch, ...]
+
+    @property
+    def overlap_range(self) -> tuple[float, float] | None:
+        """The rotations ``(action - margin, action + margin)`` (None at the root)."""
+        if self.action_deg is None or self.margin_deg is None:
+            return None
+        return self.action_deg - self.margin_deg, self.action_deg + self.margin_deg
+
+    def held_by(self, reading: float | None) -> tuple[int, ...]:
+        """The indices of the branches that hold ``reading`` (:meth:`Branch.holds`)."""
+        return tuple(k for k, b in enumerate(self.branches) if b.holds(reading))
+
+    def follow(self, reading: float | None) -> int | None:
+        """The first branch that holds ``reading``; None: a foreign part or a sensor fault."""
+        held = self.held_by(reading)
+        return held[0] if held else None
+
+
+Node = Step | Leaf
+
+
+@dataclass(frozen=True)
+class PlanStats:
+    """The plan file's ``stats`` (design.md and feederkit's own fields, see plans/stats.py).
+
+    ``min_margin_deg`` is None when the plan makes no rotation; the Fig. 14 class fields are
+    None for a mix.
+    """
+
+    length: int
+    expected_length: float
+    min_margin_deg: float | None
+    optimal: bool
+    lower_bound: int
+    objective: str | None = None
+    grouping: str | None = None
+    polygon_class: int | None = None
+    class_bound: int | None = None
+    meets_bound: bool | None = None
+    certificate: Certificate | None = None
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What a strong plan guarantees beyond its declared uncertainty (design.md, plan file
+    ``stats.certificate``): the largest rotation error (deg) and shape tolerance (mm) under
+    which the plan as written still reaches its results, and the minimum length on the ideal
+    model (None when not computed), what robustness costs."""
+
+    max_rotation_error_deg: float
+    max_shape_tolerance_mm: float
+    ideal_length: int | None
+
+    def to_dict(self) -> dict[str, float | int | None]:
+        """The plan file's ``stats.certificate`` object (design.md's key order)."""
+        return {
+            "max_rotation_error_deg": self.max_rotation_error_deg,
+            "max_shape_tolerance_mm": self.max_shape_tolerance_mm,
+            "ideal_length": self.ideal_length,
+        }
+
+
+LOW_MARGIN_DEG = 1.0
+"""Below this smallest margin no robot holds the plan's rotations: every output warns."""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A plan: its sensor, its declared uncertainty, its parts (in order), the tree from
+    ``root``, and ``stats``.
+
+    ``uncertainty`` is what the plan is strong for (design.md, "Uncertainty");
+    ``uncertainty_declared`` is False for a version-1 file that declares none, read as the
+    paper's ideal model (every output that shows the uncertainty says so).
+    """
+
+    sensor: Sensor
+    parts: tuple[PlanPart, ...]
+    root: Step
+    stats: PlanStats
+    conventions: str
+    uncertainty: Uncertainty = IDEAL
+    uncertainty_declared: bool = True
+
+    def uncertainty_words(self) -> str:
+        """The declared uncertainty in one line (saying when a file declared none)."""
+        u = self.uncertainty
+        text = (
+            f"rotation error ±{u.rotation_error_deg:g}°, shape tolerance "
+            f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
+        )
+        if not self.uncertainty_declared:
+            return f"none declared (a version-1 plan): the ideal model, {text}"
+        return f"{text} (the ideal model)" if u.is_ideal else text
+
+    def certificate_words(self) -> str | None:
+        """The certificate in one line (None when the plan carries none)."""
+        c = self.stats.certificate
+        if c is None:
+            return None
+        ideal = "not computed" if c.ideal_length is None else str(c.ideal_length)
+        return (
+            f"holds up to rotation error ±{c.max_rotation_error_deg:.4g}° and shape tolerance "
+            f"{c.max_shape_tolerance_mm:.4g} mm; length {self.stats.length} here, "
+            f"{ideal} on the ideal model"
+        )
+
+    def part(self, name: str) -> PlanPart:
+        """The part called ``name``; an unknown name is bad input."""
+        return self.parts[self.part_index(name)]
+
+    def part_index(self, name: str) -> int:
+        """The index of the part called ``name``; an unknown name is bad input."""
+        for k, p in enumerate(self.parts):
+            if p.name == name:
+                return k
+        raise InputError(f"plan: no part named {name!r}")
+
+    def push_functions(self) -> tuple[PushFunction, ...]:
+        """Each part's push function, rebuilt from its hull and COM (cached)."""
+        return tuple(push_function_of(p) for p in self.parts)
+
+    def walk(self) -> Iterator[tuple[Node, int]]:
+        """Every node of the tree as written (shared subtrees once per place) with its
+        operation number (the root 1, a leaf the number of the step above it), pre-order,
+        without recursion."""
+        stack: list[tuple[Node, int]] = [(self.root, 1)]
+        while stack:
+            node, number = stack.pop()
+            yield node, number
+            if isinstance(node, Step):
+                for b in reversed(node.branches):
+                    stack.append((b.next, number + 1 if isinstance(b.next, Step) else number))
+
+    def leaves(self) -> list[Leaf]:
+        """The result nodes in pre-order."""
+        return [n for n, _ in self.walk() if isinstance(n, Leaf)]
+
+    def depth(self) -> int:
+        """The most operations on any root-to-leaf path of the tree."""
+        return max(number for node, number in self.walk() if isinstance(node, Leaf))
+
+    def smallest_margin(self) -> float | None:
+        """The smallest ``margin_deg`` of any rotation in the tree (None: no rotation)."""
+        margins = [
+            n.margin_deg for n, _ in self.walk() if isinstance(n, Step) and n.margin_deg is not None
+        ]
+        return min(margins) if margins else None
+
+    def low_margin_warning(self) -> str | None:
+        """A warning when the smallest margin is below LOW_MARGIN_DEG (None otherwise)."""
+        m = self.stats.min_margin_deg
+        if m is None or not math.isfinite(m) or m >= LOW_MARGIN_DEG:
+            return None
+        return (
+            f"the plan's smallest margin is ±{m:.3g}°, below ±{LOW_MARGIN_DEG:g}°: a robot "
+            "whose rotations err by more will not follow the plan"
+        )

@@ -1,0 +1,177 @@
+"""The one Plan model: made from files and dicts, written back byte for byte, read by all.
+
+Fixtures are the golden plan files (``tests/golden/``), so these tests need no planner.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import pytest
+
+from feederkit.errors import InputError
+from feederkit.mechanics.push import StableState
+from feederkit.plans import (
+    Branch,
+    Leaf,
+    Plan,
+    Step,
+    execute,
+    leaf_part_pairs,
+    plan_from_dict,
+    plan_json,
+    plan_to_dict,
+    push_function_of,
+    read_plan,
+    verify_plan,
+    write_plan,
+)
+from feederkit.uncertainty import IDEAL
+
+GOLDEN = Path(__file__).resolve().parent / "golden"
+
+
+def golden(name: str) -> dict:
+    return json.loads((GOLDEN / name).read_text(encoding="utf-8"))
+
+
+def deep_plan(operations: int, name: str = "rectangle-2x1.sensorless.json") -> dict:
+    """A sensorless plan ``operations`` deep: the first alignment, then rotations by 0 whose
+    leaf lists every state (so it is right, if useless)."""
+    d = golden(name)
+    part = d["parts"][0]
+    leaf = {
+        "result": [
+            {"part": part["name"], "state": s["id"], "pose_deg": s["pose_deg"]}
+            for s in part["stable_states"]
+        ]
+    }
+    node: dict = leaf
+    for _ in range(operations - 1):
+        node = {"action_deg": 0.0, "margin_deg": 0.0, "branches": [{"reading": None, "next": node}]}
+    d["root"] = {
+        "action_deg": None,
+        "margin_deg": None,
+        "branches": [{"reading": None, "next": node}],
+    }
+    d["stats"].update(length=operations, expected_length=float(operations), lower_bound=1)
+    d["stats"]["min_margin_deg"] = 0.0 if operations > 1 else None
+    return d
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in GOLDEN.glob("*.json")))
+def test_golden_files_round_trip_through_the_model(name, tmp_path):
+    text = (GOLDEN / name).read_text(encoding="utf-8")
+    plan = read_plan(GOLDEN / name)
+    assert isinstance(plan, Plan)
+    if json.loads(text)["version"] == 1 and "uncertainty" not in json.loads(text):
+        # a version-1 file reads as the ideal model; written back it is version 2
+        assert not plan.uncertainty_declared and plan.uncertainty.is_ideal
+        text = plan_json(upgraded(json.loads(text)))
+    assert plan_json(plan) == text
+    out = tmp_path / name
+    write_plan(plan, out)
+    assert out.read_text(encoding="utf-8") == text
+    assert plan_json(read_plan(out)) == text
+
+
+def upgraded(d: dict) -> dict:
+    """A version-1 plan file's object as version 2 writes it: the ideal model declared."""
+    out: dict = {}
+    for key, value in d.items():
+        out[key] = 2 if key == "version" else value
+        if key == "sensor":
+            out["uncertainty"] = IDEAL.to_dict()
+    return out
+
+
+def test_the_model_is_frozen_and_typed():
+    plan = read_plan(GOLDEN / "quadrilateral.tolerance.json")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        plan.stats = None  # type: ignore[misc]
+    assert plan.sensor.model == "tolerance" and plan.sensor.informative
+    part = plan.parts[0]
+    assert all(isinstance(s, StableState) for s in part.states)
+    assert isinstance(part.hull, tuple) and isinstance(part.com, tuple)
+    assert isinstance(plan.root, Step) and plan.root.overlap_range is None
+    nxt = next(b.next for b in plan.root.branches if isinstance(b.next, Step))
+    lo, hi = nxt.overlap_range
+    assert hi - lo == pytest.approx(2 * nxt.margin_deg)
+    assert plan.depth() == plan.stats.length
+    assert plan.smallest_margin() == pytest.approx(plan.stats.min_margin_deg)
+
+
+def test_push_functions_are_rebuilt_once_and_match_the_listed_states():
+    plan = read_plan(GOLDEN / "l-bracket.tolerance.json")
+    part = plan.parts[0]
+    assert push_function_of(part) is push_function_of(part)  # the explicit cache
+    pf = push_function_of(part)
+    assert [s.id for s in pf.states] == [s.id for s in part.states]
+    for built, listed in zip(pf.states, part.states, strict=True):
+        assert built.diameter == pytest.approx(listed.diameter, rel=1e-12)
+        assert built.normal_deg == pytest.approx(listed.normal_deg, abs=1e-9)
+    assert "__dict__" not in dir(type(part)) or not part.__dict__.get("_pf")
+
+
+def test_branches_hold_closed_intervals_without_slack():
+    leaf = Leaf(())
+    b = Branch((1.0, 2.0), leaf)
+    assert b.holds(1.0) and b.holds(2.0) and b.holds(1.5)
+    assert not b.holds(2.0 + 1e-12) and not b.holds(1.0 - 1e-12) and not b.holds(None)
+    assert Branch(None, leaf).holds(None) and Branch(None, leaf).holds(3.0)
+    step = Step(None, None, (Branch((0.0, 1.0), leaf), Branch((1.0, 2.0), leaf)))
+    assert step.held_by(1.0) == (0, 1) and step.follow(1.0) == 0
+    assert step.follow(2.5) is None
+
+
+def test_a_plan_325_operations_deep_loads_writes_verifies_and_executes(tmp_path):
+    data = deep_plan(325)
+    path = tmp_path / "deep.json"
+    path.write_text(plan_json(data), encoding="utf-8")
+    plan = read_plan(path)
+    assert plan.depth() == 325
+    assert plan_json(plan) == plan_json(upgraded(data))
+    write_plan(plan, tmp_path / "again.json")
+    assert read_plan(tmp_path / "again.json").depth() == 325
+    assert verify_plan(plan).ok
+    assert execute(plan, 0, 10.0).success
+
+
+def test_deeper_than_the_limit_is_one_line_naming_the_file(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text(plan_json(deep_plan(40)), encoding="utf-8")
+    with pytest.raises(InputError) as exc:
+        read_plan(path, max_depth=30)
+    msg = str(exc.value)
+    assert msg.startswith(str(path)) and "30 operations" in msg and "\n" not in msg
+    assert read_plan(path, max_depth=40).depth() == 40
+
+
+def test_a_file_over_the_size_limit_is_refused_before_parsing(tmp_path):
+    path = tmp_path / "big.json"
+    path.write_text("{" + " " * 2000 + "not even json", encoding="utf-8")
+    with pytest.raises(InputError) as exc:
+        read_plan(path, max_bytes=1000)
+    assert "more than the limit" in str(exc.value) and str(path) in str(exc.value)
+    with pytest.raises(InputError, match="not valid JSON"):
+        read_plan(path, max_bytes=10_000)
+
+
+def test_leaf_pairs_are_each_listed_once():
+    plan = read_plan(GOLDEN / "changeover-fig27-triangle-octagon.json")
+    pairs = leaf_part_pairs(plan)
+    assert len(pairs) == len(set(pairs))
+    assert leaf_part_pairs(plan_to_dict(plan)) == pairs  # a dict is read through the model
+
+
+def test_low_margin_warning():
+    assert read_plan(GOLDEN / "t-clip.sensorless.json").low_margin_warning() is not None
+    assert read_plan(GOLDEN / "t-clip.tolerance.json").low_margin_warning() is None
+    assert read_plan(GOLDEN / "octagon.sensorless.json").low_margin_warning() is None
+
+
+def test_plan_from_dict_accepts_only_a_checked_plan():
+    with pytest.raises(InputError, match="not a feederkit plan"):
+        plan_from_dict([1, 2, 3])
