@@ -1,16 +1,30 @@
 """Sensor models: the readings each stable state can produce; branching by reading (section 5).
 
 The reading is the part's diameter (width across the belt, mm) after alignment (design.md).
+Every model implements the :class:`Sensor` protocol, so the machine, the planners, plan
+files, execution, reports and the simulator never ask which model they hold:
 
-- :class:`NoSensor`: sensorless; every state gives the same (no) reading.
+- :class:`NoSensor`: sensorless (section 4); every state gives the same (no) reading.
 - :class:`ToleranceSensor`: a state of diameter ``d`` reads any value in the open interval
   ``(d - e, d + e)``.
 - :class:`LedSensor`: beams at heights ``k * pitch`` (k = 1, 2, ...) above the fence; a width
   ``w`` blocks the beams below it, ``count = #{k : k * pitch < w}``; with alignment noise ``e``
   the width lies anywhere in ``[d - e, d + e]``. The reading is ``count * pitch`` mm.
 
+A state's diameter may be an interval ``(lo, hi)`` (a physical resting state under
+uncertainty, docs/uncertainty.md): it reads anything any diameter in the interval can read.
+Every method taking a diameter takes either; a float is the point interval (the ideal model).
+
 Two states are indistinguishable when their reading sets overlap; an indistinguishable set
 (definition 10) is a connected component of that relation, which is not transitive.
+
+>>> s = ToleranceSensor(0.5)
+>>> s.can_read_alike(10.0, 10.9), s.can_read_alike(10.0, 11.0)
+(True, False)
+>>> [b.members for b in s.split([10.0, 10.9, 12.0])]
+[(0,), (0, 1), (1,), (2,)]
+>>> LedSensor(1.0).nominal_reading(2.5)
+2.0
 """
 
 from __future__ import annotations
@@ -18,11 +32,181 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from enum import StrEnum
+from typing import Any, Protocol, runtime_checkable
 
 from feederkit.errors import InputError
 
-Grouping = Literal["exact", "components"]
+
+class Grouping(StrEnum):
+    """How a set of states is branched on the reading.
+
+    ``exact``: each reading leads to exactly the states that can produce it. ``components``:
+    the paper's rule (section 6), a reading names its whole indistinguishable set.
+    """
+
+    EXACT = "exact"
+    COMPONENTS = "components"
+
+
+@dataclass(frozen=True)
+class ReadingBranch:
+    """The states consistent with the readings in the closed ``[lo, hi]`` (None: sensorless).
+
+    ``mask`` has bit ``k`` set for each consistent state ``k`` (the label the caller gave the
+    state: its position in the diameters split, or its machine index).
+    """
+
+    lo: float | None
+    hi: float | None
+    mask: int
+
+    @property
+    def members(self) -> tuple[int, ...]:
+        """The consistent states, ascending."""
+        out = []
+        m = self.mask
+        while m:
+            low = m & -m
+            out.append(low.bit_length() - 1)
+            m ^= low
+        return tuple(out)
+
+
+Labels = Sequence[int] | None
+"""Bit indices for the states whose diameters are split (None: their positions)."""
+
+Diameter = float | tuple[float, float]
+"""A state's diameter (mm): exact, or an interval ``(lo, hi)`` of the widths it can show."""
+
+
+def span(diameter: Diameter) -> tuple[float, float]:
+    """A diameter as its interval ``(lo, hi)``; a float is the point interval.
+
+    >>> span(3.0), span((2.0, 2.5))
+    ((3.0, 3.0), (2.0, 2.5))
+    """
+    if isinstance(diameter, tuple):
+        return float(diameter[0]), float(diameter[1])
+    return diameter, diameter
+
+
+def _points(diameters: Sequence[Diameter]) -> bool:
+    """Whether every diameter is exact (a float or a point interval)."""
+    return all(not isinstance(d, tuple) or d[0] == d[1] for d in diameters)
+
+
+def _exact(diameters: Sequence[Diameter]) -> list[float]:
+    """Exact diameters as floats (callers check :func:`_points` first)."""
+    return [d[0] if isinstance(d, tuple) else d for d in diameters]
+
+
+@runtime_checkable
+class Sensor(Protocol):
+    """What every sensor model answers (section 5): one home for reading sets and branching."""
+
+    @property
+    def model(self) -> str:
+        """The plan file's model name: ``none``, ``tolerance`` or ``led``."""
+        ...
+
+    @property
+    def informative(self) -> bool:
+        """False for the sensorless model, whose readings say nothing."""
+        ...
+
+    def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
+        """The smallest and largest reading (mm) a state of this diameter can give.
+
+        None without a sensor. A tolerance sensor's ends are open (never read exactly).
+        """
+        ...
+
+    def consistent(self, diameter: Diameter, reading: float) -> bool:
+        """Whether a state of this diameter can produce ``reading`` (mm)."""
+        ...
+
+    def reads_into(self, diameter: Diameter, lo: float, hi: float) -> bool:
+        """Whether a state of this diameter can give some reading in the closed ``[lo, hi]``."""
+        ...
+
+    def can_read_alike(self, d1: Diameter, d2: Diameter) -> bool:
+        """Whether two diameters can produce the same reading (their reading sets overlap)."""
+        ...
+
+    def reading_reach(self) -> float:
+        """The largest diameter difference (mm) two states can have and still read alike."""
+        ...
+
+    def nominal_reading(self, diameter: Diameter) -> float | None:
+        """The reading of an exact width equal to ``diameter`` (None sensorless)."""
+        ...
+
+    def read(self, width: float) -> float | None:
+        """What the sensor reports for a measured width (mm), as the simulator sees it."""
+        ...
+
+    def probe_readings(self, diameter: Diameter, inset: float) -> tuple[float, ...]:
+        """Readings that exercise a state's whole reading set: its extremes and nominal.
+
+        ``inset`` is how far inside an open interval the extremes are taken.
+        """
+        ...
+
+    def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
+        """Probability that a state gives a reading in ``[lo, hi]`` (readings uniform over
+        the state's reading set: the width for the LED array)."""
+        ...
+
+    def split(
+        self,
+        diameters: Sequence[float],
+        grouping: Grouping | str = Grouping.EXACT,
+        labels: Labels = None,
+    ) -> list[ReadingBranch]:
+        """Branch a set of states (given by their diameters) on the reading, in reading order.
+
+        Branch intervals are closed and may share endpoints; a reading on a shared endpoint
+        is consistent with a subset of either branch. Each branch's ``mask`` sets bit
+        ``labels[j]`` (default ``j``) for the j-th diameter.
+        """
+        ...
+
+    def indistinguishable_sets(self, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+        """Definition 10: connected components of the overlap relation, sorted by diameter."""
+        ...
+
+    def reading_windows(self, diameters: Sequence[float]) -> list[int] | None:
+        """For diameters in ascending order, per state ``a`` the mask of states ``a..b``
+        that can read alike with it from above (a fast path for the planners).
+
+        The states that can give one reading are then a run whose ends read alike. None
+        when the sensor offers no such shortcut, or when some pair sits on the edge of
+        reading alike within rounding (the reading cells then decide).
+        """
+        ...
+
+    def shared_reading_probability(self, diameters: Sequence[float]) -> list[float] | None:
+        """For diameters in ascending order, none of them inseparable, per state the
+        probability that its reading could also come from another of them (a fast path
+        for the expected objective). None when the sensor offers no closed form.
+        """
+        ...
+
+    def uncovered_reading(
+        self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
+    ) -> float | None:
+        """A reading (mm) this state can give that none of the closed ``intervals`` holds, or
+        None when they cover its whole reading set (interval arithmetic, not sampling)."""
+        ...
+
+    def describe(self) -> str:
+        """The model and its parameters in words, for people."""
+        ...
+
+    def to_dict(self) -> dict[str, Any]:
+        """The plan file's ``sensor`` object."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -31,6 +215,67 @@ class NoSensor:
 
     model: str = "none"
 
+    @property
+    def informative(self) -> bool:
+        return False
+
+    def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
+        return None
+
+    def consistent(self, diameter: Diameter, reading: float) -> bool:
+        return True
+
+    def reads_into(self, diameter: Diameter, lo: float, hi: float) -> bool:
+        return True
+
+    def can_read_alike(self, d1: Diameter, d2: Diameter) -> bool:
+        return True
+
+    def reading_reach(self) -> float:
+        return math.inf
+
+    def nominal_reading(self, diameter: Diameter) -> float | None:
+        return None
+
+    def read(self, width: float) -> float | None:
+        return None
+
+    def probe_readings(self, diameter: Diameter, inset: float) -> tuple[float, ...]:
+        return ()
+
+    def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
+        return 1.0
+
+    def split(
+        self,
+        diameters: Sequence[float],
+        grouping: Grouping | str = Grouping.EXACT,
+        labels: Labels = None,
+    ) -> list[ReadingBranch]:
+        n = len(diameters)
+        return [ReadingBranch(None, None, _mask(range(n), labels))] if n else []
+
+    def indistinguishable_sets(self, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+        order = sorted(range(len(diameters)), key=lambda i: diameters[i])
+        return [tuple(order)] if order else []
+
+    def reading_windows(self, diameters: Sequence[float]) -> list[int] | None:
+        return None
+
+    def shared_reading_probability(self, diameters: Sequence[float]) -> list[float] | None:
+        return None
+
+    def uncovered_reading(
+        self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
+    ) -> float | None:
+        return None
+
+    def describe(self) -> str:
+        return "no sensor: a sensorless plan"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"model": "none"}
+
 
 @dataclass(frozen=True)
 class ToleranceSensor:
@@ -38,6 +283,176 @@ class ToleranceSensor:
 
     tolerance: float
     model: str = "tolerance"
+
+    @property
+    def informative(self) -> bool:
+        return True
+
+    def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
+        lo, hi = span(diameter)
+        return max(0.0, lo - self.tolerance), hi + self.tolerance
+
+    def consistent(self, diameter: Diameter, reading: float) -> bool:
+        if not isinstance(diameter, tuple):
+            return abs(reading - diameter) < self.tolerance
+        lo, hi = diameter
+        return lo - self.tolerance < reading < hi + self.tolerance
+
+    def reads_into(self, diameter: Diameter, lo: float, hi: float) -> bool:
+        a, b = span(diameter)
+        return a - self.tolerance < hi and b + self.tolerance > lo
+
+    def can_read_alike(self, d1: Diameter, d2: Diameter) -> bool:
+        if not isinstance(d1, tuple) and not isinstance(d2, tuple):
+            return abs(d1 - d2) < 2.0 * self.tolerance
+        (a1, b1), (a2, b2) = span(d1), span(d2)
+        two = 2.0 * self.tolerance
+        return a1 - b2 < two and a2 - b1 < two
+
+    def reading_reach(self) -> float:
+        return 2.0 * self.tolerance
+
+    def nominal_reading(self, diameter: Diameter) -> float | None:
+        lo, hi = span(diameter)
+        return (lo + hi) / 2.0
+
+    def read(self, width: float) -> float | None:
+        return width
+
+    def probe_readings(self, diameter: Diameter, inset: float) -> tuple[float, ...]:
+        e = self.tolerance
+        lo, hi = span(diameter)
+        return (max(inset, lo - e + inset), (lo + hi) / 2.0, hi + e - inset)
+
+    def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
+        if lo is None or hi is None:
+            return 1.0
+        e = self.tolerance
+        d_lo, d_hi = span(diameter)
+        a, b = max(lo, d_lo - e), min(hi, d_hi + e)
+        return max(0.0, min(1.0, (b - a) / (d_hi - d_lo + 2.0 * e)))
+
+    def uncovered_reading(
+        self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
+    ) -> float | None:
+        # The reading set is the open interval (lo - e, hi + e), clipped at 0.
+        d_lo, d_hi = span(diameter)
+        start, end = max(0.0, d_lo - self.tolerance), d_hi + self.tolerance
+        cur = start  # readings up to cur are covered (cur itself only once an interval holds it)
+        for a, b in sorted(intervals):
+            if b <= cur:
+                continue
+            if a > cur:
+                return (cur + min(a, end)) / 2.0 if cur < end else None
+            cur = b
+            if cur >= end:
+                return None
+        return (cur + end) / 2.0 if cur < end else None
+
+    def split(
+        self,
+        diameters: Sequence[float],
+        grouping: Grouping | str = Grouping.EXACT,
+        labels: Labels = None,
+    ) -> list[ReadingBranch]:
+        """The reading cells: between consecutive ends ``d -/+ e`` (clipped at 0) the states
+        within ``e`` of the cell's middle, neighbours with equal states merged.
+
+        Those states are a run of the diameters in ascending order, so two pointers find
+        them in one sweep: O(n log n) for n states.
+        """
+        if Grouping(grouping) is Grouping.COMPONENTS:
+            return _component_branches(self, diameters, labels)
+        if not _points(diameters):
+            return _interval_branches(self, diameters, labels)
+        diameters = _exact(diameters)
+        e = self.tolerance
+        order = sorted(range(len(diameters)), key=lambda j: diameters[j])
+        ds = [diameters[j] for j in order]
+        prefix = [0]
+        for j in order:
+            prefix.append(prefix[-1] | 1 << (j if labels is None else labels[j]))
+        points = sorted({max(0.0, d - e) for d in ds} | {d + e for d in ds})
+        k = len(ds)
+        a = b = 0
+        out: list[list] = []
+        last_run = None
+        for lo, hi in zip(points, points[1:], strict=False):
+            x = (lo + hi) / 2.0
+            while a < k and ds[a] < x and not abs(ds[a] - x) < e:
+                a += 1
+            b = max(b, a)
+            while b < k and abs(ds[b] - x) < e:
+                b += 1
+            if a == b:
+                last_run = None
+                continue
+            if last_run == (a, b):
+                out[-1][1] = hi
+                continue
+            out.append([lo, hi, prefix[b] ^ prefix[a]])
+            last_run = (a, b)
+        return [ReadingBranch(lo, hi, m) for lo, hi, m in out]
+
+    def indistinguishable_sets(self, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+        return _components(diameters, lambda d: self.reading_interval(d), closed=False)
+
+    def reading_windows(self, diameters: Sequence[Diameter]) -> list[int] | None:
+        if not _points(diameters):
+            return None
+        diameters = _exact(diameters)
+        n = len(diameters)
+        if any(diameters[i] > diameters[i + 1] for i in range(n - 1)):
+            return None
+        two = 2.0 * self.tolerance
+        fuzz = 1e-9 * max(max(diameters, default=1.0), two)
+        out = []
+        b = 0
+        for a in range(n):
+            b = max(b, a)
+            while b < n and diameters[b] - diameters[a] < two:
+                b += 1
+            near = [j for j in (b - 1, b) if a <= j < n]
+            if any(abs(diameters[j] - diameters[a] - two) < fuzz for j in near):
+                return None
+            out.append(((1 << b) - 1) ^ ((1 << a) - 1))
+        return out
+
+    def shared_reading_probability(self, diameters: Sequence[Diameter]) -> list[float] | None:
+        if not _points(diameters):
+            return None
+        diameters = _exact(diameters)
+        # A reading orients exactly when it comes from one state alone: the part of the
+        # state's interval that its neighbours in diameter order do not reach.
+        e = self.tolerance
+        d = diameters
+        k = len(d)
+        out = []
+        for t in range(k):
+            lo = d[t] - e if t == 0 else max(d[t] - e, d[t - 1] + e)
+            hi = d[t] + e if t == k - 1 else min(d[t] + e, d[t + 1] - e)
+            out.append(1.0 - max(0.0, hi - lo) / (2.0 * e))
+        return out
+
+    def describe(self) -> str:
+        return f"diameter sensor: a reading lies within \u00b1{self.tolerance:.4g} mm of it"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"model": "tolerance", "tolerance_mm": self.tolerance}
+
+
+LED_EDGE_REL = 1e-6
+"""A width within this fraction of the pitch of a beam's height may block that beam or not."""
+
+READING_EPS = 1e-9
+"""Readings within this fraction of the pitch of a beam count are taken as that count."""
+
+
+def led_count(pitch: float, width: float) -> int:
+    """Number of beams at heights ``k * pitch`` (k >= 1) strictly below ``width``."""
+    if width <= 0.0:
+        return 0
+    return max(0, math.ceil(width / pitch - 1e-12) - 1)
 
 
 @dataclass(frozen=True)
@@ -48,17 +463,195 @@ class LedSensor:
     noise: float = 0.0
     model: str = "led"
 
+    @property
+    def informative(self) -> bool:
+        return True
+
+    def counts(self, diameter: Diameter) -> tuple[int, int]:
+        """The smallest and largest beam count a state of this diameter can block.
+
+        Widths within ``LED_EDGE_REL * pitch`` of a beam's height count both ways, so a
+        diameter that sits on a beam (an exact multiple of the pitch) is not trusted to one
+        count.
+        """
+        e = self.noise + LED_EDGE_REL * self.pitch
+        lo, hi = span(diameter)
+        return led_count(self.pitch, lo - e), led_count(self.pitch, hi + e)
+
+    def count_of(self, reading: float) -> int:
+        """The beam count a reading (mm) stands for."""
+        return round(reading / self.pitch)
+
+    def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
+        c0, c1 = self.counts(diameter)
+        return c0 * self.pitch, c1 * self.pitch
+
+    def consistent(self, diameter: Diameter, reading: float) -> bool:
+        c0, c1 = self.counts(diameter)
+        return c0 <= self.count_of(reading) <= c1
+
+    def reads_into(self, diameter: Diameter, lo: float, hi: float) -> bool:
+        c0, c1 = self.counts(diameter)
+        first = math.ceil(lo / self.pitch - READING_EPS)
+        last = math.floor(hi / self.pitch + READING_EPS)
+        return max(c0, first) <= min(c1, last)
+
+    def can_read_alike(self, d1: Diameter, d2: Diameter) -> bool:
+        a, b = self.counts(d1), self.counts(d2)
+        return a[0] <= b[1] and b[0] <= a[1]
+
+    def reading_reach(self) -> float:
+        return 2.0 * self.noise + self.pitch
+
+    def nominal_reading(self, diameter: Diameter) -> float | None:
+        lo, hi = span(diameter)
+        return led_count(self.pitch, (lo + hi) / 2.0) * self.pitch
+
+    def read(self, width: float) -> float | None:
+        return led_count(self.pitch, width) * self.pitch
+
+    def probe_readings(self, diameter: Diameter, inset: float) -> tuple[float, ...]:
+        c0, c1 = self.counts(diameter)
+        return tuple(c * self.pitch for c in range(c0, c1 + 1))
+
+    def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
+        if lo is None or hi is None:
+            return 1.0
+        # Count c means c * p < width <= (c + 1) * p; the branch holds counts lo/p .. hi/p.
+        wlo, whi = lo, hi + self.pitch
+        e = self.noise
+        d_lo, d_hi = span(diameter)
+        if d_hi - d_lo + 2.0 * e <= 0.0:
+            return 1.0 if wlo < d_lo <= whi else 0.0
+        a, b = max(wlo, d_lo - e), min(whi, d_hi + e)
+        return max(0.0, min(1.0, (b - a) / (d_hi - d_lo + 2.0 * e)))
+
+    def uncovered_reading(
+        self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
+    ) -> float | None:
+        c0, c1 = self.counts(diameter)
+        p = self.pitch
+        held = [
+            (math.ceil(a / p - READING_EPS), math.floor(b / p + READING_EPS)) for a, b in intervals
+        ]
+        for c in range(c0, c1 + 1):
+            if not any(a <= c <= b for a, b in held):
+                return c * p
+        return None
+
+    def split(
+        self,
+        diameters: Sequence[float],
+        grouping: Grouping | str = Grouping.EXACT,
+        labels: Labels = None,
+    ) -> list[ReadingBranch]:
+        if not diameters:
+            return []
+        if Grouping(grouping) is Grouping.COMPONENTS:
+            return _component_branches(self, diameters, labels)
+        n = len(diameters)
+        extents = [self.counts(d) for d in diameters]
+        c_lo = min(c for c, _ in extents)
+        c_hi = max(c for _, c in extents)
+        cells = []
+        for c in range(c_lo, c_hi + 1):
+            members = [i for i in range(n) if extents[i][0] <= c <= extents[i][1]]
+            cells.append((float(c), float(c), _mask(members, labels)))
+        return [
+            ReadingBranch(a * self.pitch, b * self.pitch, m)
+            for a, b, m in _merge_cells(cells, gap=1.0)
+        ]
+
+    def indistinguishable_sets(self, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+        return _components(diameters, lambda d: self.reading_interval(d), closed=True)
+
+    def reading_windows(self, diameters: Sequence[float]) -> list[int] | None:
+        return None
+
+    def shared_reading_probability(self, diameters: Sequence[float]) -> list[float] | None:
+        return None
+
+    def describe(self) -> str:
+        return (
+            f"LED array: beams every {self.pitch:.4g} mm, alignment noise {self.noise:.4g} mm; "
+            "the reading is the blocked beams times the pitch"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"model": "led", "pitch_mm": self.pitch, "noise_mm": self.noise}
+
 
 SensorModel = NoSensor | ToleranceSensor | LedSensor
+"""The concrete models (for type hints where a value, not the protocol, is meant)."""
 
 
-@dataclass(frozen=True)
-class ReadingBranch:
-    """The states consistent with each reading in the closed ``[lo, hi]`` (None: sensorless)."""
+def _mask(positions: Sequence[int] | range, labels: Labels) -> int:
+    """The bit mask of the states at these positions, by their labels."""
+    m = 0
+    for j in positions:
+        m |= 1 << (j if labels is None else labels[j])
+    return m
 
-    lo: float | None
-    hi: float | None
-    members: tuple[int, ...]
+
+def _merge_cells(cells: list[tuple[float, float, int]], gap: float) -> list[list]:
+    """Drop empty cells and join neighbours (at most ``gap`` apart) with equal members."""
+    merged: list[list] = []
+    for a, b, members in cells:
+        if not members:
+            continue
+        if merged and merged[-1][2] == members and merged[-1][1] >= a - gap:
+            merged[-1][1] = b
+        else:
+            merged.append([a, b, members])
+    return merged
+
+
+def _interval_branches(
+    sensor: ToleranceSensor, diameters: Sequence[Diameter], labels: Labels
+) -> list[ReadingBranch]:
+    """Exact reading cells of states with diameter intervals (open reading sets).
+
+    Between consecutive ends of the reading sets, the states whose set holds the cell's
+    middle; neighbours with equal states merged. O(n * cells): intervals can nest, so the
+    states of a cell need not be a run.
+    """
+    sets = [sensor.reading_interval(d) for d in diameters]
+    ends = sorted({x for iv in sets if iv is not None for x in iv})
+    cells = []
+    for lo, hi in zip(ends, ends[1:], strict=False):
+        x = (lo + hi) / 2.0
+        inside = [j for j, iv in enumerate(sets) if iv is not None and iv[0] < x < iv[1]]
+        cells.append((lo, hi, _mask(inside, labels)))
+    return [ReadingBranch(a, b, m) for a, b, m in _merge_cells(cells, gap=0.0)]
+
+
+def _components(diameters: Sequence[float], extent, closed: bool) -> list[tuple[int, ...]]:
+    """Connected components of overlapping reading intervals, in diameter order."""
+    order = sorted(range(len(diameters)), key=lambda i: diameters[i])
+    groups: list[list[int]] = []
+    reach = -math.inf
+    for i in order:
+        lo, hi = extent(diameters[i])
+        if groups and (lo <= reach if closed else lo < reach):
+            groups[-1].append(i)
+            reach = max(reach, hi)
+        else:
+            groups.append([i])
+            reach = hi
+    return [tuple(g) for g in groups]
+
+
+def _component_branches(
+    sensor: Sensor, diameters: Sequence[float], labels: Labels = None
+) -> list[ReadingBranch]:
+    """The paper's branching: one branch per indistinguishable set, over its whole extent."""
+    out = []
+    for comp in sensor.indistinguishable_sets(diameters):
+        ivs = [sensor.reading_interval(diameters[i]) for i in comp]
+        lo = min(iv[0] for iv in ivs if iv is not None)
+        hi = max(iv[1] for iv in ivs if iv is not None)
+        out.append(ReadingBranch(lo, hi, _mask(comp, labels)))
+    return out
 
 
 def make_sensor(
@@ -68,7 +661,11 @@ def make_sensor(
     led_pitch: float | None = None,
     noise: float | None = None,
 ) -> SensorModel:
-    """The sensor model for the command line's options; impossible settings are bad input."""
+    """The sensor model for the given settings; impossible settings are bad input.
+
+    >>> make_sensor(tolerance=0.2)
+    ToleranceSensor(tolerance=0.2, model='tolerance')
+    """
     chosen = sum([sensorless, tolerance is not None, led_pitch is not None])
     if chosen > 1:
         raise InputError("choose one of --sensorless, --tolerance and --led-pitch")
@@ -88,161 +685,92 @@ def make_sensor(
     return NoSensor()
 
 
-def sensor_to_dict(sensor: SensorModel) -> dict[str, object]:
-    """The plan file's ``sensor`` object."""
-    if isinstance(sensor, ToleranceSensor):
-        return {"model": "tolerance", "tolerance_mm": sensor.tolerance}
-    if isinstance(sensor, LedSensor):
-        return {"model": "led", "pitch_mm": sensor.pitch, "noise_mm": sensor.noise}
-    return {"model": "none"}
-
-
 def sensor_from_dict(data: object) -> SensorModel:
-    """Read the plan file's ``sensor`` object."""
+    """Read the plan file's ``sensor`` object (the inverse of ``Sensor.to_dict``)."""
     if not isinstance(data, dict) or "model" not in data:
         raise InputError("the plan's 'sensor' must be an object with a 'model'")
     model = data["model"]
+    read = _FROM_DICT.get(model) if isinstance(model, str) else None
+    if read is None:
+        raise InputError(f"unknown sensor model {model!r}")
     try:
-        if model == "none":
-            return NoSensor()
-        if model == "tolerance":
-            return make_sensor(tolerance=float(data["tolerance_mm"]))
-        if model == "led":
-            return make_sensor(
-                led_pitch=float(data["pitch_mm"]), noise=float(data.get("noise_mm", 0.0))
-            )
+        return read(data)
     except (KeyError, TypeError, ValueError):
         raise InputError(f"the plan's {model!r} sensor lacks its parameters") from None
-    raise InputError(f"unknown sensor model {model!r}")
 
 
-def led_count(pitch: float, width: float) -> int:
-    """Number of beams at heights ``k * pitch`` (k >= 1) strictly below ``width``."""
-    if width <= 0.0:
-        return 0
-    return max(0, math.ceil(width / pitch - 1e-12) - 1)
+_FROM_DICT: dict[str, Any] = {
+    "none": lambda data: NoSensor(),
+    "tolerance": lambda data: make_sensor(tolerance=float(data["tolerance_mm"])),
+    "led": lambda data: make_sensor(
+        led_pitch=float(data["pitch_mm"]), noise=float(data.get("noise_mm", 0.0))
+    ),
+}
+"""Per model name, how its ``to_dict`` object is read back: a new model adds its line."""
 
 
-LED_EDGE_REL = 1e-6
-"""A width within this fraction of the pitch of a beam's height may block that beam or not."""
+def sensor_warnings(sensor: Sensor, diameters: Sequence[float]) -> list[str]:
+    """Settings that make the sensor useless for states of these diameters, in words.
 
+    Not errors (a plan can still be made: it is the sensorless one), but almost always a
+    mistake in units or scale: every state reads alike, or the sensor cannot tell apart two
+    widths as far apart as the part is wide (an LED pitch or a tolerance larger than the
+    part).
 
-def led_counts(sensor: LedSensor, diameter: float) -> tuple[int, int]:
-    """The smallest and largest beam count a state of this diameter can block.
-
-    Widths within ``LED_EDGE_REL * pitch`` of a beam's height count both ways, so a diameter
-    that sits on a beam (an exact multiple of the pitch) is not trusted to one count.
+    >>> sensor_warnings(ToleranceSensor(0.01), [10.0, 12.0])
+    []
+    >>> sensor_warnings(LedSensor(50.0), [10.0, 12.0])  # doctest: +NORMALIZE_WHITESPACE
+    ['every state reads alike (diameters 10 to 12 mm): the plan cannot use the readings',
+     'states up to 50 mm apart can read alike, more than the largest diameter (12 mm)']
     """
-    e = sensor.noise + LED_EDGE_REL * sensor.pitch
-    return led_count(sensor.pitch, diameter - e), led_count(sensor.pitch, diameter + e)
+    if not sensor.informative or not diameters:
+        return []
+    lo, hi = min(diameters), max(diameters)
+    out = []
+    if len(diameters) > 1 and sensor.can_read_alike(lo, hi):
+        out.append(
+            f"every state reads alike (diameters {lo:.4g} to {hi:.4g} mm): "
+            "the plan cannot use the readings"
+        )
+    reach = sensor.reading_reach()
+    if reach > hi:
+        out.append(
+            f"states up to {reach:.4g} mm apart can read alike, "
+            f"more than the largest diameter ({hi:.4g} mm)"
+        )
+    return out
 
 
-def can_read_alike(sensor: SensorModel, d1: float, d2: float) -> bool:
-    """Whether two diameters can produce the same reading (their reading sets overlap)."""
-    if isinstance(sensor, NoSensor):
-        return True
-    if isinstance(sensor, ToleranceSensor):
-        return abs(d1 - d2) < 2.0 * sensor.tolerance
-    a, b = led_counts(sensor, d1), led_counts(sensor, d2)
-    return a[0] <= b[1] and b[0] <= a[1]
+# Transitional function forms of the protocol's methods, for callers not yet moved to it.
 
 
-def indistinguishable_sets(
-    sensor: SensorModel, diameters: Sequence[float]
-) -> list[tuple[int, ...]]:
-    """Definition 10: connected components of the overlap relation, sorted by diameter."""
-    order = sorted(range(len(diameters)), key=lambda i: diameters[i])
-    if isinstance(sensor, NoSensor):
-        return [tuple(order)] if order else []
-    groups: list[list[int]] = []
-    reach = -math.inf
-    closed = isinstance(sensor, LedSensor)  # LED counts are closed ranges, tolerances open
-    for i in order:
-        lo, hi = _reading_extent(sensor, diameters[i])
-        if groups and (lo <= reach if closed else lo < reach):
-            groups[-1].append(i)
-            reach = max(reach, hi)
-        else:
-            groups.append([i])
-            reach = hi
-    return [tuple(g) for g in groups]
+def sensor_to_dict(sensor: Sensor) -> dict[str, Any]:
+    """``sensor.to_dict()``."""
+    return sensor.to_dict()
 
 
-def _reading_extent(sensor: SensorModel, d: float) -> tuple[float, float]:
-    """The smallest and largest reading of a diameter (counts for the LED array)."""
-    if isinstance(sensor, ToleranceSensor):
-        return d - sensor.tolerance, d + sensor.tolerance
-    if isinstance(sensor, LedSensor):
-        c0, c1 = led_counts(sensor, d)
-        return float(c0), float(c1)
-    return -math.inf, math.inf
+def can_read_alike(sensor: Sensor, d1: float, d2: float) -> bool:
+    """``sensor.can_read_alike(d1, d2)``."""
+    return sensor.can_read_alike(d1, d2)
+
+
+def reading_consistent(sensor: Sensor, diameter: float, reading: float) -> bool:
+    """``sensor.consistent(diameter, reading)``."""
+    return sensor.consistent(diameter, reading)
+
+
+def indistinguishable_sets(sensor: Sensor, diameters: Sequence[float]) -> list[tuple[int, ...]]:
+    """``sensor.indistinguishable_sets(diameters)``."""
+    return sensor.indistinguishable_sets(diameters)
 
 
 def split_by_reading(
-    sensor: SensorModel, diameters: Sequence[float], grouping: Grouping = "exact"
+    sensor: Sensor, diameters: Sequence[float], grouping: Grouping | str = Grouping.EXACT
 ) -> list[ReadingBranch]:
-    """Branch a set of states (given by their diameters) on the reading, in reading order.
-
-    ``exact``: each reading leads to exactly the states that can produce it; consecutive
-    readings with the same states form one branch. ``components``: the paper's rule, a
-    reading names its whole indistinguishable set. Branch intervals are closed and may share
-    endpoints; a reading on a shared endpoint is consistent with a subset of either branch.
-    """
-    n = len(diameters)
-    if n == 0:
-        return []
-    if isinstance(sensor, NoSensor):
-        return [ReadingBranch(None, None, tuple(range(n)))]
-    if grouping == "components":
-        out = []
-        for comp in indistinguishable_sets(sensor, diameters):
-            lo = min(_reading_extent(sensor, diameters[i])[0] for i in comp)
-            hi = max(_reading_extent(sensor, diameters[i])[1] for i in comp)
-            out.append(_branch(sensor, lo, hi, tuple(sorted(comp))))
-        return out
-    if isinstance(sensor, ToleranceSensor):
-        e = sensor.tolerance
-        points = sorted({d - e for d in diameters} | {d + e for d in diameters})
-        cells = []
-        for a, b in zip(points, points[1:], strict=False):
-            x = (a + b) / 2.0
-            members = tuple(i for i in range(n) if abs(diameters[i] - x) < e)
-            cells.append((a, b, members))
-    else:
-        extents = [led_counts(sensor, d) for d in diameters]
-        c_lo = min(c for c, _ in extents)
-        c_hi = max(c for _, c in extents)
-        cells = []
-        for c in range(c_lo, c_hi + 1):
-            members = tuple(i for i in range(n) if extents[i][0] <= c <= extents[i][1])
-            cells.append((float(c), float(c), members))
-    merged: list[list] = []
-    for a, b, members in cells:
-        if not members:
-            continue
-        if (
-            merged
-            and merged[-1][2] == members
-            and merged[-1][1] >= a - (1 if isinstance(sensor, LedSensor) else 0)
-        ):
-            merged[-1][1] = b
-        else:
-            merged.append([a, b, members])
-    return [_branch(sensor, a, b, members) for a, b, members in merged]
+    """``sensor.split(diameters, grouping)``."""
+    return sensor.split(diameters, grouping)
 
 
-def _branch(sensor: SensorModel, lo: float, hi: float, members: tuple[int, ...]) -> ReadingBranch:
-    if isinstance(sensor, LedSensor):
-        return ReadingBranch(lo * sensor.pitch, hi * sensor.pitch, members)
-    return ReadingBranch(lo, hi, members)
-
-
-def reading_consistent(sensor: SensorModel, diameter: float, reading: float) -> bool:
-    """Whether a state of this diameter can produce ``reading`` (mm)."""
-    if isinstance(sensor, NoSensor):
-        return True
-    if isinstance(sensor, ToleranceSensor):
-        return abs(reading - diameter) < sensor.tolerance
-    c0, c1 = led_counts(sensor, diameter)
-    c = round(reading / sensor.pitch)
-    return c0 <= c <= c1
+def led_counts(sensor: LedSensor, diameter: float) -> tuple[int, int]:
+    """``sensor.counts(diameter)``."""
+    return sensor.counts(diameter)

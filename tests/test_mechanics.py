@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from feederkit.machine import build_machine, mask_of, overlap_ranges
 from feederkit.mechanics import (
     PushFunction,
     StableState,
     action_ranges,
     diameter,
-    overlap_ranges,
     polygon_class,
     push,
     push_diameter,
@@ -30,6 +30,7 @@ from feederkit.mechanics.symmetry import periods_of
 from feederkit.outline import load_outline_json, make_outline
 from feederkit.part import Part, make_part
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 LONG_EDGE_RANGE = 2 * math.degrees(math.atan(2.0))  # 126.87
@@ -223,16 +224,17 @@ def test_action_ranges_of_the_rectangle() -> None:
 def test_overlap_ranges_of_the_long_edges() -> None:
     pf = push_function(RECT)
     ids = [s.id for s in pf.states if s.edge in (0, 2)]
-    cells = overlap_ranges([action_ranges(pf, i) for i in ids])
+    machine = build_machine([pf], uncertainty=IDEAL)
+    cells = overlap_ranges(machine, mask_of(ids))
     assert len(cells) <= len(ids) * pf.n
     assert sum(c.hi - c.lo for c in cells) == pytest.approx(360.0)
     for c in cells:
         a = c.representative
         assert c.margin == pytest.approx((c.hi - c.lo) / 2)
-        got = tuple(push(pf, pf.states[i].normal_deg - a).id for i in ids)
-        assert got == c.targets
-    # The symmetric pair always lands on symmetric states: never on one state.
-    assert all(len(set(c.targets)) == 2 for c in cells)
+        got = {push(pf, pf.states[i].normal_deg - a).id for i in ids}
+        assert mask_of(got) == c.image
+        # The symmetric pair always lands on symmetric states: never on one state.
+        assert c.image.bit_count() == 2
 
 
 # --- symmetry (definitions 3, 6-8) on hand-made push functions ----------------------------

@@ -16,10 +16,10 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from feederkit.hull import convex_hull
+from feederkit.machine import build_machine, mask_of, overlap_ranges
 from feederkit.mechanics import (
     action_ranges,
     diameter,
-    overlap_ranges,
     polygon_class,
     push,
     push_diameter,
@@ -31,6 +31,7 @@ from feederkit.mechanics.symmetry import periods_of, push_periods
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
 from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 SETTINGS = settings(
     max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much]
@@ -229,14 +230,14 @@ def test_overlap_ranges_agree_with_push(poly, data) -> None:
     subset = data.draw(
         st.lists(st.sampled_from(range(pf.n)), min_size=1, max_size=pf.n, unique=True)
     )
-    cells = overlap_ranges([action_ranges(pf, i) for i in subset])
+    cells = overlap_ranges(build_machine([pf], uncertainty=IDEAL), mask_of(subset))
     assert len(cells) <= len(subset) * pf.n
     assert sum(c.hi - c.lo for c in cells) == pytest.approx(360.0)
     for c in cells:
         for f in (0.05, 0.5, 0.95):
             a = c.lo + f * (c.hi - c.lo)
-            got = tuple(push(pf, pf.states[i].normal_deg - a).id for i in subset)
-            assert got == c.targets
+            got = {push(pf, pf.states[i].normal_deg - a).id for i in subset}
+            assert mask_of(got) == c.image
         assert 0.0 <= c.representative < 360.0 and c.margin > 0.0
 
 

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from test_mix_planner import random_part
 
 from feederkit.mechanics.push import push_function
-from feederkit.mix.classes import push_classes, push_diameter_classes
+from feederkit.mix.behaviour import push_classes, push_diameter_classes
 from feederkit.mix.lookalike import build_lookalike
 from feederkit.mix.signatures import (
     matching_shifts,

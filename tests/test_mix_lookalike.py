@@ -18,8 +18,8 @@ from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
 from feederkit.mix.lookalike import (
     build_lookalike,
-    lookalike_same_push,
-    lookalike_same_push_diameter,
+    lookalike_same_push_detail,
+    lookalike_same_push_diameter_detail,
     similar,
 )
 from feederkit.mix.pairs import distinguishable
@@ -71,7 +71,7 @@ def test_catalog_parts_get_checked_lookalikes(path, keep):
 @pytest.mark.parametrize("n", [3, 4, 5, 6, 7])
 def test_regular_polygons_theorem_6(n):
     src = regular(n)
-    look = lookalike_same_push_diameter(src, 0)
+    look = lookalike_same_push_diameter_detail(src, 0).part
     assert_same(src, look, "push-diameter")
 
 
@@ -79,8 +79,8 @@ def test_regular_polygons_theorem_6(n):
 @given(st.integers(0, 10**6), st.integers(0, 100))
 def test_random_lookalikes(seed, k):
     src = random_part(seed, "src")
-    assert_same(src, lookalike_same_push(src, k), "push")
-    pdf = lookalike_same_push_diameter(src, k)
+    assert_same(src, lookalike_same_push_detail(src, k).part, "push")
+    pdf = lookalike_same_push_diameter_detail(src, k).part
     assert_same(src, pdf, "push-diameter")
     w = distinguishable(push_function(src), push_function(pdf), ToleranceSensor(0.01))
     assert w is not None and w.kind == "same-push-diameter"
@@ -105,7 +105,7 @@ def test_theorem_4_rejects_a_vertex_that_is_not_a_transition_vertex():
     non = [v for v in range(len(part.hull)) if v not in transition_vertices(push_function(part))]
     assert non
     with pytest.raises(InputError, match="not a transition vertex"):
-        lookalike_same_push(part, 0, vertices=[non[0]])
+        lookalike_same_push_detail(part, 0, vertices=[non[0]])
 
 
 def test_cli_writes_the_outline_file_and_says_what_it_checked(tmp_path, capsys):
@@ -147,9 +147,9 @@ def test_cli_bad_input_exits_2_with_one_line(args, capsys, monkeypatch):
 
 def test_heptagon_file_is_theorem_4_applied_to_the_catalog_triangle():
     tri = make_part(load_outline_json(CATALOG / "equilateral-triangle.json"))
-    built = lookalike_same_push(
+    built = lookalike_same_push_detail(
         tri, vertices=[1, 2], fractions=[(0.5, 0.5, 0.6), (0.3, 0.4, 0.35)], name="heptagon-fig17"
-    )
+    ).part
     stored = load_outline_json(CATALOG / "heptagon-fig17.json")
     assert stored.com == tri.com
     assert len(stored.vertices) == 7

@@ -21,6 +21,7 @@ from feederkit.mix.signatures import same_push_diameter_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 sensors = st.one_of(
     st.floats(0.01, 8.0).map(ToleranceSensor),
@@ -33,7 +34,7 @@ sensors = st.one_of(
 @given(st.integers(0, 10**6), st.integers(0, 10**6), sensors)
 def test_cross_pairs_are_the_product_machines_inseparable_pairs(sa, sb, sensor):
     a, b = push_function(random_part(sa, "a")), push_function(random_part(sb, "b"))
-    machine = build_machine([a, b], sensor)
+    machine = build_machine([a, b], sensor, uncertainty=IDEAL)
     ins = inseparable(machine)
     expected = sorted(
         (i, j - a.n) for i in range(a.n) for j in range(a.n, machine.n) if ins[i] >> j & 1

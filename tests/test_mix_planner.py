@@ -20,6 +20,7 @@ from feederkit.planning.api import plan
 from feederkit.plans.make import make_plan
 from feederkit.plans.verify import verify_plan
 from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 
 def random_part(seed: int, name: str, kmax: int = 6):
@@ -57,7 +58,7 @@ def test_mix_planner_agrees_with_exhaustive_search(mix):
     parts = [random_part(s, f"m{k}") for k, s in enumerate(seeds)]
     tol = rel_tol * max(p.size for p in parts)
     pfs = [push_function(p) for p in parts]
-    result = plan(build_machine(pfs, ToleranceSensor(tol)))
+    result = plan(build_machine(pfs, ToleranceSensor(tol), uncertainty=IDEAL))
     assert result.optimal
     assert result.length == oracle_length(parts, tol)
 
@@ -68,7 +69,7 @@ def test_sensorless_mix_agrees_with_exhaustive_search(seeds):
     parts = [random_part(s, f"s{k}", kmax=4) for k, s in enumerate(seeds)]
     pfs = [push_function(p) for p in parts]
     try:
-        result = plan(build_machine(pfs, NoSensor()))
+        result = plan(build_machine(pfs, NoSensor(), uncertainty=IDEAL))
     except PlanningError:
         with pytest.raises(AssertionError):
             oracle_length(parts, None)
@@ -86,7 +87,9 @@ def test_oracle_reproduces_the_paper_figure_27_mix():
     )
     assert oracle_length([tri, octagon], 0.01) == 2
     result = plan(
-        build_machine([push_function(tri), push_function(octagon)], ToleranceSensor(0.01))
+        build_machine(
+            [push_function(tri), push_function(octagon)], ToleranceSensor(0.01), uncertainty=IDEAL
+        )
     )
     assert result.length == 2
 
@@ -97,7 +100,7 @@ def test_every_mix_plan_passes_verification_for_every_part(mix):
     seeds, rel_tol = mix
     parts = [random_part(s, f"v{k}") for k, s in enumerate(seeds)]
     tol = rel_tol * max(p.size for p in parts)
-    made = make_plan([push_function(p) for p in parts], ToleranceSensor(tol))
+    made = make_plan([push_function(p) for p in parts], ToleranceSensor(tol), uncertainty=IDEAL)
     assert made.report.ok
     for k in range(len(parts)):
         report = verify_plan(made.plan, [k])

@@ -8,6 +8,7 @@ the state it is really in, and only states inseparable from it.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 from itertools import product
 
@@ -27,19 +28,19 @@ from feederkit.machine import (
 )
 from feederkit.mechanics import push_function
 from feederkit.mechanics.actions import ActionRange
-from feederkit.mechanics.classes import polygon_class
+from feederkit.mechanics.polygon_classes import polygon_class
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.api import plan
+from feederkit.planning.options import Grouping, Method, Objective, PlanningOptions
 from feederkit.planning.stats import expected_operations
 from feederkit.planning.tree import Leaf
 from feederkit.sensors import (
     LedSensor,
     NoSensor,
     ToleranceSensor,
-    led_counts,
-    reading_consistent,
 )
+from feederkit.uncertainty import IDEAL
 
 # ---------------------------------------------------------------- helpers
 
@@ -95,7 +96,7 @@ def check_plan(result) -> int:
         if isinstance(sensor, ToleranceSensor):
             e = sensor.tolerance
             return max(branch.lo, d - e) < min(branch.hi, d + e)
-        return any(reading_consistent(sensor, d, r) for r in _reading_points(machine, branch))
+        return any(sensor.consistent(d, r) for r in _reading_points(machine, branch))
 
     def run(node, state, ops):
         nonlocal longest
@@ -125,12 +126,11 @@ def check_plan(result) -> int:
             return
         if isinstance(sensor, ToleranceSensor):
             e = sensor.tolerance
-            pts = sorted(
-                {d - e, d + e} | {x for b in mine for x in (b.lo, b.hi) if d - e < x < d + e}
-            )
+            lo = max(0.0, d - e)  # readings are never negative
+            pts = sorted({lo, d + e} | {x for b in mine for x in (b.lo, b.hi) if lo < x < d + e})
             probes = [(a + b) / 2 for a, b in zip(pts, pts[1:], strict=False)]
         else:
-            c0, c1 = led_counts(sensor, d)
+            c0, c1 = sensor.counts(d)
             probes = [c * sensor.pitch for c in range(c0, c1 + 1)]
         for x in probes:
             assert any(b.lo - 1e-12 <= x <= b.hi + 1e-12 for b in mine), f"reading {x} uncovered"
@@ -145,7 +145,9 @@ def check_plan(result) -> int:
 
 
 def test_rectangle_sensorless_length_2_up_to_symmetry():
-    m = build_machine([part("rect", [(-1, -0.5), (1, -0.5), (1, 0.5), (-1, 0.5)])])
+    m = build_machine(
+        [part("rect", [(-1, -0.5), (1, -0.5), (1, 0.5), (-1, 0.5)])], uncertainty=IDEAL
+    )
     r = plan(m)
     assert r.length == 2 and r.optimal
     check_plan(r)
@@ -159,8 +161,8 @@ def test_rectangle_sensorless_length_2_up_to_symmetry():
 
 def test_isosceles_right_triangle():
     pf = part("tri", TRIANGLE)
-    with_sensor = plan(build_machine([pf], ToleranceSensor(0.01)))
-    without = plan(build_machine([pf], NoSensor()))
+    with_sensor = plan(build_machine([pf], ToleranceSensor(0.01), uncertainty=IDEAL))
+    without = plan(build_machine([pf], NoSensor(), uncertainty=IDEAL))
     assert (with_sensor.length, without.length) == (2, 3)
     check_plan(with_sensor)
     check_plan(without)
@@ -169,7 +171,7 @@ def test_isosceles_right_triangle():
 
 @pytest.mark.parametrize("n", range(5, 13))
 def test_offset_regular_polygon_needs_n(n):
-    m = build_machine([regular(n)])
+    m = build_machine([regular(n)], uncertainty=IDEAL)
     r = plan(m)
     assert r.length == n == 1 + shortest_synchronizing_word(m)
     check_plan(r)
@@ -178,7 +180,7 @@ def test_offset_regular_polygon_needs_n(n):
 def test_all_diameters_distinct_gives_length_1():
     pf = part("scalene", [(0, 0), (4, 0), (1, 3)])
     assert len({round(s.diameter, 6) for s in pf.states}) == pf.n
-    r = plan(build_machine([pf], ToleranceSensor(1e-3)))
+    r = plan(build_machine([pf], ToleranceSensor(1e-3), uncertainty=IDEAL))
     assert r.length == 1
     assert abs(r.expected_length - 1.0) < 1e-12
     assert all(isinstance(sub, Leaf) for _, sub in r.root.branches)
@@ -238,18 +240,28 @@ SENSORS = [NoSensor(), ToleranceSensor(0.01), ToleranceSensor(0.2), LedSensor(0.
 @pytest.mark.parametrize("sensor", SENSORS, ids=lambda s: repr(s))
 def test_methods_agree_and_bounds_hold(name, verts, com, sensor):
     pf = part(name, verts, com)
-    m = build_machine([pf], sensor)
+    m = build_machine([pf], sensor, uncertainty=IDEAL)
     r = plan(m)
     check_plan(r)
     assert r.optimal and r.lower_bound == r.length
-    assert plan(m, method="andor").length == r.length
-    assert plan(m, method="bottom-up").length == r.length
-    sensorless = plan(build_machine([pf], NoSensor()))
+    assert plan(m, PlanningOptions(method="andor")).length == r.length
+    assert plan(m, PlanningOptions(method="bottom-up")).length == r.length
+    sensorless = plan(build_machine([pf], NoSensor(), uncertainty=IDEAL))
     assert r.length <= sensorless.length
-    assert plan(build_machine([pf], NoSensor()), method="bfs").length == sensorless.length
-    assert plan(build_machine([pf], NoSensor()), method="backchain").length == sensorless.length
+    assert (
+        plan(
+            build_machine([pf], NoSensor(), uncertainty=IDEAL), PlanningOptions(method="bfs")
+        ).length
+        == sensorless.length
+    )
+    assert (
+        plan(
+            build_machine([pf], NoSensor(), uncertainty=IDEAL), PlanningOptions(method="backchain")
+        ).length
+        == sensorless.length
+    )
     assert r.length <= polygon_class(pf, sensor).bound
-    comp = plan(m, grouping="components")
+    comp = plan(m, PlanningOptions(grouping="components"))
     check_plan(comp)
     assert r.length <= comp.length
 
@@ -259,17 +271,19 @@ def test_methods_agree_and_bounds_hold(name, verts, com, sensor):
 def test_random_parts_methods_agree(seed, n, rel_tol):
     pf = random_convex(seed, n)
     sensor = NoSensor() if rel_tol == 0.0 else ToleranceSensor(rel_tol * pf.part.size)
-    m = build_machine([pf], sensor)
+    m = build_machine([pf], sensor, uncertainty=IDEAL)
     r = plan(m)
     check_plan(r)
-    assert plan(m, method="andor").length == r.length
+    assert plan(m, PlanningOptions(method="andor")).length == r.length
     if pf.n <= 10:
-        assert plan(m, method="bottom-up").length == r.length
-    sensorless = build_machine([pf], NoSensor())
+        assert plan(m, PlanningOptions(method="bottom-up")).length == r.length
+    sensorless = build_machine([pf], NoSensor(), uncertainty=IDEAL)
     s = plan(sensorless)
     assert r.length <= s.length
     assert (
-        plan(sensorless, method="bfs").length == s.length == plan(sensorless, method="andor").length
+        plan(sensorless, PlanningOptions(method="bfs")).length
+        == s.length
+        == plan(sensorless, PlanningOptions(method="andor")).length
     )
     assert r.length <= polygon_class(pf, sensor).bound
     assert s.length <= polygon_class(pf, NoSensor()).bound
@@ -281,21 +295,23 @@ def test_random_parts_methods_agree(seed, n, rel_tol):
 @pytest.mark.parametrize(("name", "verts", "com"), PARTS)
 def test_no_plan_of_the_same_length_keeps_a_larger_margin(name, verts, com):
     for sensor in (NoSensor(), ToleranceSensor(0.2)):
-        m = build_machine([part(name, verts, com)], sensor)
+        m = build_machine([part(name, verts, com)], sensor, uncertainty=IDEAL)
         r = plan(m)
         if r.length == 1:
             assert r.min_margin == math.inf
             continue
         assert 0.0 < r.min_margin < 180.0
         with contextlib.suppress(PlanningError):
-            assert plan(m, min_margin=r.min_margin * (1 + 1e-9)).length > r.length
+            assert (
+                plan(m, PlanningOptions(min_margin_deg=r.min_margin * (1 + 1e-9))).length > r.length
+            )
 
 
 def test_expected_objective_never_worse_and_statistics_consistent():
     for name, verts, com in PARTS:
-        m = build_machine([part(name, verts, com)], ToleranceSensor(0.05))
+        m = build_machine([part(name, verts, com)], ToleranceSensor(0.05), uncertainty=IDEAL)
         w = plan(m)
-        e = plan(m, objective="expected")
+        e = plan(m, PlanningOptions(objective="expected"))
         check_plan(e)
         assert e.expected_length <= w.expected_length + 1e-12
         assert abs(expected_operations(m, e.root) - e.expected_length) < 1e-12
@@ -304,38 +320,74 @@ def test_expected_objective_never_worse_and_statistics_consistent():
 
 def test_min_margin_respected_or_named():
     pf = regular(7)
-    m = build_machine([pf])
+    m = build_machine([pf], uncertainty=IDEAL)
     r = plan(m)
     floor = r.min_margin
-    same = plan(m, min_margin=floor)
+    same = plan(m, PlanningOptions(min_margin_deg=floor))
     assert same.min_margin >= floor and same.length == r.length
     with pytest.raises(PlanningError) as err:
-        plan(m, min_margin=179.0)
+        plan(m, PlanningOptions(min_margin_deg=179.0))
     assert "largest margin" in str(err.value)
     best = float(str(err.value).split("is ")[-1].split(" deg")[0])
-    ok = plan(m, min_margin=best * 0.999)
+    ok = plan(m, PlanningOptions(min_margin_deg=best * 0.999))
     check_plan(ok)
     assert ok.min_margin >= best * 0.999
 
 
 def test_time_limit_returns_a_valid_plan_with_a_lower_bound():
     # The plain AND/OR search needs about a second for the offset 12-gon.
-    m = build_machine([regular(12)])
-    r = plan(m, method="andor", time_limit=0.05)
+    m = build_machine([regular(12)], uncertainty=IDEAL)
+    r = plan(m, PlanningOptions(method="andor", time_limit_s=0.05))
     check_plan(r)
     assert not r.optimal
     assert 2 <= r.lower_bound <= 12 <= r.length
     # One part's push machine: backchaining gives a plan at once when the search cannot.
-    blind = plan(build_machine([regular(32, (0.02, 0.008))]), method="andor", time_limit=1e-4)
+    blind = plan(
+        build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL),
+        PlanningOptions(method="andor", time_limit_s=1e-4),
+    )
     check_plan(blind)
     assert not blind.optimal and blind.length >= 32 >= blind.lower_bound
     # A mix has no such fallback.
     with pytest.raises(PlanningError, match="time limit"):
-        plan(build_machine([regular(12), regular(11)]), method="andor", time_limit=1e-4)
+        plan(
+            build_machine([regular(12), regular(11)], uncertainty=IDEAL),
+            PlanningOptions(method="andor", time_limit_s=1e-4),
+        )
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"objective": "best"}, "the objective must be one of worst, expected, got 'best'"),
+        ({"grouping": "pairs"}, "the reading grouping must be one of exact, components"),
+        ({"method": "dfs"}, "the planning method must be one of auto, andor, bottom-up"),
+        ({"min_margin_deg": -1.0}, r"the minimum margin must be in \[0, 180\) degrees"),
+        ({"min_margin_deg": math.nan}, "the minimum margin must be in"),
+        ({"min_margin_deg": 180.0}, "the minimum margin must be in"),
+        ({"min_margin_deg": "5"}, "the minimum margin must be in"),
+        ({"time_limit_s": 0.0}, "the time limit must be a positive number of seconds"),
+        ({"time_limit_s": math.inf}, "the time limit must be a positive number of seconds"),
+    ],
+)
+def test_bad_options_are_refused_once_in_library_words(options, message):
+    with pytest.raises(InputError, match=message):
+        PlanningOptions(**options)
+
+
+def test_options_normalise_strings_to_enums_and_are_values():
+    o = PlanningOptions(objective="expected", grouping="components", method="bottom-up")
+    assert o.objective is Objective.EXPECTED and o.method is Method.BOTTOM_UP
+    assert o.grouping is Grouping.COMPONENTS
+    assert o == PlanningOptions(Objective.EXPECTED, 0, Grouping.COMPONENTS, None, Method.BOTTOM_UP)
+    assert isinstance(o.min_margin_deg, float)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        o.min_margin_deg = 1.0  # type: ignore[misc]
 
 
 def test_bad_arguments():
-    m = build_machine([part("tri", TRIANGLE)])
+    m = build_machine([part("tri", TRIANGLE)], uncertainty=IDEAL)
+    # The older keyword spelling goes through the same validation.
     for kwargs in (
         {"objective": "best"},
         {"grouping": "pairs"},
@@ -346,8 +398,14 @@ def test_bad_arguments():
     ):
         with pytest.raises(InputError):
             plan(m, **kwargs)
-    with pytest.raises(InputError):
-        plan(build_machine([part("tri", TRIANGLE)], ToleranceSensor(0.01)), method="bfs")
+    assert plan(m, min_margin=1.0) == plan(m, PlanningOptions(min_margin_deg=1.0))
+    with pytest.raises(TypeError):
+        plan(m, PlanningOptions(), method="andor")
+    with pytest.raises(InputError, match="sensorless"):
+        plan(
+            build_machine([part("tri", TRIANGLE)], ToleranceSensor(0.01), uncertainty=IDEAL),
+            PlanningOptions(method="bfs"),
+        )
 
 
 # ---------------------------------------------------------------- hand-built machines
@@ -399,7 +457,20 @@ def test_hand_machine_equal_readings_are_sensorless():
 def test_led_sensor_plans_are_valid():
     for name, verts, com in PARTS:
         for pitch, noise in product((0.1, 0.3), (0.0, 0.04)):
-            m = build_machine([part(name, verts, com)], LedSensor(pitch, noise))
+            m = build_machine([part(name, verts, com)], LedSensor(pitch, noise), uncertainty=IDEAL)
             r = plan(m)
             check_plan(r)
-            assert plan(m, method="bottom-up").length == r.length
+            assert plan(m, PlanningOptions(method="bottom-up")).length == r.length
+
+
+def test_a_part_thinner_than_the_tolerance_reads_from_zero():
+    """Readings are clipped at 0: a sliver's thin states read in [0, d + e)."""
+    m = build_machine(
+        [part("sliver", [(0, 0), (10, 0), (10, 0.1), (0, 0.1)])],
+        ToleranceSensor(0.3),
+        uncertainty=IDEAL,
+    )
+    r = plan(m)
+    check_plan(r)
+    lows = [b.lo for b, _ in r.root.branches]
+    assert min(lows) == 0.0 and all(lo >= 0.0 for lo in lows)

@@ -24,7 +24,9 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.api import plan
+from feederkit.planning.options import PlanningOptions
 from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 GAP = 1e-3
 """Parts whose angles come closer than this (deg) to a tie are skipped as degenerate."""
@@ -177,9 +179,9 @@ def own_length(part: OwnPart, tol: float | None, components: bool = False) -> in
 def product_length(pts, com, tol: float | None, components: bool = False) -> int:
     pf = push_function(make_part(make_outline("random", pts), com))
     sensor = NoSensor() if tol is None else ToleranceSensor(tol)
-    m = build_machine([pf], sensor)
+    m = build_machine([pf], sensor, uncertainty=IDEAL)
     assert inseparable(m) == (0,) * m.n  # random parts: every pair can be told apart
-    return plan(m, grouping="components" if components else "exact").length
+    return plan(m, PlanningOptions(grouping="components" if components else "exact")).length
 
 
 def _compare(seed: int, n: int, rel: float | None, components: bool = False) -> None:

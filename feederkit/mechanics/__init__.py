@@ -6,8 +6,8 @@ local minima, divergent orientations its local maxima, resting ranges the interv
 them, the push function maps each resting range onto its stable orientation.
 """
 
-from feederkit.mechanics.actions import ActionRange, OverlapRange, action_ranges, overlap_ranges
-from feederkit.mechanics.classes import PolygonClass, polygon_class
+from feederkit.mechanics.actions import ActionRange, action_ranges
+from feederkit.mechanics.polygon_classes import PolygonClass, polygon_class
 from feederkit.mechanics.push import (
     PushFunction,
     StableState,
@@ -21,14 +21,12 @@ from feederkit.mechanics.symmetry import Symmetry, push_diameter_period, push_pe
 
 __all__ = [
     "ActionRange",
-    "OverlapRange",
     "PolygonClass",
     "PushFunction",
     "StableState",
     "Symmetry",
     "action_ranges",
     "diameter",
-    "overlap_ranges",
     "polygon_class",
     "push",
     "push_diameter",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from feederkit.mechanics.classes import PolygonClass, polygon_class
+from feederkit.mechanics.polygon_classes import PolygonClass, polygon_class
 from feederkit.mechanics.push import (
     PushFunction,
     StableState,
@@ -20,7 +20,7 @@ from feederkit.mechanics.push import (
 )
 from feederkit.mechanics.symmetry import Symmetry, symmetry
 from feederkit.part import Part
-from feederkit.sensors import SensorModel, indistinguishable_sets, sensor_to_dict
+from feederkit.sensors import Sensor
 
 
 @dataclass(frozen=True)
@@ -75,13 +75,13 @@ class PartAnalysis:
     part: Part
     push: PushFunction
     symmetry: Symmetry
-    sensor: SensorModel | None
+    sensor: Sensor | None
     polygon_class: PolygonClass | None
     indistinguishable_sets: tuple[tuple[int, ...], ...]
     near_metastable: tuple[NearMetastable, ...]
 
 
-def analyze_part(part: Part, sensor: SensorModel | None = None) -> PartAnalysis:
+def analyze_part(part: Part, sensor: Sensor | None = None) -> PartAnalysis:
     """Analyse ``part``: exact push function and symmetry; its Fig. 14 class for ``sensor``."""
     pf = push_function(part)
     sym = symmetry(pf)
@@ -89,7 +89,7 @@ def analyze_part(part: Part, sensor: SensorModel | None = None) -> PartAnalysis:
     sets: tuple[tuple[int, ...], ...] = ()
     if sensor is not None:
         diam = [s.diameter for s in pf.states]
-        sets = tuple(tuple(sorted(g)) for g in indistinguishable_sets(sensor, diam))
+        sets = tuple(tuple(sorted(g)) for g in sensor.indistinguishable_sets(diam))
         cls = polygon_class(pf, sensor, sets)
     vertex = nearer_vertices(pf) if pf.near_metastable_edges else []
     near = tuple(
@@ -133,7 +133,7 @@ def analysis_to_dict(a: PartAnalysis) -> dict[str, object]:
         c = a.polygon_class
         out["class"] = c.number
         out["bound"] = c.bound
-        out["sensor"] = sensor_to_dict(a.sensor)
+        out["sensor"] = a.sensor.to_dict()
         out["class_description"] = c.description
         out["m"] = c.m
         out["p"] = c.p

@@ -181,7 +181,13 @@ def push_function(part: Part, near_metastable_deg: float = NEAR_METASTABLE_DEG) 
     at the start of its normal cone (the foot on edge ``i`` falls before ``j``) and falls at its
     end (the foot on edge ``j`` falls after ``j``); the divergent orientation is then the
     direction from the COM to the vertex. Edges whose foot is within ``near_metastable_deg`` of
-    an end are flagged.
+    an end are flagged (Akella & Mason 1999, section 3.1).
+
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> pf = push_function(make_part(make_outline("rect", [(0, 0), (20, 0), (20, 10), (0, 10)])))
+    >>> pf.n, [round(s.diameter, 6) for s in pf.states]
+    (4, [10.0, 20.0, 10.0, 20.0])
     """
     hull = part.hull
     n = len(hull)

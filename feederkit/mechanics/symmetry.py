@@ -162,8 +162,3 @@ def symmetry(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> Symm
     if g > 1:
         return Symmetry("symmetric", 360.0 / g, tp, part_t)
     return Symmetry("quasi-symmetric", 360.0 / b, tp, part_t)
-
-
-def part_period(pf: PushFunction) -> float:
-    """Smallest shift preserving the push function and the exact diameters of the states."""
-    return symmetry(pf).part_period_deg

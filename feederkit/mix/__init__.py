@@ -2,7 +2,7 @@
 
 - :mod:`~feederkit.mix.signatures`: rotation-invariant signatures of push and push-diameter
   functions; "same" in the sense of section 8.3, with a phase shift alpha.
-- :mod:`~feederkit.mix.classes`: classes of parts with the same push (push-diameter) function,
+- :mod:`~feederkit.mix.behaviour`: classes of parts with the same push (push-diameter) function,
   by hashing signatures (no all-pairs pass).
 - :mod:`~feederkit.mix.pairs`: exact distinguishability of two parts (a greatest fixpoint),
   ``PairWitness``, ``unrecognizable_pairs`` pruned by diameters.
@@ -10,7 +10,7 @@
 - :mod:`~feederkit.mix.analyze`: a catalog's analysis (classes, counts, pairs).
 """
 
-from feederkit.mix.classes import BehaviourClass, push_classes, push_diameter_classes
+from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import (
     PairWitness,
     candidate_pairs,

@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from feederkit.mechanics.push import PushFunction
-from feederkit.mix.classes import BehaviourClass, push_classes, push_diameter_classes
+from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
-from feederkit.sensors import NoSensor, SensorModel, sensor_to_dict
+from feederkit.sensors import Sensor
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,7 @@ class MixAnalysis:
     """
 
     names: tuple[str, ...]
-    sensor: SensorModel
+    sensor: Sensor
     angle_tol_deg: float
     length_tol_mm: float
     push_classes: tuple[BehaviourClass, ...]
@@ -71,7 +71,7 @@ class MixAnalysis:
             }
 
         return {
-            "sensor": sensor_to_dict(self.sensor),
+            "sensor": self.sensor.to_dict(),
             "tolerances": {"angle_deg": self.angle_tol_deg, "diameter_mm": self.length_tol_mm},
             "counts": self.counts(),
             "push_classes": [cls(c) for c in self.shared_push],
@@ -83,7 +83,7 @@ class MixAnalysis:
 
 def analyze_mix(
     pfs: Sequence[PushFunction],
-    sensor: SensorModel,
+    sensor: Sensor,
     *,
     angle_tol: float = ANGLE_TOL_DEG,
     length_tol: float = LENGTH_TOL_MM,
@@ -95,7 +95,7 @@ def analyze_mix(
     pc = push_classes(sigs, angle_tol)
     pdc = push_diameter_classes(sigs, angle_tol, length_tol)
     t2 = time.perf_counter()
-    if isinstance(sensor, NoSensor):
+    if not sensor.informative:
         pairs, cand = None, len(pfs) * (len(pfs) - 1) // 2
     else:
         todo = candidate_pairs(pfs, sensor)

@@ -335,11 +335,6 @@ def lookalike_same_push_detail(
     raise InputError(f"{part.name}: Theorem 4's construction failed its check at every attempt")
 
 
-def lookalike_same_push(part: Part, rng: np.random.Generator | int | None = None, **kw) -> Part:
-    """A non-similar convex polygon with the same push function (Theorem 4), checked."""
-    return lookalike_same_push_detail(part, rng, **kw).part
-
-
 def lookalike_same_push_diameter_detail(
     part: Part, rng: np.random.Generator | int | None = None, *, name: str | None = None
 ) -> Lookalike:
@@ -436,13 +431,6 @@ def _shrink_and_expand(
     return None
 
 
-def lookalike_same_push_diameter(
-    part: Part, rng: np.random.Generator | int | None = None, **kw
-) -> Part:
-    """A non-similar convex polygon with the same push-diameter function (Theorem 6), checked."""
-    return lookalike_same_push_diameter_detail(part, rng, **kw).part
-
-
 def build_lookalike(
     part: Part, keep: str, rng: np.random.Generator | int | None = None
 ) -> Lookalike:
@@ -451,7 +439,7 @@ def build_lookalike(
         return lookalike_same_push_detail(part, rng)
     if keep == "push-diameter":
         return lookalike_same_push_diameter_detail(part, rng)
-    raise InputError(f"--keep must be push or push-diameter, got {keep!r}")
+    raise InputError(f"a look-alike keeps the push or the push-diameter function, got {keep!r}")
 
 
 __all__ = [
@@ -460,9 +448,7 @@ __all__ = [
     "build_lookalike",
     "check_lookalike",
     "diameter_determining",
-    "lookalike_same_push",
     "lookalike_same_push_detail",
-    "lookalike_same_push_diameter",
     "lookalike_same_push_diameter_detail",
     "matching_shifts",
     "phase_shift",

@@ -4,7 +4,7 @@ Two parts are distinguishable (definition 11) when an action sequence makes thei
 differ. Decided here exactly, not only by Theorem 9's sufficient condition: a state of part A
 and a state of part B are *inseparable* when their readings can agree and every action sends
 them to two states that are again inseparable (a greatest fixpoint over the pairs of the two
-parts' product machine, as :func:`feederkit.machine.inseparable` computes for any machine;
+parts' product machine, by the fixpoint of :mod:`feederkit.machine.inseparable`;
 two different parts' states are never merged into one). The parts are recognizable from any
 start iff no pair of their states is inseparable.
 
@@ -16,14 +16,13 @@ inseparable pairs, with the reason in words. With noise the relation is not tran
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from feederkit.machine import prune_pairs
-from feederkit.mechanics.actions import action_ranges, merge_boundaries
+from feederkit.machine import greatest_fixpoint, pair_successors
+from feederkit.mechanics.actions import action_ranges
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.signatures import (
@@ -33,7 +32,7 @@ from feederkit.mix.signatures import (
     matching_shifts,
     signature,
 )
-from feederkit.sensors import LedSensor, NoSensor, SensorModel, ToleranceSensor, can_read_alike
+from feederkit.sensors import Sensor
 
 REASON_SAME_PDF = (
     "same push-diameter function (Lemma 8): identical mechanical behaviour and diameters"
@@ -98,7 +97,7 @@ def _ranges(pf: PushFunction) -> list[tuple[list[float], list[int]]]:
 def inseparable_cross_pairs(
     pf_a: PushFunction,
     pf_b: PushFunction,
-    sensor: SensorModel,
+    sensor: Sensor,
     *,
     _ranges_a: Sequence[tuple[list[float], list[int]]] | None = None,
     _ranges_b: Sequence[tuple[list[float], list[int]]] | None = None,
@@ -117,77 +116,63 @@ def inseparable_cross_pairs(
     db = [s.diameter for s in pf_b.states]
 
     def alike(i: int, j: int) -> bool:
-        return abs(da[i] - db[j]) <= eps or can_read_alike(sensor, da[i], db[j])
+        return abs(da[i] - db[j]) <= eps or sensor.can_read_alike(da[i], db[j])
 
     alive = {(i, j) for i in range(pf_a.n) for j in range(pf_b.n) if alike(i, j)}
-    if not alive:
-        return []
-    preds: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
-    dead: list[tuple[int, int]] = []
-    for i, j in alive:
-        (la, ta), (lb, tb) = ra[i], rb[j]
-        bounds = merge_boundaries([la, lb])
-        m = len(bounds)
-        for k in range(m):
-            hi = bounds[k + 1] if k + 1 < m else bounds[0] + 360.0
-            mid = (bounds[k] + hi) / 2.0
-            q = (_target(la, ta, mid), _target(lb, tb, mid))
-            if q not in alive:
-                dead.append((i, j))
-                break
-            preds[q].append((i, j))
-    prune_pairs(alive, dead, preds)
-    return sorted(alive)
 
+    def successors(p: tuple[int, int]) -> list[tuple[int, int]]:
+        (la, ta), (lb, tb) = ra[p[0]], rb[p[1]]
+        return pair_successors(la, ta, lb, tb)
 
-def _target(los: list[float], targets: list[int], action: float) -> int:
-    """The target of a state's action ranges (``los`` sorted) for a rotation inside one of them."""
-    k = bisect.bisect_right(los, action % 360.0) - 1
-    return targets[k if k >= 0 else len(los) - 1]
+    return sorted(greatest_fixpoint(alive, successors))
 
 
 def _reason(
     pf_a: PushFunction,
     pf_b: PushFunction,
-    sensor: SensorModel,
+    sensor: Sensor,
     pairs: Sequence[tuple[int, int]],
     sig_a: Signature | None,
     sig_b: Signature | None,
 ) -> tuple[str, str]:
-    if isinstance(sensor, NoSensor):
+    if not sensor.informative:
         return "sensorless", REASON_SENSORLESS
     sa = sig_a or signature(pf_a)
     sb = sig_b or signature(pf_b)
     if matching_shifts(sa, sb, angle_tol=ANGLE_TOL_DEG, length_tol=LENGTH_TOL_MM):
         return "same-push-diameter", REASON_SAME_PDF
     diams = [s.diameter for s in pf_a.states] + [s.diameter for s in pf_b.states]
-    if all(can_read_alike(sensor, x, y) for x in diams for y in diams):
+    if all(sensor.can_read_alike(x, y) for x in diams for y in diams):
         return "single-diameter", REASON_SINGLE
     da = [s.diameter for s in pf_a.states]
     db = [s.diameter for s in pf_b.states]
     if all(abs(da[i] - db[j]) <= LENGTH_TOL_MM for i, j in pairs):
         return "same-diameters", REASON_SAME_DIAMETERS
-    return "tolerance", REASON_TOLERANCE + f" ({_sensor_words(sensor)})"
-
-
-def _sensor_words(sensor: SensorModel) -> str:
-    if isinstance(sensor, ToleranceSensor):
-        return f"tolerance {sensor.tolerance:g} mm"
-    if isinstance(sensor, LedSensor):
-        return f"LED pitch {sensor.pitch:g} mm, noise {sensor.noise:g} mm"
-    return "no sensor"
+    return "tolerance", REASON_TOLERANCE + f" ({sensor.describe()})"
 
 
 def distinguishable(
     pf_a: PushFunction,
     pf_b: PushFunction,
-    sensor: SensorModel,
+    sensor: Sensor,
     *,
     index_a: int = 0,
     index_b: int = 1,
 ) -> PairWitness | None:
     """None when some action sequence tells the two parts apart from any start (definition 11),
-    else the witness: the inseparable state pairs and the reason in words."""
+    else the witness: the inseparable state pairs and the reason in words.
+
+    >>> from feederkit.mechanics.push import push_function
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> from feederkit.sensors import ToleranceSensor
+    >>> def pf(name, w, h):
+    ...     return push_function(make_part(make_outline(name, [(0, 0), (w, 0), (w, h), (0, h)])))
+    >>> distinguishable(pf("square", 10, 10), pf("rect", 20, 10), ToleranceSensor(0.5)) is None
+    True
+    >>> distinguishable(pf("a", 20, 10), pf("b", 20, 10), ToleranceSensor(0.5)).kind
+    'same-push-diameter'
+    """
     pairs = inseparable_cross_pairs(pf_a, pf_b, sensor)
     if not pairs:
         return None
@@ -208,22 +193,13 @@ def _witness(pf_a, pf_b, sensor, pairs, sig_a, sig_b, index_a, index_b) -> PairW
     )
 
 
-def reading_reach(sensor: SensorModel) -> float:
-    """The largest diameter difference (mm) two states can have and still read alike."""
-    if isinstance(sensor, ToleranceSensor):
-        return 2.0 * sensor.tolerance
-    if isinstance(sensor, LedSensor):
-        return 2.0 * sensor.noise + sensor.pitch
-    return math.inf
-
-
 def _covers(
     xs: Sequence[float], ys: Sequence[float], alike: Callable[[float, float], bool]
 ) -> bool:
     return all(any(alike(x, y) for y in ys) for x in xs)
 
 
-def candidate_pairs(pfs: Sequence[PushFunction], sensor: SensorModel) -> list[tuple[int, int]]:
+def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[int, int]]:
     """Pairs of parts that may be unrecognizable, found without an all-pairs pass.
 
     Necessary condition: every state of each part reads alike some state of the other (any
@@ -233,9 +209,9 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: SensorModel) -> list[tu
     neighbouring cells are compared. A sensorless model gives every pair.
     """
     n = len(pfs)
-    if isinstance(sensor, NoSensor):
+    if not sensor.informative:
         return [(i, j) for i in range(n) for j in range(i + 1, n)]
-    reach = reading_reach(sensor)
+    reach = sensor.reading_reach()
     diams = [sorted(s.diameter for s in pf.states) for pf in pfs]
     eps = [DIAMETER_REL_EPS * pf.part.size for pf in pfs]
     cell = reach + max(eps, default=0.0) + 1e-12
@@ -244,7 +220,7 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: SensorModel) -> list[tu
         grid[(math.floor(d[0] / cell), math.floor(d[-1] / cell))].append(i)
 
     def alike(x: float, y: float) -> bool:
-        return can_read_alike(sensor, x, y) or abs(x - y) <= cell - reach
+        return sensor.can_read_alike(x, y) or abs(x - y) <= cell - reach
 
     out = []
     for (cx, cy), here in grid.items():
@@ -267,7 +243,7 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: SensorModel) -> list[tu
 
 def unrecognizable_pairs(
     pfs: Sequence[PushFunction],
-    sensor: SensorModel,
+    sensor: Sensor,
     candidates: Sequence[tuple[int, int]] | None = None,
 ) -> list[PairWitness]:
     """Every pair of parts of a mix that no plan can tell apart, each with its witness.
@@ -300,6 +276,5 @@ __all__ = [
     "candidate_pairs",
     "distinguishable",
     "inseparable_cross_pairs",
-    "reading_reach",
     "unrecognizable_pairs",
 ]

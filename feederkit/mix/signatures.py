@@ -114,11 +114,6 @@ def phase_shift(a: Signature, b: Signature, shift: int) -> float:
     return norm360(b.normals[shift % b.n] - a.normals[0])
 
 
-def state_correspondence(a: Signature, b: Signature, shift: int) -> list[tuple[int, int]]:
-    """Pairs (state id of a, state id of b) that a matching shift puts on one another."""
-    return [(a.state_ids[k], b.state_ids[(k + shift) % b.n]) for k in range(a.n)]
-
-
 def same_push_function(
     a: PushFunction | Signature, b: PushFunction | Signature, angle_tol: float = ANGLE_TOL_DEG
 ) -> float | None:

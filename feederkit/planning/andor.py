@@ -5,6 +5,11 @@ sets the reading can leave. ``length(mask)`` is the smallest number of further p
 operations that orient every state of ``mask`` (0 for a goal). The search is depth-first
 iterative deepening with memoised proven bounds per set (a set that failed with ``k`` steps
 is never retried with ``k``), so repeated sets and repeated depths cost nothing.
+
+References
+----------
+Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient parts.
+The International Journal of Robotics Research 18(10), section 6.1 (AND/OR search).
 """
 
 from __future__ import annotations
@@ -32,11 +37,6 @@ class Deadline:
         self._count += 1
         if self._count & 7 == 0 and time.perf_counter() > self.end:
             raise Timeout
-
-    @property
-    def expired(self) -> bool:
-        """Whether the limit has passed."""
-        return self.end is not None and time.perf_counter() > self.end
 
 
 class WorstCase:
@@ -68,7 +68,7 @@ class WorstCase:
         if self.ub.get(mask, k + 1) <= k:
             return True
         self.deadline.check()
-        for act in self.p.search_actions(mask):
+        for act in self.p.choices.search_actions(mask):
             ok = True
             for c in act.children:  # largest first: the likeliest to fail
                 if not self.within(c, k - 1):

@@ -1,92 +1,221 @@
-"""The planners' public entry point: ``plan(machine, ...) -> PlanResult``.
+"""The planners' public entry point: ``plan(machine, options) -> PlanResult``.
 
 The root is the first alignment from an unknown orientation (``Step(action=None)``); its
 branches are the readings of the full set of states. Each branch is then oriented by a
-minimum worst-case plan (sections 4 and 6), ties broken by issue 3's order (see
-:mod:`feederkit.planning.refine`). ``length`` counts the first alignment (design.md).
+minimum worst-case plan (sections 4 and 6), ties broken by the order of docs/planning.md
+(see :mod:`feederkit.planning.refine`). ``length`` counts the first alignment (design.md).
+
+References
+----------
+Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient parts.
+The International Journal of Robotics Research 18(10), sections 4 (sensorless plans), 6
+(AND/OR search 6.1, bottom-up 6.4) and 8.5 (mixes).
+Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 10
+(backchaining, the sensorless fallback here).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Literal
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import PushAlignMachine, SetAction, overlap_cells
+from feederkit.machine import OverlapRange, PushAlignMachine, search_space
 from feederkit.planning.andor import Deadline, Timeout, WorstCase
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
-from feederkit.planning.problem import Problem, maximal_sets
+from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import EXPECTED_HORIZON, Refiner, child_masses
 from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.sensorless import Backchain, push_circle
+from feederkit.planning.solvable import solve, unsolvable
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.tree import Leaf, PlanResult, Step
-
-Objective = Literal["worst", "expected"]
-Method = Literal["auto", "andor", "bottom-up", "bfs", "backchain"]
-METHODS = ("auto", "andor", "bottom-up", "bfs", "backchain")
 
 FALLBACK_SHARE = 0.3
 """With a time limit, the share of it kept for finding some plan when the exact search fails."""
 
 
-def plan(
-    machine: PushAlignMachine,
-    *,
-    objective: Objective = "worst",
-    min_margin: float = 0.0,
-    grouping: str = "exact",
-    time_limit: float | None = None,
-    method: Method = "auto",
-) -> PlanResult:
-    """A plan orienting every state of ``machine`` (up to inseparable states), by issue 3's rules.
+class NoStrongPlan(PlanningError):
+    """No strong plan exists under the machine's declared uncertainty (design.md)."""
 
-    Raises InputError for bad arguments and PlanningError when no plan keeps ``min_margin``
-    (naming the largest margin that works) or none is found within ``time_limit``.
+
+def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
+    u = machine.uncertainty
+    what = (
+        f"rotation error {u.rotation_error_deg:g} deg, shape tolerance "
+        f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
+    )
+    if undecided:
+        return NoStrongPlan(f"no strong plan found within {_limit(machine)} operations ({what})")
+    return NoStrongPlan(
+        f"no strong plan exists under the declared uncertainty ({what}): for every action "
+        "some outcome leaves states that must be told apart reading alike"
+    )
+
+
+def strong_plan_exists(machine: PushAlignMachine, options: PlanningOptions | None = None) -> bool:
+    """Whether some strong plan orients every state of ``machine`` (no margin floor).
+
+    Decided by :func:`~feederkit.planning.solvable.unsolvable`; True when undecided (too
+    many sets), so a bisection over uncertainties on it errs toward the planner's own answer.
     """
-    _check_args(machine, objective, min_margin, grouping, time_limit, method)
+    options = options or PlanningOptions()
+    if machine.n == 0:
+        return False
+    if machine.deterministic:
+        return True  # the ideal push machine: a part is always oriented up to inseparable states
+    sorted_machine, _old = by_diameter(machine)
+    problem = Problem(sorted_machine, options.grouping, 0.0)
+    every = sorted({b.mask for b in problem.readings.branches(problem.full)})
+    bad = unsolvable(problem, sorted(maximal_sets(every)))
+    return bad is None or not bad
+
+
+FIRST_LIMIT = 8
+"""Under uncertainty with readings, the AND/OR search first tries plans of at most this many
+operations before deciding whether a strong plan exists at all (:func:`_decide`)."""
+
+
+def _decide(problem: Problem, roots, deadline: Deadline, machine: PushAlignMachine):
+    """Every reachable set's length (``solve``), raising NoStrongPlan when a root has none;
+    None when undecided (too many sets, or out of time)."""
+    try:
+        known = solve(problem.with_margin(0.0), roots, deadline)
+    except Timeout:
+        return None
+    if known is not None and any(known[r] == math.inf for r in roots):
+        raise _no_strong_plan(machine)
+    return known
+
+
+def _limit(machine: PushAlignMachine) -> int:
+    """A cap on a strong plan's length when solvability is undecided (sets too many)."""
+    return 4 * machine.n + 4
+
+
+def plan(
+    machine: PushAlignMachine, options: PlanningOptions | None = None, **legacy: object
+) -> PlanResult:
+    """A plan orienting every state of ``machine`` (up to inseparable states).
+
+    The plan has the minimum worst-case number of operations (sections 4 and 6), ties
+    broken as :mod:`feederkit.planning.refine` says; ``options`` default to
+    :class:`PlanningOptions` ``()``. The keyword arguments ``objective``, ``min_margin``,
+    ``grouping``, ``time_limit`` and ``method`` are the older spelling of the options.
+
+    Raises InputError for bad options and PlanningError when no plan keeps the minimum
+    margin (naming the largest margin that works) or none is found within the time limit.
+
+    >>> from feederkit.machine import ActionRange, MachineState, PushAlignMachine
+    >>> from feederkit.sensors import NoSensor
+    >>> m = PushAlignMachine(("toy",), (MachineState(0, 0, 1.0, 0.5), MachineState(0, 1, 2.0, 0.5)),
+    ...     ((ActionRange(0.0, 180.0, 0), ActionRange(180.0, 360.0, 1)),
+    ...      (ActionRange(0.0, 180.0, 0), ActionRange(180.0, 360.0, 0))), NoSensor())
+    >>> result = plan(m)
+    >>> result.length, result.root.branches[0][1].action.representative
+    (2, 90.0)
+    """
+    options = _options(options, legacy)
+    if machine.n == 0:
+        raise InputError("the machine has no states")
     # Plan with the states numbered by diameter (readings then pick runs of bits).
     sorted_machine, old = by_diameter(machine)
-    root, optimal, length, lower = _plan(
-        sorted_machine, objective, min_margin, grouping, time_limit, method
-    )
+    root, optimal, length, lower = _plan(sorted_machine, options)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
-    return _result(machine, root, optimal, length, lower, objective, grouping)
+    return _result(
+        machine, root, optimal, length, lower, options.objective.value, options.grouping.value
+    )
 
 
-def _plan(machine, objective, min_margin, grouping, time_limit, method):
+_LEGACY = {
+    "objective": "objective",
+    "min_margin": "min_margin_deg",
+    "grouping": "grouping",
+    "time_limit": "time_limit_s",
+    "method": "method",
+}
+
+
+def _options(options: PlanningOptions | None, legacy: dict[str, object]) -> PlanningOptions:
+    """The options, from a value or from the older keyword arguments (not both)."""
+    unknown = sorted(set(legacy) - set(_LEGACY))
+    if unknown:
+        raise TypeError(f"plan() got unexpected keyword arguments {', '.join(unknown)}")
+    if options is None:
+        return PlanningOptions(**{_LEGACY[k]: v for k, v in legacy.items()})  # type: ignore[arg-type]
+    if legacy:
+        raise TypeError("plan() takes PlanningOptions or keyword arguments, not both")
+    return options
+
+
+def _plan(machine: PushAlignMachine, options: PlanningOptions):
     """``plan`` on a machine whose states are numbered by diameter.
 
     Returns the plan tree, whether it is proven optimal, its proven length (None when the
     tree's own length is the answer) and a proven lower bound.
     """
-    problem = Problem(machine, grouping, min_margin)  # type: ignore[arg-type]
+    objective = options.objective.value
+    min_margin = options.min_margin_deg
+    grouping = options.grouping
+    time_limit = options.time_limit_s
+    method = options.method.value
+    problem = Problem(machine, grouping, min_margin)
     if problem.sensorless:
         # One path for every start: the expected number of operations is the length, so
         # the plans of minimum length are exactly those of minimum expected length.
         objective = "worst"
     elif objective == "expected":
-        problem = Problem(machine, grouping, min_margin, problem.insep, distinct_maps=True)  # type: ignore[arg-type]
+        problem = Problem(machine, grouping, min_margin, problem.insep, distinct_maps=True)
     if method in ("bfs", "backchain") and not problem.sensorless:
         raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
-    root_branches = problem.branches(problem.full)
+    if method == "backchain" and not machine.deterministic:
+        raise InputError(
+            "backchaining needs the ideal model (exact push functions): use rotation error 0, "
+            "or the bfs or andor method under uncertainty"
+        )
+    root_branches = problem.readings.branches(problem.full)
     # Without a margin floor a reading set inside another is oriented by its rotations in no
     # more operations, so the length depends on the maximal ones only. Margins are not
-    # monotone that way (Problem.exact_actions): the floor below looks at every branch.
+    # monotone that way (Choices.exact_actions): the floor below looks at every branch.
     every = sorted({b.mask for b in root_branches})
     roots = sorted(maximal_sets(every)) if min_margin == 0.0 else every
     start_mass = [s.weight for s in machine.states]
+    exact_deadline = Deadline(None if time_limit is None else time_limit * (1 - FALLBACK_SHARE))
+    limit = None
+    known: dict[int, float] | None = None
+    if not machine.deterministic:
+        # Strong plans need not exist. Sensorless, decide first: one pass over the reachable
+        # sets gives every set's length (a shortest path, which iterative deepening finds
+        # slowly), and the search reads them. With readings, plans are short: search to
+        # FIRST_LIMIT operations, and decide only when that fails (below).
+        if problem.sensorless:
+            known = _decide(problem, roots, exact_deadline, machine)
+            limit = None if known is not None else _limit(machine)
+        else:
+            limit = FIRST_LIMIT
     if min_margin > 0.0:
         _check_margin(problem, roots, min_margin)
-
-    exact_deadline = Deadline(None if time_limit is None else time_limit * (1 - FALLBACK_SHARE))
     worst = make_oracle(problem, method, exact_deadline)
+    if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
+        worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
     try:
-        lengths = root_lengths(problem, worst, roots, method)
+        try:
+            lengths = root_lengths(problem, worst, roots, method, limit)
+        except ValueError:
+            if machine.deterministic or known is not None or method in ("bfs", "bottom-up"):
+                raise
+            known = _decide(problem, roots, exact_deadline, machine)
+            if known is not None and min_margin == 0.0:
+                worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
+            lengths = root_lengths(problem, worst, roots, method, _limit(machine))
     except Timeout:
         return _fallback(problem, worst, roots, root_branches, time_limit)
+    except ValueError:
+        exact = method in ("bfs", "bottom-up") or known is not None
+        raise _no_strong_plan(machine, undecided=not exact) from None
     length = 1 + max(lengths.values(), default=0)
     budget = length - 1
     children = _root_children(problem, root_branches, start_mass)
@@ -124,21 +253,6 @@ def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
     return Step(None, tuple(subs))
 
 
-def _check_args(machine, objective, min_margin, grouping, time_limit, method) -> None:
-    if machine.n == 0:
-        raise InputError("the machine has no states")
-    if objective not in ("worst", "expected"):
-        raise InputError(f"objective must be 'worst' or 'expected', got {objective!r}")
-    if grouping not in ("exact", "components"):
-        raise InputError(f"grouping must be 'exact' or 'components', got {grouping!r}")
-    if method not in METHODS:
-        raise InputError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    if not math.isfinite(min_margin) or min_margin < 0.0:
-        raise InputError(f"min_margin must be a non-negative number of degrees, got {min_margin}")
-    if time_limit is not None and (not math.isfinite(time_limit) or time_limit <= 0.0):
-        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
-
-
 def _check_margin(problem: Problem, roots: list[int], min_margin: float) -> None:
     """Raise PlanningError when no plan keeps ``min_margin``, naming the largest that does."""
     floored = largest_margin(problem, roots)
@@ -160,7 +274,7 @@ def _fallback(problem, worst, roots, root_branches, time_limit):
     """Some plan when the exact search ran out of time, with the lower bound it proved.
 
     A depth-first search with a generous budget (the greedy action order of
-    ``Problem.lazy_actions``) finds a plan; the tree follows the actions that proved it. A
+    ``Choices.lazy_actions``) finds a plan; the tree follows the actions that proved it. A
     reading set the search never met lies inside one it did (its "witness"), and without a
     margin floor it follows the witness's rotations.
     """
@@ -206,14 +320,14 @@ def _fallback(problem, worst, roots, root_branches, time_limit):
             r = act.action.representative
             lo, hi, img = next(
                 c
-                for c in overlap_cells(problem.machine, mask)
+                for c in search_space(problem.machine).overlap_cells(mask)
                 if c[0] < r < c[1] or c[0] < r + 360.0 < c[1]
             )
-            action = SetAction(lo, hi, img)
+            action = OverlapRange(lo, hi, img)
         else:
             action = act.action
         subs = []
-        for b in problem.image_branches(action.image):
+        for b in problem.readings.image_branches(action.image):
             subs.append((b, build(b.mask, witness_of(b.mask, act.children))))
         return Step(action, tuple(subs))
 
@@ -244,9 +358,11 @@ def _sensorless_plan(problem: Problem, root_branches) -> Step | None:
             node: Step | Leaf = Leaf(mask)
         else:
             k = chain.length(mask)
-            lo, hi, img = next(c for c in problem.cells(mask, False) if chain.length(c[2]) < k)
-            subs = tuple((b, build(b.mask)) for b in problem.image_branches(img))
-            node = Step(SetAction(lo, hi, img), subs)
+            lo, hi, img = next(
+                c for c in problem.choices.cells(mask, False) if chain.length(c[2]) < k
+            )
+            subs = tuple((b, build(b.mask)) for b in problem.readings.image_branches(img))
+            node = Step(OverlapRange(lo, hi, img), subs)
         made[mask] = node
         return node
 

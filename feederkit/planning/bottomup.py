@@ -5,6 +5,11 @@ most the states that can give it). The programme finds the best action of every 
 smallest sets first; an action whose branches are all smaller is final at once, and the
 paper's "second pass" for branches of the same size is a relaxation repeated until no value
 changes. Exponential in the size of the largest reading set (``MAX_SUBSETS`` guards it).
+
+References
+----------
+Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient parts.
+The International Journal of Robotics Research 18(10), section 6.4 (the bottom-to-top algorithm).
 """
 
 from __future__ import annotations
@@ -57,7 +62,7 @@ def bottom_up_lengths(
             for s in todo:
                 deadline.check()
                 best = value[s]
-                for act in problem.search_actions(s):
+                for act in problem.choices.search_actions(s):
                     v = 1 + max(value.get(c, math.inf) for c in act.children)
                     if v < best:
                         best = v

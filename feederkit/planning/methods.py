@@ -4,8 +4,12 @@
 - ``bottom-up``: the bottom-to-top dynamic programme (section 6.4);
 - ``bfs``: breadth-first search over sets, sensorless (section 4);
 - ``backchain``: Goldberg's backchaining, sensorless one-part push machines (section 4);
-- ``auto``: backchaining where it applies (sensorless, one part, no margin floor), else
-  AND/OR search.
+- ``auto``: backchaining where it applies (sensorless, one part, no margin floor, the ideal
+  model), else AND/OR search.
+
+Under uncertainty (outcome sets) every method but backchaining searches sets of states with
+the union image and the bisimulation goal, so each finds the minimum worst-case length of a
+strong plan. Backchaining does not apply: its arcs assume an exact, monotone push function.
 
 Every method yields the same lengths; the tie-breaking stages then query the oracle.
 """
@@ -35,18 +39,19 @@ def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
 
 
 def root_lengths(
-    problem: Problem, worst: WorstCase, roots: list[int], method: str
+    problem: Problem, worst: WorstCase, roots: list[int], method: str, limit: int | None = None
 ) -> dict[int, int]:
     """Minimum worst-case operations after the first alignment, per root branch mask.
 
-    Lengths found by another algorithm are recorded in ``worst`` as exact values.
+    Lengths found by another algorithm are recorded in ``worst`` as exact values. ``limit``
+    caps the AND/OR search (ValueError beyond it).
     """
     if method == "bfs":
         out = {r: bfs_length(problem, r, worst.deadline) for r in roots}
     elif method == "bottom-up":
         out = bottom_up_lengths(problem, roots, worst.deadline)
     else:
-        return {r: worst.length(r) for r in roots}
+        return {r: worst.length(r, limit) for r in roots}
     for r, v in out.items():
         worst.exact[r] = v
     return out

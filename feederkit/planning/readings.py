@@ -1,4 +1,4 @@
-"""How likely each reading branch is: the distribution the expected objective uses.
+"""The readings of a set of states: its branches (section 6.1) and how likely each is.
 
 The paper leaves the reading distribution open (section 6: "the expected number of
 operations depends on the initial distribution of part orientations"). feederkit fixes it:
@@ -6,36 +6,190 @@ operations depends on the initial distribution of part orientations"). feederkit
 - the initial orientation is uniform on the circle, so the first alignment ends in state
   ``s`` with probability ``MachineState.weight`` (its resting range / 360);
 - a reading error is uniform over the state's reading set: with ``ToleranceSensor(e)`` a
-  state of diameter ``d`` reads uniformly in ``(d - e, d + e)``; with ``LedSensor(p, e)``
+  state of diameter ``d`` reads uniformly in ``(d - e, d + e)`` (a physical state of diameter
+  interval ``[lo, hi]`` in ``(lo - e, hi + e)``); with ``LedSensor(p, e)``
   the width is uniform in ``[d - e, d + e]`` (exactly ``d`` when ``e = 0``) and the count is
   the number of beams below it; without a sensor there is one reading.
 
 A state therefore follows a branch ``[lo, hi]`` with the probability that its reading falls
 in it, and its probability mass is split between the branches it can follow in that
 proportion (with exact branching they add up to 1; with the components rule each state
-follows one branch). Planner and statistics use this same model.
+follows one branch). Under uncertainty a state's mass moves to its outcome set, shared
+equally among its outcomes (nature's choice is not a probability the model knows; the
+expected number of operations is a tie-break, the worst case is what is guaranteed).
+Planner and statistics use this same model.
 """
 
 from __future__ import annotations
 
-from feederkit.machine import Branch
-from feederkit.sensors import LedSensor, SensorModel, ToleranceSensor
+from feederkit.machine import Grouping, PushAlignMachine, ReadingBranch, members, search_space
 
 
-def reading_probability(sensor: SensorModel, branch: Branch, diameter: float) -> float:
-    """Probability that a state of this diameter gives a reading in ``branch``."""
-    if branch.lo is None or branch.hi is None:
-        return 1.0
-    if isinstance(sensor, ToleranceSensor):
-        e = sensor.tolerance
-        lo, hi = max(branch.lo, diameter - e), min(branch.hi, diameter + e)
-        return max(0.0, min(1.0, (hi - lo) / (2.0 * e)))
-    if isinstance(sensor, LedSensor):
-        # Count c means c * p < width <= (c + 1) * p; the branch holds counts lo/p .. hi/p.
-        wlo, whi = branch.lo, branch.hi + sensor.pitch
-        e = sensor.noise
-        if e <= 0.0:
-            return 1.0 if wlo < diameter <= whi else 0.0
-        lo, hi = max(wlo, diameter - e), min(whi, diameter + e)
-        return max(0.0, min(1.0, (hi - lo) / (2.0 * e)))
-    return 1.0
+def reading_probability(machine: PushAlignMachine, branch: ReadingBranch, state: int) -> float:
+    """Probability that ``state`` gives a reading in ``branch`` (the sensor's model)."""
+    return machine.sensor.reading_probability(machine.states[state].sensed, branch.lo, branch.hi)
+
+
+def maximal_sets(masks) -> tuple[int, ...]:
+    """The distinct masks not contained in another, largest first."""
+    out: list[int] = []
+    for m in sorted(set(masks), key=lambda c: -c.bit_count()):
+        if not any(m & o == m for o in out):
+            out.append(m)
+    return tuple(out)
+
+
+class Readings:
+    """The reading branches of the sets a search meets, cached per set.
+
+    ``children(image)`` are the maximal branches (the length view: a subset of a set is
+    oriented by the set's rotations in no more operations); ``all_children(image)`` every
+    distinct one (the exact view). With exact branching a subset's branches are the whole
+    machine's reading cells restricted to it, computed once; the sensor may offer a faster
+    path (``Sensor.reading_windows``) when states are numbered by diameter.
+    """
+
+    def __init__(
+        self, machine: PushAlignMachine, grouping: Grouping, insep: tuple[int, ...]
+    ) -> None:
+        self.machine = machine
+        self.grouping = Grouping(grouping)
+        self.insep = insep
+        self._space = search_space(machine)
+        self._diam = [s.sensed for s in machine.states]
+        full = machine.all_states
+        self.informative = machine.sensor.informative
+        self.sensorless = not self.informative or all(
+            b.mask == full for b in self._space.branches(full, Grouping.EXACT)
+        )
+        exact = self.grouping is Grouping.EXACT
+        self._window = (machine.sensor.reading_windows(self._diam) or []) if exact else []
+        self._cell_masks: list[int] | None = None
+        self._cell_span: list[tuple[int, int]] = []
+        if exact and not self.sensorless:
+            cells = self._space.branches(full, Grouping.EXACT)
+            self._cell_masks = [b.mask for b in cells]
+            span = [[len(cells), 0] for _ in range(machine.n)]
+            for c, b in enumerate(cells):
+                for i in members(b.mask):
+                    span[i][0] = min(span[i][0], c)
+                    span[i][1] = max(span[i][1], c + 1)
+            self._cell_span = [(a, b) for a, b in span]
+        self._branches: dict[int, tuple[ReadingBranch, ...]] = {}
+        self._maximal: dict[int, tuple[int, ...]] = {}
+        self._all: dict[int, tuple[int, ...]] = {}
+        self._open: dict[int, dict[int, float] | None] = {}
+        self._tables: dict[int, list[tuple[ReadingBranch, list[int], list[float]]]] = {}
+        self._prob: dict[tuple[float | None, float | None, int], float] = {}
+
+    def branches(self, mask: int) -> tuple[ReadingBranch, ...]:
+        """The reading branches of a set (cached)."""
+        b = self._branches.get(mask)
+        if b is None:
+            b = tuple(self._space.branches(mask, self.grouping))
+            self._branches[mask] = b
+        return b
+
+    def image_branches(self, image: int) -> tuple[ReadingBranch, ...]:
+        """Every reading branch of an image (no sensor: the image itself, no reading)."""
+        if not self.informative:
+            return (ReadingBranch(None, None, image),)
+        return self.branches(image)
+
+    def all_children(self, image: int) -> tuple[int, ...]:
+        """Every distinct reading branch set of an image, largest first (cached)."""
+        out = self._all.get(image)
+        if out is None:
+            masks = {b.mask for b in self.branches(image)}
+            out = tuple(sorted(masks, key=int.bit_count, reverse=True))
+            self._all[image] = out
+        return out
+
+    def children(self, image: int) -> tuple[int, ...]:
+        """The maximal reading branches of an image (cached)."""
+        out = self._maximal.get(image)
+        if out is None:
+            if self._window:
+                out = self._window_runs(image)
+            elif self._cell_masks is not None:
+                out = maximal_sets(self._restricted_cells(image))
+            else:
+                out = maximal_sets(b.mask for b in self.branches(image))
+            self._maximal[image] = out
+        return out
+
+    def _window_runs(self, image: int) -> tuple[int, ...]:
+        """Maximal branches from the sensor's reading windows (states numbered by diameter).
+
+        Each member's run is one mask operation, and a run is maximal when it reaches
+        further than the one before.
+        """
+        win = self._window
+        runs = []
+        top = -1
+        m = image
+        while m:
+            low = m & -m
+            r = image & win[low.bit_length() - 1]
+            t = r.bit_length()
+            if t > top:
+                runs.append(r)
+                top = t
+            m ^= low
+        if len(runs) > 1:
+            runs.sort(key=int.bit_count, reverse=True)
+        return tuple(runs)
+
+    def _restricted_cells(self, image: int) -> set[int]:
+        """The image's states in each reading cell of the whole machine that meets it."""
+        cm = self._cell_masks
+        assert cm is not None
+        span = self._cell_span
+        ranges = sorted(span[i] for i in members(image))
+        out = set()
+        end = 0
+        for a, b in ranges:
+            for c in range(max(a, end), b):
+                out.add(cm[c] & image)
+            end = max(end, b)
+        return out
+
+    def probability(self, branch: ReadingBranch, state: int) -> float:
+        """Probability that ``state`` gives a reading in ``branch`` (cached)."""
+        key = (branch.lo, branch.hi, state)
+        p = self._prob.get(key)
+        if p is None:
+            p = reading_probability(self.machine, branch, state)
+            self._prob[key] = p
+        return p
+
+    def branch_table(self, image: int) -> list[tuple[ReadingBranch, list[int], list[float]]]:
+        """Per reading branch of an image: the branch, its states and their probabilities."""
+        table = self._tables.get(image)
+        if table is None:
+            table = []
+            for b in self.image_branches(image):
+                idx = members(b.mask)
+                table.append((b, idx, [self.probability(b, s) for s in idx]))
+            self._tables[image] = table
+        return table
+
+    def open_probability(self, image: int) -> dict[int, float] | None:
+        """Per state of ``image``: the probability that its reading leaves it with others.
+
+        From the sensor's closed form (``Sensor.shared_reading_probability``) when the
+        reading windows apply and no two states of the image are inseparable; None
+        otherwise (the branch table then decides).
+        """
+        if not self._window:
+            return None
+        if image in self._open:
+            return self._open[image]
+        idx = members(image)
+        out: dict[int, float] | None = None
+        if not any(self.insep[i] & image for i in idx):
+            shared = self.machine.sensor.shared_reading_probability([self._diam[s] for s in idx])
+            if shared is not None:
+                out = dict(zip(idx, shared, strict=True))
+        self._open[image] = out
+        return out

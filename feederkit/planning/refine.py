@@ -1,8 +1,9 @@
 """Choosing among plans of minimum worst-case length, and building the plan tree.
 
-Issue 3's order among plans of minimum length: the larger smallest margin (the half-width of
-an action's overlap range), then the smaller expected number of operations (the
-distribution of ``readings``), then smaller rotations (node by node from the root). With
+The order among plans of minimum length (docs/planning.md): the larger smallest margin
+(the half-width of an action's overlap range), then the smaller expected number of
+operations (the distribution of ``readings``), then smaller rotations (node by node from
+the root). With
 ``objective="expected"`` the expected number of operations comes first, over plans of at
 most ``EXPECTED_HORIZON`` times the minimum worst-case length, then the larger margin and
 the smaller rotation of each action.
@@ -19,8 +20,9 @@ import math
 from collections.abc import Callable
 
 from feederkit.angles import norm360
-from feederkit.machine import Branch, SetAction, members
+from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
+from feederkit.planning.choices import spread
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step
 
@@ -33,26 +35,30 @@ Masses = tuple[float, ...]
 
 
 def child_masses(
-    problem: Problem, mask: int, masses: Masses, act: Act | None, branches: tuple[Branch, ...] = ()
-) -> list[tuple[Branch, float, Masses]]:
+    problem: Problem,
+    mask: int,
+    masses: Masses,
+    act: Act | None,
+    branches: tuple[ReadingBranch, ...] = (),
+) -> list[tuple[ReadingBranch, float, Masses]]:
     """For each branch of ``act`` from ``mask``: its probability and its normalised masses.
 
     A member's mass moves to its successor; a state's mass then splits over the branches by
     the probability of its reading falling in each (``readings``). ``act`` None is the first
     alignment: nothing moves and ``branches`` are the readings.
     """
-    moved: dict[int, float] = {}
-    targets = members(mask) if act is None else problem.targets(mask, act.action)
-    for w, t in zip(masses, targets, strict=True):
-        moved[t] = moved.get(t, 0.0) + w
+    if act is None:
+        moved = dict(zip(members(mask), masses, strict=True))
+    else:
+        moved = spread(masses, problem.choices.targets(mask, act.action))
     out = []
     if act is None:
         table = [
-            (b, members(b.mask), [problem.probability(b, s) for s in members(b.mask)])
+            (b, members(b.mask), [problem.readings.probability(b, s) for s in members(b.mask)])
             for b in branches
         ]
     else:
-        table = problem.branch_table(act.action.image)
+        table = problem.readings.branch_table(act.action.image)
     for b, idx, probs in table:
         ws = [moved.get(s, 0.0) * p for s, p in zip(idx, probs, strict=True)]
         total = sum(ws)
@@ -85,7 +91,7 @@ class Refiner:
         decide.
         """
         if self.p.min_margin == 0.0 and not self.p.sensorless:
-            return all(self.w.within(c, k) for c in self.p.children(act.action.image))
+            return all(self.w.within(c, k) for c in self.p.readings.children(act.action.image))
         return all(self.w.within(c, k) for c in act.children)
 
     def allowed(self, act: Act, k: int) -> bool:
@@ -116,18 +122,18 @@ class Refiner:
         best = -math.inf
         if self.p.sensorless:
             # One branch per action: walk the ranges widest first, no branch objects needed.
-            for lo, hi, img in self.p.cells(mask, useful=False):
+            for lo, hi, img in self.p.choices.cells(mask, useful=False):
                 m = (hi - lo) / 2.0
                 if m <= best or best >= cap:
                     break
                 if self.w.within(img, k - 1):
                     best = max(best, self.margin(img, k - 1, min(m, cap)))
         else:
-            for cell in self.p.cells(mask, useful=False):  # widest first
+            for cell in self.p.choices.cells(mask, useful=False):  # widest first
                 m = (cell[1] - cell[0]) / 2.0
                 if m <= best or best >= cap:
                     break
-                act = self.p.act(mask, cell, exact=True)
+                act = self.p.choices.act(mask, cell, exact=True)
                 if not self.feasible(act, k - 1):
                     continue
                 val = min(m, cap)
@@ -151,7 +157,7 @@ class Refiner:
         self.deadline.check()
         if k == 1:
             # Every allowed action orients the set at once: cost 1, so only ties are left.
-            acts = self.p.exact_actions(mask)
+            acts = self.p.choices.exact_actions(mask)
             for act in sorted(acts, key=lambda a: (-a.action.margin, a.rotation)):
                 if self.allowed(act, 1):
                     self._exp[key] = (1.0, act)
@@ -160,10 +166,10 @@ class Refiner:
             return math.inf, None
         best, best_act = math.inf, None
         options = []
-        for cell in self.p.cells(mask, useful=False):
+        for cell in self.p.choices.cells(mask, useful=False):
             if (cell[1] - cell[0]) / 2.0 >= self.floor:
                 # Every branch not yet oriented needs at least one more operation.
-                sa = SetAction(*cell)
+                sa = OverlapRange(*cell)
                 options.append((1.0 + self._open_mass(mask, masses, sa), sa.representative, cell))
         options.sort(key=lambda o: (o[0], o[1]))
         # Cheapest bound first; whether a plan within k can start with the action is only
@@ -171,7 +177,7 @@ class Refiner:
         for bound, _rot, cell in options:
             if bound > best + _TIE:
                 break
-            act = self.p.act(mask, cell, exact=True)
+            act = self.p.choices.act(mask, cell, exact=True)
             if not self.allowed(act, k):
                 continue
             if k == 2:
@@ -189,16 +195,14 @@ class Refiner:
         self._exp[key] = out
         return out
 
-    def _open_mass(self, mask: int, masses: Masses, sa: SetAction) -> float:
+    def _open_mass(self, mask: int, masses: Masses, sa: OverlapRange) -> float:
         """Probability that a reading after the action leaves a set not yet oriented."""
-        moved: dict[int, float] = {}
-        for w, t in zip(masses, self.p.targets(mask, sa), strict=True):
-            moved[t] = moved.get(t, 0.0) + w
-        fast = self.p.open_probability(sa.image)
+        moved = spread(masses, self.p.choices.targets(mask, sa))
+        fast = self.p.readings.open_probability(sa.image)
         if fast is not None:
             return sum(w * fast[t] for t, w in moved.items())
         total = 0.0
-        for b, idx, probs in self.p.branch_table(sa.image):
+        for b, idx, probs in self.p.readings.branch_table(sa.image):
             if not self.p.is_goal(b.mask):
                 total += sum(moved.get(s, 0.0) * p for s, p in zip(idx, probs, strict=True))
         return total
@@ -209,7 +213,7 @@ class Refiner:
         ``"first"`` takes the first allowed action in the problem's order (no tie-breaking).
         """
         if tie == "first":
-            for act in self.p.exact_actions(mask):
+            for act in self.p.choices.exact_actions(mask):
                 if self.allowed(act, k):
                     return act
             raise AssertionError("no feasible action within the proven length")
@@ -217,10 +221,12 @@ class Refiner:
             act = self.expected(mask, masses, k)[1]
             assert act is not None
             return act
-        for cell in sorted(self.p.cells(mask, False), key=lambda c: norm360((c[0] + c[1]) / 2.0)):
+        for cell in sorted(
+            self.p.choices.cells(mask, False), key=lambda c: norm360((c[0] + c[1]) / 2.0)
+        ):
             if (cell[1] - cell[0]) / 2.0 < self.floor:
                 continue
-            act = self.p.act(mask, cell, exact=True)
+            act = self.p.choices.act(mask, cell, exact=True)
             if act is not None and self.allowed(act, k):
                 return act
         raise AssertionError("no feasible action within the proven length")

@@ -7,8 +7,14 @@ Nothing else depends on the numbering.
 
 from __future__ import annotations
 
-from feederkit.machine import Branch, PushAlignMachine, SetAction, members
-from feederkit.mechanics.actions import ActionRange
+from feederkit.machine import (
+    ActionRange,
+    OutcomeRange,
+    OverlapRange,
+    PushAlignMachine,
+    ReadingBranch,
+    members,
+)
 from feederkit.planning.tree import Leaf, PlanTree, Step
 
 
@@ -20,11 +26,21 @@ def by_diameter(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[int]]
     new = [0] * machine.n
     for k, i in enumerate(old):
         new[i] = k
-    maps = tuple(
-        tuple(ActionRange(r.lo, r.hi, new[r.target]) for r in machine.action_maps[i]) for i in old
-    )
+
+    def moved(r: ActionRange | OutcomeRange) -> ActionRange | OutcomeRange:
+        if isinstance(r, OutcomeRange):
+            out = 0
+            for t in members(r.targets):
+                out |= 1 << new[t]
+            return OutcomeRange(r.lo, r.hi, out)
+        return ActionRange(r.lo, r.hi, new[r.target])
+
+    maps = tuple(tuple(moved(r) for r in machine.action_maps[i]) for i in old)
     states = tuple(machine.states[i] for i in old)
-    return PushAlignMachine(machine.part_names, states, maps, machine.sensor), old
+    sorted_machine = PushAlignMachine(
+        machine.part_names, states, maps, machine.sensor, machine.uncertainty
+    )
+    return sorted_machine, old
 
 
 def remap_mask(mask: int, old: list[int]) -> int:
@@ -58,8 +74,10 @@ def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
         else:
             action = n.action
             if action is not None:
-                action = SetAction(action.lo, action.hi, mask(action.image))
-            subs = tuple((Branch(b.lo, b.hi, mask(b.mask)), convert(s)) for b, s in n.branches)
+                action = OverlapRange(action.lo, action.hi, mask(action.image))
+            subs = tuple(
+                (ReadingBranch(b.lo, b.hi, mask(b.mask)), convert(s)) for b, s in n.branches
+            )
             out = Step(action, subs)
         nodes[id(n)] = out
         return out

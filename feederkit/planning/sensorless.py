@@ -14,6 +14,14 @@ is oriented up to that symmetry: the same recursion on the circle of circumferen
 The circle is read off the machine's action maps (state ``i``'s range to ``j`` is
 ``(psi_i - rho_j, psi_i - lambda_j)``, definition 9), so hand-built machines work as long as
 they are push functions; ``push_circle`` returns None otherwise.
+
+References
+----------
+Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 10,
+201-225 (the backchaining algorithm).
+Chen, Y.-B. and Ierardi, D. J. (1995). The complexity of oblivious plans for orienting and
+distinguishing polygonal parts. Algorithmica 14, 367-397 (the O(n) bound on its length).
+Akella, S. and Mason, M. T. (1999), section 4 (sensorless plans on the push-align machine).
 """
 
 from __future__ import annotations
@@ -64,12 +72,12 @@ def push_circle(machine: PushAlignMachine, insep: tuple[int, ...]) -> PushCircle
     Also None when the machine's inseparable pairs are not exactly the push symmetry classes.
     """
     n = machine.n
-    if n == 0 or len({s.part for s in machine.states}) != 1:
-        return None
+    if n == 0 or len({s.part for s in machine.states}) != 1 or not machine.deterministic:
+        return None  # outcome sets: the arc images of backchaining are no longer exact
     maps = machine.action_maps
     to: list[dict[int, tuple[float, float]]] = []
     for i in range(n):
-        d = {r.target: (r.lo, r.hi) for r in maps[i]}
+        d = {t: (r.lo, r.hi) for r, t in zip(maps[i], machine.targets[i], strict=True)}
         if len(d) != n or len(maps[i]) != n:
             return None
         to.append(d)
@@ -197,7 +205,7 @@ def bfs_length(problem: Problem, mask: int, deadline: Deadline | None = None) ->
     while frontier:
         deadline.check()
         cur, d = frontier.popleft()
-        for act in problem.search_actions(cur):
+        for act in problem.choices.search_actions(cur):
             img = act.children[0]
             if problem.is_goal(img):
                 return d + 1

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from feederkit.machine import PushAlignMachine, successor
+from feederkit.machine import PushAlignMachine
 from feederkit.planning.readings import reading_probability
 from feederkit.planning.tree import Leaf, PlanTree, Step
 
@@ -49,6 +49,8 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
     weighted sum, over start states, of the expected operations of a part in that state.
     """
     memo: dict[tuple[int, int], float] = {}
+    if not machine.deterministic:
+        return _expected_sets(machine, root)
     probs: dict[tuple[float | None, float | None, int], float] = {}
 
     def ops(node: PlanTree, state: int) -> float:
@@ -59,16 +61,46 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
         if hit is not None:
             return hit
         if node.action is not None:
-            state = successor(machine, state, node.action.representative)
+            state = machine.successor(state, node.action.representative)
         total = 1.0
         for b, sub in node.branches:
             if b.mask >> state & 1:
                 p = probs.get((b.lo, b.hi, state))
                 if p is None:
-                    d = machine.states[state].diameter
-                    p = probs[(b.lo, b.hi, state)] = reading_probability(machine.sensor, b, d)
+                    p = probs[(b.lo, b.hi, state)] = reading_probability(machine, b, state)
                 if p > 0.0:
                     total += p * ops(sub, state)
+        memo[key] = total
+        return total
+
+    return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+
+
+def _expected_sets(machine: PushAlignMachine, root: Step) -> float:
+    """``expected_operations`` when actions have outcome sets: a state's mass moves to its
+    outcome set, shared equally (docs/planning.md); a part follows a branch with the
+    probability that its reading falls in it."""
+    memo: dict[tuple[int, int], float] = {}
+
+    def ops(node: PlanTree, state: int) -> float:
+        if isinstance(node, Leaf):
+            return 0.0
+        key = (id(node), state)
+        hit = memo.get(key)
+        if hit is not None:
+            return hit
+        if node.action is None:
+            outs = [state]
+        else:
+            out = machine.outcomes(state, node.action.representative)
+            outs = [t for t in range(machine.n) if out >> t & 1]
+        total = 1.0
+        for t in outs:
+            for b, sub in node.branches:
+                if b.mask >> t & 1:
+                    p = reading_probability(machine, b, t)
+                    if p > 0.0:
+                        total += p * ops(sub, t) / len(outs)
         memo[key] = total
         return total
 

@@ -9,8 +9,12 @@ inseparable); all its states are correct answers.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from feederkit.machine import Branch, PushAlignMachine, SetAction
+from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch
+
+if TYPE_CHECKING:
+    from feederkit.uncertainty import Uncertainty
 
 
 @dataclass(frozen=True)
@@ -28,11 +32,34 @@ class Step:
     the set of states consistent with the reading) with the subtree that follows.
     """
 
-    action: SetAction | None
-    branches: tuple[tuple[Branch, Step | Leaf], ...]
+    action: OverlapRange | None
+    branches: tuple[tuple[ReadingBranch, Step | Leaf], ...]
 
 
 PlanTree = Step | Leaf
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What a strong plan guarantees beyond its declared uncertainty (design.md, plan file).
+
+    ``max_rotation_error_deg``: the largest rotation error (a supremum) under which the plan
+    as written still reaches its results for every outcome; ``max_shape_tolerance_mm``: the
+    largest shape tolerance likewise (to the bisection's resolution); ``ideal_length``: the
+    minimum length on the ideal model (zero uncertainty), what robustness costs.
+    """
+
+    max_rotation_error_deg: float
+    max_shape_tolerance_mm: float
+    ideal_length: int | None
+
+    def to_dict(self) -> dict[str, float | int | None]:
+        """The plan file's ``stats.certificate`` object."""
+        return {
+            "max_rotation_error_deg": self.max_rotation_error_deg,
+            "max_shape_tolerance_mm": self.max_shape_tolerance_mm,
+            "ideal_length": self.ideal_length,
+        }
 
 
 @dataclass(frozen=True)
@@ -44,7 +71,10 @@ class PlanResult:
     (each first state weighted by its resting range). ``min_margin`` is the smallest
     half-width of the plan's actions (inf when it has none). ``optimal`` says the length
     (or the expected length, for that objective) is proven minimal; ``lower_bound`` is a
-    proven lower bound on the optimum.
+    proven lower bound on the optimum. Under uncertainty the length is the worst case over
+    every outcome nature can pick (a strong plan), ``min_margin`` the extra rotation error
+    beyond the declared one that an action tolerates without changing its outcome sets, and
+    ``certificate`` (set by :func:`feederkit.plans.make.make_plan`) what the plan guarantees.
     """
 
     machine: PushAlignMachine
@@ -56,3 +86,9 @@ class PlanResult:
     lower_bound: int
     objective: str = "worst"
     grouping: str = "exact"
+    certificate: Certificate | None = None
+
+    @property
+    def uncertainty(self) -> Uncertainty:
+        """The declared uncertainty the plan is strong for (the machine's)."""
+        return self.machine.uncertainty

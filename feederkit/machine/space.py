@@ -1,0 +1,423 @@
+"""The planners' search space: sets of states of a push-align machine (section 3.3).
+
+A node of a plan's search holds the set of states consistent with the operations so far (a
+bit mask). For a set this module gives its overlap ranges (section 3.2.2) with their
+images (under uncertainty: the ranges of rotations over which every member's outcome set
+stays the same, the image the union of those sets), its reading branches (section 5), and
+whether it is oriented (the goal, see :mod:`feederkit.machine.inseparable`).
+:class:`SearchSpace` owns the per-machine tables these need; :func:`search_space` builds
+one per machine, once.
+"""
+
+from __future__ import annotations
+
+import weakref
+from functools import cached_property
+
+import numpy as np
+
+from feederkit.angles import ANGLE_EPS, norm360
+from feederkit.machine.inseparable import inseparable_masks
+from feederkit.machine.model import OverlapRange, PushAlignMachine, members
+from feederkit.sensors import Grouping, ReadingBranch
+
+_NUMPY_MIN_EVENTS = 256
+"""Sets with at least this many action-range boundaries are swept with numpy."""
+
+
+class SearchSpace:
+    """A machine's sets of states, with the tables their queries share (built on first use).
+
+    The space refers to its machine weakly (the registry of :func:`search_space` must not
+    keep machines alive): whoever asks holds the machine.
+    """
+
+    def __init__(self, machine: PushAlignMachine) -> None:
+        self._machine = weakref.ref(machine)
+
+    @property
+    def machine(self) -> PushAlignMachine:
+        """The machine whose sets these are."""
+        m = self._machine()
+        if m is None:
+            raise ReferenceError("the machine of this search space is gone")
+        return m
+
+    @cached_property
+    def triples(self) -> tuple[tuple[tuple[float, int, int], ...], ...]:
+        """Per state ``i``, its action-range starts as ``(lo, i, target)``; under uncertainty
+        ``(lo, i, targets mask)``."""
+        m = self.machine
+        table = m.targets if m.deterministic else m.outcomes_of
+        return tuple(
+            tuple((lo, i, t) for lo, t in zip(m.starts[i], table[i], strict=True))
+            for i in range(m.n)
+        )
+
+    @cached_property
+    def numpy_table(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Per-state boundary and target arrays, when every state has as many ranges, each
+        one target, and there are at most 64 states (the images then fit an unsigned 64-bit
+        word)."""
+        maps = self.machine.action_maps
+        if not self.machine.deterministic:
+            return None
+        if 0 < self.machine.n <= 64 and len({len(rs) for rs in maps}) == 1:
+            los = np.array([[r.lo for r in rs] for rs in maps], dtype=float)
+            tgs = np.array(self.machine.targets, dtype=np.int64)
+            return los, tgs
+        return None
+
+    @cached_property
+    def set_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """Per state its range starts and outcome masks, flattened (``starts``, ``state``,
+        ``mask`` arrays and each state's last mask), when outcome sets fit a signed 64-bit
+        word (at most 62 states)."""
+        m = self.machine
+        if not 0 < m.n <= 62:
+            return None
+        lo = np.array([x for i in range(m.n) for x in m.starts[i]], dtype=float)
+        st = np.array([i for i in range(m.n) for _ in m.starts[i]], dtype=np.int64)
+        mk = np.array([x for i in range(m.n) for x in m.outcomes_of[i]], dtype=np.int64)
+        last = np.array([m.outcomes_of[i][-1] for i in range(m.n)], dtype=np.int64)
+        return lo, st, mk, last
+
+    @cached_property
+    def inseparable(self) -> tuple[int, ...]:
+        """For each state, the mask of states it is inseparable from."""
+        return inseparable_masks(self.machine)
+
+    def is_goal(self, mask: int) -> bool:
+        """Whether every pair of states in ``mask`` is inseparable: the set is oriented."""
+        return is_goal(self.inseparable, mask)
+
+    def overlap_cells(self, mask: int) -> list[tuple[float, float, int]]:
+        """The overlap ranges of a set as plain ``(lo, hi, image)`` tuples, neighbours with
+        equal images merged (for planners' inner loops).
+
+        The cells are those of ``merge_boundaries`` (boundaries within ANGLE_EPS merged),
+        each with the image of its middle rotation, found by one sweep over the sorted
+        boundaries that keeps each member's successor up to date: O(k n log(k n)) for k
+        states of a part with n. Large sets of one part are swept with numpy. Merging is
+        sound: every rotation inside a merged range sends the set to the same image, so its
+        half-width is the rotation error the action really tolerates.
+        """
+        idx = members(mask)
+        table = self.numpy_table
+        cells = None
+        if table is not None and len(idx) * table[0].shape[1] >= _NUMPY_MIN_EVENTS:
+            cells = _cells_numpy(self, mask, idx, table)
+        if cells is None and not self.machine.deterministic and self.set_table is not None:
+            cells = _cells_numpy_sets(self, mask, idx, self.set_table)
+        if cells is None:
+            sweep = _cells_sweep if self.machine.deterministic else _cells_sweep_sets
+            cells = sweep(self, mask, idx)
+        merged: list[list] = []
+        for cell in cells:
+            if merged and merged[-1][2] == cell[2]:
+                merged[-1][1] = cell[1]
+            else:
+                merged.append(cell)
+        if len(merged) > 1 and merged[0][2] == merged[-1][2]:
+            last = merged.pop()
+            merged[0][0] = last[0] - 360.0 if last[0] > merged[0][0] else last[0]
+            if merged[0][0] < 0.0:
+                merged[0][0] += 360.0
+                merged[0][1] += 360.0
+        if len(merged) == 1:
+            merged[0][0], merged[0][1] = 0.0, 360.0
+        return [(lo, hi, img) for lo, hi, img in merged]
+
+    def overlap_ranges(self, mask: int) -> list[OverlapRange]:
+        """The overlap ranges of a set of states (section 3.2.2), equal neighbours merged."""
+        return [OverlapRange(lo, hi, img) for lo, hi, img in self.overlap_cells(mask)]
+
+    def branches(self, mask: int, grouping: Grouping | str = Grouping.EXACT) -> list[ReadingBranch]:
+        """Split a set of states by the sensor reading (exact reading branching by default).
+
+        A state with a diameter interval reads anything any width in it can read.
+        """
+        idx = members(mask)
+        states = self.machine.states
+        return self.machine.sensor.split([states[i].sensed for i in idx], grouping, idx)
+
+
+_spaces: dict[int, SearchSpace] = {}
+
+
+def search_space(machine: PushAlignMachine) -> SearchSpace:
+    """The machine's search space, built once per machine (dropped with the machine)."""
+    key = id(machine)
+    space = _spaces.get(key)
+    if space is None or space._machine() is not machine:
+        space = SearchSpace(machine)
+        _spaces[key] = space
+        weakref.finalize(machine, _spaces.pop, key, None)
+    return space
+
+
+def is_goal(insep: tuple[int, ...] | list[int], mask: int) -> bool:
+    """Whether every pair of states in ``mask`` is inseparable (``insep[i]``: the states
+    ``i`` is inseparable from): the set is oriented, a plan may stop."""
+    m = mask
+    while m:
+        low = m & -m
+        i = low.bit_length() - 1
+        if mask & ~insep[i] & ~low:
+            return False
+        m ^= low
+    return True
+
+
+def overlap_cells(machine: PushAlignMachine, mask: int) -> list[tuple[float, float, int]]:
+    """``search_space(machine).overlap_cells(mask)``."""
+    return search_space(machine).overlap_cells(mask)
+
+
+def overlap_ranges(machine: PushAlignMachine, mask: int) -> list[OverlapRange]:
+    """``search_space(machine).overlap_ranges(mask)``."""
+    return search_space(machine).overlap_ranges(mask)
+
+
+def branches(
+    machine: PushAlignMachine, mask: int, grouping: Grouping | str = Grouping.EXACT
+) -> list[ReadingBranch]:
+    """``search_space(machine).branches(mask, grouping)``."""
+    return search_space(machine).branches(mask, grouping)
+
+
+def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:
+    """``search_space(machine).inseparable``: per state, the states it is inseparable from."""
+    return search_space(machine).inseparable
+
+
+def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
+    """The cells ``[lo, hi, image]`` of a set, by a sweep in pure Python."""
+    machine = space.machine
+    targets = machine.targets
+    triples = space.triples
+    evs = [e for i in idx for e in triples[i]]
+    evs.sort()
+    eps = ANGLE_EPS
+    # Cluster the sorted boundaries exactly as merge_boundaries does.
+    reps: list[float] = []
+    starts: list[int] = []
+    for k, (b, _i, _t) in enumerate(evs):
+        if not reps or b - reps[-1] > eps:
+            reps.append(b)
+            starts.append(k)
+    n_ev = len(evs)
+    if len(reps) > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        # The last cluster wraps into the first: its events restart each member's last range.
+        reps.pop()
+        n_ev = starts.pop()
+    m = len(reps)
+    # Before the first boundary every member is in its last action range.
+    count: dict[int, int] = {}
+    cur: dict[int, int] = {}
+    img = 0
+    for i in idx:
+        t = targets[i][-1]
+        cur[i] = t
+        c = count.get(t, 0)
+        if c == 0:
+            img |= 1 << t
+        count[t] = c + 1
+    cells: list[list] = []
+    for k in range(m):
+        end = starts[k + 1] if k + 1 < m else n_ev
+        lo = reps[k]
+        hi = reps[k + 1] if k + 1 < m else reps[0] + 360.0
+        mid = (lo + hi) / 2.0
+        last_b = lo
+        for _b, i, t in evs[starts[k] : end]:
+            last_b = _b
+            old = cur[i]
+            if old == t:
+                continue
+            cur[i] = t
+            c = count[old] - 1
+            count[old] = c
+            if c == 0:
+                img &= ~(1 << old)
+            c = count.get(t, 0)
+            if c == 0:
+                img |= 1 << t
+            count[t] = c + 1
+        if last_b >= mid:  # a degenerate cell narrower than its own boundary cluster
+            cells.append([lo, hi, machine.image(mask, norm360(mid))])
+        else:
+            cells.append([lo, hi, img])
+    return cells
+
+
+def _cells_sweep_sets(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
+    """The cells ``[lo, hi, image]`` of a set whose members have outcome *sets* (a sweep).
+
+    The image of a cell is the union of its members' outcome sets there; a count per target
+    state keeps it up to date as each member's outcome set changes at a boundary.
+    """
+    machine = space.machine
+    outs = machine.outcomes_of
+    triples = space.triples
+    evs = [e for i in idx for e in triples[i]]
+    evs.sort()
+    eps = ANGLE_EPS
+    reps: list[float] = []
+    starts: list[int] = []
+    for k, (b, _i, _t) in enumerate(evs):
+        if not reps or b - reps[-1] > eps:
+            reps.append(b)
+            starts.append(k)
+    n_ev = len(evs)
+    if len(reps) > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        reps.pop()
+        n_ev = starts.pop()
+    m = len(reps)
+    count = [0] * machine.n
+    cur: dict[int, int] = {}
+    img = 0
+
+    def add(t: int, sign: int) -> int:
+        nonlocal img
+        while t:
+            low = t & -t
+            b = low.bit_length() - 1
+            c = count[b] + sign
+            count[b] = c
+            if c == 0:
+                img &= ~low
+            elif c == 1 and sign > 0:
+                img |= low
+            t ^= low
+        return img
+
+    for i in idx:
+        cur[i] = outs[i][-1]
+        add(cur[i], 1)
+    cells: list[list] = []
+    for k in range(m):
+        end = starts[k + 1] if k + 1 < m else n_ev
+        lo = reps[k]
+        hi = reps[k + 1] if k + 1 < m else reps[0] + 360.0
+        mid = (lo + hi) / 2.0
+        last_b = lo
+        for _b, i, t in evs[starts[k] : end]:
+            last_b = _b
+            old = cur[i]
+            if old == t:
+                continue
+            cur[i] = t
+            add(old, -1)
+            add(t, 1)
+        if last_b >= mid:  # a degenerate cell narrower than its own boundary cluster
+            cells.append([lo, hi, machine.image(mask, norm360(mid))])
+        else:
+            cells.append([lo, hi, img])
+    return cells
+
+
+def _cells_numpy_sets(space: SearchSpace, mask: int, idx: list[int], table) -> list[list] | None:
+    """The cells of ``_cells_sweep_sets`` by numpy (None: clusters too irregular)."""
+    lo_all, st_all, mk_all, last = table
+    sel = np.zeros(space.machine.n, dtype=bool)
+    sel[idx] = True
+    keep = sel[st_all]
+    lo_s, st_s, mk_s = lo_all[keep], st_all[keep], mk_all[keep]
+    order = np.argsort(lo_s, kind="stable")
+    b = lo_s[order]
+    row_of = np.full(space.machine.n, -1, dtype=np.int64)
+    row_of[idx] = np.arange(len(idx))
+    st = row_of[st_s[order]]
+    tg = mk_s[order]
+    eps = ANGLE_EPS
+    if len(b) == 0:
+        return None
+    new = np.empty(len(b), dtype=bool)
+    new[0] = True
+    new[1:] = np.diff(b) > eps
+    first = np.flatnonzero(new)
+    lastk = np.append(first[1:] - 1, len(b) - 1)
+    if np.any(b[lastk] - b[first] > eps):
+        return None
+    cid = np.cumsum(new) - 1
+    reps = b[first]
+    m = len(reps)
+    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        k2 = cid < m - 1
+        st, tg, cid = st[k2], tg[k2], cid[k2]
+        lastk = lastk[:-1]
+        m -= 1
+        reps = reps[:m]
+    k = len(idx)
+    grid = np.full((k, m + 1), -1, dtype=np.int64)
+    grid[:, 0] = last[idx]
+    grid[st, cid + 1] = tg
+    pos = np.where(grid >= 0, np.arange(m + 1), 0)
+    np.maximum.accumulate(pos, axis=1, out=pos)
+    outs = np.take_along_axis(grid, pos, axis=1)[:, 1:]
+    imgs = np.bitwise_or.reduce(outs, axis=0)
+    his = np.append(reps[1:], reps[0] + 360.0)
+    mids = (reps + his) / 2.0
+    imgs = imgs.astype(object)
+    for c in np.flatnonzero(b[lastk] >= mids).tolist():  # a cell narrower than its cluster
+        imgs[c] = space.machine.image(mask, norm360(float(mids[c])))
+    return [
+        [lo, hi, int(im)]
+        for lo, hi, im in zip(reps.tolist(), his.tolist(), imgs.tolist(), strict=True)
+    ]
+
+
+def _cells_numpy(space: SearchSpace, mask: int, idx: list[int], table) -> list[list] | None:
+    """The cells of ``_cells_sweep`` by numpy (None: clusters too irregular, use the sweep)."""
+    los, tgs = table
+    k, r = len(idx), los.shape[1]
+    sel = np.array(idx)
+    lo_all = los[sel].ravel()
+    order = np.argsort(lo_all, kind="stable")
+    b = lo_all[order]
+    st = np.repeat(np.arange(k), r)[order]
+    tg = tgs[sel].ravel()[order]
+    eps = ANGLE_EPS
+    new = np.empty(len(b), dtype=bool)
+    new[0] = True
+    new[1:] = np.diff(b) > eps
+    first = np.flatnonzero(new)
+    last = np.append(first[1:] - 1, len(b) - 1)
+    if np.any(b[last] - b[first] > eps):
+        return None  # a chain of close boundaries: merge_boundaries's rule differs
+    cid = np.cumsum(new) - 1
+    reps = b[first]
+    m = len(reps)
+    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        keep = cid < m - 1
+        st, tg, cid = st[keep], tg[keep], cid[keep]
+        last = last[:-1]
+        m -= 1
+        reps = reps[:m]
+    grid = np.full((k, m + 1), -1, dtype=np.int64)
+    grid[:, 0] = tgs[sel, -1]
+    grid[st, cid + 1] = tg
+    pos = np.where(grid >= 0, np.arange(m + 1), 0)
+    np.maximum.accumulate(pos, axis=1, out=pos)
+    targets = np.take_along_axis(grid, pos, axis=1)[:, 1:]
+    bits = np.left_shift(np.uint64(1), targets.astype(np.uint64))
+    imgs = np.bitwise_or.reduce(bits, axis=0)
+    his = np.append(reps[1:], reps[0] + 360.0)
+    mids = (reps + his) / 2.0
+    bad = np.flatnonzero(b[last] >= mids)
+    if len(bad):
+        imgs = imgs.astype(object)
+        for c in bad.tolist():  # a degenerate cell narrower than its own boundary cluster
+            imgs[c] = space.machine.image(mask, norm360(float(mids[c])))
+    # Merge neighbours with equal images here; overlap_cells merges the rest.
+    keep = np.ones(m, dtype=bool)
+    keep[1:] = imgs[1:] != imgs[:-1]
+    starts = np.flatnonzero(keep)
+    ends = np.append(starts[1:] - 1, m - 1)
+    return [
+        [lo, hi, int(im)]
+        for lo, hi, im in zip(
+            reps[starts].tolist(), his[ends].tolist(), imgs[starts].tolist(), strict=True
+        )
+    ]

@@ -1,0 +1,84 @@
+"""Whether a strong plan exists: a least fixpoint over the sets a plan can meet.
+
+With outcome sets (design.md, "Uncertainty") some sets have no strong plan: every action may
+send two states that must be told apart into one reading, or merge them only sometimes. The
+sets reachable from the roots (through the length view's actions and reading branches) are
+finite; a set is solvable when it is a goal or some action has every branch solvable, and
+its minimum worst-case length is the least fixpoint of ``1 + min over actions of max over
+branches``. :func:`solve` finds both, level by level with a counter per action, in time
+linear in the explored graph; the planners then read the lengths instead of searching.
+Subsets of solvable sets are solvable (images and branches shrink with the set), so the
+length view's pruning is sound here too.
+"""
+
+from __future__ import annotations
+
+import math
+
+from feederkit.planning.andor import Deadline
+from feederkit.planning.problem import Problem
+
+MAX_SETS = 200_000
+"""The most sets the check explores before it gives up (None: undecided)."""
+
+
+def solve(
+    problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
+) -> dict[int, float] | None:
+    """The minimum worst-case number of operations of every set reachable from ``roots``
+    (inf: no strong plan); None when more than ``max_sets`` sets are reachable.
+
+    Knuth's generalisation of Dijkstra to AND/OR graphs with unit costs: sets are settled
+    level by level from the goals (0); an action is complete when all its branch sets are
+    settled, and the first completed action of a set settles it one level above its last
+    child (a level-by-level order makes that child the largest).
+    """
+    deadline = deadline or Deadline(None)
+    acts: dict[int, list[tuple[int, ...]]] = {}
+    value: dict[int, float] = {}
+    stack = list(roots)
+    while stack:
+        m = stack.pop()
+        if m in acts or m in value:
+            continue
+        deadline.check()
+        if problem.is_goal(m):
+            value[m] = 0
+            continue
+        children = [tuple(set(a.children)) for a in problem.choices.search_actions(m)]
+        acts[m] = children
+        if len(acts) > max_sets:
+            return None
+        for ch in children:
+            stack.extend(c for c in ch if c not in acts and c not in value)
+    preds: dict[int, list[list]] = {}
+    level = [m for m, v in value.items() if v == 0]
+    for m, children in acts.items():
+        for ch in children:
+            edge = [m, len(ch)]
+            for c in ch:
+                preds.setdefault(c, []).append(edge)
+    depth = 0
+    while level:
+        nxt: list[int] = []
+        for c in level:
+            for edge in preds.get(c, ()):
+                edge[1] -= 1
+                if edge[1] == 0 and edge[0] not in value:
+                    value[edge[0]] = depth + 1
+                    nxt.append(edge[0])
+        level = nxt
+        depth += 1
+    for m in acts:
+        value.setdefault(m, math.inf)
+    return value
+
+
+def unsolvable(
+    problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
+) -> list[int] | None:
+    """The roots no strong plan orients (empty: all solvable); None when undecided."""
+    value = solve(problem, roots, deadline, max_sets)
+    if value is None:
+        return None
+    return [r for r in roots if value[r] == math.inf]
