@@ -12,7 +12,8 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 from feederkit.errors import InputError
@@ -130,85 +131,124 @@ def read_json(
 
 
 def _umask() -> int:
-    """The process's umask (read by setting and restoring it)."""
+    """The process's umask (read without changing it for long)."""
     current = os.umask(0o022)
     os.umask(current)
     return current
 
 
-def write_bytes_atomic(
-    path: str | os.PathLike[str], data: bytes, *, what: str = "file", mode: int | None = None
-) -> None:
-    """Write ``data`` to ``path`` atomically: a temporary file beside it, then a rename.
+@dataclass(frozen=True)
+class OutputFile:
+    """A file to write: where, its content (text is written as UTF-8), and what it is (for
+    error messages: ``<path>: cannot write the <what> (<reason>)``)."""
 
-    ``mode`` sets the file's permissions; by default those of a newly created file (0666 less
-    the umask), as a plain ``open(path, "w")`` would give, so a controller's account can read
-    the plan file. A path that cannot be written is bad input:
-    ``<path>: cannot write the <what> (<reason>)``.
-    """
-    if mode is None:
-        mode = 0o666 & ~_umask()
-    target = Path(path)
+    path: Path
+    data: str | bytes
+    what: str = "file"
+
+
+def _cannot(path: object, what: str, exc: OSError) -> InputError:
+    return InputError(f"{path}: cannot write the {what} ({_reason(exc)})")
+
+
+def _stage(f: OutputFile, mode: int) -> str:
+    """Write ``f`` in full to a temporary file beside its target; return the temporary's path."""
+    target = Path(f.path)
+    if target.is_dir():
+        raise InputError(f"{target}: cannot write the {f.what} (a folder is there)")
     directory = target.parent if str(target.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
     except OSError as exc:
-        raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
+        raise _cannot(target, f.what, exc) from None
+    data = f.data.encode("utf-8") if isinstance(f.data, str) else f.data
     try:
         with os.fdopen(fd, "wb") as fh:
             os.fchmod(fh.fileno(), mode)
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, target)
     except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
+            raise _cannot(target, f.what, exc) from None
         raise
+    return tmp
+
+
+class StagedFiles:
+    """Files written in full to temporaries beside their targets, not yet in place.
+
+    The slow part (where a full disk or an unwritable folder shows) happens on staging;
+    :meth:`commit` then renames every temporary onto its target, which on one file system
+    does not fail halfway for lack of space. Leaving a ``with`` block without a commit
+    discards the temporaries. ``mode`` sets the permissions; by default those of a newly
+    created file (0666 less the umask), as a plain ``open(path, "w")`` gives, so a
+    controller's account can read a plan file.
+    """
+
+    def __init__(self, files: Iterable[OutputFile], mode: int | None = None) -> None:
+        mode = 0o666 & ~_umask() if mode is None else mode
+        self._staged: list[tuple[OutputFile, str]] = []
+        self.committed = False
+        try:
+            for f in files:
+                self._staged.append((f, _stage(f, mode)))
+        except BaseException:
+            self.discard()
+            raise
+
+    @property
+    def paths(self) -> list[Path]:
+        """The target paths, in order."""
+        return [Path(f.path) for f, _ in self._staged]
+
+    def commit(self) -> None:
+        """Rename every temporary onto its target, in order."""
+        for f, tmp in self._staged:
+            try:
+                os.replace(tmp, f.path)
+            except OSError as exc:
+                self.discard()
+                raise _cannot(f.path, f.what, exc) from None
+        self.committed = True
+
+    def discard(self) -> None:
+        """Remove the temporaries not yet renamed."""
+        for _, tmp in self._staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+
+    def undo(self) -> None:
+        """Remove the files a commit put in place (best effort: their old contents are gone)."""
+        if self.committed:
+            for f, _ in self._staged:
+                if Path(f.path).is_file():
+                    Path(f.path).unlink()
+            self.committed = False
+
+    def __enter__(self) -> StagedFiles:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if not self.committed:
+            self.discard()
+
+
+def write_files(files: Iterable[OutputFile], mode: int | None = None) -> None:
+    """Write every file, or (when one cannot be written) none: ``plan -o PLAN --report
+    REPORT`` writes both or neither. Errors are bad input naming the file."""
+    with StagedFiles(files, mode) as staged:
+        staged.commit()
+
+
+def write_bytes_atomic(
+    path: str | os.PathLike[str], data: bytes, *, what: str = "file", mode: int | None = None
+) -> None:
+    """Write ``data`` to ``path`` atomically: a temporary file beside it, then a rename."""
+    write_files([OutputFile(Path(path), data, what)], mode)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str, *, what: str = "file") -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically; an unwritable path is bad input."""
-    write_bytes_atomic(path, text.encode("utf-8"), what=what)
-
-
-def write_all_atomic(files: Sequence[tuple[str | os.PathLike[str], bytes, str]]) -> None:
-    """Write several files as one effect: each ``(path, data, what)`` goes to a temporary file
-    beside its target first; only when all were written are they renamed, in order.
-
-    A failure while writing (disk full, unwritable folder) removes every temporary and leaves
-    every target as it was; that covers ``plan -o PLAN --report REPORT`` writing both or
-    neither. Errors are bad input naming the file: ``<path>: cannot write the <what> (...)``.
-    """
-    mode = 0o666 & ~_umask()
-    staged: list[tuple[str, Path]] = []
-    try:
-        for path, data, what in files:
-            target = Path(path)
-            if target.is_dir():
-                raise InputError(f"{path}: cannot write the {what} (a folder is there)")
-            directory = target.parent if str(target.parent) else Path(".")
-            try:
-                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-            except OSError as exc:
-                raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
-            staged.append((tmp, target))
-            try:
-                with os.fdopen(fd, "wb") as fh:
-                    os.fchmod(fh.fileno(), mode)
-                    fh.write(data)
-                    fh.flush()
-                    os.fsync(fh.fileno())
-            except OSError as exc:
-                raise InputError(f"{path}: cannot write the {what} ({_reason(exc)})") from None
-        for tmp, target in staged:
-            try:
-                os.replace(tmp, target)
-            except OSError as exc:
-                raise InputError(f"{target}: cannot write the file ({_reason(exc)})") from None
-    finally:
-        for tmp, _ in staged:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+    write_files([OutputFile(Path(path), text, what)])

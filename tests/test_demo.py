@@ -1,25 +1,108 @@
-"""``feederkit demo``, the main job, on the bundled catalog: every file it writes is right."""
+"""``feederkit demo``, the main job: the pipeline (:func:`feederkit.demo.run_demo`) on a few
+sample parts, fast, and the whole bundled catalog through the command line (slow)."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import shutil
 from pathlib import Path
 
 import pytest
 
 from feederkit.cli.app import main
+from feederkit.demo import DemoResult, run_demo
+from feederkit.errors import InputError
 from feederkit.plans.fileformat import read_plan
 from feederkit.plans.verify import check_plan
 
 ROOT = Path(__file__).resolve().parents[1]
+FEW = ("isosceles-right-triangle", "octagon", "quadrilateral", "rectangle-2x1")
+
+
+@pytest.fixture(scope="module")
+def few(tmp_path_factory: pytest.TempPathFactory) -> DemoResult:
+    """The demo pipeline on four sample parts (the paper's mix and the look-alike's)."""
+    folder = tmp_path_factory.mktemp("parts")
+    for name in FEW:
+        shutil.copy(ROOT / "catalog" / f"{name}.json", folder)
+    return run_demo(folder, tmp_path_factory.mktemp("out"), reports=False)
+
+
+def test_pipeline_plans_every_part_both_ways(few: DemoResult) -> None:
+    assert [p.name for p in few.plans] == sorted(FEW)
+    for p in few.plans:
+        assert p.sensed["stats"]["length"] <= p.sensorless["stats"]["length"]
+        for f in p.files:
+            check_plan(read_plan(f))
+    # The regular octagon's states share one diameter: no sensor is to blame for that.
+    assert {p.name: p.warnings for p in few.plans}["octagon"] == ()
+
+
+def test_pipeline_compiles_the_papers_changeover(few: DemoResult) -> None:
+    by_name = {c.name: c for c in few.changeovers}
+    fig27 = by_name["fig27-triangle-octagon"]
+    assert fig27.compiled.plan["stats"]["length"] == 2
+    assert fig27.compiled.witnesses == () and not fig27.lookalike
+
+
+def test_pipeline_shows_a_lookalike_pair_no_plan_can_tell_apart(few: DemoResult) -> None:
+    pair = {c.name: c for c in few.changeovers}["lookalike-pair"]
+    assert pair.lookalike
+    assert [{w.part_a, w.part_b} for w in pair.compiled.witnesses] == [
+        {"quadrilateral", "quadrilateral-twin"}
+    ]
+    assert pair.compiled.lumped == [("quadrilateral", "quadrilateral-twin")]
+    assert any("Lemma 8" in w.reason for w in pair.compiled.witnesses)
+    summary = pair.to_dict()
+    assert summary["unrecognizable_pairs"] and summary["lookalike"] is True
+    check_plan(read_plan(pair.plan_path))
+
+
+def test_the_lookalike_report_is_given_the_pair(tmp_path: Path, monkeypatch) -> None:
+    import feederkit.reports
+
+    def fake_report(plan, *, unrecognizable, outlines):
+        pairs = sorted((u["part_a"], u["part_b"]) for u in unrecognizable)
+        return f"<p>{pairs} {sorted(outlines)}</p>"
+
+    monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
+    for name in ("quadrilateral", "rectangle-2x1"):
+        shutil.copy(ROOT / "catalog" / f"{name}.json", tmp_path)
+    result = run_demo(tmp_path, tmp_path / "out")
+    (pair,) = result.changeovers
+    assert pair.name == "lookalike-pair" and pair.report_path is not None
+    html = pair.report_path.read_text(encoding="utf-8")
+    assert "('quadrilateral', 'quadrilateral-twin')" in html and "rectangle-2x1" in html
+
+
+def test_summary_is_json(few: DemoResult) -> None:
+    data = json.loads(json.dumps(few.to_dict(), allow_nan=False))
+    assert {p["name"] for p in data["parts"]} == set(FEW)
+    assert all("warnings" in p for p in data["plans"])
+    assert all("warnings" in c and "min_margin_deg" in c for c in data["changeovers"])
+
+
+def test_demo_margins_show_their_digits() -> None:
+    from feederkit.cli.demo import margin_text
+
+    assert margin_text(0.04363826470942911) == "0.0436°"
+    assert margin_text(45.00000000000001) == "45°"
+    assert margin_text(None) == "-" and margin_text(float("inf")) == "-"
+
+
+def test_demo_rejects_a_missing_folder_and_a_bad_percentage(tmp_path: Path, capsys) -> None:
+    assert main(["demo", "--catalog-dir", str(tmp_path / "nope"), "-o", str(tmp_path)]) == 2
+    rc = main(["demo", "--catalog-dir", str(tmp_path), "--tolerance-percent", "60"])
+    assert rc == 2 and "--tolerance-percent" in capsys.readouterr().err
+    with pytest.raises(InputError, match="sensor tolerance"):
+        run_demo(tmp_path, tmp_path / "o", percent=0.0)
 
 
 @pytest.fixture(scope="module")
 def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     out = tmp_path_factory.mktemp("demo")
-    import contextlib
-    import io
-
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
         code = main(["demo", "--catalog-dir", str(ROOT / "catalog"), "-o", str(out), "--json"])
@@ -27,6 +110,7 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     return json.loads(buf.getvalue()), out
 
 
+@pytest.mark.slow
 def test_demo_plans_every_orientable_part_both_ways(demo_run: tuple[dict, Path]) -> None:
     summary, out = demo_run
     names = {p.stem for p in (ROOT / "catalog").glob("*.json")}
@@ -38,21 +122,21 @@ def test_demo_plans_every_orientable_part_both_ways(demo_run: tuple[dict, Path])
             check_plan(read_plan(f))
 
 
-def test_demo_compiles_the_papers_changeover(demo_run: tuple[dict, Path]) -> None:
+@pytest.mark.slow
+def test_demo_compiles_the_papers_changeover_and_the_lookalike(
+    demo_run: tuple[dict, Path],
+) -> None:
     summary, out = demo_run
     by_name = {c["name"]: c for c in summary["changeovers"]}
     fig27 = by_name["fig27-triangle-octagon"]
     assert fig27["parts"] == ["isosceles-right-triangle", "octagon"]
     assert fig27["length"] == 2
     assert fig27["unrecognizable_pairs"] == []
-    assert len(by_name) >= 2
+    assert by_name["lookalike-pair"]["unrecognizable_pairs"]
+    assert len(by_name) >= 4
     for c in summary["changeovers"]:
-        plan = read_plan(c["plan"])
-        check_plan(plan)
+        check_plan(read_plan(c["plan"]))
+        plan = json.loads(Path(c["plan"]).read_text(encoding="utf-8"))
         assert {p["name"] for p in plan["parts"]} == set(c["parts"])
         html = Path(c["report"]).read_text(encoding="utf-8")
         assert "<svg" in html and c["parts"][0] in html
-
-
-def test_demo_rejects_a_missing_folder(tmp_path: Path) -> None:
-    assert main(["demo", "--catalog-dir", str(tmp_path / "nope"), "-o", str(tmp_path)]) == 2

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from feederkit.errors import InputError
-from feederkit.jsonio import read_json, write_all_atomic, write_text_atomic
+from feederkit.jsonio import OutputFile, read_json, write_files, write_text_atomic
 
 
 def test_atomic_write_gives_the_permissions_of_a_plain_write(tmp_path: Path) -> None:
@@ -86,16 +86,26 @@ def test_several_files_are_written_together_or_not_at_all(tmp_path: Path) -> Non
     plan, report = tmp_path / "plan.json", tmp_path / "report.html"
     plan.write_text("old plan")
     with pytest.raises(InputError) as exc:
-        write_all_atomic(
-            [(plan, b"new plan", "plan file"), (tmp_path / "gone" / "r.html", b"x", "report")]
+        write_files(
+            [
+                OutputFile(plan, b"new plan", "plan file"),
+                OutputFile(tmp_path / "gone" / "r.html", b"x", "report"),
+            ]
         )
     assert "gone" in str(exc.value) and "cannot write the report" in str(exc.value)
     (tmp_path / "folder.html").mkdir()
     with pytest.raises(InputError, match="a folder is there"):
-        write_all_atomic([(plan, b"new plan", "plan file"), (tmp_path / "folder.html", b"x", "r")])
+        write_files(
+            [
+                OutputFile(plan, b"new plan", "plan file"),
+                OutputFile(tmp_path / "folder.html", b"x", "r"),
+            ]
+        )
     assert plan.read_text() == "old plan"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.html", "plan.json"]
-    write_all_atomic([(plan, b"new plan", "plan file"), (report, b"<html>", "report")])
+    write_files(
+        [OutputFile(plan, b"new plan", "plan file"), OutputFile(report, b"<html>", "report")]
+    )
     assert plan.read_text() == "new plan" and report.read_text() == "<html>"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.html", "plan.json", "report.html"]
 
@@ -112,5 +122,10 @@ def test_a_failed_write_in_the_middle_leaves_no_temporaries(tmp_path: Path, monk
 
     monkeypatch.setattr(os, "fsync", fsync)
     with pytest.raises(InputError, match=r"b\.json: cannot write the file \(No space left"):
-        write_all_atomic([(tmp_path / "a.json", b"1", "file"), (tmp_path / "b.json", b"2", "file")])
+        write_files(
+            [
+                OutputFile(tmp_path / "a.json", b"1", "file"),
+                OutputFile(tmp_path / "b.json", b"2", "file"),
+            ]
+        )
     assert list(tmp_path.iterdir()) == []

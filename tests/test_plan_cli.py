@@ -5,12 +5,14 @@ from __future__ import annotations
 import json
 import math
 import random
+from pathlib import Path
 
 import pytest
 from shared import one_line_error
 
 from feederkit.cli.app import main
 
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 RECT = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
 TRI = [[0, 0], [1, 0], [0, 1]]
 
@@ -83,7 +85,9 @@ def test_right_triangle_tolerance_and_sensorless(tmp_path, capsys):
 
 def test_random_convex_part_led(tmp_path, capsys):
     src = outline(tmp_path, "rnd", random_convex(7))
-    plan, _ = plan_file(tmp_path, capsys, [src, "--led-pitch", "1.0", "--noise", "0.2"])
+    # ``run --all`` executes the ideal model: plan on it (strong plans: tests/test_strong_*.py).
+    args = [src, "--led-pitch", "1.0", "--noise", "0.2", "--rotation-error", "0"]
+    plan, _ = plan_file(tmp_path, capsys, args)
     assert plan["sensor"] == {"model": "led", "pitch_mm": 1.0, "noise_mm": 0.2}
     assert plan["stats"]["meets_bound"] is True
     run_all(tmp_path / "plan.json", [src], capsys)
@@ -203,3 +207,92 @@ def test_catalog_names(tmp_path, capsys):
     rc = main(["run", str(tmp_path / "plan.json"), "tri", "--catalog", db, "--all"])
     assert rc == 0, capsys.readouterr().err
     one_line_error(capsys, ["plan", "no-such-part", "--catalog", db])
+
+
+def test_plan_and_report_are_written_both_or_neither(tmp_path, capsys, monkeypatch):
+    import feederkit.cli.common
+
+    # The report's content does not matter here (test_report_is_written draws a real one).
+    monkeypatch.setattr(feederkit.cli.common, "report_html", lambda *a: "<!DOCTYPE html>")
+    src = outline(tmp_path, "tri", TRI)
+    plan_path = tmp_path / "p.json"
+    bad_report = tmp_path / "missing" / "r.html"
+    args = ["plan", src, "--tolerance", "0.01", "-o", str(plan_path), "--report", str(bad_report)]
+    assert "r.html" in one_line_error(capsys, args)
+    assert not plan_path.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["tri.json"]  # no temporaries either
+
+
+@pytest.mark.parametrize(
+    ("extra", "flag", "words"),
+    [
+        (["--min-margin", "180"], "--min-margin", "minimum margin"),
+        (["--time-limit", "-3"], "--time-limit", "time limit"),
+        (["--objective", "fastest"], "--objective", "objective"),
+    ],
+)
+def test_options_are_checked_once_by_the_library_and_named_by_flag(
+    tmp_path, capsys, extra, flag, words
+):
+    src = outline(tmp_path, "tri", TRI)
+    err = one_line_error(capsys, ["plan", src, *extra])
+    assert flag in err and words in err
+
+
+def test_the_default_time_limit_reaches_the_planner(tmp_path, capsys, monkeypatch):
+    import feederkit.cli.plan as cli_plan
+    from feederkit.cli.common import DEFAULT_TIME_LIMIT_S
+
+    seen = []
+    real = cli_plan.plan_mix
+
+    def spy(pfs, sensor, options, **kw):
+        seen.append(options)
+        return real(pfs, sensor, options, **kw)
+
+    monkeypatch.setattr(cli_plan, "plan_mix", spy)
+    src = outline(tmp_path, "tri", TRI)
+    plan_file(tmp_path, capsys, [src, "--tolerance", "0.01"])
+    plan_file(tmp_path, capsys, [src, "--tolerance", "0.01", "--time-limit", "7"], name="b.json")
+    assert [o.time_limit_s for o in seen] == [DEFAULT_TIME_LIMIT_S, 7.0]
+    assert 10.0 <= DEFAULT_TIME_LIMIT_S <= 600.0  # sensible: a minute or so
+
+
+def test_a_margin_below_one_degree_is_warned_about(tmp_path, capsys):
+    # On the ideal model the t-clip's shortest sensorless plan turns within ±0.044° of an
+    # action range's end; at the default rotation error of 1° the strong plan needs no warning.
+    ideal = [str(CATALOG / "t-clip.json"), "--sensorless", "--rotation-error", "0"]
+    plan, cap = plan_file(tmp_path, capsys, ideal)
+    assert plan["stats"]["min_margin_deg"] < 1.0
+    assert "no robot holds ±0.044°" in cap.err
+    _, cap = plan_file(tmp_path, capsys, [str(CATALOG / "t-clip.json"), "--tolerance", "0.3"])
+    assert "no robot holds" not in cap.err
+    plan, cap = plan_file(tmp_path, capsys, [str(CATALOG / "t-clip.json"), "--sensorless"])
+    assert plan["uncertainty"]["rotation_error_deg"] == 1.0
+    assert "no robot holds" not in cap.err
+
+
+def test_a_sensor_that_reads_every_state_alike_is_warned_about(tmp_path, capsys):
+    src = outline(tmp_path, "tri", TRI)
+    plan, cap = plan_file(tmp_path, capsys, [src, "--tolerance", "5"])
+    assert "every state reads alike" in cap.err
+    assert plan["stats"]["length"] == 3  # as long as the sensorless plan
+
+
+def test_no_plan_within_the_time_limit_names_the_flag(tmp_path, capsys):
+    def regular(n):
+        pts = [[math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n)] for k in range(n)]
+        return outline(tmp_path, f"regular-{n}", pts, com=[0.13, 0.05])
+
+    args = ["plan", regular(12), regular(11), "--sensorless", "--time-limit", "0.0001"]
+    err = one_line_error(capsys, args, code=1)
+    assert "time limit of 0.0001 s" in err and "at least" in err and "--time-limit" in err
+
+
+def test_the_time_limit_note_names_the_lower_bound():
+    from feederkit.cli.common import time_limit_note
+
+    stats = {"length": 5, "lower_bound": 3, "optimal": False}
+    note = time_limit_note(stats, 60.0)
+    assert "60 s" in note and "at least 3" in note and "--time-limit" in note
+    assert time_limit_note({**stats, "optimal": True}, 60.0) is None

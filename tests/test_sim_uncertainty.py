@@ -40,7 +40,8 @@ from feederkit.uncertainty import IDEAL, Uncertainty
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden"
-V1 = GOLDEN / "equilateral-triangle.tolerance.json"
+V1 = GOLDEN / "v1" / "equilateral-triangle.tolerance.json"
+"""A plan file of version 1 as the first release wrote it (no declared uncertainty)."""
 
 
 @lru_cache(maxsize=8)

@@ -1,31 +1,44 @@
 """Shared pieces of the command line: the console, error reporting, JSON output, the options
-several commands take (design.md fixes their names) and the progress bar."""
+several commands take (design.md fixes their names), the progress bar and the search spinner.
+
+A command builds its sensor and its :class:`PlanningOptions` once here; the library validates
+them and speaks of its own terms ("minimum margin"), which :func:`with_flags` follows with the
+flag that sets them (``--min-margin``). Warnings print as one ``warning:`` line each.
+"""
 
 from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
     Progress,
+    SpinnerColumn,
     TextColumn,
     TimeElapsedColumn,
 )
 
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
-from feederkit.errors import InputError
+from feederkit.errors import FeederkitError, InputError
+from feederkit.jsonio import OutputFile
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.pairs import PairWitness
+from feederkit.planning.options import PlanningOptions
+from feederkit.plans.fileformat import plan_json
+from feederkit.sensors import Sensor, make_sensor
+from feederkit.uncertainty import Uncertainty
 
 console = Console()
 err_console = Console(stderr=True)
-
-OBJECTIVES = ("worst", "expected")
-GROUPINGS = ("exact", "components")
 
 SensorlessOpt = Annotated[
     bool,
@@ -63,7 +76,9 @@ MinMarginOpt = Annotated[
 TimeLimitOpt = Annotated[
     float | None,
     typer.Option(
-        "--time-limit", metavar="S", help="Seconds; then the best plan found, optimal: false."
+        "--time-limit",
+        metavar="S",
+        help="Seconds; then the best plan found (optimal: false) and a proven lower bound.",
     ),
 ]
 GroupingOpt = Annotated[
@@ -93,21 +108,187 @@ ReportOpt = Annotated[
     typer.Option("--report", metavar="REPORT.html", help="Also write the HTML report here."),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
+RotationErrorOpt = Annotated[
+    float,
+    typer.Option(
+        "--rotation-error",
+        metavar="DEG",
+        help="The robot's rotation is off by up to ±DEG (default 1; 0: the ideal model).",
+    ),
+]
+ShapeToleranceOpt = Annotated[
+    float,
+    typer.Option(
+        "--shape-tolerance",
+        metavar="MM",
+        help="Every hull vertex lies within MM of its drawn position (default 0).",
+    ),
+]
+ComToleranceOpt = Annotated[
+    float,
+    typer.Option(
+        "--com-tolerance",
+        metavar="MM",
+        help="The centre of mass lies within MM of its nominal position (default 0).",
+    ),
+]
 
 
-def check_planning_options(
+DEFAULT_TIME_LIMIT_S = 60.0
+"""The ``plan`` and ``changeover compile`` commands' time limit unless ``--time-limit`` is given:
+long enough for every sample part, short enough to keep a mistyped mix from hanging."""
+
+FLAG_TERMS = (
+    ("minimum margin", "--min-margin"),
+    ("time limit", "--time-limit"),
+    ("objective", "--objective"),
+    ("reading grouping", "--grouping"),
+    ("sensor tolerance", "--tolerance"),
+    ("beam pitch", "--led-pitch"),
+    ("alignment noise", "--noise"),
+    ("rotation error", "--rotation-error"),
+    ("shape tolerance", "--shape-tolerance"),
+    ("com tolerance", "--com-tolerance"),
+)
+"""The library's words for what a command-line flag sets: a library message that names one
+is shown with the flag."""
+
+
+def with_flags(message: str, terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> str:
+    """``message`` followed by the flags of the library terms it names, e.g. ``(--min-margin)``.
+
+    A flag the message already names is not repeated.
+    """
+    lower = message.lower()
+    flags = [f for term, f in terms if term in lower and f not in message]
+    flags = list(dict.fromkeys(flags))
+    return f"{message} ({', '.join(flags)})" if flags else message
+
+
+@contextmanager
+def flag_words(terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> Iterator[None]:
+    """Re-raise feederkit's errors inside the block with the flags of the terms they name."""
+    try:
+        yield
+    except FeederkitError as exc:
+        text = with_flags(str(exc), terms)
+        if text == str(exc):
+            raise
+        err = type(exc)(text)
+        err.exit_code = exc.exit_code
+        raise err from None
+
+
+def planning_options(
     objective: str, grouping: str, min_margin: float, time_limit: float | None
-) -> None:
-    """Bad planning options (``--objective``, ``--grouping``, ``--min-margin``,
-    ``--time-limit``) are bad input, one line each."""
-    if objective not in OBJECTIVES:
-        raise InputError(f"--objective must be worst or expected, got {objective!r}")
-    if grouping not in GROUPINGS:
-        raise InputError(f"--grouping must be exact or components, got {grouping!r}")
-    if not 0.0 <= min_margin < 180.0:
-        raise InputError(f"--min-margin must be at least 0 and below 180 degrees, got {min_margin}")
-    if time_limit is not None and not time_limit > 0.0:
-        raise InputError(f"--time-limit must be a positive number of seconds, got {time_limit}")
+) -> PlanningOptions:
+    """The one :class:`PlanningOptions` of a command; the library validates, errors name flags."""
+    with flag_words():
+        return PlanningOptions(
+            objective=objective,
+            min_margin_deg=min_margin,
+            grouping=grouping,
+            time_limit_s=time_limit,
+        )
+
+
+def uncertainty_option(
+    rotation_error: float, shape_tolerance: float, com_tolerance: float
+) -> Uncertainty:
+    """The one declared :class:`Uncertainty` of a command; the library validates, errors name
+    flags (a shape tolerance too large for a part is refused when the part is planned)."""
+    with flag_words():
+        return Uncertainty(rotation_error, shape_tolerance, com_tolerance)
+
+
+def uncertainty_text(data: dict[str, Any] | None) -> str:
+    """A plan file's ``uncertainty`` in words (every output says which values it used)."""
+    if data is None:
+        return "not declared (a plan made on the ideal model)"
+    r, t, c = data["rotation_error_deg"], data["shape_tolerance_mm"], data["com_tolerance_mm"]
+    text = f"rotation error ±{r:g}°, shape tolerance {t:g} mm, COM tolerance {c:g} mm"
+    return text + (" (the ideal model)" if r == t == c == 0 else "")
+
+
+def sensor_option(
+    sensorless: bool, tolerance: float | None, led_pitch: float | None, noise: float | None
+) -> Sensor:
+    """The one sensor of a command (:func:`feederkit.sensors.make_sensor`); errors name flags."""
+    with flag_words():
+        return make_sensor(
+            sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
+        )
+
+
+def print_warnings(lines: Iterable[str]) -> None:
+    """Each line as ``warning: ...`` on stderr: plain text, one line however long."""
+    for line in lines:
+        err_console.print(
+            f"warning: {with_flags(line)}", highlight=False, markup=False, soft_wrap=True
+        )
+
+
+@contextmanager
+def searching(what: str, time_limit: float | None) -> Iterator[None]:
+    """A spinner with the elapsed time on stderr while a search runs, naming ``--time-limit``."""
+    limit = "no time limit" if time_limit is None else f"time limit {time_limit:g} s"
+    with Progress(
+        SpinnerColumn(),
+        TextColumn(f"{escape(what)} ({limit}; set it with --time-limit S)"),
+        TimeElapsedColumn(),
+        console=err_console,
+        transient=True,
+        disable=not err_console.is_terminal,
+    ) as bar:
+        bar.add_task(what, total=None)
+        yield
+
+
+def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | None:
+    """One line when the search stopped at the time limit: the plan and the proven lower bound."""
+    if stats.get("optimal", True) or time_limit is None:
+        return None
+    return (
+        f"the time limit of {time_limit:g} s was reached: this plan has {stats['length']} "
+        f"operations and is not proven shortest; a plan needs at least {stats['lower_bound']} "
+        "(allow more time with --time-limit S)"
+    )
+
+
+def report_html(
+    plan: dict[str, Any], pfs: Sequence[PushFunction], witnesses: Sequence[PairWitness]
+) -> str:
+    """The HTML report of a plan (the report library's, imported only when asked for)."""
+    from feederkit.reports import render_report
+
+    return render_report(
+        plan,
+        unrecognizable=[w.to_dict() for w in witnesses],
+        outlines={pf.part.name: pf.part.outline for pf in pfs},
+    )
+
+
+def plan_outputs(
+    plan: dict[str, Any],
+    pfs: Sequence[PushFunction],
+    witnesses: Sequence[PairWitness],
+    output: Path | None,
+    report: Path | None,
+) -> list[OutputFile]:
+    """The files ``-o`` and ``--report`` ask for (the report rendered here, before any write)."""
+    files = []
+    if output is not None:
+        files.append(OutputFile(output, plan_json(plan), "plan file"))
+    if report is not None:
+        files.append(OutputFile(report, report_html(plan, pfs, witnesses), "report"))
+    return files
+
+
+def print_written(output: Path | None, report: Path | None) -> None:
+    """Say which files were written."""
+    for path, what in ((output, "plan"), (report, "report")):
+        if path is not None:
+            console.print(f"wrote the {what} to {path}", highlight=False, markup=False)
 
 
 def print_json(data: Any) -> None:

@@ -18,6 +18,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import unrecognizable_pairs
 from feederkit.plans.make import make_plan
 from feederkit.sensors import LedSensor
+from feederkit.uncertainty import IDEAL
 
 
 @dataclass(frozen=True)
@@ -56,7 +57,7 @@ def pitch_row(pfs: Sequence[PushFunction], pitch: float, noise: float) -> PitchR
     bad = tuple((w.part_a, w.part_b) for w in unrecognizable_pairs(list(pfs), sensor))
     if bad:
         return PitchRow(pitch, noise, bad)
-    result = make_plan(list(pfs), sensor).result
+    result = make_plan(list(pfs), sensor, uncertainty=IDEAL).result
     return PitchRow(pitch, noise, (), result.length, result.expected_length)
 
 

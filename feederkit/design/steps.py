@@ -35,6 +35,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.planning.api import plan
 from feederkit.plans.make import make_plan
 from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 
 @dataclass(frozen=True)
@@ -72,7 +73,7 @@ class Evaluation:
 
 def mix_breakpoints(pfs: Sequence[PushFunction]) -> tuple[float, ...]:
     """Where the read-alike relation of the mix's states changes (the machine's diameters)."""
-    diameters = [s.diameter for s in build_machine(list(pfs)).states]
+    diameters = [s.diameter for s in build_machine(list(pfs), uncertainty=IDEAL).states]
     eps = 0.0  # the machine has already made equal diameters exactly equal
     return breakpoints_of(diameters, diameters, eps)
 
@@ -91,7 +92,7 @@ def _first_at_or_above(breaks: Sequence[float], x: float) -> int:
 
 def plan_evaluation(pfs: Sequence[PushFunction], tolerance: float) -> Evaluation:
     """Length and expected length of the verified optimal plan at ``tolerance`` mm."""
-    result = make_plan(list(pfs), ToleranceSensor(tolerance)).result
+    result = make_plan(list(pfs), ToleranceSensor(tolerance), uncertainty=IDEAL).result
     return Evaluation(result.length, result.expected_length)
 
 
@@ -101,7 +102,7 @@ def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
     The search's probes need only the length; the steps' own plans are made and verified
     by :func:`plan_evaluation`.
     """
-    return plan(build_machine(list(pfs), ToleranceSensor(tolerance))).length
+    return plan(build_machine(list(pfs), ToleranceSensor(tolerance), uncertainty=IDEAL)).length
 
 
 def length_steps(

@@ -1,0 +1,358 @@
+"""The demo pipeline: the main job on a folder of part files, as one library call.
+
+Imports the folder into a temporary catalog, analyses every part (states, symmetry, Fig. 14
+class and bound), plans each orientable part sensorless and with a diameter sensor, and
+compiles changeovers: the paper's triangle and 8-gon (Figs. 18 and 27), the paper's shapes,
+the feeder parts, and a mix with a look-alike (Theorem 6: a part with the same push-diameter
+function) that no plan can tell apart from its original (section 8.4). Every plan file and a
+report per changeover are written to the output folder. :func:`run_demo` returns what
+happened; ``feederkit demo`` prints it (docs/changeovers.md).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from feederkit.catalog import add_outline, import_directory, list_parts, open_catalog
+from feederkit.errors import InputError
+from feederkit.jsonio import OutputFile, write_files
+from feederkit.loading import load_parts
+from feederkit.mechanics.analysis import analyze_part
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.changeover import CompiledChangeover, compile_changeover
+from feederkit.mix.lookalike import build_lookalike
+from feederkit.plans.fileformat import plan_json
+from feederkit.plans.make import make_plan
+from feederkit.sensors import NoSensor, Sensor, ToleranceSensor
+
+PAPER_MIX = ("isosceles-right-triangle", "octagon")
+"""Figs. 18 and 27: the parts the paper orients and recognizes with one plan."""
+
+LOOKALIKE_MIX = ("quadrilateral", "rectangle-2x1")
+"""The look-alike changeover: a look-alike of the first part joins them (when both exist)."""
+
+LOOKALIKE_SEED = 0
+"""The look-alike construction's seed (the demo is the same every time)."""
+
+SMALL_PART_MM = 10.0
+"""Parts below this size are the paper's unit-sized shapes; larger ones are feeder parts."""
+
+Progress = Callable[[str, int, int | None], None]
+"""``progress(what, done, total)``: called as the pipeline advances (total None: unknown)."""
+
+
+@dataclass(frozen=True)
+class PartRow:
+    """One part's analysis: states, distinct diameters, symmetry period, class and bound."""
+
+    name: str
+    size_mm: float
+    states: int
+    diameters: int
+    period_deg: float
+    polygon_class: int | None
+    bound: int | None
+    sensor: Sensor
+    near_metastable_edges: tuple[int, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``parts`` entry of ``feederkit demo --json``."""
+        return {
+            "name": self.name,
+            "states": self.states,
+            "symmetry_period_deg": self.period_deg,
+            "class": self.polygon_class,
+            "bound": self.bound,
+            "sensor": self.sensor.to_dict(),
+            "near_metastable_edges": list(self.near_metastable_edges),
+        }
+
+
+@dataclass(frozen=True)
+class DemoPlan:
+    """One part planned sensorless and with the sensor, with its files and warnings."""
+
+    name: str
+    sensor: Sensor
+    sensorless: dict[str, Any]
+    sensed: dict[str, Any]
+    files: tuple[Path, Path]
+    warnings: tuple[str, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``plans`` entry of ``feederkit demo --json``."""
+        return {
+            "name": self.name,
+            "sensorless": self.sensorless["stats"],
+            "sensor": {**self.sensor.to_dict(), **self.sensed["stats"]},
+            "files": [str(f) for f in self.files],
+            "warnings": list(self.warnings),
+        }
+
+
+@dataclass(frozen=True)
+class DemoChangeover:
+    """A compiled changeover with its plan file and report; ``lookalike``: the mix holds a
+    look-alike, so some pair is expected to be unrecognizable."""
+
+    compiled: CompiledChangeover
+    members: tuple[str, ...]
+    plan_path: Path
+    report_path: Path | None
+    lookalike: bool = False
+
+    @property
+    def name(self) -> str:
+        """The changeover's name."""
+        return self.compiled.name
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``changeovers`` entry of ``feederkit demo --json``."""
+        stats = self.compiled.plan["stats"]
+        return {
+            "name": self.name,
+            "parts": list(self.members),
+            "sensor": self.compiled.plan["sensor"],
+            "length": stats["length"],
+            "expected_length": stats["expected_length"],
+            "min_margin_deg": stats.get("min_margin_deg"),
+            "lookalike": self.lookalike,
+            "unrecognizable_pairs": [w.to_dict() for w in self.compiled.witnesses],
+            "warnings": list(self.compiled.warnings),
+            "plan": str(self.plan_path),
+            "report": None if self.report_path is None else str(self.report_path),
+        }
+
+
+@dataclass(frozen=True)
+class DemoResult:
+    """Everything the demo did, for printing or as ``--json``."""
+
+    source_dir: Path
+    output: Path
+    percent: float
+    part_count: int
+    not_orientable: tuple[str, ...]
+    rows: tuple[PartRow, ...]
+    notes: tuple[str, ...]
+    plans: tuple[DemoPlan, ...]
+    changeovers: tuple[DemoChangeover, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """``feederkit demo --json``."""
+        return {
+            "catalog_dir": str(self.source_dir),
+            "output": str(self.output),
+            "not_orientable": list(self.not_orientable),
+            "parts": [r.to_dict() for r in self.rows],
+            "plans": [p.to_dict() for p in self.plans],
+            "changeovers": [c.to_dict() for c in self.changeovers],
+        }
+
+
+def default_catalog_dir() -> Path:
+    """``./catalog`` when it exists, else the ``catalog/`` beside the installed package."""
+    here = Path("catalog")
+    if here.is_dir():
+        return here
+    return Path(__file__).resolve().parents[1] / "catalog"
+
+
+def demo_sensor(pfs: list[PushFunction], percent: float) -> ToleranceSensor:
+    """A diameter sensor whose tolerance is ``percent`` of the largest part's size (3 digits)."""
+    size = max(pf.part.size for pf in pfs)
+    return ToleranceSensor(float(f"{size * percent / 100.0:.3g}"))
+
+
+def _quiet(what: str, done: int, total: int | None) -> None:
+    """The default progress: none."""
+
+
+def analyse(pfs: list[PushFunction], percent: float) -> tuple[list[PartRow], list[str]]:
+    """Each part's row (class and bound for its demo sensor) and notes on near-metastable edges."""
+    rows, notes = [], []
+    for pf in pfs:
+        sensor = demo_sensor([pf], percent)
+        a = analyze_part(pf.part, sensor)
+        cls = a.polygon_class
+        if a.near_metastable:
+            edges = ", ".join(str(n.edge) for n in a.near_metastable)
+            notes.append(f"{pf.part.name}: near-metastable edges {edges} (may rest on a neighbour)")
+        rows.append(
+            PartRow(
+                name=pf.part.name,
+                size_mm=pf.part.size,
+                states=pf.n,
+                diameters=len({round(s.diameter, 9) for s in pf.states}),
+                period_deg=a.symmetry.part_period_deg,
+                polygon_class=cls.number if cls else None,
+                bound=cls.bound if cls else None,
+                sensor=sensor,
+                near_metastable_edges=tuple(n.edge for n in a.near_metastable),
+            )
+        )
+    return rows, notes
+
+
+def plan_parts(
+    pfs: list[PushFunction], percent: float, folder: Path, progress: Progress = _quiet
+) -> list[DemoPlan]:
+    """Plan each part sensorless and with its demo sensor; write both plan files."""
+    plans = []
+    for k, pf in enumerate(pfs):
+        progress(f"planning {pf.part.name}", k, len(pfs))
+        name = pf.part.name
+        sensor = demo_sensor([pf], percent)
+        blind = make_plan([pf], NoSensor())
+        sensed = make_plan([pf], sensor)
+        files = (folder / f"{name}.sensorless.json", folder / f"{name}.sensor.json")
+        write_files(
+            [
+                OutputFile(files[0], plan_json(blind.plan), "plan file"),
+                OutputFile(files[1], plan_json(sensed.plan), "plan file"),
+            ]
+        )
+        warnings = [f"{name} (sensorless): {w}" for w in blind.warnings]
+        warnings += [f"{name} (sensor): {w}" for w in sensed.warnings]
+        plans.append(DemoPlan(name, sensor, blind.plan, sensed.plan, files, tuple(warnings)))
+    progress("planning", len(pfs), len(pfs))
+    return plans
+
+
+def demo_mixes(pfs: list[PushFunction]) -> list[tuple[str, list[str]]]:
+    """The changeovers to compile: Figs. 18/27, then the paper's shapes, then the feeder parts."""
+    names = [pf.part.name for pf in pfs]
+    size = {pf.part.name: pf.part.size for pf in pfs}
+    mixes: list[tuple[str, list[str]]] = []
+    if all(n in names for n in PAPER_MIX):
+        mixes.append(("fig27-triangle-octagon", list(PAPER_MIX)))
+    small = [n for n in names if size[n] < SMALL_PART_MM]
+    large = [n for n in names if size[n] >= SMALL_PART_MM]
+    if len(small) > 2:
+        mixes.append(("paper-shapes", small))
+    if len(large) > 1:
+        mixes.append(("feeder-parts", large))
+    return mixes
+
+
+def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> tuple[str, list[str]] | None:
+    """Store a look-alike of ``LOOKALIKE_MIX[0]`` (same push-diameter function, Theorem 6) in the
+    catalog; return its changeover (name, members), or None when the mix's parts are missing."""
+    by_name = {pf.part.name: pf for pf in pfs}
+    if not all(n in by_name for n in LOOKALIKE_MIX):
+        return None
+    original = by_name[LOOKALIKE_MIX[0]].part
+    twin_name = f"{original.name}-twin"
+    twin = build_lookalike(original, "push-diameter", LOOKALIKE_SEED).part
+    add_outline(catalog, twin.outline, name=twin_name)
+    return "lookalike-pair", [original.name, twin_name, *LOOKALIKE_MIX[1:]]
+
+
+def _report(compiled: CompiledChangeover) -> str:
+    """The changeover's HTML report (the report library's), naming the pairs no plan tells apart."""
+    from feederkit.reports import render_report
+
+    return render_report(
+        compiled.plan,
+        unrecognizable=[w.to_dict() for w in compiled.witnesses],
+        outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
+    )
+
+
+def compile_demo_changeover(
+    catalog: Path,
+    name: str,
+    members: list[str],
+    folder: Path,
+    percent: float,
+    lookalike: bool,
+    report: bool = True,
+) -> DemoChangeover:
+    """Compile one changeover with the demo sensor; its plan file and (when ``report``) its
+    report are written with it."""
+    loaded = load_parts(members, catalog=catalog)
+    sensor = demo_sensor(list(loaded.push_functions), percent)
+    plan_path, report_path = folder / f"{name}.json", folder / f"{name}.html"
+
+    def outputs(c: CompiledChangeover) -> list[OutputFile]:
+        files = [OutputFile(plan_path, plan_json(c.plan), "plan file")]
+        if report:
+            files.append(OutputFile(report_path, _report(c), "report"))
+        return files
+
+    compiled = compile_changeover(catalog, name, members, sensor, replace=True, outputs=outputs)
+    return DemoChangeover(
+        compiled, tuple(members), plan_path, report_path if report else None, lookalike
+    )
+
+
+def run_demo(
+    source_dir: str | os.PathLike[str],
+    output: str | os.PathLike[str],
+    percent: float = 1.0,
+    progress: Progress = _quiet,
+    *,
+    reports: bool = True,
+) -> DemoResult:
+    """Run the demo on the part files in ``source_dir``, writing into ``output``.
+
+    ``percent``: the diameter sensor's tolerance in percent of the largest part's size, in
+    (0, 50); ``reports``: write each changeover's HTML report (its part plots are most of the
+    demo's time). Raises InputError for a missing folder, a bad percentage, or bad part files.
+    """
+    src, out = Path(source_dir), Path(output)
+    if not src.is_dir():
+        raise InputError(f"{src}: no such folder of part files")
+    if not (0.0 < percent < 50.0):
+        raise InputError(
+            f"the sensor tolerance must be above 0 and below 50 percent, got {percent}"
+        )
+    try:
+        (out / "plans").mkdir(parents=True, exist_ok=True)
+        (out / "changeovers").mkdir(exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{out}: cannot make the output folder ({exc.strerror})") from None
+    with tempfile.TemporaryDirectory(prefix="feederkit-demo-") as tmp:
+        catalog = Path(tmp) / "demo.db"
+        open_catalog(catalog, create=True).close()
+
+        def imported(phase: str, done: int, total: int, item: str) -> None:
+            progress(f"{phase} {item}".strip(), done, total)
+
+        import_directory(catalog, src, progress=imported)
+        summaries = list_parts(catalog)
+        loaded = load_parts(
+            [s.name for s in summaries], catalog=catalog, leave_out_not_orientable=True
+        )
+        skipped = tuple(s.name for s in summaries if s.name not in loaded.names)
+        pfs = list(loaded.push_functions)
+        rows, notes = analyse(pfs, percent)
+        plans = plan_parts(pfs, percent, out / "plans", progress)
+        mixes = [(name, members, False) for name, members in demo_mixes(pfs)]
+        twin = add_lookalike(catalog, pfs)
+        if twin is not None:
+            mixes.append((*twin, True))
+        changeovers = []
+        for k, (name, members, lookalike) in enumerate(mixes):
+            progress(f"compiling changeover {name}", k, len(mixes))
+            changeovers.append(
+                compile_demo_changeover(
+                    catalog, name, members, out / "changeovers", percent, lookalike, reports
+                )
+            )
+    return DemoResult(
+        source_dir=src,
+        output=out,
+        percent=percent,
+        part_count=len(summaries),
+        not_orientable=skipped,
+        rows=tuple(rows),
+        notes=(*loaded.warnings, *notes),
+        plans=tuple(plans),
+        changeovers=tuple(changeovers),
+    )

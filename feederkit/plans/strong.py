@@ -1,0 +1,441 @@
+"""Verification and certificate of strong plans (design.md, "Uncertainty"; docs/planning.md).
+
+A strong plan must reach its result for every outcome the declared uncertainty allows and
+every reading the sensor can give. :func:`verify_strong` checks a plan file on mechanics
+rebuilt from the file alone (each part's hull and COM, the declared ``uncertainty``), never
+from the machine the planner used: every start physical state runs through the plan; at an
+action every outcome of :func:`~feederkit.mechanics.uncertain.outcome_set` is followed; at a
+node every branch whose closed reading interval the state's reading set meets is followed,
+and a reading that no branch holds is a failure (interval arithmetic over the branches' ends,
+:meth:`~feederkit.sensors.Sensor.uncovered_reading`, not sampling). Every path must end in a
+leaf naming its state (all its ideal member states, for that part); the worst path must
+take exactly the stated length.
+
+:func:`certificate` computes what the plan guarantees beyond the declared uncertainty: per
+action node the largest rotation error keeping every outcome of every state that reaches
+the node within the states its subtree handles (``max_rotation_error``; the plan's value is
+the minimum), and the largest shape tolerance under which the plan still verifies (a
+bisection re-verifying the plan).
+
+:func:`ideal_view` writes a strong plan over the parts' ideal stable states, so the plan
+file names a physical state by its ideal members (docs/planning.md, "Results").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from feederkit.errors import CheckFailed, InputError
+from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, members
+from feederkit.machine.build import snap
+from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mechanics.uncertain import (
+    UncertainMechanics,
+    max_rotation_error,
+    outcome_set,
+    uncertain_mechanics,
+)
+from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
+from feederkit.plans.model import PlanPart, push_function_of
+from feederkit.plans.verify import PartCheck, VerificationReport
+from feederkit.sensors import Sensor, sensor_from_dict
+from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
+
+MAX_ROTATION_ERROR_DEG = 90.0
+"""The certificate of a plan with no rotation: every error design.md allows (below 90)."""
+
+SHAPE_REL_TOL = 1e-3
+"""The shape-tolerance certificate's bisection stops at this fraction of its bound."""
+
+State = tuple[int, int]
+"""A physical state of the plan: (part index, physical state id)."""
+
+
+@dataclass(frozen=True)
+class StrongModel:
+    """The parts of a plan file with their mechanics under one uncertainty.
+
+    ``diameters[p][s]``: physical state ``s``'s diameter interval, endpoints snapped across
+    the parts as the machine snaps them (so exact ties survive rounding).
+    """
+
+    names: tuple[str, ...]
+    mechanics: tuple[UncertainMechanics, ...]
+    diameters: tuple[tuple[tuple[float, float], ...], ...]
+    sensor: Sensor
+
+    def states(self) -> Iterator[State]:
+        """Every physical state of every part."""
+        for p, mech in enumerate(self.mechanics):
+            for s in mech.states:
+                yield (p, s.id)
+
+
+def _parts(plan: Mapping[str, Any]) -> list[PushFunction]:
+    out = []
+    for part in plan["parts"]:
+        pp = PlanPart(
+            name=part["name"],
+            revision=part.get("revision"),
+            com=tuple(part["com"]),
+            hull=tuple(tuple(v) for v in part["hull"]),
+            states=(),
+        )
+        out.append(push_function_of(pp))
+    return out
+
+
+def declared_uncertainty(plan: Mapping[str, Any]) -> Uncertainty:
+    """The plan file's declared uncertainty (the ideal model when the file has none: a plan
+    written before uncertainty was declared)."""
+    data = plan.get("uncertainty")
+    return IDEAL if data is None else Uncertainty.from_dict(data)
+
+
+def strong_model(
+    plan: Mapping[str, Any],
+    uncertainty: Uncertainty | None = None,
+    *,
+    vibration_mm: float | None = None,
+    parts: Sequence[PushFunction] | None = None,
+) -> StrongModel:
+    """The plan's parts rebuilt from its hulls and COMs, with their mechanics.
+
+    ``uncertainty`` defaults to the declared one; ``vibration_mm`` to the mechanics' own
+    rule, except that a plan declared on the ideal model keeps vibration off (so a
+    certificate of an ideal plan speaks of that model).
+    """
+    declared = declared_uncertainty(plan)
+    unc = declared if uncertainty is None else uncertainty
+    if vibration_mm is None and declared.is_ideal:
+        vibration_mm = 0.0
+    pfs = list(parts) if parts is not None else _parts(plan)
+    mechs = tuple(uncertain_mechanics(pf.part, unc, vibration_mm=vibration_mm) for pf in pfs)
+    eps = DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
+    ends = snap([x for m in mechs for s in m.states for x in s.diameter], eps)
+    diam: list[tuple[tuple[float, float], ...]] = []
+    k = 0
+    for m in mechs:
+        row = []
+        for _ in m.states:
+            row.append((ends[k], ends[k + 1]))
+            k += 2
+        diam.append(tuple(row))
+    return StrongModel(
+        tuple(pf.part.name for pf in pfs), mechs, tuple(diam), sensor_from_dict(plan["sensor"])
+    )
+
+
+class _Run:
+    """Every path of every start through one plan, memoised per (node, state)."""
+
+    def __init__(self, plan: Mapping[str, Any], model: StrongModel) -> None:
+        self.model = model
+        self.shared = plan.get("nodes") or {}
+        self.by_name = {n: p for p, n in enumerate(model.names)}
+        self._worst: dict[tuple[int, State], int] = {}
+        self._paths: dict[tuple[int, State], int] = {}
+        self._handles: dict[tuple[int, State], bool] = {}
+
+    def node(self, node: Mapping[str, Any]) -> Mapping[str, Any]:
+        """A node with a shared-subplan reference resolved."""
+        seen = 0
+        while "ref" in node:
+            ref = node["ref"]
+            if ref not in self.shared or seen > len(self.shared):
+                raise InputError(f"the plan refers to an unknown shared subplan {ref!r}")
+            node = self.shared[ref]
+            seen += 1
+        return node
+
+    def outcomes(self, node: Mapping[str, Any], x: State) -> list[State]:
+        """Where state ``x`` can rest after the node's rotation (itself at the root)."""
+        a = node.get("action_deg")
+        if a is None:
+            return [x]
+        p, s = x
+        return [(p, t) for t in sorted(outcome_set(self.model.mechanics[p], s, float(a)))]
+
+    def follow(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]]:
+        """The branches resting state ``x`` can follow; CheckFailed when a reading it can
+        give is in none."""
+        p, s = x
+        diam = self.model.diameters[p][s]
+        branches = node["branches"]
+        sensor = self.model.sensor
+        if not sensor.informative or all(b["reading"] is None for b in branches):
+            return [b["next"] for b in branches]
+        ivs = [tuple(b["reading"]) for b in branches if b["reading"] is not None]
+        miss = sensor.uncovered_reading(diam, ivs)
+        if miss is not None:
+            raise CheckFailed(
+                f"{self.model.names[p]}: physical state {s} (diameter {diam[0]:.6g} to "
+                f"{diam[1]:.6g} mm) can read {miss:.6g} mm, which no branch after rotation "
+                f"{node.get('action_deg')} holds"
+            )
+        return [
+            b["next"]
+            for b in branches
+            if b["reading"] is not None and sensor.reads_into(diam, *b["reading"])
+        ]
+
+    def named(self, leaf: Mapping[str, Any], x: State) -> bool:
+        """Whether a leaf names state ``x``: every ideal member of it, for its part."""
+        p, s = x
+        listed = {e["state"] for e in leaf["result"] if self.by_name.get(e["part"]) == p}
+        return set(self.model.mechanics[p].states[s].members) <= listed
+
+    def worst(self, node: Mapping[str, Any], x: State) -> int:
+        """Operations from ``node`` on for a part resting in ``x`` before it, worst case;
+        CheckFailed on the first path that fails."""
+        node = self.node(node)
+        key = (id(node), x)
+        hit = self._worst.get(key)
+        if hit is not None:
+            return hit
+        if "result" in node:
+            if not self.named(node, x):
+                p, s = x
+                ideal = list(self.model.mechanics[p].states[s].members)
+                raise CheckFailed(
+                    f"{self.model.names[p]}: a path ends in a result that does not name its "
+                    f"physical state {s} (ideal states {ideal})"
+                )
+            self._worst[key], self._paths[key] = 0, 1
+            return 0
+        longest, paths = 0, 0
+        for y in self.outcomes(node, x):
+            for nxt in self.follow(node, y):
+                longest = max(longest, self.worst(nxt, y))
+                paths += self._paths[(id(self.node(nxt)), y)]
+        self._worst[key], self._paths[key] = 1 + longest, paths
+        return 1 + longest
+
+    def handles(self, node: Mapping[str, Any], x: State) -> bool:
+        """Whether every path of ``x`` from ``node`` on ends in a leaf naming its state."""
+        node = self.node(node)
+        key = (id(node), x)
+        hit = self._handles.get(key)
+        if hit is None:
+            if "result" in node:
+                hit = self.named(node, x)
+            else:
+                hit = all(self.settles(node, y) for y in self.outcomes(node, x))
+            self._handles[key] = hit
+        return hit
+
+    def settles(self, node: Mapping[str, Any], y: State) -> bool:
+        """Whether a part resting in ``y`` after ``node``'s rotation is handled from there."""
+        try:
+            nexts = self.follow(node, y)
+        except CheckFailed:
+            return False
+        return bool(nexts) and all(self.handles(n, y) for n in nexts)
+
+
+def verify_strong(
+    plan: Mapping[str, Any],
+    uncertainty: Uncertainty | None = None,
+    *,
+    vibration_mm: float | None = None,
+    parts: Sequence[PushFunction] | None = None,
+) -> VerificationReport:
+    """Execute every start, outcome and reading branch of ``plan`` on rebuilt mechanics.
+
+    ``uncertainty`` defaults to the plan's declared one (another value re-verifies the plan
+    under it). Returns the report (per part: starts, paths, the worst operations); raises
+    CheckFailed with the first failing path, or when the worst path's length differs from
+    the stated one.
+    """
+    model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
+    run = _Run(plan, model)
+    root = plan["root"]
+    checks = []
+    overall = 0
+    for p, name in enumerate(model.names):
+        worst, paths = 0, 0
+        states = [x for x in model.states() if x[0] == p]
+        for x in states:
+            worst = max(worst, run.worst(root, x))
+            paths += run._paths[(id(run.node(root)), x)]
+        overall = max(overall, worst)
+        checks.append(PartCheck(name, len(states), paths, worst, 0))
+    stated = plan["stats"]["length"]
+    if overall != stated:
+        raise CheckFailed(
+            f"the plan's length is {stated}, but its worst path under the declared uncertainty "
+            f"takes {overall} operations"
+        )
+    return VerificationReport(tuple(checks))
+
+
+def strong_holds(
+    plan: Mapping[str, Any],
+    uncertainty: Uncertainty,
+    *,
+    vibration_mm: float | None = None,
+    parts: Sequence[PushFunction] | None = None,
+) -> bool:
+    """Whether every path of ``plan`` under ``uncertainty`` ends in a leaf naming its state."""
+    try:
+        model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
+    except InputError:
+        return False
+    run = _Run(plan, model)
+    return all(run.handles(plan["root"], x) for x in model.states())
+
+
+def max_rotation_error_deg(
+    plan: Mapping[str, Any], *, parts: Sequence[PushFunction] | None = None
+) -> float:
+    """The largest rotation error (deg, a supremum) under which ``plan`` as written still
+    succeeds: per action node, ``max_rotation_error`` over the states that reach it, allowed
+    to end in the states its subtree handles; the minimum over the nodes."""
+    model = strong_model(plan, parts=parts)
+    run = _Run(plan, model)
+    best = MAX_ROTATION_ERROR_DEG
+    all_states = list(model.states())
+    stack: list[tuple[Mapping[str, Any], frozenset[State]]] = [
+        (run.node(plan["root"]), frozenset(all_states))
+    ]
+    seen: set[tuple[int, frozenset[State]]] = set()
+    while stack:
+        node, reach = stack.pop()
+        if (id(node), reach) in seen or "result" in node:
+            continue
+        seen.add((id(node), reach))
+        a = node.get("action_deg")
+        if a is not None:
+            ok = [y for y in all_states if run.settles(node, y)]
+            for p, mech in enumerate(model.mechanics):
+                here = [s for q, s in reach if q == p]
+                if not here:
+                    continue
+                allowed = frozenset(s for q, s in ok if q == p)
+                r = max_rotation_error(mech, here, float(a), dict.fromkeys(here, allowed))
+                best = min(best, r)
+        after = {y for x in reach for y in run.outcomes(node, x)}
+        nexts: dict[int, tuple[Mapping[str, Any], set[State]]] = {}
+        for y in after:
+            try:
+                follow = run.follow(node, y)
+            except CheckFailed:
+                continue
+            for nxt in follow:
+                n = run.node(nxt)
+                nexts.setdefault(id(n), (n, set()))[1].add(y)
+        stack.extend((n, frozenset(ys)) for n, ys in nexts.values())
+    return best
+
+
+def max_shape_tolerance_mm(
+    plan: Mapping[str, Any],
+    *,
+    parts: Sequence[PushFunction] | None = None,
+    rel_tol: float = SHAPE_REL_TOL,
+) -> float:
+    """The largest shape tolerance (mm) under which ``plan`` still verifies at its declared
+    rotation error and COM tolerance: a bisection re-verifying the plan (outcome sets and
+    reading intervals grow with the tolerance) to ``rel_tol`` of the bound, half the parts'
+    smallest hull edge. Returns the lower end of the final bracket, where the plan holds."""
+    declared = declared_uncertainty(plan)
+    pfs = list(parts) if parts is not None else _parts(plan)
+    vib = 0.0 if declared.is_ideal else None
+    limit = min(shape_tolerance_limit(pf.part) for pf in pfs)
+
+    def holds(t: float) -> bool:
+        unc = Uncertainty(declared.rotation_error_deg, t, declared.com_tolerance_mm)
+        return strong_holds(plan, unc, vibration_mm=vib, parts=pfs)
+
+    lo = declared.shape_tolerance_mm
+    hi = limit * (1.0 - 1e-9)
+    if holds(hi):
+        return hi
+    while hi - lo > rel_tol * limit:
+        mid = (lo + hi) / 2.0
+        lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+    return lo
+
+
+def ideal_view(result: PlanResult, ideal: PushAlignMachine) -> PlanResult:
+    """``result`` over the parts' ideal stable states (the machine ``ideal``, built from the
+    same push functions at zero uncertainty): each physical state becomes its ideal members
+    in every mask, so a leaf names a physical state by all its ideal stable states."""
+    machine = result.machine
+    index = {(s.part, s.state): k for k, s in enumerate(ideal.states)}
+    expand = []
+    for s in machine.states:
+        m = 0
+        for i in s.ideal_states:
+            m |= 1 << index[(s.part, i)]
+        expand.append(m)
+    masks: dict[int, int] = {}
+
+    def mask(m: int) -> int:
+        out = masks.get(m)
+        if out is None:
+            out = 0
+            for k in members(m):
+                out |= expand[k]
+            masks[m] = out
+        return out
+
+    nodes: dict[int, PlanTree] = {}
+    order: list[PlanTree] = []
+    stack: list[PlanTree] = [result.root]
+    while stack:  # post-order without recursion
+        n = stack.pop()
+        order.append(n)
+        if isinstance(n, Step):
+            stack.extend(sub for _b, sub in n.branches)
+    for n in reversed(order):
+        if id(n) in nodes:
+            continue
+        if isinstance(n, Leaf):
+            nodes[id(n)] = Leaf(mask(n.mask))
+            continue
+        action = n.action
+        if action is not None:
+            action = OverlapRange(action.lo, action.hi, mask(action.image))
+        subs = tuple(
+            (ReadingBranch(b.lo, b.hi, mask(b.mask)), nodes[id(sub)]) for b, sub in n.branches
+        )
+        nodes[id(n)] = Step(action, subs)
+    root = nodes[id(result.root)]
+    assert isinstance(root, Step)
+    return PlanResult(
+        machine=ideal,
+        root=root,
+        length=result.length,
+        expected_length=result.expected_length,
+        min_margin=result.min_margin,
+        optimal=result.optimal,
+        lower_bound=result.lower_bound,
+        objective=result.objective,
+        grouping=result.grouping,
+        certificate=result.certificate,
+    )
+
+
+def finite_or_none(x: float) -> float | None:
+    """A JSON-safe number: None for infinities."""
+    return x if math.isfinite(x) else None
+
+
+__all__ = [
+    "MAX_ROTATION_ERROR_DEG",
+    "StrongModel",
+    "declared_uncertainty",
+    "finite_or_none",
+    "ideal_view",
+    "max_rotation_error_deg",
+    "max_shape_tolerance_mm",
+    "strong_holds",
+    "strong_model",
+    "verify_strong",
+]

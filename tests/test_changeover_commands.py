@@ -1,0 +1,147 @@
+"""``changeover compile|remove|export|report|show|list`` (docs/changeovers.md): stored and written
+together, exported byte for byte, reported with the pairs no plan can tell apart, and a
+warning when a part has a newer revision than the one the changeover is made for."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from shared import one_line_error
+
+from feederkit.cli.app import main
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+PARTS = ("isosceles-right-triangle", "octagon", "quadrilateral", "rectangle-2x1")
+FIG27 = ["changeover", "compile", "fig27", "--mix", "isosceles-right-triangle,octagon"]
+
+
+def ok(capsys, args: list[str], code: int = 0):
+    rc = main(args)
+    captured = capsys.readouterr()
+    assert rc == code, captured.err
+    return captured
+
+
+@pytest.fixture()
+def db(tmp_path, capsys) -> Path:
+    """A catalog with four sample parts and a push-diameter look-alike of the quadrilateral."""
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    for name in PARTS:
+        shutil.copy(CATALOG / f"{name}.json", folder)
+    path = tmp_path / "parts.db"
+    ok(capsys, ["catalog", "init", "--catalog", str(path)])
+    ok(capsys, ["catalog", "import", str(folder), "--catalog", str(path)])
+    twin = tmp_path / "quad-twin.json"
+    src = str(folder / "quadrilateral.json")
+    ok(
+        capsys,
+        ["lookalike", src, "--keep", "push-diameter", "--name", "quad-twin", "-o", str(twin)],
+    )
+    ok(capsys, ["catalog", "add", str(twin), "--catalog", str(path)])
+    return path
+
+
+def test_export_writes_the_stored_plan_byte_for_byte(db, tmp_path, capsys):
+    compiled = tmp_path / "compiled.json"
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "-o", str(compiled), "--catalog", str(db)])
+    exported = tmp_path / "exported.json"
+    cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(exported), "--catalog", str(db)])
+    assert exported.read_bytes() == compiled.read_bytes()
+    assert str(exported) in cap.out
+    ok(capsys, ["run", str(exported), "--all"])
+    err = one_line_error(
+        capsys, ["changeover", "export", "nope", "-o", str(exported), "--catalog", str(db)]
+    )
+    assert "nope" in err
+
+
+@pytest.mark.slow
+def test_report_names_the_pair_no_plan_can_tell_apart(db, tmp_path, capsys):
+    args = ["changeover", "compile", "twins", "--mix", "quadrilateral,quad-twin"]
+    ok(capsys, [*args, "--tolerance", "0.01", "--catalog", str(db)], code=1)
+    html = tmp_path / "twins.html"
+    ok(capsys, ["changeover", "report", "twins", "-o", str(html), "--catalog", str(db)])
+    text = html.read_text(encoding="utf-8")
+    assert text.startswith("<!DOCTYPE html>")
+    assert "quad-twin" in text and "Lemma 8" in text
+
+
+def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, monkeypatch):
+    import feederkit.reports
+
+    def fake_report(plan, *, unrecognizable, outlines):
+        pairs = sorted(sorted((u["part_a"], u["part_b"])) for u in unrecognizable)
+        return f"<p>{pairs} {sorted(outlines)}</p>"
+
+    monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
+    args = ["changeover", "compile", "twins", "--mix", "quadrilateral,quad-twin"]
+    ok(capsys, [*args, "--tolerance", "0.01", "--catalog", str(db)], code=1)
+    html = tmp_path / "twins.html"
+    ok(capsys, ["changeover", "report", "twins", "-o", str(html), "--catalog", str(db)])
+    names = "['quad-twin', 'quadrilateral']"
+    assert html.read_text() == f"<p>[{names}] {names}</p>"
+    one_line_error(capsys, ["changeover", "report", "nope", "-o", str(html), "--catalog", str(db)])
+
+
+def test_remove_deletes_one_changeover_and_keeps_the_parts(db, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    cap = ok(capsys, ["changeover", "remove", "fig27", "--catalog", str(db)])
+    assert "removed" in cap.out
+    assert json.loads(ok(capsys, ["changeover", "list", "--json", "--catalog", str(db)]).out) == []
+    one_line_error(capsys, ["changeover", "show", "fig27", "--catalog", str(db)])
+    one_line_error(capsys, ["changeover", "remove", "fig27", "--catalog", str(db)])
+    assert "octagon" in ok(capsys, ["catalog", "list", "--catalog", str(db)]).out
+
+
+def test_a_newer_part_revision_is_warned_about(db, tmp_path, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    changed = tmp_path / "octagon.json"
+    data = json.loads((CATALOG / "octagon.json").read_text())
+    data["vertices"][0] = [data["vertices"][0][0] * 1.1, data["vertices"][0][1]]
+    changed.write_text(json.dumps(data))
+    ok(capsys, ["catalog", "add", str(changed), "--revise", "--catalog", str(db)])
+    cap = ok(capsys, ["changeover", "show", "fig27", "--json", "--catalog", str(db)])
+    shown = json.loads(cap.out)
+    assert "revision 1" in cap.err and "latest is 2" in cap.err
+    assert len(shown["warnings"]) == 1 and "octagon" in shown["warnings"][0]
+    listed = json.loads(ok(capsys, ["changeover", "list", "--json", "--catalog", str(db)]).out)
+    assert listed[0]["warnings"] == shown["warnings"]
+    out = tmp_path / "e.json"
+    cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(out), "--catalog", str(db)])
+    assert "latest is 2" in cap.err
+    # Compiling against the old revision on purpose says so, too.
+    pinned = ["changeover", "compile", "old", "--mix", "octagon@1,rectangle-2x1"]
+    cap = ok(capsys, [*pinned, "--tolerance", "0.01", "--json", "--catalog", str(db)])
+    assert any("latest is 2" in w for w in json.loads(cap.out)["warnings"])
+
+
+def test_compile_stores_nothing_when_its_files_cannot_be_written(db, tmp_path, capsys, monkeypatch):
+    import feederkit.cli.common
+
+    monkeypatch.setattr(feederkit.cli.common, "report_html", lambda *a: "<!DOCTYPE html>")
+    plan = tmp_path / "fig27.json"
+    bad_report = tmp_path / "no" / "such" / "r.html"
+    args = [*FIG27, "--tolerance", "0.01", "-o", str(plan), "--report", str(bad_report)]
+    err = one_line_error(capsys, [*args, "--catalog", str(db)])
+    assert "r.html" in err
+    assert not plan.exists()
+    assert json.loads(ok(capsys, ["changeover", "list", "--json", "--catalog", str(db)]).out) == []
+    assert list(tmp_path.glob(".fig27.json.*")) == []  # no temporary left behind
+
+
+def test_an_existing_name_says_replace(db, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    err = one_line_error(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    assert "--replace" in err
+
+
+def test_compile_json_has_warnings_and_a_file_member_is_refused(db, tmp_path, capsys):
+    cap = ok(capsys, [*FIG27, "--tolerance", "0.01", "--json", "--catalog", str(db)])
+    assert json.loads(cap.out)["warnings"] == []
+    src = str(CATALOG / "octagon.json")
+    args = ["changeover", "compile", "f", "--mix", f"{src},rectangle-2x1", "--catalog", str(db)]
+    assert "catalog part" in one_line_error(capsys, args)
