@@ -200,6 +200,13 @@ class Sensor(Protocol):
         None when they cover its whole reading set (interval arithmetic, not sampling)."""
         ...
 
+    def narrowed(self, inset: float) -> Sensor:
+        """The sensor as a verifier reads it: readings within ``inset`` mm of an open end of
+        a reading set are not taken (design.md: a tolerance sensor never reads its ends;
+        rounding can make two ends that touch overlap by an ulp). Models with closed reading
+        sets return themselves."""
+        ...
+
     def describe(self) -> str:
         """The model and its parameters in words, for people."""
         ...
@@ -269,6 +276,9 @@ class NoSensor:
         self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
     ) -> float | None:
         return None
+
+    def narrowed(self, inset: float) -> NoSensor:
+        return self
 
     def describe(self) -> str:
         return "no sensor: a sensorless plan"
@@ -434,6 +444,9 @@ class ToleranceSensor:
             out.append(1.0 - max(0.0, hi - lo) / (2.0 * e))
         return out
 
+    def narrowed(self, inset: float) -> ToleranceSensor:
+        return ToleranceSensor(max(self.tolerance - inset, self.tolerance / 2.0))
+
     def describe(self) -> str:
         return f"diameter sensor: a reading lies within \u00b1{self.tolerance:.4g} mm of it"
 
@@ -570,6 +583,9 @@ class LedSensor:
 
     def shared_reading_probability(self, diameters: Sequence[float]) -> list[float] | None:
         return None
+
+    def narrowed(self, inset: float) -> LedSensor:
+        return self
 
     def describe(self) -> str:
         return (
