@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/bench_sim_uncertainty.py [--trials N] [--only NAME,...] [--creep]``.
 
-Plans every part of ``catalog/`` and every drawing of ``/work/shared/samples/`` that can be
+Plans every part of ``catalog/`` and every drawing of ``../shared/samples/`` that can be
 oriented (rotation error 1 degree, a tolerance sensor of 1 % of the part's size) and the
 demo's changeovers (the demo's mixes and its look-alike pair, a sensor of 1 % of the largest
 part), then simulates each plan for ``--trials`` trials (default 200) sampling the declared
@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SAMPLES = Path("/work/shared/samples")
+SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "samples"
 
 from feederkit.demo import LOOKALIKE_MIX, LOOKALIKE_SEED, demo_mixes  # noqa: E402
 from feederkit.errors import InputError, PlanningError  # noqa: E402
