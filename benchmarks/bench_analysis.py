@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 
 from feederkit.mechanics.analysis import analysis_to_dict, analyze_part
-from feederkit.mechanics.classes import polygon_class
+from feederkit.mechanics.polygon_classes import polygon_class
 from feederkit.mechanics.push import push_function
 from feederkit.mechanics.symmetry import symmetry
 from feederkit.outline import make_outline

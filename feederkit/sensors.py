@@ -755,38 +755,3 @@ def sensor_warnings(sensor: Sensor, diameters: Sequence[float]) -> list[str]:
             f"more than the largest diameter ({hi:.4g} mm)"
         )
     return out
-
-
-# Transitional function forms of the protocol's methods, for callers not yet moved to it.
-
-
-def sensor_to_dict(sensor: Sensor) -> dict[str, Any]:
-    """``sensor.to_dict()``."""
-    return sensor.to_dict()
-
-
-def can_read_alike(sensor: Sensor, d1: float, d2: float) -> bool:
-    """``sensor.can_read_alike(d1, d2)``."""
-    return sensor.can_read_alike(d1, d2)
-
-
-def reading_consistent(sensor: Sensor, diameter: float, reading: float) -> bool:
-    """``sensor.consistent(diameter, reading)``."""
-    return sensor.consistent(diameter, reading)
-
-
-def indistinguishable_sets(sensor: Sensor, diameters: Sequence[float]) -> list[tuple[int, ...]]:
-    """``sensor.indistinguishable_sets(diameters)``."""
-    return sensor.indistinguishable_sets(diameters)
-
-
-def split_by_reading(
-    sensor: Sensor, diameters: Sequence[float], grouping: Grouping | str = Grouping.EXACT
-) -> list[ReadingBranch]:
-    """``sensor.split(diameters, grouping)``."""
-    return sensor.split(diameters, grouping)
-
-
-def led_counts(sensor: LedSensor, diameter: float) -> tuple[int, int]:
-    """``sensor.counts(diameter)``."""
-    return sensor.counts(diameter)

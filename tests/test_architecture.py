@@ -74,9 +74,6 @@ KNOWN_EXCEPTIONS: set[tuple[str, str]] = {
     # Transitional re-export: ``from feederkit.machine import build_machine`` still works
     # while callers move to ``feederkit.machine.build``.
     ("feederkit.machine", "feederkit.machine.build"),
-    # The plan-model refactor moves rich rendering into feederkit/cli/; until then the
-    # library module re-exports it from there.
-    ("feederkit.plans.render", "feederkit.cli.plan_render"),
 }
 
 

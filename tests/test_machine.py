@@ -11,8 +11,7 @@ import pytest
 
 from feederkit.errors import InputError
 from feederkit.machine import (
-    Branch,
-    SetAction,
+    OverlapRange,
     branches,
     build_machine,
     image,
@@ -78,7 +77,7 @@ def reference_overlap_ranges(machine, mask):
             merged[0][1] += 360.0
     if len(merged) == 1:
         merged[0][0], merged[0][1] = 0.0, 360.0
-    return [SetAction(lo, hi, img) for lo, hi, img in merged]
+    return [OverlapRange(lo, hi, img) for lo, hi, img in merged]
 
 
 MACHINES = [
@@ -132,7 +131,7 @@ def reference_branches(machine, mask, grouping="exact"):
     """The sensor's split of the set's diameters, relabelled to machine states by hand."""
     idx = members(mask)
     split = machine.sensor.split([machine.states[i].diameter for i in idx], grouping)
-    return [Branch(b.lo, b.hi, mask_of(idx[j] for j in b.members)) for b in split]
+    return [ReadingBranch(b.lo, b.hi, mask_of(idx[j] for j in b.members)) for b in split]
 
 
 def reference_tolerance_cells(machine, mask, e):
@@ -153,7 +152,7 @@ def reference_tolerance_cells(machine, mask, e):
         else:
             out.append([lo, hi, here])
         joinable = True
-    return [Branch(lo, hi, m) for lo, hi, m in out]
+    return [ReadingBranch(lo, hi, m) for lo, hi, m in out]
 
 
 @pytest.mark.parametrize("tol", [1e-4, 0.05, 0.3, 1.0, 3.0])
@@ -270,7 +269,7 @@ def test_branches_are_labelled_by_machine_state():
     for b in branches(m, mask):
         assert b.mask & ~mask == 0
         assert b.members == tuple(members(b.mask))
-        assert isinstance(b, ReadingBranch) and Branch is ReadingBranch
+        assert isinstance(b, ReadingBranch)
 
 
 # ---------------------------------------------------------------- sensors

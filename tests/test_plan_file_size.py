@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from feederkit.errors import PlanningError
-from feederkit.machine import Branch, build_machine, overlap_ranges
+from feederkit.machine import ReadingBranch, build_machine, overlap_ranges
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -18,7 +18,7 @@ def _shared_chain(depth: int) -> tuple[PlanResult, object]:
     pf = push_function(make_part(make_outline("rect", [(0, 0), (2, 0), (2, 1), (0, 1)])))
     m = build_machine([pf], NoSensor())
     action = overlap_ranges(m, m.all_states)[0]
-    branch = Branch(None, None, m.all_states)
+    branch = ReadingBranch(None, None, m.all_states)
     node: Step | Leaf = Leaf(1)
     for _ in range(depth):  # two branches to one shared child: 2**depth leaves when written
         node = Step(action, ((branch, node), (branch, node)))

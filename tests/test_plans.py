@@ -17,6 +17,7 @@ from feederkit.machine import branches, build_machine, inseparable, is_goal, ove
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Leaf, PlanResult, Step
 from feederkit.plans import (
     CONVENTIONS,
@@ -394,12 +395,14 @@ def test_emitted_plans_of_random_parts_verify(pts, kind):
         "tol": ToleranceSensor(0.03 * size),
         "led": LedSensor(0.05 * size, 0.01 * size),
     }[kind]
-    made = make_plan([pf], sensor, time_limit=5.0, uncertainty=IDEAL)
+    made = make_plan([pf], sensor, PlanningOptions(time_limit_s=5.0), uncertainty=IDEAL)
     assert made.report.ok
     if made.plan["stats"]["meets_bound"] is not None and made.plan["stats"]["optimal"]:
         assert made.plan["stats"]["meets_bound"]
     try:  # at design.md's default rotation error: a strong plan that verifies, or none at all
-        strong = make_plan([pf], sensor, time_limit=5.0, uncertainty=Uncertainty(1.0))
+        strong = make_plan(
+            [pf], sensor, PlanningOptions(time_limit_s=5.0), uncertainty=Uncertainty(1.0)
+        )
     except PlanningError as exc:
         assert "no strong plan" in str(exc)
     else:

@@ -25,12 +25,12 @@ from feederkit.cli.common import (
     print_json,
     progress_bar,
 )
+from feederkit.cli.plan_render import sensor_text
 from feederkit.errors import CheckFailed, InputError
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.render import sensor_text
-from feederkit.sensors import NoSensor, make_sensor, sensor_to_dict
+from feederkit.sensors import NoSensor, make_sensor
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -106,7 +106,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
     c = result.counts()
     summary = Table(title="catalog analysis (section 8)", show_header=False)
     summary.add_row("parts", str(c["parts"]))
-    summary.add_row("sensor", sensor_text(sensor_to_dict(result.sensor)))
+    summary.add_row("sensor", sensor_text(result.sensor))
     summary.add_row(
         "tolerances",
         f"{result.angle_tol_deg:g} deg per resting-range side, "

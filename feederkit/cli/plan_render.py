@@ -18,7 +18,7 @@ from rich.text import Text
 from rich.tree import Tree
 
 from feederkit.errors import InputError
-from feederkit.mechanics.classes import CLASS_NAMES
+from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
 from feederkit.plans.fileformat import MAX_PLAN_BYTES, as_plan, read_plan
 from feederkit.plans.model import Leaf, Plan, Step

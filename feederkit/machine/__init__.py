@@ -38,15 +38,8 @@ from feederkit.machine.space import (
 )
 from feederkit.sensors import Grouping, ReadingBranch
 
-Branch = ReadingBranch
-"""Transitional alias: a reading branch of a set of states (``lo``, ``hi``, ``mask``)."""
-
-SetAction = OverlapRange
-"""Transitional alias of :class:`OverlapRange`, the paper's name."""
-
 __all__ = [
     "ActionRange",
-    "Branch",
     "Grouping",
     "MachineState",
     "OutcomeRange",
@@ -55,7 +48,6 @@ __all__ = [
     "ReadingBranch",
     "RotationRange",
     "SearchSpace",
-    "SetAction",
     "branches",
     "build_machine",
     "greatest_fixpoint",

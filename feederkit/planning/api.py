@@ -95,15 +95,12 @@ def _limit(machine: PushAlignMachine) -> int:
     return 4 * machine.n + 4
 
 
-def plan(
-    machine: PushAlignMachine, options: PlanningOptions | None = None, **legacy: object
-) -> PlanResult:
+def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> PlanResult:
     """A plan orienting every state of ``machine`` (up to inseparable states).
 
     The plan has the minimum worst-case number of operations (sections 4 and 6), ties
     broken as :mod:`feederkit.planning.refine` says; ``options`` default to
-    :class:`PlanningOptions` ``()``. The keyword arguments ``objective``, ``min_margin``,
-    ``grouping``, ``time_limit`` and ``method`` are the older spelling of the options.
+    :class:`PlanningOptions` ``()``.
 
     Raises InputError for bad options and PlanningError when no plan keeps the minimum
     margin (naming the largest margin that works) or none is found within the time limit.
@@ -117,7 +114,9 @@ def plan(
     >>> result.length, result.root.branches[0][1].action.representative
     (2, 90.0)
     """
-    options = _options(options, legacy)
+    options = PlanningOptions() if options is None else options
+    if not isinstance(options, PlanningOptions):
+        raise InputError(f"the planning options must be PlanningOptions, got {options!r}")
     if machine.n == 0:
         raise InputError("the machine has no states")
     # Plan with the states numbered by diameter (readings then pick runs of bits).
@@ -128,27 +127,6 @@ def plan(
     return _result(
         machine, root, optimal, length, lower, options.objective.value, options.grouping.value
     )
-
-
-_LEGACY = {
-    "objective": "objective",
-    "min_margin": "min_margin_deg",
-    "grouping": "grouping",
-    "time_limit": "time_limit_s",
-    "method": "method",
-}
-
-
-def _options(options: PlanningOptions | None, legacy: dict[str, object]) -> PlanningOptions:
-    """The options, from a value or from the older keyword arguments (not both)."""
-    unknown = sorted(set(legacy) - set(_LEGACY))
-    if unknown:
-        raise TypeError(f"plan() got unexpected keyword arguments {', '.join(unknown)}")
-    if options is None:
-        return PlanningOptions(**{_LEGACY[k]: v for k, v in legacy.items()})  # type: ignore[arg-type]
-    if legacy:
-        raise TypeError("plan() takes PlanningOptions or keyword arguments, not both")
-    return options
 
 
 def _plan(machine: PushAlignMachine, options: PlanningOptions):

@@ -10,7 +10,6 @@
 - :mod:`~feederkit.plans.verify`: ``verify_plan`` / ``check_plan``: every start, reading and
   rotation, by interval arithmetic.
 - :mod:`~feederkit.plans.match`: which plan part a loaded part is; parts a plan lumps together.
-- :mod:`~feederkit.plans.render`: rich tree and tables.
 """
 
 from feederkit.plans.execute import Trace, TraceStep, execute

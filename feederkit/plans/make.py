@@ -43,14 +43,6 @@ DIAMETER_DIGITS = 9
 """Diameters (mm) equal to this many decimals are one diameter: a regular polygon's states
 differ only by rounding, and reading alike is then no fault of the sensor."""
 
-_LEGACY = {
-    "objective": "objective",
-    "min_margin": "min_margin_deg",
-    "grouping": "grouping",
-    "time_limit": "time_limit_s",
-    "method": "method",
-}
-
 
 @dataclass(frozen=True)
 class MadePlan:
@@ -73,20 +65,6 @@ def margin_warning(min_margin_deg: float) -> str | None:
     )
 
 
-def _options(options: PlanningOptions | None, legacy: dict[str, Any]) -> PlanningOptions:
-    """The options, from a value or (transitional) the older keyword arguments."""
-    unknown = sorted(set(legacy) - set(_LEGACY))
-    if unknown:
-        raise TypeError(f"make_plan() got unexpected keyword arguments {', '.join(unknown)}")
-    if options is not None and legacy:
-        raise TypeError("make_plan() takes options or keyword arguments, not both")
-    if options is None:
-        return PlanningOptions(**{_LEGACY[k]: v for k, v in legacy.items()})
-    if not isinstance(options, PlanningOptions):
-        raise InputError(f"the planning options must be PlanningOptions, got {options!r}")
-    return options
-
-
 BISECT_STEPS = 12
 """Bisection steps for the largest uncertainty at which a strong plan exists (to 1/4096)."""
 
@@ -98,12 +76,10 @@ def make_plan(
     *,
     uncertainty: Uncertainty | None = None,
     certify: bool = True,
-    **legacy: Any,
 ) -> MadePlan:
     """Plan for ``push_functions`` (one part, or a mix: section 8.5) and verify the plan file.
 
-    ``options`` default to ``PlanningOptions()``; the keyword arguments ``objective``,
-    ``min_margin``, ``grouping`` and ``time_limit`` are its older spelling. ``uncertainty``
+    ``options`` default to ``PlanningOptions()``. ``uncertainty``
     defaults to ``Uncertainty()`` (rotation error 1 degree); ``IDEAL`` is the paper's model.
     ``certify=False`` skips the certificate (the plan file then has none; for callers that
     re-plan many times, such as property tests). The result's ``warnings`` flag (on the
@@ -113,7 +89,9 @@ def make_plan(
     meets the request (under uncertainty: naming the largest uncertainty with a strong
     plan), and CheckFailed when the plan fails verification.
     """
-    opts = _options(options, legacy)
+    opts = PlanningOptions() if options is None else options
+    if not isinstance(opts, PlanningOptions):
+        raise InputError(f"the planning options must be PlanningOptions, got {opts!r}")
     unc = Uncertainty() if uncertainty is None else uncertainty
     if not isinstance(unc, Uncertainty):
         raise InputError(f"the uncertainty must be an Uncertainty, got {unc!r}")

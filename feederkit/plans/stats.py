@@ -10,7 +10,7 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from feederkit.mechanics.classes import polygon_class
+from feederkit.mechanics.polygon_classes import polygon_class
 from feederkit.mechanics.push import PushFunction
 
 if TYPE_CHECKING:

@@ -1,8 +1,9 @@
 """Write the golden plan files: what feederkit plans today for the sample catalog.
 
 The plans are made on the ideal model (zero uncertainty), the paper's, whose output the
-structural refactor had to keep byte-identical. Run by hand only (``.venv/bin/python tests/golden/make_golden.py``), when a change of the
-plans is intended; ``tests/test_golden_plans.py`` regenerates every case through the library
+structural refactor had to keep byte-identical. Run by hand only
+(``.venv/bin/python tests/golden/make_golden.py``), when a change of the plans is intended;
+``tests/test_golden_plans.py`` regenerates every case through the library
 and asserts the same bytes. The cases: every part of ``catalog/`` sensorless and with a
 tolerance sensor of 1 % of its size (as ``feederkit demo`` plans them), one LED array, and
 the demo's changeovers (the changeover compiler on a catalog imported from ``catalog/``).
