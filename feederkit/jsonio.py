@@ -98,7 +98,9 @@ def parse_json(text: str, where: str, max_depth: int = MAX_JSON_DEPTH) -> object
             parse_constant=_parse_constant,
         )
     except json.JSONDecodeError as exc:
-        raise InputError(f"{where}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+        raise InputError(
+            f"{where}: not valid JSON ({exc.msg.removesuffix(' at')} at line {exc.lineno})"
+        ) from None
     except _BadNumber as exc:
         raise InputError(f"{where}: not valid JSON for feederkit ({exc})") from None
     except RecursionError:

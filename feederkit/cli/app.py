@@ -38,6 +38,7 @@ EXIT_BUG = 70
 """``EX_SOFTWARE`` of sysexits.h: an internal error."""
 
 app = typer.Typer(
+    rich_markup_mode="markdown",
     name="feederkit",
     help="Orient and recognize flat parts on a flexible parts feeder (Akella & Mason 1999).",
     no_args_is_help=True,

@@ -79,6 +79,7 @@ RICH_TABLE_ROWS = 200
 """Longer tables are printed as plain columns."""
 
 catalog_app = typer.Typer(
+    rich_markup_mode="markdown",
     name="catalog",
     help="The parts catalog (SQLite): import CAD files, list, show, remove and export parts.",
     no_args_is_help=True,

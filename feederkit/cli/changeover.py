@@ -62,6 +62,7 @@ from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import plan_json
 
 changeover_app = typer.Typer(
+    rich_markup_mode="markdown",
     name="changeover",
     help="Changeovers: one verified plan that orients and recognizes every part of a mix.",
     no_args_is_help=True,

@@ -28,6 +28,7 @@ from feederkit.errors import InputError
 from feederkit.loading import load_parts
 
 design_app = typer.Typer(
+    rich_markup_mode="markdown",
     name="design",
     help="Choose the cell: which sensor a product mix needs.",
     no_args_is_help=True,

@@ -67,6 +67,7 @@ NEAR_LIST_MAX = 8
 """At most this many near-metastable edges are named in a warning line; the rest are counted."""
 
 part_app = typer.Typer(
+    rich_markup_mode="markdown",
     name="part",
     help="Analyse a part's push-align mechanics, or plot them.",
     no_args_is_help=True,

@@ -140,7 +140,7 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
         t.add_row("reading branching", str(s.grouping))
     if s.polygon_class is not None:
         t.add_row("polygon class (Fig. 14)", f"{s.polygon_class}: {CLASS_NAMES[s.polygon_class]}")
-        meets = "meets it" if s.meets_bound else "EXCEEDS it"
+        meets = "within it" if s.meets_bound else "EXCEEDS it"
         t.add_row("class bound", f"{s.class_bound} ({meets})")
     if report is not None:
         verdict = "passed" if report.ok else "FAILED"

@@ -192,7 +192,9 @@ def simulate_command(
         TextColumn("trials"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err_console, transient=True) as bar:
+    with Progress(
+        *columns, console=err_console, transient=True, disable=not err_console.is_terminal
+    ) as bar:
         task = bar.add_task("simulate", total=trials)
 
         def advance(done: int, total: int) -> None:
