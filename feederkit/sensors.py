@@ -203,8 +203,9 @@ class Sensor(Protocol):
     def narrowed(self, inset: float) -> Sensor:
         """The sensor as a verifier reads it: readings within ``inset`` mm of an open end of
         a reading set are not taken (design.md: a tolerance sensor never reads its ends;
-        rounding can make two ends that touch overlap by an ulp). Models with closed reading
-        sets return themselves."""
+        rounding can make two ends that touch overlap by an ulp; ``inset`` is a rounding
+        margin, ``feederkit.plans.execute.rounding_inset``). Models with closed reading sets
+        return themselves."""
         ...
 
     def describe(self) -> str:

@@ -33,3 +33,17 @@ def test_narrowing_moves_only_open_ends() -> None:
     s = ToleranceSensor(1.0)
     assert s.narrowed(1e-6).tolerance == 1.0 - 1e-6
     assert s.narrowed(5.0).tolerance == 0.5
+
+
+def test_an_ideal_plan_at_a_breakpoint_tolerance_verifies() -> None:
+    """The ideal verifier reads the same way: at e = (12.3912 - 3.3246) / 2 the two states'
+    open intervals touch and overlap by an ulp in floats (d2 - e < d1 + e)."""
+    from feederkit.uncertainty import IDEAL
+
+    rng = np.random.default_rng(304)
+    while True:
+        pfs = [random_pf(rng, f"t4p{i}") for i in range(3)]
+        if sum(pf.n for pf in pfs) <= 9:
+            break
+    made = make_plan(pfs, ToleranceSensor(4.533321953052435), uncertainty=IDEAL)
+    assert made.report.ok

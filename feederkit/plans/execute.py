@@ -35,6 +35,18 @@ def reading_inset(sensor: Sensor, size: float) -> float:
     return min(max(e * 1e-6, 2e-9 * size), e / 4.0)
 
 
+ROUNDING_REL = 1e-12
+"""Reading sets that overlap by less than this fraction of the part's size only touch: two
+open intervals meeting at a breakpoint tolerance (``d1 - e == d2 + e``) may overlap by an ulp
+in floating point, as the planner's reading cells (midpoint tests) already assume."""
+
+
+def rounding_inset(size: float) -> float:
+    """How far inside an open reading end a verifier starts reading (mm): rounding only,
+    far below any branch a plan can hold (docs/conventions.md)."""
+    return ROUNDING_REL * size
+
+
 def extreme_readings(
     sensor: Sensor, diameter: float, inset: float
 ) -> tuple[float | None, float | None]:

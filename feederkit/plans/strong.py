@@ -40,7 +40,7 @@ from feederkit.mechanics.uncertain import (
     uncertain_mechanics,
 )
 from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
-from feederkit.plans.execute import reading_inset
+from feederkit.plans.execute import rounding_inset
 from feederkit.plans.model import PlanPart, push_function_of
 from feederkit.plans.verify import PartCheck, VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
@@ -168,10 +168,8 @@ class _Run:
         p, s = x
         diam = self.model.diameters[p][s]
         branches = node["branches"]
-        # The ideal verifier's rounding policy: readings a hair inside an open end only.
-        sensor = self.model.sensor.narrowed(
-            reading_inset(self.model.sensor, self.model.mechanics[p].part.size)
-        )
+        # The ideal verifier's rounding policy: touching open ends do not overlap.
+        sensor = self.model.sensor.narrowed(rounding_inset(self.model.mechanics[p].part.size))
         if not sensor.informative or all(b["reading"] is None for b in branches):
             return [b["next"] for b in branches]
         ivs = [tuple(b["reading"]) for b in branches if b["reading"] is not None]

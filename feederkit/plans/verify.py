@@ -29,7 +29,7 @@ from typing import Any
 from feederkit.angles import angle_close, norm360
 from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
-from feederkit.plans.execute import Trace, TraceStep, finish
+from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, Step, push_function_of
 from feederkit.sensors import Sensor
@@ -174,8 +174,10 @@ class _PartSearch:
 
     def __init__(self, plan: Plan, p: int) -> None:
         self.plan = plan
-        self.sensor = plan.sensor
         self.pf: PushFunction = push_function_of(plan.parts[p])
+        # Readings a hair inside an open end only (docs/conventions.md): two reading sets
+        # that touch at a breakpoint tolerance may overlap by an ulp in floating point.
+        self.sensor = plan.sensor.narrowed(rounding_inset(self.pf.part.size))
         self.name = plan.parts[p].name
         listed = {s.id: s.diameter for s in plan.parts[p].states}
         # readings are those of the diameters the plan was made on (checked against geometry)
