@@ -140,3 +140,16 @@ def test_demo_compiles_the_papers_changeover_and_the_lookalike(
         assert {p["name"] for p in plan["parts"]} == set(c["parts"])
         html = Path(c["report"]).read_text(encoding="utf-8")
         assert "<svg" in html and c["parts"][0] in html
+
+
+def test_the_plans_tables_fit_80_columns(few: DemoResult) -> None:
+    """The demo's plan tables are read in an 80-column terminal: no cell cut to '...'."""
+    from rich.console import Console
+
+    from feederkit.cli.demo import plans_tables
+
+    out = Console(width=80, record=True, file=io.StringIO())
+    for table in plans_tables(few.plans):
+        out.print(table)
+    text = out.export_text()
+    assert "\u2026" not in text and max(len(line) for line in text.splitlines()) <= 80

@@ -77,34 +77,41 @@ def _certified(stats: dict) -> str:
     return "-" if cert is None else f"±{cert['max_rotation_error_deg']:.3g}°"
 
 
-def plans_table(plans: tuple[DemoPlan, ...]) -> Table:
-    """Each part's plans side by side: length (expected), smallest margin, class bound."""
-    t = Table(
-        title="plans: length (expected), smallest margin; blind = sensorless; cert = the "
-        "sensor plan's certified rotation error, ideal = its ideal-model length",
-        box=SIMPLE_HEAD,
-        pad_edge=False,
-        collapse_padding=True,
+def _length(stats: dict) -> tuple[str, str]:
+    """A plan's worst-case length and its expected number of operations, as two cells."""
+    return str(stats["length"]), f"{stats['expected_length']:.2f}"
+
+
+def plans_tables(plans: tuple[DemoPlan, ...]) -> tuple[Table, Table]:
+    """Each part's sensorless plan, then its sensor plan with bound and certificate, in two
+    tables narrow enough for 80 columns."""
+    style = {"box": SIMPLE_HEAD, "pad_edge": False, "collapse_padding": True}
+    blind = Table(title="sensorless plans: worst-case length, expected, smallest margin", **style)
+    sensed = Table(
+        title="sensor plans; cert = certified rotation error, ideal = ideal-model length",
+        **style,
     )
-    t.add_column("part", no_wrap=True)
-    for col in ("blind", "margin", "tol mm", "sensor", "margin", "bound", "cert", "ideal"):
-        t.add_column(col, justify="right", no_wrap=True)
+    blind.add_column("part", overflow="fold")
+    sensed.add_column("part", overflow="fold")
+    for col in ("length", "expected", "margin"):
+        blind.add_column(col, justify="right", no_wrap=True)
+    for col in ("tol mm", "length", "exp.", "margin", "bound", "cert", "ideal"):
+        sensed.add_column(col, justify="right", no_wrap=True)
     for p in plans:
         a, b = p.sensorless["stats"], p.sensed["stats"]
         bound = b.get("class_bound")
         meets = "" if b.get("meets_bound") in (None, True) else " exceeded!"
-        t.add_row(
+        blind.add_row(escape(p.name), *_length(a), margin_text(a.get("min_margin_deg")))
+        sensed.add_row(
             escape(p.name),
-            f"{a['length']} ({a['expected_length']:.2f})".replace(".00)", ")"),
-            margin_text(a.get("min_margin_deg")),
             f"{p.sensor.to_dict()['tolerance_mm']:g}",
-            f"{b['length']} ({b['expected_length']:.2f})".replace(".00)", ")"),
+            *_length(b),
             margin_text(b.get("min_margin_deg")),
             ("-" if bound is None else str(bound)) + meets,
             _certified(b),
             str(b.get("certificate", {}).get("ideal_length", "-")),
         )
-    return t
+    return blind, sensed
 
 
 def print_changeover(say: Console, c: DemoChangeover) -> None:
@@ -153,7 +160,8 @@ def print_result(say: Console, result: DemoResult) -> None:
     if result.plans:
         declared = result.plans[0].sensed.get("uncertainty")
         say.print(f"plans are strong for: {uncertainty_text(declared)}", highlight=False)
-    say.print(plans_table(result.plans))
+    for table in plans_tables(result.plans):
+        say.print(table)
     for p in result.plans:
         for w in p.warnings:
             say.print(f"  warning: {escape(w)}", highlight=False)
