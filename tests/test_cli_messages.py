@@ -26,3 +26,15 @@ def test_simulate_errors_start_on_the_first_line(tmp_path, capfd) -> None:
     assert main(["simulate", str(plan), "--trials", "0"]) == 2
     err = capfd.readouterr().err
     assert err.startswith("error:") and len(err.strip().splitlines()) == 1
+
+
+def test_a_sensor_finer_than_rounding_is_bad_input(capsys) -> None:
+    from pathlib import Path
+
+    from feederkit.cli.app import main
+
+    part = Path(__file__).resolve().parents[1] / "catalog" / "rectangle-2x1.json"
+    assert main(["plan", str(part), "--tolerance", "1e-300"]) == 2
+    err = capsys.readouterr().err
+    assert "resolution" in err and "root has no branches" not in err
+    assert len(err.strip().splitlines()) == 1

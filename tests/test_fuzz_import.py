@@ -17,15 +17,13 @@ import sys
 import time
 from pathlib import Path
 
+import fixtures_cad as fx
 import pytest
 import trimesh
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.errors import InputError  # noqa: E402
-from feederkit.importers import ImportOptions, import_parts  # noqa: E402
-from feederkit.importers.budget import ImportLimits  # noqa: E402
+from feederkit.errors import InputError
+from feederkit.importers import ImportOptions, import_parts
+from feederkit.importers.budget import ImportLimits
 
 SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "samples"
 SMALL_SAMPLES = ("cadquery__vslot-2020_1.dxf", "trimesh__sliding-base.dxf",

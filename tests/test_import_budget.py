@@ -6,19 +6,16 @@ answered well within a second or two (docs/import.md, budgets).
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
+import fixtures_cad as fx
 import pytest
 import trimesh
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.errors import InputError  # noqa: E402
-from feederkit.importers import ImportOptions, import_parts  # noqa: E402
-from feederkit.importers.budget import ImportLimits  # noqa: E402
+from feederkit.errors import InputError
+from feederkit.importers import ImportOptions, import_parts
+from feederkit.importers.budget import ImportLimits
 
 QUICK_S = 2.0
 

@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
+import fixtures_cad as fx
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.catalog import import_directory  # noqa: E402
-from feederkit.catalog.bulk import is_outline_file, source_files  # noqa: E402
-from feederkit.errors import InputError  # noqa: E402
+from feederkit.catalog import import_directory
+from feederkit.catalog.bulk import is_outline_file, source_files
+from feederkit.errors import InputError
 
 SQUARE = '{"name": "%s", "vertices": [[0, 0], [10, 0], [10, 10], [0, 10]]}'
 

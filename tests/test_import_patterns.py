@@ -9,20 +9,17 @@ is one part; paper-space geometry is named as such.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
+import fixtures_cad as fx
 import numpy as np
 import pytest
 import shapely
 import trimesh
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import fixtures_cad as fx  # noqa: E402
-
-from feederkit.errors import InputError  # noqa: E402
-from feederkit.importers import ImportOptions, import_parts  # noqa: E402
-from feederkit.importers.mesh import load_mesh, solid  # noqa: E402
+from feederkit.errors import InputError
+from feederkit.importers import ImportOptions, import_parts
+from feederkit.importers.mesh import load_mesh, solid
 
 
 def parts(path: Path, **options):

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import pytest
 import trimesh
@@ -207,7 +205,6 @@ def test_plan_landings_refuses_nothing_and_duplicates():
 def test_a_chiral_plate_as_a_mesh_lands_on_its_two_mirror_image_faces(tmp_path):
     # The extruded L's two big faces are its up and down sides: their footprints (the
     # convex hull from above) are mirror images, not congruent, each about 45 % likely.
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
     import fixtures_cad as fx
 
     ell_ring = [(0, 0), (40, 0), (40, 10), (10, 10), (10, 25), (0, 25)]

@@ -12,6 +12,7 @@ carries its certificate (:class:`~feederkit.planning.tree.Certificate`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -98,6 +99,7 @@ def make_plan(
     pfs = list(push_functions)
     for pf in pfs:
         check_for_part(unc, pf.part)
+    _check_resolution(sensor, pfs)
     machine = build_machine(pfs, sensor, unc)
     try:
         result = plan_machine(machine, opts)
@@ -126,6 +128,26 @@ def make_plan(
     if margin is not None:
         warnings.append(margin)
     return MadePlan(data, result, report, tuple(warnings))
+
+
+RESOLUTION_REL = 1e-9
+"""A sensor whose reading reach is below this fraction of the largest part's size cannot be
+told from the rounding of the diameters (``DIAMETER_REL_EPS`` snaps them at this scale)."""
+
+
+def _check_resolution(sensor: Sensor, push_functions: Sequence[PushFunction]) -> None:
+    """Bad input: a sensor finer than the diameters themselves are known (a tolerance of
+    1e-300 mm would make every reading interval empty in floating point)."""
+    reach = sensor.reading_reach()
+    if not math.isfinite(reach) or not push_functions:
+        return
+    floor = RESOLUTION_REL * max(pf.part.size for pf in push_functions)
+    if reach / 2.0 < floor:
+        raise InputError(
+            f"the sensor's resolution ({reach / 2.0:.3g} mm) is finer than the parts' "
+            f"diameters are known ({floor:.3g} mm, a billionth of the part's size): "
+            "give a larger sensor tolerance or pitch"
+        )
 
 
 def with_uncertainty(data: dict[str, Any], uncertainty: Uncertainty) -> dict[str, Any]:
