@@ -38,3 +38,17 @@ def test_a_sensor_finer_than_rounding_is_bad_input(capsys) -> None:
     err = capsys.readouterr().err
     assert "resolution" in err and "root has no branches" not in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_lookalike_prints_its_check_as_json(tmp_path, capsys) -> None:
+    import json
+    from pathlib import Path
+
+    from feederkit.cli.app import main
+
+    part = Path(__file__).resolve().parents[1] / "catalog" / "l-bracket.json"
+    out = tmp_path / "twin.json"
+    assert main(["lookalike", str(part), "--keep", "push", "-o", str(out), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["same_push"] is True and d["similar"] is False
+    assert json.loads(out.read_text())["vertices"] == d["outline"]["vertices"]

@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from feederkit.cli.common import CatalogOpt, console, err_console
+from feederkit.cli.common import CatalogOpt, JsonOpt, console, err_console, print_json
 from feederkit.cli.importopts import (
     AllowLargeOpt,
     AllPartsOpt,
@@ -78,9 +78,13 @@ def lookalike_command(
     max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
     max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
     import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
+    json_out: JsonOpt = False,
 ) -> None:
     """A non-similar part with the same push function (Theorem 4) or the same push-diameter
-    function (Theorem 6), checked numerically before it is written."""
+    function (Theorem 6), checked numerically before it is written.
+
+    With --json the check and the outline are printed as one JSON object (the outline is
+    still written to -o when given)."""
     if keep not in ("push", "push-diameter"):
         raise InputError(f"--keep must be push or push-diameter, got {keep!r}")
     if output is not None and output.suffix.lower() != ".json":
@@ -127,6 +131,25 @@ def lookalike_command(
     table.add_row(
         "center of mass", f"({part.com[0]:.6g}, {part.com[1]:.6g}) mm, stated in the file"
     )
+    if json_out:
+        if output is not None:
+            write_text_atomic(output, text)
+        print_json(
+            {
+                "source": part.name,
+                "keep": keep,
+                "construction": result.construction,
+                "hull_vertices": [check.source_vertices, check.vertices],
+                "same_push": check.same_push,
+                "max_angle_error_deg": check.angle_error_deg,
+                "same_push_diameter": check.same_push_diameter,
+                "max_diameter_error_mm": check.diameter_error_mm,
+                "similar": check.similar,
+                "output": None if output is None else str(output),
+                "outline": data,
+            }
+        )
+        return
     if output is None:
         err_console.print(table)
         typer.echo(text, nl=False)
