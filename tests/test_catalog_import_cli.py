@@ -42,3 +42,13 @@ def test_an_import_budget_is_an_option(tmp_path, capsys) -> None:
     (d / "bad.dxf").unlink()
     db = tmp_path / "c.db"
     assert main(["catalog", "import", str(d), "--catalog", str(db), "--max-loops", "1"]) == 0
+
+
+def test_catalog_list_fits_80_columns(tmp_path, capsys) -> None:
+    db = tmp_path / "c.db"
+    assert main(["catalog", "import", str(CATALOG), "--catalog", str(db)]) == 0
+    capsys.readouterr()
+    assert main(["catalog", "list", "--catalog", str(db)]) == 0
+    out = capsys.readouterr().out
+    assert "isosceles-right-triangle" in out
+    assert max(len(line) for line in out.splitlines()) <= 80

@@ -404,24 +404,30 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
             ]
         )
         return
-    headers = ("part", "rev", "kind", "units", "area mm2", "holes", "hull", "orientable", "updated")
+    # Fits 80 columns for names up to 24 characters: units are in --json and catalog show.
+    headers = ("part", "rev", "kind", "mm2", "holes", "hull", "orient.", "updated")
     rows = [
         (
             p.name,
             str(p.revision),
             p.source_kind,
-            p.source_units,
             f"{p.area:.1f}",
             str(p.n_holes),
             str(p.n_hull),
             "yes" if p.orientable else "no",
-            p.updated_at,
+            _date(p.updated_at),
         )
         for p in parts
     ]
-    sys.stdout.write(plain_table(headers, rows, right=(1, 4, 5, 6)))
+    sys.stdout.write(plain_table(headers, rows, right=(1, 3, 4, 5)))
     sys.stdout.write(f"{len(parts)} parts\n")
     sys.stdout.flush()
+
+
+def _date(stamp: str) -> str:
+    """An ISO time stamp as the date it was written (the list is read at 80 columns; the
+    full stamp is in --json and in catalog show)."""
+    return stamp[:10]
 
 
 def plain_table(
