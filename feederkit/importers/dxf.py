@@ -239,13 +239,45 @@ def curve_path(entity: DXFGraphic) -> dxfpath.Path | None:
         return dxfpath.make_path(entity)
 
 
-def flatten(path: dxfpath.Path, distance: float) -> list[np.ndarray]:
-    """The path as polylines (drawing units, x y), curves within ``distance`` of their chords."""
+FLATTEN_CHUNK = 4096
+"""Vertices counted against the budget at a time while a curve is flattened."""
+
+MAX_FLATTEN_RATIO = 1e8
+"""A curve whose control points span more than this many flatten tolerances is refused: its
+subdivision would not end (the flatten tolerance is at least 1e-5 of the drawing's size, so
+no real curve comes near)."""
+
+
+def flatten(path: dxfpath.Path, distance: float, budget: Budget | None = None) -> list[np.ndarray]:
+    """The path as polylines (drawing units, x y), curves within ``distance`` of their chords.
+
+    The vertices are counted against ``budget`` (and its deadline) while they are made: a
+    curve with one hostile control point could otherwise ask for billions of them. ezdxf
+    subdivides each Bezier piece in one uninterruptible call, and never finishes when the
+    piece is far larger than ``distance`` allows in floating point, so such pieces are
+    refused before (ValueError, which the caller names).
+    """
+    cps = np.array([(v.x, v.y) for v in path.control_vertices()], dtype=float)
+    if len(cps):
+        if not np.isfinite(cps).all():
+            raise ValueError("NaN or infinite control points")
+        extent = float(np.ptp(cps, axis=0).max())
+        if extent > MAX_FLATTEN_RATIO * distance:
+            raise ValueError(
+                f"its control points span {extent:.3g} drawing units, more than "
+                f"{MAX_FLATTEN_RATIO:.0e} times the flatten tolerance"
+            )
     out = []
     for sub in path.sub_paths():
-        pts = np.array([(v.x, v.y) for v in sub.flattening(distance)], dtype=float)
+        pts: list[tuple[float, float]] = []
+        for v in sub.flattening(distance):
+            pts.append((v.x, v.y))
+            if budget is not None and len(pts) % FLATTEN_CHUNK == 0:
+                budget.vertices(FLATTEN_CHUNK)
+        if budget is not None:
+            budget.vertices(len(pts) % FLATTEN_CHUNK)
         if len(pts) >= 2:
-            out.append(pts)
+            out.append(np.array(pts, dtype=float))
     return out
 
 
@@ -324,11 +356,12 @@ def dxf_lines(
         try:
             with warnings.catch_warnings(), np.errstate(all="ignore"):
                 warnings.simplefilter("ignore")
-                pieces = flatten(path, distance)
+                pieces = flatten(path, distance, budget)  # counts the vertices as it goes
+        except InputError:
+            raise
         except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
             raise InputError(f"{label}: cannot flatten {_label(entity)} ({exc})") from None
         for pts in pieces:
-            budget.vertices(len(pts))
             if not np.isfinite(pts).all():
                 raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates")
             lines.append(pts * scale)
