@@ -210,9 +210,12 @@ def test_the_wrench_rests_across_its_two_bottom_edges() -> None:
     assert merged.diameter[0] <= min(widths) and merged.diameter[1] >= max(widths)
     assert merged.diameter == pytest.approx(width_range(part.hull, lo, hi))
     assert float(diameter(part, (lo + hi) / 2.0)) <= merged.diameter[1]
-    # The fragile side state is transient: the part always leaves it.
+    # The fragile side state is kept as one the part may stay in (the feeder's vibration is
+    # not known); a push ending there may also end beyond its low barrier.
     side = next(s.id for s in pf.states if s.barrier_mm < 0.01 and s.id not in bottom)
-    assert mech.state_of[side] is None and len(mech.destinations[side]) >= 1
+    own = mech.state_of[side]
+    assert own is not None and own in mech.destinations[side]
+    assert len(mech.destinations[side]) >= 2
 
 
 def test_the_d_washer_arc_facets_merge_and_the_flat_stays() -> None:
