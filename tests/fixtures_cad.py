@@ -441,12 +441,24 @@ def write_crossing_lines(path: Path, n: int, seed: int = 0) -> Path:
 
 
 def write_big_polyline(path: Path, n: int) -> Path:
-    """A closed LWPOLYLINE with ``n`` vertices on a circle of radius 50."""
-    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    """A closed LWPOLYLINE with ``n`` vertices on a circle of radius 50.
+
+    The points are written into the DXF text directly: ezdxf appends them one array copy
+    at a time, which takes minutes for a million.
+    """
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4
-    doc.modelspace().add_lwpolyline(np.c_[50 * np.cos(t), 50 * np.sin(t)], close=True)
+    doc.modelspace().add_lwpolyline([(1.5, 0), (0, 2.5), (-3.5, 0)], close=True)
     doc.saveas(path)
+    text = path.read_text()
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    points = "".join(
+        f" 10\n{x:.6f}\n 20\n{y:.6f}\n" for x, y in zip(50 * np.cos(t), 50 * np.sin(t), strict=True)
+    )
+    head, rest = text.split(" 90\n3\n", 1)
+    start = rest.index(" 10\n1.5\n")
+    end = rest.index(" 20\n0.0\n", rest.index(" 10\n-3.5\n")) + len(" 20\n0.0\n")
+    path.write_text(head + f" 90\n{n}\n" + rest[:start] + points + rest[end:])
     return path
 
 
@@ -477,4 +489,52 @@ def write_obj_repeated_face(path: Path, repeats: int) -> Path:
     lines = ["v 0 0 0", "v 10 0 0", "v 0 10 0", "v 0 0 10", "f 1 3 2", "f 1 2 4", "f 2 3 4"]
     lines.append("f " + " ".join(["1", "4", "3"] * repeats))
     path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def with_units(path: Path, insunits: int) -> Path:
+    """The drawing at ``path`` with its ``$INSUNITS`` changed to ``insunits`` (in place)."""
+    doc = ezdxf.readfile(path)
+    doc.header["$INSUNITS"] = insunits
+    doc.saveas(path)
+    return path
+
+
+HOSTILE_CURVES = ("arc_z", "circle_z", "spline_z", "spline_knot", "ellipse_ratio", "bulge")
+"""Curves :func:`write_hostile_curve` can break (which number of which entity)."""
+
+
+def write_hostile_curve(path: Path, kind: str, value: str) -> Path:
+    """A 100 x 60 rectangle and one curve whose number ``kind`` is the text ``value``.
+
+    ``arc_z``: an ARC centre's z (``inf`` there is fuzz seed 2, input 73, which sent ezdxf's
+    flattening into 2**1000 calls); ``circle_z``, ``spline_z`` (a control point's z),
+    ``spline_knot``, ``ellipse_ratio``, ``bulge`` (an LWPOLYLINE bulge).
+    """
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (100, 0), (100, 60), (0, 60)], close=True)
+    s = 777.125  # written as "777.125" (a ratio as "0.777125"), then replaced by the value
+    if kind == "arc_z":
+        msp.add_arc((50, 30, s), 10, 0, 219.9)
+    elif kind == "circle_z":
+        msp.add_circle((50, 30, s), 5)
+    elif kind == "spline_z":
+        msp.add_open_spline([(10, 10), (20, 40, s), (40, 10), (60, 30)])
+    elif kind == "spline_knot":
+        msp.add_open_spline(
+            [(10, 10), (20, 40), (40, 10), (60, 30), (70, 20)], knots=[0, 0, 0, 0, s, 2, 2, 2, 2]
+        )
+    elif kind == "ellipse_ratio":
+        s = 0.777125
+        msp.add_ellipse((50, 30), (10, 0), s, 0, math.pi)
+    elif kind == "bulge":
+        msp.add_lwpolyline([(20, 20, 0, 0, s), (30, 20), (30, 30)], format="xyseb")
+    else:
+        raise ValueError(f"unknown hostile curve {kind!r}")
+    doc.saveas(path)
+    text = path.read_text()
+    assert str(s) in text
+    path.write_text(text.replace(str(s), value))
     return path

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 import random
+import time
 from pathlib import Path
 
 import ezdxf
 import fixtures_cad as fx
+import numpy as np
 import pytest
 import shapely
 from hypothesis import given, settings
@@ -378,3 +380,171 @@ def test_simplified_hull_properties(corners, radius, tol, shift):
         return {(round(x, 9), round(y, 9)) for x, y in points}
 
     assert rounded(clean_hull(ring[k:] + ring[:k], tol)) == rounded(simple)
+
+
+# Flattening: feederkit's bounded subdivision gives ezdxf's vertices on real curves, and ends
+# (refused in one line) where ezdxf's never returns (docs/import.md, budgets).
+
+SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "samples"
+SAMPLE_DRAWINGS = sorted(SAMPLES.glob("*.dxf")) + sorted(SAMPLES.glob("*.DXF"))
+FIXTURE_DRAWINGS = {
+    "plate": fx.write_plate,
+    "fit_spline": fx.write_fit_spline,
+    "ellipse_hole": fx.write_ellipse_hole,
+    "gap_spline": lambda p: fx.write_gap_spline(p, 0.1),
+    "gear": fx.write_gear,
+    "nested_mirrored": fx.write_nested_mirrored,
+}
+
+
+def drawing_paths(path: Path) -> list:
+    from collections import Counter
+
+    from feederkit.importers import dxf
+    from feederkit.importers.budget import Budget, ImportLimits
+
+    doc = dxf.read_document(path)
+    found = dxf.explode(doc.modelspace(), "", 0, Counter(), Budget(ImportLimits(), str(path)))
+    return [p for p in (dxf.curve_path(e) for e, _ in found) if p is not None]
+
+
+def ezdxf_flattening(paths, distance, budget=None):
+    """The reference: ezdxf's own ``Path.flattening`` of each sub-path (x y)."""
+    out = []
+    for path in paths:
+        subs = [[(v.x, v.y) for v in sub.flattening(distance)] for sub in path.sub_paths()]
+        out.append([np.array(s, dtype=float) for s in subs if len(s) >= 2])
+    return out
+
+
+@pytest.mark.parametrize("name", list(FIXTURE_DRAWINGS) + [p.name for p in SAMPLE_DRAWINGS])
+def test_flattening_gives_ezdxfs_vertices(tmp_path, name):
+    from feederkit.importers.dxf import flatten_paths
+
+    if name in FIXTURE_DRAWINGS:
+        path = FIXTURE_DRAWINGS[name](tmp_path / f"{name}.dxf")
+    else:
+        path = SAMPLES / name
+    paths = drawing_paths(path)
+    assert paths
+    for distance in (0.001, 0.01, 0.1):
+        ours, theirs = flatten_paths(paths, distance), ezdxf_flattening(paths, distance)
+        assert len(ours) == len(theirs) == len(paths)
+        for a, b in zip(ours, theirs, strict=True):
+            assert [len(x) for x in a] == [len(y) for y in b]
+            for x, y in zip(a, b, strict=True):
+                np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * max(1.0, np.abs(y).max()))
+
+
+@pytest.mark.skipif(not SAMPLE_DRAWINGS, reason=f"{SAMPLES} is absent")
+@pytest.mark.parametrize("name", [p.name for p in SAMPLE_DRAWINGS])
+def test_sample_hulls_as_with_ezdxfs_flattening(monkeypatch, name):
+    from feederkit.importers import dxf
+
+    options = ImportOptions(all_parts=True)
+    _, ours = import_parts(SAMPLES / name, options)
+    monkeypatch.setattr(dxf, "flatten_paths", ezdxf_flattening)
+    _, theirs = import_parts(SAMPLES / name, options)
+    assert len(ours) == len(theirs) >= 1
+    for a, b in zip(ours, theirs, strict=True):
+        ha, hb = np.array(a.part.hull), np.array(b.part.hull)
+        size = float(np.ptp(hb, axis=0).max())
+        assert ha.shape == hb.shape
+        np.testing.assert_allclose(ha, hb, rtol=0, atol=1e-6 * size)
+
+
+def test_flattening_stays_within_the_tolerance_of_the_true_curve():
+    from feederkit.importers.flatten import bezier_points, cubic_flattening
+
+    rng = np.random.default_rng(3)
+    cp = rng.uniform(-50, 50, size=(40, 4, 2))
+    piece, pts = cubic_flattening(cp, 0.01)
+    for k in range(len(cp)):
+        ring = np.vstack([cp[k, :1], pts[piece == k]])
+        np.testing.assert_array_equal(ring[-1], cp[k, 3])  # ends on the last control point
+        t = np.linspace(0, 1, 2001)
+        curve = bezier_points(np.repeat(cp[k : k + 1], len(t), axis=0), t)
+        gap = shapely.LineString(ring).hausdorff_distance(shapely.LineString(curve))
+        assert gap < 0.05  # the midpoint test bounds the chord error to a few tolerances
+
+
+def test_non_finite_curve_points_name_their_piece():
+    from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
+
+    cp = np.zeros((3, 4, 2))
+    cp[:, :, 0] = [0, 1, 2, 3]
+    cp[2, 1, 1] = np.nan
+    with pytest.raises(NonFiniteCurve) as info:
+        cubic_flattening(cp, 0.01)
+    assert info.value.piece == 2
+
+
+def test_flattening_stops_halving_at_the_level_cap(monkeypatch):
+    from feederkit.importers import flatten
+
+    monkeypatch.setattr(flatten, "MAX_LEVELS", 3)
+    cp = np.array([[[0.0, 0.0], [3.0, 5.0], [6.0, -5.0], [9.0, 0.0]]])
+    _, pts = flatten.cubic_flattening(cp, 1e-300)
+    assert len(pts) == flatten.MIN_SEGMENTS * 2**3  # every segment halved 3 times, no more
+
+
+def test_an_unreachable_tolerance_is_refused_by_the_vertex_budget():
+    from feederkit.importers.budget import Budget, ImportLimits
+    from feederkit.importers.flatten import cubic_flattening
+
+    cp = np.array([[[1e6, 0.0], [1e6 + 3.0, 5.0], [1e6 + 6.0, -5.0], [1e6 + 9.0, 0.0]]])
+    start = time.monotonic()
+    with pytest.raises(InputError, match=r"more than 10,000 vertices after flattening"):
+        cubic_flattening(cp, 1e-300, Budget(ImportLimits(vertices=10_000), "x.dxf"))
+    assert time.monotonic() - start < 0.5
+    with pytest.raises(InputError, match=r"the curve: more than 1,000,000 vertices"):
+        cubic_flattening(cp, 1e-300)  # the default budget, not all the memory there is
+
+
+def test_flattening_counts_vertices_against_the_budget():
+    from feederkit.importers.budget import Budget, ImportLimits
+    from feederkit.importers.flatten import cubic_flattening
+
+    circle_ish = np.array([[[0.0, 0.0], [0.0, 100.0], [100.0, 100.0], [100.0, 0.0]]])
+    with pytest.raises(InputError, match=r"more than 1,000 vertices after flattening"):
+        cubic_flattening(circle_ish, 1e-6, Budget(ImportLimits(vertices=1000), "x.dxf"))
+    budget = Budget(ImportLimits(), "x.dxf")
+    _, pts = cubic_flattening(circle_ish, 1e-3, budget)
+    assert budget.counts["vertices"] == len(pts)
+
+
+@pytest.mark.parametrize("kind", fx.HOSTILE_CURVES)
+@pytest.mark.parametrize("value", ["inf", "nan", "-inf"])
+def test_curves_with_a_non_finite_number_are_refused_quickly(tmp_path, kind, value):
+    # arc_z inf is fuzz seed 2, input 73: it sent ezdxf's flattening into 2**1000 calls
+    path = fx.write_hostile_curve(tmp_path / "curve.dxf", kind, value)
+    start = time.monotonic()
+    words = r"[A-Z]+ \w+ has a NaN or infinite value \((center|control points|knots|ratio|points)\)"
+    with pytest.raises(InputError, match=words) as info:
+        import_parts(path, ImportOptions())
+    assert time.monotonic() - start < 2.0
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("kind", fx.HOSTILE_CURVES)
+def test_the_same_curves_with_a_plain_number_import(tmp_path, kind):
+    path = fx.write_hostile_curve(tmp_path / "curve.dxf", kind, "0.5")
+    shell = shapely.Polygon(one(path).part.outline.vertices)
+    assert shell.area == pytest.approx(6000.0, rel=1e-6)  # the rectangle is the part
+
+
+def test_a_z_of_1e20_is_beyond_any_part(tmp_path):
+    path = fx.write_hostile_curve(tmp_path / "curve.dxf", "spline_z", "1e20")
+    with pytest.raises(InputError, match=r"SPLINE \w+ has a coordinate of 1e\+20 mm, beyond any"):
+        import_parts(path, ImportOptions())
+
+
+def test_flattening_checks_the_deadline_at_every_level():
+    from feederkit.importers.budget import Budget, ImportLimits
+    from feederkit.importers.flatten import cubic_flattening
+
+    budget = Budget(ImportLimits(seconds=1e-9), "x.dxf")
+    time.sleep(0.001)
+    cp = np.array([[[0.0, 0.0], [0.0, 100.0], [100.0, 100.0], [100.0, 0.0]]])
+    with pytest.raises(InputError, match=r"x.dxf: the import took longer than 1e-09 s"):
+        cubic_flattening(cp, 0.01, budget)

@@ -1,16 +1,19 @@
 """DXF drawings (ezdxf + shapely): entities to flattened lines in millimetres, then parts.
 
 Block references are exploded recursively in world coordinates (rotated, scaled, mirrored
-and nested inserts alike). Curves are flattened within a tolerance; text, dimensions,
-hatches and other annotation are skipped. The loops are built in :mod:`.loops`.
+and nested inserts alike). Curves are flattened within a tolerance by :mod:`.flatten` (a
+bounded version of ezdxf's subdivision); text, dimensions, hatches and other annotation are
+skipped. The loops are built in :mod:`.loops`.
 """
 
 from __future__ import annotations
 
 import logging
+import math
+import re
 import warnings
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import ezdxf
@@ -20,9 +23,12 @@ from ezdxf import recover
 from ezdxf.document import Drawing as DxfDocument
 from ezdxf.entities import DXFGraphic
 from ezdxf.lldxf.const import DXFError
+from ezdxf.math import Vec2, Vec3
+from ezdxf.path import Command
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
+from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
 from feederkit.importers.loops import Region, drawing_from_lines
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
@@ -56,6 +62,9 @@ INSUNITS: dict[int, tuple[str, float]] = {
 """``$INSUNITS`` codes and millimetres per unit (0, unitless, is read as mm with a warning)."""
 
 
+SECTION_NAME = re.compile(rb"SECTION[ \t]*\r?\n[ \t]*2[ \t]*\r?\n[ \t]*(\w+)")
+"""A section's name after the ``0 SECTION`` tag (a literal first: fast on a 50 MB file)."""
+
 DRAWN_SECTIONS = frozenset({b"ENTITIES", b"BLOCKS"})
 """Sections whose entities are drawn (the others hold tables, classes and objects)."""
 
@@ -64,28 +73,31 @@ def prescan(path: Path, budget: Budget) -> None:
     """Count an ASCII DXF's entities and points from its raw tags, before ezdxf parses it.
 
     Parsing costs about a millisecond per entity, so a file with 200,000 entities or a
-    million-vertex polyline is refused here, in a fraction of that time. Binary DXF files
-    are left to the parser (the file size limit bounds them).
+    million-vertex polyline is refused here, in a fraction of that time: the group codes of
+    the drawn sections (entities and blocks) are tallied at C speed, ``0`` for an entity and
+    ``10`` for a point. Binary DXF files are left to the parser (the file size limit bounds
+    them).
     """
     with path.open("rb") as fh:
         if fh.read(22) == b"AutoCAD Binary DXF\r\n\x1a\x00":
             return
         fh.seek(0)
         data = fh.read()
-    lines = data.splitlines()
+    starts = []  # (offset of the section's "0" line, whether it is drawn)
+    for m in SECTION_NAME.finditer(data):
+        line = data.rfind(b"\n", 0, m.start()) + 1  # the "SECTION" line; its code line before
+        starts.append((data.rfind(b"\n", 0, max(0, line - 1)) + 1, m.group(1) in DRAWN_SECTIONS))
     entities = points = 0
-    drawn = False
-    codes, values = lines[0::2], lines[1::2]
-    for k in range(min(len(codes), len(values))):
-        code = codes[k].strip()
-        if code == b"0":
-            value = values[k].strip()
-            if value == b"SECTION" and k + 1 < len(values):
-                drawn = values[k + 1].strip() in DRAWN_SECTIONS
-            elif drawn:
-                entities += 1
-        elif drawn and code == b"10":
-            points += 1
+    for k, (start, drawn) in enumerate(starts):
+        budget.check_time()
+        if not drawn:
+            continue
+        end = starts[k + 1][0] if k + 1 < len(starts) else len(data)
+        for code, n in Counter(data[start:end].splitlines()[0::2]).items():
+            code = code.strip()
+            entities += n if code == b"0" else 0
+            points += n if code == b"10" else 0
+        entities -= 1  # the section's own "0 SECTION" tag
     budget.need("entities", entities, "entities in the file")
     budget.need("vertices", points, "points in the file")
     budget.check_time()
@@ -199,7 +211,10 @@ def explode(
         eff = layer if (own == "0" and layer) else own
         if kind == "INSERT":
             if depth >= MAX_BLOCK_DEPTH:
-                raise InputError(f"block references nested deeper than {MAX_BLOCK_DEPTH}")
+                raise InputError(
+                    f"{budget.label}: block references nested deeper than {MAX_BLOCK_DEPTH}"
+                )
+            check_finite(entity, budget.label)
             try:
                 with warnings.catch_warnings(), np.errstate(all="ignore"):
                     warnings.simplefilter("ignore")
@@ -210,7 +225,7 @@ def explode(
                     )
             except Exception as exc:  # noqa: BLE001 - broken block definitions
                 raise InputError(
-                    f"cannot explode block {entity.dxf.get('name', '?')!r} ({exc})"
+                    f"{budget.label}: cannot explode block {entity.dxf.get('name', '?')!r} ({exc})"
                 ) from None
             yield from explode(subs, eff, depth + 1, skipped, budget)
         else:
@@ -240,49 +255,142 @@ def curve_path(entity: DXFGraphic) -> dxfpath.Path | None:
 
 
 FLATTEN_CHUNK = 4096
-"""Vertices counted against the budget at a time while a curve is flattened."""
-
-MAX_FLATTEN_RATIO = 1e8
-"""A curve whose control points span more than this many flatten tolerances is refused: its
-subdivision would not end (the flatten tolerance is at least 1e-5 of the drawing's size, so
-no real curve comes near)."""
+"""Path commands read between two checks of the deadline."""
 
 
-def flatten(path: dxfpath.Path, distance: float, budget: Budget | None = None) -> list[np.ndarray]:
-    """The path as polylines (drawing units, x y), curves within ``distance`` of their chords.
+def flatten_paths(
+    paths: Sequence[dxfpath.Path], distance: float, budget: Budget | None = None
+) -> list[list[np.ndarray]]:
+    """Each path as polylines (drawing units, x y), curves within ``distance`` of their chords.
 
-    The vertices are counted against ``budget`` (and its deadline) while they are made: a
-    curve with one hostile control point could otherwise ask for billions of them. ezdxf
-    subdivides each Bezier piece in one uninterruptible call, and never finishes when the
-    piece is far larger than ``distance`` allows in floating point, so such pieces are
-    refused before (ValueError, which the caller names).
+    Not ezdxf's ``Path.flattening``, which never returns for a curve with a NaN or infinite
+    coordinate (docs/import.md, curves): the Bezier pieces of all the paths are flattened
+    together, in the x-y plane, by :func:`.flatten.cubic_flattening`, the same subdivision
+    with its levels capped and the vertices counted against ``budget`` as they are made.
+    Quadratic pieces are raised to cubic ones (the same curve). Raises
+    :class:`.flatten.NonFiniteCurve` whose ``piece`` is the index of the path.
     """
-    cps = np.array([(v.x, v.y) for v in path.control_vertices()], dtype=float)
-    if len(cps):
-        if not np.isfinite(cps).all():
-            raise ValueError("NaN or infinite control points")
-        extent = float(np.ptp(cps, axis=0).max())
-        if extent > MAX_FLATTEN_RATIO * distance:
-            raise ValueError(
-                f"its control points span {extent:.3g} drawing units, more than "
-                f"{MAX_FLATTEN_RATIO:.0e} times the flatten tolerance"
-            )
-    out = []
-    for sub in path.sub_paths():
-        pts: list[tuple[float, float]] = []
-        for v in sub.flattening(distance):
-            pts.append((v.x, v.y))
-            if budget is not None and len(pts) % FLATTEN_CHUNK == 0:
-                budget.vertices(FLATTEN_CHUNK)
-        if budget is not None:
-            budget.vertices(len(pts) % FLATTEN_CHUNK)
-        if len(pts) >= 2:
-            out.append(np.array(pts, dtype=float))
+    owner: list[int] = []
+    cubics: list[tuple[float, ...]] = []
+    plans: list[list[list[tuple[float, float] | int]]] = []
+    for k, path in enumerate(paths):
+        subs: list[list[tuple[float, float] | int]] = []
+        for sub in path.sub_paths():
+            if not len(sub):
+                continue  # a lone start point: ezdxf flattens it to nothing
+            prev = sub.start
+            items: list[tuple[float, float] | int] = [(prev.x, prev.y)]
+            lines = 1
+            for n, cmd in enumerate(sub.commands()):
+                if budget is not None and n % FLATTEN_CHUNK == FLATTEN_CHUNK - 1:
+                    budget.check_time()
+                end = cmd.end
+                if cmd.type == Command.CURVE4_TO:
+                    c1, c2 = cmd.ctrl1, cmd.ctrl2
+                elif cmd.type == Command.CURVE3_TO:
+                    c1 = prev + (cmd.ctrl - prev) * (2.0 / 3.0)
+                    c2 = end + (cmd.ctrl - end) * (2.0 / 3.0)
+                else:
+                    items.append((end.x, end.y))
+                    lines += 1
+                    prev = end
+                    continue
+                cubics.append((prev.x, prev.y, c1.x, c1.y, c2.x, c2.y, end.x, end.y))
+                owner.append(k)
+                items.append(len(cubics) - 1)
+                prev = end
+            if budget is not None:
+                budget.vertices(lines)
+            subs.append(items)
+        plans.append(subs)
+    try:
+        piece, points = cubic_flattening(np.array(cubics, dtype=float), distance, budget)
+    except NonFiniteCurve as exc:
+        raise NonFiniteCurve(owner[exc.piece]) from None
+    bounds = np.searchsorted(piece, np.arange(len(cubics) + 1))
+    out: list[list[np.ndarray]] = []
+    for subs in plans:
+        polylines = []
+        for items in subs:
+            chunks: list[np.ndarray] = []
+            run: list[tuple[float, float]] = []
+            for item in items:
+                if isinstance(item, tuple):
+                    run.append(item)
+                    continue
+                if run:
+                    chunks.append(np.array(run, dtype=float))
+                    run = []
+                chunks.append(points[bounds[item] : bounds[item + 1]])
+            if run:
+                chunks.append(np.array(run, dtype=float))
+            pts = np.concatenate(chunks)
+            if len(pts) >= 2:
+                polylines.append(pts)
+        out.append(polylines)
     return out
 
 
 def _label(entity: DXFGraphic) -> str:
-    return f"{entity.dxftype()} {entity.dxf.get('handle', '?')}"
+    """``ARC 47``; an entity of a block: ``ARC from block 'B' (INSERT 2F)``, the top reference."""
+    kind = entity.dxftype()
+    handle = entity.dxf.get("handle")
+    if handle:
+        return f"{kind} {handle}"
+    ref = entity.source_block_reference
+    while ref is not None and not ref.dxf.get("handle"):
+        ref = ref.source_block_reference
+    if ref is None:
+        return kind
+    return f"{kind} from block {ref.dxf.get('name', '?')!r} (INSERT {ref.dxf.handle})"
+
+
+def _first_non_finite(entity: DXFGraphic) -> str | None:
+    """The name of an attribute of ``entity`` holding NaN or infinity, else None.
+
+    Every number the curve is made of: its DXF attributes (centre, radius, angles, ratio,
+    extrusion, elevation, scale factors), LWPOLYLINE points with their widths and bulges,
+    POLYLINE vertices, SPLINE control and fit points, knots and weights. A NaN angle or
+    radius could otherwise drop a curve without a word, and an infinite z would send the
+    flattening into a loop (fuzz seed 2, input 73: an ARC centre's z of inf).
+    """
+    for name, value in entity.dxf.all_existing_dxf_attribs().items():
+        if isinstance(value, float):
+            if not math.isfinite(value):
+                return name
+        elif isinstance(value, tuple | Vec3 | Vec2) and not all(
+            isinstance(v, int | float) and math.isfinite(v) for v in value
+        ):
+            return name
+    kind = entity.dxftype()
+    arrays: dict[str, object] = {}
+    if kind == "LWPOLYLINE":
+        arrays["points"] = entity.lwpoints.values
+    elif kind == "SPLINE":
+        arrays = {
+            "control points": entity.control_points.values,
+            "fit points": entity.fit_points.values,
+            "knots": entity.knots,
+            "weights": entity.weights,
+        }
+    for name, values in arrays.items():
+        if not np.isfinite(np.asarray(values, dtype=float)).all():
+            return name
+    if kind == "POLYLINE":
+        for vertex in entity.vertices:
+            found = _first_non_finite(vertex)
+            if found is not None:
+                return f"vertex {found}"
+    return None
+
+
+def check_finite(entity: DXFGraphic, label: str) -> None:
+    """Refuse an entity with a NaN or infinite number in one line naming it and the value."""
+    found = _first_non_finite(entity)
+    if found is not None:
+        raise InputError(
+            f"{label}: {_label(entity)} has a NaN or infinite value ({found.replace('_', ' ')})"
+        )
 
 
 def dxf_lines(
@@ -315,24 +423,30 @@ def dxf_lines(
             if wanted and layer.lower() not in wanted:
                 continue
             budget.need("vertices", _point_count(entity), "points in one entity")
+            budget.check_time()
+            check_finite(entity, label)
             try:
                 path = curve_path(entity)
                 if path is None:
                     continue
-                cv = np.array([(v.x, v.y) for v in path.control_vertices()], dtype=float)
+                cv = np.array([v.xyz for v in path.control_vertices()], dtype=float)
             except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
                 raise InputError(f"{label}: cannot read {_label(entity)} ({exc})") from None
             if len(cv) == 0:
                 continue
-            if not np.isfinite(cv).all():
-                raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates")
+            if not np.isfinite(cv).all():  # finite numbers whose curve overflows (radius 1e300)
+                raise InputError(
+                    f"{label}: {_label(entity)} has coordinates too large to compute, beyond "
+                    "any part a feeder can hold (check the units)"
+                )
             far = float(np.abs(cv).max()) * scale
             if far > MAX_COORD_MM:
                 raise InputError(
                     f"{label}: {_label(entity)} has a coordinate of {far:.3g} mm, beyond any "
                     f"part a feeder can hold ({MAX_COORD_MM:g} mm; check the units)"
                 )
-            lo, hi = np.minimum(lo, cv.min(axis=0)), np.maximum(hi, cv.max(axis=0))
+            xy = cv[:, :2]
+            lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
             paths.append((entity, path))
     notes: list[str] = []
     if wanted and not paths and seen:
@@ -351,20 +465,14 @@ def dxf_lines(
             f"drawing's size, {size_mm:.4g} mm)"
         )
     distance = flatten_mm / scale
-    lines: list[np.ndarray] = []
-    for entity, path in paths:
-        try:
-            with warnings.catch_warnings(), np.errstate(all="ignore"):
-                warnings.simplefilter("ignore")
-                pieces = flatten(path, distance, budget)  # counts the vertices as it goes
-        except InputError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
-            raise InputError(f"{label}: cannot flatten {_label(entity)} ({exc})") from None
-        for pts in pieces:
-            if not np.isfinite(pts).all():
-                raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates")
-            lines.append(pts * scale)
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            flat = flatten_paths([p for _, p in paths], distance, budget)  # counts vertices
+    except NonFiniteCurve as exc:
+        entity = paths[exc.piece][0]
+        raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates") from None
+    lines = [pts * scale for pieces in flat for pts in pieces]
     return lines, skipped, notes, flatten_mm
 
 

@@ -167,6 +167,8 @@ def closed_loops(
             budget.loops(len(parts))
         merged = shapely.union_all(parts)
         for poly in shapely.get_parts(merged):
+            if budget is not None:
+                budget.check_time()
             if isinstance(poly, Polygon) and poly.area > 0.0:
                 inside = [f for f in parts if poly.contains(f.representative_point())]
                 loops.append(
@@ -237,12 +239,13 @@ def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
     return 0
 
 
-def regions_from_loops(found: Sequence[Loop | Polygon]) -> Drawing:
+def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = None) -> Drawing:
     """Parts (largest loop first) from closed loops; skips drawing frames.
 
     A loop at even nesting depth is a part, the loops directly inside it are its holes; parts
     inside a part's holes (a cut sheet: pieces cut from a plate's window) are separate parts.
-    Drawing frames (:func:`frame_kind`) around the parts are dropped.
+    Drawing frames (:func:`frame_kind`) around the parts are dropped; each one costs a
+    nesting of all loops, so the deadline of ``budget`` is checked between them.
     """
     loops = sorted(
         (lp if isinstance(lp, Loop) else Loop(lp, 1, lp.area) for lp in found),
@@ -250,6 +253,8 @@ def regions_from_loops(found: Sequence[Loop | Polygon]) -> Drawing:
     )
     frames = 0
     while loops:
+        if budget is not None:
+            budget.check_time()
         kids = _children([lp.polygon for lp in loops]).get(0, [])
         drop = frame_kind(loops[0], loops, kids)
         if not drop:
@@ -365,7 +370,7 @@ def drawing_from_lines(
     if not loops:
         detail = f" ({len(dangles)} open ends)" if dangles else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
-    drawing = regions_from_loops(loops)
+    drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
     x0, y0, x1, y1 = Polygon(drawing.regions[0].shell).bounds

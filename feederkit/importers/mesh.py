@@ -27,6 +27,9 @@ from feederkit.outline import make_outline, unit_scale
 
 DOWN = np.array([0.0, 0.0, -1.0])
 
+CHECK_EVERY = 65_536
+"""Lines of a mesh file read between two checks of the import deadline."""
+
 POSE_KEY_DIGITS = 6
 """Decimals of a pose's probability and normal compared when sorting poses."""
 
@@ -69,9 +72,11 @@ def _precount_faces(path: Path, budget: Budget) -> None:
         if suffix == ".obj":
             fh.seek(0)
             total = 0
-            for line in fh:
+            for n, line in enumerate(fh):
                 if line.startswith(b"f ") or line.startswith(b"f\t"):
                     total += max(1, len(line.split()) - 3)
+                if n % CHECK_EVERY == CHECK_EVERY - 1:
+                    budget.check_time()
             budget.need("faces", total, noun)
 
 
@@ -154,16 +159,24 @@ def _closed(body: trimesh.Trimesh) -> trimesh.Trimesh | None:
     return fixed if fixed.is_watertight and fixed.is_volume else None
 
 
-def solid(mesh: trimesh.Trimesh, com_given: bool, label: str) -> Solid:
+def solid(
+    mesh: trimesh.Trimesh, com_given: bool, label: str, budget: Budget | None = None
+) -> Solid:
     """The mesh as one solid for its COM: a closed volume, possibly with internal voids.
 
     Small holes are filled (with a warning). Shells inside the outer shell are cavities
     (and shells inside a cavity material again): one physical part, whose COM is that of
     the solid with its cavities. Shells side by side are separate parts and refused; a
     surface that is not closed is refused as "not a closed solid" unless ``--com`` is given.
+    A mesh of many bodies costs a repair per body and a winding number per pair of shells:
+    the deadline of ``budget`` is checked between them.
     """
     bodies = list(mesh.split(only_watertight=False)) or [mesh]
-    closed = [_closed(b) for b in bodies]
+    closed = []
+    for body in bodies:
+        if budget is not None:
+            budget.check_time()
+        closed.append(_closed(body))
     if any(c is None for c in closed):
         if com_given and len(bodies) == 1:
             note = (
@@ -191,6 +204,8 @@ def solid(mesh: trimesh.Trimesh, com_given: bool, label: str) -> Solid:
     lo, hi = outer.bounds
     depth = [0] * len(shells)
     for k, shell in enumerate(shells[1:], start=1):
+        if budget is not None:
+            budget.check_time()
         inside_box = bool((shell.bounds[0] >= lo).all() and (shell.bounds[1] <= hi).all())
         if not inside_box or abs(winding_number(outer, shell.vertices[0])) < 0.5:
             raise InputError(
@@ -311,12 +326,13 @@ def read_mesh(
     budget = budget or Budget(options.limits, str(path))
     mesh, unit_name, notes = load_mesh(path, options.units, budget)
     budget.check_time()
-    s = solid(mesh, options.com is not None, str(path))
-    try:
-        hull_faces = hull_face_count(s.mesh, options.limits.hull_faces)
+    try:  # before the solid is split into shells and repaired: a hull of 40,000 faces is
+        hull_faces = hull_face_count(mesh, options.limits.hull_faces)  # refused in a moment
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
     budget.need("hull_faces", hull_faces, "faces of the mesh's convex hull")
+    budget.check_time()
+    s = solid(mesh, options.com is not None, str(path), budget)
     budget.check_time()
     notes += size_warnings(float(s.mesh.extents.max()), unit_name, options.units is not None)
     try:
