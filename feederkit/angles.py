@@ -48,6 +48,39 @@ def merge_boundaries(
     return out
 
 
+def boundary_cells(
+    boundary_lists: Sequence[Sequence[float]], eps: float = ANGLE_EPS
+) -> list[tuple[float, float]]:
+    """The open cells between consecutive boundary angles that are wider than ``eps``.
+
+    A cell runs from one boundary to the next (``lo`` in [0, 360), ``hi`` may pass 360), so
+    no boundary lies inside it and its middle is half its width from the nearest boundary:
+    for action-range boundaries these are the overlap ranges a plan can rotate in (section
+    3.2.2), each with its true margin. Cells no wider than ``eps`` are left out: no robot
+    holds such a rotation (docs/conventions.md, "Numeric tolerances"). With boundaries
+    grouped as :func:`merge_boundaries` groups them, these are exactly the cells from the
+    last boundary of one group to the first of the next that are wider than ``eps``.
+
+    >>> boundary_cells([[10.0, 90.0], [90.00000005, 200.0]])
+    [(10.0, 90.0), (90.00000005, 200.0), (200.0, 370.0)]
+    >>> boundary_cells([[359.99999995, 0.0, 180.0]])
+    [(0.0, 180.0), (180.0, 359.99999995)]
+    """
+    allb = sorted(norm360(b) for bl in boundary_lists for b in bl)
+    return cells_between(allb, eps)
+
+
+def cells_between(bounds: Sequence[float], eps: float = ANGLE_EPS) -> list[tuple[float, float]]:
+    """:func:`boundary_cells` of boundaries already sorted in [0, 360)."""
+    if not bounds:
+        return []
+    out = [(a, b) for a, b in zip(bounds, bounds[1:], strict=False) if b - a > eps]
+    last, wrap = bounds[-1], bounds[0] + 360.0
+    if wrap - last > eps:
+        out.append((last, wrap))
+    return out
+
+
 @dataclass(frozen=True)
 class RotationRange:
     """Rotations ``lo < a < hi`` (deg; ``hi`` may pass 360) that all have the same result.

@@ -177,8 +177,9 @@ class Sensor(Protocol):
         ...
 
     def reading_windows(self, diameters: Sequence[float]) -> list[int] | None:
-        """For diameters in ascending order, per state ``a`` the mask of states ``a..b``
-        that can read alike with it from above (a fast path for the planners).
+        """For diameters in ascending order (intervals: both ends ascending), per state
+        ``a`` the mask of states ``a..b`` that can read alike with it from above (a fast
+        path for the planners).
 
         The states that can give one reading are then a run whose ends read alike. None
         when the sensor offers no such shortcut, or when some pair sits on the edge of
@@ -187,9 +188,10 @@ class Sensor(Protocol):
         ...
 
     def shared_reading_probability(self, diameters: Sequence[float]) -> list[float] | None:
-        """For diameters in ascending order, none of them inseparable, per state the
-        probability that its reading could also come from another of them (a fast path
-        for the expected objective). None when the sensor offers no closed form.
+        """For diameters in ascending order (intervals: both ends ascending), none of them
+        inseparable, per state the probability that its reading could also come from
+        another of them (a fast path for the expected objective). None when the sensor
+        offers no closed form.
         """
         ...
 
@@ -409,40 +411,45 @@ class ToleranceSensor:
         return _components(diameters, lambda d: self.reading_interval(d), closed=False)
 
     def reading_windows(self, diameters: Sequence[Diameter]) -> list[int] | None:
-        if not _points(diameters):
-            return None
-        diameters = _exact(diameters)
-        n = len(diameters)
-        if any(diameters[i] > diameters[i + 1] for i in range(n - 1)):
+        # Spans ascending at both ends (points, or snapped clusters, docs/conventions.md):
+        # the states a reading r can come from, lo - e < r < hi + e, are then a run.
+        spans = [span(d) for d in diameters]
+        n = len(spans)
+        if any(
+            spans[i][0] > spans[i + 1][0] or spans[i][1] > spans[i + 1][1] for i in range(n - 1)
+        ):
             return None
         two = 2.0 * self.tolerance
-        fuzz = 1e-9 * max(max(diameters, default=1.0), two)
+        fuzz = 1e-9 * max(max((hi for _lo, hi in spans), default=1.0), two)
         out = []
         b = 0
         for a in range(n):
             b = max(b, a)
-            while b < n and diameters[b] - diameters[a] < two:
+            top = spans[a][1]
+            while b < n and spans[b][0] - top < two:
                 b += 1
             near = [j for j in (b - 1, b) if a <= j < n]
-            if any(abs(diameters[j] - diameters[a] - two) < fuzz for j in near):
+            if any(abs(spans[j][0] - top - two) < fuzz for j in near):
                 return None
             out.append(((1 << b) - 1) ^ ((1 << a) - 1))
         return out
 
     def shared_reading_probability(self, diameters: Sequence[Diameter]) -> list[float] | None:
-        if not _points(diameters):
-            return None
-        diameters = _exact(diameters)
         # A reading orients exactly when it comes from one state alone: the part of the
-        # state's interval that its neighbours in diameter order do not reach.
+        # state's reading set that its neighbours in diameter order do not reach (spans
+        # ascending at both ends, as for the reading windows).
+        spans = [span(d) for d in diameters]
+        k = len(spans)
+        if any(
+            spans[i][0] > spans[i + 1][0] or spans[i][1] > spans[i + 1][1] for i in range(k - 1)
+        ):
+            return None
         e = self.tolerance
-        d = diameters
-        k = len(d)
         out = []
-        for t in range(k):
-            lo = d[t] - e if t == 0 else max(d[t] - e, d[t - 1] + e)
-            hi = d[t] + e if t == k - 1 else min(d[t] + e, d[t + 1] - e)
-            out.append(1.0 - max(0.0, hi - lo) / (2.0 * e))
+        for t, (d_lo, d_hi) in enumerate(spans):
+            lo = d_lo - e if t == 0 else max(d_lo - e, spans[t - 1][1] + e)
+            hi = d_hi + e if t == k - 1 else min(d_hi + e, spans[t + 1][0] - e)
+            out.append(1.0 - max(0.0, hi - lo) / (d_hi - d_lo + 2.0 * e))
         return out
 
     def narrowed(self, inset: float) -> ToleranceSensor:

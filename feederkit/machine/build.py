@@ -23,15 +23,51 @@ from feederkit.uncertainty import IDEAL, Uncertainty
 
 
 def snap(values: Sequence[float], eps: float) -> list[float]:
-    """Replace values equal within ``eps`` (chained in sorted order) by their cluster's first."""
+    """Replace each value by its cluster's first (:func:`snap_spans`)."""
+    return [lo for lo, _hi in snap_spans(values, eps)]
+
+
+def snap_spans(values: Sequence[float], eps: float) -> list[tuple[float, float]]:
+    """Per value, the smallest and largest value of its cluster: in sorted order, a cluster
+    is a value and every later one within ``eps`` of it.
+
+    A state whose diameter is snapped reads as its cluster's span: equal spans keep exact
+    ties (symmetric poses read alike exactly), and the span holds every member's true,
+    unsnapped value, so no reading a member can give falls outside the reading sets the
+    planner branches on (docs/conventions.md, "Numeric tolerances").
+
+    >>> snap_spans([2.0, 1.0, 1.0 + 1e-12, 3.0], 1e-9)
+    [(2.0, 2.0), (1.0, 1.000000000001), (1.0, 1.000000000001), (3.0, 3.0)]
+    """
     order = sorted(range(len(values)), key=lambda i: values[i])
-    out = list(values)
-    rep = None
-    for i in order:
-        if rep is None or values[i] - rep > eps:
-            rep = values[i]
-        out[i] = rep
+    out: list[tuple[float, float]] = [(0.0, 0.0)] * len(values)
+    k = 0
+    while k < len(order):
+        j = k + 1
+        while j < len(order) and values[order[j]] - values[order[k]] <= eps:
+            j += 1
+        span = (values[order[k]], values[order[j - 1]])
+        for i in order[k:j]:
+            out[i] = span
+        k = j
     return out
+
+
+def snap_intervals(
+    intervals: Sequence[tuple[float, float]], eps: float
+) -> list[tuple[float, float]]:
+    """Diameter intervals with their ends snapped outward: each lower end to its cluster's
+    smallest value, each upper end to its cluster's largest (ends of all intervals clustered
+    together, as :func:`snap_spans`).
+
+    Equal-within-``eps`` intervals become exactly equal and each still holds its true one,
+    so the reading sets the planner branches on hold every reading a state can give.
+
+    >>> snap_intervals([(1.0, 2.0), (1.0 + 1e-12, 2.0 - 1e-12)], 1e-9)
+    [(1.0, 2.0), (1.0, 2.0)]
+    """
+    spans = snap_spans([x for iv in intervals for x in iv], eps)
+    return [(spans[2 * k][0], spans[2 * k + 1][1]) for k in range(len(intervals))]
 
 
 def build_machine(
@@ -45,9 +81,12 @@ def build_machine(
     ``IDEAL`` gives the paper's machine: one state per stable state, exact diameters, one
     target per action range. Otherwise a state is a physical resting state with a diameter
     interval and its action ranges lead to outcome sets (:func:`uncertain_machine`).
-    Diameters equal within ``DIAMETER_REL_EPS`` of the largest part are made exactly equal
-    (docs/conventions.md), so exact symmetry survives rounding. Raises InputError for a shape
-    tolerance too large for a part.
+    Diameters equal within ``DIAMETER_REL_EPS`` of the largest part are snapped
+    (docs/conventions.md): each such state reads as its cluster's span (``diameter`` the
+    span's smallest value, ``diameter_range`` the span when it is not a point), so exact
+    symmetry survives rounding and every reading a state's true diameter can give lies in
+    the reading sets the planner branches on. Raises InputError for a shape tolerance too
+    large for a part.
     """
     sensor = NoSensor() if sensor is None else sensor
     uncertainty = Uncertainty() if uncertainty is None else uncertainty
@@ -60,7 +99,7 @@ def build_machine(
         offsets.append(total)
         total += pf.n
     eps = DIAMETER_REL_EPS * max(pf.part.size for pf in push_functions)
-    diam = snap([s.diameter for pf in push_functions for s in pf.states], eps)
+    spans = snap_spans([s.diameter for pf in push_functions for s in pf.states], eps)
     states = []
     maps = []
     k = 0
@@ -68,7 +107,9 @@ def build_machine(
     for p, pf in enumerate(push_functions):
         widths = resting_widths(pf)
         for s in pf.states:
-            states.append(MachineState(p, s.id, diam[k], widths[s.id] / 360.0 / share))
+            lo, hi = spans[k]
+            reads = None if lo == hi else (lo, hi)
+            states.append(MachineState(p, s.id, lo, widths[s.id] / 360.0 / share, reads))
             ranges = action_ranges(pf, s.id)
             maps.append(tuple(ActionRange(r.lo, r.hi, r.target + offsets[p]) for r in ranges))
             k += 1
@@ -89,7 +130,7 @@ def uncertain_machine(
     """The machine of the parts' physical resting states under their mechanics' uncertainty.
 
     A state's ``members`` are its ideal stable states, ``state`` the first of them,
-    ``diameter_range`` its reading interval (endpoints snapped like exact diameters) and its
+    ``diameter_range`` its reading interval (ends snapped outward, :func:`snap_intervals`) and its
     weight the resting ranges of the ideal states a first alignment can end in, each shared
     equally among the physical states it may settle in (``destinations``).
     """
@@ -99,7 +140,7 @@ def uncertain_machine(
         offsets.append(total)
         total += mech.n
     eps = DIAMETER_REL_EPS * max(pf.part.size for pf in push_functions)
-    ends = snap([x for mech in mechanics for s in mech.states for x in s.diameter], eps)
+    ends = snap_intervals([s.diameter for mech in mechanics for s in mech.states], eps)
     share = len(push_functions)
     states = []
     maps = []
@@ -111,8 +152,8 @@ def uncertain_machine(
             for t in dest:
                 weight[t] += widths[i] / 360.0 / share / len(dest)
         for s in mech.states:
-            lo, hi = ends[k], ends[k + 1]
-            k += 2
+            lo, hi = ends[k]
+            k += 1
             states.append(
                 MachineState(p, s.members[0], (lo + hi) / 2.0, weight[s.id], (lo, hi), s.members)
             )

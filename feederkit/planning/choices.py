@@ -2,16 +2,40 @@
 
 A set's overlap ranges (one per distinct outcome, the widest, then the smallest rotation),
 above a margin floor, each with the reading branches its image can leave.
+
+The ranges a plan rotates in are **cells** (:func:`~feederkit.angles.boundary_cells`): the
+open intervals between consecutive action-range boundaries of the set's members
+(boundaries within ``ANGLE_EPS`` grouped as :func:`~feederkit.angles.merge_boundaries`
+groups them), over which every member keeps one outcome (one outcome set under
+uncertainty). A cell's middle is the representative and its half-width the margin, so the
+representative is at least the margin from every boundary of every member: in the ideal
+model each member's turned fence orientation is at least the margin from every divergent
+orientation (section 3.1: a part pushed exactly at one never settles); under uncertainty
+no member's outcome set changes within the margin. Neighbouring cells with the same image
+are not joined, since the boundary between them is some member's.
+
+Cells no wider than ``ANGLE_EPS`` (1e-7 deg) are never used: no robot holds such a
+rotation, and rebuilding the push function moves boundaries by about 1e-12 deg. Every
+wider cell is offered, so the planners' lengths are optimal among plans whose rotations
+all keep a margin above ``ANGLE_EPS / 2`` (docs/conventions.md); a shorter plan may exist
+only through narrower cells.
 """
 
 from __future__ import annotations
 
+import bisect
+import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from feederkit.angles import norm360
+import numpy as np
+
+from feederkit.angles import ANGLE_EPS, cells_between, norm360
 from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
 from feederkit.planning.readings import Readings
+
+_NUMPY_MIN_BOUNDS = 256
+"""Sets with at least this many action-range boundaries get their cells from numpy."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +83,59 @@ class Choices:
         self._exact: dict[int, tuple[Act, ...]] = {}
         self._lazy: dict[int, list] = {}
         self._targets: dict[tuple[int, float], tuple[int, ...]] = {}
+        self._fixed: dict[int, list[tuple[float, float, int]]] = {}
+
+    def fixed_cells(self, mask: int) -> list[tuple[float, float, int]]:
+        """The set's cells as ``(lo, hi, image)``, in angular order (cached; see the module).
+
+        The :func:`~feederkit.angles.boundary_cells` of the members' action-range
+        boundaries: no member's boundary lies inside one, none is ``ANGLE_EPS`` wide or
+        less. The image is that of the search space's overlap range holding the cell
+        (those ranges tile the circle and end on boundaries).
+        """
+        hit = self._fixed.get(mask)
+        if hit is not None:
+            return hit
+        starts = self.machine.starts  # each in [0, 360), ascending
+        ranges = sorted(
+            (norm360(lo), norm360(lo) + (hi - lo), img)
+            for lo, hi, img in self._space.overlap_cells(mask)
+        )
+        los = [r[0] for r in ranges]
+        idx = members(mask)
+        count = sum(len(starts[i]) for i in idx)
+        if count >= _NUMPY_MIN_BOUNDS:
+            b = np.sort(np.fromiter(itertools.chain.from_iterable(starts[i] for i in idx), float))
+            lo = b
+            hi = np.append(b[1:], b[0] + 360.0)
+            keep = hi - lo > ANGLE_EPS
+            lo, hi = lo[keep], hi[keep]
+            mid = (lo + hi) / 2.0
+            mid = np.where(mid >= 360.0, mid - 360.0, mid)
+            at = np.searchsorted(np.asarray(los), mid, side="right") - 1
+            out = [
+                (a, z, ranges[k][2])
+                for a, z, k in zip(lo.tolist(), hi.tolist(), at.tolist(), strict=True)
+            ]
+        else:
+            bounds = sorted(itertools.chain.from_iterable(starts[i] for i in idx))
+            out = []
+            for a, z in cells_between(bounds):
+                x = (a + z) / 2.0
+                x = x - 360.0 if x >= 360.0 else x
+                k = bisect.bisect_right(los, x) - 1  # -1: the last range, which wraps past 360
+                out.append((a, z, ranges[k][2]))
+        self._fixed[mask] = out
+        return out
+
+    def range_at(self, mask: int, rotation: float) -> OverlapRange | None:
+        """The set's cell holding ``rotation`` (deg) strictly inside, or None (a rotation on
+        or within ``ANGLE_EPS`` of a boundary)."""
+        r = norm360(rotation)
+        for lo, hi, img in self.fixed_cells(mask):
+            if lo < r < hi or lo < r + 360.0 < hi:
+                return OverlapRange(lo, hi, img)
+        return None
 
     def cells(self, mask: int, useful: bool = True) -> list[tuple[float, float, int]]:
         """The set's overlap ranges as ``(lo, hi, image)``, widest first (cached).
@@ -73,7 +150,7 @@ class Choices:
             return cells
         best: dict[object, tuple[float, float, int]] = {}
         floor = 2.0 * self.min_margin
-        for cell in self._space.overlap_cells(mask):
+        for cell in self.fixed_cells(mask):
             lo, hi, img = cell
             if hi - lo < floor:
                 continue

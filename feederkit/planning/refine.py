@@ -8,10 +8,22 @@ the root). With
 most ``EXPECTED_HORIZON`` times the minimum worst-case length, then the larger margin and
 the smaller rotation of each action.
 
-All three stages are exact searches over sets with a length budget: ``margin(mask, k)`` is
+With action costs (:class:`~feederkit.planning.options.ActionCosts`), ties among equal
+expected operation counts prefer the smaller expected seconds, before margin and rotation.
+``timed`` (the ``time`` objective) minimises the expected seconds per part first (same
+horizon as ``expected``), ties by the expected operations, margin, rotation. ``worst-time``
+(:meth:`Refiner.worst_seconds`) keeps the minimum worst-case length and minimises the
+seconds of the slowest path, every subtree itself fastest in its worst case, ties by the
+larger margin and the smaller rotation. With costs the actions of a set are one per
+distinct outcome with the cheapest rotation (then the widest) rather than the widest: the
+rotation a plan uses is still its range's middle.
+
+All the stages are exact searches over sets with a length budget: ``margin(mask, k)`` is
 the largest smallest margin of a plan of at most ``k`` operations (a max-min recursion
 memoised per set and budget); ``expected(mask, masses, k)`` the smallest expected number of
-operations (memoised per set, normalised masses and budget, with a branch-and-bound cut).
+operations (memoised per set, normalised masses and budget, with a branch-and-bound cut);
+``worst_seconds(mask, k)`` the fewest seconds of the slowest path (memoised per set and
+budget, cheapest action first).
 """
 
 from __future__ import annotations
@@ -23,6 +35,7 @@ from feederkit.angles import norm360
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.choices import spread
+from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step
 
@@ -32,6 +45,10 @@ EXPECTED_HORIZON = 2
 _TIE = 1e-9
 
 Masses = tuple[float, ...]
+Value = tuple[float, float]
+"""An expected figure and its tie-break: (operations, seconds), or (seconds, operations)
+with the time objective; seconds are 0 without action costs."""
+Cell = tuple[float, float, int]
 
 
 def child_masses(
@@ -75,14 +92,68 @@ class Refiner:
     """The tie-breaking stages and the tree builder over one problem."""
 
     def __init__(
-        self, problem: Problem, worst: WorstCase, deadline: Deadline | None = None
+        self,
+        problem: Problem,
+        worst: WorstCase,
+        deadline: Deadline | None = None,
+        *,
+        costs: ActionCosts | None = None,
+        timed: bool = False,
     ) -> None:
+        if timed and costs is None:
+            raise ValueError("the time objective needs action costs")
         self.p = problem
         self.w = worst
         self.deadline = deadline or Deadline(None)
         self.floor = -math.inf
+        self.costs = costs
+        self.timed = timed
         self._margin: dict[tuple[int, int], tuple[float, bool]] = {}
-        self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[float, Act | None]] = {}
+        self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[Value, Act | None]] = {}
+        self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
+        self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
+
+    def seconds(self, act: Act) -> float:
+        """Seconds of the operation ``act`` (0 without action costs)."""
+        return 0.0 if self.costs is None else self.costs.seconds(act.rotation)
+
+    def _step(self, act: Act) -> Value:
+        """What one operation adds to the expected figure."""
+        if self.timed:
+            return (self.seconds(act), 1.0)
+        return (1.0, self.seconds(act))
+
+    def cells(self, mask: int, by_map: bool) -> list[Cell]:
+        """The set's ranges to choose among, above the margin floor: without costs the
+        problem's (``Choices.cells``); with costs one per distinct outcome (the map of the
+        members with ``by_map``, else the image) with the cheapest rotation, then the
+        widest, cheapest first, among those that keep the problem's and the refiner's
+        margin floors (cached)."""
+        if self.costs is None:
+            return self.p.choices.cells(mask, useful=False)
+        # The refiner's margin floor too: a cheaper range below it must not hide a wider one
+        # with the same outcome.
+        floor = 2.0 * max(self.p.min_margin, self.floor)
+        key = (mask, by_map, floor)
+        hit = self._cheap.get(key)
+        if hit is not None:
+            return hit
+        costs = self.costs
+        best: dict[object, tuple[float, float, float, Cell]] = {}
+        for cell in self.p.choices.fixed_cells(mask):
+            lo, hi, img = cell
+            if hi - lo < floor:
+                continue
+            sa = OverlapRange(lo, hi, img)
+            rot = sa.representative
+            k: object = self.p.choices.targets(mask, sa) if by_map else img
+            rank = (costs.seconds(rot), lo - hi, norm360(rot), cell)
+            old = best.get(k)
+            if old is None or rank[:3] < old[:3]:
+                best[k] = rank
+        out = [r[3] for r in sorted(best.values(), key=lambda r: r[:3])]
+        self._cheap[key] = out
+        return out
 
     def feasible(self, act: Act, k: int) -> bool:
         """Whether every branch of ``act`` can be oriented in ``k`` more operations.
@@ -146,53 +217,111 @@ class Refiner:
         self._margin[key] = (best, best < cap)
         return best
 
-    def expected(self, mask: int, masses: Masses, k: int) -> tuple[float, Act | None]:
-        """Fewest expected further operations (per unit mass) within ``k``, and the action."""
+    def expected(self, mask: int, masses: Masses, k: int) -> tuple[Value, Act | None]:
+        """Fewest expected further operations (per unit mass) within ``k``, and the action.
+
+        The value is ``(operations, seconds)``, or ``(seconds, operations)`` when
+        ``timed``; the first is minimised, the second breaks ties (docstring above).
+        """
         if self.p.is_goal(mask):
-            return 0.0, None
-        key = (mask, k, _key(masses) if len(masses) > 1 else ())
+            return (0.0, 0.0), None
+        # Sensorless, a set has one path whatever its masses: its figure does not depend on them.
+        weighed = len(masses) > 1 and not self.p.sensorless
+        key = (mask, k, _key(masses) if weighed else ())
         hit = self._exp.get(key)
         if hit is not None:
             return hit
         self.deadline.check()
         if k == 1:
-            # Every allowed action orients the set at once: cost 1, so only ties are left.
+            # Every allowed action orients the set at once: one operation, so only ties
+            # (its seconds, margin, rotation) are left.
             acts = self.p.choices.exact_actions(mask)
-            for act in sorted(acts, key=lambda a: (-a.action.margin, a.rotation)):
+            if self.costs is not None:
+                acts = tuple(
+                    self.p.choices.act(mask, c, exact=True) for c in self.cells(mask, True)
+                )
+            for act in sorted(acts, key=lambda a: (self.seconds(a), -a.action.margin, a.rotation)):
                 if self.allowed(act, 1):
-                    self._exp[key] = (1.0, act)
-                    return 1.0, act
-            self._exp[key] = (math.inf, None)
-            return math.inf, None
-        best, best_act = math.inf, None
+                    out: tuple[Value, Act | None] = (self._step(act), act)
+                    self._exp[key] = out
+                    return out
+            self._exp[key] = ((math.inf, math.inf), None)
+            return (math.inf, math.inf), None
+        best: Value = (math.inf, math.inf)
+        best_act = None
+        least = 1.0 if not self.timed else self.costs.least_s  # type: ignore[union-attr]
         options = []
-        for cell in self.p.choices.cells(mask, useful=False):
+        for cell in self.cells(mask, True):
             if (cell[1] - cell[0]) / 2.0 >= self.floor:
                 # Every branch not yet oriented needs at least one more operation.
                 sa = OverlapRange(*cell)
-                options.append((1.0 + self._open_mass(mask, masses, sa), sa.representative, cell))
+                act0 = Act(sa, ())
+                step = self._step(act0)[0]
+                bound = step + least * self._open_mass(mask, masses, sa)
+                options.append((bound, sa.representative, cell))
         options.sort(key=lambda o: (o[0], o[1]))
         # Cheapest bound first; whether a plan within k can start with the action is only
         # asked of actions that could still win.
+        shortcut = k == 2 and self.costs is None
         for bound, _rot, cell in options:
-            if bound > best + _TIE:
+            if bound > best[0] + _TIE:
                 break
             act = self.p.choices.act(mask, cell, exact=True)
             if not self.allowed(act, k):
                 continue
-            if k == 2:
-                val = bound  # each open branch then takes exactly one more operation
+            if shortcut:
+                val = (bound, 0.0)  # each open branch then takes exactly one more operation
             else:
-                val = 1.0
+                first, second = self._step(act)
                 for b, pb, ms in child_masses(self.p, mask, masses, act):
                     if pb > 0.0:
-                        val += pb * self.expected(b.mask, ms, k - 1)[0]
-                    if val > best + _TIE:
+                        sub = self.expected(b.mask, ms, k - 1)[0]
+                        first += pb * sub[0]
+                        second += pb * sub[1]
+                    if first > best[0] + _TIE:
                         break
+                val = (first, second)
+            if _better(val, best) or (_equal(val, best) and _prefer(act, best_act)):
+                # Without costs keep the smaller of two tied figures (the memo is a bound).
+                best = val if self.costs is not None else (min(val[0], best[0]), 0.0)
+                best_act = act
+        result = (best, best_act)
+        self._exp[key] = result
+        return result
+
+    def worst_seconds(self, mask: int, k: int) -> tuple[float, Act | None]:
+        """Fewest seconds of the slowest path of a plan for ``mask`` within ``k``, and its
+        first action (the ``worst-time`` stage; needs action costs)."""
+        if self.p.is_goal(mask):
+            return 0.0, None
+        if k <= 0:
+            return math.inf, None
+        key = (mask, k)
+        hit = self._wsec.get(key)
+        if hit is not None:
+            return hit
+        self.deadline.check()
+        best, best_act = math.inf, None
+        least = self.costs.least_s  # type: ignore[union-attr]
+        for cell in self.cells(mask, False):  # cheapest first
+            if (cell[1] - cell[0]) / 2.0 < self.floor:
+                continue
+            act = self.p.choices.act(mask, cell, exact=True)
+            here = self.seconds(act)
+            if here > best + _TIE:
+                break  # the cells come cheapest first
+            open_ = any(not self.p.is_goal(c) for c in act.children)
+            if here + (least if open_ else 0.0) > best + _TIE or not self.allowed(act, k):
+                continue
+            val = here
+            for c in act.children:
+                val = max(val, here + self.worst_seconds(c, k - 1)[0])
+                if val > best + _TIE:
+                    break
             if val < best - _TIE or (val <= best + _TIE and _prefer(act, best_act)):
                 best, best_act = min(val, best), act
         out = (best, best_act)
-        self._exp[key] = out
+        self._wsec[key] = out
         return out
 
     def _open_mass(self, mask: int, masses: Masses, sa: OverlapRange) -> float:
@@ -208,9 +337,11 @@ class Refiner:
         return total
 
     def choose_worst(self, mask: int, masses: Masses, k: int, tie: str) -> Act:
-        """The action of a plan within ``k``; ``tie``: ``expected``, ``rotation`` or ``first``.
+        """The action of a plan within ``k``; ``tie``: ``expected``, ``worst-time``,
+        ``rotation`` or ``first``.
 
-        ``"first"`` takes the first allowed action in the problem's order (no tie-breaking).
+        ``"first"`` takes the first allowed action in the problem's order (no tie-breaking);
+        ``"worst-time"`` the first action of :meth:`worst_seconds`.
         """
         if tie == "first":
             for act in self.p.choices.exact_actions(mask):
@@ -219,6 +350,10 @@ class Refiner:
             raise AssertionError("no feasible action within the proven length")
         if tie == "expected":
             act = self.expected(mask, masses, k)[1]
+            assert act is not None
+            return act
+        if tie == "worst-time":
+            act = self.worst_seconds(mask, k)[1]
             assert act is not None
             return act
         for cell in sorted(
@@ -251,3 +386,40 @@ def _prefer(a: Act, b: Act | None) -> bool:
     if a.action.margin != b.action.margin:
         return a.action.margin > b.action.margin
     return a.rotation < b.rotation
+
+
+def _better(a: Value, b: Value) -> bool:
+    """Whether ``a`` is smaller than ``b``: the first figure, then the second (1e-9 ties)."""
+    if a[0] < b[0] - _TIE:
+        return True
+    return a[0] <= b[0] + _TIE and a[1] < b[1] - _TIE * max(1.0, abs(b[1]))
+
+
+def _equal(a: Value, b: Value) -> bool:
+    """Whether ``a`` and ``b`` tie on both figures (within 1e-9)."""
+    return abs(a[0] - b[0]) <= _TIE and abs(a[1] - b[1]) <= _TIE * max(1.0, abs(b[1]))
+
+
+def stage(objective: str, refiner: Refiner, every: list[int], budget: int) -> tuple[str, int]:
+    """The tie rule and the horizon of ``objective``'s refinement stage over the root
+    branches ``every`` (each with ``budget`` further operations); for ``worst`` it sets the
+    refiner's margin floor first (docs/planning.md, "Which plan among the shortest").
+
+    ``worst``: the largest smallest margin, then the expected operations (seconds break
+    their ties when the refiner has costs; sensorless without costs: the smaller rotation);
+    ``worst-time``: the fewest seconds on the slowest path; both within ``budget``.
+    ``expected`` and ``time``: the expected figure within ``EXPECTED_HORIZON * budget``.
+    """
+    if objective == "worst":
+        # The smallest margin over the root branches; each only has to beat the least so far.
+        floor = math.inf
+        for r in sorted(every, key=lambda r: -r.bit_count()):
+            floor = refiner.margin(r, budget, floor)
+        refiner.floor = floor
+        sensorless = refiner.p.sensorless and refiner.costs is None
+        return ("rotation" if sensorless else "expected"), budget
+    if objective == "worst-time":
+        if refiner.costs is None:
+            raise ValueError("the worst-time objective needs action costs")
+        return "worst-time", budget
+    return "expected", EXPECTED_HORIZON * budget

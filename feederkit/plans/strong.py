@@ -8,8 +8,12 @@ action every outcome of :func:`~feederkit.mechanics.uncertain.outcome_set` is fo
 node every branch whose closed reading interval the state's reading set meets is followed,
 and a reading that no branch holds is a failure (interval arithmetic over the branches' ends,
 :meth:`~feederkit.sensors.Sensor.uncovered_reading`, not sampling). Every path must end in a
-leaf naming its state (all its ideal member states, for that part); the worst path must
-take exactly the stated length.
+leaf naming its state (all its ideal member states, for that part and landing); the worst
+path must take exactly the stated length; no landing may be listed both in a reject leaf and
+in an accept leaf; and the stated expected length must be the one of the uncertain model
+(:func:`expected_operations`: a rotation's outcomes shared equally, the members weighted by
+their shares). The plan's tree may be a DAG (shared subplans, ``"nodes"``): every check is
+memoised per (node, state), so it costs the distinct nodes, not the paths.
 
 :func:`certificate` computes what the plan guarantees beyond the declared uncertainty: per
 action node the largest rotation error keeping every outcome of every state that reaches
@@ -30,8 +34,8 @@ from typing import Any
 
 from feederkit.errors import CheckFailed, InputError
 from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, members
-from feederkit.machine.build import snap
-from feederkit.mechanics.push import PushFunction
+from feederkit.machine.build import snap_intervals
+from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mechanics.uncertain import (
     UncertainMechanics,
@@ -41,7 +45,7 @@ from feederkit.mechanics.uncertain import (
 )
 from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
 from feederkit.plans.execute import rounding_inset
-from feederkit.plans.model import PlanPart, push_function_of
+from feederkit.plans.model import PlanPart, member_label, push_function_of
 from feederkit.plans.verify import PartCheck, VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -61,7 +65,7 @@ State = tuple[int, int]
 class StrongModel:
     """The parts of a plan file with their mechanics under one uncertainty.
 
-    ``diameters[p][s]``: physical state ``s``'s diameter interval, endpoints snapped across
+    ``diameters[p][s]``: physical state ``s``'s diameter interval, endpoints snapped outward across
     the parts as the machine snaps them (so exact ties survive rounding).
     """
 
@@ -69,6 +73,17 @@ class StrongModel:
     mechanics: tuple[UncertainMechanics, ...]
     diameters: tuple[tuple[tuple[float, float], ...], ...]
     sensor: Sensor
+    landings: tuple[str | None, ...] = ()
+
+    @property
+    def members(self) -> tuple[tuple[str, str | None], ...]:
+        """Each part's ``(name, landing)``, as result entries name it."""
+        landings = self.landings or (None,) * len(self.names)
+        return tuple(zip(self.names, landings, strict=True))
+
+    def label(self, p: int) -> str:
+        """Part ``p`` in words: ``NAME`` or ``NAME (LANDING)``."""
+        return member_label(*self.members[p])
 
     def states(self) -> Iterator[State]:
         """Every physical state of every part."""
@@ -118,17 +133,22 @@ def strong_model(
     pfs = list(parts) if parts is not None else _parts(plan)
     mechs = tuple(uncertain_mechanics(pf.part, unc, vibration_mm=vibration_mm) for pf in pfs)
     eps = DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
-    ends = snap([x for m in mechs for s in m.states for x in s.diameter], eps)
+    # The same outward-snapped intervals the machine's states read in (machine.build).
+    ends = snap_intervals([s.diameter for m in mechs for s in m.states], eps)
     diam: list[tuple[tuple[float, float], ...]] = []
     k = 0
     for m in mechs:
         row = []
         for _ in m.states:
-            row.append((ends[k], ends[k + 1]))
-            k += 2
+            row.append(ends[k])
+            k += 1
         diam.append(tuple(row))
     return StrongModel(
-        tuple(pf.part.name for pf in pfs), mechs, tuple(diam), sensor_from_dict(plan["sensor"])
+        tuple(part["name"] for part in plan["parts"]),
+        mechs,
+        tuple(diam),
+        sensor_from_dict(plan["sensor"]),
+        tuple(part.get("landing") for part in plan["parts"]),
     )
 
 
@@ -138,9 +158,10 @@ class _Run:
     def __init__(self, plan: Mapping[str, Any], model: StrongModel) -> None:
         self.model = model
         self.shared = plan.get("nodes") or {}
-        self.by_name = {n: p for p, n in enumerate(model.names)}
+        self.by_name = {n: p for p, n in enumerate(model.members)}
         self._worst: dict[tuple[int, State], int] = {}
         self._paths: dict[tuple[int, State], int] = {}
+        self.rejected: dict[tuple[int, State], int] = {}
         self._handles: dict[tuple[int, State], bool] = {}
 
     def node(self, node: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -176,7 +197,7 @@ class _Run:
         miss = sensor.uncovered_reading(diam, ivs)
         if miss is not None:
             raise CheckFailed(
-                f"{self.model.names[p]}: physical state {s} (diameter {diam[0]:.6g} to "
+                f"{self.model.label(p)}: physical state {s} (diameter {diam[0]:.6g} to "
                 f"{diam[1]:.6g} mm) can read {miss:.6g} mm, which no branch after rotation "
                 f"{node.get('action_deg')} holds"
             )
@@ -187,9 +208,14 @@ class _Run:
         ]
 
     def named(self, leaf: Mapping[str, Any], x: State) -> bool:
-        """Whether a leaf names state ``x``: every ideal member of it, for its part."""
+        """Whether a leaf names state ``x``: every ideal member of it, for its part and
+        landing."""
         p, s = x
-        listed = {e["state"] for e in leaf["result"] if self.by_name.get(e["part"]) == p}
+        listed = {
+            e["state"]
+            for e in leaf["result"]
+            if self.by_name.get((e["part"], e.get("landing"))) == p
+        }
         return set(self.model.mechanics[p].states[s].members) <= listed
 
     def worst(self, node: Mapping[str, Any], x: State) -> int:
@@ -205,17 +231,20 @@ class _Run:
                 p, s = x
                 ideal = list(self.model.mechanics[p].states[s].members)
                 raise CheckFailed(
-                    f"{self.model.names[p]}: a path ends in a result that does not name its "
+                    f"{self.model.label(p)}: a path ends in a result that does not name its "
                     f"physical state {s} (ideal states {ideal})"
                 )
             self._worst[key], self._paths[key] = 0, 1
+            self.rejected[key] = 1 if node.get("reject") is True else 0
             return 0
-        longest, paths = 0, 0
+        longest, paths, rejected = 0, 0, 0
         for y in self.outcomes(node, x):
             for nxt in self.follow(node, y):
                 longest = max(longest, self.worst(nxt, y))
                 paths += self._paths[(id(self.node(nxt)), y)]
+                rejected += self.rejected[(id(self.node(nxt)), y)]
         self._worst[key], self._paths[key] = 1 + longest, paths
+        self.rejected[key] = rejected
         return 1 + longest
 
     def handles(self, node: Mapping[str, Any], x: State) -> bool:
@@ -259,21 +288,131 @@ def verify_strong(
     root = plan["root"]
     checks = []
     overall = 0
-    for p, name in enumerate(model.names):
-        worst, paths = 0, 0
+    for p, (name, landing) in enumerate(model.members):
+        worst, paths, rejected = 0, 0, 0
         states = [x for x in model.states() if x[0] == p]
         for x in states:
             worst = max(worst, run.worst(root, x))
             paths += run._paths[(id(run.node(root)), x)]
+            rejected += run.rejected[(id(run.node(root)), x)]
         overall = max(overall, worst)
-        checks.append(PartCheck(name, len(states), paths, worst, 0))
+        checks.append(PartCheck(name, len(states), paths, worst, 0, landing, rejected))
     stated = plan["stats"]["length"]
     if overall != stated:
         raise CheckFailed(
             f"the plan's length is {stated}, but its worst path under the declared uncertainty "
             f"takes {overall} operations"
         )
+    clash = reject_clash(plan)
+    if clash is not None:
+        raise CheckFailed(
+            f"{member_label(*clash)} is listed in a reject result and in an accept result: a "
+            "landing the next station cannot take must never reach an accept result"
+        )
+    if uncertainty is None:
+        pfs = list(parts) if parts is not None else _parts(plan)
+        expected = expected_operations(plan, model, pfs)
+        given = plan["stats"]["expected_length"]
+        if abs(given - expected) > EXPECTED_REL_TOL * max(1.0, expected):
+            raise CheckFailed(
+                f"the plan's expected length is {given:.10g}, but under the declared "
+                f"uncertainty (outcomes shared equally, the parts weighted by their shares) "
+                f"it is {expected:.10g}"
+            )
     return VerificationReport(tuple(checks))
+
+
+def reject_clash(plan: Mapping[str, Any]) -> tuple[str, str | None] | None:
+    """A member (part, landing) listed both in a reject leaf and in an accept leaf (None:
+    there is none); each distinct node of the file once."""
+    shared = plan.get("nodes") or {}
+    rejected: set[tuple[str, str | None]] = set()
+    accepted: set[tuple[str, str | None]] = set()
+    seen: set[int] = set()
+    stack = [plan["root"]]
+    while stack:
+        node = stack.pop()
+        while "ref" in node:
+            node = shared[node["ref"]]
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if "result" in node:
+            into = rejected if node.get("reject") is True else accepted
+            into.update((e["part"], e.get("landing")) for e in node["result"])
+        else:
+            stack.extend(b["next"] for b in node["branches"])
+    both = [m for m in rejected if m in accepted]
+    return min(both, key=str) if both else None
+
+
+EXPECTED_REL_TOL = 1e-6
+"""The stated expected length must be the computed one within this fraction."""
+
+
+def member_shares(plan: Mapping[str, Any]) -> list[float]:
+    """Each part's prior share, normalised (equal when the file gives none)."""
+    given = [part.get("share") for part in plan["parts"]]
+    if any(x is None for x in given):
+        return [1.0 / len(given)] * len(given)
+    total = math.fsum(given)
+    return [x / total for x in given]
+
+
+def expected_operations(
+    plan: Mapping[str, Any], model: StrongModel, parts: Sequence[PushFunction]
+) -> float:
+    """The expected number of operations of a strong plan on the uncertain model, as the
+    planner defines it (docs/planning.md): a part starts in each physical state with the
+    resting ranges of the ideal states a first alignment can end there (each shared equally
+    among its destinations) times its member's share; a rotation by ``action_deg`` shares a
+    state's mass equally among its outcome set; a branch keeps the probability that the
+    state's reading falls in it. Memoised per (node, state), without recursion."""
+    run = _Run(plan, model)
+    sensor = model.sensor
+    memo: dict[tuple[int, State], float] = {}
+
+    def continuations(node: Mapping[str, Any], x: State) -> list[tuple[float, Any, State]]:
+        """(probability, next node, state) of every continuation of ``x`` at a step."""
+        outs = run.outcomes(node, x)
+        branches = node["branches"]
+        out = []
+        for y in outs:
+            if not sensor.informative or all(b["reading"] is None for b in branches):
+                out.append((1.0 / len(outs), run.node(branches[0]["next"]), y))
+                continue
+            diam = model.diameters[y[0]][y[1]]
+            for b in branches:
+                pr = sensor.reading_probability(diam, *b["reading"])
+                if pr > 0.0:
+                    out.append((pr / len(outs), run.node(b["next"]), y))
+        return out
+
+    expected = 0.0
+    shares = member_shares(plan)
+    root = run.node(plan["root"])
+    for p, (mech, pf) in enumerate(zip(model.mechanics, parts, strict=True)):
+        widths = resting_widths(pf)
+        weight = [0.0] * mech.n
+        for i, dest in enumerate(mech.destinations):
+            for t in dest:
+                weight[t] += widths[i] / 360.0 / len(dest)
+        for s in range(mech.n):
+            stack: list[tuple[Mapping[str, Any], State]] = [(root, (p, s))]
+            while stack:
+                node, x = stack[-1]
+                if (id(node), x) in memo:
+                    stack.pop()
+                    continue
+                steps = [c for c in continuations(node, x) if "result" not in c[1]]
+                missing = [(n, y) for _pr, n, y in steps if (id(n), y) not in memo]
+                if missing:
+                    stack.extend(missing)
+                    continue
+                memo[(id(node), x)] = 1.0 + math.fsum(pr * memo[(id(n), y)] for pr, n, y in steps)
+                stack.pop()
+            expected += shares[p] * weight[s] * memo[(id(root), (p, s))]
+    return expected
 
 
 def strong_holds(

@@ -12,10 +12,15 @@ interval arithmetic rather than by sampling:
   reading must be held by some branch, and every branch that holds one (on a shared endpoint
   both) must be right.
 
-Every path must end in a result that lists the part's final state, and the longest must take
-exactly the plan's stated length. The plan's listed stable states must be the ones its hulls
-and COMs give. Paths that share a (node, state) share their future, so the search is
-memoised and linear in plan size times states.
+Every path must end in a result that lists the part's final state (its landing too, in a
+plan over landings), and the longest must take exactly the plan's stated length. The plan's
+listed stable states must be the ones its hulls and COMs give. A landing listed in a reject
+leaf must never be listed in an accept leaf (design.md, "Landings": a rejected landing never
+reaches an accept leaf). The stated expected length must be the expected number of
+operations with the start uniform on the circle and each member weighted by its share
+(:func:`expected_operations`). Paths that share a (node, state) share their future, so the
+search is memoised and linear in the plan's distinct nodes times states, however many paths
+shared subplans make.
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from feederkit.angles import angle_close, norm360
@@ -31,7 +36,7 @@ from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
 from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan, Step, push_function_of
+from feederkit.plans.model import Leaf, Plan, Step, member_label, push_function_of
 from feederkit.sensors import Sensor
 
 ANGLE_EPS_DEG = 1e-7
@@ -41,20 +46,31 @@ on resting-range boundaries, which rebuilding the push function reproduces to ab
 
 @dataclass(frozen=True)
 class PartCheck:
-    """What was tried for one part: starts, complete paths, the most operations any run took."""
+    """What was tried for one member: starts, complete paths, the most operations any run
+    took; ``landing`` the member's landing (None: not a plan over landings) and
+    ``rejects`` the paths that end in a reject leaf."""
 
     part: str
     starts: int
     paths: int
     worst_operations: int
     failed_starts: int
+    landing: str | None = None
+    rejects: int = 0
+
+    @property
+    def label(self) -> str:
+        """The member in words: ``PART`` or ``PART (LANDING)``."""
+        return member_label(self.part, self.landing)
 
     def to_dict(self) -> dict[str, Any]:
         """As JSON."""
         return {
             "part": self.part,
+            "landing": self.landing,
             "starts": self.starts,
             "paths": self.paths,
+            "rejects": self.rejects,
             "worst_operations": self.worst_operations,
             "failed_starts": self.failed_starts,
         }
@@ -112,6 +128,7 @@ class _Outcome:
     paths: int
     worst: int
     failure: _Failure | None
+    rejects: int = 0
 
 
 def _discrete(sensor: Sensor, diameter: float) -> bool:
@@ -179,17 +196,24 @@ class _PartSearch:
         # that touch at a breakpoint tolerance may overlap by an ulp in floating point.
         self.sensor = plan.sensor.narrowed(rounding_inset(self.pf.part.size))
         self.name = plan.parts[p].name
-        listed = {s.id: s.diameter for s in plan.parts[p].states}
-        # readings are those of the diameters the plan was made on (checked against geometry)
-        self.diameter = {s.id: listed.get(s.id, s.diameter) for s in self.pf.states}
+        self.landing = plan.parts[p].landing
+        # Readings are those of the rebuilt part's true diameters, not the file's listed
+        # (snapped) values: every reading a state can really give must lie in a branch.
+        self.diameter = {s.id: s.diameter for s in self.pf.states}
         self.memo: dict[tuple[int, int], _Outcome] = {}
 
     def after_push(self, node: Step, number: int, state: StableState) -> _Outcome:
-        """Outcome of every continuation once operation ``number`` of ``node`` left ``state``."""
+        """Outcome of every continuation once operation ``number`` of ``node`` left ``state``
+        (``worst``: the number of the last operation of the longest).
+
+        Memoised per (node, state) with the operations below the node, not their numbers: a
+        shared subplan may be reached after different numbers of operations.
+        """
         key = (id(node), state.id)
-        if key in self.memo:
-            return self.memo[key]
-        paths, worst, failure = 0, number, None
+        hit = self.memo.get(key)
+        if hit is not None:
+            return replace(hit, worst=number + hit.worst)
+        paths, worst, failure, rejects = 0, number, None, 0
         explored: set[int] = set()
         for reading in candidate_readings(self.sensor, node, self.diameter[state.id]):
             held = node.held_by(reading)
@@ -203,13 +227,15 @@ class _PartSearch:
                 nxt = branch.next
                 if isinstance(nxt, Leaf):
                     paths += 1
-                    if not nxt.accepts(self.name, state.id) and failure is None:
+                    rejects += nxt.reject
+                    if not nxt.accepts(self.name, state.id, self.landing) and failure is None:
                         failure = _Failure(reading, b, branch.reading, (), state, nxt)
                     continue
                 assert nxt.action_deg is not None
                 for s2 in rotation_outcomes(self.pf, state.normal_deg, nxt):
                     sub = self.after_push(nxt, number + 1, s2)
                     paths += sub.paths
+                    rejects += sub.rejects
                     worst = max(worst, sub.worst)
                     if sub.failure is not None and failure is None:
                         f = sub.failure
@@ -229,16 +255,16 @@ class _PartSearch:
                         failure = _Failure(
                             reading, b, branch.reading, (step, *f.rest), f.final, f.leaf
                         )
-        out = _Outcome(paths, worst, failure)
-        self.memo[key] = out
-        return out
+        self.memo[key] = _Outcome(paths, worst - number, failure, rejects)
+        return _Outcome(paths, worst, failure, rejects)
 
     def run(self) -> tuple[PartCheck, list[Trace]]:
-        paths, worst, failed = 0, 0, []
+        paths, worst, failed, rejects = 0, 0, [], 0
         starts = self.pf.states
         for s0 in starts:
             o = self.after_push(self.plan.root, 1, s0)
             paths += o.paths
+            rejects += o.rejects
             worst = max(worst, o.worst)
             if o.failure is not None:
                 f = o.failure
@@ -246,8 +272,11 @@ class _PartSearch:
                 first = TraceStep(
                     1, None, theta, s0.id, s0.edge, s0.diameter, f.reading, f.branch, f.interval
                 )
-                failed.append(finish(self.name, theta, (first, *f.rest), f.final, f.leaf))
-        return PartCheck(self.name, len(starts), paths, worst, len(failed)), failed
+                # a path's k-th step is operation k, wherever a shared subplan was first met
+                steps = [replace(t, number=k) for k, t in enumerate((first, *f.rest), 1)]
+                failed.append(finish(self.name, theta, steps, f.final, f.leaf, self.landing))
+        check = PartCheck(self.name, len(starts), paths, worst, len(failed), self.landing, rejects)
+        return check, failed
 
 
 def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
@@ -272,7 +301,7 @@ def _state_problems(plan: Plan, p: int) -> list[str]:
     listed = {s.id: s for s in part.states}
     if set(listed) != {s.id for s in pf.states}:
         return [
-            f"part {part.name!r}: the plan lists stable states {sorted(listed)}, but its hull "
+            f"part {part.label!r}: the plan lists stable states {sorted(listed)}, but its hull "
             f"and COM give {pf.n}"
         ]
     eps_d = 1e-9 * pf.part.size + 1e-12
@@ -289,7 +318,7 @@ def _state_problems(plan: Plan, p: int) -> list[str]:
         )
         if not same:
             out.append(
-                f"part {part.name!r} state {s.id}: the plan says edge {f.edge}, normal "
+                f"part {part.label!r} state {s.id}: the plan says edge {f.edge}, normal "
                 f"{f.normal_deg:.6g} deg, diameter {f.diameter:.10g}, but its hull and COM "
                 f"give edge {s.edge}, normal {s.normal_deg:.6g} deg, diameter {s.diameter:.10g}"
             )
@@ -298,17 +327,111 @@ def _state_problems(plan: Plan, p: int) -> list[str]:
 
 def _pose_problems(plan: Plan) -> list[str]:
     """Result entries whose pose is not the pose of the state they name."""
-    poses = {(p.name, s.id): s.pose_deg for p in plan.parts for s in p.states}
+    poses = {(*p.key, s.id): s.pose_deg for p in plan.parts for s in p.states}
     out = []
     for leaf in plan.leaves():
         for e in leaf.results:
-            want = poses[(e.part, e.state)]
+            want = poses[(e.part, e.landing, e.state)]
             if not angle_close(e.pose_deg, want, 1e-6):
                 out.append(
-                    f"a result gives {e.part} state {e.state} the pose {e.pose_deg:.6g} deg, "
-                    f"but that state's pose is {want:.6g} deg"
+                    f"a result gives {member_label(e.part, e.landing)} state {e.state} the "
+                    f"pose {e.pose_deg:.6g} deg, but that state's pose is {want:.6g} deg"
                 )
     return out
+
+
+def reject_problems(plan: Plan) -> list[str]:
+    """Members (part and landing) listed both in a reject leaf and in an accept leaf: a
+    rejected landing must never reach an accept leaf, nor an accepted one be rejected
+    (design.md, "Landings")."""
+    rejected: dict[tuple[str, str | None], None] = {}
+    accepted: set[tuple[str, str | None]] = set()
+    for leaf in plan.leaves():
+        for e in leaf.results:
+            if leaf.reject:
+                rejected.setdefault(e.key)
+            else:
+                accepted.add(e.key)
+    return [
+        f"{member_label(*key)} is listed in a reject result and in an accept result: a "
+        "landing the next station cannot take must never reach an accept result"
+        for key in rejected
+        if key in accepted
+    ]
+
+
+EXPECTED_REL_TOL = 1e-6
+"""The stated expected length must be the computed one within this fraction."""
+
+
+def _branch_probabilities(sensor: Sensor, step: Step, diameter: float) -> list[float]:
+    """The probability that a state of this diameter follows each branch of ``step``: the
+    controller takes the first branch holding the reading (design.md), so a reading on a
+    shared endpoint (a positive probability only for an LED array's counts) counts once."""
+    if not sensor.informative:
+        return [1.0] + [0.0] * (len(step.branches) - 1)
+    if _discrete(sensor, diameter):
+        out = [0.0] * len(step.branches)
+        for r in sorted(set(sensor.probe_readings(diameter, 0.0))):
+            k = step.follow(r)
+            if k is not None:
+                out[k] += sensor.reading_probability(diameter, r, r)
+        return out
+    return [
+        0.0 if b.reading is None else sensor.reading_probability(diameter, *b.reading)
+        for b in step.branches
+    ]
+
+
+def expected_operations(plan: Plan) -> float:
+    """The expected number of operations of a plan on the kinematic model (the first
+    alignment counted): the start uniform on the circle (a state weighs its resting range
+    over 360), each member weighted by its normalised share (:meth:`Plan.shares`), a
+    rotation by the step's ``action_deg``, and each branch followed with the probability
+    that the state's reading falls in it (the sensor model, section 5). Memoised per
+    (node, state), without recursion."""
+    total = 0.0
+    for p, share in enumerate(plan.shares()):
+        pf = push_function_of(plan.parts[p])
+        listed = {s.id: s.diameter for s in plan.parts[p].states}
+        by_id = {s.id: s for s in pf.states}
+        memo: dict[tuple[int, int], float] = {}
+        for s0 in pf.states:
+            stack: list[tuple[Step, StableState, bool]] = [(plan.root, s0, False)]
+            while stack:
+                node, state, expanded = stack.pop()
+                key = (id(node), state.id)
+                if key in memo:
+                    continue
+                d = listed.get(state.id, state.diameter)
+                probs = _branch_probabilities(plan.sensor, node, d)
+                todo = []
+                for b, pr in zip(node.branches, probs, strict=True):
+                    nxt = b.next
+                    if pr > 0.0 and isinstance(nxt, Step):
+                        assert nxt.action_deg is not None
+                        s2 = by_id[push(pf, rotation_after(state.normal_deg, nxt.action_deg)).id]
+                        todo.append((pr, nxt, s2))
+                if not expanded and any((id(n), t.id) not in memo for _, n, t in todo):
+                    stack.append((node, state, True))
+                    stack.extend((n, t, False) for _, n, t in todo)
+                    continue
+                memo[key] = 1.0 + math.fsum(pr * memo[(id(n), t.id)] for pr, n, t in todo)
+            lo, hi = s0.resting_range_deg
+            total += share * (hi - lo) / 360.0 * memo[(id(plan.root), s0.id)]
+    return total
+
+
+def expected_problems(plan: Plan, expected: float) -> list[str]:
+    """The stated expected length against ``expected``, the computed one."""
+    stated = plan.stats.expected_length
+    if abs(stated - expected) <= EXPECTED_REL_TOL * max(1.0, expected):
+        return []
+    weights = "each part's share" if plan.parts[0].share is not None else "equal part shares"
+    return [
+        f"the plan's expected length is {stated:.10g}, but with the start uniform and "
+        f"{weights} it is {expected:.10g}"
+    ]
 
 
 def verify_plan(
@@ -323,7 +446,7 @@ def verify_plan(
     """
     plan = as_plan(plan)
     indices = range(len(plan.parts)) if part_indices is None else part_indices
-    problems = _pose_problems(plan)
+    problems = _pose_problems(plan) + reject_problems(plan)
     checks, failures = [], []
     length = plan.stats.length
     old = sys.getrecursionlimit()
@@ -346,6 +469,8 @@ def verify_plan(
         # every node is reachable (its states are images of every start), so some path is as
         # long as the tree: a shorter longest path means a branch no part can reach
         problems.append(f"the plan's length is {length}, but no path takes more than {longest}")
+    if not failures and not problems:
+        problems += expected_problems(plan, expected_operations(plan))
     return VerificationReport(tuple(checks), tuple(failures), tuple(problems))
 
 
@@ -376,10 +501,10 @@ def verify_declared(
     from feederkit.plans.strong import verify_strong
 
     indices = range(len(plan.parts)) if part_indices is None else part_indices
-    problems = _pose_problems(plan)
+    problems = _pose_problems(plan) + reject_problems(plan)
     for p in indices:
         problems += _state_problems(plan, p)
-    names = {plan.parts[p].name for p in indices}
+    names = {plan.parts[p].key for p in indices}
     try:
         strong = verify_strong(plan_to_dict(plan))
     except CheckFailed as exc:
@@ -387,7 +512,7 @@ def verify_declared(
         problems.append(f"at the declared uncertainty ({unc}): {exc}")
         checks = tuple(PartCheck(plan.parts[p].name, 0, 0, 0, 0) for p in indices)
         return VerificationReport(checks, (), tuple(problems))
-    checks = tuple(c for c in strong.parts if c.part in names)
+    checks = tuple(c for c in strong.parts if (c.part, c.landing) in names)
     return VerificationReport(checks, (), tuple(problems))
 
 
