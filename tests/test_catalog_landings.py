@@ -206,3 +206,28 @@ def test_cli_side_probability_and_show(tmp_path, capsys, monkeypatch):
     assert main(["catalog", "show", "ell", "--catalog", db]) == 0
     out = capsys.readouterr().out
     assert "up: probability 0.250" in out and "down: probability 0.750" in out
+
+
+def test_plan_of_a_catalog_part_covers_its_stored_landings(tmp_path, capsys):
+    db = tmp_path / "c.db"
+    cat.add_outline(db, ell_outline(), side_probability=0.25)
+    out = tmp_path / "plan.json"
+    args = ["plan", "ell", "--catalog", str(db), "--tolerance", "0.5", "-o", str(out)]
+    assert main(args) == 0, capsys.readouterr().err
+    plan = json.loads(out.read_text())
+    parts = [(p["name"], p["revision"], p["landing"], p["share"]) for p in plan["parts"]]
+    assert parts == [("ell", "1", "up", 0.25), ("ell", "1", "down", 0.75)]
+
+
+def test_plan_of_a_catalog_mesh_picks_its_stored_poses(tmp_path, capsys, box_stl):
+    db = tmp_path / "c.db"
+    cat.add_file(db, box_stl, ImportOptions(units="mm"))
+    out = tmp_path / "plan.json"
+    box = ["plan", "box", "--catalog", str(db), "--tolerance", "0.5", "-o", str(out)]
+    assert main([*box, "--landings", "0,4", "--json"]) == 0, capsys.readouterr().err
+    plan = json.loads(capsys.readouterr().out)
+    assert [p["landing"] for p in plan["parts"]] == ["pose-0", "pose-4"]
+    shares = [p["share"] for p in plan["parts"]]
+    stored = {x.name: x.probability for x in cat.get_revision(db, "box").landings}
+    total = stored["pose-0"] + stored["pose-4"]
+    assert shares == pytest.approx([stored["pose-0"] / total, stored["pose-4"] / total])

@@ -18,6 +18,7 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.stats import expected_operations
 from feederkit.planning.tree import Leaf, PlanResult, Step
 from feederkit.plans import (
     CONVENTIONS,
@@ -79,7 +80,8 @@ def hand_plan(pfs, sensor, length):
                 walk(c)
 
     walk(root)
-    return PlanResult(m, root, length, float(length), min(margins, default=math.inf), True, length)
+    expected = expected_operations(m, root)
+    return PlanResult(m, root, length, expected, min(margins, default=math.inf), True, length)
 
 
 @pytest.fixture(scope="module")
@@ -256,7 +258,7 @@ def test_execute_tri(tri_plan, choice, start):
     assert t.success, t.message
     assert 1 <= len(t.steps) <= 2
     assert t.steps[0].action_deg is None and t.steps[0].theta_deg == start
-    assert t.final_pose_deg in {e[2] for e in t.result}
+    assert t.final_pose_deg in {e.pose_deg for e in t.result}
 
 
 def test_execute_stops_on_a_foreign_reading(tri_plan):

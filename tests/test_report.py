@@ -79,6 +79,13 @@ def rectangle_plan(name="rect"):
     return plan_file([rect], {"model": "none"}, root, stats)
 
 
+def _share(entry, state):
+    """The probability that the first alignment leaves the part in ``state``: its resting
+    range's share of the circle."""
+    lo, hi = entry["stable_states"][state]["resting_range_deg"]
+    return ((hi - lo) % 360.0) / 360.0
+
+
 def triangle_plan(name=NASTY, e=0.01):
     """The isosceles right triangle (legs 1), tolerance e: length 2.
 
@@ -99,7 +106,7 @@ def triangle_plan(name=NASTY, e=0.01):
     )
     stats = {
         "length": 2,
-        "expected_length": 5 / 3,
+        "expected_length": 2.0 - _share(tri, 1),  # s1 is named at once; the others take two
         "min_margin_deg": 18.43,
         "optimal": True,
         "lower_bound": 2,
@@ -133,7 +140,7 @@ def twin_plan():
     )
     stats = {
         "length": 2,
-        "expected_length": 5 / 3,
+        "expected_length": 2.0 - _share(a, 1),
         "min_margin_deg": 18.43,
         "optimal": True,
         "lower_bound": 2,
@@ -265,14 +272,59 @@ def test_statistics_cycle_time_and_simulation():
     )
     text = "".join(parse(html).text)
     assert "2 push-align operations" in text
-    assert "1.667 operations" in text
+    expected = triangle_plan()["stats"]["expected_length"]
+    assert f"{expected:.3f} operations" in text
     assert "\u00b118.43\u00b0" in text
-    assert "7.5 s expected, 9 s worst case at 4.5 s per operation" in text
+    assert f"{4.5 * expected:.3g} s expected, 9 s worst case at 4.5 s per operation" in text
     assert "19 of 20 trials oriented correctly (95%)" in text
     assert "yes: no shorter plan exists (lower bound 2)" in text
     assert "within \u00b10.01 mm" in text
     without = "".join(parse(render_report(triangle_plan())).text)
-    assert "give seconds per operation" in without
+    assert "not known: give a cell profile with timing" in without
+
+
+def test_the_cell_profiles_cycle_time_is_shown_and_named():
+    plan = triangle_plan()
+    plan["stats"]["cycle_time"] = {
+        "profile": "cell-a.toml (overridden: --tolerance)",
+        "expected_s": 3.0,
+        "worst_s": 4.0,
+        "parts_per_minute": 20.0,
+        "worst_parts_per_minute": 15.0,
+    }
+    text = "".join(parse(render_report(plan)).text)
+    assert "3 s per part, 20 parts per minute" in text
+    assert "4 s per part, 15 parts per minute" in text
+    assert "cell-a.toml (overridden: --tolerance)" in text
+    del plan["stats"]["cycle_time"]["worst_s"]
+    with pytest.raises(InputError, match="cycle_time needs expected_s, worst_s and profile"):
+        render_report(plan)
+
+
+def test_the_sensor_design_table_and_plot():
+    design = {
+        "sensor_model": "tolerance",
+        "critical_tolerance_mm": 0.5,
+        "pairs": [
+            {"a": "p", "b": "q", "critical_tolerance_mm": 0.5},
+            {"a": "p", "b": "r", "critical_tolerance_mm": None},
+        ],
+        "lengths": [
+            {"tolerance_mm": [0.0, 0.25], "length": 2, "expected": 1.5},
+            {"tolerance_mm": [0.25, 0.5], "length": 3, "expected": 2.25},
+        ],
+        "model": "ideal model",
+        "answer": "this mix is recognizable with a tolerance up to 0.5 mm",
+    }
+    doc = parse(render_report(triangle_plan(), design=design))
+    text = "".join(doc.text)
+    assert "this mix is recognizable with a tolerance up to 0.5 mm" in text
+    assert "none: no sensor separates them" in text
+    assert "0.25 < tolerance ≤ 0.5 mm" in text
+    svgs = [a for t, a in doc.tags if t == "svg" and "design-plot" in a.get("class", "")]
+    assert len(svgs) == 1
+    with pytest.raises(InputError, match="design sensor"):
+        render_report(triangle_plan(), design={"sensor_model": "magic"})
 
 
 def test_per_part_section_has_a_state_table_and_an_embedded_plot():

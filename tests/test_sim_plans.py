@@ -114,6 +114,26 @@ def _margins(node: dict) -> list[float]:
     return own + [m for b in node["branches"] for m in _margins(b["next"])]
 
 
+def _expected_length(pf: PushFunction, root: dict) -> float:
+    """Operations on average from a uniform start: each first resting state weighted by its
+    resting range, then the plan followed on the push function."""
+    total = 0.0
+    for s in pf.states:
+        lo, hi = s.resting_range_deg
+        node, state, ops = root, s, 0
+        while "result" not in node:
+            if node["action_deg"] is not None:
+                state = push(pf, state.normal_deg - node["action_deg"])
+            ops += 1
+            node = next(
+                b["next"]
+                for b in node["branches"]
+                if b["reading"] is None or b["reading"][0] <= state.diameter <= b["reading"][1]
+            )
+        total += (hi - lo) / 360.0 * ops
+    return total
+
+
 def build_plan(part: Part, tolerance: float | None) -> dict:
     """A plan file (design.md) orienting ``part`` with a tolerance sensor (None: sensorless)."""
     pf = push_function(part)
@@ -136,7 +156,7 @@ def build_plan(part: Part, tolerance: float | None) -> dict:
         "root": root,
         "stats": {
             "length": _depth(root),
-            "expected_length": float(_depth(root)),  # an upper bound: not computed here
+            "expected_length": _expected_length(pf, root),
             "min_margin_deg": min(margins) if margins else None,
             "optimal": False,
             "lower_bound": 1,

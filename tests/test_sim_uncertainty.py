@@ -403,3 +403,27 @@ def test_strong_catalog_plans_succeed_in_the_physics_check():
     for name in ("rectangle-2x1", "t-clip", "quadrilateral"):
         s = simulate_plan(strong(name), 100, seed=7)
         assert s.success_rate >= 0.97, (name, s.by_cause())
+
+
+@pytest.mark.slow
+def test_a_plan_over_landings_draws_members_by_share_and_counts_rejects():
+    """The l-bracket dropped up (70 %) or down, the next station taking only ``up``: every
+    ``down`` trial ends in the reject leaf naming it, none in an accepting leaf (design.md,
+    "Landings")."""
+    from feederkit.landing.model import landings_of_outline
+    from feederkit.landing.plan import plan_landings
+    from feederkit.sim import simulate_plan
+
+    part = load_part(str(ROOT / "catalog" / "l-bracket.json"))
+    landings = landings_of_outline(part, 0.7)
+    made = plan_landings(
+        landings, ToleranceSensor(0.01 * part.size), uncertainty=Uncertainty(1.0), accept={"up"}
+    ).made
+    s = simulate_plan(made.plan, 40, seed=0)
+    assert s.parts == ("l-bracket (up)", "l-bracket (down)")
+    up, down = s.part_trials
+    assert up + down == 40 and 18 <= up <= 36  # 28 expected at a 70 % share
+    assert s.successes == 40 and s.wrong_accepts == 0
+    assert s.rejects == down
+    d = s.to_dict()
+    assert (d["rejects"], d["wrong_accepts"]) == (down, 0)

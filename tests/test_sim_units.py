@@ -204,3 +204,90 @@ def test_simulate_checks_plan_files_as_run_and_report_do(tmp_path: Path, mutate,
     lines = [line for line in out.stderr.splitlines() if line.strip()]
     assert out.returncode == code, out.stderr
     assert len(lines) == 1 and words in lines[0] and "Traceback" not in out.stderr
+
+
+# --- plans over landings (design.md, "Landings") ----------------------------------------------
+
+
+def test_a_leaf_names_a_member_by_its_landing() -> None:
+    from feederkit.plans.model import ResultEntry
+    from feederkit.sim.trial import leaf_holds
+
+    accept = Leaf((ResultEntry("bracket", 2, 0.0, "up"),))
+    reject = Leaf((ResultEntry("bracket", 2, 0.0, "down"),), reject=True)
+    assert leaf_holds(accept, "bracket", 2, "up")
+    assert not leaf_holds(accept, "bracket", 2, "down")
+    assert not leaf_holds(accept, "bracket", 1, "up")
+    assert leaf_holds(reject, "bracket", 2, "down")
+    old = Leaf((ResultEntry("bracket", 2, 0.0),))  # a plan not made over landings
+    assert leaf_holds(old, "bracket", 2, None) and not leaf_holds(old, "bracket", 2, "up")
+
+
+def test_wrong_accepts_are_counted_apart_from_rejects() -> None:
+    from feederkit.sim.summary import SimSettings, SimulationSummary, TrialResult
+
+    def trial(i: int, outcome: str, rejected: bool, cause: str | None = None) -> TrialResult:
+        return TrialResult(
+            i,
+            "bracket",
+            0.0,
+            outcome,
+            None,
+            None,
+            0,
+            (),
+            cause=cause,
+            predicted=None if outcome == "success" else True,
+            landing="down",
+            rejected=rejected,
+        )
+
+    wrong_accept = trial(2, "failure", False, "wrong result")
+    wrong_reject = trial(3, "failure", True, "wrong result")
+    no_branch = trial(4, "failure", False, "reading in no branch")
+    assert wrong_accept.wrong_accept and not wrong_reject.wrong_accept
+    assert not no_branch.wrong_accept and not trial(1, "success", True).wrong_accept
+    s = SimulationSummary(
+        settings=SimSettings(5, 0, 1.0, 0.1, 0.5, 0.2, 0.002),
+        parts=("bracket (up)", "bracket (down)"),
+        part_trials=(1, 4),
+        part_successes=(1, 1),
+        scales=(1.0, 1.0),
+        min_margin_deg=None,
+        successes=2,
+        failures=(wrong_accept, wrong_reject, no_branch),
+        unsettled=(),
+        pushes=0,
+        settled_pushes=0,
+        push_agreements=0,
+        push_misses=(),
+        wall_time_s=0.0,
+        sim_time_s=0.0,
+        rejects=1,
+    )
+    d = s.to_dict()
+    assert (d["rejects"], d["wrong_accepts"]) == (1, 1)
+    assert [r["landing"] for r in d["failures"]] == ["down"] * 3
+    assert [r["rejected"] for r in d["failures"]] == [False, True, False]
+
+
+def test_members_are_drawn_by_their_shares() -> None:
+    from dataclasses import replace
+
+    from feederkit.sim.api import _member_shares
+
+    plan = plan_from_dict(build_plan(rectangle(), 1.0))
+    assert _member_shares(plan) is None  # no shares: equally likely, drawn as before
+    two = replace(plan, parts=(plan.parts[0], replace(plan.parts[0], name="copy")))
+    assert _member_shares(two) is None
+    if not hasattr(plan.parts[0], "share"):
+        pytest.skip("plan parts carry no share in this version of the plan model")
+    shares = replace(
+        two, parts=tuple(replace(p, share=w) for p, w in zip(two.parts, (3.0, 1.0), strict=True))
+    )
+    assert _member_shares(shares).tolist() == pytest.approx([0.75, 0.25])
+    bad = replace(
+        two, parts=tuple(replace(p, share=w) for p, w in zip(two.parts, (0.0, 0.0), strict=True))
+    )
+    with pytest.raises(InputError, match="shares"):
+        _member_shares(bad)

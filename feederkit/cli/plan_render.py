@@ -21,7 +21,7 @@ from feederkit.errors import InputError
 from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
 from feederkit.plans.fileformat import MAX_PLAN_BYTES, as_plan, read_plan
-from feederkit.plans.model import Leaf, Plan, Step
+from feederkit.plans.model import Leaf, Plan, Step, member_label
 from feederkit.plans.verify import VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
 
@@ -64,10 +64,26 @@ def _interval(r: tuple[float, float] | None) -> str:
 def _result_text(leaf: Leaf, plan: Plan) -> Text:
     parts = []
     for e in leaf.results:
-        s = plan.part(e.part).state(e.state)
-        parts.append(f"{e.part} state {e.state} (edge {s.edge}), pose {e.pose_deg:.6g}°")
+        s = plan.part(e.part, e.landing).state(e.state)
+        who = member_label(e.part, e.landing)
+        parts.append(f"{who} state {e.state} (edge {s.edge}), pose {e.pose_deg:.6g}°")
+    if leaf.reject:
+        landings = sorted({member_label(e.part, e.landing) for e in leaf.results})
+        lead = "reject (recirculate or re-drop): " + ", ".join(landings)
+        return Text(lead, style="bold yellow")
     lead = "done: " if len(leaf.results) == 1 else "done, one of: "
     return Text(lead + "; ".join(parts), style="bold green")
+
+
+def _uses(plan: Plan) -> dict[int, int]:
+    """How many branches lead to each distinct step (more than one: a shared subplan)."""
+    uses: dict[int, int] = {}
+    for node, _number in plan.walk():
+        if isinstance(node, Step):
+            for b in node.branches:
+                if isinstance(b.next, Step):
+                    uses[id(b.next)] = uses.get(id(b.next), 0) + 1
+    return uses
 
 
 def _op_text(step: Step, number: int) -> Text:
@@ -81,13 +97,25 @@ def _op_text(step: Step, number: int) -> Text:
 def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
     """The plan as a tree: operations, rotations and margins, reading intervals, results.
 
-    A chain of single-branch operations stays flat; built without recursion.
+    A chain of single-branch operations stays flat; a shared subplan (the file's
+    ``"nodes"``) is drawn once, with a letter, and named by it in its other places, so the
+    drawing grows with the distinct nodes; built without recursion.
     """
     plan = as_plan(plan)
     tree = Tree(Text(f"plan: at most {plan.stats.length} push-align operations", style="bold"))
+    uses = _uses(plan)
+    names: dict[int, str] = {}
     stack: list[tuple[Tree, Step, int]] = [(tree, plan.root, 1)]
     while stack:
         parent, step, number = stack.pop()
+        if uses.get(id(step), 0) > 1:
+            if id(step) in names:
+                parent.add(
+                    Text(f"the shared subplan {names[id(step)]} (drawn above)", style="cyan")
+                )
+                continue
+            names[id(step)] = f"S{len(names) + 1}"
+            parent = parent.add(Text(f"shared subplan {names[id(step)]}:", style="cyan"))
         while len(step.branches) == 1:  # a chain of single-branch operations
             (b,) = step.branches
             label = _op_text(step, number)
@@ -96,6 +124,9 @@ def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
             parent.add(label)
             if isinstance(b.next, Leaf):
                 parent.add(_result_text(b.next, plan))
+                break
+            if uses.get(id(b.next), 0) > 1:
+                stack.append((parent, b.next, number + 1))
                 break
             step, number = b.next, number + 1
         else:
@@ -121,7 +152,10 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
     t.add_column("what")
     t.add_column("value")
     t.add_row("length (worst case, first alignment counted)", str(s.length))
-    t.add_row("expected operations (uniform start)", f"{s.expected_length:.4f}")
+    weighted = (
+        "uniform start, members weighted by share" if plan.parts[0].share else "uniform start"
+    )
+    t.add_row(f"expected operations ({weighted})", f"{s.expected_length:.4f}")
     margin = s.min_margin_deg
     shown = "no rotation" if margin is None else f"±{margin:.4f}°"
     if plan.low_margin_warning():
@@ -150,7 +184,8 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
 
 def trace_table(trace: Trace) -> Table:
     """One run, step by step: rotation, where the part rests, reading and branch."""
-    t = Table(title=f"{trace.part} from theta {trace.start_theta_deg:.6g}°")
+    who = member_label(trace.part, trace.landing)
+    t = Table(title=f"{who} from theta {trace.start_theta_deg:.6g}°")
     for col in ("op", "rotation", "theta", "state (edge)", "diameter", "reading", "branch"):
         t.add_column(col)
     for s in trace.steps:
@@ -190,9 +225,18 @@ def verification_table(report: VerificationReport, plan: Plan | None = None) -> 
     if plan is not None:
         title += " " + verification_title(plan).removeprefix("verified ")
     t = Table(title=title)
-    for col in ("part", "starts", "paths", "worst operations", "failed starts"):
+    landings = any(p.landing is not None for p in report.parts)
+    cols = (
+        ["part", "landing", "starts", "paths", "rejects"]
+        if landings
+        else ["part", "starts", "paths"]
+    )
+    for col in (*cols, "worst operations", "failed starts"):
         t.add_column(col)
     for p in report.parts:
         failed = Text(str(p.failed_starts), style="bold red" if p.failed_starts else "green")
-        t.add_row(p.part, str(p.starts), str(p.paths), str(p.worst_operations), failed)
+        head = [p.part, str(p.landing), str(p.starts), str(p.paths), str(p.rejects)]
+        if not landings:
+            head = [p.part, str(p.starts), str(p.paths)]
+        t.add_row(*head, str(p.worst_operations), failed)
     return t

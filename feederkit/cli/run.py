@@ -5,7 +5,10 @@ without SOURCE every part of the plan is run; a SOURCE names a part that must be
 plan's (same hull and COM: the plan is checked against the current part). One run from
 ``--start-deg`` step by step, or ``--all`` for the full verification at the plan's declared
 uncertainty (a strong plan: every outcome and reading; the ideal model: the kinematic model).
-Exit 1 when anything fails, including a plan that fails verification.
+In a plan over landings every member is a part in one landing: the tables and messages name
+it as ``PART (LANDING)``, and a run that ends in a reject result says "reject" (the next
+station cannot take that landing: recirculate or re-drop). Exit 1 when anything fails,
+including a plan that fails verification.
 """
 
 from __future__ import annotations
@@ -93,7 +96,19 @@ def run_command(
         else:
             console.print(verification_table(report, plan))
             if report.ok:
-                console.print(f"all {report.paths} paths end in their result", highlight=False)
+                rejects = sum(p.rejects for p in report.parts)
+                tail = ""
+                if rejects:
+                    tail = (
+                        f", {rejects} of them in a reject result (a landing the next station "
+                        "cannot take: recirculate or re-drop)"
+                    )
+                console.print(
+                    f"all {report.paths} paths end in their result{tail}",
+                    highlight=False,
+                    markup=False,
+                    soft_wrap=True,
+                )
         if not report.ok:
             raise CheckFailed(f"the plan failed: {report.first_problem()}")
         return

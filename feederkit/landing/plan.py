@@ -1,22 +1,39 @@
-"""Plan a part over its landings: each landing is one member of a mix (section 8.5).
+"""Plan parts over their landings: each landing is one member of a mix (section 8.5).
 
 The paper's multi-part planner orients a product mix and tells its parts apart; the
-landings of one part (``up``/``down``, mesh poses) are such members: the plan's results name
-the landing's part (``PART/up``, ``PART/pose-2``), which :class:`LandingPlan` maps back to
-``(part, landing, state)``. Landings that no plan can tell apart (section 8.4) are reported
-as the mix's indistinguishable pairs, and a result leaf then lists several landings. The
-planners and the plan file are used unchanged (docs/landings.md says what is left for them).
+landings of a part (``up``/``down``, mesh poses) are such members. Each member carries its
+prior share (the part's share times the landing's probability, normalised over the landings
+planned) and whether the next station takes it: the planners weight the expected length by
+the shares and end every set of rejected landings' states in a reject leaf
+(:func:`feederkit.plans.make.make_plan`). The plan file (version 2) names part and landing
+in every result; :class:`LandingPlan` reads them back as :class:`LandingResult`. Landings
+that no plan can tell apart (section 8.4) are reported as the mix's indistinguishable pairs,
+and a result leaf then lists several landings. :func:`load_landings` finds the landings of
+the sources a command names. docs/landings.md has the details.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import os
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
+from feederkit.catalog import default_catalog_path, get_revision, landings_for
 from feederkit.errors import InputError
-from feederkit.landing.model import Landing
-from feederkit.mechanics.push import push_function
-from feederkit.mix.changeover import plan_mix
+from feederkit.importers import ImportOptions
+from feederkit.importers.orientable import orientability
+from feederkit.importers.reader import MESH_SUFFIXES, import_parts
+from feederkit.landing.model import (
+    Landing,
+    check_landing_name,
+    landings_of_outline,
+    select_landings,
+)
+from feederkit.loading import LoadedParts, load_parts
+from feederkit.mechanics.analysis import fragile_warning
+from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.mix.changeover import landing_members, plan_mix
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import plan_from_dict
@@ -46,6 +63,18 @@ class LandingResult:
 
 
 @dataclass(frozen=True)
+class LandingLeaf:
+    """A result leaf of a plan over landings: its entries, and whether it is a reject leaf
+    (every entry a landing the next station cannot take). Iterating gives the entries."""
+
+    results: tuple[LandingResult, ...]
+    reject: bool = False
+
+    def __iter__(self) -> Iterator[LandingResult]:
+        return iter(self.results)
+
+
+@dataclass(frozen=True)
 class LandingPair:
     """Two landings no plan can tell apart, and the witness of the mix analysis."""
 
@@ -56,33 +85,47 @@ class LandingPair:
 
 @dataclass(frozen=True)
 class LandingPlan:
-    """A verified plan over landings, its landings in plan-part order, and the pairs of
-    landings no plan can tell apart."""
+    """A verified plan over landings, its landings in plan-part order, the pairs of landings
+    no plan can tell apart, and the labels (``PART/LANDING``) of the landings it rejects."""
 
     landings: tuple[Landing, ...]
     made: MadePlan
     indistinguishable: tuple[LandingPair, ...]
+    rejected: frozenset[str] = frozenset()
 
-    def landing_of(self, plan_part: str) -> Landing:
-        """The landing whose part the plan calls ``plan_part`` (``PART/LANDING``)."""
+    def landing_of(self, part: str, landing: str | None = None) -> Landing:
+        """The landing ``landing`` of ``part`` (or, with one argument, the one labelled
+        ``PART/LANDING``); InputError when the plan has none."""
         for x in self.landings:
-            if x.label == plan_part:
+            if (x.part_name, x.name) == (part, landing) or (landing is None and x.label == part):
                 return x
-        raise InputError(f"the plan has no landing part {plan_part!r}")
+        shown = part if landing is None else f"{part}/{landing}"
+        raise InputError(f"the plan has no landing {shown!r}")
 
     def resolve(self, entry: Mapping[str, object]) -> LandingResult:
-        """A plan file result entry (``{"part": "PART/LANDING", "state", "pose_deg"}``) as
-        the part, its landing and its state."""
-        x = self.landing_of(str(entry["part"]))
+        """A plan file result entry (``{"part", "landing", "state", "pose_deg"}``) as the
+        part, its landing and its state."""
+        landing = entry.get("landing")
+        x = self.landing_of(str(entry["part"]), None if landing is None else str(landing))
         return LandingResult(x.part_name, x.name, int(entry["state"]), float(entry["pose_deg"]))
 
-    def leaves(self) -> tuple[tuple[LandingResult, ...], ...]:
+    def leaves(self) -> tuple[LandingLeaf, ...]:
         """Every result leaf of the plan (pre-order) with its entries resolved."""
         plan = plan_from_dict(self.made.plan)
         return tuple(
-            tuple(
-                self.resolve({"part": e.part, "state": e.state, "pose_deg": e.pose_deg})
-                for e in leaf.results
+            LandingLeaf(
+                tuple(
+                    self.resolve(
+                        {
+                            "part": e.part,
+                            "landing": e.landing,
+                            "state": e.state,
+                            "pose_deg": e.pose_deg,
+                        }
+                    )
+                    for e in leaf.results
+                ),
+                leaf.reject,
             )
             for leaf in plan.leaves()
         )
@@ -94,15 +137,20 @@ def plan_landings(
     options: PlanningOptions | None = None,
     *,
     uncertainty: Uncertainty | None = None,
+    accept: Collection[str] | None = None,
+    part_shares: Sequence[float] | None = None,
 ) -> LandingPlan:
     """Plan over ``landings`` (of one part, or of several) as the members of one mix.
 
     Every landing's part becomes a push function for
     :func:`feederkit.mix.changeover.plan_mix` (which goes through
-    :func:`feederkit.plans.make.make_plan` and verifies the plan); ``uncertainty`` defaults
-    to design.md's. The landings' probabilities are not used by the planners yet: the plan
-    is a strong plan for every landing. Raises InputError for no landings or two with the
-    same label.
+    :func:`feederkit.plans.make.make_plan` and verifies the plan), with the shares and
+    accept/reject of :func:`~feederkit.mix.changeover.landing_members` (``part_shares``: the
+    parts' shares of a mix, None: equal); ``uncertainty`` defaults to design.md's. The
+    pairs reported leave out those of two rejected landings (the plan need not tell them
+    apart). Raises InputError for no landings, two with the same label, an accepted name
+    that is no landing, or every landing rejected, PlanningError when an accepted and a
+    rejected landing cannot be told apart.
     """
     members = tuple(landings)
     if not members:
@@ -111,8 +159,108 @@ def plan_landings(
     dup = sorted({n for n in labels if labels.count(n) > 1})
     if dup:
         raise InputError(f"landing {dup[0]} is given twice")
+    named = landing_members(members, accept, part_shares)
     pfs = [push_function(x.part) for x in members]
-    made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
+    made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, members=named)
     by_label = {x.label: x for x in members}
-    found = tuple(LandingPair(by_label[w.part_a], by_label[w.part_b], w) for w in pairs)
-    return LandingPlan(members, made, found)
+    rejected = frozenset(x.label for x, m in zip(members, named, strict=True) if not m.accept)
+    found = tuple(
+        LandingPair(by_label[w.part_a], by_label[w.part_b], w)
+        for w in pairs
+        if not {w.part_a, w.part_b} <= rejected
+    )
+    return LandingPlan(members, made, found, rejected)
+
+
+@dataclass(frozen=True)
+class LoadedLandings:
+    """The parts to plan for (:class:`LoadedParts`) and, per part in the same order, the
+    landings selected (design.md, "Landings")."""
+
+    parts: LoadedParts
+    landings: tuple[tuple[Landing, ...], ...]
+
+    @property
+    def all(self) -> tuple[Landing, ...]:
+        """Every selected landing of every part, part by part."""
+        return tuple(x for lands in self.landings for x in lands)
+
+    @property
+    def several(self) -> bool:
+        """Whether some part has more than one landing selected."""
+        return any(len(lands) > 1 for lands in self.landings)
+
+
+def landing_names(text: str, what: str = "--landings") -> tuple[str, ...]:
+    """Landing names from ``LANDING,...`` (``up``, ``down``, ``pose-K`` or ``K`` for
+    ``pose-K``); InputError naming ``what`` for an empty list or a name that is no landing."""
+    names = []
+    for item in text.split(","):
+        item = item.strip()
+        if not item:
+            raise InputError(f"{what}: an empty landing name in {text!r}")
+        name = f"pose-{int(item)}" if item.isdigit() else item
+        try:
+            check_landing_name(name)
+        except InputError as exc:
+            raise InputError(f"{what}: {exc}") from None
+        if name not in names:
+            names.append(name)
+    return tuple(names)
+
+
+def _landings_of(
+    source: str,
+    pf: PushFunction,
+    catalog: str | None,
+    options: ImportOptions | None,
+) -> tuple[Landing, ...]:
+    """The landings of the part loaded from ``source``: a catalog part's stored ones (computed
+    from its outline for a revision stored before landings), ``up`` and ``down`` of an
+    outline or DXF file (one when the sides are congruent), every resting pose of a mesh."""
+    path = Path(source)
+    if path.is_file():
+        if path.suffix.lower() not in MESH_SUFFIXES:
+            return landings_of_outline(pf.part)
+        opts = options or ImportOptions()
+        _, imported = import_parts(path, opts)
+        return landings_for(imported[0], opts, path)
+    db = Path(catalog) if catalog is not None else default_catalog_path()
+    revision = None if pf.part.revision is None else int(pf.part.revision)
+    stored = get_revision(db, pf.part.name, revision).landings
+    return stored or landings_of_outline(pf.part)
+
+
+def load_landings(
+    sources: Sequence[str],
+    *,
+    catalog: str | os.PathLike[str] | None = None,
+    options: ImportOptions | None = None,
+    which: str | Sequence[str] = "all",
+) -> LoadedLandings:
+    """Load the parts of ``sources`` (:func:`load_parts`) with their landings, ``which``
+    selecting them (``"all"`` or landing names, :func:`feederkit.landing.select_landings`).
+
+    Raises InputError as :func:`load_parts` does, for a landing a part does not have, and
+    for a selected landing that pushing cannot orient (a mesh pose on a round face).
+    """
+    loaded = load_parts(sources, catalog=catalog, options=options)
+    db = None if catalog is None else str(Path(catalog))
+    per_part = []
+    warnings = list(loaded.warnings)
+    for source, pf in zip(sources, loaded.push_functions, strict=True):
+        lands = select_landings(_landings_of(source, pf, db, options), which)
+        for x in lands:
+            if x.name.startswith("pose-"):
+                verdict = orientability(x.part, None)
+                if not verdict.orientable:
+                    raise InputError(
+                        f"{source}: landing {x.name} is not orientable by pushing: "
+                        f"{verdict.reason}; choose the landings to plan with --landings"
+                    )
+                fragile = fragile_warning(push_function(x.part))
+                if fragile is not None and fragile not in warnings:
+                    warnings.append(fragile)
+        per_part.append(lands)
+    parts = LoadedParts(loaded.push_functions, tuple(warnings), loaded.left_out)
+    return LoadedLandings(parts, tuple(per_part))

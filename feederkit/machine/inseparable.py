@@ -21,23 +21,37 @@ copies) and Lemma 8 twins stay inseparable. docs/planning.md ("Strong plans") sa
 
 from __future__ import annotations
 
+import bisect
 from collections import defaultdict
 from collections.abc import Callable, Hashable, Iterable, Sequence
 from typing import TypeVar
 
-from feederkit.angles import merge_boundaries
+import numpy as np
+
+from feederkit.angles import ANGLE_EPS, merge_boundaries, norm360
 from feederkit.machine.model import PushAlignMachine, target_at
 
 P = TypeVar("P", bound=Hashable)
 
+Check = Callable[[], None]
+"""A budget's poll (``Deadline.check`` of :mod:`feederkit.planning.budget`): raises to stop."""
 
-def prune_pairs(alive: set[P], dead: list[P], preds: dict[P, list[P]]) -> None:
+
+def _no_check() -> None:
+    return None
+
+
+def prune_pairs(
+    alive: set[P], dead: list[P], preds: dict[P, list[P]], check: Check = _no_check
+) -> None:
     """The worklist step of a greatest fixpoint over state pairs, in place.
 
     Removes the ``dead`` pairs from ``alive`` and, transitively, every alive pair that some
-    action sends to a removed one (``preds[q]``: the pairs that lead to ``q``).
+    action sends to a removed one (``preds[q]``: the pairs that lead to ``q``). ``check``
+    is polled once per pair (a budget stops the fixpoint by raising).
     """
     while dead:
+        check()
         p = dead.pop()
         if p not in alive:
             continue
@@ -45,15 +59,19 @@ def prune_pairs(alive: set[P], dead: list[P], preds: dict[P, list[P]]) -> None:
         dead.extend(q for q in preds.get(p, ()) if q in alive)
 
 
-def greatest_fixpoint(alive: set[P], successors: Callable[[P], Iterable[P] | None]) -> set[P]:
+def greatest_fixpoint(
+    alive: set[P], successors: Callable[[P], Iterable[P] | None], check: Check = _no_check
+) -> set[P]:
     """The largest subset of ``alive`` closed under ``successors``, in place.
 
     ``successors(p)`` lists where the actions send pair ``p``, or is None when some action
     merges it (it is then separable). A pair is dropped when a successor is not alive.
+    ``check`` is polled once per pair.
     """
     preds: dict[P, list[P]] = defaultdict(list)
     dead: list[P] = []
     for p in alive:
+        check()
         nxt = successors(p)
         if nxt is None:
             dead.append(p)
@@ -63,7 +81,7 @@ def greatest_fixpoint(alive: set[P], successors: Callable[[P], Iterable[P] | Non
                 dead.append(p)
                 break
             preds[q].append(p)
-    prune_pairs(alive, dead, preds)
+    prune_pairs(alive, dead, preds, check)
     return alive
 
 
@@ -85,31 +103,157 @@ def pair_successors(
     return out
 
 
-def inseparable_masks(machine: PushAlignMachine) -> tuple[int, ...]:
+def _norm360(a: np.ndarray) -> np.ndarray:
+    """:func:`feederkit.angles.norm360` elementwise."""
+    r = np.fmod(a, 360.0) + 0.0
+    r = np.where(r < 0.0, r + 360.0, r)
+    return np.where(r >= 360.0 - 1e-12, 0.0, r)
+
+
+SMALL_MAPS = 48
+"""Pairs of states with fewer action-range boundaries than this are merged in plain Python
+(numpy's per-call cost is larger than the work)."""
+
+DENSE_STATES = 4000
+"""Up to this many states the fixpoint keeps the alive pairs in an n x n boolean array."""
+
+
+class _PairCells:
+    """The overlap ranges of two states' action maps (section 3.2.2).
+
+    ``ranges(i, j)`` gives, for each cell of ``merge_boundaries([starts[i], starts[j]])`` in
+    rotation order, the index of the range of ``i`` and of ``j`` holding the cell's middle
+    (what :func:`target_at` looks up). Long maps are merged with numpy; the cells are
+    exactly those of ``merge_boundaries`` (where a chain of boundaries closer than
+    ``ANGLE_EPS`` spans more than it, so a gap test and the chained merge could differ, the
+    merge itself is called).
+    """
+
+    def __init__(self, starts: Sequence[Sequence[float]]) -> None:
+        self.starts = starts
+        self.arrays = [np.asarray(s, dtype=float) for s in starts]
+
+    def ranges(self, i: int, j: int) -> tuple[Sequence[int], Sequence[int]]:
+        """Per cell, the range index of ``i`` and of ``j`` (lists, or arrays for long maps)."""
+        sa, sb = self.starts[i], self.starts[j]
+        if len(sa) + len(sb) < SMALL_MAPS:
+            bounds = merge_boundaries([sa, sb])
+            m = len(bounds)
+            ka, kb = [], []
+            for k in range(m):
+                hi = bounds[k + 1] if k + 1 < m else bounds[0] + 360.0
+                mid = norm360((bounds[k] + hi) / 2.0)
+                ka.append(bisect.bisect_right(sa, mid) - 1)
+                kb.append(bisect.bisect_right(sb, mid) - 1)
+            return ka, kb
+        a, b = self.arrays[i], self.arrays[j]
+        allb = np.sort(_norm360(np.concatenate((a, b))))
+        keep = np.empty(len(allb), dtype=bool)
+        keep[0] = True
+        np.greater(np.diff(allb), ANGLE_EPS, out=keep[1:])
+        nb = allb[keep]
+        if len(nb) < len(allb) and np.any(allb - nb[np.cumsum(keep) - 1] > ANGLE_EPS):
+            nb = np.asarray(merge_boundaries([sa, sb]))
+        if len(nb) > 1 and nb[0] + 360.0 - nb[-1] <= ANGLE_EPS:
+            nb = nb[:-1]
+        his = np.empty(len(nb))
+        his[:-1] = nb[1:]
+        his[-1] = nb[0] + 360.0
+        mid = _norm360((nb + his) / 2.0)
+        ka = np.searchsorted(a, mid, side="right") - 1
+        kb = np.searchsorted(b, mid, side="right") - 1
+        return ka, kb
+
+
+def inseparable_masks(machine: PushAlignMachine, check: Check | None = None) -> tuple[int, ...]:
     """For each state, the mask of states it is inseparable from (see the module docstring).
 
     Starts from the pairs whose readings can agree; drops a pair when some action merges it
-    or sends it to a dropped pair, until nothing changes.
+    or sends it to a dropped pair, until nothing changes. ``check`` (a planning budget's
+    poll) is called every few pairs and stops the fixpoint by raising.
     """
+    check = _no_check if check is None else check
     n = machine.n
     sensor = machine.sensor
     d = [s.sensed for s in machine.states]
-    starts, targets = machine.starts, machine.targets
-    alive = {(i, j) for i in range(n) for j in range(i + 1, n) if sensor.can_read_alike(d[i], d[j])}
+    alive: set[tuple[int, int]] = set()
+    for i in range(n):
+        check()
+        di = d[i]
+        alive.update((i, j) for j in range(i + 1, n) if sensor.can_read_alike(di, d[j]))
+    cells = _PairCells(machine.starts)
     if not machine.deterministic:
-        return _masks(_bisimilar(machine, alive), n)
+        return _masks(_bisimilar(machine, alive, cells, check), n)
+    targets = machine.targets
 
     def successors(p: tuple[int, int]) -> list[tuple[int, int]] | None:
         i, j = p
-        out = []
-        for a, b in pair_successors(starts[i], targets[i], starts[j], targets[j]):
+        ka, kb = cells.ranges(i, j)
+        ti, tj = targets[i], targets[j]
+        out = set()
+        for x, y in zip(ka, kb, strict=True):
+            a, b = ti[x], tj[y]
             if a == b:
                 return None
-            out.append((a, b) if a < b else (b, a))
-        return out
+            out.add((a, b) if a < b else (b, a))
+        return list(out)
 
-    greatest_fixpoint(alive, successors)
-    return _masks(alive, n)
+    if n > DENSE_STATES or not alive:
+        greatest_fixpoint(alive, successors, check)
+        return _masks(alive, n)
+    arrays = [np.asarray(t, dtype=np.int64) for t in targets]
+
+    def successor_arrays(p: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
+        i, j = p
+        ka, kb = cells.ranges(i, j)
+        a, b = arrays[i][ka], arrays[j][kb]
+        if np.any(a == b):
+            return None
+        return np.minimum(a, b), np.maximum(a, b)
+
+    return _masks(_dense_fixpoint(n, sorted(alive), successor_arrays, check), n)
+
+
+def _dense_fixpoint(
+    n: int,
+    pairs: list[tuple[int, int]],
+    successors: Callable[[tuple[int, int]], tuple[np.ndarray, np.ndarray] | None],
+    check: Check,
+) -> set[tuple[int, int]]:
+    """:func:`greatest_fixpoint` in rounds over arrays: the alive pairs an ``n x n``
+    boolean table, every pair's successors one flat array; each round drops, at once, the
+    pairs with a successor no longer alive."""
+    owner: list[np.ndarray] = []
+    lo: list[np.ndarray] = []
+    hi: list[np.ndarray] = []
+    live = np.ones(len(pairs), dtype=bool)
+    for k, p in enumerate(pairs):
+        check()
+        nxt = successors(p)
+        if nxt is None:
+            live[k] = False
+            continue
+        owner.append(np.full(len(nxt[0]), k, dtype=np.int64))
+        lo.append(nxt[0])
+        hi.append(nxt[1])
+    pi = np.array([p[0] for p in pairs], dtype=np.int64)
+    pj = np.array([p[1] for p in pairs], dtype=np.int64)
+    table = np.zeros((n, n), dtype=bool)
+    table[pi[live], pj[live]] = True
+    own = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
+    slo = np.concatenate(lo) if lo else own
+    shi = np.concatenate(hi) if hi else own
+    while True:
+        check()
+        keep = live[own]
+        own, slo, shi = own[keep], slo[keep], shi[keep]
+        broken = own[~table[slo, shi]]
+        if len(broken) == 0:
+            break
+        dead = np.unique(broken)
+        live[dead] = False
+        table[pi[dead], pj[dead]] = False
+    return {pairs[k] for k in np.flatnonzero(live).tolist()}
 
 
 def _masks(pairs: set[tuple[int, int]], n: int) -> tuple[int, ...]:
@@ -143,11 +287,26 @@ def _bits(mask: int) -> list[int]:
     return out
 
 
-def _bisimilar(machine: PushAlignMachine, alive: set[tuple[int, int]]) -> set[tuple[int, int]]:
+def _bisimilar(
+    machine: PushAlignMachine,
+    alive: set[tuple[int, int]],
+    cells: _PairCells,
+    check: Check,
+) -> set[tuple[int, int]]:
     """The greatest bisimulation inside ``alive`` (pairs ``i < j``), in place: a pair stays
     while, on every overlap range, each outcome of either state has a different outcome of
-    the other that is still paired with it."""
-    cases = {p: sorted(set(pair_outcomes(machine, *p))) for p in alive}
+    the other that is still paired with it.
+
+    A worklist: a pair is looked at again only when a pair its cases mention was dropped.
+    """
+    outs = machine.outcomes_of
+    cases: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for p in alive:
+        check()
+        i, j = p
+        ka, kb = cells.ranges(i, j)
+        oi, oj = outs[i], outs[j]
+        cases[p] = sorted({(oi[x], oj[y]) for x, y in zip(ka, kb, strict=True)})
 
     def linked(x: int, y: int) -> bool:
         return x != y and ((x, y) if x < y else (y, x)) in alive
@@ -158,11 +317,29 @@ def _bisimilar(machine: PushAlignMachine, alive: set[tuple[int, int]]) -> set[tu
             any(linked(x, y) for x in xs) for y in ys
         )
 
-    changed = True
-    while changed:
-        changed = False
-        for p in sorted(alive):
-            if not all(matched(a, b) for a, b in cases[p]):
-                alive.discard(p)
-                changed = True
+    # Who mentions whom: a pair's cases name the pairs (x, y) of an outcome of each state.
+    users: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
+    for p, cs in cases.items():
+        check()
+        named = set()
+        for a, b in cs:
+            for x in _bits(a):
+                for y in _bits(b):
+                    if x != y:
+                        named.add((x, y) if x < y else (y, x))
+        for q in named:
+            if q in alive:
+                users[q].append(p)
+    todo = sorted(alive)
+    queued = set(todo)
+    while todo:
+        check()
+        p = todo.pop()
+        queued.discard(p)
+        if p in alive and not all(matched(a, b) for a, b in cases[p]):
+            alive.discard(p)
+            for u in users.get(p, ()):
+                if u in alive and u not in queued:
+                    queued.add(u)
+                    todo.append(u)
     return alive

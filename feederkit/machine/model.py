@@ -29,9 +29,16 @@ class MachineState:
     """A state of the machine: stable state ``state`` of part ``part``.
 
     ``weight`` is the probability that the first alignment from a uniformly random
-    orientation ends here (resting range / 360, divided by the number of parts).
+    orientation ends here (resting range / 360 times the member's prior share: divided by
+    the number of parts unless :func:`feederkit.machine.weights.weigh_members` gave shares).
     Under uncertainty ``state`` is the first of the ideal ``members`` of a physical resting
     state and ``diameter_range`` the interval of widths it can show (``diameter`` its middle).
+    On the ideal model a snapped state's ``diameter`` is its cluster's smallest value and
+    ``diameter_range`` (when set) the cluster's span (:func:`feederkit.machine.build.snap_spans`).
+    ``reject`` marks a state of a member the next station cannot take (a rejected landing,
+    design.md "Landings"): a set of only such states is a goal, a reject leaf
+    (:attr:`feederkit.machine.space.SearchSpace.inseparable`). It travels with the state, so
+    renumbering the states keeps it.
     """
 
     part: int
@@ -40,6 +47,7 @@ class MachineState:
     weight: float
     diameter_range: tuple[float, float] | None = None
     members: tuple[int, ...] = ()
+    reject: bool = False
 
     @property
     def sensed(self) -> Diameter:

@@ -4,7 +4,8 @@ A node of a plan's search holds the set of states consistent with the operations
 bit mask). For a set this module gives its overlap ranges (section 3.2.2) with their
 images (under uncertainty: the ranges of rotations over which every member's outcome set
 stays the same, the image the union of those sets), its reading branches (section 5), and
-whether it is oriented (the goal, see :mod:`feederkit.machine.inseparable`).
+whether it is oriented (the goal, see :mod:`feederkit.machine.inseparable`) or holds only
+states of rejected landings (a reject leaf).
 :class:`SearchSpace` owns the per-machine tables these need; :func:`search_space` builds
 one per machine, once.
 """
@@ -18,7 +19,7 @@ import numpy as np
 
 from feederkit.angles import ANGLE_EPS, norm360
 from feederkit.machine.inseparable import inseparable_masks
-from feederkit.machine.model import OverlapRange, PushAlignMachine, members
+from feederkit.machine.model import OverlapRange, PushAlignMachine, mask_of, members
 from feederkit.sensors import Grouping, ReadingBranch
 
 _NUMPY_MIN_EVENTS = 256
@@ -83,9 +84,30 @@ class SearchSpace:
         return lo, st, mk, last
 
     @cached_property
-    def inseparable(self) -> tuple[int, ...]:
-        """For each state, the mask of states it is inseparable from."""
+    def bisimilar(self) -> tuple[int, ...]:
+        """For each state, the mask of states no plan can tell it from or merge it with
+        (:func:`~feederkit.machine.inseparable.inseparable_masks`)."""
         return inseparable_masks(self.machine)
+
+    @cached_property
+    def rejected(self) -> int:
+        """The mask of the states of rejected members (``MachineState.reject``)."""
+        return mask_of(i for i, s in enumerate(self.machine.states) if s.reject)
+
+    @cached_property
+    def inseparable(self) -> tuple[int, ...]:
+        """For each state, the mask of states a plan need not tell it from: the goal relation.
+
+        The :attr:`bisimilar` states and, for a state of a rejected member, every other
+        state of a rejected member: a set of only rejected states ends in a reject leaf as
+        soon as the plan knows it (design.md "Landings"), whichever of them the part is in.
+        Without rejected members it is :attr:`bisimilar` itself.
+        """
+        base = self.bisimilar
+        rej = self.rejected
+        if not rej:
+            return base
+        return tuple(b | (rej & ~(1 << i)) if rej >> i & 1 else b for i, b in enumerate(base))
 
     def is_goal(self, mask: int) -> bool:
         """Whether every pair of states in ``mask`` is inseparable: the set is oriented."""
@@ -98,9 +120,10 @@ class SearchSpace:
         The cells are those of ``merge_boundaries`` (boundaries within ANGLE_EPS merged),
         each with the image of its middle rotation, found by one sweep over the sorted
         boundaries that keeps each member's successor up to date: O(k n log(k n)) for k
-        states of a part with n. Large sets of one part are swept with numpy. Merging is
-        sound: every rotation inside a merged range sends the set to the same image, so its
-        half-width is the rotation error the action really tolerates.
+        states of a part with n. Large sets of one part are swept with numpy. Every rotation
+        inside a merged range sends the set to the same image, but a merged range may hold a
+        member's boundary (a divergent orientation) inside it, so its half-width is not a
+        margin: planners rotate in :meth:`~feederkit.planning.choices.Choices.fixed_cells`.
         """
         idx = members(mask)
         table = self.numpy_table

@@ -1,4 +1,5 @@
-"""Plans as files a controller can run: JSON version 1, execution and verification on geometry.
+"""Plans as files a controller can run: JSON version 2 (version 1 read), execution and
+verification on geometry; plans over landings (reject results) and shared subplans.
 
 - :mod:`~feederkit.plans.model`: the one immutable :class:`Plan` (parts, sensor, tree, stats).
 - :mod:`~feederkit.plans.fileformat`: the only maker and writer of a Plan:
@@ -33,6 +34,7 @@ from feederkit.plans.model import (
     Branch,
     Leaf,
     Plan,
+    PlanMember,
     PlanPart,
     PlanStats,
     ResultEntry,
@@ -52,6 +54,7 @@ __all__ = [
     "Leaf",
     "PartCheck",
     "Plan",
+    "PlanMember",
     "PlanPart",
     "PlanStats",
     "ResultEntry",

@@ -5,6 +5,8 @@ plan was made on, only at geometry (the push function of section 3.1, computed f
 and COM the plan records) and at the plan itself. A controller does the same steps: rotate
 by ``action_deg``, let the part align (the push function), read the diameter, follow the
 branch whose closed interval holds the reading (:meth:`~feederkit.plans.model.Branch.holds`).
+A run that ends in a reject leaf (design.md, "Landings": a landing the next station cannot
+take) is right when the leaf lists the part's landing and state; its message says "reject".
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from typing import Any, Literal
 
 from feederkit.mechanics.push import StableState, push, rotation_after
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan, Step, push_function_of
+from feederkit.plans.model import Leaf, Plan, ResultEntry, Step, member_label, push_function_of
 from feederkit.sensors import Sensor
 
 ReadingChoice = Literal["nominal", "low", "high"] | Sequence[float | None]
@@ -99,8 +101,10 @@ class TraceStep:
 class Trace:
     """One execution of a plan for one part from one start.
 
-    ``result`` is the leaf's entries ``(part, state, pose_deg)`` (empty when the run stopped
-    on a reading no branch holds); ``success``: the part's final (part, state) is among them.
+    ``result`` is the leaf's entries (empty when the run stopped on a reading no branch
+    holds); ``success``: the part's final (part, landing, state) is among them. ``landing``
+    is the member's landing (None: a plan not made over landings); ``reject``: the run ended
+    in a reject leaf, the part is to be recirculated or re-dropped.
     """
 
     part: str
@@ -108,23 +112,37 @@ class Trace:
     steps: tuple[TraceStep, ...]
     final_state: int
     final_pose_deg: float
-    result: tuple[tuple[str, int, float], ...]
+    result: tuple[ResultEntry, ...]
     success: bool
     message: str
+    landing: str | None = None
+    reject: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The trace as JSON."""
         return {
             "part": self.part,
+            "landing": self.landing,
             "start_theta_deg": self.start_theta_deg,
             "steps": [s.to_dict() for s in self.steps],
             "final_state": self.final_state,
             "final_pose_deg": self.final_pose_deg,
-            "result": [{"part": p, "state": s, "pose_deg": a} for p, s, a in self.result],
+            "result": [entry_dict(e) for e in self.result],
+            "reject": self.reject,
             "operations": len(self.steps),
             "success": self.success,
             "message": self.message,
         }
+
+
+def entry_dict(e: ResultEntry) -> dict[str, Any]:
+    """A result entry as the plan file writes it (``landing`` only when planned over
+    landings)."""
+    out: dict[str, Any] = {"part": e.part}
+    if e.landing is not None:
+        out["landing"] = e.landing
+    out.update(state=e.state, pose_deg=e.pose_deg)
+    return out
 
 
 def _ops(k: int) -> str:
@@ -134,6 +152,11 @@ def _ops(k: int) -> str:
 def leaf_entries(leaf: Leaf) -> tuple[tuple[str, int, float], ...]:
     """A leaf's entries as ``(part, state, pose_deg)``."""
     return tuple((e.part, e.state, e.pose_deg) for e in leaf.results)
+
+
+def entry_text(e: ResultEntry) -> str:
+    """A result entry in words: ``PART (LANDING) state S``."""
+    return f"{member_label(e.part, e.landing)} state {e.state}"
 
 
 def path_text(steps: Sequence[TraceStep]) -> str:
@@ -155,13 +178,16 @@ def finish(
     steps: Sequence[TraceStep],
     state: StableState,
     leaf: Leaf | None,
+    landing: str | None = None,
 ) -> Trace:
-    """The trace of a run that ended in ``state`` at ``leaf`` (None: on an unheld reading).
+    """The trace of a run of member ``(name, landing)`` that ended in ``state`` at ``leaf``
+    (None: on an unheld reading).
 
-    A failure's message gives the whole run in one line (:func:`path_text`).
+    A failure's message gives the whole run in one line (:func:`path_text`); a run that
+    ends in a reject leaf listing its state is right, and its message says "reject".
     """
     steps = tuple(steps)
-    head = f"{name} from theta {start:.10g} deg"
+    head = f"{member_label(name, landing)} from theta {start:.10g} deg"
     if leaf is None:
         last = steps[-1]
         shown = "none" if last.reading is None else f"{last.reading:.10g} mm"
@@ -170,21 +196,39 @@ def finish(
             f"{state.diameter:.6g} mm) is in no branch: a foreign part or a sensor fault; stop "
             f"[{path_text(steps)}]"
         )
-        return Trace(name, start, steps, state.id, state.pose_deg, (), False, msg)
-    result = leaf_entries(leaf)
-    ok = any(p == name and s == state.id for p, s, _ in result)
-    if ok:
+        return Trace(name, start, steps, state.id, state.pose_deg, (), False, msg, landing=landing)
+    result = leaf.results
+    ok = leaf.accepts(name, state.id, landing)
+    if ok and leaf.reject:
+        side = "" if landing is None else f" (landing {landing})"
+        msg = (
+            f"{head}: reject{side} after {_ops(len(steps))}, resting in state {state.id} "
+            f"(edge {state.edge}): the next station cannot take it; recirculate or re-drop"
+        )
+    elif ok:
         msg = (
             f"{head}: oriented in {_ops(len(steps))}, state {state.id} (edge {state.edge}), "
             f"pose {state.pose_deg:.6g} deg"
         )
     else:
-        listed = ", ".join(f"{p} state {s}" for p, s, _ in result)
+        listed = ", ".join(entry_text(e) for e in result)
+        said = "rejects" if leaf.reject else "says"
         msg = (
             f"{head}: ends in state {state.id} (edge {state.edge}) after {_ops(len(steps))}, "
-            f"but the plan's result says {listed} [{path_text(steps)}]"
+            f"but the plan's result {said} {listed} [{path_text(steps)}]"
         )
-    return Trace(name, start, steps, state.id, state.pose_deg, result, ok, msg)
+    return Trace(
+        name,
+        start,
+        steps,
+        state.id,
+        state.pose_deg,
+        result,
+        ok,
+        msg,
+        landing=landing,
+        reject=leaf.reject,
+    )
 
 
 def _pick_reading(
@@ -223,6 +267,7 @@ def execute(
         raise ValueError(f"the plan has no part {part_index}")
     pf = push_function_of(plan.parts[part_index])
     name = plan.parts[part_index].name
+    landing = plan.parts[part_index].landing
     node: Step | Leaf = plan.root
     state = push(pf, start_theta_deg)
     theta = float(start_theta_deg)
@@ -248,6 +293,6 @@ def execute(
             )
         )
         if b is None:
-            return finish(name, start_theta_deg, steps, state, None)
+            return finish(name, start_theta_deg, steps, state, None, landing)
         node = node.branches[b].next
-    return finish(name, start_theta_deg, steps, state, node)
+    return finish(name, start_theta_deg, steps, state, node, landing)

@@ -8,7 +8,12 @@ closed reading interval holds the reading; a leaf lists the poses the part is th
 Version 2 declares the uncertainty the plan is strong for (``"uncertainty"``, right after
 ``"sensor"``) and its certificate (``stats.certificate``, last); a version-1 file without
 ``"uncertainty"`` is read as the paper's ideal model and marked so
-(``Plan.uncertainty_declared``).
+(``Plan.uncertainty_declared``). A plan over landings (design.md, "Landings") lists one part
+entry per landing (``"landing"``, ``"share"``), names the landing in every result entry and
+ends the landings the next station cannot take in ``"reject": true`` results. A subtree that
+occurs more than once is written once, in the top-level ``"nodes"`` table, and referred to
+as ``{"ref": ID}``: the reader makes it one shared object again, so the size of a file and
+the cost of every walk is its number of distinct nodes.
 
 Made only here: :func:`plan_from_result` (a planner's result), :func:`plan_from_dict` (a
 loaded file, checked: types, ranges, the stated length against the tree, a depth limit) and
@@ -24,10 +29,11 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import sys
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -40,10 +46,12 @@ from feederkit.plans.model import (
     Leaf,
     Node,
     Plan,
+    PlanMember,
     PlanPart,
     PlanStats,
     ResultEntry,
     Step,
+    member_label,
     push_function_of,
 )
 from feederkit.sensors import Grouping, Sensor, sensor_from_dict
@@ -84,7 +92,8 @@ CONVENTIONS = (
 
 
 MAX_FILE_NODES = 100_000
-"""A plan whose file would hold more nodes than this is refused: no controller wants it."""
+"""A plan whose file would hold more nodes than this is refused: no controller wants it.
+Shared subplans count once (they are written once, in ``"nodes"``)."""
 
 MAX_PLAN_BYTES = 50_000_000
 """A plan file larger than this (bytes) is refused before it is parsed (``max_bytes`` raises
@@ -100,7 +109,7 @@ _JSON_LEVELS_PER_OPERATION = 3
 # ---------------------------------------------------------------- from a planner's result
 
 
-def members(mask: int) -> list[int]:
+def state_members(mask: int) -> list[int]:
     """The machine states in a set (a bit mask), in increasing order."""
     out = []
     while mask:
@@ -110,8 +119,11 @@ def members(mask: int) -> list[int]:
     return out
 
 
-def _plan_part(machine: PushAlignMachine, p: int, pf: PushFunction) -> PlanPart:
-    """A part's name, revision, COM, hull and stable states (diameters as planned on)."""
+def _plan_part(
+    machine: PushAlignMachine, p: int, pf: PushFunction, member: PlanMember | None
+) -> PlanPart:
+    """A part's name (its member's, when given, with landing and share), revision, COM,
+    hull and stable states (diameters as planned on)."""
     diameter = {(ms.part, ms.state): ms.diameter for ms in machine.states}
     states = tuple(
         StableState(
@@ -125,11 +137,13 @@ def _plan_part(machine: PushAlignMachine, p: int, pf: PushFunction) -> PlanPart:
         for s in pf.states
     )
     return PlanPart(
-        name=pf.part.name,
+        name=pf.part.name if member is None else member.name,
         revision=pf.part.revision,
         com=tuple(pf.part.com),
         hull=tuple(tuple(v) for v in pf.part.hull),
         states=states,
+        landing=None if member is None else member.landing,
+        share=None if member is None else member.share,
     )
 
 
@@ -144,39 +158,34 @@ def _reading(machine: PushAlignMachine, branch: Any) -> tuple[float, float] | No
         return (branch.lo, branch.hi)
     if not machine.sensor.informative:
         return None
-    diameters = [machine.states[i].diameter for i in members(branch.mask)]
+    diameters = [machine.states[i].diameter for i in state_members(branch.mask)]
     split = machine.sensor.split(diameters, Grouping.COMPONENTS)
     return (min(b.lo for b in split), max(b.hi for b in split))
 
 
-def file_nodes(root: TreeStep | TreeLeaf) -> int:
-    """How many nodes the plan file holds once shared subtrees are written out in full.
+def file_nodes(root: Node) -> int:
+    """How many nodes the plan file of this tree holds: each distinct step once (a shared
+    one in ``"nodes"``), and each leaf once per place (leaves are written in place).
 
-    Counted on the planner's shared structure (each distinct node once, without recursion),
-    so a plan whose written tree would be astronomically large is measured without being
-    built.
+    Counted on the distinct nodes, without recursion, so a plan whose tree has
+    astronomically many paths is measured by what is written.
     """
-    from feederkit.planning.tree import Leaf as TreeLeaf
-
-    memo: dict[int, int] = {}
-    stack: list[tuple[TreeStep | TreeLeaf, bool]] = [(root, False)]
-    while stack:
-        node, expanded = stack.pop()
-        key = id(node)
-        if key in memo:
-            continue
-        if isinstance(node, TreeLeaf):
-            memo[key] = 1
-        elif expanded:
-            memo[key] = 1 + sum(memo[id(nxt)] for _b, nxt in node.branches)
-        else:
-            stack.append((node, True))
-            stack.extend((nxt, False) for _b, nxt in node.branches if id(nxt) not in memo)
-    return memo[id(root)]
+    shape = _shape(root)
+    return len(shape.steps) + sum(
+        1 for c in shape.steps for k in shape.children[c] if k not in shape.steps
+    )
 
 
-def _tree(result: PlanResult, parts: Sequence[PushFunction]) -> Step:
-    """The planner's tree as plan nodes; shared subtrees stay shared (built once)."""
+def _tree(
+    result: PlanResult,
+    parts: Sequence[PushFunction],
+    members: Sequence[PlanMember] | None,
+) -> Step:
+    """The planner's tree as plan nodes; shared subtrees stay shared (built once).
+
+    A leaf whose every state belongs to a member the next station does not accept is a
+    reject leaf (design.md, "Landings").
+    """
     from feederkit.planning.tree import Leaf as TreeLeaf
 
     machine = result.machine
@@ -189,11 +198,18 @@ def _tree(result: PlanResult, parts: Sequence[PushFunction]) -> Step:
             continue
         if isinstance(node, TreeLeaf):
             entries = []
-            for i in members(node.mask):
+            rejected = True
+            for i in state_members(node.mask):
                 ms = machine.states[i]
                 s = parts[ms.part].states[ms.state]
-                entries.append(ResultEntry(parts[ms.part].part.name, s.id, s.pose_deg))
-            built[key] = Leaf(tuple(entries))
+                if members is None:
+                    entries.append(ResultEntry(parts[ms.part].part.name, s.id, s.pose_deg))
+                    rejected = False
+                    continue
+                m = members[ms.part]
+                entries.append(ResultEntry(m.name, s.id, s.pose_deg, m.landing))
+                rejected = rejected and not m.accept
+            built[key] = Leaf(tuple(entries), reject=rejected and bool(entries))
         elif expanded:
             built[key] = Step(
                 None if node.action is None else node.action.representative,
@@ -208,11 +224,16 @@ def _tree(result: PlanResult, parts: Sequence[PushFunction]) -> Step:
     return root
 
 
+members = state_members
+"""The older name of :func:`state_members`."""
+
+
 def plan_from_result(
     result: PlanResult,
     parts: Sequence[PushFunction],
     *,
     uncertainty: Uncertainty | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> Plan:
     """The plan of a planner's result on the machine of ``parts`` (in order).
 
@@ -222,20 +243,30 @@ def plan_from_result(
     declared uncertainty here.
 
     ``parts`` are the push functions the machine was built from (``build_machine``): the plan
-    records each part's hull and COM, so it can be checked on the geometry alone. Raises
-    InputError when two parts share a name (results name their part) and PlanningError when
-    the written tree would exceed MAX_FILE_NODES nodes (a plan found under a time limit for a
-    part whose states nearly all read alike can share subtrees that would expand beyond any
-    file).
+    records each part's hull and COM, so it can be checked on the geometry alone.
+    ``members`` (one per part, in order) name the plan's members when they are not the
+    parts' own names: a plan over landings gives each landing's part its part name, landing
+    and share, and ends sets of states of members it does not accept in reject leaves
+    (design.md, "Landings"). Raises InputError when two members share a name and landing
+    (results name their member) and PlanningError when the file would hold more than
+    MAX_FILE_NODES distinct nodes (shared subplans count once).
     """
     machine = result.machine
     names = [pf.part.name for pf in parts]
     if tuple(names) != machine.part_names or sum(pf.n for pf in parts) != machine.n:
         raise ValueError("plan_from_result: the parts are not the ones the machine was built from")
-    if len(set(names)) != len(names):
-        dup = next(n for n in names if names.count(n) > 1)
-        raise InputError(f"two parts of the mix are both named {dup!r}: a plan names its parts")
-    size = file_nodes(result.root)
+    if members is not None:
+        members = tuple(members)
+        if len(members) != len(parts):
+            raise ValueError("plan_from_result: one member per part is needed")
+        _check_shares([m.share for m in members], InputError)
+    keys = [(n, None) for n in names] if members is None else [(m.name, m.landing) for m in members]
+    if len(set(keys)) != len(keys):
+        dup = next(k for k in keys if keys.count(k) > 1)
+        which = f"named {dup[0]!r}" if dup[1] is None else repr(member_label(*dup))
+        raise InputError(f"two parts of the mix are both {which}: a plan names its parts")
+    root = _tree(result, parts, members)
+    size = file_nodes(root)
     if size > MAX_FILE_NODES:
         found = f"the plan found ({result.length} operations"
         if not result.optimal:
@@ -262,8 +293,11 @@ def plan_from_result(
     )
     return Plan(
         sensor=machine.sensor,
-        parts=tuple(_plan_part(machine, p, pf) for p, pf in enumerate(parts)),
-        root=_tree(result, parts),
+        parts=tuple(
+            _plan_part(machine, p, pf, None if members is None else members[p])
+            for p, pf in enumerate(parts)
+        ),
+        root=root,
         stats=stats,
         conventions=CONVENTIONS,
         uncertainty=getattr(machine, "uncertainty", IDEAL) if uncertainty is None else uncertainty,
@@ -286,8 +320,13 @@ def _certificate_of(result: PlanResult) -> Certificate | None:
 
 
 def _part_dict(part: PlanPart) -> dict[str, Any]:
+    head: dict[str, Any] = {"name": part.name}
+    if part.landing is not None:
+        head["landing"] = part.landing
+    if part.share is not None:
+        head["share"] = part.share
     return {
-        "name": part.name,
+        **head,
         "revision": part.revision,
         "com": list(part.com),
         "hull": [list(v) for v in part.hull],
@@ -323,64 +362,168 @@ def _stats_dict(s: PlanStats) -> dict[str, Any]:
     return out
 
 
-def _tree_dict(root: Node) -> dict[str, Any]:
-    """The tree as the file's nested NODE objects, built without recursion."""
+@dataclass(frozen=True)
+class _Shape:
+    """The distinct structures of a tree (canonical structural equality, section-free):
+    ``rep[c]`` a node of structure ``c``, ``children[c]`` its branches' structures,
+    ``steps`` the structures that are steps, ``uses[c]`` how many branches of distinct steps
+    lead to ``c``, ``root`` the root's structure."""
 
-    def shell(node: Node) -> dict[str, Any]:
-        if isinstance(node, Leaf):
-            return {
-                "result": [
-                    {"part": e.part, "state": e.state, "pose_deg": e.pose_deg} for e in node.results
-                ]
-            }
-        return {"action_deg": node.action_deg, "margin_deg": node.margin_deg, "branches": []}
+    rep: tuple[Node, ...]
+    children: tuple[tuple[int, ...], ...]
+    steps: frozenset[int]
+    uses: tuple[int, ...]
+    root: int
 
-    top = shell(root)
-    stack: list[tuple[Node, dict[str, Any]]] = [(root, top)]
+
+def _leaf_key(leaf: Leaf) -> tuple[Any, ...]:
+    return (
+        "leaf",
+        leaf.reject,
+        tuple((e.part, e.landing, e.state, e.pose_deg) for e in leaf.results),
+    )
+
+
+def _shape(root: Node) -> _Shape:
+    """Intern every subtree by its structure, bottom-up without recursion: two subtrees are
+    one when their written JSON is the same (so shared objects and equal copies alike)."""
+    of: dict[int, int] = {}
+    index: dict[tuple[Any, ...], int] = {}
+    rep: list[Node] = []
+    children: list[tuple[int, ...]] = []
+    stack: list[tuple[Node, bool]] = [(root, False)]
     while stack:
-        node, out = stack.pop()
-        if isinstance(node, Step):
-            for b in node.branches:
-                child = shell(b.next)
-                reading = None if b.reading is None else list(b.reading)
-                out["branches"].append({"reading": reading, "next": child})
-                stack.append((b.next, child))
-    return top
+        node, expanded = stack.pop()
+        if id(node) in of:
+            continue
+        if isinstance(node, Step) and not expanded:
+            stack.append((node, True))
+            stack.extend((b.next, False) for b in node.branches if id(b.next) not in of)
+            continue
+        if isinstance(node, Leaf):
+            key, kids = _leaf_key(node), ()
+        else:
+            kids = tuple(of[id(b.next)] for b in node.branches)
+            readings = tuple(b.reading for b in node.branches)
+            key = ("step", node.action_deg, node.margin_deg, readings, kids)
+        c = index.setdefault(key, len(rep))
+        if c == len(rep):
+            rep.append(node)
+            children.append(kids)
+        of[id(node)] = c
+    steps = frozenset(c for c, n in enumerate(rep) if isinstance(n, Step))
+    uses = [0] * len(rep)
+    for c in steps:
+        for k in children[c]:
+            uses[k] += 1
+    return _Shape(tuple(rep), tuple(children), steps, tuple(uses), of[id(root)])
+
+
+def _leaf_dict(leaf: Leaf) -> dict[str, Any]:
+    entries = []
+    for e in leaf.results:
+        entry: dict[str, Any] = {"part": e.part}
+        if e.landing is not None:
+            entry["landing"] = e.landing
+        entry.update(state=e.state, pose_deg=e.pose_deg)
+        entries.append(entry)
+    out: dict[str, Any] = {"result": entries}
+    if leaf.reject:
+        out["reject"] = True
+    return out
+
+
+def _tree_dicts(root: Node) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+    """The tree as the file's NODE objects and its ``"nodes"`` table, without recursion.
+
+    Every step structure used by more than one branch is written once in the table (ids
+    ``n1``, ``n2``, ... in the order the file first refers to them) and as ``{"ref": ID}`` in
+    its places; a leaf is always written in place (it is no larger than a reference and
+    its table entry). The result depends on the structure only, so a file read back and
+    written again gives the same bytes.
+    """
+    shape = _shape(root)
+    shared = {c for c in shape.steps if shape.uses[c] > 1}
+    ids: dict[int, str] = {}
+    pending: list[int] = []
+
+    def emit(top: int) -> dict[str, Any]:
+        holder: list[dict[str, Any]] = []
+        stack: list[tuple[int, list[dict[str, Any]], bool, tuple[float, float] | None]] = [
+            (top, holder, True, None)
+        ]
+        while stack:
+            c, out, first, reading = stack.pop()
+            node = shape.rep[c]
+            if c in shared and not first:
+                if c not in ids:
+                    ids[c] = f"n{len(ids) + 1}"
+                    pending.append(c)
+                d: dict[str, Any] = {"ref": ids[c]}
+            elif isinstance(node, Leaf):
+                d = _leaf_dict(node)
+            else:
+                d = {"action_deg": node.action_deg, "margin_deg": node.margin_deg, "branches": []}
+                for b, k in reversed(list(zip(node.branches, shape.children[c], strict=True))):
+                    stack.append((k, d["branches"], False, b.reading))
+            if out is holder:
+                holder.append(d)
+            else:
+                out.append({"reading": None if reading is None else list(reading), "next": d})
+        return holder[0]
+
+    tree = emit(shape.root)
+    table: dict[str, dict[str, Any]] = {}
+    k = 0
+    while k < len(pending):
+        c = pending[k]
+        table[ids[c]] = emit(c)
+        k += 1
+    return tree, table
 
 
 def plan_to_dict(
-    plan: Plan | PlanResult, parts: Sequence[PushFunction] | None = None
+    plan: Plan | PlanResult,
+    parts: Sequence[PushFunction] | None = None,
+    *,
+    members: Sequence[PlanMember] | None = None,
 ) -> dict[str, Any]:
-    """The plan file's JSON object of a :class:`Plan`.
+    """The plan file's JSON object of a :class:`Plan` (``"nodes"`` only when some subtree
+    is shared, right after ``"root"``).
 
-    Also called as ``plan_to_dict(result, parts)`` for a planner's result (the form
-    ``plans/make.py`` uses): that is ``plan_to_dict(plan_from_result(result, parts))``.
+    Also called as ``plan_to_dict(result, parts, members=None)`` for a planner's result (the
+    form ``plans/make.py`` uses): that is ``plan_to_dict(plan_from_result(result, parts,
+    members=members))``.
     """
     if not isinstance(plan, Plan):
         if parts is None:
             raise TypeError("plan_to_dict(result, parts): the push functions are needed")
-        plan = plan_from_result(plan, parts)
-    return {
+        plan = plan_from_result(plan, parts, members=members)
+    root, table = _tree_dicts(plan.root)
+    out: dict[str, Any] = {
         "format": FORMAT,
         "version": VERSION,
         "conventions": plan.conventions,
         "sensor": plan.sensor.to_dict(),
         "uncertainty": plan.uncertainty.to_dict(),
         "parts": [_part_dict(p) for p in plan.parts],
-        "root": _tree_dict(plan.root),
-        "stats": _stats_dict(plan.stats),
+        "root": root,
     }
+    if table:
+        out["nodes"] = table
+    out["stats"] = _stats_dict(plan.stats)
+    return out
 
 
 def _one_line(value: object) -> str | None:
     """The text of a value written on one line, or None when it is spread over lines.
 
     Lists of plain values (points, intervals) and small flat objects (result entries, the
-    sensor) stay on one line.
+    sensor, references) stay on one line.
     """
     if isinstance(value, dict):
         plain = all(not isinstance(v, dict | list) for v in value.values())
-        if (plain and len(value) <= 3) or not value:
+        if (plain and len(value) <= 4) or not value:
             return json.dumps(value, allow_nan=False)
         return None
     if isinstance(value, list | tuple):
@@ -563,10 +706,46 @@ def _check_certificate(c: _Checker, raw: object, unc: Uncertainty) -> Certificat
     return Certificate(r, t, ideal)
 
 
+LANDING_RE = re.compile(r"^(up|down|pose-(0|[1-9][0-9]*))$")
+"""A landing's name (design.md, "Landings"): ``up``, ``down`` or ``pose-K``."""
+
+SHARE_SUM_EPS = 1e-6
+"""The members' shares may sum to at most this above 1 (rounding of the products)."""
+
+
+def _check_shares(shares: Sequence[float | None], fail: Any) -> None:
+    """Every member's share or none, each in (0, 1], their sum at most 1: a share is a prior
+    probability (part share times landing probability). ``fail`` makes the error."""
+    given = [x for x in shares if x is not None]
+    if not given:
+        return
+    if len(given) != len(shares):
+        raise fail("either every part gives its 'share' or none does")
+    for x in given:
+        if isinstance(x, bool) or not isinstance(x, int | float) or not 0.0 < x <= 1.0:
+            raise fail(f"a part's share must be a number in (0, 1], got {_shown(x)}")
+    if math.fsum(given) > 1.0 + SHARE_SUM_EPS:
+        raise fail(f"the parts' shares sum to {math.fsum(given):.6g}, more than 1")
+
+
+def _check_landing(c: _Checker, value: object, where: str) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, str) or not LANDING_RE.match(value):
+        raise c.fail(f"{where} landing must be up, down or pose-K, got {_shown(value)}")
+    return value
+
+
 def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     d = c.obj(raw, f"part {index}")
     name = c.str_(c.key(d, "name", f"part {index}"), f"part {index} name")
-    where = f"part {name!r}"
+    landing = _check_landing(c, d.get("landing"), f"part {name!r}")
+    where = f"part {member_label(name, landing)!r}"
+    share = d.get("share")
+    if share is not None:
+        share = c.num(share, f"{where} share")
+        if not 0.0 < share <= 1.0:
+            raise c.fail(f"{where} share {share:g} is not in (0, 1]")
     rev = d.get("revision")
     if rev is not None and (isinstance(rev, bool) or not isinstance(rev, str | int)):
         raise c.fail(f"{where} 'revision' must be a string, an integer or null")
@@ -596,7 +775,7 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
             raise c.fail(f"{sw} diameter must be positive")
         pose = c.num(c.key(sd, "pose_deg", sw), f"{sw} pose_deg")
         states.append(StableState(sid, edge, normal, (lo, hi), diameter, pose))
-    part = PlanPart(name, rev, com, hull, tuple(states))
+    part = PlanPart(name, rev, com, hull, tuple(states), landing, share)
     try:
         push_function_of(part)  # the hull and COM must make a part (cached for later use)
     except InputError as exc:
@@ -604,38 +783,151 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     return part
 
 
-def _walk(root: object) -> Iterator[tuple[object, int]]:
-    """Every raw node with its depth (root 0), pre-order, without recursion."""
-    stack = [(root, 0)]
-    while stack:
-        node, depth = stack.pop()
-        yield node, depth
-        if isinstance(node, dict) and isinstance(node.get("branches"), list):
-            for b in reversed(node["branches"]):
-                if isinstance(b, dict) and "next" in b:
-                    stack.append((b["next"], depth + 1))
+Member = tuple[str, str | None]
+"""A plan member as results name it: (part name, landing)."""
 
 
 def _check_leaf(
-    c: _Checker, node: dict[str, Any], where: str, parts: Mapping[str, PlanPart]
+    c: _Checker, node: dict[str, Any], where: str, parts: Mapping[Member, PlanPart]
 ) -> Leaf:
     entries = c.lst(node["result"], f"{where} result")
     if not entries:
         raise c.fail(f"{where} has an empty result")
+    reject = node.get("reject", False)
+    if not isinstance(reject, bool):
+        raise c.fail(f"{where} 'reject' must be true or false, got {_shown(reject)}")
+    names = {name for name, _ in parts}
     out = []
     for e in entries:
         ed = c.obj(e, f"{where} result entry")
         part = c.key(ed, "part", f"{where} result entry")
         if not isinstance(part, str):
             raise c.fail(f"{where} result part must be a part's name, got {_shown(part)}")
-        if part not in parts:
+        if part not in names:
             raise c.fail(f"{where} names the unknown part {part!r}")
+        landing = _check_landing(c, ed.get("landing"), f"{where} result")
+        member = parts.get((part, landing))
+        if member is None:
+            listed = ", ".join(str(k[1]) for k in parts if k[0] == part)
+            said = "no landing" if landing is None else f"landing {landing!r}"
+            raise c.fail(
+                f"{where} names part {part!r} with {said}, but the plan lists it with "
+                f"landing {listed}"
+            )
         sid = c.int_(c.key(ed, "state", f"{where} result entry"), f"{where} result state")
-        if all(s.id != sid for s in parts[part].states):
-            raise c.fail(f"{where} names state {sid}, which part {part!r} does not list")
+        if all(s.id != sid for s in member.states):
+            raise c.fail(f"{where} names state {sid}, which part {member.label!r} does not list")
         pose = c.num(c.key(ed, "pose_deg", f"{where} result entry"), f"{where} result pose_deg")
-        out.append(ResultEntry(part, sid, pose))
-    return Leaf(tuple(out))
+        out.append(ResultEntry(part, sid, pose, landing))
+    return Leaf(tuple(out), reject)
+
+
+def _check_table(c: _Checker, data: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """The ``"nodes"`` table of shared subplans: a non-empty object of NODE objects, none of
+    them itself a reference (absent: no shared subplans)."""
+    if "nodes" not in data:
+        return {}
+    table = data["nodes"]
+    if not isinstance(table, dict) or not table:
+        raise c.fail("'nodes' must be a non-empty object of shared subplans {ID: NODE}")
+    for key, node in table.items():
+        if not isinstance(node, dict):
+            raise c.fail(f"shared node {key!r} must be a JSON object")
+        if "ref" in node:
+            raise c.fail(f"shared node {key!r} is itself a reference: give the node")
+    return table
+
+
+class _Graph:
+    """The file's nodes with references resolved: each raw node object (a table entry once)
+    is one node of the plan."""
+
+    def __init__(self, c: _Checker, table: dict[str, dict[str, Any]]) -> None:
+        self.c = c
+        self.table = table
+        self.used: set[str] = set()
+
+    def resolve(self, raw: object, where: str) -> tuple[object, str]:
+        """The node ``raw`` stands for (a reference's table entry) and where it is."""
+        if not isinstance(raw, dict) or "ref" not in raw:
+            return raw, where
+        ref = raw["ref"]
+        if len(raw) != 1:
+            raise self.c.fail(f"{where} is a reference with other keys than 'ref'")
+        if not isinstance(ref, str):
+            raise self.c.fail(f"{where} refers to {_shown(ref)}: a reference names a shared node")
+        if ref not in self.table:
+            raise self.c.fail(f"{where} refers to the unknown shared node {ref!r}")
+        self.used.add(ref)
+        return self.table[ref], f"shared node {ref!r}"
+
+
+def _check_tree(
+    c: _Checker,
+    root: object,
+    table: dict[str, dict[str, Any]],
+    parts: Mapping[Member, PlanPart],
+    sensorless: bool,
+    max_depth: int,
+) -> Step:
+    """Check every distinct node once and build the plan bottom-up, without recursion.
+
+    A depth-first search over the nodes with references resolved: a reference back to a
+    node on the current path is a cycle; the plan's depth (the longest path, memoised per
+    node) must be at most ``max_depth``; every table entry must be used.
+    """
+    graph = _Graph(c, table)
+    if isinstance(root, dict) and "ref" in root:
+        raise c.fail("the root is written in place, not as a reference")
+    on_path: set[int] = set()
+    built: dict[int, Node] = {}
+    below: dict[int, int] = {}
+    fields: dict[int, tuple[float | None, float | None, list[Any], list[object], str]] = {}
+    count = 0
+    # (raw node, where, depth of its first place, entering: False once its children are done)
+    stack: list[tuple[object, str, int, bool]] = [(root, "the root", 0, True)]
+    while stack:
+        raw, where, depth, entering = stack.pop()
+        key = id(raw)
+        if entering:
+            if key in built:
+                continue
+            if key in on_path:
+                raise c.fail(f"{where} refers back to itself: the shared subplans form a cycle")
+            node = c.obj(raw, where)
+            if "result" in node:
+                if depth == 0:
+                    raise c.fail(
+                        "the root must be an operation (the first alignment), not a result"
+                    )
+                built[key], below[key] = _check_leaf(c, node, where, parts), 0
+                continue
+            action, margin, branches = _check_step_fields(c, node, where, depth, sensorless)
+            resolved = []
+            for _reading, nxt in branches:
+                count += 1
+                resolved.append(graph.resolve(nxt, f"node {count} (depth {depth + 1})"))
+            fields[key] = (action, margin, branches, [t for t, _ in resolved], where)
+            on_path.add(key)
+            stack.append((raw, where, depth, False))
+            stack.extend((t, there, depth + 1, True) for t, there in reversed(resolved))
+            continue
+        on_path.discard(key)
+        action, margin, branches, kids, where = fields.pop(key)
+        below[key] = 1 + max(below[id(t)] for t in kids)
+        if below[key] > max_depth:
+            raise InputError(_too_deep(c.source, max_depth))
+        built[key] = Step(
+            action,
+            margin,
+            tuple(Branch(r, built[id(t)]) for (r, _n), t in zip(branches, kids, strict=True)),
+        )
+    unused = sorted(set(table) - graph.used)
+    if unused:
+        raise c.fail(f"shared node {unused[0]!r} of 'nodes' is never used")
+    top = built[id(root)]
+    assert isinstance(top, Step)
+    return top
 
 
 def _check_step_fields(
@@ -675,32 +967,6 @@ def _check_step_fields(
                 )
         out.append((interval, c.key(bd, "next", f"{where} branch")))
     return action, margin, out
-
-
-def _check_tree(
-    c: _Checker, root: object, parts: Mapping[str, PlanPart], sensorless: bool, max_depth: int
-) -> Step:
-    """Check every node (pre-order, no recursion) and build the tree bottom-up."""
-    order: list[tuple[object, int, str]] = []
-    for count, (raw, depth) in enumerate(_walk(root)):
-        if depth > max_depth:
-            raise InputError(_too_deep(c.source, max_depth))
-        order.append((raw, depth, "the root" if depth == 0 else f"node {count} (depth {depth})"))
-    built: dict[int, Node] = {}
-    for raw, depth, where in reversed(order):
-        node = c.obj(raw, where)
-        if "result" in node:
-            if depth == 0:
-                raise c.fail("the root must be an operation (the first alignment), not a result")
-            built[id(raw)] = _check_leaf(c, node, where, parts)
-            continue
-        action, margin, branches = _check_step_fields(c, node, where, depth, sensorless)
-        built[id(raw)] = Step(
-            action, margin, tuple(Branch(r, built[id(nxt)]) for r, nxt in branches)
-        )
-    top = built[id(root)]
-    assert isinstance(top, Step)
-    return top
 
 
 def _check_stats(c: _Checker, raw: object, plan: Plan) -> PlanStats:
@@ -762,7 +1028,10 @@ def _check_stats(c: _Checker, raw: object, plan: Plan) -> PlanStats:
 def plan_from_dict(data: object, source: str = "plan", max_depth: int = MAX_PLAN_DEPTH) -> Plan:
     """The :class:`Plan` of a loaded plan file, checked (design.md, versions 1 and 2).
 
-    Types (a version is the integer 1 or 2, a result's part a name), the declared
+    Types (a version is the integer 1 or 2, a result's part a name, a landing ``up``,
+    ``down`` or ``pose-K``, ``reject`` a boolean, shares in (0, 1] summing to at most 1, for
+    every part or none), results naming listed members (part and landing), the shared
+    subplans (``"nodes"``: every reference known, no cycle, every entry used), the declared
     uncertainty (required from version 2; a version-1 file without it is the ideal model)
     and the certificate (at least the declared uncertainty), ranges (actions in
     [0, 360), margins in [0, 180), reading intervals lo <= hi), names (results name listed
@@ -790,19 +1059,25 @@ def plan_from_dict(data: object, source: str = "plan", max_depth: int = MAX_PLAN
     parts_raw = c.lst(c.key(data, "parts", "the plan"), "'parts'")
     if not parts_raw:
         raise c.fail("the plan lists no parts")
-    parts: dict[str, PlanPart] = {}
+    parts: dict[Member, PlanPart] = {}
     for i, p in enumerate(parts_raw):
         part = _check_part(c, p, i)
-        if part.name in parts:
-            raise c.fail(f"two parts are both named {part.name!r}")
-        parts[part.name] = part
+        if part.key in parts:
+            if part.landing is None:
+                raise c.fail(f"two parts are both named {part.name!r}")
+            raise c.fail(f"two parts are both {part.label!r}")
+        parts[part.key] = part
         limit = max_shape_tolerance(push_function_of(part).part)
         if unc.shape_tolerance_mm >= limit:
             raise c.fail(
                 f"the shape tolerance {unc.shape_tolerance_mm:g} mm is not below half part "
                 f"{part.name!r}'s smallest hull edge ({limit:.4g} mm)"
             )
-    root = _check_tree(c, c.key(data, "root", "the plan"), parts, not sensor.informative, max_depth)
+    _check_shares([p.share for p in parts.values()], c.fail)
+    table = _check_table(c, data)
+    root = _check_tree(
+        c, c.key(data, "root", "the plan"), table, parts, not sensor.informative, max_depth
+    )
     draft = Plan(
         sensor,
         tuple(parts.values()),

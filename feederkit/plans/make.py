@@ -8,23 +8,38 @@ degree). On the ideal model the plan is verified on the kinematic model
 (:func:`~feederkit.plans.verify.check_plan`); under uncertainty it is a strong plan, verified
 for every outcome and reading (:func:`~feederkit.plans.strong.verify_strong`). Every plan
 carries its certificate (:class:`~feederkit.planning.tree.Certificate`).
+
+A plan over landings (design.md "Landings", plan file version 2) names its members with
+:class:`~feederkit.plans.model.PlanMember`: each landing of each part is one member of the
+mix (section 8), with its prior share (the landing's probability times the part's share) and
+whether the next station takes it. The shares weight the expected length; a set of states of
+rejected members only is the planners' goal too
+(:attr:`feederkit.machine.space.SearchSpace.inseparable`), so it ends in a reject leaf as
+soon as the plan knows the part will be rejected.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 from feederkit.errors import InputError, PlanningError
+from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
+from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import pose_difference
 from feederkit.planning.api import NoStrongPlan, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
+from feederkit.planning.budget import Deadline
+from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Certificate, PlanResult
 from feederkit.plans.fileformat import plan_to_dict
+from feederkit.plans.model import PlanMember, member_label
 from feederkit.plans.strong import (
     ideal_view,
     max_rotation_error_deg,
@@ -77,8 +92,17 @@ def make_plan(
     *,
     uncertainty: Uncertainty | None = None,
     certify: bool = True,
+    members: Sequence[PlanMember] | None = None,
+    weights: Sequence[float] | None = None,
 ) -> MadePlan:
     """Plan for ``push_functions`` (one part, or a mix: section 8.5) and verify the plan file.
+
+    ``members`` (one per push function, in order) name the plan's parts as the file writes
+    them, with their landings, prior shares (normalised to sum to 1) and accept/reject
+    (:class:`~feederkit.plans.model.PlanMember`); None: the push functions' parts, equal
+    shares, every one accepted, written exactly as before. ``weights`` are the members'
+    prior shares alone (one per push function, e.g. a product mix's part shares), for
+    members that do not carry their own.
 
     ``options`` default to ``PlanningOptions()``. ``uncertainty``
     defaults to ``Uncertainty()`` (rotation error 1 degree); ``IDEAL`` is the paper's model.
@@ -88,7 +112,8 @@ def make_plan(
     every state alike. Raises InputError
     for bad options or a shape tolerance too large for a part, PlanningError when no plan
     meets the request (under uncertainty: naming the largest uncertainty with a strong
-    plan), and CheckFailed when the plan fails verification.
+    plan; or an accepted and a rejected member no plan can tell apart), and CheckFailed when
+    the plan fails verification.
     """
     opts = PlanningOptions() if options is None else options
     if not isinstance(opts, PlanningOptions):
@@ -96,24 +121,31 @@ def make_plan(
     unc = Uncertainty() if uncertainty is None else uncertainty
     if not isinstance(unc, Uncertainty):
         raise InputError(f"the uncertainty must be an Uncertainty, got {unc!r}")
+    started = time.monotonic()
     pfs = list(push_functions)
     for pf in pfs:
         check_for_part(unc, pf.part)
     _check_resolution(sensor, pfs)
-    machine = build_machine(pfs, sensor, unc)
+    named = _check_members(_weighted_members(members, weights, pfs), pfs)
+    shares, rejected = _member_weights(named)
+    machine = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
+    if rejected:
+        _check_rejects_separable(machine, named)
     try:
         result = plan_machine(machine, opts)
     except NoStrongPlan as exc:
-        raise PlanningError(f"{exc}; {largest_uncertainty(pfs, sensor, unc, opts)}") from None
+        raise PlanningError(
+            f"{exc}; {largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))}"
+        ) from None
     if unc.is_ideal:
-        data = with_uncertainty(plan_to_dict(result, pfs), unc)
+        data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
         report = check_plan(data)
         ideal_length = result.length
     else:
-        ideal = build_machine(pfs, sensor, IDEAL)
-        data = with_uncertainty(plan_to_dict(ideal_view(result, ideal), pfs), unc)
+        ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
+        data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
         report = verify_strong(data)
-        ideal_length = plan_machine(ideal, opts).length if certify else None
+        ideal_length = _ideal_length(ideal, opts, started) if certify else None
     if certify:
         cert = Certificate(
             max_rotation_error_deg=max_rotation_error_deg(data),
@@ -124,10 +156,165 @@ def make_plan(
         result = replace(result, certificate=cert)
     diameters = sorted({round(s.diameter, DIAMETER_DIGITS) for pf in pfs for s in pf.states})
     warnings = sensor_warnings(sensor, diameters)
+    lumped = lumped_words(result.machine, result.lumped_pairs)
+    if lumped:
+        warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
     margin = margin_warning(result.min_margin) if unc.is_ideal else None
     if margin is not None:
         warnings.append(margin)
     return MadePlan(data, result, report, tuple(warnings))
+
+
+NEAR_SYMMETRIC_REL = 0.01
+"""Lumped poses whose outlines differ by more than this share of the part's size are not
+called near-symmetric: the output says the plan does not orient them apart."""
+
+
+def _lump_shapes(
+    machine: PushAlignMachine, pfs: Sequence[PushFunction], pairs: Sequence[tuple[int, int]]
+) -> str:
+    """How alike the lumped poses of one part look (:func:`pose_difference`), in words: near
+    symmetry the user can accept, or a warning that the plan leaves them unoriented."""
+    worst, size = 0.0, 1.0
+    for i, j in pairs:
+        a, b = machine.states[i], machine.states[j]
+        if a.part != b.part:
+            continue  # parts that behave alike: reported as pairs of the mix
+        pf = pfs[a.part]
+        d = pose_difference(pf, a.state, b.state)
+        if d / pf.part.size >= worst / size:
+            worst, size = d, pf.part.size
+    if worst == 0.0:
+        return ""
+    share = 100.0 * worst / size
+    words = f"; their outlines differ by at most {worst:.3g} mm ({share:.2g} % of the part)"
+    if worst > NEAR_SYMMETRIC_REL * size:
+        words += (
+            ": not near-symmetric, so the plan does not orient them apart; a smaller "
+            "rotation error (--rotation-error) may"
+        )
+    return words
+
+
+def _left(options: PlanningOptions, started: float) -> float | None:
+    """Seconds left of the options' time limit since ``started`` (None: no limit)."""
+    if options.time_limit_s is None:
+        return None
+    return options.time_limit_s - (time.monotonic() - started)
+
+
+def _ideal_length(ideal: PushAlignMachine, options: PlanningOptions, started: float) -> int | None:
+    """The optimal length on the ideal model (the certificate's ``ideal_length``), within
+    what is left of the time limit; None when no time is left, or when the ideal model
+    cannot meet the options (e.g. a margin floor it cannot keep)."""
+    left = _left(options, started)
+    if left is not None and left <= 0.0:
+        return None
+    opts = options if left is None else replace(options, time_limit_s=left)
+    try:
+        return plan_machine(ideal, opts).length
+    except PlanningError:
+        return None
+
+
+def _weighted_members(
+    members_: Sequence[PlanMember] | None,
+    weights: Sequence[float] | None,
+    push_functions: Sequence[PushFunction],
+) -> Sequence[PlanMember] | None:
+    """``members_`` with the shares ``weights`` (None: as given); without members, one per
+    push function named as its part."""
+    if weights is None:
+        return members_
+    shares = normalised_shares(weights, len(push_functions))
+    if members_ is None:
+        return tuple(
+            PlanMember(pf.part.name, share=w) for pf, w in zip(push_functions, shares, strict=True)
+        )
+    named = tuple(members_)
+    if len(named) != len(shares) or any(
+        not isinstance(m, PlanMember) or m.share is not None for m in named
+    ):
+        raise InputError("give the shares either with the plan members or as weights, not both")
+    return tuple(replace(m, share=w) for m, w in zip(named, shares, strict=True))
+
+
+def _check_members(
+    members_: Sequence[PlanMember] | None, push_functions: Sequence[PushFunction]
+) -> tuple[PlanMember, ...] | None:
+    """The members as given, checked; None when they change nothing (plain parts)."""
+    if members_ is None:
+        return None
+    named = tuple(members_)
+    if len(named) != len(push_functions):
+        raise InputError(
+            f"{len(named)} plan members for {len(push_functions)} parts: give one per part"
+        )
+    for m in named:
+        if not isinstance(m, PlanMember):
+            raise InputError(f"a plan member must be a PlanMember, got {m!r}")
+    labels = [(m.name, m.landing) for m in named]
+    for key in labels:
+        if labels.count(key) > 1:
+            twice = member_label(*key)
+            raise InputError(f"{twice} is a member twice: a plan names each member once")
+    given = [m.share is not None for m in named]
+    if any(given) and not all(given):
+        raise InputError("give every plan member a share, or none (equal shares)")
+    plain = all(
+        m.landing is None and m.name == pf.part.name
+        for m, pf in zip(named, push_functions, strict=True)
+    )
+    if plain and not any(given) and all(m.accept for m in named):
+        return None
+    if not any(m.accept for m in named):
+        raise InputError("every member is rejected: accept at least one landing")
+    return named
+
+
+def _member_weights(
+    named: tuple[PlanMember, ...] | None,
+) -> tuple[tuple[float, ...] | None, frozenset[int]]:
+    """The members' normalised shares (None: equal) and the indices of the rejected ones."""
+    if named is None:
+        return None, frozenset()
+    shares = None
+    if named and named[0].share is not None:
+        shares = normalised_shares([float(m.share or 0.0) for m in named], len(named))
+    return shares, frozenset(k for k, m in enumerate(named) if not m.accept)
+
+
+def _check_rejects_separable(machine: PushAlignMachine, named: Sequence[PlanMember]) -> None:
+    """PlanningError when an accepted and a rejected member have states no plan can tell
+    apart (section 8.4): no plan can then accept the one and reject the other."""
+    space = search_space(machine)
+    bisimilar, rejected = space.bisimilar, space.rejected
+    for i, s in enumerate(machine.states):
+        if s.reject or not bisimilar[i] & rejected:
+            continue
+        j = members(bisimilar[i] & rejected)[0]
+        a, b = named[s.part], named[machine.states[j].part]
+        raise PlanningError(
+            f"{member_label(a.name, a.landing)} is accepted and "
+            f"{member_label(b.name, b.landing)} rejected, but no plan can tell them apart "
+            "(their readings and push behaviour stay alike): accept both or neither, or use "
+            "a finer sensor"
+        )
+
+
+def _plan_dict(
+    result: PlanResult,
+    push_functions: Sequence[PushFunction],
+    named: tuple[PlanMember, ...] | None,
+    shares: tuple[float, ...] | None,
+) -> dict[str, Any]:
+    """The plan file's object of a planner's result, its parts named by ``named`` (with the
+    normalised ``shares``; design.md plan file v2)."""
+    if named is None:
+        return plan_to_dict(result, push_functions)
+    if shares is not None:
+        named = tuple(replace(m, share=x) for m, x in zip(named, shares, strict=True))
+    return plan_to_dict(result, push_functions, members=named)
 
 
 RESOLUTION_REL = 1e-9
@@ -167,38 +354,66 @@ def largest_uncertainty(
     sensor: Sensor,
     uncertainty: Uncertainty,
     options: PlanningOptions,
+    seconds: float | None = None,
 ) -> str:
     """In words: the largest rotation error (and shape tolerance) with a strong plan.
 
     Bisection over machine builds (a strong plan existing at an uncertainty exists at every
-    smaller one: outcome sets and reading intervals shrink), ``BISECT_STEPS`` steps.
+    smaller one: outcome sets and reading intervals shrink), ``BISECT_STEPS`` steps, or
+    fewer when ``seconds`` run out (the bound found so far is then a lower one).
     """
     u = uncertainty
+    stop = None if seconds is None else time.monotonic() + max(seconds, 0.0)
 
-    def exists(unc: Uncertainty) -> bool:
-        return strong_plan_exists(build_machine(push_functions, sensor, unc), options)
-
-    def largest(make, top: float) -> float | None:
-        if not exists(make(0.0)):
+    def exists(unc: Uncertainty) -> bool | None:
+        """Whether a strong plan exists at ``unc``; None when not decided in time."""
+        left = None if stop is None else max(stop - time.monotonic(), 0.0)
+        machine = build_machine(push_functions, sensor, unc)
+        budget = Deadline(left)
+        found = strong_plan_exists(machine, options, budget)
+        if budget.end is not None and time.perf_counter() > budget.end:
             return None
+        return found
+
+    def largest(make, top: float) -> tuple[float | None, bool]:
+        """The largest value with a plan (None: none, or undecided at 0) and whether the
+        bisection finished."""
+        at_zero = exists(make(0.0))
+        if not at_zero:
+            return None, at_zero is not None
         lo, hi = 0.0, top
         for _ in range(BISECT_STEPS):
             mid = (lo + hi) / 2.0
-            lo, hi = (mid, hi) if exists(make(mid)) else (lo, mid)
-        return lo
+            found = exists(make(mid))
+            if found is None:
+                return lo, False
+            lo, hi = (mid, hi) if found else (lo, mid)
+        return lo, True
+
+    def said(value: float, done: bool, what: str, unit: str) -> str:
+        if done and value > 0.0:
+            return f"the largest {what} with a strong plan is {value:.4g} {unit}"
+        if done:
+            return f"a strong plan exists only with no {what} at all (0 {unit})"
+        return (
+            f"a strong plan exists at {what} {value:.4g} {unit} (larger values were not "
+            "decided within the time limit)"
+        )
 
     words = []
-    r = largest(
+    r, r_done = largest(
         lambda x: Uncertainty(x, u.shape_tolerance_mm, u.com_tolerance_mm), u.rotation_error_deg
     )
+    if r is None and not r_done:
+        return "the largest uncertainty with a strong plan was not found within the time limit"
     if r is not None:
-        words.append(f"the largest rotation error with a strong plan is {r:.4g} deg")
+        words.append(said(r, r_done, "rotation error", "deg"))
     if u.shape_tolerance_mm > 0.0:
-        t = largest(
+        t, t_done = largest(
             lambda x: Uncertainty(u.rotation_error_deg, x, u.com_tolerance_mm), u.shape_tolerance_mm
         )
         if t is not None:
-            words.append(f"the largest shape tolerance with one is {t:.4g} mm")
+            words.append(said(t, t_done, "shape tolerance", "mm"))
     if not words:
         return (
             "even a rotation error near 0 leaves no strong plan: the resting states the "

@@ -46,14 +46,17 @@ def match_part(plan: Plan | Mapping[str, Any], part: Part, source: str) -> int:
 
 
 def leaf_part_pairs(plan: Plan | Mapping[str, Any]) -> list[tuple[str, str]]:
-    """Pairs of parts that some result lists together: the plan cannot tell them apart.
+    """Pairs of members that some result lists together: the plan cannot tell them apart.
 
-    Each pair once, in the plan's part order.
+    Members are named by their labels (``NAME``, or ``NAME (LANDING)`` in plans over
+    landings, so two landings of one part lumped together are a pair too). Each pair once,
+    in the plan's part order.
     """
     plan = as_plan(plan)
     pairs: set[tuple[str, str]] = set()
-    order = {p.name: k for k, p in enumerate(plan.parts)}
+    label = {p.key: p.label for p in plan.parts}
+    order = {p.label: k for k, p in enumerate(plan.parts)}
     for leaf in plan.leaves():
-        names = sorted({e.part for e in leaf.results}, key=order.__getitem__)
+        names = sorted({label[e.key] for e in leaf.results}, key=order.__getitem__)
         pairs.update((a, b) for i, a in enumerate(names) for b in names[i + 1 :])
     return sorted(pairs, key=lambda ab: (order[ab[0]], order[ab[1]]))

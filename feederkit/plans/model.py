@@ -5,8 +5,11 @@ A plan (sections 4, 6 and 8.5 of Akella & Mason 1999; the file is design.md's
 overlap range ``action_deg ± margin_deg`` (none at the root, the first alignment from an
 unknown orientation), lets it align on the fence and reads its diameter; each
 :class:`Branch` is followed when its closed reading interval holds the reading; a
-:class:`Leaf` lists the (part, state) pairs the part may then be in, every one a correct
-answer.
+:class:`Leaf` lists the (part, landing, state) triples the part may then be in, every one a
+correct answer, and a reject leaf (``reject``) lists landings the next station cannot take
+(design.md, "Landings"). The tree may share subtrees (a DAG: the file's ``"nodes"`` table);
+every walk here visits each distinct node once, so a plan with astronomically many paths
+costs its number of distinct nodes.
 
 Only :mod:`feederkit.plans.fileformat` makes a :class:`Plan` (from a file, a dict or a
 planner's result) and writes one; everything else reads it. Every value here is a frozen
@@ -33,10 +36,14 @@ Point = tuple[float, float]
 
 @dataclass(frozen=True)
 class PlanPart:
-    """A part of the plan's mix as the plan records it: hull and COM (part frame), states.
+    """A member of the plan's mix as the plan records it: hull and COM (part frame), states.
 
     ``states`` are the stable states the plan lists (the diameters it was planned on); the
-    push function the hull and COM give is :func:`push_function_of`.
+    push function the hull and COM give is :func:`push_function_of`. A plan over landings
+    (design.md, "Landings") has one member per landing of each part: ``landing`` is
+    ``"up"``, ``"down"`` or ``"pose-K"`` (the hull and COM are the part as it then lies) and
+    ``share`` the member's prior probability (part share times landing probability; None:
+    every member equally likely). A member is identified by ``(name, landing)``.
     """
 
     name: str
@@ -44,6 +51,18 @@ class PlanPart:
     com: Point
     hull: tuple[Point, ...]
     states: tuple[StableState, ...]
+    landing: str | None = None
+    share: float | None = None
+
+    @property
+    def key(self) -> tuple[str, str | None]:
+        """``(name, landing)``: what result entries name."""
+        return (self.name, self.landing)
+
+    @property
+    def label(self) -> str:
+        """The member in words: ``NAME`` or ``NAME (LANDING)``."""
+        return member_label(self.name, self.landing)
 
     def state(self, sid: int) -> StableState:
         """The listed state with id ``sid``; an unknown id is bad input."""
@@ -74,25 +93,57 @@ def push_function_of(part: PlanPart) -> PushFunction:
     return push_function(make_part(outline, hull_tolerance=0.0, revision=revision))
 
 
+def member_label(name: str, landing: str | None) -> str:
+    """A member of a plan in words: ``NAME``, or ``NAME (LANDING)`` in a plan over landings."""
+    return name if landing is None else f"{name} ({landing})"
+
+
 @dataclass(frozen=True)
 class ResultEntry:
-    """One correct answer of a leaf: part ``part`` resting in its state ``state``."""
+    """One correct answer of a leaf: part ``part``, lying in ``landing`` (None: a plan not
+    made over landings), resting in its state ``state``."""
 
     part: str
     state: int
     pose_deg: float
+    landing: str | None = None
+
+    @property
+    def key(self) -> tuple[str, str | None]:
+        """``(part, landing)``: the plan member the entry names."""
+        return (self.part, self.landing)
 
 
 @dataclass(frozen=True)
 class Leaf:
     """The end of a plan: the part rests in one of ``results`` (several: no plan tells them
-    apart)."""
+    apart).
+
+    ``reject``: the landings listed are ones the next station cannot take (design.md,
+    "Landings"); the controller recirculates or re-drops the part (docs/plans.md).
+    """
 
     results: tuple[ResultEntry, ...]
+    reject: bool = False
 
-    def accepts(self, part: str, state: int) -> bool:
-        """Whether ``part`` resting in ``state`` is one of the answers."""
-        return any(r.part == part and r.state == state for r in self.results)
+    def accepts(self, part: str, state: int, landing: str | None = None) -> bool:
+        """Whether ``part`` lying in ``landing`` and resting in ``state`` is one of the
+        answers (for a reject leaf: one of the states it rejects)."""
+        return any(
+            r.part == part and r.state == state and r.landing == landing for r in self.results
+        )
+
+
+@dataclass(frozen=True)
+class PlanMember:
+    """What a plan maker knows of one member beyond its push function: its name and landing
+    in the plan file, its prior share, and whether the next station takes it (``accept``
+    False: sets of its states end in reject leaves)."""
+
+    name: str
+    landing: str | None = None
+    share: float | None = None
+    accept: bool = True
 
 
 @dataclass(frozen=True)
@@ -127,6 +178,22 @@ class Step:
     action_deg: float | None
     margin_deg: float | None
     branches: tuple[Branch, ...]
+
+    def __post_init__(self) -> None:
+        # A plan may share subtrees (a DAG with astronomically many paths): the structural
+        # hash is computed once, from the children's, so hashing never walks the paths.
+        key = (self.action_deg, self.margin_deg, tuple(self.branches))
+        object.__setattr__(self, "_hash", hash(key))
+
+    def __hash__(self) -> int:
+        return self._hash  # type: ignore[attr-defined,no-any-return]
+
+    def __repr__(self) -> str:
+        # one level only: the repr of a shared subtree would repeat it once per path
+        readings = ", ".join(str(b.reading) for b in self.branches)
+        return f"Step(action_deg={self.action_deg!r}, margin_deg={self.margin_deg!r}, " + (
+            f"branches on readings [{readings}])"
+        )
 
     @property
     def overlap_range(self) -> tuple[float, float] | None:
@@ -189,6 +256,25 @@ class Certificate:
         }
 
 
+def operations_below(root: Node) -> int:
+    """The most operations on any path from ``root`` to a leaf (0 at a leaf), memoised per
+    distinct node, without recursion."""
+    memo: dict[int, int] = {}
+    stack: list[tuple[Node, bool]] = [(root, False)]
+    while stack:
+        node, expanded = stack.pop()
+        if id(node) in memo:
+            continue
+        if isinstance(node, Leaf):
+            memo[id(node)] = 0
+        elif expanded:
+            memo[id(node)] = 1 + max(memo[id(b.next)] for b in node.branches)
+        else:
+            stack.append((node, True))
+            stack.extend((b.next, False) for b in node.branches if id(b.next) not in memo)
+    return memo[id(root)]
+
+
 LOW_MARGIN_DEG = 1.0
 """Below this smallest margin no robot holds the plan's rotations: every output warns."""
 
@@ -234,40 +320,75 @@ class Plan:
             f"{ideal} on the ideal model"
         )
 
-    def part(self, name: str) -> PlanPart:
-        """The part called ``name``; an unknown name is bad input."""
-        return self.parts[self.part_index(name)]
+    def part(self, name: str, landing: str | None = None) -> PlanPart:
+        """The member ``(name, landing)``; an unknown one is bad input (see
+        :meth:`part_index`)."""
+        return self.parts[self.part_index(name, landing)]
 
-    def part_index(self, name: str) -> int:
-        """The index of the part called ``name``; an unknown name is bad input."""
+    def part_index(self, name: str, landing: str | None = None) -> int:
+        """The index of the member ``(name, landing)``.
+
+        Without a landing, a name that only one member has is enough; an unknown member,
+        or a name several landings share, is bad input.
+        """
         for k, p in enumerate(self.parts):
-            if p.name == name:
+            if p.name == name and p.landing == landing:
                 return k
-        raise InputError(f"plan: no part named {name!r}")
+        named = [k for k, p in enumerate(self.parts) if p.name == name]
+        if landing is None and len(named) == 1:
+            return named[0]
+        if not named:
+            raise InputError(f"plan: no part named {name!r}")
+        if landing is None:
+            which = ", ".join(str(self.parts[k].landing) for k in named)
+            raise InputError(f"plan: part {name!r} has several landings ({which}): name one")
+        raise InputError(f"plan: part {name!r} has no landing {landing!r}")
+
+    def shares(self) -> tuple[float, ...]:
+        """Each member's prior probability, normalised to sum 1 (equal when none is given):
+        the weights of the expected length."""
+        given = [p.share for p in self.parts]
+        if any(x is None for x in given):
+            return tuple(1.0 / len(self.parts) for _ in self.parts)
+        total = math.fsum(x for x in given if x is not None)
+        return tuple((x or 0.0) / total for x in given)
+
+    @property
+    def over_landings(self) -> bool:
+        """Whether the plan was made over landings (its members name them)."""
+        return any(p.landing is not None for p in self.parts)
 
     def push_functions(self) -> tuple[PushFunction, ...]:
         """Each part's push function, rebuilt from its hull and COM (cached)."""
         return tuple(push_function_of(p) for p in self.parts)
 
     def walk(self) -> Iterator[tuple[Node, int]]:
-        """Every node of the tree as written (shared subtrees once per place) with its
-        operation number (the root 1, a leaf the number of the step above it), pre-order,
-        without recursion."""
+        """Every distinct node of the plan once (a shared subtree at its first place), with
+        the operation number of that place (the root 1, a leaf the number of the step above
+        it), pre-order, without recursion. For a plan without shared nodes this is every
+        node of the tree."""
+        seen: set[int] = set()
         stack: list[tuple[Node, int]] = [(self.root, 1)]
         while stack:
             node, number = stack.pop()
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
             yield node, number
             if isinstance(node, Step):
                 for b in reversed(node.branches):
-                    stack.append((b.next, number + 1 if isinstance(b.next, Step) else number))
+                    if id(b.next) not in seen:
+                        nxt = number + 1 if isinstance(b.next, Step) else number
+                        stack.append((b.next, nxt))
 
     def leaves(self) -> list[Leaf]:
-        """The result nodes in pre-order."""
+        """The distinct result nodes in pre-order (a shared leaf once)."""
         return [n for n, _ in self.walk() if isinstance(n, Leaf)]
 
     def depth(self) -> int:
-        """The most operations on any root-to-leaf path of the tree."""
-        return max(number for node, number in self.walk() if isinstance(node, Leaf))
+        """The most operations on any root-to-leaf path, memoised per distinct node (linear
+        in the distinct nodes however many paths share them)."""
+        return operations_below(self.root)
 
     def smallest_margin(self) -> float | None:
         """The smallest ``margin_deg`` of any rotation in the tree (None: no rotation)."""

@@ -10,7 +10,6 @@ rest of the page.
 from __future__ import annotations
 
 import base64
-from collections.abc import Mapping
 
 from feederkit.outline import Outline
 from feederkit.plans.model import PlanPart, push_function_of
@@ -21,18 +20,18 @@ from feederkit.reports.tree_html import Drawing
 POSE_PX = 64
 
 
-def _states_table(entry: PlanPart, draw: Drawing) -> str:
+def _states_table(index: int, entry: PlanPart, draw: Drawing) -> str:
     rows = []
     for s in entry.states:
         svg = pose_svg(
-            draw.rings.get(entry.name, [entry.hull]),
+            draw.rings[index],
             entry.hull,
             entry.com,
             s.pose_deg,
             radius_mm=draw.radius_mm,
-            colour=draw.colours[entry.name],
+            colour=draw.colours[index],
             px=POSE_PX,
-            title=f"{entry.name}, state {s.id} on the fence",
+            title=f"{entry.label}, state {s.id} on the fence",
         )
         lo, hi = s.resting_range_deg
         rows.append(
@@ -49,20 +48,36 @@ def _states_table(entry: PlanPart, draw: Drawing) -> str:
 
 
 def part_section(
-    index: int, entry: PlanPart, draw: Drawing, outlines: Mapping[str, Outline] | None
+    index: int,
+    entry: PlanPart,
+    draw: Drawing,
+    outline: Outline | None,
+    share: float | None = None,
 ) -> str:
-    """One part: name, stable-state table with poses, and its radius/push/push-diameter plot."""
+    """One member (a part, or a part in one landing): its label, prior share (None: not
+    given), stable-state table with poses, and its radius/push/push-diameter plot."""
     pf = push_function_of(entry)
-    outline = (outlines or {}).get(entry.name)
     svg = part_plot_bytes(pf, "svg", outline=outline)
     uri = "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
     rev = f' <span class="muted">rev {esc(str(entry.revision))}</span>' if entry.revision else ""
+    share_text = (
+        "" if share is None else f' <span class="muted">share {num(100.0 * share, 3)}%</span>'
+    )
+    landing = "" if entry.landing is None else f"Landing {esc(entry.landing)}"
     return (
-        f'<section class="part" id="part-{index}" data-part="{esc(entry.name)}">'
-        f'<h3><span class="swatch" style="background:{draw.colours[entry.name]}"></span>'
-        f"{esc(entry.name)}{rev}</h3>"
-        f'<div class="part-grid"><div>{_states_table(entry, draw)}</div>'
-        f'<figure class="plot"><img src="{uri}" alt="{esc(entry.name)}: outline, radius, push '
+        f'<section class="part" id="part-{index}" data-part="{esc(entry.name)}" '
+        f'data-landing="{esc(entry.landing or "")}" '
+        f'data-share="{"" if share is None else num(share, 6)}">'
+        f'<h3><span class="swatch" style="background:{draw.colours[index]}"></span>'
+        f"{esc(entry.label)}{rev}{share_text}</h3>"
+        + (
+            f'<p class="muted">{landing}: the hull and COM as the part then lies '
+            "(docs/landings.md).</p>"
+            if landing
+            else ""
+        )
+        + f'<div class="part-grid"><div>{_states_table(index, entry, draw)}</div>'
+        f'<figure class="plot"><img src="{uri}" alt="{esc(entry.label)}: outline, radius, push '
         'and push-diameter functions"><figcaption>Outline with hull (dashed), COM and numbered '
         "stable edges (dotted: fragile); below, over the fence orientation theta: radius, push "
         "and push-diameter functions, resting ranges shaded.</figcaption></figure></div></section>"

@@ -1,11 +1,12 @@
 """The changeover report: one self-contained HTML page (inline SVG, no scripts, no network).
 
-Sections: mix and sensor, the plan as a tree, statistics, per-part states and plots, the pairs
-the plan cannot tell apart, and the conventions. The plan is verified at its declared
-uncertainty (:func:`feederkit.plans.verify.verify_declared`: a strong plan for every outcome and
-reading, an ideal one on the kinematic model) as it is drawn: a plan that fails gets a red
-banner at the top naming the first problem; a plan whose smallest margin is below 1 degree a
-warning (docs/reports.md).
+Sections: mix and sensor, the plan as a tree, statistics (with the cycle time in the cell
+profile the plan was made for), the sensor design (when the caller gives it), per-part states
+and plots, the pairs the plan cannot tell apart, and the conventions. The plan is verified at
+its declared uncertainty (:func:`feederkit.plans.verify.verify_declared`: a strong plan for
+every outcome and reading, an ideal one on the kinematic model) as it is drawn: a plan that
+fails gets a red banner at the top naming the first problem; a plan whose smallest margin is
+below 1 degree a warning (docs/reports.md).
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from typing import Any
 from feederkit.errors import InputError
 from feederkit.outline import Outline
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan
+from feederkit.plans.model import Leaf, Plan, PlanPart, Step
 from feederkit.plans.verify import VerificationReport, verify_declared
+from feederkit.reports.design_html import design_section
 from feederkit.reports.parts_html import part_section
 from feederkit.reports.sections import (
     conventions_section,
@@ -35,23 +37,54 @@ CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:"
 """The page may load nothing: inline styles and data-URI images only."""
 
 
-def _rings(plan: Plan, outlines: Mapping[str, Outline] | None) -> dict[str, list[Ring]]:
-    """Outline and holes of each part the caller gave, else its hull."""
-    out: dict[str, list[Ring]] = {}
+def member_outline(part: PlanPart, outlines: Mapping[str, Outline] | None) -> Outline | None:
+    """The caller's outline of a member: keyed ``PART/LANDING`` for a landing (the part as
+    it then lies, docs/landings.md), else by the part's name; None: draw the hull."""
+    if not outlines:
+        return None
+    if part.landing is not None:
+        return outlines.get(f"{part.name}/{part.landing}")
+    return outlines.get(part.name)
+
+
+def member_rings(plan: Plan, outlines: Mapping[str, Outline] | None) -> list[list[Ring]]:
+    """Outline and holes of each member the caller gave, else its hull (by member index)."""
+    out: list[list[Ring]] = []
     for p in plan.parts:
-        outline = (outlines or {}).get(p.name)
-        out[p.name] = [p.hull] if outline is None else [outline.vertices, *outline.holes]
+        outline = member_outline(p, outlines)
+        out.append([p.hull] if outline is None else [outline.vertices, *outline.holes])
     return out
 
 
-def _tree_section(numbered: Sequence[Place], tree: str) -> str:
-    n_leaves = sum(isinstance(p.node, Leaf) for p in numbered)
+def _leaves(n: int) -> str:
+    return "leaf" if n == 1 else "leaves"
+
+
+def tree_section(numbered: Sequence[Place], tree: str) -> str:
+    """The plan section: the drawn tree, its distinct nodes, accepting and reject leaves and
+    shared subplans counted (also as ``data-`` attributes, for scripts)."""
+    leaves = [p.node for p in numbered if isinstance(p.node, Leaf)]
+    rejects = sum(leaf.reject for leaf in leaves)
+    shared = sum(p.shared and isinstance(p.node, Step) for p in numbered)
+    counts = (
+        f"{len(numbered)} distinct nodes; {len(leaves) - rejects} accepting "
+        f"{_leaves(len(leaves) - rejects)} and {rejects} reject {_leaves(rejects)}"
+    )
+    if shared:
+        counts += (
+            f"; {shared} shared subplan{'s' if shared != 1 else ''}, each drawn once and named "
+            "where it is used again"
+        )
     return (
-        f'<section id="plan-tree" data-nodes="{len(numbered)}" data-leaves="{n_leaves}">'
+        f'<section id="plan-tree" data-nodes="{len(numbered)}" data-leaves="{len(leaves)}" '
+        f'data-accepts="{len(leaves) - rejects}" data-rejects="{rejects}" '
+        f'data-shared="{shared}">'
         '<h2>The plan</h2><p class="muted">Each box is a plan node with the states the part '
         "may be in, drawn on the fence. Each edge says the rotation the robot applies and the "
         "reading that leads there. Shaded boxes are the final poses: green one known pose, blue "
-        "poses alike up to symmetry, red parts the plan cannot tell apart.</p>"
+        "poses alike up to symmetry, red parts the plan cannot tell apart, yellow a reject "
+        "leaf: landings the next station cannot take, recirculated or re-dropped.</p>"
+        f'<p class="counts">{esc(counts)}.</p>'
         f"{tree}</section>"
     )
 
@@ -76,6 +109,21 @@ def _banners(plan: Plan, report: VerificationReport) -> str:
     return out
 
 
+def plan_section(plan: Plan, outlines: Mapping[str, Outline] | None = None) -> str:
+    """The plan section alone (no part plots): what grows with the plan's distinct nodes."""
+    numbered = places(plan)
+    draw = drawing_for(plan, member_rings(plan, outlines))
+    return tree_section(numbered, tree_html(plan, numbered, trace_plan(plan, numbered), draw))
+
+
+def _shares(plan: Plan) -> list[float | None]:
+    """Each member's prior share as the report shows it: normalised when the plan gives
+    shares (:meth:`Plan.shares`), None when every member is equally likely by default."""
+    if any(p.share is None for p in plan.parts):
+        return [None] * len(plan.parts)
+    return list(plan.shares())
+
+
 def render_report(
     plan: Plan | Mapping[str, Any],
     *,
@@ -83,35 +131,48 @@ def render_report(
     simulation: Mapping[str, Any] | None = None,
     unrecognizable: Sequence[Mapping[str, Any]] | None = None,
     outlines: Mapping[str, Outline] | None = None,
+    cycle_time: Mapping[str, Any] | None = None,
+    design: Mapping[str, Any] | None = None,
 ) -> str:
     """The HTML report of a plan (or a plan file's JSON object, checked; design.md).
 
-    ``seconds_per_op`` adds the cycle time; ``simulation`` (``trials``, ``successes``, ...) the
-    simulator's result; ``unrecognizable`` pairs ``{part_a, part_b, states_a, states_b, reason}``
-    from the mix analysis; ``outlines`` (part name -> Outline) draws holes around the plan's
-    hulls. Raises InputError for a malformed plan or option.
+    ``cycle_time`` (default: the plan file's ``stats.cycle_time``, docs/cell.md) gives the
+    seconds per part in a named cell profile; ``seconds_per_op`` a flat cycle time instead;
+    ``simulation`` (``trials``, ``successes``, ...) the simulator's result; ``unrecognizable``
+    pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis;
+    ``outlines`` (part name, or ``PART/LANDING`` for a member of a plan over landings, ->
+    Outline) draws holes around the plan's hulls; ``design`` (the
+    JSON of ``feederkit design sensor``) adds the sensor design table and plot. Raises
+    InputError for a malformed plan or option.
     """
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
         raise InputError("seconds per operation must be a positive number")
+    if cycle_time is None and isinstance(plan, Mapping):
+        stats = plan.get("stats")
+        cycle_time = stats.get("cycle_time") if isinstance(stats, Mapping) else None
     plan = as_plan(plan)
     report = verify_declared(plan)
     numbered = places(plan)
     trace = trace_plan(plan, numbered)
-    draw = drawing_for(plan, _rings(plan, outlines))
-    names = ", ".join(p.name for p in plan.parts)
+    draw = drawing_for(plan, member_rings(plan, outlines))
+    names = ", ".join(dict.fromkeys(p.name for p in plan.parts))
     symmetric = [(p.node_id, p.node) for p in numbered if isinstance(p.node, Leaf)]
     body = "".join(
         [
             f"<h1>Changeover report: {esc(names)}</h1>",
             _banners(plan, report),
             mix_section(plan, draw),
-            _tree_section(numbered, tree_html(plan, numbered, trace, draw)),
-            stats_section(plan, seconds_per_op, simulation),
+            tree_section(numbered, tree_html(plan, numbered, trace, draw)),
+            stats_section(plan, seconds_per_op, simulation, cycle_time),
+            "" if design is None else design_section(design),
             '<section id="parts"><h2>Parts</h2>',
-            "".join(part_section(i, p, draw, outlines) for i, p in enumerate(plan.parts)),
+            "".join(
+                part_section(i, p, draw, member_outline(p, outlines), share)
+                for i, (p, share) in enumerate(zip(plan.parts, _shares(plan), strict=True))
+            ),
             "</section>",
             lookalike_section(
-                plan, confusions(numbered, trace), list(unrecognizable or []), symmetric
+                plan, confusions(plan, numbered, trace), list(unrecognizable or []), symmetric
             ),
             conventions_section(plan),
         ]

@@ -31,12 +31,20 @@ CONVENTIONS = (
 
 
 def mix_section(plan: Plan, draw: Drawing) -> str:
-    """The parts of the mix (with their colours), the sensor and the plan's verdict in brief."""
+    """The members of the mix (a part, or a part in one landing: design.md "Landings") with
+    their colours and prior shares, the sensor."""
+    shares = plan.shares() if all(p.share is not None for p in plan.parts) else None
     items = "".join(
-        f'<li><span class="swatch" style="background:{draw.colours[p.name]}"></span>'
-        f'<a href="#part-{i}">{esc(p.name)}</a>'
+        f'<li><span class="swatch" style="background:{draw.colours[i]}"></span>'
+        f'<a href="#part-{i}">{esc(p.label)}</a>'
         + (f' <span class="muted">rev {esc(str(p.revision))}</span>' if p.revision else "")
-        + f' <span class="muted">\u00b7 {len(p.states)} stable states</span></li>'
+        + f' <span class="muted">\u00b7 {len(p.states)} stable states</span>'
+        + (
+            ""
+            if shares is None
+            else f' <span class="muted">\u00b7 share {num(100.0 * shares[i], 3)}%</span>'
+        )
+        + "</li>"
         for i, p in enumerate(plan.parts)
     )
     return (
@@ -53,9 +61,14 @@ def stats_section(
     plan: Plan,
     seconds_per_op: float | None,
     simulation: Mapping[str, Any] | None,
+    cycle_time: Mapping[str, Any] | None = None,
 ) -> str:
     """Length, expected length, smallest margin, the declared uncertainty and the certificate
-    (design.md, "Uncertainty"), optimality, cycle time, simulation results."""
+    (design.md, "Uncertainty"), optimality, cycle time, simulation results.
+
+    ``cycle_time`` is the plan's ``stats.cycle_time`` (:func:`feederkit.cell.cycle_time_dict`:
+    seconds per part in the cell profile it names); without it, ``seconds_per_op`` gives a
+    flat cycle time (the same seconds for every operation)."""
     stats = plan.stats
     length = float(stats.length)
     expected = stats.expected_length
@@ -86,8 +99,10 @@ def stats_section(
     opt = "yes: no shorter plan exists" if stats.optimal else "not proven"
     opt += f" (lower bound {stats.lower_bound})"
     rows.append(_row("optimal", esc(opt)))
-    if seconds_per_op is None:
-        rows.append(_row("cycle time", "give seconds per operation to see it"))
+    if cycle_time is not None:
+        rows += _cycle_rows(cycle_time)
+    elif seconds_per_op is None:
+        rows.append(_row("cycle time", "not known: give a cell profile with timing (docs/cell.md)"))
     else:
         worst = f"{num(length * seconds_per_op, 2)} s worst case"
         mean = f"{num(expected * seconds_per_op, 2)} s expected, "
@@ -98,6 +113,26 @@ def stats_section(
         rows.append(_row("simulation", esc(simulation_text(simulation))))
     table = f'<table class="kv">{"".join(rows)}</table>'
     return f'<section id="stats"><h2>Statistics</h2>{table}</section>'
+
+
+def _cycle_rows(cycle: Mapping[str, Any]) -> list[str]:
+    """Expected and worst seconds per part and parts per minute, naming the profile."""
+    try:
+        exp, worst = float(cycle["expected_s"]), float(cycle["worst_s"])
+        profile = str(cycle["profile"])
+    except (KeyError, TypeError, ValueError):
+        raise InputError(
+            "stats cycle_time needs expected_s, worst_s and profile (docs/cell.md)"
+        ) from None
+
+    def rate(seconds: float) -> str:
+        return "" if seconds <= 0.0 else f", {num(60.0 / seconds, 1)} parts per minute"
+
+    return [
+        _row("cycle time, expected", f"{num(exp, 2)} s per part{rate(exp)}"),
+        _row("cycle time, worst case", f"{num(worst, 2)} s per part{rate(worst)}"),
+        _row("cell profile", esc(profile)),
+    ]
 
 
 def _count(value: object) -> int | None:
@@ -157,8 +192,19 @@ def _unique(items: Sequence[str]) -> list[str]:
     return list(dict.fromkeys(items))
 
 
-def _rows(confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]) -> list[str]:
-    """One row per pair of parts, whichever order they are named in: the plan's leaves that
+def _member_words(plan: Plan, name: str) -> str:
+    """A name from the mix analysis as the report names members: ``PART/LANDING`` (the
+    landing's part, docs/landings.md) becomes the member's label ``PART (LANDING)``."""
+    for p in plan.parts:
+        if p.landing is not None and name == f"{p.name}/{p.landing}":
+            return p.label
+    return name
+
+
+def _rows(
+    plan: Plan, confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]
+) -> list[str]:
+    """One row per pair of members, whichever order they are named in: the plan's leaves that
     hold both (each a witness) and the mix analysis's reason; no pairing listed twice."""
     rows: dict[frozenset[str], dict[str, Any]] = {}
 
@@ -175,7 +221,8 @@ def _rows(confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]) -
     for i, pair in enumerate(given):
         if not isinstance(pair, Mapping):
             raise InputError(f"unrecognizable pair {i} must be a mapping")
-        a, b = str(pair.get("part_a", "?")), str(pair.get("part_b", "?"))
+        a = _member_words(plan, str(pair.get("part_a", "?")))
+        b = _member_words(plan, str(pair.get("part_b", "?")))
         r = row(a, b, "mix")
         if r["a"] != a:  # named the other way round: keep the row's order
             a, b = b, a
@@ -209,7 +256,7 @@ def lookalike_section(
 ) -> str:
     """Pairs of parts that cannot be told apart, with their witnesses, and symmetric leaves
     (``symmetric``: the numbered leaves)."""
-    rows = _rows(confusions, given)
+    rows = _rows(plan, confusions, given)
     if rows:
         body = (
             "<p>These parts behave alike under every push-align operation the sensor can "
@@ -218,15 +265,21 @@ def lookalike_section(
             f"<th>inseparable states</th><th>witness</th></tr>{''.join(rows)}</table>"
         )
     elif len(plan.parts) > 1:
-        body = "<p>Every part of the mix is recognized: no leaf of the plan holds two parts.</p>"
+        what = "member (part and landing)" if plan.over_landings else "part"
+        body = (
+            f"<p>Every {what} of the mix is recognized: no accepting leaf of the plan holds "
+            f"two.</p>"
+        )
     else:
         body = "<p>One part only: nothing to recognize.</p>"
     sym = [
-        c for c in symmetric if len({r.part for r in c[1].results}) == 1 and len(c[1].results) > 1
+        c
+        for c in symmetric
+        if not c[1].reject and len({r.key for r in c[1].results}) == 1 and len(c[1].results) > 1
     ]
     if sym:
         items = "".join(
-            f"<li>{esc(leaf.results[0].part)}: states "
+            f"<li>{esc(plan.part(*leaf.results[0].key).label)}: states "
             f"{esc(_states([r.state for r in leaf.results]))} at leaf {node_id}</li>"
             for node_id, leaf in sym
         )

@@ -46,6 +46,10 @@ ul.tree ul > li::after { content: ""; position: absolute; left: 0; top: 1.3rem; 
 .tree-node.result { background: #eaf6ee; border-color: #8cc59c; }
 .tree-node.result.symmetric { background: #eef3fb; border-color: #8fa9d6; }
 .tree-node.result.confused { background: #fbeeee; border-color: #d68f8f; }
+.tree-node.result.reject { background: #fdf6e3; border-color: #d6b36a; }
+.shared-tag { color: #0b5a8a; font-weight: 600; }
+.tree-ref { display: inline-block; padding: 3px 8px; border: 1px dashed var(--line);
+  border-radius: 6px; color: #0b5a8a; }
 .node-head { font-size: .92rem; margin-bottom: .2rem; }
 .node-op { font-size: .88rem; color: var(--muted); margin-top: .15rem; }
 .poses { display: flex; flex-wrap: wrap; gap: .25rem .5rem; }

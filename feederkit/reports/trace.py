@@ -1,11 +1,15 @@
-"""The plan as the report draws it: numbered nodes, the states possible at each, witnesses.
+"""The plan as the report draws it: its distinct nodes numbered, the states possible at each.
 
-Nodes are numbered in pre-order from 0 (the root), each place in the written tree once (a
-subplan the planner shares is drawn wherever it is used). A state's push is the state whose
-resting range holds the new fence orientation ``normal - action`` (design.md conventions,
-read off the plan's listed states); a state follows a branch when its reading set meets the
-branch's closed range (:meth:`Sensor.reads_into`). Everything here iterates: a plan as deep as
-the reader accepts is drawn without recursion.
+A plan may share subplans (a DAG, design.md's ``"nodes"``): the report numbers each distinct
+node once, in the pre-order of :meth:`Plan.walk` (root 0; for a plan without shared nodes
+every node of the tree), so a plan with astronomically many paths costs its distinct nodes.
+States are keyed by member (a plan over landings has one member per landing, design.md
+"Landings") and state id. The states possible at a node are the union over its parents of the
+states each parent's branch lets through; the path shown to a node is the first one in
+pre-order. A state's push is the state whose resting range holds the new fence orientation
+``normal - action`` (design.md conventions, read off the plan's listed states); a state follows
+a branch when its reading set meets the branch's closed range (:meth:`Sensor.reads_into`).
+Everything here iterates: a plan as deep as the reader accepts is drawn without recursion.
 """
 
 from __future__ import annotations
@@ -18,39 +22,42 @@ from feederkit.angles import norm360
 from feederkit.mechanics.push import StableState, rotation_after
 from feederkit.plans.model import Leaf, Node, Plan, PlanPart, Step
 
-StateKey = tuple[str, int]
-"""A state of the mix: (part name, state id)."""
+StateKey = tuple[int, int]
+"""A state of the mix: (member index in ``plan.parts``, state id)."""
 
 
 @dataclass(frozen=True)
 class Place:
-    """A node where the report draws it: its number (pre-order), the operations before it,
-    the node, and the numbers of the nodes its branches lead to (in branch order)."""
+    """A distinct node of the plan: its number (pre-order of distinct nodes), its depth (the
+    operations before it on its first path), the node, the numbers of the nodes its branches
+    lead to (in branch order) and how many branches lead to it (more than one: shared)."""
 
     node_id: int
     depth: int
     node: Node
     children: tuple[int, ...]
+    uses: int = 1
+
+    @property
+    def shared(self) -> bool:
+        """Whether several branches lead here (the report draws it once, refers to it)."""
+        return self.uses > 1
 
 
 def places(plan: Plan) -> list[Place]:
-    """Every node of the written tree, numbered in pre-order (root 0), without recursion."""
-    out: list[Place] = []
-    pending: list[tuple[Node, int, int | None]] = [(plan.root, 0, None)]  # node, depth, parent
-    kids: dict[int, list[int]] = {}
-    order: list[tuple[Node, int]] = []
-    while pending:
-        node, depth, parent = pending.pop()
-        number = len(order)
-        order.append((node, depth))
-        if parent is not None:
-            kids[parent].append(number)
-        kids[number] = []
+    """Every distinct node of the plan once, numbered in :meth:`Plan.walk` order (root 0)."""
+    walked = list(plan.walk())
+    number = {id(node): k for k, (node, _) in enumerate(walked)}
+    uses = [0] * len(walked)
+    for node, _ in walked:
         if isinstance(node, Step):
-            for b in reversed(node.branches):
-                pending.append((b.next, depth + 1, number))
-    for number, (node, depth) in enumerate(order):
-        out.append(Place(number, depth, node, tuple(kids[number])))
+            for b in node.branches:
+                uses[number[id(b.next)]] += 1
+    out = []
+    for k, (node, op) in enumerate(walked):
+        kids = tuple(number[id(b.next)] for b in node.branches) if isinstance(node, Step) else ()
+        depth = op - 1 if isinstance(node, Step) else op
+        out.append(Place(k, depth, node, kids, max(uses[k], 1)))
     return out
 
 
@@ -64,7 +71,8 @@ class TraceStep:
 
 @dataclass(frozen=True)
 class Trace:
-    """Possible states at each node (before its operation) and the operations that lead there."""
+    """Possible states at each node (before its operation; the union over its parents) and
+    one path of operations that leads there (the first in pre-order)."""
 
     states: Mapping[int, tuple[StateKey, ...]]
     paths: Mapping[int, tuple[TraceStep, ...]]
@@ -72,7 +80,7 @@ class Trace:
 
 @dataclass(frozen=True)
 class Confusion:
-    """Two parts a leaf of the plan leaves together: the plan cannot tell them apart."""
+    """Two members a leaf of the plan leaves together: the plan cannot tell them apart."""
 
     part_a: str
     part_b: str
@@ -93,52 +101,83 @@ def pushed(part: PlanPart, state: StableState, action_deg: float) -> StableState
     return min(part.states, key=lambda s: abs(norm360(s.normal_deg - theta + 180.0) - 180.0))
 
 
+def _topological(numbered: list[Place]) -> list[int]:
+    """The node numbers, every parent before its children (Kahn's algorithm)."""
+    waiting = [0] * len(numbered)
+    for place in numbered:
+        for k in place.children:
+            waiting[k] += 1
+    ready = [p.node_id for p in numbered if waiting[p.node_id] == 0]
+    order: list[int] = []
+    while ready:
+        k = ready.pop()
+        order.append(k)
+        for child in reversed(numbered[k].children):
+            waiting[child] -= 1
+            if waiting[child] == 0:
+                ready.append(child)
+    return order
+
+
 def trace_plan(plan: Plan, numbered: list[Place]) -> Trace:
-    """Follow every state of the mix through the plan from the root (pre-order, no recursion)."""
-    states: dict[int, tuple[StateKey, ...]] = {
-        0: tuple((p.name, s.id) for p in plan.parts for s in p.states)
+    """Follow every state of every member through the plan from the root, each distinct node
+    once, parents before children (no recursion)."""
+    reached: dict[int, dict[StateKey, None]] = {
+        0: {(m, s.id): None for m, p in enumerate(plan.parts) for s in p.states}
     }
     paths: dict[int, tuple[TraceStep, ...]] = {0: ()}
-    for place in numbered:
+    for number in _topological(numbered):
+        place = numbered[number]
         node = place.node
         if not isinstance(node, Step):
             continue
-        here, path = states[place.node_id], paths[place.node_id]
-        image: list[StateKey] = []
-        for name, sid in here:
-            part = plan.part(name)
+        here = reached.get(number, {})
+        image: dict[StateKey, None] = {}
+        for m, sid in here:
+            part = plan.parts[m]
             s = part.state(sid)
             after = s if node.action_deg is None else pushed(part, s, node.action_deg)
-            if (name, after.id) not in image:
-                image.append((name, after.id))
+            image[(m, after.id)] = None
         for b, child in zip(node.branches, place.children, strict=True):
-            states[child] = tuple(
-                k
-                for k in image
-                if b.reading is None
-                or plan.sensor.reads_into(plan.part(k[0]).state(k[1]).diameter, *b.reading)
-            )
-            paths[child] = (*path, TraceStep(node.action_deg, b.reading))
-    return Trace(states=states, paths=paths)
+            into = reached.setdefault(child, {})
+            for m, sid in image:
+                diameter = plan.parts[m].state(sid).diameter
+                if b.reading is None or plan.sensor.reads_into(diameter, *b.reading):
+                    into[(m, sid)] = None
+    for place in numbered:  # pre-order: a node's first parent comes before it
+        node = place.node
+        if isinstance(node, Step):
+            for b, child in zip(node.branches, place.children, strict=True):
+                if child not in paths:
+                    paths[child] = (*paths[place.node_id], TraceStep(node.action_deg, b.reading))
+    states = {p.node_id: tuple(sorted(reached.get(p.node_id, {}))) for p in numbered}
+    return Trace(states=states, paths={p.node_id: paths.get(p.node_id, ()) for p in numbered})
 
 
-def confusions(numbered: list[Place], trace: Trace) -> list[Confusion]:
-    """Pairs of parts that end in the same leaf: the plan says no plan can tell them apart."""
+def leaf_members(plan: Plan, leaf: Leaf) -> dict[int, list[int]]:
+    """A leaf's results grouped by member index (in result order): member -> state ids."""
+    out: dict[int, list[int]] = {}
+    for r in leaf.results:
+        out.setdefault(plan.part_index(r.part, r.landing), []).append(r.state)
+    return out
+
+
+def confusions(plan: Plan, numbered: list[Place], trace: Trace) -> list[Confusion]:
+    """Pairs of members that end in the same (accepting) leaf: the plan says no plan can tell
+    them apart. A reject leaf needs no telling apart: every member there is recirculated."""
     out: list[Confusion] = []
     for place in numbered:
         leaf = place.node
-        if not isinstance(leaf, Leaf):
+        if not isinstance(leaf, Leaf) or leaf.reject:
             continue
-        by_part: dict[str, list[int]] = {}
-        for r in leaf.results:
-            by_part.setdefault(r.part, []).append(r.state)
-        for a, b in combinations(by_part, 2):
+        by_member = leaf_members(plan, leaf)
+        for a, b in combinations(by_member, 2):
             out.append(
                 Confusion(
-                    part_a=a,
-                    part_b=b,
-                    states_a=tuple(by_part[a]),
-                    states_b=tuple(by_part[b]),
+                    part_a=plan.parts[a].label,
+                    part_b=plan.parts[b].label,
+                    states_a=tuple(by_member[a]),
+                    states_b=tuple(by_member[b]),
                     node_id=place.node_id,
                     path=trace.paths[place.node_id],
                 )

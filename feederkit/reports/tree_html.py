@@ -1,20 +1,25 @@
 """The plan as a tree in HTML: each node the possible states drawn as parts in their poses.
 
-Markup contract (tests and scripts rely on it): every plan node is one element of class
-``tree-node`` with ``data-node-id`` (pre-order, root 0); operation nodes also have class ``op``,
-leaves class ``result``; each final pose of a leaf is one ``figure.final-pose`` with
-``data-part``, ``data-state`` and ``data-pose-deg``; each edge is one ``div.edge`` with
-``data-action-deg`` (empty at the root) and ``data-reading`` (``lo..hi``, empty when sensorless).
+Markup contract (tests and scripts rely on it): every distinct plan node is one element of
+class ``tree-node`` with ``data-node-id`` (pre-order of distinct nodes, root 0); operation
+nodes also have class ``op``, leaves class ``result`` (a reject leaf also ``reject``); a node
+several branches lead to (design.md's ``"nodes"``) is drawn once, at its first place (a shared
+subplan with ``data-shared``: ``S1``, ``S2``, ... in the order drawn, as ``plan_tree`` names
+them), and each other place is one ``div.tree-ref`` with ``data-ref`` (the node id); each
+drawn state is a figure with ``data-part``, ``data-landing`` (empty when the plan is not over
+landings) and ``data-state``, a final pose of a leaf a ``figure.final-pose`` also with
+``data-pose-deg``; each edge is one ``div.edge`` with ``data-action-deg`` (empty at the root)
+and ``data-reading`` (``lo..hi``, empty when sensorless).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from feederkit.plans.model import Branch, Leaf, Plan, Step
 from feederkit.reports.svgkit import Ring, esc, num, part_colour, pose_svg, reach
-from feederkit.reports.trace import Place, StateKey, Trace, TraceStep
+from feederkit.reports.trace import Place, StateKey, Trace, TraceStep, leaf_members
 
 STATE_PX = 56
 """Drawn size of a possible state inside an operation node."""
@@ -25,18 +30,19 @@ FINAL_PX = 72
 
 @dataclass(frozen=True)
 class Drawing:
-    """What the tree needs to draw a part: its rings (outline and holes, or hull), colour, scale."""
+    """What the tree needs to draw each member (by index in ``plan.parts``): its rings
+    (outline and holes, or hull), colour, and the one scale of the mix."""
 
-    rings: Mapping[str, Sequence[Ring]]
-    colours: Mapping[str, str]
+    rings: Sequence[Sequence[Ring]]
+    colours: Sequence[str]
     radius_mm: float
 
 
-def drawing_for(plan: Plan, rings: Mapping[str, Sequence[Ring]]) -> Drawing:
-    """One common scale for the whole mix, a colour per part in plan order."""
+def drawing_for(plan: Plan, rings: Sequence[Sequence[Ring]]) -> Drawing:
+    """One common scale for the whole mix, a colour per member in plan order."""
     return Drawing(
-        rings=rings,
-        colours={p.name: part_colour(i) for i, p in enumerate(plan.parts)},
+        rings=tuple(rings),
+        colours=tuple(part_colour(i) for i in range(len(plan.parts))),
         radius_mm=max(reach(p.hull, p.com) for p in plan.parts),
     )
 
@@ -69,25 +75,27 @@ def _state_figure(
     plan: Plan, draw: Drawing, key: StateKey, cls: str, px: int, pose: float | None = None
 ) -> str:
     """A state drawn on the fence; ``pose`` (deg) overrides the state's own pose."""
-    name, sid = key
-    part = plan.part(name)
+    m, sid = key
+    part = plan.parts[m]
     state = part.state(sid)
     pose_deg = state.pose_deg if pose is None else pose
-    title = f"{name}, state {sid} (edge {state.edge}) on the fence, pose {num(pose_deg, 1)} deg"
+    label = part.label
+    title = f"{label}, state {sid} (edge {state.edge}) on the fence, pose {num(pose_deg, 1)} deg"
     svg = pose_svg(
-        draw.rings.get(name, [part.hull]),
+        draw.rings[m],
         part.hull,
         part.com,
         pose_deg,
         radius_mm=draw.radius_mm,
-        colour=draw.colours[name],
+        colour=draw.colours[m],
         px=px,
         title=title,
     )
     return (
-        f'<figure class="{cls}" data-part="{esc(name)}" data-state="{sid}" '
+        f'<figure class="{cls}" data-part="{esc(part.name)}" '
+        f'data-landing="{esc(part.landing or "")}" data-state="{sid}" '
         f'data-pose-deg="{num(pose_deg, 4)}">{svg}'
-        f'<figcaption>{esc(name)} s{sid}<span class="pose-deg"> {num(pose_deg, 1)}\u00b0</span>'
+        f'<figcaption>{esc(label)} s{sid}<span class="pose-deg"> {num(pose_deg, 1)}\u00b0</span>'
         f"</figcaption></figure>"
     )
 
@@ -104,7 +112,15 @@ def _edge(parent: Step, branch: Branch) -> str:
     )
 
 
-def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place) -> str:
+def _shared_tag(name: str | None) -> tuple[str, str]:
+    """The attribute and the head note of a shared subplan's one drawing."""
+    if name is None:
+        return "", ""
+    note = f' <span class="shared-tag">shared subplan {esc(name)}</span>'
+    return f' data-shared="{esc(name)}"', note
+
+
+def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str | None) -> str:
     node = place.node
     assert isinstance(node, Step)
     here = trace.states[place.node_id]
@@ -118,55 +134,79 @@ def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place) -> str:
         step = f"next: align from an unknown orientation{read}"
     else:
         step = f"next: {action_text(node.action_deg)}{margin}, align{read}"
+    attr, note = _shared_tag(shared)
     return (
         f'<div class="tree-node op" data-node-id="{place.node_id}" data-depth="{place.depth}" '
-        f'data-states="{len(here)}"><div class="node-head">'
+        f'data-states="{len(here)}"{attr}><div class="node-head">'
         f"<strong>operation {place.depth + 1}</strong> "
-        f'<span class="muted">node {place.node_id} \u00b7 {esc(count)}</span></div>'
+        f'<span class="muted">node {place.node_id} \u00b7 {esc(count)}</span>{note}</div>'
         f'<div class="poses">{figures}</div>'
         f'<div class="node-op">{esc(step)}</div></div>'
     )
 
 
-def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place) -> str:
+REJECT_WORDS = "reject (recirculate or re-drop)"
+"""A reject leaf in words: the next station cannot take these landings (docs/plans.md)."""
+
+
+def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str | None) -> str:
     node = place.node
     assert isinstance(node, Leaf)
-    keys = [(r.part, r.state) for r in node.results]
+    keys = [(plan.part_index(r.part, r.landing), r.state) for r in node.results]
     figures = "".join(
-        _state_figure(plan, draw, (r.part, r.state), "final-pose", FINAL_PX, r.pose_deg)
-        for r in node.results
+        _state_figure(plan, draw, k, "final-pose", FINAL_PX, r.pose_deg)
+        for k, r in zip(keys, node.results, strict=True)
     )
-    parts = {r.part for r in node.results}
-    if len(node.results) == 1:
-        head = f"done: {node.results[0].part} in state {node.results[0].state}"
+    members = leaf_members(plan, node)
+    if node.reject:
+        labels = ", ".join(plan.parts[m].label for m in members)
+        head = f"{REJECT_WORDS}: {labels}"
+        kind = "reject"
+    elif len(node.results) == 1:
+        head = f"done: {plan.parts[keys[0][0]].label} in state {keys[0][1]}"
         kind = "known"
-    elif len(parts) == 1:
+    elif len(members) == 1:
         head = f"done up to symmetry: {len(node.results)} poses that no plan tells apart"
         kind = "symmetric"
     else:
-        head = f"not recognized: {len(parts)} parts end here together"
+        what = "landings" if plan.over_landings else "parts"
+        head = f"not recognized: {len(members)} {what} end here together"
         kind = "confused"
     note = ""
     reached = set(trace.states[place.node_id])
     if reached != set(keys):
-        got = ", ".join(f"{p} s{s}" for p, s in sorted(reached)) or "none"
+        got = ", ".join(f"{plan.parts[m].label} s{s}" for m, s in sorted(reached)) or "none"
         note = (
             f'<p class="warn">Following the plan, the states that reach this leaf are: '
             f"{esc(got)}.</p>"
         )
+    attr, tag = _shared_tag(shared)
     return (
         f'<div class="tree-node result {kind}" data-node-id="{place.node_id}" '
-        f'data-depth="{place.depth}" data-states="{len(node.results)}">'
+        f'data-depth="{place.depth}" data-states="{len(node.results)}"{attr}>'
         f'<div class="node-head"><strong>{esc(head)}</strong> '
-        f'<span class="muted">node {place.node_id}</span></div>'
+        f'<span class="muted">node {place.node_id}</span>{tag}</div>'
         f'<div class="poses">{figures}</div>{note}</div>'
     )
 
 
+def _ref(place: Place, name: str | None) -> str:
+    """Another place of a shared node: its name (a shared subplan) and node, drawn above."""
+    what = "the result" if name is None else f"the shared subplan {esc(name)}"
+    return (
+        f'<div class="tree-ref" data-ref="{place.node_id}">{what} '
+        f"(node {place.node_id}, drawn above)</div>"
+    )
+
+
 def tree_html(plan: Plan, numbered: Sequence[Place], trace: Trace, draw: Drawing) -> str:
-    """The whole plan as nested lists: operation nodes, labelled edges, leaves (no recursion)."""
+    """The whole plan as nested lists: operation nodes, labelled edges, leaves; each distinct
+    node drawn once (at its first place; a shared subplan named ``S1``, ``S2``, ... and
+    referred to by name elsewhere, as ``plan_tree`` does), without recursion."""
     out: list[str] = ['<ul class="tree">']
     stack: list[str | tuple[int, str]] = [(0, "")]
+    names: dict[int, str | None] = {}
+    drawn: set[int] = set()
     while stack:
         item = stack.pop()
         if isinstance(item, str):
@@ -174,10 +214,18 @@ def tree_html(plan: Plan, numbered: Sequence[Place], trace: Trace, draw: Drawing
             continue
         number, edge = item
         place = numbered[number]
-        if isinstance(place.node, Leaf):
-            out.append(f"<li>{edge}{_result_node(plan, trace, draw, place)}</li>")
+        if number in drawn:
+            out.append(f"<li>{edge}{_ref(place, names[number])}</li>")
             continue
-        out.append(f"<li>{edge}{_op_node(plan, trace, draw, place)}<ul>")
+        drawn.add(number)
+        shared = None
+        if place.shared and isinstance(place.node, Step):
+            shared = f"S{sum(n is not None for n in names.values()) + 1}"
+        names[number] = shared
+        if isinstance(place.node, Leaf):
+            out.append(f"<li>{edge}{_result_node(plan, trace, draw, place, shared)}</li>")
+            continue
+        out.append(f"<li>{edge}{_op_node(plan, trace, draw, place, shared)}<ul>")
         stack.append("</ul></li>")
         step = place.node
         stack.extend(

@@ -120,15 +120,35 @@ def simulate_push(
     return PushCheck(out, state, push(pf, theta_deg), divergent_distance(pf, theta_deg))
 
 
-def _models(plan: Plan) -> dict[str, TrialModel]:
-    """Each part's model at the plan's declared uncertainty (the one it was verified on)."""
+def _models(plan: Plan) -> list[TrialModel]:
+    """Each member's model at the plan's declared uncertainty (the one it was verified on), in
+    the order of the plan's parts."""
     from feederkit.plans.strong import strong_model
 
     model = strong_model(plan_to_dict(plan))
-    return {
-        name: TrialModel(mech, diam, plan.sensor)
-        for name, mech, diam in zip(model.names, model.mechanics, model.diameters, strict=True)
-    }
+    return [
+        TrialModel(mech, diam, plan.sensor)
+        for mech, diam in zip(model.mechanics, model.diameters, strict=True)
+    ]
+
+
+def _label(name: str, landing: str | None) -> str:
+    """A plan member in words: ``NAME``, or ``NAME (LANDING)`` in a plan over landings."""
+    return name if landing is None else f"{name} ({landing})"
+
+
+def _member_shares(plan: Plan) -> np.ndarray | None:
+    """The members' prior shares, normalised (design.md, "Landings"); None when a member has
+    none (every member equally likely, drawn as before shares existed)."""
+    shares = [getattr(pp, "share", None) for pp in plan.parts]
+    if any(x is None for x in shares):
+        return None
+    total = float(sum(shares))
+    if not (math.isfinite(total) and total > 0.0) or any(x < 0.0 for x in shares):
+        raise InputError(
+            f"the plan's member shares must be non-negative with a positive sum, got {shares}"
+        )
+    return np.asarray(shares, dtype=float) / total
 
 
 def simulate_plan(
@@ -148,14 +168,16 @@ def simulate_plan(
 ) -> SimulationSummary:
     """Simulate a plan (or a plan file's JSON object, checked) over ``trials`` trials.
 
-    Each trial draws a part of the mix uniformly and a start orientation uniformly on the
-    circle, and (unless ``ideal``) nature's draw (:mod:`feederkit.sim.sampling`): a part
-    perturbed within the declared shape and COM tolerances, the friction coefficients from
-    their ranges (``friction_*``: a number, ``LO:HI`` or a pair; default
-    ``DEFAULT_FRICTION_*_RANGE``), and per rotation an error uniform in ``[-r, +r]``, ``r``
-    the declared rotation error (``rotation_noise_deg`` overrides it, to stress a plan beyond
-    its claim). Trial ``i`` draws from generators seeded with ``(seed, i)``, so a trial's
-    outcome does not depend on the others. Every operation is judged by the plan's model.
+    Each trial draws a member of the mix (a part, or a part in one of its landings:
+    design.md, "Landings") by the plan's shares (uniformly when it has none) and a start
+    orientation uniformly on the circle, and (unless ``ideal``) nature's draw
+    (:mod:`feederkit.sim.sampling`): a part perturbed within the declared shape and COM
+    tolerances, the friction coefficients from their ranges (``friction_*``: a number,
+    ``LO:HI`` or a pair; default ``DEFAULT_FRICTION_*_RANGE``), and per rotation an error
+    uniform in ``[-r, +r]``, ``r`` the declared rotation error (``rotation_noise_deg``
+    overrides it, to stress a plan beyond its claim). Trial ``i`` draws from generators
+    seeded with ``(seed, i)``, so a trial's outcome does not depend on the others. Every
+    operation is judged by the plan's model.
 
     The plan is verified at its declared uncertainty first (CheckFailed when it fails);
     ``check=False`` skips that, to watch how a plan known to be wrong fails physically.
@@ -192,19 +214,25 @@ def simulate_plan(
         )
     )
     shapes = sampled.shape_tolerance_mm > 0.0 or sampled.com_tolerance_mm > 0.0
-    aligners = {
-        pp.name: PushAligner(push_function_of(pp).part, base, rule) for pp in sim_plan.parts
-    }
+    members = list(sim_plan.parts)
+    aligners = [PushAligner(push_function_of(pp).part, base, rule) for pp in members]
     models = _models(sim_plan)
-    names = [pp.name for pp in sim_plan.parts]
+    shares = _member_shares(sim_plan)
+    landings = [getattr(pp, "landing", None) for pp in members]
+    labels = [_label(pp.name, x) for pp, x in zip(members, landings, strict=True)]
     t0 = time.perf_counter()
     results: list[TrialResult] = []
+    member_of_trial: list[int] = []
     for i in range(trials):
         rng = np.random.default_rng([seed, i])
-        name = names[int(rng.integers(len(names)))]
+        if shares is None:
+            k = int(rng.integers(len(members)))
+        else:
+            k = int(rng.choice(len(members), p=shares))
         start = float(rng.uniform(0.0, 360.0))
-        pp = sim_plan.part(name)
-        aligner, edges = aligners[name], None
+        pp = members[k]
+        name = pp.name
+        aligner, edges = aligners[k], None
         if ideal:
             draw = None
             aligner.set_friction(fb.nominal, ff.nominal)
@@ -217,7 +245,7 @@ def simulate_plan(
             draw = draw_trial(nature, len(pp.hull), sampled, fb, ff)
             if shapes:
                 perturbed = perturbed_part(pp, push_function_of(pp), draw)
-                aligner = PushAligner(perturbed.part, base, rule, scale=aligners[name].scale)
+                aligner = PushAligner(perturbed.part, base, rule, scale=aligners[k].scale)
                 edges = perturbed.basin_of_edge
             aligner.set_friction(draw.friction_belt, draw.friction_fence)
 
@@ -231,10 +259,12 @@ def simulate_plan(
             start,
             error,
             index=i,
-            model=models[name],
+            model=models[k],
             state_of_edge=edges,
+            landing=landings[k],
         )
         results.append(replace(result, draw=draw))
+        member_of_trial.append(k)
         if progress is not None:
             progress(i + 1, trials)
     wall = time.perf_counter() - t0
@@ -274,14 +304,19 @@ def simulate_plan(
             friction_fence_range=ff,
             contact=contact_words(base),
         ),
-        parts=tuple(names),
-        part_trials=tuple(sum(r.part == n for r in results) for n in names),
+        parts=tuple(labels),
+        part_trials=tuple(member_of_trial.count(k) for k in range(len(members))),
         part_successes=tuple(
-            sum(r.part == n and r.outcome == "success" for r in results) for n in names
+            sum(
+                m == k and r.outcome == "success"
+                for m, r in zip(member_of_trial, results, strict=True)
+            )
+            for k in range(len(members))
         ),
-        scales=tuple(aligners[n].scale for n in names),
+        scales=tuple(a.scale for a in aligners),
         min_margin_deg=sim_plan.stats.min_margin_deg,
         successes=sum(r.outcome == "success" for r in results),
+        rejects=sum(r.outcome == "success" and r.rejected for r in results),
         failures=wrong("failure"),
         unsettled=wrong("unsettled"),
         pushes=len(pushes),

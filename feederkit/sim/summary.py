@@ -93,12 +93,22 @@ class TrialResult:
     cause: str | None = None
     predicted: bool | None = None
     draw: TrialDraw | None = None
+    landing: str | None = None
+    rejected: bool = False
+
+    @property
+    def wrong_accept(self) -> bool:
+        """A part that ended in an accepting leaf not naming its landing and state (design.md,
+        "Landings": the next station takes a part it should not)."""
+        return self.outcome == "failure" and self.cause == "wrong result" and not self.rejected
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
         return {
             "trial": self.index,
             "part": self.part,
+            "landing": self.landing,
+            "rejected": self.rejected,
             "start_deg": _r(self.start_deg),
             "outcome": self.outcome,
             "step": self.step,
@@ -186,7 +196,10 @@ class SimulationSummary:
     """The outcome of simulating a plan over many trials.
 
     ``trials == successes + len(failures) + len(unsettled)``; ``part_trials`` and
-    ``part_successes`` split them by the parts of the mix. Push agreement counts the
+    ``part_successes`` split them by the members of the mix (``parts``: ``NAME`` or
+    ``NAME (LANDING)``). ``rejects`` of the successes ended in a reject leaf that names the
+    member (design.md, "Landings"); ``wrong_accepts`` of the failures in an accepting leaf that
+    does not. Push agreement counts the
     settled pushes that ended where the push function predicts from the actual drop
     orientation (physics against the kinematic model, whatever the rotation error).
     """
@@ -206,6 +219,13 @@ class SimulationSummary:
     push_misses: tuple[PushMiss, ...]
     wall_time_s: float
     sim_time_s: float
+    rejects: int = 0
+    """Successes that ended in a reject leaf naming the member's landing (correct rejects)."""
+
+    @property
+    def wrong_accepts(self) -> int:
+        """Failures that ended in an accepting leaf not naming the part's landing and state."""
+        return sum(r.wrong_accept for r in self.failures)
 
     @property
     def trials(self) -> int:
@@ -249,6 +269,8 @@ class SimulationSummary:
             "trials": self.trials,
             "successes": self.successes,
             "success_rate": _r(self.success_rate, 6),
+            "rejects": self.rejects,
+            "wrong_accepts": self.wrong_accepts,
             "model_errors": self.model_errors,
             "by_cause": self.by_cause(),
             "went_wrong": [r.to_dict() for r in self.went_wrong],

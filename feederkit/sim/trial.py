@@ -48,6 +48,19 @@ def _sim_part(part: PlanPart) -> _SimPart:
     return _SimPart(part, push_function_of(part), {s.edge: s.id for s in part.states})
 
 
+def member_of(plan: Plan, name: str, landing: str | None) -> PlanPart:
+    """The plan member ``(name, landing)`` (a plan file before landings: by name alone)."""
+    return plan.part(name) if landing is None else plan.part(name, landing)
+
+
+def leaf_holds(leaf: Leaf, name: str, state: int, landing: str | None) -> bool:
+    """Whether ``leaf`` names member ``(name, landing)`` resting in ``state`` (design.md,
+    "Landings": a reject leaf names the landings and states it rejects)."""
+    if landing is None:
+        return leaf.accepts(name, state)
+    return leaf.accepts(name, state, landing)
+
+
 def _state_id(pp: _SimPart, theta_deg: float) -> int:
     return pp.state_of_edge[push(pp.pf, theta_deg).edge]
 
@@ -108,6 +121,7 @@ def run_trial(
     *,
     model: TrialModel | None = None,
     state_of_edge: Sequence[int | None] | None = None,
+    landing: str | None = None,
 ) -> TrialResult:
     """Execute ``plan`` on ``part_name`` dropped first at fence orientation ``start_deg``.
 
@@ -118,9 +132,12 @@ def run_trial(
     nominal orientation). A failed trial's step is the first operation the model did not
     predict (``predicted`` False: a model error), else the one where the plan broke (its
     cause one of :data:`CAUSES`). Branches are followed by the plan's one rule
-    (:meth:`~feederkit.plans.model.Branch.holds`).
+    (:meth:`~feederkit.plans.model.Branch.holds`). ``landing`` names the member of a plan over
+    landings (design.md, "Landings"); a trial ending in a reject leaf that names the member's
+    landing and state is a success with ``rejected`` set, one ending in a non-reject leaf that
+    does not name them a ``wrong result`` failure (a wrong accept).
     """
-    pp = _sim_part(plan.part(part_name))
+    pp = _sim_part(member_of(plan, part_name, landing))
     edges = dict(pp.state_of_edge) if state_of_edge is None else dict(enumerate(state_of_edge))
     node: Step | Leaf = plan.root
     records: list[PushRecord] = []
@@ -128,7 +145,9 @@ def run_trial(
     rest_theta = start_deg
     state: int | None = None
 
-    def finish(outcome: str, step: int | None, cause: str | None, why: str | None) -> TrialResult:
+    def finish(
+        outcome: str, step: int | None, cause: str | None, why: str | None, rejected: bool = False
+    ) -> TrialResult:
         predicted = None
         if outcome != "success":
             predicted = unpredicted is None and outcome != "unsettled"
@@ -145,6 +164,8 @@ def run_trial(
             tuple(records),
             cause=cause,
             predicted=predicted,
+            landing=landing,
+            rejected=rejected,
         )
 
     while isinstance(node, Step):
@@ -214,13 +235,17 @@ def run_trial(
         rest_theta = out.theta_end_deg
         node = node.branches[branch].next
     assert isinstance(node, Leaf)
-    if state is not None and node.accepts(part_name, state):
-        return finish("success", None, None, None)
+    reject = bool(getattr(node, "reject", False))
+    if state is not None and leaf_holds(node, part_name, state, landing):
+        return finish("success", None, None, None, rejected=reject)
+    what = f"state {state}" if landing is None else f"landing {landing}, state {state}"
+    leaf = "reject result" if reject else "result"
     return finish(
         "failure",
         len(records),
         "wrong result",
-        f"the plan's result does not hold state {state}",
+        f"the plan's {leaf} does not hold {what}",
+        rejected=reject,
     )
 
 

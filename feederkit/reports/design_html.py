@@ -1,0 +1,154 @@
+"""The report's sensor design section: which sensor the mix needs (docs/design.md).
+
+It draws the JSON of ``feederkit design sensor --json`` (``ToleranceDesign.to_dict`` or
+``PitchDesign.to_dict``, computed by the caller: the report never plans): the one-line
+answer, the pairs' critical tolerances (Theorem 9), the plan length as a step function of
+the tolerance (or per LED pitch) as a table, and the same as an inline SVG step plot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from feederkit.errors import InputError
+from feederkit.reports.svgkit import esc, num
+
+WIDTH, HEIGHT, PAD = 520, 220, 44
+"""The plot's size and its left/bottom padding (px)."""
+
+MAX_PAIRS = 12
+"""Pairs listed in the table, tightest first (the rest are counted)."""
+
+
+def design_section(design: Mapping[str, Any]) -> str:
+    """The sensor design as an HTML section (answer, pairs, steps table and plot)."""
+    if not isinstance(design, Mapping) or design.get("sensor_model") not in ("tolerance", "led"):
+        raise InputError("the sensor design must be the JSON of 'feederkit design sensor'")
+    answer = esc(design.get("answer", ""))
+    pairs = _pairs_table(design.get("pairs") or [])
+    if design["sensor_model"] == "tolerance":
+        rows = [
+            (r["tolerance_mm"][0], r["tolerance_mm"][1], r["length"], r["expected"])
+            for r in design.get("lengths") or []
+        ]
+        table = _steps_table(rows)
+        plot = _step_plot(rows, design.get("critical_tolerance_mm"))
+    else:
+        table = _pitch_table(design.get("pitches") or [])
+        plot = ""
+    note = esc(design.get("model", ""))
+    return (
+        '<section id="sensor-design"><h2>Sensor design</h2>'
+        f'<p><strong>{answer}</strong></p><p class="muted">{note}</p>'
+        f"{plot}{table}{pairs}</section>"
+    )
+
+
+def _pairs_table(pairs: Sequence[Mapping[str, Any]]) -> str:
+    if not pairs:
+        return ""
+
+    def key(p: Mapping[str, Any]) -> float:
+        x = p.get("critical_tolerance_mm")
+        return -1.0 if x is None else float(x)
+
+    shown = sorted(pairs, key=key)[:MAX_PAIRS]
+    rows = "".join(
+        f"<tr><td>{esc(p['a'])}</td><td>{esc(p['b'])}</td><td>"
+        + (
+            "none: no sensor separates them"
+            if p.get("critical_tolerance_mm") is None
+            else f"{num(float(p['critical_tolerance_mm']), 6)} mm"
+        )
+        + "</td></tr>"
+        for p in shown
+    )
+    more = len(pairs) - len(shown)
+    extra = f'<p class="muted">and {more} more pairs</p>' if more > 0 else ""
+    return (
+        '<table class="design-pairs"><caption>Critical tolerance of each pair (the largest at '
+        "which they still read apart), tightest first</caption>"
+        "<tr><th>part A</th><th>part B</th><th>critical tolerance</th></tr>"
+        f"{rows}</table>{extra}"
+    )
+
+
+def _steps_table(rows: Sequence[tuple[float, float | None, int, float]]) -> str:
+    body = "".join(
+        f"<tr><td>{num(lo, 6)} &lt; tolerance &le; "
+        f"{'&infin;' if hi is None else num(hi, 6)} mm</td>"
+        f"<td>{length}</td><td>{num(expected, 4)}</td></tr>"
+        for lo, hi, length, expected in rows
+    )
+    return (
+        '<table class="design-steps"><caption>Optimal plan length against the sensor '
+        "tolerance</caption><tr><th>tolerance</th><th>length (operations)</th>"
+        f"<th>expected operations</th></tr>{body}</table>"
+    )
+
+
+def _pitch_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    body = "".join(
+        f"<tr><td>{num(float(r['pitch_mm']), 6)} mm</td>"
+        f"<td>{'yes' if r.get('recognizable') else 'no'}</td>"
+        f"<td>{'' if r.get('length') is None else esc(r['length'])}</td>"
+        f"<td>{'' if r.get('expected') is None else num(float(r['expected']), 4)}</td></tr>"
+        for r in rows
+    )
+    return (
+        '<table class="design-steps"><caption>LED pitches, each decided on its own</caption>'
+        "<tr><th>pitch</th><th>recognizable</th><th>length</th><th>expected operations</th>"
+        f"</tr>{body}</table>"
+    )
+
+
+def _step_plot(
+    rows: Sequence[tuple[float, float | None, int, float]], critical: float | None
+) -> str:
+    """Plan length (y) against tolerance (x) as an SVG step plot; the critical tolerance as
+    a dashed line."""
+    if not rows:
+        return ""
+    ends = [hi for _lo, hi, _n, _e in rows if hi is not None]
+    x_max = max(ends + [critical or 0.0, rows[-1][0] * 2.0]) or 1.0
+    y_max = max(n for _lo, _hi, n, _e in rows) + 1
+    w, h = WIDTH - PAD - 10, HEIGHT - PAD - 10
+
+    def x(v: float) -> float:
+        return PAD + w * v / x_max
+
+    def y(v: float) -> float:
+        return 10 + h * (1.0 - v / y_max)
+
+    segments = "".join(
+        f'<line x1="{x(lo):.1f}" y1="{y(n):.1f}" x2="{x(x_max if hi is None else hi):.1f}" '
+        f'y2="{y(n):.1f}" stroke="#0072b2" stroke-width="3"/>'
+        for lo, hi, n, _e in rows
+    )
+    ticks = "".join(
+        f'<text x="{PAD - 6}" y="{y(k) + 4:.1f}" text-anchor="end" font-size="11">{k}</text>'
+        for k in range(0, y_max + 1)
+    )
+    marks = ""
+    if critical is not None:
+        marks = (
+            f'<line x1="{x(critical):.1f}" y1="10" x2="{x(critical):.1f}" y2="{10 + h}" '
+            'stroke="#d55e00" stroke-dasharray="4 3"/>'
+            f'<text x="{x(critical) - 4:.1f}" y="22" text-anchor="end" font-size="11" '
+            f'fill="#d55e00">critical {num(critical, 4)} mm</text>'
+        )
+    axes = (
+        f'<line x1="{PAD}" y1="{10 + h}" x2="{PAD + w}" y2="{10 + h}" stroke="#444"/>'
+        f'<line x1="{PAD}" y1="10" x2="{PAD}" y2="{10 + h}" stroke="#444"/>'
+        f'<text x="{PAD}" y="{HEIGHT - 8}" font-size="11">0</text>'
+        f'<text x="{PAD + w}" y="{HEIGHT - 8}" text-anchor="end" font-size="11">'
+        f"{num(x_max, 4)} mm</text>"
+        f'<text x="{PAD + w / 2:.1f}" y="{HEIGHT - 8}" text-anchor="middle" font-size="11">'
+        "sensor tolerance</text>"
+    )
+    return (
+        f'<svg class="design-plot" viewBox="0 0 {WIDTH} {HEIGHT}" width="{WIDTH}" '
+        f'height="{HEIGHT}" role="img" aria-label="plan length against sensor tolerance">'
+        f"{axes}{ticks}{segments}{marks}</svg>"
+    )
