@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_mix_planner import random_part
 
+from feederkit.errors import InputError
 from feederkit.machine import build_machine, inseparable
 from feederkit.mechanics.push import push_function
 from feederkit.mix.lookalike import build_lookalike
@@ -161,3 +165,45 @@ def test_candidate_pairs_keep_every_unrecognizable_pair(seed, tol):
     assert brute <= cand
     assert {(w.index_a, w.index_b) for w in unrecognizable_pairs(pfs, sensor)} == brute
     assert len(cand) < len(pfs) * (len(pfs) - 1) // 2
+
+
+def _crowded_catalog(count: int, seed: int):
+    """Parts made to look alike: random 3- to 6-gons, each with copies whose vertices move by
+    up to 0.001-0.5 mm, plus push and push-diameter look-alikes (Theorems 4 and 6)."""
+    rng = np.random.default_rng(seed)
+    parts = []
+    k = 0
+    while len(parts) < count:
+        base = random_part(int(rng.integers(0, 10**6)), f"b{k}")
+        parts.append(base)
+        for jitter in (1e-3, 0.05, 0.5):
+            verts = np.asarray(base.outline.vertices)
+            pts = verts + rng.uniform(-jitter, jitter, verts.shape)
+            with contextlib.suppress(InputError):
+                parts.append(make_part(make_outline(f"b{k}-{jitter:g}", pts.tolist()), base.com))
+        parts.append(build_lookalike(base, "push-diameter", rng).part)
+        parts.append(build_lookalike(base, "push", rng).part)
+        k += 1
+    return [push_function(p) for p in parts[:count]]
+
+
+@pytest.mark.parametrize(
+    "sensor", [ToleranceSensor(0.3), ToleranceSensor(1.5), LedSensor(1.0, 0.2)], ids=str
+)
+def test_grouped_candidates_give_exactly_the_all_pairs_answer(sensor):
+    pfs = _crowded_catalog(90, 7)
+    every = [(i, j) for i in range(len(pfs)) for j in range(i + 1, len(pfs))]
+    brute = unrecognizable_pairs(pfs, sensor, every)
+    grouped = unrecognizable_pairs(pfs, sensor)
+    assert [w.to_dict() for w in grouped] == [w.to_dict() for w in brute]
+    assert len(brute) >= 30  # the look-alikes are there: the test can fail
+    assert len(candidate_pairs(pfs, sensor)) < len(every) // 10
+
+
+@pytest.mark.slow
+def test_grouped_candidates_on_a_few_hundred_parts():
+    pfs = _crowded_catalog(400, 11)
+    sensor = ToleranceSensor(0.5)
+    every = [(i, j) for i in range(len(pfs)) for j in range(i + 1, len(pfs))]
+    brute = unrecognizable_pairs(pfs, sensor, every)
+    assert [w.to_dict() for w in unrecognizable_pairs(pfs, sensor)] == [w.to_dict() for w in brute]

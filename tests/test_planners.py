@@ -24,6 +24,7 @@ from feederkit.machine import (
     build_machine,
     inseparable,
     members,
+    search_space,
     successor,
 )
 from feederkit.mechanics import push_function
@@ -31,8 +32,10 @@ from feederkit.mechanics.actions import ActionRange
 from feederkit.mechanics.polygon_classes import polygon_class
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import plan
+from feederkit.planning.api import _result, _sensorless_plan, plan
+from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import Grouping, Method, Objective, PlanningOptions
+from feederkit.planning.problem import Problem
 from feederkit.planning.stats import expected_operations
 from feederkit.planning.tree import Leaf
 from feederkit.sensors import (
@@ -334,32 +337,60 @@ def test_min_margin_respected_or_named():
     assert ok.min_margin >= best * 0.999
 
 
+def _goal_known(m):
+    """The machine, its goal relation computed (the states of these are already sorted by
+    diameter, so ``plan`` reuses it and a tiny time limit reaches the search)."""
+    assert len(search_space(m).inseparable) == m.n
+    return m
+
+
 def test_time_limit_returns_a_valid_plan_with_a_lower_bound():
     # The plain AND/OR search needs about a second for the offset 12-gon.
-    m = build_machine([regular(12)], uncertainty=IDEAL)
-    r = plan(m, PlanningOptions(method="andor", time_limit_s=0.05))
+    m = _goal_known(build_machine([regular(12)], uncertainty=IDEAL))
+    r = plan(m, PlanningOptions(method="andor", time_limit_s=2.0))
     check_plan(r)
-    assert not r.optimal
     assert 2 <= r.lower_bound <= 12 <= r.length
-    # One part's push machine: backchaining gives a plan at once when the search cannot.
+    # A mix has no backchaining fallback.
+    with pytest.raises(PlanningError, match="time limit"):
+        plan(
+            _goal_known(build_machine([regular(12), regular(11)], uncertainty=IDEAL)),
+            PlanningOptions(method="andor", time_limit_s=1e-4),
+        )
+
+
+def test_backchaining_fallback_is_a_valid_plan_of_the_sensorless_length():
+    m = _goal_known(build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL))
+    problem = Problem(m)
+    root = _sensorless_plan(problem, problem.readings.branches(problem.full), Deadline())
+    blind = _result(m, root, False, None, 2, "worst", "exact")
+    check_plan(blind)
+    assert blind.length == 32  # the sensorless optimum (nothing to read)
+    with pytest.raises(Timeout):
+        _sensorless_plan(problem, problem.readings.branches(problem.full), Deadline(1e-9))
+
+
+@pytest.mark.slow
+def test_time_limit_falls_back_to_backchaining():
+    # One part's push machine: backchaining gives a plan when the search cannot.
     blind = plan(
-        build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL),
-        PlanningOptions(method="andor", time_limit_s=1e-4),
+        _goal_known(build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL)),
+        PlanningOptions(method="andor", time_limit_s=2.0),
     )
     check_plan(blind)
     assert not blind.optimal and blind.length >= 32 >= blind.lower_bound
-    # A mix has no such fallback.
-    with pytest.raises(PlanningError, match="time limit"):
-        plan(
-            build_machine([regular(12), regular(11)], uncertainty=IDEAL),
-            PlanningOptions(method="andor", time_limit_s=1e-4),
-        )
+
+
+def test_the_time_limit_holds_for_the_goal_fixpoint_too():
+    # The clock starts before the inseparability fixpoint, which polls it.
+    m = build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL)
+    with pytest.raises(PlanningError, match="inseparable"):
+        plan(m, PlanningOptions(time_limit_s=1e-6))
 
 
 @pytest.mark.parametrize(
     ("options", "message"),
     [
-        ({"objective": "best"}, "the objective must be one of worst, expected, got 'best'"),
+        ({"objective": "best"}, "the objective must be one of worst, expected, .*got 'best'"),
         ({"grouping": "pairs"}, "the reading grouping must be one of exact, components"),
         ({"method": "dfs"}, "the planning method must be one of auto, andor, bottom-up"),
         ({"min_margin_deg": -1.0}, r"the minimum margin must be in \[0, 180\) degrees"),

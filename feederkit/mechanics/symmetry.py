@@ -146,6 +146,34 @@ class Symmetry:
         return max(1, round(360.0 / self.period_deg)) if self.period_deg > 0 else 1
 
 
+def pose_difference(pf: PushFunction, a: int, b: int) -> float:
+    """How far apart (mm) the part looks resting in stable states ``a`` and ``b``: the
+    Hausdorff distance of its hull in the two poses on the fence, each resting on the fence
+    line and centred along it (the position along the fence is not observed). 0 for states
+    that a symmetry of the hull maps onto each other (definitions 3, 6); small for the
+    near-symmetric states a plan under uncertainty may list together.
+
+    >>> from feederkit.mechanics.push import push_function
+    >>> from feederkit.part import make_part
+    >>> from feederkit.outline import make_outline
+    >>> rect = push_function(make_part(make_outline("r", [[0, 0], [4, 0], [4, 2], [0, 2]])))
+    >>> round(pose_difference(rect, 0, 2), 9), round(pose_difference(rect, 0, 1), 3)
+    (0.0, 2.0)
+    """
+    from shapely import Polygon, hausdorff_distance
+
+    hull = np.asarray(pf.part.hull, dtype=float)
+
+    def placed(state: int) -> np.ndarray:
+        t = math.radians(pf.states[state].pose_deg)
+        rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+        pts = hull @ rot.T
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        return pts - np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+
+    return float(hausdorff_distance(Polygon(placed(a)), Polygon(placed(b))))
+
+
 def symmetry(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> Symmetry:
     """Classify the push-diameter function by definitions 6-8 for the given state labels."""
     labels = exact_labels(pf) if labels is None else list(labels)

@@ -15,9 +15,12 @@ rotation is off by up to ``r`` degrees. Everything rests on three facts, with ``
 
 A push descends the perturbed radius function and can never pass one of its local maxima, so
 from a fence orientation it ends on a rest candidate (F3) between the nearest sure hilltops on
-either side (F1, F2). At ``t = c = 0`` every set here is the ideal one exactly; otherwise each
-is a superset of what the perturbed parts can do (provably conservative), and the docstrings
-say which. docs/uncertainty.md gives the derivations and the measured price of conservatism.
+either side (F1, F2); a push starting within ``PUSH_BAND_DEG`` of a hilltop, or beside a
+shallow state less than twice the vibration below it, may be carried over it (the push bands,
+measured in the physics check). With ``t = c = 0`` and no
+vibration every set here is the ideal one exactly; otherwise each is a superset of what the
+perturbed parts can do (provably conservative), and the docstrings say which.
+docs/uncertainty.md gives the derivations and the measured price of conservatism.
 """
 
 from __future__ import annotations
@@ -40,6 +43,32 @@ from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
 _BISECT_STEPS = 48
 BOUNDARY_EPS_DEG = 1e-9
 """Fence orientations this close to a cell's end count as on it (both sides' outcomes)."""
+PUSH_BAND_DEG = 2.0
+"""A push starting less than this many degrees from an ordinary hilltop may end on either side.
+
+Measured, not derived (docs/uncertainty.md, "Push bands"): in the physics check
+(docs/simulation.md, MuJoCo) the part hits the fence at the belt's speed and chatters, and
+pushes starting up to 1.07 degrees from a divergent orientation on the angle block, and up to
+1.5 degrees on plain corners, ended on the far side; 2 degrees is the margin. Angular, not a
+depth, so parts with the same push function (Lemma 8, symmetric poses) get the same bands.
+"""
+PUSH_BAND_FACTOR = 2.0
+"""Beside a shallow state a push starting less than this many vibrations below the hilltop may
+end on either side (the depth rule).
+
+Measured (docs/uncertainty.md, "Push bands"): on the gear, whose tooth tips are states 0.14
+vibrations deep, starts up to 3.6 degrees (0.86-0.99 vibrations) below a hilltop beside a tip
+were carried over it onto the tip; the factor 2 is the margin.
+"""
+SHALLOW_WELL_FACTOR = 5.0
+"""A state whose well beside a hilltop (the hilltop's radius minus the radius at the state's
+normal) is less than this many vibrations deep is shallow: that hilltop gets the depth rule.
+
+Chosen from the gear (docs/uncertainty.md, "Push bands"): its tooth tips, 0.14 vibrations
+deep, carried pushes over both their hilltops; its roots are 8.6 deep. Over the catalog and the
+sample drawings the wells lie below 2.2 vibrations (tips, arc facets) or above 9.5, with the
+gear's roots the only ones between; 5 splits them with a margin on each side.
+"""
 
 
 @dataclass(frozen=True)
@@ -67,7 +96,9 @@ class Band:
 
     Every perturbed shape has a local maximum of its radius function in ``[lo_deg, hi_deg]``
     (``lo <= divergent <= hi``, ``hi`` may pass 360): a push starting inside may end on either
-    side, one starting outside never crosses it. At ``t = c = 0`` the band is the point.
+    side, one starting outside never crosses it. With the vibration on it is widened by the
+    push band (:data:`PUSH_BAND_DEG`, or the depth rule beside a shallow state: :func:`_bands`);
+    at ``t = c = 0`` and vibration 0 it is the point.
     """
 
     divergent_deg: float
@@ -273,20 +304,47 @@ def _level_crossing(
     """Bisection brackets of where r, monotone on [low, high], crosses ``level`` (vectorized).
 
     Returns ``(below, above)``: r(below) < level <= r(above) when r rises from low to high.
+    The radius at each probe is the projection of its supporting vertex (a binary search on
+    the unwrapped edge normals), so a step costs O(hills log n), not O(hills n).
     """
-    rising = _radius(hull, com, high) >= _radius(hull, com, low)
+    nrm = _normals(hull)
+    unwrapped = nrm[0] + np.concatenate([[0.0], np.cumsum(np.mod(np.diff(nrm), 360.0))])
+    rel = hull - com
+
+    def radius(phi_deg: np.ndarray) -> np.ndarray:
+        v = rel[_support_index(unwrapped, phi_deg)]
+        phi = np.radians(phi_deg)
+        return v[:, 0] * np.cos(phi) + v[:, 1] * np.sin(phi)
+
+    rising = radius(high) >= radius(low)
     a, b = low.copy(), high.copy()
     for _ in range(_BISECT_STEPS):
         mid = (a + b) / 2.0
-        up = _radius(hull, com, mid) >= level
+        up = radius(mid) >= level
         go_low = up == rising  # the crossing lies between a and mid
         b = np.where(go_low, mid, b)
         a = np.where(go_low, a, mid)
     return a, b
 
 
-def _bands(pf: PushFunction, eps: float, sure: np.ndarray, peaks: np.ndarray) -> list[Band]:
-    """Bands around the sure hilltops (F1, F2); the divergent orientations when eps = 0."""
+def _bands(
+    pf: PushFunction,
+    eps: float,
+    sure: np.ndarray,
+    peaks: np.ndarray,
+    heights: np.ndarray,
+    vibration: float = 0.0,
+) -> list[Band]:
+    """Bands around the sure hilltops (F1, F2), widened by the push bands; the divergent
+    orientations when eps = 0 and ``vibration`` = 0.
+
+    The F2 band holds every perturbed hilltop. With ``vibration > 0`` it is widened on each
+    flank (a push starting there may be carried over the hill: docs/uncertainty.md, "Push
+    bands") by :data:`PUSH_BAND_DEG`; at a hilltop beside a shallow state (a well on either
+    side less than :data:`SHALLOW_WELL_FACTOR` vibrations deep, ``heights`` the radius at
+    each state's normal) by how far the drawn radius stays within :data:`PUSH_BAND_FACTOR`
+    vibrations of the hilltop, if that is wider. Clipped to the neighbouring states' normals.
+    """
     div = np.asarray(pf.divergent_deg, dtype=float)
     m = len(div)
     rs = pf.range_state
@@ -297,14 +355,15 @@ def _bands(pf: PushFunction, eps: float, sure: np.ndarray, peaks: np.ndarray) ->
     left = np.asarray([rs[(k - 1) % m] for k in ks])
     right = np.asarray([rs[k] for k in ks])
     d = div[ks]
-    if eps == 0.0:
-        lo, hi = d.copy(), d.copy()
-    else:
-        h = np.asarray(pf.part.hull, dtype=float)
-        com = np.asarray(pf.part.com, dtype=float)
+    lo, hi = d.copy(), d.copy()
+    if eps == 0.0 and vibration == 0.0:
+        return _band_list(d, lo, hi, left, right)
+    h = np.asarray(pf.part.hull, dtype=float)
+    com = np.asarray(pf.part.com, dtype=float)
+    lpsi = d - np.mod(d - psi[left], 360.0)
+    rpsi = d + np.mod(psi[right] - d, 360.0)
+    if eps > 0.0:
         level = peaks[ks] - 2.0 * eps
-        lpsi = d - np.mod(d - psi[left], 360.0)
-        rpsi = d + np.mod(psi[right] - d, 360.0)
         lo, _ = _level_crossing(h, com, lpsi, d, level)
         _, hi = _level_crossing(h, com, d, rpsi, level)
         rho = np.hypot(*(h - com).T)
@@ -320,9 +379,28 @@ def _bands(pf: PushFunction, eps: float, sure: np.ndarray, peaks: np.ndarray) ->
             if keep.any():
                 lo[j] = d[j] + min(float(a_lo[keep].min()), 0.0)
                 hi[j] = d[j] + max(float(a_hi[keep].max()), 0.0)
+    if vibration > 0.0:
+        w_lo = np.full(len(ks), PUSH_BAND_DEG)
+        w_hi = np.full(len(ks), PUSH_BAND_DEG)
+        shallow = np.minimum(peaks[ks] - heights[left], peaks[ks] - heights[right])
+        near = np.flatnonzero(shallow < SHALLOW_WELL_FACTOR * vibration)
+        if len(near):
+            level = peaks[ks[near]] - PUSH_BAND_FACTOR * vibration
+            p_lo, _ = _level_crossing(h, com, lpsi[near], d[near], level)
+            _, p_hi = _level_crossing(h, com, d[near], rpsi[near], level)
+            w_lo[near] = np.maximum(w_lo[near], d[near] - p_lo)
+            w_hi[near] = np.maximum(w_hi[near], p_hi - d[near])
+        lo = np.maximum(lpsi, lo - w_lo)
+        hi = np.minimum(rpsi, hi + w_hi)
+    return _band_list(d, lo, hi, left, right)
+
+
+def _band_list(
+    d: np.ndarray, lo: np.ndarray, hi: np.ndarray, left: np.ndarray, right: np.ndarray
+) -> list[Band]:
     return [
         Band(float(d[j]), float(lo[j]), float(hi[j]), int(left[j]), int(right[j]))
-        for j in range(len(ks))
+        for j in range(len(d))
     ]
 
 
@@ -471,8 +549,11 @@ def uncertain_mechanics(
     is kept as one it may stay in: the feeder's vibration is not known, and the physics check
     shows parts resting on such edges. ``vibration_mm`` defaults to the fragile
     threshold (1e-3 of the part's size, a breath of vibration) unless the uncertainty is ideal,
-    where it is 0 and every physical state is one ideal state. Raises InputError for a shape
-    tolerance of half the smallest hull edge or more.
+    where it is 0 and every physical state is one ideal state. Bands: with the vibration on, a
+    push starting within ``PUSH_BAND_DEG`` of a hilltop (wherever F2 puts it) may end on either
+    side; at a hilltop beside a shallow state, within ``PUSH_BAND_FACTOR`` vibrations of its
+    height (:func:`_bands`). Raises InputError for a shape tolerance of half the smallest hull
+    edge or more.
     """
     check_for_part(uncertainty, part)
     pf = push_function(part)
@@ -565,7 +646,7 @@ def uncertain_mechanics(
             diam = (max(min(w_lo, *exact) - 2.0 * t, 0.0), max(w_hi, *exact) + 2.0 * t)
         states.append(PhysicalState(pid, members, rest, (cap_lo, cap_hi), diam))
 
-    bands = _bands(pf, eps, sure, peaks)
+    bands = _bands(pf, eps, sure, peaks, heights, vibration_mm)
     cells = _fence_cells(bands, cands, destinations)
     return UncertainMechanics(
         push=pf,
@@ -811,6 +892,9 @@ def mechanics_to_dict(mech: UncertainMechanics) -> dict[str, object]:
 
 
 __all__ = [
+    "PUSH_BAND_DEG",
+    "PUSH_BAND_FACTOR",
+    "SHALLOW_WELL_FACTOR",
     "Band",
     "FenceCell",
     "PhysicalState",

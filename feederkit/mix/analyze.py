@@ -23,7 +23,9 @@ class MixAnalysis:
     """Classes of a set of parts and, with a sensor, every pair no plan can tell apart.
 
     ``pairs`` is None without a sensor (every pair is unrecognizable). ``candidates`` is how
-    many pairs the diameter test left for the exact fixpoint. ``seconds`` times each stage.
+    many pairs the cheap tests (diameters and landing profiles,
+    :func:`~feederkit.mix.pairs.candidate_pairs`) left for the exact fixpoint. ``seconds``
+    times each stage.
     """
 
     names: tuple[str, ...]

@@ -16,14 +16,16 @@ inseparable pairs, with the reason in words. With noise the relation is not tran
 
 from __future__ import annotations
 
-import math
+import itertools
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from feederkit.machine import greatest_fixpoint, pair_successors
 from feederkit.mechanics.actions import action_ranges
-from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.signatures import (
     ANGLE_TOL_DEG,
@@ -119,12 +121,29 @@ def inseparable_cross_pairs(
         return abs(da[i] - db[j]) <= eps or sensor.can_read_alike(da[i], db[j])
 
     alive = {(i, j) for i in range(pf_a.n) for j in range(pf_b.n) if alike(i, j)}
+    if len(alive) == pf_a.n * pf_b.n:
+        # Every cross pair reads alike: every successor is alive, nothing is ever dropped.
+        return sorted(alive)
+    if not any((0, j) in alive and _lands_alike(ra[0], rb[j], alike) for j in range(pf_b.n)):
+        # State 0 of a must be inseparable from some state of b when any pair is (module
+        # docstring); a pair is only if its first actions already land reading alike.
+        return []
 
     def successors(p: tuple[int, int]) -> list[tuple[int, int]]:
         (la, ta), (lb, tb) = ra[p[0]], rb[p[1]]
         return pair_successors(la, ta, lb, tb)
 
     return sorted(greatest_fixpoint(alive, successors))
+
+
+def _lands_alike(
+    range_a: tuple[list[float], list[int]],
+    range_b: tuple[list[float], list[int]],
+    alike: Callable[[int, int], bool],
+) -> bool:
+    """Whether every action sends the two states to states that read alike (one step of the
+    fixpoint: necessary for the pair to be inseparable)."""
+    return all(alike(x, y) for x, y in pair_successors(*range_a, *range_b))
 
 
 def _reason(
@@ -199,14 +218,56 @@ def _covers(
     return all(any(alike(x, y) for y in ys) for x in xs)
 
 
+QUANTILE_BINS = 8
+"""The landing distribution of diameters is summarised by its mean over this many equal
+slices of probability (see :func:`landing_profile`)."""
+
+HASH_BINS = (1, 3, 6)
+"""The slices whose means key the candidate grid (three, so 27 neighbouring cells)."""
+
+
+def landing_profile(pf: PushFunction, bins: int = QUANTILE_BINS) -> list[float]:
+    """The diameter a push-align operation leaves, as a distribution over the rotation,
+    summarised by the mean of its quantile function over ``bins`` equal slices.
+
+    From any state, rotating by a uniform angle and pushing lands in state ``k`` for a
+    rotation set as wide as ``k``'s resting range, so the distribution is the same for
+    every start: diameter ``d_k`` with weight ``w_k / 360``. If two states of two parts are
+    inseparable, every rotation sends them to states that read alike (module docstring), a
+    coupling of the two distributions in which diameters differ by at most the sensor's
+    reach: their infinity-Wasserstein distance, and so the difference of the means of any
+    slice of their quantile functions, is at most the reach. Slice means, unlike the
+    quantiles at fixed levels, move continuously with the widths (rounding cannot flip them).
+    """
+    widths = resting_widths(pf)
+    total = sum(widths)
+    order = sorted(range(pf.n), key=lambda k: pf.states[k].diameter)
+    out = [0.0] * bins
+    cum = 0.0
+    for k in order:
+        lo, hi = cum, cum + widths[k] / total
+        cum = hi
+        d = pf.states[k].diameter
+        b0 = min(bins - 1, int(lo * bins))
+        b = b0
+        while b < bins and b / bins < hi:
+            a, z = max(lo, b / bins), min(hi, (b + 1) / bins)
+            if z > a:
+                out[b] += d * (z - a) * bins
+            b += 1
+    return out
+
+
 def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[int, int]]:
     """Pairs of parts that may be unrecognizable, found without an all-pairs pass.
 
-    Necessary condition: every state of each part reads alike some state of the other (any
-    inseparable pair reaches every state, see the module docstring). In particular the two
-    smallest diameters read alike and so do the two largest: parts are hashed on a grid of
-    (smallest, largest diameter) with cells as wide as the sensor's reach and only
-    neighbouring cells are compared. A sensorless model gives every pair.
+    Two necessary conditions, both from the parts alone: every state of each part reads
+    alike some state of the other (any inseparable pair reaches every state, see the module
+    docstring; so also the smallest diameters read alike, and the largest), and their
+    :func:`landing_profile` slices differ by at most the sensor's reach. Parts are hashed
+    on a grid of three slice means with cells as wide as the reach, so only neighbouring
+    cells are compared; the full tests then run on those pairs only. A sensorless model
+    gives every pair.
     """
     n = len(pfs)
     if not sensor.informative:
@@ -214,29 +275,41 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[i
     reach = sensor.reading_reach()
     diams = [sorted(s.diameter for s in pf.states) for pf in pfs]
     eps = [DIAMETER_REL_EPS * pf.part.size for pf in pfs]
-    cell = reach + max(eps, default=0.0) + 1e-12
-    grid: dict[tuple[int, int], list[int]] = defaultdict(list)
-    for i, d in enumerate(diams):
-        grid[(math.floor(d[0] / cell), math.floor(d[-1] / cell))].append(i)
+    biggest = max((pf.part.size for pf in pfs), default=0.0)
+    # Slack for rounding: the profiles are sums of products of diameters and widths.
+    cell = reach + max(eps, default=0.0) + 1e-9 * biggest + 1e-12
+    profiles = np.array([landing_profile(pf) for pf in pfs], dtype=float).reshape(n, QUANTILE_BINS)
+    keys = np.floor(profiles[:, list(HASH_BINS)] / cell).astype(np.int64)
+    grid: dict[tuple[int, ...], list[int]] = defaultdict(list)
+    for i, key in enumerate(map(tuple, keys.tolist())):
+        grid[key].append(i)
 
     def alike(x: float, y: float) -> bool:
         return sensor.can_read_alike(x, y) or abs(x - y) <= cell - reach
 
     out = []
-    for (cx, cy), here in grid.items():
-        for dx in (-1, 0, 1):
-            for dy in (-1, 0, 1):
-                there = grid.get((cx + dx, cy + dy))
-                if not there:
+    steps = list(itertools.product((-1, 0, 1), repeat=len(HASH_BINS)))
+    for key, here in grid.items():
+        there_all = []
+        for step in steps:
+            there = grid.get(tuple(k + d for k, d in zip(key, step, strict=True)))
+            if there:
+                there_all.extend(there)
+        if not there_all:
+            continue
+        others = np.array(sorted(there_all), dtype=np.int64)
+        for i in here:
+            js = others[others > i]
+            if len(js) == 0:
+                continue
+            close = np.all(np.abs(profiles[js] - profiles[i]) <= cell, axis=1)
+            lo_i, hi_i = diams[i][0], diams[i][-1]
+            for j in js[close].tolist():
+                dj = diams[j]
+                if not (alike(lo_i, dj[0]) and alike(hi_i, dj[-1])):
                     continue
-                for i in here:
-                    for j in there:
-                        if (
-                            i < j
-                            and _covers(diams[i], diams[j], alike)
-                            and _covers(diams[j], diams[i], alike)
-                        ):
-                            out.append((i, j))
+                if _covers(diams[i], dj, alike) and _covers(dj, diams[i], alike):
+                    out.append((i, j))
     out.sort()
     return out
 
@@ -276,5 +349,6 @@ __all__ = [
     "candidate_pairs",
     "distinguishable",
     "inseparable_cross_pairs",
+    "landing_profile",
     "unrecognizable_pairs",
 ]

@@ -14,29 +14,10 @@ The International Journal of Robotics Research 18(10), section 6.1 (AND/OR searc
 
 from __future__ import annotations
 
-import time
-
+from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Act, Problem
 
-
-class Timeout(Exception):
-    """The search ran out of its time limit."""
-
-
-class Deadline:
-    """A wall-clock limit checked every few search nodes."""
-
-    def __init__(self, seconds: float | None) -> None:
-        self.end = None if seconds is None else time.perf_counter() + seconds
-        self._count = 0
-
-    def check(self) -> None:
-        """Raise Timeout once the limit has passed."""
-        if self.end is None:
-            return
-        self._count += 1
-        if self._count & 7 == 0 and time.perf_counter() > self.end:
-            raise Timeout
+__all__ = ["Deadline", "Timeout", "WorstCase"]
 
 
 class WorstCase:
@@ -54,8 +35,8 @@ class WorstCase:
         self.exact: dict[int, int] = {}
         self.deadline = deadline or Deadline(None)
 
-    def within(self, mask: int, k: int) -> bool:
-        """Whether ``mask`` can be oriented in at most ``k`` operations."""
+    def _known(self, mask: int, k: int) -> bool | None:
+        """What the memo already says about ``within(mask, k)`` (None: search)."""
         if self.p.is_goal(mask):
             return True
         if k <= 0:
@@ -67,20 +48,68 @@ class WorstCase:
             return False
         if self.ub.get(mask, k + 1) <= k:
             return True
+        return None
+
+    def within(self, mask: int, k: int) -> bool:
+        """Whether ``mask`` can be oriented in at most ``k`` operations.
+
+        A depth-first AND/OR search kept on an explicit stack (a frame per open set: its
+        budget, its action iterator, the action being tried and its next child), so a deep
+        budget never meets Python's recursion limit.
+        """
+        known = self._known(mask, k)
+        if known is not None:
+            return known
         self.deadline.check()
-        for act in self.p.choices.search_actions(mask):
-            ok = True
-            for c in act.children:  # largest first: the likeliest to fail
-                if not self.within(c, k - 1):
-                    ok = False
+        # frame: [mask, k, actions, act or None, index of the next child]
+        stack: list[list] = [[mask, k, self.p.choices.search_actions(mask), None, 0]]
+        result = False
+        while stack:
+            f = stack[-1]
+            fmask, fk, acts, act, ci = f
+            pushed = False
+            while True:
+                if act is None:
+                    act = next(acts, None)
+                    if act is None:
+                        break  # every action failed
+                    ci = 0
+                children = act.children  # largest first: the likeliest to fail
+                while ci < len(children):
+                    c = children[ci]
+                    known = self._known(c, fk - 1)
+                    if known is None:
+                        f[3], f[4] = act, ci
+                        self.deadline.check()
+                        stack.append([c, fk - 1, self.p.choices.search_actions(c), None, 0])
+                        pushed = True
+                        break
+                    if not known:
+                        break
+                    ci += 1
+                if pushed:
                     break
-            if ok:
-                self.ub[mask] = k
-                if mask not in self.choice or self.choice[mask][0] > k:
-                    self.choice[mask] = (k, act)
-                return True
-        self.lb[mask] = k + 1
-        return False
+                if ci == len(children):
+                    break  # every child within fk - 1: act works
+                act = None  # a child failed: the next action
+            if pushed:
+                continue
+            stack.pop()
+            if act is not None:
+                self.ub[fmask] = fk
+                if fmask not in self.choice or self.choice[fmask][0] > fk:
+                    self.choice[fmask] = (fk, act)
+                result = True
+            else:
+                self.lb[fmask] = fk + 1
+                result = False
+            if stack:
+                parent = stack[-1]
+                if result:
+                    parent[4] += 1  # that child is within: the parent's next child
+                else:
+                    parent[3] = None  # the parent's action failed: its next action
+        return result
 
     def length(self, mask: int, limit: int | None = None) -> int:
         """The minimum worst-case number of operations for ``mask`` (iterative deepening).

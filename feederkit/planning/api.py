@@ -16,17 +16,23 @@ Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 
 
 from __future__ import annotations
 
+import gc
 import math
+from collections.abc import Callable, Hashable, Iterable
+from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import OverlapRange, PushAlignMachine, search_space
-from feederkit.planning.andor import Deadline, Timeout, WorstCase
+from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, search_space
+from feederkit.machine.inseparable import inseparable_masks
+from feederkit.planning.andor import WorstCase
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.lumping import lumped_goal
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import EXPECTED_HORIZON, Refiner, child_masses
+from feederkit.planning.refine import Refiner, child_masses, stage
 from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import solve, unsolvable
@@ -35,6 +41,18 @@ from feederkit.planning.tree import Leaf, PlanResult, Step
 
 FALLBACK_SHARE = 0.3
 """With a time limit, the share of it kept for finding some plan when the exact search fails."""
+
+FALLBACK_MAX_OPERATIONS = 100
+"""The depth-first fallback looks for plans of at most this many operations: longer ones are
+of no use on a feeder, and every consumer of a plan walks it level by level."""
+
+EXACT_MEMORY_SHARE = 0.8
+"""With a memory limit, the share of it the exact search may hold; the rest is headroom for
+the plan built when it stops."""
+
+FIRST_TREE_SHARE = 0.85
+"""Where (as a share of the time limit) the tree of a proven length with no tie-breaking
+must be built; after that the fallback answers."""
 
 
 class NoStrongPlan(PlanningError):
@@ -55,21 +73,31 @@ def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStr
     )
 
 
-def strong_plan_exists(machine: PushAlignMachine, options: PlanningOptions | None = None) -> bool:
+def strong_plan_exists(
+    machine: PushAlignMachine,
+    options: PlanningOptions | None = None,
+    deadline: Deadline | None = None,
+) -> bool:
     """Whether some strong plan orients every state of ``machine`` (no margin floor).
 
     Decided by :func:`~feederkit.planning.solvable.unsolvable`; True when undecided (too
-    many sets), so a bisection over uncertainties on it errs toward the planner's own answer.
+    many sets, or ``deadline`` passed), so a bisection over uncertainties on it errs toward
+    the planner's own answer.
     """
     options = options or PlanningOptions()
     if machine.n == 0:
         return False
     if machine.deterministic:
         return True  # the ideal push machine: a part is always oriented up to inseparable states
+    budget = Deadline() if deadline is None else deadline
     sorted_machine, _old = by_diameter(machine)
-    problem = Problem(sorted_machine, options.grouping, 0.0)
-    every = sorted({b.mask for b in problem.readings.branches(problem.full)})
-    bad = unsolvable(problem, sorted(maximal_sets(every)))
+    try:
+        insep = goal_relation(sorted_machine, budget)
+        problem = Problem(sorted_machine, options.grouping, 0.0, insep)
+        every = sorted({b.mask for b in problem.readings.branches(problem.full)})
+        bad = unsolvable(problem, sorted(maximal_sets(every)), budget)
+    except Timeout:
+        return True
     return bad is None or not bad
 
 
@@ -98,9 +126,10 @@ def _limit(machine: PushAlignMachine) -> int:
 def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> PlanResult:
     """A plan orienting every state of ``machine`` (up to inseparable states).
 
-    The plan has the minimum worst-case number of operations (sections 4 and 6), ties
-    broken as :mod:`feederkit.planning.refine` says; ``options`` default to
-    :class:`PlanningOptions` ``()``.
+    The plan has the minimum worst-case number of operations (sections 4 and 6) among plans
+    whose rotations all keep a margin above ``ANGLE_EPS / 2`` (narrower cells are not
+    physical: docs/conventions.md), ties broken as :mod:`feederkit.planning.refine` says;
+    ``options`` default to :class:`PlanningOptions` ``()``.
 
     Raises InputError for bad options and PlanningError when no plan keeps the minimum
     margin (naming the largest margin that works) or none is found within the time limit.
@@ -117,20 +146,61 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
     options = PlanningOptions() if options is None else options
     if not isinstance(options, PlanningOptions):
         raise InputError(f"the planning options must be PlanningOptions, got {options!r}")
+    # The one budget of this call: every stage below polls it (docs/planning.md).
+    budget = Deadline(options.time_limit_s, options.memory_limit_mb)
     if machine.n == 0:
         raise InputError("the machine has no states")
     # Plan with the states numbered by diameter (readings then pick runs of bits).
     sorted_machine, old = by_diameter(machine)
-    root, optimal, length, lower = _plan(sorted_machine, options)
+    lumping = None
+    try:
+        root, optimal, length, lower = _plan(sorted_machine, options, budget)
+    except NoStrongPlan:
+        # Near-symmetric states (docs/planning.md): lump the pairs no strong plan resolves.
+        lumping = lumped_goal(sorted_machine, options.grouping, budget)
+        if lumping is None:
+            raise
+        root, optimal, length, lower = _plan(sorted_machine, options, budget, lumping.insep)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
-    return _result(
+    result = _result(
         machine, root, optimal, length, lower, options.objective.value, options.grouping.value
     )
+    if lumping is None:
+        return result
+    return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
 
 
-def _plan(machine: PushAlignMachine, options: PlanningOptions):
-    """``plan`` on a machine whose states are numbered by diameter.
+def _out_of_budget(options: PlanningOptions, reason: str) -> str:
+    """The limit that stopped a search, in words."""
+    if reason == "memory" and options.memory_limit_mb is not None:
+        return f"the memory limit of {options.memory_limit_mb:g} MB"
+    return f"the time limit of {options.time_limit_s:g} s"
+
+
+def goal_relation(machine: PushAlignMachine, budget: Deadline) -> tuple[int, ...]:
+    """The machine's goal relation (``SearchSpace.inseparable``), its fixpoint polled.
+
+    The inseparability fixpoint is the first long stage of a plan, so it runs under the
+    plan's budget (:func:`~feederkit.machine.inseparable.inseparable_masks` polls it); its
+    result fills the search space's cached table, so nothing computes it twice.
+    """
+    space = search_space(machine)
+    if "inseparable" not in vars(space):
+        slot = "bisimilar" if hasattr(type(space), "bisimilar") else "inseparable"
+        if slot not in vars(space):
+            vars(space)[slot] = inseparable_masks(machine, budget.check)
+    return space.inseparable
+
+
+def _plan(
+    machine: PushAlignMachine,
+    options: PlanningOptions,
+    budget: Deadline,
+    goal: tuple[int, ...] | None = None,
+):
+    """``plan`` on a machine whose states are numbered by diameter, under ``budget``; ``goal``
+    replaces the goal relation (the lumped one, :func:`~feederkit.planning.lumping.lumped_goal`).
 
     Returns the plan tree, whether it is proven optimal, its proven length (None when the
     tree's own length is the answer) and a proven lower bound.
@@ -138,14 +208,20 @@ def _plan(machine: PushAlignMachine, options: PlanningOptions):
     objective = options.objective.value
     min_margin = options.min_margin_deg
     grouping = options.grouping
-    time_limit = options.time_limit_s
     method = options.method.value
-    problem = Problem(machine, grouping, min_margin)
-    if problem.sensorless:
+    try:
+        insep = goal_relation(machine, budget) if goal is None else goal
+    except Timeout as exc:
+        raise PlanningError(
+            f"no plan found within {_out_of_budget(options, exc.reason)}: it ran out while "
+            f"finding which of the {machine.n} states are inseparable"
+        ) from None
+    problem = Problem(machine, grouping, min_margin, insep)
+    if problem.sensorless and objective == "expected":
         # One path for every start: the expected number of operations is the length, so
         # the plans of minimum length are exactly those of minimum expected length.
         objective = "worst"
-    elif objective == "expected":
+    elif objective in ("expected", "time"):
         problem = Problem(machine, grouping, min_margin, problem.insep, distinct_maps=True)
     if method in ("bfs", "backchain") and not problem.sensorless:
         raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
@@ -161,7 +237,7 @@ def _plan(machine: PushAlignMachine, options: PlanningOptions):
     every = sorted({b.mask for b in root_branches})
     roots = sorted(maximal_sets(every)) if min_margin == 0.0 else every
     start_mass = [s.weight for s in machine.states]
-    exact_deadline = Deadline(None if time_limit is None else time_limit * (1 - FALLBACK_SHARE))
+    exact_deadline = budget.until(1.0 - FALLBACK_SHARE, EXACT_MEMORY_SHARE)
     limit = None
     known: dict[int, float] | None = None
     if not machine.deterministic:
@@ -174,9 +250,12 @@ def _plan(machine: PushAlignMachine, options: PlanningOptions):
             limit = None if known is not None else _limit(machine)
         else:
             limit = FIRST_LIMIT
-    if min_margin > 0.0:
-        _check_margin(problem, roots, min_margin)
     worst = make_oracle(problem, method, exact_deadline)
+    if min_margin > 0.0:
+        try:
+            _check_margin(problem, roots, min_margin, exact_deadline)
+        except Timeout as exc:
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
     if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
         worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
     try:
@@ -189,36 +268,33 @@ def _plan(machine: PushAlignMachine, options: PlanningOptions):
             if known is not None and min_margin == 0.0:
                 worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
             lengths = root_lengths(problem, worst, roots, method, _limit(machine))
-    except Timeout:
-        return _fallback(problem, worst, roots, root_branches, time_limit)
+    except Timeout as exc:
+        return _fallback(problem, worst, roots, root_branches, budget, options, exc)
     except ValueError:
         exact = method in ("bfs", "bottom-up") or known is not None
         raise _no_strong_plan(machine, undecided=not exact) from None
     length = 1 + max(lengths.values(), default=0)
-    budget = length - 1
+    budget_ops = length - 1
     children = _root_children(problem, root_branches, start_mass)
-    refiner = Refiner(problem, worst, exact_deadline)
+    refiner = Refiner(
+        problem, worst, exact_deadline, costs=options.costs, timed=objective == "time"
+    )
     try:
-        if objective == "worst":
-            # The smallest margin over the root branches; each only has to beat the least so far.
-            floor = math.inf
-            for r in sorted(every, key=lambda r: -r.bit_count()):
-                floor = refiner.margin(r, budget, floor)
-            refiner.floor = floor
-            tie = "rotation" if problem.sensorless else "expected"
-            horizon = budget
-        else:
-            tie = "expected"
-            horizon = EXPECTED_HORIZON * budget
+        tie, horizon = stage(objective, refiner, every, budget_ops)
         root = _build(refiner, children, horizon, tie)
         complete = True
     except Timeout:
-        # The lengths are proven; the tie-breaking stages ran out of time.
-        worst.deadline = refiner.deadline = Deadline(None)
+        # The lengths are proven; the tie-breaking stages ran out of time: the first
+        # action that keeps the proven length at each node, while time remains.
+        worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
         refiner.floor = -math.inf
-        root = _build(refiner, children, budget, "first")
+        try:
+            root = _build(refiner, children, budget_ops, "first")
+        except Timeout as exc:
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
         complete = objective == "worst"
-    return root, complete, length if objective == "worst" else None, length
+    shortest = objective in ("worst", "worst-time")
+    return root, complete, length if shortest else None, length
 
 
 def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
@@ -231,12 +307,17 @@ def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
     return Step(None, tuple(subs))
 
 
-def _check_margin(problem: Problem, roots: list[int], min_margin: float) -> None:
-    """Raise PlanningError when no plan keeps ``min_margin``, naming the largest that does."""
-    floored = largest_margin(problem, roots)
+def _check_margin(
+    problem: Problem, roots: list[int], min_margin: float, deadline: Deadline
+) -> None:
+    """Raise PlanningError when no plan keeps ``min_margin``, naming the largest that does
+    (Timeout when ``deadline`` passes first)."""
+    floored = largest_margin(problem, roots, deadline)
     if floored >= min_margin:
         return
-    best = largest_margin(problem.with_margin(0.0), roots)
+    best = largest_margin(problem.with_margin(0.0), roots, deadline)
+    if best == -math.inf:
+        raise _no_strong_plan(problem.machine)
     raise PlanningError(
         f"no plan keeps a margin of {min_margin:g} deg; the largest margin any plan keeps is "
         f"{best:.6g} deg"
@@ -248,78 +329,167 @@ def _root_children(problem: Problem, root_branches, start_mass):
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
 
 
-def _fallback(problem, worst, roots, root_branches, time_limit):
-    """Some plan when the exact search ran out of time, with the lower bound it proved.
+def _fallback(
+    problem: Problem,
+    worst: WorstCase,
+    roots: list[int],
+    root_branches,
+    budget: Deadline,
+    options: PlanningOptions,
+    stop: Timeout,
+):
+    """Some plan when the exact search ran out of its budget, with the lower bound it proved.
 
-    A depth-first search with a generous budget (the greedy action order of
-    ``Choices.lazy_actions``) finds a plan; the tree follows the actions that proved it. A
-    reading set the search never met lies inside one it did (its "witness"), and without a
-    margin floor it follows the witness's rotations.
+    Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
+    part, no margin floor; with readings within half of what is left), then a depth-first
+    search (the greedy action order of ``Choices.lazy_actions``, on an explicit stack) for
+    something shorter; the tree follows the actions that proved it. A reading set the search never
+    met lies inside one it did (its "witness"), and without a margin floor it follows the
+    witness's rotations. PlanningError when neither finds a plan in time.
     """
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
-    blind = _sensorless_plan(problem, root_branches)
-    anytime = WorstCase(problem, Deadline(time_limit * FALLBACK_SHARE))
-    cap = 2 * problem.n + 1
+    if stop.reason == "memory":
+        # Let the exact search's tables go: the fallback starts from a fresh problem.
+        problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
+        del worst
+        gc.collect()
+    rest = budget.remaining()
+    share = budget
+    if rest is not None and not problem.sensorless:
+        # With readings its tree can be large: keep half of the rest for the search.
+        share = Deadline(
+            memory_mb=budget.memory_mb, end=budget.end - rest / 2.0, memory_base=budget.memory_base
+        )
+    try:
+        blind = _sensorless_plan(problem, root_branches, share)
+    except Timeout:
+        blind = None
+    anytime = WorstCase(problem, budget)
+    if stop.reason != "memory" and type(worst) is WorstCase:
+        # What the exact search proved stays true (its exact lengths are left out: they
+        # may come without the action that proves them).
+        anytime.lb.update(worst.lb)
+        anytime.ub.update(worst.ub)
+        anytime.choice.update(worst.choice)
+    cap = min(2 * problem.n + 1, FALLBACK_MAX_OPERATIONS)
     if blind is not None:
         cap = tree_length(blind) - 2  # look only for something shorter
+    # With a deadline, lengths at the proven bound and one above it first (each with a third
+    # of the time left), then the generous cap: a plan within one operation of the bound
+    # when the search finds one, some plan else.
+    near = (lower - 1, lower) if budget.end is not None else ()
+    caps = sorted({k for k in near if k < cap}) + [cap]
+    found = None
+    last = Timeout(stop.reason)
+    for k in caps:
+        rest = budget.remaining()
+        end = None if rest is None or k == cap else budget.end - rest * 2.0 / 3.0
+        anytime.deadline = Deadline(
+            memory_mb=budget.memory_mb, end=end or budget.end, memory_base=budget.memory_base
+        )
+        try:
+            if all(anytime.within(r, k) for r in roots):
+                found = k
+                break
+        except Timeout as exc:
+            last = exc
+            if exc.reason == "memory":
+                break
     try:
-        for r in roots:
-            if not anytime.within(r, cap):
-                raise Timeout
-    except Timeout:
+        if found is None:
+            raise last
+        anytime.deadline = budget
+        root = _choice_plan(problem, anytime.choice, roots, root_branches, budget)
+    except Timeout as exc:
         if blind is not None:
             return blind, False, None, lower
+        reason = exc.reason if exc.reason == "memory" else stop.reason
         raise PlanningError(
-            f"no plan found within the time limit of {time_limit:g} s "
+            f"no plan found within {_out_of_budget(options, reason)} "
             f"(a plan needs at least {lower} operations)"
         ) from None
+    return root, False, None, lower
 
-    choice = anytime.choice
+
+def _dag(
+    keys: Iterable[Hashable],
+    expand: Callable[[Hashable], Leaf | tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]],
+    deadline: Deadline,
+) -> dict[Hashable, Step | Leaf]:
+    """The plan nodes of ``keys`` and everything below, built on an explicit stack.
+
+    ``expand(key)`` is a Leaf or a node's action with its (branch, child key) pairs; equal
+    keys share one node (the tree is a DAG in memory). The keys must not lead back to
+    themselves (each expansion gets closer to a goal), and no depth meets Python's
+    recursion limit.
+    """
+    made: dict[Hashable, Step | Leaf] = {}
+    pending: dict[Hashable, tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]] = {}
+    stack: list[tuple[Hashable, bool]] = [(k, False) for k in keys]
+    while stack:
+        key, ready = stack.pop()
+        if key in made:
+            continue
+        if ready:
+            action, subs = pending.pop(key)
+            made[key] = Step(action, tuple((b, made[c]) for b, c in subs))
+            continue
+        if key in pending:
+            continue
+        deadline.check()
+        node = expand(key)
+        if isinstance(node, Leaf):
+            made[key] = node
+            continue
+        pending[key] = node
+        stack.append((key, True))
+        stack.extend((c, False) for _b, c in node[1] if c not in made)
+    return made
+
+
+def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:
+    """The plan that follows a search's ``choice`` table (the action that proved each set)."""
 
     def witness_of(mask: int, supersets) -> int:
         if problem.is_goal(mask) or mask in choice:
             return mask
         return next(c for c in supersets if mask & c == mask)
 
-    made: dict[tuple[int, int], Step | Leaf] = {}  # equal cases share their subtree
-
-    def build(mask: int, witness: int) -> Step | Leaf:
-        if (mask, witness) not in made:
-            made[(mask, witness)] = make(mask, witness)
-        return made[(mask, witness)]
-
-    def make(mask: int, witness: int) -> Step | Leaf:
+    def expand(key):
+        mask, witness = key
         if problem.is_goal(mask):
             return Leaf(mask)
-        k, act = choice[witness]
+        _k, act = choice[witness]
         if witness != mask:
             # Follow the witness's rotation: the set's range holding it (any rotation in it
             # sends the set inside the witness's image).
-            r = act.action.representative
-            lo, hi, img = next(
-                c
-                for c in search_space(problem.machine).overlap_cells(mask)
-                if c[0] < r < c[1] or c[0] < r + 360.0 < c[1]
-            )
-            action = OverlapRange(lo, hi, img)
+            # A subset's boundaries are among the witness's, so the rotation lies strictly
+            # inside one of the subset's cells between real boundaries (Choices.fixed_cells):
+            # its margin is the one every member has, never a merged range's.
+            action = problem.choices.range_at(mask, act.action.representative)
+            if action is None:
+                raise AssertionError("a witness's rotation lies on a boundary of its subset")
         else:
             action = act.action
-        subs = []
-        for b in problem.readings.image_branches(action.image):
-            subs.append((b, build(b.mask, witness_of(b.mask, act.children))))
-        return Step(action, tuple(subs))
+        subs = [
+            (b, (b.mask, witness_of(b.mask, act.children)))
+            for b in problem.readings.image_branches(action.image)
+        ]
+        return action, subs
 
-    root = Step(None, tuple((b, build(b.mask, witness_of(b.mask, roots))) for b in root_branches))
-    return root, False, None, lower
+    top = [(b, (b.mask, witness_of(b.mask, roots))) for b in root_branches]
+    made = _dag([k for _b, k in top], expand, deadline)
+    return Step(None, tuple((b, made[k]) for b, k in top))
 
 
-def _sensorless_plan(problem: Problem, root_branches) -> Step | None:
+def _sensorless_plan(problem: Problem, root_branches, deadline: Deadline) -> Step | None:
     """A plan that takes the readings but chooses rotations by backchaining, or None.
 
     For one part's push machine (no margin floor), Goldberg's table says how many
     operations collapse any set with no sensor; each step takes a rotation that lowers
-    that number, and a reading only leaves a subset, which needs no more. Instant, and
-    never longer than the sensorless plan.
+    that number, and a reading only leaves a subset, which needs no more. Never longer than
+    the sensorless plan; its size grows with the distinct reading sets, so it is built
+    under ``deadline`` (Timeout).
     """
     if problem.min_margin > 0.0:
         return None
@@ -327,24 +497,18 @@ def _sensorless_plan(problem: Problem, root_branches) -> Step | None:
     if circle is None:
         return None
     chain = Backchain(circle)
-    made: dict[int, Step | Leaf] = {}  # equal sets share their subtree
 
-    def build(mask: int) -> Step | Leaf:
-        if mask in made:
-            return made[mask]
+    def expand(mask: int):
         if problem.is_goal(mask):
-            node: Step | Leaf = Leaf(mask)
-        else:
-            k = chain.length(mask)
-            lo, hi, img = next(
-                c for c in problem.choices.cells(mask, False) if chain.length(c[2]) < k
-            )
-            subs = tuple((b, build(b.mask)) for b in problem.readings.image_branches(img))
-            node = Step(OverlapRange(lo, hi, img), subs)
-        made[mask] = node
-        return node
+            return Leaf(mask)
+        k = chain.length(mask)
+        lo, hi, img = next(c for c in problem.choices.cells(mask, False) if chain.length(c[2]) < k)
+        return OverlapRange(lo, hi, img), [
+            (b, b.mask) for b in problem.readings.image_branches(img)
+        ]
 
-    return Step(None, tuple((b, build(b.mask)) for b in root_branches))
+    made = _dag([b.mask for b in root_branches], expand, deadline)
+    return Step(None, tuple((b, made[b.mask]) for b in root_branches))
 
 
 def _proven(worst: WorstCase, mask: int) -> int:

@@ -22,15 +22,84 @@ from enum import StrEnum
 from feederkit.errors import InputError
 from feederkit.machine import Grouping
 
-__all__ = ["Grouping", "Method", "Objective", "PlanningOptions"]
+__all__ = ["ActionCosts", "Grouping", "Method", "Objective", "PlanningOptions"]
 
 
 class Objective(StrEnum):
-    """What a plan minimises: the worst-case number of operations (sections 4, 6), or the
-    expected number over uniformly random starts and readings, among the shortest."""
+    """What a plan minimises (docs/planning.md, "Which plan among the shortest").
+
+    ``worst``: the worst-case number of operations (sections 4, 6); ``expected``: the
+    expected number over the start states' weights and the readings; ``time``: the expected
+    seconds per part under :class:`ActionCosts` (same horizon as ``expected``);
+    ``worst-time``: among the plans of minimum worst-case length, the fewest seconds on the
+    slowest path. The last two need ``costs``.
+    """
 
     WORST = "worst"
     EXPECTED = "expected"
+    TIME = "time"
+    WORST_TIME = "worst-time"
+
+    @property
+    def timed(self) -> bool:
+        """Whether the objective counts seconds (and so needs action costs)."""
+        return self in (Objective.TIME, Objective.WORST_TIME)
+
+
+def _seconds(value: object, what: str) -> float:
+    """``value`` as a finite number of seconds >= 0, else bad input naming ``what``."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not (math.isfinite(value) and value >= 0.0)
+    ):
+        raise InputError(f"the {what} must be zero or a positive number of seconds, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class ActionCosts:
+    """What one push-align operation costs in seconds (section 3.3; docs/cell.md).
+
+    The first alignment (the part dropped from the feeder) costs ``drift_s``; every later
+    operation costs ``pick_place_s + turn / rotation_speed_deg_s + drift_s``, with ``turn``
+    the plan's rotation the shorter way round. ``rotation_speed_deg_s`` may be ``inf``
+    (rotations cost nothing). The planners see only this value, never a cell profile.
+
+    >>> ActionCosts(1.2, 180.0, 1.5).seconds(270.0)
+    3.2
+    """
+
+    pick_place_s: float
+    rotation_speed_deg_s: float
+    drift_s: float
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "pick_place_s", _seconds(self.pick_place_s, "pick-and-place time"))
+        set_(self, "drift_s", _seconds(self.drift_s, "drift time"))
+        v = self.rotation_speed_deg_s
+        if isinstance(v, bool) or not isinstance(v, int | float) or not v > 0.0:
+            raise InputError(f"the rotation speed must be a positive number of deg/s, got {v!r}")
+        set_(self, "rotation_speed_deg_s", float(v))
+
+    @property
+    def first_s(self) -> float:
+        """Seconds of the first alignment (no pick, no rotation)."""
+        return self.drift_s
+
+    @property
+    def least_s(self) -> float:
+        """The fewest seconds any later operation takes (a rotation by 0)."""
+        return self.pick_place_s + self.drift_s
+
+    def seconds(self, rotation_deg: float | None) -> float:
+        """Seconds of one operation rotating by ``rotation_deg`` (None: the first alignment)."""
+        if rotation_deg is None:
+            return self.first_s
+        a = rotation_deg % 360.0
+        turn = min(a, 360.0 - a)
+        return self.pick_place_s + turn / self.rotation_speed_deg_s + self.drift_s
 
 
 class Method(StrEnum):
@@ -64,7 +133,11 @@ class PlanningOptions:
     ``min_margin_deg``: use only rotations whose overlap range is at least twice this wide
     (the rotation error a plan tolerates, section 3.2.2); ``grouping``: how readings branch
     (:class:`Grouping`); ``time_limit_s``: give up proving optimality after this long (None:
-    no limit).
+    no limit); ``memory_limit_mb``: stop searching when the process holds more than this
+    many megabytes (None: no limit), answering as at the time limit; ``costs``: the seconds
+    of an operation (:class:`ActionCosts`), needed by the ``time`` and ``worst-time``
+    objectives; with the operation objectives it breaks ties among equal operation counts
+    toward less time.
     """
 
     objective: Objective = Objective.WORST
@@ -72,6 +145,8 @@ class PlanningOptions:
     grouping: Grouping = Grouping.EXACT
     time_limit_s: float | None = None
     method: Method = Method.AUTO
+    memory_limit_mb: float | None = None
+    costs: ActionCosts | None = None
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -91,3 +166,19 @@ class PlanningOptions:
             ):
                 raise InputError(f"the time limit must be a positive number of seconds, got {t}")
             set_(self, "time_limit_s", float(t))
+        mem = self.memory_limit_mb
+        if mem is not None:
+            if (
+                isinstance(mem, bool)
+                or not isinstance(mem, int | float)
+                or not (math.isfinite(mem) and mem > 0.0)
+            ):
+                raise InputError(f"the memory limit must be a positive number of MB, got {mem}")
+            set_(self, "memory_limit_mb", float(mem))
+        if self.costs is not None and not isinstance(self.costs, ActionCosts):
+            raise InputError(f"the action costs must be ActionCosts, got {self.costs!r}")
+        if self.objective.timed and self.costs is None:  # type: ignore[attr-defined]
+            raise InputError(
+                f"the objective {self.objective.value!r} needs the seconds of an operation "
+                "(action costs: pick-and-place time, rotation speed, drift time)"
+            )

@@ -14,6 +14,7 @@ length view's pruning is sound here too.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from feederkit.planning.andor import Deadline
 from feederkit.planning.problem import Problem
@@ -23,10 +24,17 @@ MAX_SETS = 200_000
 
 
 def solve(
-    problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
+    problem: Problem,
+    roots: list[int],
+    deadline: Deadline | None = None,
+    max_sets: int = MAX_SETS,
+    hopeless: Callable[[int], bool] | None = None,
 ) -> dict[int, float] | None:
     """The minimum worst-case number of operations of every set reachable from ``roots``
     (inf: no strong plan); None when more than ``max_sets`` sets are reachable.
+
+    ``hopeless(mask)`` may name sets already known to have no strong plan (they are given
+    inf and not expanded; :mod:`feederkit.planning.lumping` uses it to prune).
 
     Knuth's generalisation of Dijkstra to AND/OR graphs with unit costs: sets are settled
     level by level from the goals (0); an action is complete when all its branch sets are
@@ -44,6 +52,9 @@ def solve(
         deadline.check()
         if problem.is_goal(m):
             value[m] = 0
+            continue
+        if hopeless is not None and hopeless(m):
+            value[m] = math.inf
             continue
         children = [tuple(set(a.children)) for a in problem.choices.search_actions(m)]
         acts[m] = children

@@ -1,4 +1,5 @@
-"""Statistics of a plan tree: worst-case length, expected length, smallest margin.
+"""Statistics of a plan tree: worst-case length, expected length, smallest margin, and the
+expected and worst seconds per part under action costs (docs/cell.md).
 
 The expected number of operations uses the distribution of :mod:`feederkit.planning.readings`
 (uniform initial orientation, uniform reading error), the same one the planners minimise.
@@ -9,8 +10,10 @@ node, so shared subtrees cost once.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from feederkit.machine import PushAlignMachine
+from feederkit.planning.options import ActionCosts
 from feederkit.planning.readings import reading_probability
 from feederkit.planning.tree import Leaf, PlanTree, Step
 
@@ -48,9 +51,43 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
     times the probability that its reading falls in the branch. By linearity this is the
     weighted sum, over start states, of the expected operations of a part in that state.
     """
-    memo: dict[tuple[int, int], float] = {}
+    return _expected(machine, root, lambda _node: 1.0)
+
+
+def expected_seconds(machine: PushAlignMachine, root: Step, costs: ActionCosts) -> float:
+    """Expected seconds per part of a plan (docs/cell.md): each operation costs
+    ``costs.seconds`` of its representative rotation, the first alignment ``costs.first_s``;
+    the distribution is the one of :func:`expected_operations`."""
+    return _expected(machine, root, lambda node: _node_seconds(node, costs))
+
+
+def worst_seconds(root: PlanTree, costs: ActionCosts) -> float:
+    """Seconds per part on the plan's slowest path (every branch any state can take)."""
+    memo: dict[int, float] = {}
+
+    def slowest(node: PlanTree) -> float:
+        if isinstance(node, Leaf):
+            return 0.0
+        hit = memo.get(id(node))
+        if hit is None:
+            hit = _node_seconds(node, costs) + max(
+                (slowest(sub) for _, sub in node.branches), default=0.0
+            )
+            memo[id(node)] = hit
+        return hit
+
+    return slowest(root)
+
+
+def _node_seconds(node: Step, costs: ActionCosts) -> float:
+    return costs.seconds(None if node.action is None else node.action.representative)
+
+
+def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], float]) -> float:
+    """The expectation of the summed ``cost`` of the operations a part goes through."""
     if not machine.deterministic:
-        return _expected_sets(machine, root)
+        return _expected_sets(machine, root, cost)
+    memo: dict[tuple[int, int], float] = {}
     probs: dict[tuple[float | None, float | None, int], float] = {}
 
     def ops(node: PlanTree, state: int) -> float:
@@ -62,7 +99,7 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
             return hit
         if node.action is not None:
             state = machine.successor(state, node.action.representative)
-        total = 1.0
+        total = cost(node)
         for b, sub in node.branches:
             if b.mask >> state & 1:
                 p = probs.get((b.lo, b.hi, state))
@@ -76,8 +113,8 @@ def expected_operations(machine: PushAlignMachine, root: Step) -> float:
     return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
 
 
-def _expected_sets(machine: PushAlignMachine, root: Step) -> float:
-    """``expected_operations`` when actions have outcome sets: a state's mass moves to its
+def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step], float]) -> float:
+    """``_expected`` when actions have outcome sets: a state's mass moves to its
     outcome set, shared equally (docs/planning.md); a part follows a branch with the
     probability that its reading falls in it."""
     memo: dict[tuple[int, int], float] = {}
@@ -94,7 +131,7 @@ def _expected_sets(machine: PushAlignMachine, root: Step) -> float:
         else:
             out = machine.outcomes(state, node.action.representative)
             outs = [t for t in range(machine.n) if out >> t & 1]
-        total = 1.0
+        total = cost(node)
         for t in outs:
             for b, sub in node.branches:
                 if b.mask >> t & 1:

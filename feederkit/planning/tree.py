@@ -75,6 +75,9 @@ class PlanResult:
     every outcome nature can pick (a strong plan), ``min_margin`` the extra rotation error
     beyond the declared one that an action tolerates without changing its outcome sets, and
     ``certificate`` (set by :func:`feederkit.plans.make.make_plan`) what the plan guarantees.
+    ``lumped_pairs``: pairs some result lists together that are not inseparable, because
+    no strong plan tells them apart or merges them under the declared uncertainty
+    (near-symmetric states, :mod:`feederkit.planning.lumping`).
     """
 
     machine: PushAlignMachine
@@ -87,6 +90,7 @@ class PlanResult:
     objective: str = "worst"
     grouping: str = "exact"
     certificate: Certificate | None = None
+    lumped_pairs: tuple[tuple[int, int], ...] = ()
 
     @property
     def uncertainty(self) -> Uncertainty:

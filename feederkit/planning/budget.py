@@ -1,0 +1,119 @@
+"""The one budget a plan is computed under: a wall-clock deadline and a memory limit.
+
+``plan`` makes a :class:`Deadline` on its first line, from ``PlanningOptions.time_limit_s``
+and ``memory_limit_mb``; every stage that can run long (the inseparability fixpoint, the
+exact searches, the tie-breaking stages, the fallbacks) polls it with :meth:`Deadline.check`
+and stops with :class:`Timeout` when either limit is passed. Stages get shares of one budget
+(:meth:`Deadline.until`), so the clock started before the first of them holds for the last
+(docs/planning.md, "Time and memory limits").
+
+The check is cheap: a clock read per call (well under a microsecond; a search node costs
+tens of microseconds or more, so reading it less often only lets a stage of expensive nodes
+overrun) and the resident set size (``/proc/self/statm``, one small read) at most every
+:data:`MEMORY_POLL_S` seconds.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import time
+
+MEMORY_POLL_S = 0.02
+"""``check`` reads the resident set size at most this often (seconds)."""
+
+_PAGE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
+
+
+def rss_mb() -> float:
+    """The process's resident set size in MB (its peak where ``/proc`` is missing)."""
+    try:
+        with open("/proc/self/statm", "rb") as f:
+            return int(f.read().split()[1]) * _PAGE / 1e6
+    except (OSError, ValueError, IndexError):
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        return peak / 1e3  # kilobytes on Linux
+
+
+class Timeout(Exception):
+    """A search ran out of its budget; ``reason`` is ``"time"`` or ``"memory"``."""
+
+    def __init__(self, reason: str = "time") -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+class Deadline:
+    """A wall-clock deadline and a memory limit, either None (no limit).
+
+    ``seconds`` counts from now, or ``end`` gives the :func:`time.perf_counter` instant
+    itself (shares of one budget keep its start). ``memory_base`` is what the process held
+    when the budget began (read now unless given): shares of the memory are shares of the
+    growth from it to the limit.
+    """
+
+    def __init__(
+        self,
+        seconds: float | None = None,
+        memory_mb: float | None = None,
+        *,
+        end: float | None = None,
+        start: float | None = None,
+        memory_base: float | None = None,
+    ) -> None:
+        now = time.perf_counter()
+        self.start = now if start is None else start
+        self.end = end if end is not None or seconds is None else now + seconds
+        self.memory_mb = memory_mb
+        self.memory_base = memory_base
+        if memory_base is None and memory_mb is not None:
+            self.memory_base = min(rss_mb(), memory_mb)
+        self._next_memory = now
+        self._limited = self.end is not None or memory_mb is not None
+
+    @property
+    def limited(self) -> bool:
+        """Whether any limit is set."""
+        return self._limited
+
+    def check(self) -> None:
+        """Raise Timeout once the deadline or the memory limit has passed."""
+        if not self._limited:
+            return
+        now = time.perf_counter()
+        if self.end is not None and now > self.end:
+            raise Timeout("time")
+        if self.memory_mb is not None and now >= self._next_memory:
+            self._next_memory = now + MEMORY_POLL_S
+            if rss_mb() > self.memory_mb:
+                raise Timeout("memory")
+
+    def expired(self) -> bool:
+        """Whether a limit has passed (reads the clock and the memory now)."""
+        self._next_memory = 0.0
+        try:
+            self.check()
+        except Timeout:
+            return True
+        return False
+
+    def remaining(self) -> float | None:
+        """Seconds left (never negative; None: no deadline)."""
+        if self.end is None:
+            return None
+        return max(0.0, self.end - time.perf_counter())
+
+    def until(self, time_share: float, memory_share: float = 1.0) -> Deadline:
+        """A budget for one stage: ending ``time_share`` of the way from this budget's start
+        to its end, and letting the process grow ``memory_share`` of the way from what it
+        held at the start to the memory limit."""
+        end = None if self.end is None else self.start + time_share * (self.end - self.start)
+        memory = base = None
+        if self.memory_mb is not None and self.memory_base is not None:
+            base = self.memory_base
+            memory = base + memory_share * (self.memory_mb - base)
+        return Deadline(memory_mb=memory, end=end, start=self.start, memory_base=base)
+
+
+UNLIMITED = Deadline()
+"""A budget with no limit (its checks return at once)."""

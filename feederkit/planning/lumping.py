@@ -1,0 +1,260 @@
+"""Near-symmetric states under uncertainty: lump the pairs no strong plan can resolve.
+
+Under a declared uncertainty (design.md, "Uncertainty") two states can be neither bisimilar
+(so not inseparable, :mod:`feederkit.machine.inseparable`) nor resolvable: a part whose
+centre of mass sits a hair off a symmetry axis has two poses whose outcome sets differ only
+by an outcome nature may pick, and the rotation error keeps every strong plan from either
+telling them apart by a reading or merging them. With the inseparable goal alone such a
+part has no strong plan at all. This module widens the goal the way the ideal model treats
+exact symmetry (section 3.3: a result lists the poses no plan can tell apart):
+
+- a pair of states is *resolvable* when a strong plan takes the set of the two to a goal of
+  the machine's inseparable pairs (``R``), i.e. separates them by readings or merges them
+  for every outcome; :func:`kept_apart` proves many pairs unresolvable cheaply (a pair
+  fixpoint like the bisimulation), :func:`~feederkit.planning.solvable.solve` decides the
+  rest from their pair sets at once (one pass over the sets they reach, shared);
+- the *lumped* relation is ``R`` together with the unresolvable pairs ``U``; a set is a
+  goal when every pair in it is lumped (the same pairwise test as before, over more pairs).
+
+One round is the fixpoint: solvability is monotone in the goal (a plan reaching ``R``-goals
+reaches the larger ``R ∪ U``-goals), so a pair resolvable under ``R`` stays resolvable,
+and a pair of ``U`` is a goal itself; no iteration adds pairs. The relation need not be
+transitive (``a ~ b`` and ``b ~ c`` lumped, ``a`` and ``c`` resolvable): a set holding ``a``
+and ``c`` is still not a goal, so a plan never reports two states together that some
+strong plan tells apart. Every pair being resolvable or lumped does **not** make every set
+solvable under nondeterminism (an action's outcome sets can grow a set again; three states
+whose every pair some action merges while every action maps the three onto themselves are
+the smallest case), so :func:`lumped_goal` also checks the roots and gives up (None, the
+planner then keeps "no strong plan") when they stay unsolvable: conservative, never wrong.
+
+On the ideal model a plan always exists (docs/planning.md, "The goal"), so lumping is only
+for machines with outcome sets and only when the inseparable goal leaves no strong plan.
+docs/planning.md ("Near-symmetric states under uncertainty") says more.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from feederkit.machine import Grouping, PushAlignMachine, members, pair_outcomes
+from feederkit.planning.andor import Deadline, Timeout
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.planning.solvable import MAX_SETS, solve
+from feederkit.planning.tree import PlanTree, Step
+
+Pair = tuple[int, int]
+
+PAIR_SETS = 20_000
+"""The most sets the exact pair check explores before it settles for :func:`kept_apart`."""
+
+
+@dataclass(frozen=True)
+class Lumping:
+    """The goal widened by the pairs no strong plan resolves.
+
+    ``insep[i]``: the states ``i`` is lumped with (inseparable or unresolvable), the masks a
+    :class:`~feederkit.planning.problem.Problem` takes as its goal; ``pairs``: the lumped
+    pairs ``(i, j)``, ``i < j``, sorted (not inseparable, yet no strong plan separates or
+    merges them under the machine's declared uncertainty); ``exact``: they are all such
+    pairs (False: those :func:`kept_apart` proves, when the exact check was too large).
+    """
+
+    insep: tuple[int, ...]
+    pairs: tuple[Pair, ...]
+    exact: bool = True
+
+    def renumbered(self, old: Sequence[int]) -> Lumping:
+        """The same lumping over the original numbering (``old[new_index]``, as
+        :func:`~feederkit.planning.reindex.by_diameter` returns it)."""
+        masks = [0] * len(self.insep)
+        for k, m in enumerate(self.insep):
+            masks[old[k]] = sum(1 << old[j] for j in members(m))
+        pairs = sorted((min(old[i], old[j]), max(old[i], old[j])) for i, j in self.pairs)
+        return Lumping(tuple(masks), tuple(pairs), self.exact)
+
+    def in_leaves(self, root: PlanTree) -> tuple[Pair, ...]:
+        """The lumped pairs that some leaf of the plan ``root`` reports together (the ones
+        the output must name), sorted."""
+        lumped = set(self.pairs)
+        found: set[Pair] = set()
+        seen: set[int] = set()
+        stack: list[PlanTree] = [root]
+        while stack:
+            node = stack.pop()
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
+            if isinstance(node, Step):
+                stack.extend(sub for _b, sub in node.branches)
+                continue
+            idx = members(node.mask)
+            for a, i in enumerate(idx):
+                found.update((i, j) for j in idx[a + 1 :] if (i, j) in lumped)
+        return tuple(sorted(found))
+
+
+def candidate_pairs(problem: Problem) -> list[Pair]:
+    """The pairs a goal test can meet that are not inseparable.
+
+    With exact reading branching every set a plan reaches holds states that can all give one
+    reading, so only pairs that can read alike meet; the components rule can join states
+    that cannot (through a third), so there every pair is a candidate.
+    """
+    machine = problem.machine
+    sensor = machine.sensor
+    sensed = [s.sensed for s in machine.states]
+    exact = problem.grouping is Grouping.EXACT
+    return [
+        (i, j)
+        for i in range(machine.n)
+        for j in range(i + 1, machine.n)
+        if not problem.insep[i] >> j & 1
+        and (not exact or sensor.can_read_alike(sensed[i], sensed[j]))
+    ]
+
+
+def kept_apart(problem: Problem, pairs: Sequence[Pair]) -> set[Pair]:
+    """The pairs of ``pairs`` nature can keep apart for ever: the greatest subset such that
+    on every overlap range of a pair (section 3.2.2) some outcome of the one and a
+    *different* outcome of the other again form a kept pair.
+
+    Sound for unresolvability, and cheap (a fixpoint over pairs, like the bisimulation of
+    :mod:`feederkit.machine.inseparable`): nature answers every action with such outcomes and
+    every reading with one both can give (kept pairs can read alike), so every set a plan
+    meets holds a kept pair, which is not inseparable: no leaf is a goal. It can miss pairs
+    of :func:`unresolvable_pairs` whose plans fail only on a larger set (three states each
+    pair of which some action merges, but no action all three).
+    """
+    machine = problem.machine
+    alive = set(pairs)
+    cases = {p: sorted(set(pair_outcomes(machine, *p))) for p in alive}
+
+    def keeps(a: int, b: int) -> bool:
+        xs, ys = members(a), members(b)
+        return any(x != y and ((x, y) if x < y else (y, x)) in alive for x in xs for y in ys)
+
+    changed = True
+    while changed:
+        changed = False
+        for p in sorted(alive):
+            if not all(keeps(a, b) for a, b in cases[p]):
+                alive.discard(p)
+                changed = True
+    return alive
+
+
+def unresolvable_pairs(
+    problem: Problem, deadline: Deadline | None = None, max_sets: int = PAIR_SETS
+) -> tuple[Pair, ...] | None:
+    """The candidate pairs from whose set no strong plan reaches a goal of ``problem`` (no
+    margin floor), exactly; None when undecided (more than ``max_sets`` sets). Raises
+    Timeout when ``deadline`` passes.
+
+    The pairs :func:`kept_apart` finds are unresolvable at once, and so is every set that
+    holds one (nature keeps that pair); :func:`~feederkit.planning.solvable.solve` decides
+    the rest from their pair sets together, those sets pruned.
+    """
+    pairs = candidate_pairs(problem)
+    kept = kept_apart(problem, pairs)
+    rest = [p for p in pairs if p not in kept]
+    found = set(kept)
+    if rest:
+        holds = lumped([0] * problem.n, sorted(kept))
+
+        def hopeless(mask: int) -> bool:
+            return any(holds[i] & mask for i in members(mask))
+
+        roots = [(1 << i) | (1 << j) for i, j in rest]
+        value = solve(problem.with_margin(0.0), roots, deadline, max_sets, hopeless)
+        if value is None:
+            return None
+        found.update(p for p, r in zip(rest, roots, strict=True) if value[r] == math.inf)
+    return tuple(sorted(found))
+
+
+def lumped(insep: Sequence[int], pairs: Sequence[Pair]) -> tuple[int, ...]:
+    """The masks ``insep`` with every pair of ``pairs`` added (both ways)."""
+    masks = list(insep)
+    for i, j in pairs:
+        masks[i] |= 1 << j
+        masks[j] |= 1 << i
+    return tuple(masks)
+
+
+def lumped_goal(
+    machine: PushAlignMachine,
+    grouping: Grouping | str = Grouping.EXACT,
+    deadline: Deadline | None = None,
+    max_sets: int = MAX_SETS,
+    pair_sets: int = PAIR_SETS,
+) -> Lumping | None:
+    """The lumped goal of ``machine`` when it gives every root reading set a strong plan.
+
+    The lumped pairs are :func:`unresolvable_pairs`; when deciding them all takes more than
+    ``pair_sets`` sets, the pairs :func:`kept_apart` finds (every one unresolvable, maybe
+    not all; ``Lumping.exact`` False). None when lumping does not help or cannot be
+    decided: the machine is ideal (a plan always exists there), no pair is lumped (the
+    set-level failure of the module docstring), the roots stay unsolvable under the lumped
+    goal, there are more than ``max_sets`` sets from the roots, or ``deadline`` passes. The
+    caller then keeps its "no strong plan".
+    """
+    if machine.deterministic or machine.n < 2:
+        return None
+    problem = Problem(machine, grouping, 0.0)
+    try:
+        pairs = unresolvable_pairs(problem, deadline, pair_sets)
+        exact = pairs is not None
+        if pairs is None:
+            pairs = tuple(sorted(kept_apart(problem, candidate_pairs(problem))))
+        if not pairs:
+            return None
+        goal = lumped(problem.insep, pairs)
+        wide = Problem(machine, grouping, 0.0, goal)
+        roots = sorted(maximal_sets(b.mask for b in wide.readings.branches(wide.full)))
+        value = solve(wide, roots, deadline, max_sets)
+    except Timeout:
+        return None
+    if value is None or any(value[r] == math.inf for r in roots):
+        return None
+    return Lumping(goal, pairs, exact)
+
+
+WORDS_PAIRS = 4
+""":func:`lumped_words` names at most this many pairs, then counts the rest."""
+
+
+def lumped_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
+    """One sentence naming the lumped pairs, for the plan's output (empty when none).
+
+    A physical state is named by its ideal stable states (docs/planning.md, "Results").
+    """
+    if not pairs:
+        return ""
+    u = machine.uncertainty
+
+    def name(i: int) -> str:
+        s = machine.states[i]
+        ids = "/".join(str(k) for k in s.ideal_states)
+        return f"{machine.part_names[s.part]} state {ids}"
+
+    listed = "; ".join(f"{name(i)} with {name(j)}" for i, j in pairs[:WORDS_PAIRS])
+    if len(pairs) > WORDS_PAIRS:
+        listed += f"; and {len(pairs) - WORDS_PAIRS} more pairs"
+    return (
+        f"results list states together that no strong plan tells apart under "
+        f"rotation error {u.rotation_error_deg:g} deg ({listed})"
+    )
+
+
+__all__ = [
+    "Lumping",
+    "candidate_pairs",
+    "kept_apart",
+    "lumped",
+    "lumped_goal",
+    "lumped_words",
+    "unresolvable_pairs",
+]

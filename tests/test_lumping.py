@@ -1,0 +1,442 @@
+"""Near-symmetric states under uncertainty: the pairs no strong plan resolves are lumped.
+
+docs/planning.md, "Near-symmetric states under uncertainty". The brute-force reference here
+shares no planning code: its own rotations (the middle of every cell between all
+action-range boundaries), outcomes looked up in the maps, reading branches from the open
+reading intervals, and plain depth-bounded recursion over outcome sets (a bound of 2^n is
+exact: a shortest strong plan never meets a set twice on a path).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import pytest
+
+import feederkit.planning.api as api
+from feederkit.machine import (
+    MachineState,
+    OutcomeRange,
+    PushAlignMachine,
+    build_machine,
+    inseparable,
+    members,
+)
+from feederkit.mechanics import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.api import NoStrongPlan
+from feederkit.planning.lumping import (
+    Lumping,
+    candidate_pairs,
+    kept_apart,
+    lumped_goal,
+    lumped_words,
+    unresolvable_pairs,
+)
+from feederkit.planning.problem import Problem
+from feederkit.planning.reindex import by_diameter
+from feederkit.planning.tree import Leaf
+from feederkit.plans.make import make_plan
+from feederkit.plans.strong import verify_strong
+from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import IDEAL, Uncertainty
+
+SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "samples"
+
+
+def near_rectangle(dx: float = 0.008):
+    """The 5 x 2.5 rectangle with its COM ``dx`` mm off the centre along the long side."""
+    outline = make_outline("rect", [[0, 0], [5, 0], [5, 2.5], [0, 2.5]])
+    return push_function(make_part(outline, [2.5 + dx, 1.25]))
+
+
+@pytest.fixture
+def wired(monkeypatch):
+    """The lumpings ``api.plan`` makes (over the diameter-sorted machine ``_plan`` sees),
+    collected in the list: ``plan`` plans to the lumped goal when the inseparable goal
+    leaves no strong plan (docs/planning.md)."""
+    real = api.lumped_goal
+    made: list[Lumping] = []
+
+    def lumped_goal_(*args, **kwargs):
+        lump = real(*args, **kwargs)
+        if lump is not None:
+            made.append(lump)
+        return lump
+
+    monkeypatch.setattr(api, "lumped_goal", lumped_goal_)
+    return made
+
+
+def leaf_masks(root) -> list[int]:
+    out, stack = [], [root]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, Leaf):
+            out.append(n.mask)
+        else:
+            stack.extend(sub for _b, sub in n.branches)
+    return out
+
+
+def file_leaves(node, nodes=None) -> list[list[int]]:
+    """The states of every result of a plan file's tree (shared subplans followed)."""
+    if "ref" in node:
+        return file_leaves(nodes[node["ref"]], nodes)
+    if "result" in node:
+        return [sorted(e["state"] for e in node["result"])]
+    return [x for b in node["branches"] for x in file_leaves(b["next"], nodes)]
+
+
+# --- the defect, fixed ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sensor", [NoSensor(), ToleranceSensor(0.2)], ids=["none", "tol"])
+def test_the_near_symmetric_rectangle_plans_with_the_defaults_and_verifies(wired, sensor):
+    pf = near_rectangle()
+    machine = build_machine([pf], sensor, Uncertainty())
+    assert not any(inseparable(machine))  # not bisimilar: the COM is off centre
+    made = make_plan([pf], sensor, certify=False)  # the default rotation error, 1 deg
+    verify_strong(made.plan)
+    (lump,) = wired
+    _sorted, old = by_diameter(machine)
+    pairs = lump.renumbered(old).pairs
+    assert pairs == ((0, 2), (1, 3))  # each pose with its near-symmetric twin, 180 deg on
+    for leaf in file_leaves(made.plan["root"], made.plan.get("nodes")):
+        assert leaf in ([0, 2], [1, 3])
+    assert made.result.length == (2 if sensor == NoSensor() else 1)
+    words = lumped_words(machine, pairs)
+    assert "rect state 0 with rect state 2" in words and "rotation error 1 deg" in words
+
+
+def test_without_lumping_the_rectangle_has_no_strong_plan(monkeypatch):
+    """The defect itself, so the test above cannot pass by accident."""
+    machine = build_machine([near_rectangle()], NoSensor(), Uncertainty())
+    monkeypatch.setattr(api, "lumped_goal", lambda *a, **k: None)
+    with pytest.raises(NoStrongPlan):
+        api.plan(machine)
+
+
+def test_a_verifier_refuses_a_lumped_leaf_that_drops_a_state(wired):
+    made = make_plan([near_rectangle()], NoSensor(), certify=False)
+    import copy
+
+    broken = copy.deepcopy(made.plan)
+    stack = [broken["root"]]
+    while stack:
+        n = stack.pop()
+        if "result" in n:
+            n["result"] = n["result"][:1]
+        else:
+            stack.extend(b["next"] for b in n["branches"])
+    from feederkit.errors import CheckFailed
+
+    with pytest.raises(CheckFailed, match="does not name"):
+        verify_strong(broken)
+
+
+@pytest.mark.skipif(not SAMPLES.is_dir(), reason=f"{SAMPLES} is absent")
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["trimesh__apu-mount.DXF", "trimesh__sliding-base.dxf"])
+def test_the_sample_drawings_plan_with_the_defaults_and_verify(wired, name):
+    from feederkit.importers import ImportOptions, import_parts
+
+    _, parts = import_parts(SAMPLES / name, ImportOptions())
+    pf = push_function(parts[0].part)
+    assert not api.strong_plan_exists(build_machine([pf], NoSensor(), Uncertainty()))
+    made = make_plan([pf], NoSensor(), certify=False)
+    verify_strong(made.plan)
+    assert len(wired) == 1 and wired[0].pairs
+    machine = made.result.machine
+    _sorted, old = by_diameter(machine)
+    lump = wired[0].renumbered(old)
+    assert lump.in_leaves(made.result.root)  # some leaf reports a lumped pair
+    for mask in leaf_masks(made.result.root):  # and only lumped or inseparable pairs
+        idx = members(mask)
+        assert all(lump.insep[i] >> j & 1 for i in idx for j in idx if i < j)
+
+
+# The hull and COM (mm) of the sample trimesh__apu-mount.DXF as feederkit imports it: a plate
+# with rounded corners on one long side only, so its COM sits 0.06 mm off the middle.
+APU_MOUNT_HULL = [
+    [108.65203812348, 68.34424926754001],
+    [254.70203812347998, 68.34424926754001],
+    [254.70203812347995, 180.3214505228224],
+    [254.3954738396105, 181.31496409302707],
+    [253.77771399091992, 182.06423674777105],
+    [252.91735642558237, 182.53005589494825],
+    [252.16203812348, 182.64424926753998],
+    [111.19203812347999, 182.64424926753998],
+    [110.43671982137761, 182.53005589494825],
+    [109.57636225604007, 182.06423674777105],
+    [108.9586024073495, 181.31496409302707],
+    [108.76623149607174, 180.85956756964237],
+    [108.65203812348, 180.10424926753998],
+]
+APU_MOUNT_COM = [181.55967048403957, 125.61033879057555]
+
+
+@pytest.mark.parametrize("sensor", [NoSensor(), ToleranceSensor(0.2)], ids=["none", "tol"])
+def test_the_apu_mount_drawing_plans_with_the_defaults_and_verifies(wired, sensor):
+    pf = push_function(make_part(make_outline("apu-mount", APU_MOUNT_HULL), APU_MOUNT_COM))
+    machine = build_machine([pf], sensor, Uncertainty())
+    assert not api.strong_plan_exists(machine)
+    made = make_plan([pf], sensor, certify=False)
+    verify_strong(made.plan)
+    _sorted, old = by_diameter(machine)
+    lump = wired[0].renumbered(old)
+    assert lump.pairs == ((0, 2), (1, 3))  # the plate's two long sides, and its two short ones
+    assert lump.in_leaves(made.result.root)
+
+
+# --- the relation against brute force ----------------------------------------------------------
+
+
+def brute(machine: PushAlignMachine, tol: float | None, goal_pairs: set[tuple[int, int]]):
+    """``solvable(mask)``: whether a strong plan takes ``mask`` to a set whose pairs are all
+    in ``goal_pairs`` (own code, see the module docstring)."""
+    n = machine.n
+    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
+    mids = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+
+    def out(i, a):
+        for r in machine.action_maps[i]:
+            if 0 < (a - r.lo) % 360 < r.hi - r.lo:
+                return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
+        raise AssertionError("no range holds the rotation")
+
+    def sensed(i):
+        d = machine.states[i].sensed
+        return (d, d) if isinstance(d, float) else d
+
+    def children(mask):
+        if tol is None:
+            return [mask]
+        ivs = {i: (sensed(i)[0] - tol, sensed(i)[1] + tol) for i in members(mask)}
+        ends = sorted({x for iv in ivs.values() for x in iv})
+        found = set()
+        for a, b in zip(ends, ends[1:], strict=False):
+            x = (a + b) / 2
+            m = sum(1 << i for i, (lo, hi) in ivs.items() if lo < x < hi)
+            if m:
+                found.add(m)
+        return sorted(found)
+
+    def goal(mask):
+        idx = members(mask)
+        return all((i, j) in goal_pairs for k, i in enumerate(idx) for j in idx[k + 1 :])
+
+    memo: dict[tuple[int, int], bool] = {}
+
+    def within(mask, k):
+        if goal(mask):
+            return True
+        if k == 0:
+            return False
+        key = (mask, k)
+        if key not in memo:
+            memo[key] = False
+            for a in mids:
+                img = 0
+                for i in members(mask):
+                    img |= out(i, a)
+                if all(within(c, k - 1) for c in children(img)):
+                    memo[key] = True
+                    break
+        return memo[key]
+
+    def solvable(mask):
+        return within(mask, 1 << n)
+
+    return solvable, children
+
+
+def hand_machine(seed: int, n: int, tol: float | None) -> PushAlignMachine:
+    """A random nondeterministic machine: a few ranges per state on a 10-degree grid, mostly
+    single outcomes, some pairs of outcomes; diameters 1 or 2, some with an interval."""
+    rng = random.Random(seed)
+    states = tuple(
+        MachineState(0, i, d, 1.0 / n, (d, d + rng.choice([0.0, 0.0, 0.3])), (i,))
+        for i, d in enumerate(float(rng.choice([1, 2])) for _ in range(n))
+    )
+    maps = []
+    for _ in range(n):
+        cuts = sorted(rng.sample(range(1, 36), rng.randint(1, 4)))
+        los = [0.0] + [10.0 * c for c in cuts]
+        his = los[1:] + [360.0]
+        ranges = []
+        for lo, hi in zip(los, his, strict=True):
+            t = 1 << rng.randrange(n)
+            if rng.random() < 0.35:
+                t |= 1 << rng.randrange(n)
+            ranges.append(OutcomeRange(lo, hi, t))
+        maps.append(tuple(ranges))
+    sensor = NoSensor() if tol is None else ToleranceSensor(tol)
+    return PushAlignMachine(("hand",), states, tuple(maps), sensor)
+
+
+def _pairs(masks) -> set[tuple[int, int]]:
+    return {(i, j) for i, m in enumerate(masks) for j in members(m) if i < j}
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_lumped_pairs_are_exactly_those_no_strong_plan_resolves(seed):
+    n = 3 + seed % 3
+    tol = [None, 0.2, 0.6][seed % 3]
+    m = hand_machine(seed, n, tol)
+    problem = Problem(m)
+    insep = _pairs(inseparable(m))
+    solvable, children = brute(m, tol, insep)
+    got = unresolvable_pairs(problem)
+    alike = set(candidate_pairs(problem))
+    expect = {p for p in alike if not solvable((1 << p[0]) | (1 << p[1]))}
+    assert set(got) == expect
+    assert not set(got) & insep
+    assert kept_apart(problem, sorted(alike)) <= expect  # the cheap pass is sound
+    # The lumped goal: given exactly when the roots are solvable under it.
+    lump = lumped_goal(m)
+    roots = children(m.all_states)
+    if not expect:
+        assert lump is None
+        return
+    wide, _ = brute(m, tol, insep | expect)
+    ok = all(wide(r) for r in roots)
+    assert (lump is not None) == ok
+    if lump is not None:
+        assert set(lump.pairs) == expect
+        assert _pairs(lump.insep) == insep | expect
+
+
+def test_the_random_machines_hold_non_transitive_and_hopeless_lumps():
+    """The reference above meets both hard cases (seeds found by listing)."""
+    m = hand_machine(24, 3, None)
+    lump = lumped_goal(m)
+    assert lump is not None and lump.pairs == ((0, 2), (1, 2))  # 0 ~ 2 ~ 1, 0 and 1 resolvable
+    m = hand_machine(56, 5, 0.6)
+    assert unresolvable_pairs(Problem(m)) and lumped_goal(m) is None
+
+
+# --- hand-made cases: non-transitive, and pairs that do not make a set ------------------------
+
+
+def _machine(rows, sensor=None) -> PushAlignMachine:
+    """``rows[i]``: per 120-degree range, the outcome states of state ``i``."""
+    n = len(rows)
+    states = tuple(MachineState(0, i, 1.0, 1.0 / n, (1.0, 1.0), (i,)) for i in range(n))
+    maps = tuple(
+        tuple(
+            OutcomeRange(120.0 * k, 120.0 * (k + 1), sum(1 << t for t in outs))
+            for k, outs in enumerate(row)
+        )
+        for row in rows
+    )
+    return PushAlignMachine(("hand",), states, maps, sensor or NoSensor())
+
+
+def test_non_transitive_lumping_never_reports_a_resolvable_pair_together(wired):
+    """0 ~ 1 and 1 ~ 2 cannot be resolved, 0 and 2 merge: the plan ends in {0, 1}."""
+    m = _machine([[[0]] * 3, [[0, 1]] * 3, [[0]] * 3])
+    assert not any(inseparable(m))
+    lump = lumped_goal(m)
+    assert lump is not None and lump.pairs == ((0, 1), (1, 2))
+    result = api.plan(m)
+    assert result.length == 2
+    assert leaf_masks(result.root) == [0b011]
+    assert lump.in_leaves(result.root) == ((0, 1),)
+
+
+def test_non_transitive_lumping_that_leaves_no_plan_keeps_no_strong_plan(wired):
+    """As above, but state 1 may land anywhere: {0, 1, 2} never loses 0 or 2."""
+    m = _machine([[[0]] * 3, [[0, 1, 2]] * 3, [[0]] * 3])
+    problem = Problem(m)
+    assert unresolvable_pairs(problem) == ((0, 1), (1, 2))
+    assert lumped_goal(m) is None
+    with pytest.raises(NoStrongPlan):
+        api.plan(m)
+    assert wired == []
+
+
+def test_every_pair_resolvable_does_not_make_the_set_solvable(wired):
+    """Each pair merges under one action, every action maps the three onto themselves."""
+    m = _machine([[[0], [0, 2], [2]], [[0], [1], [0, 1]], [[1, 2], [1], [2]]])
+    solvable, _ = brute(m, None, set())
+    assert all(solvable(p) for p in (0b011, 0b101, 0b110))
+    assert not solvable(0b111)
+    assert unresolvable_pairs(Problem(m)) == ()
+    assert lumped_goal(m) is None
+    with pytest.raises(NoStrongPlan):
+        api.plan(m)
+
+
+def test_lumping_gives_up_when_undecided():
+    m = build_machine([near_rectangle()], NoSensor(), Uncertainty())
+    assert lumped_goal(m, max_sets=1) is None
+    assert unresolvable_pairs(Problem(m), max_sets=1) is None
+
+
+def test_a_pair_check_too_large_settles_for_the_pairs_nature_keeps_apart():
+    m = build_machine([near_rectangle()], NoSensor(), Uncertainty())
+    exact = lumped_goal(m)
+    assert exact is not None and exact.exact
+    rough = lumped_goal(m, pair_sets=0)
+    assert rough is not None and not rough.exact
+    assert set(rough.pairs) <= set(exact.pairs)
+    assert rough.pairs == ((0, 2), (1, 3))
+
+
+def test_the_words_name_a_few_pairs_and_count_the_rest():
+    m = build_machine([near_rectangle()], NoSensor(), Uncertainty())
+    assert lumped_words(m, ()) == ""
+    many = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    words = lumped_words(m, many)
+    assert words.count(" with ") == 4 and "and 2 more pairs" in words and "\n" not in words
+
+
+def test_renumbered_maps_masks_and_pairs_back():
+    lump = Lumping((0b010, 0b001, 0b000), ((0, 1),))
+    back = lump.renumbered([2, 0, 1])  # new 0 was old 2, new 1 was old 0
+    assert back.pairs == ((0, 2),)
+    assert back.insep == (0b100, 0b000, 0b001)
+
+
+# --- nothing changes where nothing is near-symmetric --------------------------------------------
+
+
+def random_part(seed: int):
+    rng = random.Random(seed)
+    k = rng.randint(4, 7)
+    angles = sorted(rng.uniform(0, 2 * math.pi) for _ in range(k))
+    pts = [[30 * math.cos(a) * rng.uniform(0.6, 1), 20 * math.sin(a)] for a in angles]
+    return push_function(make_part(make_outline(f"rnd{seed}", pts)))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_ideal_model_lumps_nothing_beyond_inseparable(seed):
+    pf = random_part(seed) if seed else near_rectangle()
+    for sensor in (NoSensor(), ToleranceSensor(0.1)):
+        m = build_machine([pf], sensor, IDEAL)
+        assert unresolvable_pairs(Problem(m)) == ()
+        assert lumped_goal(m) is None
+
+
+@pytest.mark.parametrize(
+    "pts",
+    [
+        [[0, 0], [7, 0], [2, 4]],  # a scalene triangle
+        [[0, 0], [6, 0], [6, 1.5], [1.5, 1.5], [1.5, 4], [0, 4]],  # an L
+    ],
+    ids=["triangle", "L"],
+)
+def test_a_clearly_asymmetric_part_never_lumps(wired, pts):
+    pf = push_function(make_part(make_outline("asym", pts)))
+    for unc in (Uncertainty(), Uncertainty(2.0)):
+        m = build_machine([pf], NoSensor(), unc)
+        assert unresolvable_pairs(Problem(m)) == ()
+        assert lumped_goal(m) is None
+    made = make_plan([pf], NoSensor(), certify=False)
+    assert wired == []
+    assert not any(inseparable(made.result.machine))
+    assert all(mask.bit_count() == 1 for mask in leaf_masks(made.result.root))
