@@ -32,8 +32,10 @@ from pathlib import Path
 from typing import Any
 
 from feederkit.errors import InputError
-from feederkit.machine import successor
+from feederkit.planning.options import ActionCosts
+from feederkit.planning.stats import expected_seconds, worst_seconds
 from feederkit.sensors import SensorModel, make_sensor
+from feederkit.uncertainty import Uncertainty
 
 DEFAULT_CELL_FILE = "feederkit.toml"
 """The profile read from the working directory when no ``--cell FILE`` is given."""
@@ -132,7 +134,7 @@ class CellProfile:
 # Per section, per key: (what the value must be, its check).
 _POSITIVE = ("a positive number", lambda v: v > 0.0)
 _NONNEGATIVE = ("zero or a positive number", lambda v: v >= 0.0)
-_ROTATION = ("a number in [0, 180)", lambda v: 0.0 <= v < 180.0)
+_ROTATION = ("a number in [0, 90)", lambda v: 0.0 <= v < 90.0)
 _FIELDS: dict[str, dict[str, tuple[str, Any] | None]] = {
     "sensor": {"model": None, "tolerance_mm": _POSITIVE, "pitch_mm": _POSITIVE,
                "noise_mm": _NONNEGATIVE},
@@ -246,10 +248,18 @@ class CellSettings:
 
     def describe(self) -> str:
         """One line naming the profile and the overrides, for every output."""
-        text = f"cell profile: {self.profile.source}"
+        return f"cell profile: {self.describe_source()}"
+
+    def describe_source(self) -> str:
+        """The profile's source and the overrides: ``feederkit.toml (overridden: --tolerance)``."""
+        text = self.profile.source
         if self.overrides:
             text += f" (overridden: {', '.join(self.overrides)})"
         return text
+
+    def costs(self) -> ActionCosts | None:
+        """The profile's action costs, or None when it gives no timing."""
+        return None if self.profile.missing_timing() else action_costs(self.profile)
 
     def to_dict(self) -> dict[str, Any]:
         """``{"profile", "overrides", "sensor", "rotation_error_deg"}`` for JSON output."""
@@ -305,9 +315,11 @@ def resolve_settings(
         sensor = profile.sensor.sensor()
     r = profile.robot.rotation_error_deg
     if rotation_error is not None:
-        if not (math.isfinite(rotation_error) and 0.0 <= rotation_error < 180.0):
-            raise InputError(f"--rotation-error must be in [0, 180) degrees, got {rotation_error}")
-        r = float(rotation_error)
+        # The one validation of a rotation error (finite, in [0, 90) degrees).
+        try:
+            r = Uncertainty(rotation_error_deg=float(rotation_error)).rotation_error_deg
+        except InputError as exc:
+            raise InputError(f"--rotation-error: {exc}") from None
         overrides.append("--rotation-error")
     return CellSettings(profile, sensor, r, tuple(overrides))
 
@@ -349,19 +361,27 @@ def rotation_deg(action_deg: float) -> float:
     return min(a, 360.0 - a)
 
 
-def operation_seconds(action_deg: float | None, profile: CellProfile) -> float:
-    """Seconds of one push-align operation: the first (``action_deg`` None) is the drift
-    from the drop to the fence; a later one adds the pick and place and the rotation."""
+def action_costs(profile: CellProfile) -> ActionCosts:
+    """The seconds of an operation in the cell, as the planners take them
+    (:class:`~feederkit.planning.options.ActionCosts`); InputError naming the timing fields
+    the profile does not give."""
     missing = profile.missing_timing()
     if missing:
         raise InputError(
             f"{profile.source}: a cycle time needs {', '.join(missing)} in the cell profile"
         )
     drift = profile.belt.drop_to_fence_mm / (profile.belt.speed_m_s * 1000.0)  # type: ignore[operator]
-    if action_deg is None:
-        return drift
-    turn = rotation_deg(action_deg) / profile.robot.rotation_speed_deg_s  # type: ignore[operator]
-    return profile.robot.pick_place_s + turn + drift  # type: ignore[operator]
+    return ActionCosts(
+        pick_place_s=profile.robot.pick_place_s,  # type: ignore[arg-type]
+        rotation_speed_deg_s=profile.robot.rotation_speed_deg_s,  # type: ignore[arg-type]
+        drift_s=drift,
+    )
+
+
+def operation_seconds(action_deg: float | None, profile: CellProfile) -> float:
+    """Seconds of one push-align operation: the first (``action_deg`` None) is the drift
+    from the drop to the fence; a later one adds the pick and place and the rotation."""
+    return action_costs(profile).seconds(action_deg)
 
 
 def cycle_time(plan: Any, profile: CellProfile) -> CycleTime:
@@ -369,52 +389,49 @@ def cycle_time(plan: Any, profile: CellProfile) -> CycleTime:
 
     ``plan`` is a planner's result (``machine`` and ``root``) or anything with such a
     ``result`` (a made plan). Expected: start states weighted as the machine says (its
-    ``MachineState.weight``), readings uniform over the sensor's reading set, as the plan's
-    expected length (:mod:`feederkit.planning.stats`); worst: the slowest path of the tree.
+    ``MachineState.weight``: the mix shares), outcomes and readings as for the plan's
+    expected length (:func:`feederkit.planning.stats.expected_seconds`); worst: the slowest
+    path of the tree.
     """
     result = getattr(plan, "result", plan)
+    costs = action_costs(profile)
     machine, root = result.machine, result.root
-    sensor = machine.sensor
-    cost: dict[int, float] = {}
+    mass = sum(s.weight for s in machine.states)
+    return CycleTime(expected_seconds(machine, root, costs) / mass, worst_seconds(root, costs))
 
-    def seconds(node: Any) -> float:
-        key = id(node)
-        if key not in cost:
-            action = None if node.action is None else node.action.representative
-            cost[key] = operation_seconds(action, profile)
-        return cost[key]
 
-    worst_memo: dict[int, float] = {}
+def cycle_time_dict(plan: Any, settings: CellSettings) -> dict[str, Any] | None:
+    """``{"profile", "expected_s", "worst_s", "parts_per_minute", "worst_parts_per_minute"}``
+    for JSON output and reports, or None when the profile has no timing fields."""
+    if settings.profile.missing_timing():
+        return None
+    return {"profile": settings.describe_source(), **cycle_time(plan, settings.profile).to_dict()}
 
-    def worst(node: Any) -> float:
-        if not hasattr(node, "branches"):
-            return 0.0
-        key = id(node)
-        if key not in worst_memo:
-            worst_memo[key] = seconds(node) + max(
-                (worst(sub) for _, sub in node.branches), default=0.0
-            )
-        return worst_memo[key]
 
-    memo: dict[tuple[int, int], float] = {}
+def annotate_cycle_time(made: Any, settings: CellSettings) -> dict[str, Any] | None:
+    """Put :func:`cycle_time_dict` of a made plan in its plan file as ``stats.cycle_time``
+    (before the file is written or stored, so reports and ``changeover show`` find it) and
+    return it; nothing is added when the profile has no timing."""
+    cycle = cycle_time_dict(made, settings)
+    if cycle is not None:
+        made.plan["stats"]["cycle_time"] = cycle
+    return cycle
 
-    def expected(node: Any, state: int) -> float:
-        if not hasattr(node, "branches"):
-            return 0.0
-        key = (id(node), state)
-        if key not in memo:
-            if node.action is not None:
-                state = successor(machine, state, node.action.representative)
-            d = machine.states[state].diameter
-            total = seconds(node)
-            for b, sub in node.branches:
-                if b.mask >> state & 1:
-                    p = sensor.reading_probability(d, b.lo, b.hi)
-                    if p > 0.0:
-                        total += p * expected(sub, state)
-            memo[key] = total
-        return memo[key]
 
-    mean = sum(s.weight for s in machine.states)
-    exp = sum(s.weight * expected(root, i) for i, s in enumerate(machine.states)) / mean
-    return CycleTime(exp, worst(root))
+def cycle_time_text(cycle: dict[str, Any] | None, profile: str | None = None) -> str:
+    """A ``cycle_time_dict`` in words, for terminal output and reports; ``profile`` names
+    the profile when there is no cycle time (``CellSettings.describe``)."""
+    if cycle is None:
+        where = f" ({profile})" if profile else ""
+        return (
+            f"cycle time: not known, the cell profile gives no robot and belt timing{where}; "
+            "see docs/cell.md"
+        )
+    ppm = cycle.get("parts_per_minute")
+    rate = "" if ppm is None else f", {ppm:.1f} parts/min"
+    worst = cycle.get("worst_parts_per_minute")
+    worst_rate = "" if worst is None else f", {worst:.1f} parts/min"
+    return (
+        f"cycle time: {cycle['expected_s']:.2f} s per part expected{rate}; "
+        f"{cycle['worst_s']:.2f} s at worst{worst_rate} (cell profile: {cycle['profile']})"
+    )

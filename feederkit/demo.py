@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from feederkit.catalog import add_outline, import_directory, list_parts, open_catalog
+from feederkit.cell import CellSettings, annotate_cycle_time
 from feederkit.errors import InputError
 from feederkit.jsonio import OutputFile, write_files
 from feederkit.loading import load_parts
@@ -111,6 +112,11 @@ class DemoChangeover:
         """The changeover's name."""
         return self.compiled.name
 
+    @property
+    def cycle_time(self) -> dict[str, Any] | None:
+        """The plan's cycle time in the demo's cell profile (None: the profile has no timing)."""
+        return self.compiled.plan["stats"].get("cycle_time")
+
     def to_dict(self) -> dict[str, Any]:
         """The ``changeovers`` entry of ``feederkit demo --json``."""
         stats = self.compiled.plan["stats"]
@@ -120,6 +126,7 @@ class DemoChangeover:
             "sensor": self.compiled.plan["sensor"],
             "length": stats["length"],
             "expected_length": stats["expected_length"],
+            "cycle_time": self.cycle_time,
             "min_margin_deg": stats.get("min_margin_deg"),
             "lookalike": self.lookalike,
             "unrecognizable_pairs": [w.to_dict() for w in self.compiled.witnesses],
@@ -142,12 +149,14 @@ class DemoResult:
     notes: tuple[str, ...]
     plans: tuple[DemoPlan, ...]
     changeovers: tuple[DemoChangeover, ...] = ()
+    cell: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """``feederkit demo --json``."""
         return {
             "catalog_dir": str(self.source_dir),
             "output": str(self.output),
+            "cell_profile": self.cell,
             "not_orientable": list(self.not_orientable),
             "parts": [r.to_dict() for r in self.rows],
             "plans": [p.to_dict() for p in self.plans],
@@ -254,13 +263,17 @@ def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> tuple[str, list[str
 
 
 def _report(compiled: CompiledChangeover) -> str:
-    """The changeover's HTML report (the report library's), naming the pairs no plan tells apart."""
+    """The changeover's HTML report (the report library's), naming the pairs no plan tells
+    apart, with the mix's sensor design (:func:`feederkit.design.report_design`)."""
+    from feederkit.design import report_design
     from feederkit.reports import render_report
 
+    rotation = (compiled.plan.get("uncertainty") or {}).get("rotation_error_deg", 0.0)
     return render_report(
         compiled.plan,
         unrecognizable=[w.to_dict() for w in compiled.witnesses],
         outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
+        design=report_design(compiled.parts, rotation),
     )
 
 
@@ -272,14 +285,17 @@ def compile_demo_changeover(
     percent: float,
     lookalike: bool,
     report: bool = True,
+    cell: CellSettings | None = None,
 ) -> DemoChangeover:
     """Compile one changeover with the demo sensor; its plan file and (when ``report``) its
-    report are written with it."""
+    report are written with it, with the cycle time when the ``cell`` profile has timing."""
     loaded = load_parts(members, catalog=catalog)
     sensor = demo_sensor(list(loaded.push_functions), percent)
     plan_path, report_path = folder / f"{name}.json", folder / f"{name}.html"
 
     def outputs(c: CompiledChangeover) -> list[OutputFile]:
+        if cell is not None:
+            annotate_cycle_time(c.made, cell)  # before the plan is written and stored
         files = [OutputFile(plan_path, plan_json(c.plan), "plan file")]
         if report:
             files.append(OutputFile(report_path, _report(c), "report"))
@@ -298,12 +314,15 @@ def run_demo(
     progress: Progress = _quiet,
     *,
     reports: bool = True,
+    cell: CellSettings | None = None,
 ) -> DemoResult:
     """Run the demo on the part files in ``source_dir``, writing into ``output``.
 
     ``percent``: the diameter sensor's tolerance in percent of the largest part's size, in
     (0, 50); ``reports``: write each changeover's HTML report (its part plots are most of the
-    demo's time). Raises InputError for a missing folder, a bad percentage, or bad part files.
+    demo's time); ``cell``: the cell profile whose timing gives each changeover's cycle time
+    (the demo keeps its own sensor). Raises InputError for a missing folder, a bad
+    percentage, or bad part files.
     """
     src, out = Path(source_dir), Path(output)
     if not src.is_dir():
@@ -342,7 +361,7 @@ def run_demo(
             progress(f"compiling changeover {name}", k, len(mixes))
             changeovers.append(
                 compile_demo_changeover(
-                    catalog, name, members, out / "changeovers", percent, lookalike, reports
+                    catalog, name, members, out / "changeovers", percent, lookalike, reports, cell
                 )
             )
     return DemoResult(
@@ -355,4 +374,5 @@ def run_demo(
         notes=(*loaded.warnings, *notes),
         plans=tuple(plans),
         changeovers=tuple(changeovers),
+        cell=None if cell is None else cell.describe(),
     )

@@ -220,3 +220,17 @@ def test_no_time_means_no_parts_per_minute():
     assert CycleTime(0.0, 0.0).parts_per_minute is None
     assert CycleTime(0.0, 0.0).to_dict()["worst_parts_per_minute"] is None
     assert CycleTime(2.0, 4.0).worst_parts_per_minute == pytest.approx(15.0)
+
+
+def test_cycle_time_follows_outcome_sets_under_uncertainty():
+    # Strong plans: a state's mass follows its outcome set (docs/planning.md); free turns
+    # and one second per operation make the seconds the expected operations again.
+    from feederkit.uncertainty import Uncertainty
+
+    pfs = [
+        push_function(load_part(str(CATALOG / f"{n}.json"))) for n in ("t-clip", "chamfered-plate")
+    ]
+    made = make_plan(pfs, ToleranceSensor(0.5), uncertainty=Uncertainty(1.0, 0.0, 0.0))
+    t = cycle_time(made, timing(0.0, 1e12, 0.1, 100.0))
+    assert t.expected_s == pytest.approx(made.result.expected_length, rel=1e-9)
+    assert t.worst_s == pytest.approx(made.result.length, rel=1e-9)

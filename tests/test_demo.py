@@ -63,7 +63,7 @@ def test_pipeline_shows_a_lookalike_pair_no_plan_can_tell_apart(few: DemoResult)
 def test_the_lookalike_report_is_given_the_pair(tmp_path: Path, monkeypatch) -> None:
     import feederkit.reports
 
-    def fake_report(plan, *, unrecognizable, outlines):
+    def fake_report(plan, *, unrecognizable, outlines, **_other):
         pairs = sorted((u["part_a"], u["part_b"]) for u in unrecognizable)
         return f"<p>{pairs} {sorted(outlines)}</p>"
 
@@ -153,3 +153,39 @@ def test_the_plans_tables_fit_80_columns(few: DemoResult) -> None:
         out.print(table)
     text = out.export_text()
     assert "\u2026" not in text and max(len(line) for line in text.splitlines()) <= 80
+
+
+def test_a_changeover_shows_its_cycle_time_with_a_profile(tmp_path: Path) -> None:
+    from feederkit.catalog import add_outline, open_catalog
+    from feederkit.cell import parse_cell, resolve_settings
+    from feederkit.demo import compile_demo_changeover
+    from feederkit.sources import load_part
+
+    catalog = tmp_path / "demo.db"
+    open_catalog(catalog, create=True).close()
+    for name in ("isosceles-right-triangle", "octagon"):
+        add_outline(catalog, load_part(str(ROOT / "catalog" / f"{name}.json")).outline, name=name)
+    profile = parse_cell(
+        {
+            "robot": {"pick_place_s": 1.0, "rotation_speed_deg_s": 90.0},
+            "belt": {"speed_m_s": 0.1, "drop_to_fence_mm": 100.0},
+        },
+        "cell.toml",
+    )
+    c = compile_demo_changeover(
+        catalog,
+        "fig27",
+        ["isosceles-right-triangle", "octagon"],
+        tmp_path,
+        1.0,
+        False,
+        report=False,
+        cell=resolve_settings(profile),
+    )
+    cycle = c.to_dict()["cycle_time"]
+    assert cycle["profile"] == "cell.toml"
+    # At least the drift of every operation, at most a half turn more per later one.
+    stats = c.compiled.plan["stats"]
+    assert stats["expected_length"] <= cycle["expected_s"]
+    assert cycle["worst_s"] <= 1.0 + (stats["length"] - 1) * 4.0 + 1e-9
+    assert json.loads((tmp_path / "fig27.json").read_text())["stats"]["cycle_time"] == cycle

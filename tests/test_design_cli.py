@@ -106,6 +106,7 @@ def test_a_lookalike_pair_exits_1_naming_lemma_8(capsys, tmp_path):
     [
         (["--pitches", ""], "--pitches is empty"),
         (["--pitches", " , "], "--pitches is empty"),
+        (["--pitches", "0.1,,0.2"], "an empty item"),
         (["--pitches", "0.2,-1"], "positive"),
         (["--pitches", "0.2,wide"], "not a number"),
         (["--pitches", "1:0.5:0.1"], "ends before"),

@@ -620,7 +620,10 @@ def cmd_export(
         print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
         return
     console.print(
-        f"wrote {output} ({rev.name} revision {rev.revision})", highlight=False, markup=False
+        f"wrote {output} ({rev.name} revision {rev.revision})",
+        highlight=False,
+        markup=False,
+        soft_wrap=True,
     )
 
 

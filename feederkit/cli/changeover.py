@@ -9,6 +9,8 @@ Every command that shows a stored changeover warns when a part has a newer revis
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -17,33 +19,37 @@ from rich.markup import escape
 from rich.table import Table
 
 from feederkit.catalog import list_changeovers, remove_changeover, resolve_catalog_path
+from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
+    AcceptOpt,
     CatalogOpt,
+    CellOpt,
     ComToleranceOpt,
     GroupingOpt,
     JsonOpt,
+    LandingsOpt,
     LedPitchOpt,
+    MemoryLimitOpt,
     MinMarginOpt,
     NoiseOpt,
     ObjectiveOpt,
     PlanOutputOpt,
+    ProfileRotationErrorOpt,
     ReportOpt,
-    RotationErrorOpt,
     SensorlessOpt,
     ShapeToleranceOpt,
     TimeLimitOpt,
     ToleranceOpt,
+    cell_planning_options,
+    cell_settings,
     console,
     flag_words,
     plan_outputs,
-    planning_options,
     print_json,
     print_warnings,
     print_written,
-    report_html,
     searching,
-    sensor_option,
     time_limit_note,
     uncertainty_option,
     uncertainty_text,
@@ -51,6 +57,7 @@ from feederkit.cli.common import (
 from feederkit.cli.plan_render import plan_tree, sensor_text, stats_table
 from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import OutputFile, write_files
+from feederkit.landing.plan import landing_names
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import (
     changeover_exists,
@@ -72,13 +79,91 @@ NameArg = Annotated[str, typer.Argument(help="Name of the changeover.")]
 
 
 def parse_mix(text: str) -> list[str]:
-    """``A,B@2,C`` as catalog SOURCEs (``NAME@REV`` is resolved by :mod:`feederkit.sources`)."""
-    members = [m.strip() for m in text.split(",")]
-    if not text.strip() or any(not m for m in members):
+    """``A,B@2,C`` (or with shares, ``A:0.7,B``) as catalog SOURCEs (``NAME@REV`` is resolved
+    by :mod:`feederkit.sources`)."""
+    return parse_mix_shares(text)[0]
+
+
+def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
+    """``--mix A:0.7,B:0.2,C:0.1``: the members and their shares, normalised to sum to 1.
+
+    A member without ``:SHARE`` takes an equal part of what the given shares leave of 1
+    (``A:0.5,B,C``: 0.5, 0.25, 0.25); none given: equal shares (None). Shares must be
+    positive finite numbers; a member may appear once. InputError (one line) otherwise.
+    """
+    items = [m.strip() for m in text.split(",")]
+    if not text.strip() or any(not m for m in items):
         raise InputError(
             f"--mix must be a comma-separated list of catalog part names, got {text!r}"
         )
-    return members
+    names: list[str] = []
+    given: list[float | None] = []
+    for item in items:
+        name, colon, share = item.partition(":")
+        name = name.strip()
+        if not name:
+            raise InputError(f"--mix: {item!r} names no part (write NAME or NAME:SHARE)")
+        if name in names:
+            raise InputError(f"--mix: {name} is listed twice; give each part once")
+        names.append(name)
+        if not colon:
+            given.append(None)
+            continue
+        try:
+            value = float(share)
+        except ValueError:
+            raise InputError(
+                f"--mix: the share of {name} must be a number, got {share.strip()!r}"
+            ) from None
+        if not (math.isfinite(value) and value > 0.0):
+            hint = " (leave a part out of the mix rather than give it no share)"
+            raise InputError(
+                f"--mix: the share of {name} must be a positive number, got "
+                f"{share.strip()!r}{hint if value == 0.0 else ''}"
+            )
+        given.append(value)
+    if all(g is None for g in given):
+        return names, None
+    total = math.fsum(g for g in given if g is not None)
+    missing = given.count(None)
+    if missing:
+        if total >= 1.0:
+            raise InputError(
+                f"--mix: the shares given add up to {total:g}, leaving nothing for "
+                f"{', '.join(n for n, g in zip(names, given, strict=True) if g is None)}; "
+                "give every part a share, or shares below 1 in all"
+            )
+        rest = (1.0 - total) / missing
+        given = [rest if g is None else g for g in given]
+        total = 1.0
+    return names, tuple(float(g) / total for g in given)  # type: ignore[arg-type]
+
+
+def shares_text(revisions: Sequence[tuple[str, int]], plan: dict[str, Any]) -> str:
+    """The mix with each part's share as the plan file stores it (equal when none)."""
+    shares = _shares(plan)
+    return ", ".join(
+        f"{name}@{rev} ({100.0 * shares.get(name, 0.0):.3g} %)" for name, rev in revisions
+    )
+
+
+def changeover_report(
+    plan: dict[str, Any], pfs: Sequence[PushFunction], witnesses: Sequence[PairWitness]
+) -> str:
+    """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
+    for a mix, the sensor design (critical tolerances and the plan length against the
+    tolerance, :func:`feederkit.design.report_design`; docs/reports.md)."""
+    from feederkit.design import report_design
+    from feederkit.reports import render_report
+
+    rotation = (plan.get("uncertainty") or {}).get("rotation_error_deg", 0.0)
+    design = report_design(pfs, rotation)
+    return render_report(
+        plan,
+        unrecognizable=[w.to_dict() for w in witnesses],
+        outlines={pf.part.name: pf.part.outline for pf in pfs},
+        design=design,
+    )
 
 
 def _pairs_table(witnesses: list[PairWitness], pfs: list[PushFunction]) -> Table:
@@ -102,7 +187,11 @@ def compile_command(
     name: NameArg,
     mix: Annotated[
         str,
-        typer.Option("--mix", help="Catalog parts, comma-separated: A,B,C (NAME@REV pins one)."),
+        typer.Option(
+            "--mix",
+            help="Catalog parts, comma-separated: A,B,C (NAME@REV pins one); A:0.7,B:0.2,C:0.1 "
+            "gives their shares of the production (default equal; normalised).",
+        ),
     ],
     sensorless: SensorlessOpt = False,
     tolerance: ToleranceOpt = None,
@@ -111,6 +200,7 @@ def compile_command(
     objective: ObjectiveOpt = "worst",
     min_margin: MinMarginOpt = 0.0,
     time_limit: TimeLimitOpt = DEFAULT_TIME_LIMIT_S,
+    memory_limit: MemoryLimitOpt = None,
     grouping: GroupingOpt = "exact",
     output: PlanOutputOpt = None,
     report: ReportOpt = None,
@@ -119,26 +209,48 @@ def compile_command(
     ] = False,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
-    rotation_error: RotationErrorOpt = 1.0,
+    cell: CellOpt = None,
+    rotation_error: ProfileRotationErrorOpt = None,
     shape_tolerance: ShapeToleranceOpt = 0.0,
     com_tolerance: ComToleranceOpt = 0.0,
+    landings: LandingsOpt = None,
+    accept: AcceptOpt = None,
 ) -> None:
     """Plan one verified sequence of push-align operations that orients (and, where possible,
     recognizes) every part of the mix, and store it against the parts' exact revisions.
 
+    ``--landings``/``--accept`` plan every part over its stored landings, the landings not
+    accepted ending in reject results (docs/landings.md).
+
+    The cell profile (``--cell`` or ./feederkit.toml) gives the sensor, the rotation error
+    and the timing; options override it. With timing, the output gives the cycle time.
     Exit 1 when some parts cannot be told apart (the plan is still written and stored).
     """
-    sensor = sensor_option(sensorless, tolerance, led_pitch, noise)
-    options = planning_options(objective, grouping, min_margin, time_limit)
-    uncertainty = uncertainty_option(rotation_error, shape_tolerance, com_tolerance)
+    members, shares = parse_mix_shares(mix)
+    settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
+    sensor = settings.sensor
+    options = cell_planning_options(
+        settings, objective, grouping, min_margin, time_limit, memory_limit
+    )
+    uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
     path = resolve_catalog_path(catalog)
-    members = parse_mix(mix)
     if not replace and changeover_exists(path, name):
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
 
     def outputs(c) -> list[OutputFile]:
-        return plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, report)
+        # Runs before the changeover is stored: its plan file carries the cycle time.
+        annotate_cycle_time(c.made, settings)
+        files = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
+        if report is not None:
+            html = changeover_report(c.plan, list(c.parts), list(c.witnesses))
+            files.append(OutputFile(report, html, "report"))
+        return files
 
+    over: dict[str, Any] = {}
+    if landings is not None:
+        over["landings"] = "all" if landings == "all" else landing_names(landings)
+    if accept is not None:
+        over["accept"] = landing_names(accept, "--accept")
     with searching(f"compiling changeover {name}", options.time_limit_s), flag_words():
         compiled = compile_changeover(
             path,
@@ -149,8 +261,11 @@ def compile_command(
             replace=replace,
             outputs=outputs,
             uncertainty=uncertainty,
+            shares=shares,
+            **over,
         )
     plan, witnesses, pfs = compiled.plan, list(compiled.witnesses), list(compiled.parts)
+    cycle = plan["stats"].get("cycle_time")
     warnings = list(compiled.warnings)
     note = time_limit_note(plan["stats"], options.time_limit_s)
     if note is not None:
@@ -160,22 +275,29 @@ def compile_command(
         print_json(
             {
                 "name": name,
-                "parts": [{"name": n, "revision": r} for n, r in compiled.revisions],
+                "parts": [
+                    {"name": n, "revision": r, "share": _shares(plan).get(n)}
+                    for n, r in compiled.revisions
+                ],
+                "cell": settings.to_dict(),
+                "cycle_time": cycle,
                 "unrecognizable_pairs": [w.to_dict() for w in witnesses],
                 "warnings": warnings,
                 "plan": plan,
             }
         )
     else:
-        mix_text = ", ".join(f"{n}@{r}" for n, r in compiled.revisions)
         console.print(
-            f"[bold]changeover {escape(name)}[/]: {escape(mix_text)}\n"
+            f"[bold]changeover {escape(name)}[/]: "
+            f"{escape(shares_text(compiled.revisions, plan))}\n"
+            f"{escape(settings.describe())}\n"
             f"sensor: {sensor_text(sensor.to_dict())}\n"
             f"uncertainty: {uncertainty_text(plan.get('uncertainty'))}",
             highlight=False,
         )
         console.print(plan_tree(plan))
         console.print(stats_table(plan, compiled.made.report))
+        console.print(escape(cycle_time_text(cycle, settings.describe())), highlight=False)
         if witnesses:
             console.print(_pairs_table(witnesses, pfs))
         console.print(f"stored changeover {name!r} in {path}", highlight=False, markup=False)
@@ -189,6 +311,19 @@ def compile_command(
             f"changeover {name!r} orients every part but cannot tell these apart: {named}; "
             "the plan's results list each candidate with its pose"
         )
+
+
+def _shares(plan: dict[str, Any]) -> dict[str, float]:
+    """Each part's share (the plan file's, its landings' summed; else equal)."""
+    parts = plan.get("parts", [])
+    names = list(dict.fromkeys(p.get("name") for p in parts))
+    out: dict[str, float] = {}
+    for p in parts:
+        share = p.get("share")
+        if share is None:
+            return {n: 1.0 / len(names) for n in names}
+        out[p.get("name")] = out.get(p.get("name"), 0.0) + float(share)
+    return out
 
 
 @changeover_app.command("list")
@@ -224,18 +359,27 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     if json_out:
-        print_json({**_info_dict(co.info), "warnings": list(co.warnings), "plan": co.plan})
+        print_json(
+            {
+                **_info_dict(co.info, co.plan),
+                "cycle_time": co.plan["stats"].get("cycle_time"),
+                "warnings": list(co.warnings),
+                "plan": co.plan,
+            }
+        )
         return
     info = co.info
     console.print(
         f"[bold]changeover {escape(info.name)}[/]: "
-        f"{escape(', '.join(f'{n}@{r}' for n, r in info.parts))}\n"
+        f"{escape(shares_text(info.parts, co.plan))}\n"
         f"sensor: {sensor_text(dict(info.sensor))}\ncreated {info.created_at} by "
         f"{escape(info.created_by)}",
         highlight=False,
     )
     console.print(plan_tree(co.plan))
     console.print(stats_table(co.plan))
+    cycle = co.plan["stats"].get("cycle_time")
+    console.print(escape(cycle_time_text(cycle, "as compiled")), highlight=False)
 
 
 @changeover_app.command("remove")
@@ -255,7 +399,7 @@ def export_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None)
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     write_files([OutputFile(output, plan_json(co.plan), "plan file")])
-    console.print(f"wrote the plan to {output}", highlight=False, markup=False)
+    console.print(f"wrote the plan to {output}", highlight=False, markup=False, soft_wrap=True)
 
 
 @changeover_app.command("report")
@@ -263,17 +407,22 @@ def report_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None)
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    html = report_html(co.plan, co.parts, co.witnesses())
+    html = changeover_report(co.plan, list(co.parts), co.witnesses())
     write_files([OutputFile(output, html, "report")])
-    console.print(f"wrote the report to {output}", highlight=False, markup=False)
+    console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)
 
 
-def _info_dict(info) -> dict[str, Any]:
+def _info_dict(info, plan: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A changeover's record; with its plan, each part's share."""
+    shares = {} if plan is None else _shares(plan)
+    parts = [{"name": n, "revision": r} for n, r in info.parts]
+    if plan is not None:
+        parts = [{**p, "share": shares.get(p["name"])} for p in parts]
     return {
         "name": info.name,
         "created_at": info.created_at,
         "created_by": info.created_by,
-        "parts": [{"name": n, "revision": r} for n, r in info.parts],
+        "parts": parts,
         "sensor": dict(info.sensor),
     }
 

@@ -9,6 +9,7 @@ flag that sets them (``--min-margin``). Warnings print as one ``warning:`` line 
 from __future__ import annotations
 
 import json
+import os
 import sys
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
@@ -28,6 +29,7 @@ from rich.progress import (
 )
 
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
+from feederkit.cell import CellSettings, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
 from feederkit.jsonio import OutputFile
 from feederkit.mechanics.push import PushFunction
@@ -62,9 +64,11 @@ ObjectiveOpt = Annotated[
     str,
     typer.Option(
         "--objective",
-        metavar="worst|expected",
-        help="worst: fewest operations in the worst case; "
-        "expected: fewest on average (uniform start).",
+        metavar="worst|expected|time|worst-time",
+        help="worst: fewest operations in the worst case; expected: fewest on average "
+        "(weighted by the mix shares); time: fewest seconds per part on average; worst-time: "
+        "fewest seconds on the slowest path among the shortest plans (the last two need the "
+        "cell profile's timing).",
     ),
 ]
 MinMarginOpt = Annotated[
@@ -79,6 +83,15 @@ TimeLimitOpt = Annotated[
         "--time-limit",
         metavar="S",
         help="Seconds; then the best plan found (optimal: false) and a proven lower bound.",
+    ),
+]
+MemoryLimitOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--memory-limit",
+        metavar="MB",
+        help="Stop searching when the process holds this many megabytes; then the best plan "
+        "found (optimal: false) and a proven lower bound (default: half the machine's memory).",
     ),
 ]
 GroupingOpt = Annotated[
@@ -108,6 +121,30 @@ ReportOpt = Annotated[
     typer.Option("--report", metavar="REPORT.html", help="Also write the HTML report here."),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
+LandingsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--landings",
+        metavar="all|up|K,...",
+        help="The landings to plan for: all (the default), or a list of up, down, pose-K or K.",
+    ),
+]
+AcceptOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--accept",
+        metavar="LANDING,...",
+        help="The landings the next station takes (default: all); the others end in reject "
+        "results.",
+    ),
+]
+LANDING_TERMS = (
+    ("has no landing", "--landings"),
+    ("every member is rejected", "--accept"),
+    ("rejected, but no plan", "--accept"),
+)
+"""The library's words for what ``--landings`` and ``--accept`` set (the commands that plan
+over landings add them to :data:`FLAG_TERMS`)."""
 RotationErrorOpt = Annotated[
     float,
     typer.Option(
@@ -141,6 +178,7 @@ long enough for every sample part, short enough to keep a mistyped mix from hang
 FLAG_TERMS = (
     ("minimum margin", "--min-margin"),
     ("time limit", "--time-limit"),
+    ("memory limit", "--memory-limit"),
     ("objective", "--objective"),
     ("reading grouping", "--grouping"),
     ("sensor tolerance", "--tolerance"),
@@ -177,19 +215,6 @@ def flag_words(terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> Iterator[None]:
         err = type(exc)(text)
         err.exit_code = exc.exit_code
         raise err from None
-
-
-def planning_options(
-    objective: str, grouping: str, min_margin: float, time_limit: float | None
-) -> PlanningOptions:
-    """The one :class:`PlanningOptions` of a command; the library validates, errors name flags."""
-    with flag_words():
-        return PlanningOptions(
-            objective=objective,
-            min_margin_deg=min_margin,
-            grouping=grouping,
-            time_limit_s=time_limit,
-        )
 
 
 def uncertainty_option(
@@ -288,7 +313,9 @@ def print_written(output: Path | None, report: Path | None) -> None:
     """Say which files were written."""
     for path, what in ((output, "plan"), (report, "report")):
         if path is not None:
-            console.print(f"wrote the {what} to {path}", highlight=False, markup=False)
+            console.print(
+                f"wrote the {what} to {path}", highlight=False, markup=False, soft_wrap=True
+            )
 
 
 def print_json(data: Any) -> None:
@@ -319,3 +346,83 @@ def progress_bar(*extra: Any, disable: bool = False) -> Progress:
         transient=True,
         disable=disable,
     )
+
+
+CellOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--cell",
+        metavar="FILE",
+        help="The cell profile (default ./feederkit.toml if present, else built-in defaults; "
+        "docs/cell.md).",
+    ),
+]
+ProfileRotationErrorOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--rotation-error",
+        metavar="DEG",
+        help="The robot's rotation is off by up to ±DEG (default: the cell profile's, else 1; "
+        "0: the ideal model).",
+    ),
+]
+
+
+def cell_settings(
+    cell: Path | None,
+    sensorless: bool,
+    tolerance: float | None,
+    led_pitch: float | None,
+    noise: float | None,
+    rotation_error: float | None,
+) -> CellSettings:
+    """The cell profile (``--cell`` or ./feederkit.toml) with the command line's options on
+    top (:func:`feederkit.cell.resolve_settings`); errors name the flags."""
+    with flag_words():
+        return resolve_settings(
+            load_cell(cell),
+            sensorless=sensorless,
+            tolerance=tolerance,
+            led_pitch=led_pitch,
+            noise=noise,
+            rotation_error=rotation_error,
+        )
+
+
+def cell_planning_options(
+    settings: CellSettings,
+    objective: str,
+    grouping: str,
+    min_margin: float,
+    time_limit: float | None,
+    memory_limit: float | None = None,
+) -> PlanningOptions:
+    """The command's :class:`PlanningOptions` with the cell's action costs (when the profile
+    gives its timing); ``--objective time|worst-time`` without them is one line naming the
+    missing profile fields."""
+    costs = settings.costs()
+    if costs is None and objective in ("time", "worst-time"):
+        missing = ", ".join(settings.profile.missing_timing())
+        raise InputError(
+            f"--objective {objective} needs the cell's timing: {missing} "
+            f"({settings.describe()}; docs/cell.md)"
+        )
+    with flag_words():
+        return PlanningOptions(
+            objective=objective,
+            min_margin_deg=min_margin,
+            grouping=grouping,
+            time_limit_s=time_limit,
+            memory_limit_mb=default_memory_limit() if memory_limit is None else memory_limit,
+            costs=costs,
+        )
+
+
+def default_memory_limit() -> float | None:
+    """Half the machine's physical memory in MB (None where the system does not say): the
+    planners stop there and answer as at the time limit, before the machine swaps."""
+    try:
+        total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+    return total / 2e6 if total > 0 else None

@@ -18,6 +18,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from feederkit.cell import cycle_time_text, load_cell, resolve_settings
+from feederkit.cli.changeover import CellOpt
 from feederkit.cli.common import (
     console,
     err_console,
@@ -128,6 +130,8 @@ def print_changeover(say: Console, c: DemoChangeover) -> None:
     say.print(stats_table(compiled.plan, compiled.made.report))
     declared = uncertainty_text(compiled.plan.get("uncertainty"))
     say.print(f"  uncertainty: {escape(declared)}", highlight=False)
+    if c.cycle_time is not None:
+        say.print(f"  {escape(cycle_time_text(c.cycle_time))}", highlight=False)
     for warning in compiled.warnings:
         say.print(f"  warning: {escape(warning)}", highlight=False)
     for w in compiled.witnesses:
@@ -154,6 +158,8 @@ def print_result(say: Console, result: DemoResult) -> None:
     if result.not_orientable:
         head += f"; not orientable by pushing: {escape(', '.join(result.not_orientable))}"
     say.print(head, highlight=False)
+    if result.cell is not None:
+        say.print(escape(result.cell), highlight=False)
     say.print(analysis_table(result.rows, result.percent))
     for note in result.notes:
         say.print(f"  note: {escape(note)}", highlight=False)
@@ -189,16 +195,22 @@ def demo_command(
         ),
     ] = 1.0,
     json_out: Annotated[bool, typer.Option("--json", help="A summary on stdout as JSON.")] = False,
+    cell: CellOpt = None,
 ) -> None:
-    """The main job on the bundled catalog: import, analyse, plan, compile changeovers, report."""
+    """The main job on the bundled catalog: import, analyse, plan, compile changeovers, report.
+
+    With a cell profile (``--cell`` or ./feederkit.toml) that gives the robot's and belt's
+    timing, every changeover also shows its cycle time (docs/cell.md).
+    """
     source_dir = catalog_dir if catalog_dir is not None else default_catalog_dir()
+    settings = resolve_settings(load_cell(cell))
     with progress_bar() as bar, flag_words(DEMO_FLAGS):
         task = bar.add_task("demo", total=None)
 
         def progress(what: str, done: int, total: int | None) -> None:
             bar.update(task, description=what, completed=done, total=total)
 
-        result = run_demo(source_dir, output, percent, progress)
+        result = run_demo(source_dir, output, percent, progress, cell=settings)
     if json_out:
         print_result(err_console, result)
         print_json(result.to_dict())

@@ -156,8 +156,8 @@ def sensor_command(
             markup=False,
         )
         if plot is not None:
-            console.print(f"wrote {plot}", highlight=False, markup=False)
-        console.print(design.answer(), highlight=False, markup=False)
+            console.print(f"wrote {plot}", highlight=False, markup=False, soft_wrap=True)
+        console.print(design.answer(), highlight=False, markup=False, soft_wrap=True)
     if not design.recognizable:
         fail(design.answer(), code=1)
 

@@ -156,7 +156,7 @@ def lookalike_command(
         return
     write_text_atomic(output, text)
     console.print(table)
-    console.print(f"wrote {output}", highlight=False, markup=False)
+    console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)
 
 
 def _yes(flag: bool) -> str:

@@ -97,4 +97,4 @@ def plot_command(
     print_import_warnings(source, loaded.warnings)
     part = loaded.part
     write_part_plot(part, output)
-    console.print(f"wrote {output}", highlight=False, markup=False)
+    console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)

@@ -1,9 +1,12 @@
 """``feederkit plan SOURCE...``: a verified orienting plan for one part or a product mix.
 
-A thin layer: build the sensor and the planning options once, load and check the parts
-(:func:`feederkit.loading.load_parts`), call :func:`feederkit.mix.changeover.plan_mix`
-(planner, plan file, verification), write the plan and the report together (both or
-neither), print the tree and the warnings (a margin below 1 degree, a time limit reached).
+A thin layer: build the sensor and the planning options once, load and check the parts and
+their landings (:func:`feederkit.landing.plan.load_landings`), call
+:func:`feederkit.mix.changeover.plan_mix` (planner, plan file, verification) or, when some
+part has several landings or ``--landings``/``--accept`` is given,
+:func:`feederkit.landing.plan.plan_landings` (every landing one member of the mix,
+docs/landings.md), write the plan and the report together (both or neither), print the tree
+and the warnings (a margin below 1 degree, a time limit reached).
 """
 
 from __future__ import annotations
@@ -13,42 +16,51 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
+from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
+    FLAG_TERMS,
+    LANDING_TERMS,
+    AcceptOpt,
     CatalogOpt,
+    CellOpt,
     ComToleranceOpt,
     GroupingOpt,
+    LandingsOpt,
     LedPitchOpt,
+    MemoryLimitOpt,
     MinMarginOpt,
     NoiseOpt,
     ObjectiveOpt,
     PlanOutputOpt,
+    ProfileRotationErrorOpt,
     ReportOpt,
-    RotationErrorOpt,
     SensorlessOpt,
     ShapeToleranceOpt,
     TimeLimitOpt,
     ToleranceOpt,
+    cell_planning_options,
+    cell_settings,
     console,
     flag_words,
     plan_outputs,
-    planning_options,
     print_json,
     print_warnings,
     print_written,
     searching,
-    sensor_option,
     time_limit_note,
     uncertainty_option,
     uncertainty_text,
 )
 from feederkit.cli.plan_render import plan_tree, sensor_text, stats_table
-from feederkit.errors import CheckFailed
+from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import write_files
-from feederkit.loading import load_parts
+from feederkit.landing.plan import LandingPlan, landing_names, load_landings, plan_landings
+from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import plan_mix
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.match import leaf_part_pairs
+from feederkit.plans.model import member_label
 
 
 def pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -> str:
@@ -69,17 +81,83 @@ def pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -
     return msg
 
 
-def _header(plan: dict[str, Any], sensor_given: bool) -> str:
-    names = escape(", ".join(p["name"] for p in plan["parts"]))
+def landing_lumps(planned: LandingPlan) -> set[tuple[str, str]]:
+    """Pairs of landings (in words, in plan order) that an accepting result lists together;
+    a reject result may list several rejected landings."""
+    order = [member_label(x.part_name, x.name) for x in planned.landings]
+    lumped: set[tuple[str, str]] = set()
+    for leaf in planned.leaves():
+        if leaf.reject:
+            continue
+        names = sorted({member_label(r.part, r.landing) for r in leaf}, key=order.index)
+        lumped |= {(a, b) for k, a in enumerate(names) for b in names[k + 1 :]}
+    return lumped
+
+
+def landing_pairs_message(planned: LandingPlan, lumped: set[tuple[str, str]]) -> str:
+    """One line naming the landings no plan can tell apart (section 8.4), and any
+    disagreement with the plan's accepting results (``lumped``, :func:`landing_lumps`)."""
+    pairs = {
+        (member_label(p.a.part_name, p.a.name), member_label(p.b.part_name, p.b.name))
+        for p in planned.indistinguishable
+    }
+    if not pairs:
+        shown = ", ".join(f"{a} & {b}" for a, b in sorted(lumped))
+        return (
+            f"the plan's results lump {shown}, which the mix analysis can tell apart: "
+            "please report this as a bug"
+        )
+    named = "; ".join(
+        f"{member_label(p.a.part_name, p.a.name)} & {member_label(p.b.part_name, p.b.name)} "
+        f"({p.witness.reason})"
+        for p in planned.indistinguishable
+    )
+    msg = (
+        f"the plan orients every landing but cannot tell these landings apart: {named}; "
+        "its results list each candidate with its pose"
+    )
+    if pairs != lumped:
+        shown = ", ".join(f"{a} & {b}" for a, b in sorted(lumped)) or "none"
+        msg += f" (but the plan's results lump {shown}: please report this as a bug)"
+    return msg
+
+
+def _landings_text(planned: LandingPlan) -> str:
+    """The landings planned, each with its share and whether the next station takes it."""
+    plan_parts = planned.made.plan["parts"]
+    rows = []
+    for x, part in zip(planned.landings, plan_parts, strict=True):
+        share = part.get("share")
+        take = "rejected" if x.label in planned.rejected else "accepted"
+        shown = "" if share is None else f" {share:.3g}"
+        rows.append(f"{member_label(x.part_name, x.name)}{shown} {take}")
+    return "landings (share): " + ", ".join(rows)
+
+
+def _header(plan: dict[str, Any], sensor_given: bool, landings: str | None = None) -> str:
+    names = escape(", ".join(dict.fromkeys(p["name"] for p in plan["parts"])))
     sensor = sensor_text(plan["sensor"])
     if not sensor_given:
         sensor = "none — no sensor option given, so the plan is sensorless"
     stats = plan["stats"]
+    lines = "" if landings is None else f"{escape(landings)}\n"
     return (
-        f"[bold]feederkit plan[/] for {names}\n"
+        f"[bold]feederkit plan[/] for {names}\n{lines}"
         f"sensor: {sensor}\nuncertainty: {uncertainty_text(plan.get('uncertainty'))}\n"
         f"objective: {stats['objective']}, reading branching: {stats['grouping']}"
     )
+
+
+def _accepted_names(text: str | None, planned_names: set[str]) -> tuple[str, ...] | None:
+    """The ``--accept`` list, each name a landing (or a merged name) of a part planned."""
+    if text is None:
+        return None
+    names = landing_names(text, "--accept")
+    for n in names:
+        if n not in planned_names:
+            known = ", ".join(sorted(planned_names))
+            raise InputError(f"--accept: no landing {n} is planned (the landings: {known})")
+    return names
 
 
 def plan_command(
@@ -96,6 +174,7 @@ def plan_command(
     objective: ObjectiveOpt = "worst",
     min_margin: MinMarginOpt = 0.0,
     time_limit: TimeLimitOpt = DEFAULT_TIME_LIMIT_S,
+    memory_limit: MemoryLimitOpt = None,
     grouping: GroupingOpt = "exact",
     output: PlanOutputOpt = None,
     json_out: Annotated[
@@ -103,26 +182,50 @@ def plan_command(
     ] = False,
     report: ReportOpt = None,
     catalog: CatalogOpt = None,
-    rotation_error: RotationErrorOpt = 1.0,
+    rotation_error: ProfileRotationErrorOpt = None,
     shape_tolerance: ShapeToleranceOpt = 0.0,
     com_tolerance: ComToleranceOpt = 0.0,
+    landings: LandingsOpt = None,
+    accept: AcceptOpt = None,
+    cell: CellOpt = None,
 ) -> None:
     """Plan the shortest conditional sequence of push-align operations that orients the part(s).
 
-    The plan is verified on the kinematic model (every start, reading and branch) before it
-    is written or printed; under the declared uncertainty (``--rotation-error``, default 1
-    degree) it is a strong plan, verified for every outcome. Exit 1 when some parts of a mix
-    cannot be told apart (the plan is still written).
+    Every landing of every part is planned for (a flat part face up and face down, a mesh in
+    each resting pose; ``--landings`` picks them) and the results name part, landing and
+    state; landings not in ``--accept`` end in reject results. The plan is verified on the
+    kinematic model (every start, reading and branch) before it is written or printed; under
+    the declared uncertainty (``--rotation-error``, default 1 degree) it is a strong plan,
+    verified for every outcome. Exit 1 when some parts of a mix, or some landings, cannot be
+    told apart (the plan is still written) or an accepted and a rejected landing cannot be.
     """
-    sensor = sensor_option(sensorless, tolerance, led_pitch, noise)
-    options = planning_options(objective, grouping, min_margin, time_limit)
-    uncertainty = uncertainty_option(rotation_error, shape_tolerance, com_tolerance)
-    loaded = load_parts(sources, catalog=catalog)
+    terms = (*FLAG_TERMS, *LANDING_TERMS)
+    settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
+    sensor = settings.sensor
+    options = cell_planning_options(
+        settings, objective, grouping, min_margin, time_limit, memory_limit
+    )
+    uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    with flag_words(terms):
+        which = "all" if landings in (None, "all") else landing_names(landings)
+        found = load_landings(sources, catalog=catalog, which=which)
+    loaded = found.parts
     print_warnings(loaded.warnings)
-    pfs = list(loaded.push_functions)
-    with searching("planning and verifying", options.time_limit_s), flag_words():
-        made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
+    planned: LandingPlan | None = None
+    if landings is None and accept is None and not found.several:
+        pfs = list(loaded.push_functions)
+        with searching("planning and verifying", options.time_limit_s), flag_words():
+            made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
+    else:
+        every = found.all
+        names = {x.name for x in every} | {m for x in every for m in x.merged}
+        taken = _accepted_names(accept, names)
+        pfs = [push_function(x.part) for x in every]
+        with searching("planning and verifying", options.time_limit_s), flag_words(terms):
+            planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
+        made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]
     plan = made.plan
+    cycle = annotate_cycle_time(made, settings)  # stats.cycle_time, before anything is written
     write_files(plan_outputs(plan, pfs, witnesses, output, report))
     notes = [*made.warnings]
     note = time_limit_note(plan["stats"], options.time_limit_s)
@@ -132,11 +235,19 @@ def plan_command(
     if json_out:
         print_json(plan)
     else:
-        sensor_given = sensorless or tolerance is not None or led_pitch is not None
-        console.print(_header(plan, sensor_given), highlight=False)
+        sensor_given = sensorless or sensor.informative
+        words = None if planned is None else _landings_text(planned)
+        console.print(escape(settings.describe()), highlight=False)
+        console.print(_header(plan, sensor_given, words), highlight=False)
         console.print(plan_tree(plan))
         console.print(stats_table(plan, made.report))
+        console.print(escape(cycle_time_text(cycle, settings.describe())), highlight=False)
         print_written(output, report)
+    if planned is not None:
+        lumps = landing_lumps(planned)
+        if planned.indistinguishable or lumps:
+            raise CheckFailed(landing_pairs_message(planned, lumps))
+        return
     lumped = leaf_part_pairs(plan)
     if witnesses or lumped:
         raise CheckFailed(pairs_message(witnesses, lumped))

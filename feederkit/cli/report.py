@@ -15,6 +15,7 @@ import typer
 from feederkit.cli.common import console, progress_bar
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import InputError
+from feederkit.jsonio import read_json
 from feederkit.plans.model import Plan
 from feederkit.reports import check_report_path, render_report, write_report
 
@@ -33,12 +34,32 @@ def _simulate(plan: Plan, trials: int, seed: int) -> dict[str, Any]:
         return simulate_plan(plan, trials, seed, progress=progress).to_dict()
 
 
+def _cycle_time(path: Path) -> dict[str, Any] | None:
+    """The plan file's ``stats.cycle_time`` (docs/cell.md), read from its JSON: the plan
+    model keeps only the statistics it checks. None when the file has none."""
+    try:
+        raw = read_json(path, "plan file", max_depth=DEEP_JSON)
+    except (InputError, RecursionError):
+        return None  # the plan itself was read and checked; only the figure is missing
+    stats = raw.get("stats") if isinstance(raw, dict) else None
+    cycle = stats.get("cycle_time") if isinstance(stats, dict) else None
+    return cycle if isinstance(cycle, dict) else None
+
+
+DEEP_JSON = 10_000
+"""How deep a plan file's JSON may nest when only its statistics are looked up."""
+
+
 def report_command(
     plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The HTML file to write.")],
     seconds_per_op: Annotated[
         float | None,
-        typer.Option("--seconds-per-op", help="Seconds per push-align operation: adds cycle time."),
+        typer.Option(
+            "--seconds-per-op",
+            help="Seconds per push-align operation: a flat cycle time instead of the plan's "
+            "own (made with a cell profile, docs/cell.md).",
+        ),
     ] = None,
     simulate: Annotated[
         int | None,
@@ -57,7 +78,12 @@ def report_command(
     if simulate is not None and simulate < 1:
         raise InputError(f"--simulate must be a positive number of trials, got {simulate}")
     simulation = None if simulate is None else _simulate(data, simulate, seed)
-    html = render_report(data, seconds_per_op=seconds_per_op, simulation=simulation)
+    html = render_report(
+        data,
+        seconds_per_op=seconds_per_op,
+        simulation=simulation,
+        cycle_time=None if seconds_per_op is not None else _cycle_time(plan),
+    )
     write_report(output, html)
     if simulation is not None:
         console.print(
@@ -65,7 +91,7 @@ def report_command(
             highlight=False,
             markup=False,
         )
-    console.print(f"wrote {output}", highlight=False, markup=False)
+    console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)
 
 
 def register(app: typer.Typer) -> None:

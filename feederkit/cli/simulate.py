@@ -58,7 +58,11 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     if len(s.parts) > 1:
         for name, t, k in zip(s.parts, s.part_trials, s.part_successes, strict=True):
             table.add_row(f"  {escape(name)}", f"{k} of {t}")
+    if s.rejects:
+        table.add_row("  of them rejected", f"{s.rejects} (a reject leaf naming the landing)")
     table.add_row("failures", str(len(s.failures)))
+    if s.wrong_accepts:
+        table.add_row("  wrong accepts", f"{s.wrong_accepts} (accepted, landing or state wrong)")
     table.add_row("never settled", str(len(s.unsettled)))
     table.add_row("model errors (not predicted)", str(s.model_errors))
     for cause, n in s.by_cause().items():

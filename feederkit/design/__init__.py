@@ -21,6 +21,7 @@ from feederkit.design.sensor import (
     ToleranceDesign,
     design_pitches,
     design_tolerance,
+    report_design,
 )
 from feederkit.design.steps import LengthStep, length_steps, mix_breakpoints
 
@@ -40,4 +41,5 @@ __all__ = [
     "pair_critical_tolerance",
     "parse_pitches",
     "pitch_rows",
+    "report_design",
 ]

@@ -71,11 +71,14 @@ def pitch_rows(
 def parse_pitches(text: str) -> tuple[float, ...]:
     """``--pitches``: a list ``0.1,0.2,0.5`` or a range ``START:STOP:STEP`` (STOP included).
 
-    InputError for an empty list, a value that is not a positive number, or a bad range.
+    InputError for an empty list or item, a value that is not a positive number, or a bad
+    range.
     """
-    items = [t.strip() for t in text.split(",") if t.strip()]
-    if not items:
+    items = [t.strip() for t in text.split(",")]
+    if not any(items):
         raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5 or 0.1:1:0.1")
+    if not all(items):
+        raise InputError(f"--pitches: an empty item in {text!r} (write 0.1,0.2, not 0.1,,0.2)")
     out: list[float] = []
     for item in items:
         if ":" in item:

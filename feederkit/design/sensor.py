@@ -191,3 +191,13 @@ def design_pitches(
     rows = pitch_rows(pfs, pitches, noise)
     names = tuple(pf.part.name for pf in pfs)
     return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs), rotation_error_deg)
+
+
+def report_design(
+    pfs: Sequence[PushFunction], rotation_error_deg: float = 0.0
+) -> dict[str, Any] | None:
+    """The sensor design a changeover report shows (``ToleranceDesign.to_dict``), or None for
+    a single part (nothing to tell apart)."""
+    if len(pfs) < 2:
+        return None
+    return design_tolerance(list(pfs), rotation_error_deg=rotation_error_deg).to_dict()
