@@ -1,6 +1,7 @@
 """Strong plans in the physics check, at the declared uncertainty (docs/simulation.md).
 
-Run: ``python benchmarks/bench_sim_uncertainty.py [--trials N] [--only NAME,...] [--creep]``.
+Run: ``python benchmarks/bench_sim_uncertainty.py [--trials N] [--only NAME,...] [--landings]
+[--creep]``.
 
 Plans every part of ``catalog/`` and every drawing of ``../shared/samples/`` that can be
 oriented (rotation error 1 degree, a tolerance sensor of 1 % of the part's size) and the
@@ -10,6 +11,11 @@ uncertainty and the default friction ranges (belt 0.4:0.6, fence 0.1:0.3). Print
 success rate with its 95 % Wilson interval and the failures by cause, model errors (outcomes
 the plan's model did not predict) counted apart. A part with no strong plan at 1 degree is
 listed as such. The target is 99.5 % success; exit 1 when a plan misses it.
+
+``--landings`` plans every catalog part over its landings instead (design.md, "Landings": a
+flat part lands ``up`` or ``down``), the next station taking only its first landing, and counts
+per plan the trials whose part was rightly rejected and the wrong accepts (a part ending in an
+accepting leaf that does not name its landing and state), members drawn by their shares.
 
 ``--creep`` measures instead how far a settled part drifts (turns, slides along the fence)
 over 5 simulated seconds under the contact settings MuJoCo offers against its soft-contact
@@ -143,6 +149,55 @@ def run(trials: int, only: set[str] | None) -> bool:
     return ok
 
 
+def landings(trials: int, only: set[str] | None) -> bool:
+    """Every catalog part planned over its landings, only the first landing accepted."""
+    from feederkit.landing.plan import load_landings, plan_landings
+
+    print(
+        f"plans over landings at rotation error {UNCERTAINTY.rotation_error_deg:g} deg, sensor "
+        f"{SENSOR_PERCENT:g} % of size, the first landing accepted; {trials} trials each, "
+        "members drawn by their shares"
+    )
+    print(
+        f"{'part':26s} {'landings':18s} {'len':>3s} {'success':>8s} {'95% Wilson':>15s} "
+        f"{'rejected':>8s} {'wrong acc':>9s}"
+    )
+    ok = True
+    totals = [0, 0, 0]
+    for source in sorted(str(p) for p in (ROOT / "catalog").glob("*.json")):
+        name = Path(source).stem
+        if only and name not in only:
+            continue
+        lands = load_landings([source]).all
+        accept = {lands[0].name}
+        sensor = ToleranceSensor(float(f"{max(x.part.size for x in lands) / 100.0:.3g}"))
+        names = "/".join(x.name for x in lands)
+        try:
+            made = plan_landings(lands, sensor, uncertainty=UNCERTAINTY, accept=accept).made
+        except (PlanningError, InputError) as exc:
+            print(f"{name:26s} {names:18s} no plan: {exc}")
+            continue
+        s = simulate_plan(made.plan, trials, seed=0)
+        lo, hi = wilson(s.successes, s.trials)
+        print(
+            f"{name:26s} {names:18s} {made.plan['stats']['length']:3d} "
+            f"{100 * s.success_rate:7.1f}% [{100 * lo:5.1f}, {100 * hi:5.1f}]% "
+            f"{s.rejects:8d} {s.wrong_accepts:9d}  {s.by_cause() or ''}"
+        )
+        totals[0] += s.successes
+        totals[1] += s.trials
+        totals[2] += s.wrong_accepts
+        ok &= s.success_rate >= TARGET and s.wrong_accepts == 0
+    if totals[1]:
+        lo, hi = wilson(totals[0], totals[1])
+        print(
+            f"{'all':26s} {'':18s}     {100 * totals[0] / totals[1]:7.2f}% "
+            f"[{100 * lo:5.2f}, {100 * hi:5.2f}]%  ({totals[0]} of {totals[1]}; wrong accepts "
+            f"{totals[2]})"
+        )
+    return ok
+
+
 CREEP_SETTINGS = {
     "elliptic, impratio 1 (chosen)": SceneConfig(),
     "elliptic, impratio 10": SceneConfig(impratio=10.0),
@@ -178,11 +233,14 @@ def main() -> int:
     ap.add_argument("--trials", type=int, default=200)
     ap.add_argument("--only", default="", help="comma-separated plan names")
     ap.add_argument("--creep", action="store_true", help="measure contact creep instead")
+    ap.add_argument("--landings", action="store_true", help="plan over landings instead")
     args = ap.parse_args()
     if args.creep:
         creep()
         return 0
     only = {s.strip() for s in args.only.split(",") if s.strip()} or None
+    if args.landings:
+        return 0 if landings(args.trials, only) else 1
     return 0 if run(args.trials, only) else 1
 
 

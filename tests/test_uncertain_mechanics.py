@@ -19,6 +19,9 @@ from feederkit.errors import InputError
 from feederkit.mechanics import action_ranges, diameter, push, push_function
 from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
 from feederkit.mechanics.uncertain import (
+    PUSH_BAND_DEG,
+    PUSH_BAND_FACTOR,
+    SHALLOW_WELL_FACTOR,
     action_map,
     fence_outcomes,
     max_rotation_error,
@@ -44,6 +47,7 @@ from feederkit.uncertainty import (
 ROOT = Path(__file__).resolve().parents[1]
 CATALOG = ROOT / "catalog"
 WRENCH = ROOT.parent / "shared" / "samples" / "trimesh__wrench.dxf"
+GEAR = ROOT.parent / "shared" / "samples" / "cadquery__gear.dxf"
 CATALOG_PARTS = sorted(p.stem for p in CATALOG.glob("*.json"))
 
 
@@ -243,7 +247,7 @@ def test_bands_are_asin_of_the_tolerance_at_a_sharp_vertex() -> None:
     part = make_part(make_outline("tri", [(0, 0), (40, 0), (10, 30)]))
     pf = push_function(part)
     unc = Uncertainty(1.0, 0.01, 0.02)
-    mech = uncertain_mechanics(part, unc)
+    mech = uncertain_mechanics(part, unc, vibration_mm=0.0)  # no push band: F2 alone
     assert len(mech.bands) == pf.n == 3
     com = np.asarray(part.com)
     for band in mech.bands:
@@ -395,3 +399,89 @@ def test_a_thousand_vertex_outline_is_fast() -> None:
     elapsed = time.perf_counter() - start
     assert mech.n >= 1
     assert elapsed < 0.25, elapsed  # typically ~40 ms; the margin absorbs a loaded machine
+
+
+def _radius_at(part, phi_deg: float) -> float:
+    u = (math.cos(math.radians(phi_deg)), math.sin(math.radians(phi_deg)))
+    return max((x - part.com[0]) * u[0] + (y - part.com[1]) * u[1] for x, y in part.hull)
+
+
+def test_push_bands_are_a_fixed_angle_at_ordinary_hilltops() -> None:
+    """Away from shallow states each flank gets PUSH_BAND_DEG, whatever the depth there."""
+    part = make_part(make_outline("tri", [(0, 0), (40, 0), (10, 30)]))
+    vib = 1e-3 * part.size
+    mech = uncertain_mechanics(part, Uncertainty(1.0), vibration_mm=vib)
+    assert len(mech.bands) == 3
+    for band in mech.bands:
+        assert band.divergent_deg - band.lo_deg == pytest.approx(PUSH_BAND_DEG, abs=1e-9)
+        assert band.hi_deg - band.divergent_deg == pytest.approx(PUSH_BAND_DEG, abs=1e-9)
+        # The depth rule would give 3.6-5 degrees here: the fixed band is narrower.
+        assert _radius_at(part, band.lo_deg) > _radius_at(part, band.divergent_deg) - 2 * vib
+        inside = band.divergent_deg - 0.9 * PUSH_BAND_DEG
+        outside = band.divergent_deg - 1.1 * PUSH_BAND_DEG
+        sides = {mech.state_of[band.left], mech.state_of[band.right]}
+        assert sides <= fence_outcomes(mech, inside, inside)
+        assert fence_outcomes(mech, outside, outside) == {mech.state_of[band.left]}
+    # With shape and COM tolerance the push band widens the F2 band by the same angle.
+    unc = Uncertainty(1.0, 0.01, 0.02)
+    tol = uncertain_mechanics(part, unc, vibration_mm=vib)
+    f2 = uncertain_mechanics(part, unc, vibration_mm=0.0)
+    for band, inner in zip(tol.bands, f2.bands, strict=True):
+        assert band.lo_deg == pytest.approx(inner.lo_deg - PUSH_BAND_DEG, abs=1e-9)
+        assert band.hi_deg == pytest.approx(inner.hi_deg + PUSH_BAND_DEG, abs=1e-9)
+    # The ideal model keeps its point bands.
+    ideal = uncertain_mechanics(part, IDEAL)
+    assert all(b.lo_deg == b.divergent_deg == b.hi_deg for b in ideal.bands)
+
+
+def test_push_bands_do_not_depend_on_size_or_depth_at_ordinary_hilltops() -> None:
+    """Parts with the same push function get the same bands (so Lemma 8 twins stay alike):
+    the look-alike of the quadrilateral, and a part and its scaled copy."""
+    from feederkit.mix.lookalike import build_lookalike
+
+    original = catalog_part("quadrilateral")
+    twin = build_lookalike(original, "push-diameter", 0).part
+    big = make_part(make_outline("big", [(3 * x, 3 * y) for x, y in original.outline.vertices]))
+    ref = uncertain_mechanics(original, Uncertainty(1.0))
+    assert not np.allclose(
+        [_radius_at(original, b.divergent_deg) for b in ref.bands],
+        [_radius_at(twin, b.divergent_deg) for b in ref.bands],
+    )
+    for other in (twin, big):
+        mech = uncertain_mechanics(other, Uncertainty(1.0))
+        assert len(mech.bands) == len(ref.bands)
+        for a, b in zip(ref.bands, mech.bands, strict=True):
+            assert b.divergent_deg == pytest.approx(a.divergent_deg, abs=1e-6)
+            assert b.lo_deg == pytest.approx(a.lo_deg, abs=1e-6)
+            assert b.hi_deg == pytest.approx(a.hi_deg, abs=1e-6)
+
+
+def test_push_bands_stop_at_a_shallow_neighbour_state() -> None:
+    """The gear's tooth tips: two hills 2.75 degrees apart around a shallow state (0.005 mm
+    deep, below SHALLOW_WELL_FACTOR vibrations); both bands end at its normal, their far flanks
+    get the depth rule, and a push starting 3 degrees before either hilltop, on the far side
+    from the tip, may end on the tip (the physics check saw it)."""
+    if not GEAR.exists():
+        pytest.skip(f"sample drawing not found: {GEAR}")
+    pf = push_function(load_part(str(GEAR)))
+    mech = uncertain_mechanics(pf.part, Uncertainty(1.0))
+    tip = min(pf.states, key=lambda s: s.resting_range_deg[1] - s.resting_range_deg[0])
+    touching = [b for b in mech.bands if tip.id in (b.left, b.right)]
+    assert len(touching) == 2
+    ideal = uncertain_mechanics(pf.part, Uncertainty(1.0), vibration_mm=0.0)
+    for b in touching:
+        tip_end = b.lo_deg if b.left == tip.id else b.hi_deg
+        assert circ(tip_end, tip.normal_deg) == pytest.approx(0.0, abs=1e-9)
+        # The far flank, beside a deep root, gets the depth rule, not the fixed angle.
+        far_end, root = (b.hi_deg, b.right) if b.left == tip.id else (b.lo_deg, b.left)
+        peak = _radius_at(pf.part, b.divergent_deg)
+        vib = mech.vibration_mm
+        assert peak - _radius_at(pf.part, tip.normal_deg) < SHALLOW_WELL_FACTOR * vib
+        assert peak - _radius_at(pf.part, pf.states[root].normal_deg) > SHALLOW_WELL_FACTOR * vib
+        assert _radius_at(pf.part, far_end) == pytest.approx(
+            peak - PUSH_BAND_FACTOR * vib, abs=1e-9
+        )
+        assert circ(far_end, b.divergent_deg) > PUSH_BAND_DEG + 1.0
+        start = b.divergent_deg + (3.0 if b.left == tip.id else -3.0)
+        assert mech.state_of[tip.id] in fence_outcomes(mech, start, start)
+        assert mech.state_of[tip.id] not in fence_outcomes(ideal, start, start)
