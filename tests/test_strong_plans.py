@@ -124,8 +124,11 @@ def run_plan(plan_data, part_index, poly, com, r, e, rng):
     theta = rng.uniform(0, 2 * math.pi)
     failures = []
     todo = [(plan_data["root"], theta, 0)]
+    shared = plan_data.get("nodes") or {}
     while todo:
         node, theta, depth = todo.pop()
+        while "ref" in node:  # a shared subplan, stored once (design.md plan file v2)
+            node = shared[node["ref"]]
         if "result" in node:
             rest = theta
             nearest = min(

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import re
 import warnings
 from collections import Counter
@@ -500,6 +501,23 @@ def read_dxf(
     except DXFError as exc:  # malformed entities that ezdxf loaded but cannot interpret
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputError(f"{path}: malformed DXF ({reason})") from None
+    except (AttributeError, KeyError, TypeError) as exc:
+        # A structure ezdxf loaded from a broken file but cannot walk (e.g. a block record
+        # without its attributes): malformed input when ezdxf itself raised it, our bug if not.
+        if not _raised_in_ezdxf(exc):
+            raise
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"{path}: malformed DXF ({reason})") from None
+
+
+def _raised_in_ezdxf(exc: BaseException) -> bool:
+    """Whether the innermost frame of ``exc``'s traceback is in the ezdxf package."""
+    tb = exc.__traceback__
+    if tb is None:
+        return False
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    return f"{os.sep}ezdxf{os.sep}" in tb.tb_frame.f_code.co_filename
 
 
 def _paper_space_hint(doc: DxfDocument, options: ImportOptions) -> str:

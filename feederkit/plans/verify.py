@@ -469,7 +469,9 @@ def verify_plan(
         # every node is reachable (its states are images of every start), so some path is as
         # long as the tree: a shorter longest path means a branch no part can reach
         problems.append(f"the plan's length is {length}, but no path takes more than {longest}")
-    if not failures and not problems:
+    if not failures and not problems and plan.uncertainty.is_ideal:
+        # A strong plan's expected length is over its physical states (plans/strong.py checks
+        # it); replayed here on the kinematic model it differs, and that is no error.
         problems += expected_problems(plan, expected_operations(plan))
     return VerificationReport(tuple(checks), tuple(failures), tuple(problems))
 
