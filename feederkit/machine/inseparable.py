@@ -29,7 +29,7 @@ from typing import TypeVar
 import numpy as np
 
 from feederkit.angles import ANGLE_EPS, merge_boundaries, norm360
-from feederkit.machine.model import PushAlignMachine, target_at
+from feederkit.machine.model import PushAlignMachine, members, target_at
 
 P = TypeVar("P", bound=Hashable)
 
@@ -278,15 +278,6 @@ def pair_outcomes(machine: PushAlignMachine, i: int, j: int) -> list[tuple[int, 
     return out
 
 
-def _bits(mask: int) -> list[int]:
-    out = []
-    while mask:
-        low = mask & -mask
-        out.append(low.bit_length() - 1)
-        mask ^= low
-    return out
-
-
 def _bisimilar(
     machine: PushAlignMachine,
     alive: set[tuple[int, int]],
@@ -312,7 +303,7 @@ def _bisimilar(
         return x != y and ((x, y) if x < y else (y, x)) in alive
 
     def matched(a: int, b: int) -> bool:
-        xs, ys = _bits(a), _bits(b)
+        xs, ys = members(a), members(b)
         return all(any(linked(x, y) for y in ys) for x in xs) and all(
             any(linked(x, y) for x in xs) for y in ys
         )
@@ -323,8 +314,8 @@ def _bisimilar(
         check()
         named = set()
         for a, b in cs:
-            for x in _bits(a):
-                for y in _bits(b):
+            for x in members(a):
+                for y in members(b):
                     if x != y:
                         named.add((x, y) if x < y else (y, x))
         for q in named:
