@@ -173,7 +173,7 @@ def test_plot_command_as_a_typer_command(tmp_path):
     assert res.exit_code == 2  # -o is required
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=4, deadline=None)
 @given(
     st.lists(
         st.tuples(st.floats(0, 359.9), st.floats(5.0, 40.0)),
