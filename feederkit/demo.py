@@ -2,11 +2,14 @@
 
 Imports the folder into a temporary catalog, analyses every part (states, symmetry, Fig. 14
 class and bound), plans each orientable part sensorless and with a diameter sensor, and
-compiles changeovers: the paper's triangle and 8-gon (Figs. 18 and 27), the paper's shapes,
-the feeder parts, and a mix with a look-alike (Theorem 6: a part with the same push-diameter
-function) that no plan can tell apart from its original (section 8.4). Every plan file and a
-report per changeover are written to the output folder. :func:`run_demo` returns what
-happened; ``feederkit demo`` prints it (docs/changeovers.md).
+compiles changeovers: the paper's triangle and 8-gon (Figs. 18 and 27), the paper's shapes
+lying face up (the paper's setting), the feeder parts over every landing with only the
+face-up ones accepted (design.md, "Landings": a part that lands face down ends in a reject
+result as early as the plan knows), and a mix with a look-alike (Theorem 6: a part with the
+same push-diameter function) that no plan can tell apart from its original on either side
+(section 8.4). Every plan file and a report per changeover are written to the output folder.
+:func:`run_demo` returns what happened; ``feederkit demo`` prints it (docs/changeovers.md,
+docs/landings.md).
 """
 
 from __future__ import annotations
@@ -20,12 +23,12 @@ from typing import Any
 
 from feederkit.catalog import add_outline, import_directory, list_parts, open_catalog
 from feederkit.cell import CellSettings, annotate_cycle_time
-from feederkit.errors import InputError
+from feederkit.errors import InputError, PlanningError
 from feederkit.jsonio import OutputFile, write_files
 from feederkit.loading import load_parts
 from feederkit.mechanics.analysis import analyze_part
 from feederkit.mechanics.push import PushFunction
-from feederkit.mix.changeover import CompiledChangeover, compile_changeover
+from feederkit.mix.changeover import CompiledChangeover, compile_changeover, landing_rows
 from feederkit.mix.lookalike import build_lookalike
 from feederkit.plans.fileformat import plan_json
 from feederkit.plans.make import make_plan
@@ -42,6 +45,23 @@ LOOKALIKE_SEED = 0
 
 SMALL_PART_MM = 10.0
 """Parts below this size are the paper's unit-sized shapes; larger ones are feeder parts."""
+
+FEEDER_ACCEPT = ("up",)
+"""The landings the next station takes in the feeder-parts changeover: face up only."""
+
+
+@dataclass(frozen=True)
+class DemoMix:
+    """A changeover the demo compiles: its members, the landings planned (None: every one)
+    and accepted (None: every one), and whether it holds a look-alike (a pair no plan can
+    tell apart is expected)."""
+
+    name: str
+    members: tuple[str, ...]
+    landings: tuple[str, ...] | None = None
+    accept: tuple[str, ...] | None = None
+    lookalike: bool = False
+
 
 Progress = Callable[[str, int, int | None], None]
 """``progress(what, done, total)``: called as the pipeline advances (total None: unknown)."""
@@ -106,11 +126,25 @@ class DemoChangeover:
     plan_path: Path
     report_path: Path | None
     lookalike: bool = False
+    note: str | None = None
+    """Why the demo planned otherwise than asked (an accept list no plan can keep)."""
+    landings_planned: tuple[str, ...] | None = None
+    """The landings planned when not every one (``--landings``)."""
 
     @property
     def name(self) -> str:
         """The changeover's name."""
         return self.compiled.name
+
+    @property
+    def landings(self) -> list[dict[str, Any]]:
+        """The landings planned with share and accept (none for a plan of parts)."""
+        return landing_rows(self.compiled.plan, self.compiled.rejected)
+
+    @property
+    def rejected_share(self) -> float:
+        """The share of the parts (by the landings' probabilities) the plan rejects."""
+        return sum(r["share"] or 0.0 for r in self.landings if not r["accept"])
 
     @property
     def cycle_time(self) -> dict[str, Any] | None:
@@ -129,6 +163,13 @@ class DemoChangeover:
             "cycle_time": self.cycle_time,
             "min_margin_deg": stats.get("min_margin_deg"),
             "lookalike": self.lookalike,
+            "landings": self.landings,
+            "rejected": sorted(self.compiled.rejected),
+            "rejected_share": self.rejected_share,
+            "landings_planned": None
+            if self.landings_planned is None
+            else list(self.landings_planned),
+            "note": self.note,
             "unrecognizable_pairs": [w.to_dict() for w in self.compiled.witnesses],
             "warnings": list(self.compiled.warnings),
             "plan": str(self.plan_path),
@@ -233,25 +274,28 @@ def plan_parts(
     return plans
 
 
-def demo_mixes(pfs: list[PushFunction]) -> list[tuple[str, list[str]]]:
-    """The changeovers to compile: Figs. 18/27, then the paper's shapes, then the feeder parts."""
+def demo_mixes(pfs: list[PushFunction]) -> list[DemoMix]:
+    """The changeovers to compile: Figs. 18/27 (mirror-symmetric parts: one landing each), the
+    paper's shapes face up (the paper's setting), the feeder parts over every landing with
+    the face-up ones accepted."""
     names = [pf.part.name for pf in pfs]
     size = {pf.part.name: pf.part.size for pf in pfs}
-    mixes: list[tuple[str, list[str]]] = []
+    mixes: list[DemoMix] = []
     if all(n in names for n in PAPER_MIX):
-        mixes.append(("fig27-triangle-octagon", list(PAPER_MIX)))
-    small = [n for n in names if size[n] < SMALL_PART_MM]
-    large = [n for n in names if size[n] >= SMALL_PART_MM]
+        mixes.append(DemoMix("fig27-triangle-octagon", PAPER_MIX))
+    small = tuple(n for n in names if size[n] < SMALL_PART_MM)
+    large = tuple(n for n in names if size[n] >= SMALL_PART_MM)
     if len(small) > 2:
-        mixes.append(("paper-shapes", small))
+        mixes.append(DemoMix("paper-shapes", small, landings=("up",)))
     if len(large) > 1:
-        mixes.append(("feeder-parts", large))
+        mixes.append(DemoMix("feeder-parts", large, accept=FEEDER_ACCEPT))
     return mixes
 
 
-def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> tuple[str, list[str]] | None:
+def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> DemoMix | None:
     """Store a look-alike of ``LOOKALIKE_MIX[0]`` (same push-diameter function, Theorem 6) in the
-    catalog; return its changeover (name, members), or None when the mix's parts are missing."""
+    catalog; return its changeover, over every landing (the look-alike is one on either
+    side), or None when the mix's parts are missing."""
     by_name = {pf.part.name: pf for pf in pfs}
     if not all(n in by_name for n in LOOKALIKE_MIX):
         return None
@@ -259,7 +303,8 @@ def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> tuple[str, list[str
     twin_name = f"{original.name}-twin"
     twin = build_lookalike(original, "push-diameter", LOOKALIKE_SEED).part
     add_outline(catalog, twin.outline, name=twin_name)
-    return "lookalike-pair", [original.name, twin_name, *LOOKALIKE_MIX[1:]]
+    members = (original.name, twin_name, *LOOKALIKE_MIX[1:])
+    return DemoMix("lookalike-pair", members, lookalike=True)
 
 
 def _report(compiled: CompiledChangeover) -> str:
@@ -279,19 +324,19 @@ def _report(compiled: CompiledChangeover) -> str:
 
 def compile_demo_changeover(
     catalog: Path,
-    name: str,
-    members: list[str],
+    mix: DemoMix,
     folder: Path,
     percent: float,
-    lookalike: bool,
     report: bool = True,
     cell: CellSettings | None = None,
 ) -> DemoChangeover:
-    """Compile one changeover with the demo sensor; its plan file and (when ``report``) its
-    report are written with it, with the cycle time when the ``cell`` profile has timing."""
-    loaded = load_parts(members, catalog=catalog)
+    """Compile one changeover with the demo sensor over the mix's landings; its plan file and
+    (when ``report``) its report are written with it, with the cycle time when the ``cell``
+    profile has timing. When no plan can accept the mix's ``accept`` landings and reject the
+    others (the sensor reads them alike), every landing is accepted and ``note`` says so."""
+    loaded = load_parts(list(mix.members), catalog=catalog)
     sensor = demo_sensor(list(loaded.push_functions), percent)
-    plan_path, report_path = folder / f"{name}.json", folder / f"{name}.html"
+    plan_path, report_path = folder / f"{mix.name}.json", folder / f"{mix.name}.html"
 
     def outputs(c: CompiledChangeover) -> list[OutputFile]:
         if cell is not None:
@@ -301,9 +346,34 @@ def compile_demo_changeover(
             files.append(OutputFile(report_path, _report(c), "report"))
         return files
 
-    compiled = compile_changeover(catalog, name, members, sensor, replace=True, outputs=outputs)
+    def compiled(accept: tuple[str, ...] | None) -> CompiledChangeover:
+        return compile_changeover(
+            catalog,
+            mix.name,
+            list(mix.members),
+            sensor,
+            replace=True,
+            outputs=outputs,
+            landings=mix.landings,
+            accept=accept,
+        )
+
+    note = None
+    try:
+        done = compiled(mix.accept)
+    except PlanningError as exc:
+        if mix.accept is None:
+            raise
+        note = f"every landing accepted: {exc}"
+        done = compiled(None)
     return DemoChangeover(
-        compiled, tuple(members), plan_path, report_path if report else None, lookalike
+        done,
+        mix.members,
+        plan_path,
+        report_path if report else None,
+        mix.lookalike,
+        note,
+        mix.landings,
     )
 
 
@@ -352,17 +422,15 @@ def run_demo(
         pfs = list(loaded.push_functions)
         rows, notes = analyse(pfs, percent)
         plans = plan_parts(pfs, percent, out / "plans", progress)
-        mixes = [(name, members, False) for name, members in demo_mixes(pfs)]
+        mixes = demo_mixes(pfs)
         twin = add_lookalike(catalog, pfs)
         if twin is not None:
-            mixes.append((*twin, True))
+            mixes.append(twin)
         changeovers = []
-        for k, (name, members, lookalike) in enumerate(mixes):
-            progress(f"compiling changeover {name}", k, len(mixes))
+        for k, mix in enumerate(mixes):
+            progress(f"compiling changeover {mix.name}", k, len(mixes))
             changeovers.append(
-                compile_demo_changeover(
-                    catalog, name, members, out / "changeovers", percent, lookalike, reports, cell
-                )
+                compile_demo_changeover(catalog, mix, out / "changeovers", percent, reports, cell)
             )
     return DemoResult(
         source_dir=src,

@@ -85,8 +85,31 @@ def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, mon
     ok(capsys, [*args, "--tolerance", "0.01", "--rotation-error", "0", "--catalog", str(db)], 1)
     html = tmp_path / "twins.html"
     ok(capsys, ["changeover", "report", "twins", "-o", str(html), "--catalog", str(db)])
-    names = "['quad-twin', 'quadrilateral']"
-    assert html.read_text() == f"<p>[{names}] {names}</p>"
+    # Every landing is planned: the look-alikes are a pair on either side (PART/LANDING).
+    pairs = "[['quad-twin/down', 'quadrilateral/down'], ['quad-twin/up', 'quadrilateral/up']]"
+    outlines = "['quad-twin/down', 'quad-twin/up', 'quadrilateral/down', 'quadrilateral/up']"
+    assert html.read_text() == f"<p>{pairs} {outlines}</p>"
+    # Face up only (--landings up), the pair and the outlines of the parts as drawn.
+    ok(
+        capsys,
+        [
+            *args,
+            "--landings",
+            "up",
+            "--tolerance",
+            "0.01",
+            "--rotation-error",
+            "0",
+            "--replace",
+            "--catalog",
+            str(db),
+        ],
+        1,
+    )
+    ok(capsys, ["changeover", "report", "twins", "-o", str(html), "--catalog", str(db)])
+    assert html.read_text() == "<p>[['quad-twin/up', 'quadrilateral/up']] " + (
+        "['quad-twin/up', 'quadrilateral/up']</p>"
+    )
     one_line_error(capsys, ["changeover", "report", "nope", "-o", str(html), "--catalog", str(db)])
 
 

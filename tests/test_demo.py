@@ -50,14 +50,90 @@ def test_pipeline_compiles_the_papers_changeover(few: DemoResult) -> None:
 def test_pipeline_shows_a_lookalike_pair_no_plan_can_tell_apart(few: DemoResult) -> None:
     pair = {c.name: c for c in few.changeovers}["lookalike-pair"]
     assert pair.lookalike
-    assert [{w.part_a, w.part_b} for w in pair.compiled.witnesses] == [
-        {"quadrilateral", "quadrilateral-twin"}
-    ]
-    assert pair.compiled.lumped == [("quadrilateral", "quadrilateral-twin")]
-    assert any("Lemma 8" in w.reason for w in pair.compiled.witnesses)
+    # Over every landing: the look-alike is one on either side, the rectangle is told apart.
+    sides = [("quadrilateral/up", "quadrilateral-twin/up")]
+    sides.append(("quadrilateral/down", "quadrilateral-twin/down"))
+    assert [(w.part_a, w.part_b) for w in pair.compiled.witnesses] == sides
+    assert pair.compiled.lumped == sides
+    assert all("Lemma 8" in w.reason for w in pair.compiled.witnesses)
     summary = pair.to_dict()
     assert summary["unrecognizable_pairs"] and summary["lookalike"] is True
+    assert len(summary["landings"]) == 6 and summary["rejected"] == []
     check_plan(read_plan(pair.plan_path))
+
+
+def test_pipeline_plans_the_papers_shapes_face_up(few: DemoResult) -> None:
+    shapes = {c.name: c for c in few.changeovers}["paper-shapes"]
+    assert shapes.landings_planned == ("up",)
+    assert {r["landing"] for r in shapes.landings} == {"up"}
+    assert shapes.compiled.witnesses == () and shapes.rejected_share == 0.0
+
+
+@pytest.fixture(scope="module")
+def feeder(tmp_path_factory: pytest.TempPathFactory) -> DemoResult:
+    """The demo pipeline on two feeder parts: the chiral L bracket and the symmetric T clip."""
+    folder = tmp_path_factory.mktemp("feeder")
+    for name in ("l-bracket", "t-clip"):
+        shutil.copy(ROOT / "catalog" / f"{name}.json", folder)
+    return run_demo(folder, tmp_path_factory.mktemp("out"), reports=False)
+
+
+def test_feeder_parts_are_planned_over_every_landing_face_down_rejected(
+    feeder: DemoResult, capsys
+) -> None:
+    (c,) = feeder.changeovers
+    assert c.name == "feeder-parts" and c.note is None
+    assert [(r["part"], r["landing"], r["accept"]) for r in c.landings] == [
+        ("l-bracket", "up", True),
+        ("l-bracket", "down", False),
+        ("t-clip", "up", True),
+    ]
+    assert c.compiled.rejected == {"l-bracket/down"}
+    assert c.rejected_share == pytest.approx(0.25)
+    summary = c.to_dict()
+    assert summary["rejected"] == ["l-bracket/down"] and summary["unrecognizable_pairs"] == []
+    plan = read_plan(c.plan_path)
+    for leaf in plan.leaves():
+        assert leaf.reject == all(e.landing == "down" for e in leaf.results)
+    assert main(["run", str(c.plan_path), "--all"]) == 0
+    assert "reject" in capsys.readouterr().out
+
+
+def test_feeder_changeover_is_printed_with_its_rejects(feeder: DemoResult) -> None:
+    from rich.console import Console
+
+    from feederkit.cli.demo import print_changeover
+
+    out = Console(width=200, record=True, file=io.StringIO())
+    print_changeover(out, feeder.changeovers[0])
+    text = out.export_text()
+    assert "l-bracket/down 25 % rejected" in text
+    assert "1 rejected (25 % of the parts end in a reject result" in text
+
+
+def test_an_accept_list_no_plan_can_keep_accepts_every_landing(tmp_path: Path, monkeypatch):
+    import feederkit.demo
+    from feederkit.catalog import add_outline, open_catalog
+    from feederkit.demo import DemoMix, compile_demo_changeover
+    from feederkit.errors import PlanningError
+    from feederkit.sources import load_part
+
+    real = feederkit.demo.compile_changeover
+
+    def refuse_rejects(*args, accept=None, **kwargs):
+        if accept is not None:
+            raise PlanningError("l-bracket (up) is accepted and l-bracket (down) rejected")
+        return real(*args, accept=accept, **kwargs)
+
+    monkeypatch.setattr(feederkit.demo, "compile_changeover", refuse_rejects)
+    catalog = tmp_path / "demo.db"
+    open_catalog(catalog, create=True).close()
+    for name in ("l-bracket", "t-clip"):
+        add_outline(catalog, load_part(str(ROOT / "catalog" / f"{name}.json")).outline, name=name)
+    mix = DemoMix("feeder-parts", ("l-bracket", "t-clip"), accept=("up",))
+    c = compile_demo_changeover(catalog, mix, tmp_path, 1.0, report=False)
+    assert c.note is not None and c.note.startswith("every landing accepted: l-bracket (up)")
+    assert c.compiled.rejected == frozenset() and len(c.landings) == 3
 
 
 def test_the_lookalike_report_is_given_the_pair(tmp_path: Path, monkeypatch) -> None:
@@ -74,7 +150,9 @@ def test_the_lookalike_report_is_given_the_pair(tmp_path: Path, monkeypatch) -> 
     (pair,) = result.changeovers
     assert pair.name == "lookalike-pair" and pair.report_path is not None
     html = pair.report_path.read_text(encoding="utf-8")
-    assert "('quadrilateral', 'quadrilateral-twin')" in html and "rectangle-2x1" in html
+    assert "('quadrilateral/up', 'quadrilateral-twin/up')" in html
+    assert "('quadrilateral/down', 'quadrilateral-twin/down')" in html
+    assert "rectangle-2x1/down" in html
 
 
 def test_summary_is_json(few: DemoResult) -> None:
@@ -133,6 +211,11 @@ def test_demo_compiles_the_papers_changeover_and_the_lookalike(
     assert fig27["length"] == 2
     assert fig27["unrecognizable_pairs"] == []
     assert by_name["lookalike-pair"]["unrecognizable_pairs"]
+    feeder = by_name["feeder-parts"]
+    assert feeder["rejected"] == ["chamfered-plate/down", "l-bracket/down"]
+    assert feeder["rejected_share"] == pytest.approx(0.25)
+    assert feeder["unrecognizable_pairs"] == [] and feeder["note"] is None
+    assert by_name["paper-shapes"]["unrecognizable_pairs"] == []
     assert len(by_name) >= 4
     for c in summary["changeovers"]:
         check_plan(read_plan(c["plan"]))
@@ -158,7 +241,7 @@ def test_the_plans_tables_fit_80_columns(few: DemoResult) -> None:
 def test_a_changeover_shows_its_cycle_time_with_a_profile(tmp_path: Path) -> None:
     from feederkit.catalog import add_outline, open_catalog
     from feederkit.cell import parse_cell, resolve_settings
-    from feederkit.demo import compile_demo_changeover
+    from feederkit.demo import DemoMix, compile_demo_changeover
     from feederkit.sources import load_part
 
     catalog = tmp_path / "demo.db"
@@ -174,11 +257,9 @@ def test_a_changeover_shows_its_cycle_time_with_a_profile(tmp_path: Path) -> Non
     )
     c = compile_demo_changeover(
         catalog,
-        "fig27",
-        ["isosceles-right-triangle", "octagon"],
+        DemoMix("fig27", ("isosceles-right-triangle", "octagon")),
         tmp_path,
         1.0,
-        False,
         report=False,
         cell=resolve_settings(profile),
     )

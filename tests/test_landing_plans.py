@@ -378,5 +378,11 @@ def test_a_changeover_over_landings_is_stored_with_its_landings(tmp_path):
     stored = load_changeover(db, "ell-up")
     assert [pf.part.name for pf in stored.parts] == ["ell/up", "ell/down"]
     assert stored.witnesses() == []
-    plain = compile_changeover(db, "ell", ["ell"], ToleranceSensor(0.5))
-    assert "landing" not in json.dumps(plain.plan)
+    assert stored.rejected == {"ell/down"}
+    # The default is every landing, too (design.md): the same members, all accepted.
+    default = compile_changeover(db, "ell", ["ell"], ToleranceSensor(0.5))
+    assert [(p["landing"], p["share"]) for p in default.plan["parts"]] == [
+        ("up", 0.5),
+        ("down", 0.5),
+    ]
+    assert default.rejected == frozenset()

@@ -116,10 +116,10 @@ def test_changeover_with_unrecognizable_parts_exits_1_and_still_stores(
     out = tmp_path / "twins.json"
     args = ["changeover", "compile", "twins", "--mix", "quadrilateral,quad-twin,rectangle-2x1"]
     report = tmp_path / "twins.html"
-    opts = ["--tolerance", "0.01", "-o", str(out), "--report", str(report)]
+    opts = ["--tolerance", "0.01", "-o", str(out), "--report", str(report), "--landings", "up"]
     assert main([*args, *opts, "--catalog", str(db)]) == 1
     err = capsys.readouterr().err
-    assert "quadrilateral & quad-twin" in err and "Lemma 8" in err
+    assert "quadrilateral/up & quad-twin/up" in err and "Lemma 8" in err
     html = report.read_text()
     assert "quad-twin" in html and "Lemma 8" in html
     plan = json.loads(out.read_text())

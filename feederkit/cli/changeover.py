@@ -2,14 +2,20 @@
 product mix, stored in the catalog against the exact part revisions (section 8.5;
 docs/changeovers.md).
 
-``compile`` exits 1 when the mix has parts no plan can tell apart: the plan still orients
-them (Corollary 7), is still written and stored, and its results list each candidate part.
-Every command that shows a stored changeover warns when a part has a newer revision.
+``compile`` plans every landing of every part (design.md, "Landings": face up and face down,
+a mesh's resting poses), each one member of the mix named ``PART/LANDING``; ``--landings``
+picks them and ``--accept`` names those the next station takes. It exits 1 when the mix has
+parts or landings no plan can tell apart (:func:`feederkit.mix.changeover.reported_pairs`,
+the rule ``plan`` follows): the plan still orients them (Corollary 7), is still written and
+stored, and its results list each candidate. Every command that shows a stored changeover
+warns when a part has a newer revision; changeovers stored before landings (no landing keys)
+show, export and report as they were.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -22,6 +28,8 @@ from feederkit.catalog import list_changeovers, remove_changeover, resolve_catal
 from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
+    FLAG_TERMS,
+    LANDING_TERMS,
     AcceptOpt,
     CatalogOpt,
     CellOpt,
@@ -62,7 +70,9 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import (
     changeover_exists,
     compile_changeover,
+    landing_rows,
     load_changeover,
+    member_name,
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
@@ -147,6 +157,31 @@ def shares_text(revisions: Sequence[tuple[str, int]], plan: dict[str, Any]) -> s
     )
 
 
+def landings_text(plan: dict[str, Any], rejected: frozenset[str]) -> str | None:
+    """The landings in words, each with its share and whether it is accepted, and the share
+    of the parts the plan rejects (None for a plan of parts)."""
+    rows = landing_rows(plan, rejected)
+    if not rows:
+        return None
+
+    def share(x: float | None) -> str:
+        return "" if x is None else f" {100.0 * x:.3g} %"
+
+    shown = ", ".join(
+        f"{member_name(r['part'], r['landing'])}{share(r['share'])}"
+        + ("" if r["accept"] else " rejected")
+        for r in rows
+    )
+    out = [r for r in rows if not r["accept"]]
+    if not out:
+        return f"landings (share): {shown}; every landing accepted"
+    total = math.fsum(r["share"] or 0.0 for r in out)
+    return (
+        f"landings (share): {shown}; {len(out)} rejected ({100.0 * total:.3g} % of the parts "
+        "end in a reject result: recirculate or re-drop them)"
+    )
+
+
 def changeover_report(
     plan: dict[str, Any], pfs: Sequence[PushFunction], witnesses: Sequence[PairWitness]
 ) -> str:
@@ -219,12 +254,15 @@ def compile_command(
     """Plan one verified sequence of push-align operations that orients (and, where possible,
     recognizes) every part of the mix, and store it against the parts' exact revisions.
 
-    ``--landings``/``--accept`` plan every part over its stored landings, the landings not
-    accepted ending in reject results (docs/landings.md).
+    Every landing of every part is planned for (a flat part face up and face down, a mesh in
+    each resting pose; ``--landings up`` plans the parts face up only), each named
+    ``PART/LANDING``; landings not in ``--accept`` end in reject results (docs/landings.md).
 
     The cell profile (``--cell`` or ./feederkit.toml) gives the sensor, the rotation error
     and the timing; options override it. With timing, the output gives the cycle time.
-    Exit 1 when some parts cannot be told apart (the plan is still written and stored).
+    Exit 1 when some parts or landings cannot be told apart, the two sides of one part too
+    (the plan is still written and stored), or when an accepted and a rejected landing
+    cannot be.
     """
     members, shares = parse_mix_shares(mix)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
@@ -251,7 +289,8 @@ def compile_command(
         over["landings"] = "all" if landings == "all" else landing_names(landings)
     if accept is not None:
         over["accept"] = landing_names(accept, "--accept")
-    with searching(f"compiling changeover {name}", options.time_limit_s), flag_words():
+    terms = (*FLAG_TERMS, *LANDING_TERMS)
+    with searching(f"compiling changeover {name}", options.time_limit_s), flag_words(terms):
         compiled = compile_changeover(
             path,
             name,
@@ -265,6 +304,7 @@ def compile_command(
             **over,
         )
     plan, witnesses, pfs = compiled.plan, list(compiled.witnesses), list(compiled.parts)
+    lands = landings_text(plan, compiled.rejected)
     cycle = plan["stats"].get("cycle_time")
     warnings = list(compiled.warnings)
     note = time_limit_note(plan["stats"], options.time_limit_s)
@@ -280,6 +320,7 @@ def compile_command(
                     for n, r in compiled.revisions
                 ],
                 "cell": settings.to_dict(),
+                "landings": landing_rows(plan, compiled.rejected),
                 "cycle_time": cycle,
                 "unrecognizable_pairs": [w.to_dict() for w in witnesses],
                 "warnings": warnings,
@@ -290,7 +331,8 @@ def compile_command(
         console.print(
             f"[bold]changeover {escape(name)}[/]: "
             f"{escape(shares_text(compiled.revisions, plan))}\n"
-            f"{escape(settings.describe())}\n"
+            + ("" if lands is None else f"{escape(lands)}\n")
+            + f"{escape(settings.describe())}\n"
             f"sensor: {sensor_text(sensor.to_dict())}\n"
             f"uncertainty: {uncertainty_text(plan.get('uncertainty'))}",
             highlight=False,
@@ -307,10 +349,23 @@ def compile_command(
         named = "; ".join(f"{w.part_a} & {w.part_b} ({w.reason})" for w in witnesses)
         if not witnesses:
             named = ", ".join(f"{a} & {b}" for a, b in lumped)
+        sides = [w for w in witnesses if _part_of(w.part_a) == _part_of(w.part_b)]
+        side_note = ""
+        if sides:
+            side_note = (
+                f" ({', '.join(dict.fromkeys(_part_of(w.part_a) for w in sides))}: known, but "
+                "not which side is up, so not its pose)"
+            )
         raise CheckFailed(
             f"changeover {name!r} orients every part but cannot tell these apart: {named}; "
-            "the plan's results list each candidate with its pose"
+            f"the plan's results list each candidate with its pose{side_note}"
         )
+
+
+def _part_of(member: str) -> str:
+    """The part of a member named ``PART`` or ``PART/LANDING``."""
+    head, _, tail = member.rpartition("/")
+    return head if head and re.fullmatch(r"up|down|pose-[0-9]+", tail) else member
 
 
 def _shares(plan: dict[str, Any]) -> dict[str, float]:
@@ -362,6 +417,7 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
         print_json(
             {
                 **_info_dict(co.info, co.plan),
+                "landings": landing_rows(co.plan, co.rejected),
                 "cycle_time": co.plan["stats"].get("cycle_time"),
                 "warnings": list(co.warnings),
                 "plan": co.plan,
@@ -369,10 +425,12 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
         )
         return
     info = co.info
+    lands = landings_text(co.plan, co.rejected)
     console.print(
         f"[bold]changeover {escape(info.name)}[/]: "
         f"{escape(shares_text(info.parts, co.plan))}\n"
-        f"sensor: {sensor_text(dict(info.sensor))}\ncreated {info.created_at} by "
+        + ("" if lands is None else f"{escape(lands)}\n")
+        + f"sensor: {sensor_text(dict(info.sensor))}\ncreated {info.created_at} by "
         f"{escape(info.created_by)}",
         highlight=False,
     )

@@ -1,9 +1,10 @@
 """``feederkit demo``: the main job on the bundled ``catalog/``, printed.
 
 The work is :func:`feederkit.demo.run_demo` (import, analyse, plan each part sensorless and
-with a diameter sensor, compile changeovers including a look-alike pair no plan can tell
-apart, write every plan file and report); this module parses the options, shows progress,
-and prints the result as tables or ``--json``.
+with a diameter sensor, compile changeovers, one over every landing with the face-down ones
+rejected and one with a look-alike pair no plan can tell apart, write every plan file and
+report); this module parses the options, shows progress, and prints the result as tables or
+``--json``.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from feederkit.cell import cycle_time_text, load_cell, resolve_settings
-from feederkit.cli.changeover import CellOpt
+from feederkit.cli.changeover import CellOpt, landings_text
 from feederkit.cli.common import (
     console,
     err_console,
@@ -127,6 +128,14 @@ def print_changeover(say: Console, c: DemoChangeover) -> None:
     )
     if c.name == "fig27-triangle-octagon":
         say.print(plan_tree(compiled.plan))
+    lands = landings_text(compiled.plan, compiled.rejected)
+    if lands is None:
+        lands = "landings: one per part (mirror-symmetric: face down is the same shape)"
+    elif c.landings_planned is not None:
+        lands = f"landings: {', '.join(c.landings_planned)} only (--landings), as in the paper"
+    say.print(f"  {escape(lands)}", highlight=False)
+    if c.note is not None:
+        say.print(f"  note: {escape(c.note)}", highlight=False)
     say.print(stats_table(compiled.plan, compiled.made.report))
     declared = uncertainty_text(compiled.plan.get("uncertainty"))
     say.print(f"  uncertainty: {escape(declared)}", highlight=False)
@@ -142,7 +151,13 @@ def print_changeover(say: Console, c: DemoChangeover) -> None:
     if c.lookalike and compiled.witnesses:
         say.print(
             "  the plan orients every part, recognizes the others, and its results list both "
-            "look-alikes with their poses (section 8.4); the report says so",
+            "look-alikes with their poses (section 8.4), on either side; the report says so",
+            highlight=False,
+        )
+    if compiled.rejected:
+        say.print(
+            "  a part in a rejected landing ends in a reject result as soon as the plan knows "
+            "(docs/landings.md); run says reject and the controller re-drops it",
             highlight=False,
         )
     say.print(f"  plan: {c.plan_path}", highlight=False)

@@ -22,7 +22,6 @@ from pathlib import Path
 from feederkit.catalog import default_catalog_path, get_revision, landings_for
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
-from feederkit.importers.orientable import orientability
 from feederkit.importers.reader import MESH_SUFFIXES, import_parts
 from feederkit.landing.model import (
     Landing,
@@ -31,9 +30,9 @@ from feederkit.landing.model import (
     select_landings,
 )
 from feederkit.loading import LoadedParts, load_parts
-from feederkit.mechanics.analysis import fragile_warning
-from feederkit.mechanics.push import PushFunction, push_function
-from feederkit.mix.changeover import landing_members, plan_mix
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.changeover import accepted_lumps, checked_landings, plan_landing_members
+from feederkit.mix.changeover import landing_members as landing_members  # re-exported
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import plan_from_dict
@@ -93,6 +92,12 @@ class LandingPlan:
     indistinguishable: tuple[LandingPair, ...]
     rejected: frozenset[str] = frozenset()
 
+    @property
+    def lumped(self) -> list[tuple[str, str]]:
+        """Pairs of landings (``PART/LANDING``) an accepting result lists together
+        (:func:`feederkit.mix.changeover.accepted_lumps`)."""
+        return accepted_lumps(self.made.plan)
+
     def landing_of(self, part: str, landing: str | None = None) -> Landing:
         """The landing ``landing`` of ``part`` (or, with one argument, the one labelled
         ``PART/LANDING``); InputError when the plan has none."""
@@ -142,15 +147,16 @@ def plan_landings(
 ) -> LandingPlan:
     """Plan over ``landings`` (of one part, or of several) as the members of one mix.
 
-    Every landing's part becomes a push function for
-    :func:`feederkit.mix.changeover.plan_mix` (which goes through
+    :func:`feederkit.mix.changeover.plan_landing_members` makes every landing's part a
+    push function for :func:`~feederkit.mix.changeover.plan_mix` (which goes through
     :func:`feederkit.plans.make.make_plan` and verifies the plan), with the shares and
     accept/reject of :func:`~feederkit.mix.changeover.landing_members` (``part_shares``: the
     parts' shares of a mix, None: equal); ``uncertainty`` defaults to design.md's. The
-    pairs reported leave out those of two rejected landings (the plan need not tell them
-    apart). Raises InputError for no landings, two with the same label, an accepted name
-    that is no landing, or every landing rejected, PlanningError when an accepted and a
-    rejected landing cannot be told apart.
+    pairs reported are :func:`~feederkit.mix.changeover.reported_pairs`' (two rejected
+    landings need not be told apart; two accepted ones, sides of one part too, are
+    reported), the rule ``changeover compile`` follows too. Raises InputError for no
+    landings, two with the same label, an accepted name that is no landing, or every landing
+    rejected, PlanningError when an accepted and a rejected landing cannot be told apart.
     """
     members = tuple(landings)
     if not members:
@@ -159,17 +165,12 @@ def plan_landings(
     dup = sorted({n for n in labels if labels.count(n) > 1})
     if dup:
         raise InputError(f"landing {dup[0]} is given twice")
-    named = landing_members(members, accept, part_shares)
-    pfs = [push_function(x.part) for x in members]
-    made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, members=named)
-    by_label = {x.label: x for x in members}
-    rejected = frozenset(x.label for x, m in zip(members, named, strict=True) if not m.accept)
-    found = tuple(
-        LandingPair(by_label[w.part_a], by_label[w.part_b], w)
-        for w in pairs
-        if not {w.part_a, w.part_b} <= rejected
+    mix = plan_landing_members(
+        members, sensor, options, uncertainty=uncertainty, accept=accept, part_shares=part_shares
     )
-    return LandingPlan(members, made, found, rejected)
+    by_label = {x.label: x for x in members}
+    found = tuple(LandingPair(by_label[w.part_a], by_label[w.part_b], w) for w in mix.witnesses)
+    return LandingPlan(members, mix.made, found, mix.rejected)
 
 
 @dataclass(frozen=True)
@@ -224,7 +225,8 @@ def _landings_of(
             return landings_of_outline(pf.part)
         opts = options or ImportOptions()
         _, imported = import_parts(path, opts)
-        return landings_for(imported[0], opts, path)
+        same = [x for x in imported if x.part.name == pf.part.name]
+        return landings_for((same or imported)[0], opts, path)
     db = Path(catalog) if catalog is not None else default_catalog_path()
     revision = None if pf.part.revision is None else int(pf.part.revision)
     stored = get_revision(db, pf.part.name, revision).landings
@@ -248,19 +250,9 @@ def load_landings(
     db = None if catalog is None else str(Path(catalog))
     per_part = []
     warnings = list(loaded.warnings)
-    for source, pf in zip(sources, loaded.push_functions, strict=True):
+    for source, pf in zip(loaded.origins, loaded.push_functions, strict=True):
         lands = select_landings(_landings_of(source, pf, db, options), which)
-        for x in lands:
-            if x.name.startswith("pose-"):
-                verdict = orientability(x.part, None)
-                if not verdict.orientable:
-                    raise InputError(
-                        f"{source}: landing {x.name} is not orientable by pushing: "
-                        f"{verdict.reason}; choose the landings to plan with --landings"
-                    )
-                fragile = fragile_warning(push_function(x.part))
-                if fragile is not None and fragile not in warnings:
-                    warnings.append(fragile)
+        checked_landings(source, lands, warnings)
         per_part.append(lands)
-    parts = LoadedParts(loaded.push_functions, tuple(warnings), loaded.left_out)
+    parts = LoadedParts(loaded.push_functions, tuple(warnings), loaded.left_out, loaded.origins)
     return LoadedLandings(parts, tuple(per_part))

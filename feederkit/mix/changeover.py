@@ -5,13 +5,18 @@ A changeover's plan orients every part of the mix; it recognizes every part exce
 that no plan can tell apart (section 8.4, Corollary 7), whose results list each candidate.
 The plan is made for the revisions it names: a part revised later does not change it, and
 :func:`stale_revisions` says when a newer revision exists.
+
+Plans cover every landing of every part unless told otherwise (design.md, "Landings"): each
+landing is one member of the mix. :func:`plan_landing_members` is the one place that plans
+landings and decides which pairs of them are reported (shared with ``feederkit plan``
+through :func:`feederkit.landing.plan.plan_landings`; docs/landings.md).
 """
 
 from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Collection, Iterable, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,17 +28,18 @@ from feederkit.catalog import (
     save_changeover,
 )
 from feederkit.errors import InputError
+from feederkit.importers.orientable import orientability
 from feederkit.jsonio import OutputFile, StagedFiles, parse_json
 from feederkit.landing.model import Landing, landings_of_outline, select_landings
 from feederkit.loading import load_parts
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.weights import normalised_shares
+from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.fileformat import plan_json, validate_plan
+from feederkit.plans.fileformat import as_plan, plan_json, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
-from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import PlanMember
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
@@ -52,6 +58,8 @@ class CompiledChangeover:
     made: MadePlan
     witnesses: tuple[PairWitness, ...]
     warnings: tuple[str, ...] = ()
+    rejected: frozenset[str] = frozenset()
+    """The landings (``PART/LANDING``) the next station does not take: reject results."""
 
     @property
     def plan(self) -> dict[str, Any]:
@@ -60,8 +68,9 @@ class CompiledChangeover:
 
     @property
     def lumped(self) -> list[tuple[str, str]]:
-        """Pairs of parts that some result of the plan lists together."""
-        return leaf_part_pairs(self.made.plan)
+        """Pairs of members that some accepting result of the plan lists together
+        (:func:`accepted_lumps`)."""
+        return accepted_lumps(self.made.plan)
 
 
 @dataclass(frozen=True)
@@ -82,11 +91,17 @@ class StoredChangeover:
         """The sensor the plan was made for."""
         return sensor_from_dict(dict(self.info.sensor))
 
+    @property
+    def rejected(self) -> frozenset[str]:
+        """The landings (``PART/LANDING``) its plan rejects (:func:`rejected_members`)."""
+        return rejected_members(self.plan)
+
     def witnesses(self) -> list[PairWitness]:
-        """The pairs of its parts no plan can tell apart (section 8.4), decided again exactly."""
+        """The pairs of its parts (or landings) no plan can tell apart (section 8.4), decided
+        again exactly, as :func:`reported_pairs` reports them."""
         if len(self.parts) < 2:
             return []
-        return unrecognizable_pairs(list(self.parts), self.sensor)
+        return reported_pairs(unrecognizable_pairs(list(self.parts), self.sensor), self.rejected)
 
 
 def _source(member: Member) -> str:
@@ -176,6 +191,154 @@ def landing_members(
     )
 
 
+def member_name(part: str, landing: str | None) -> str:
+    """A plan member as its push function is named: ``PART``, or ``PART/LANDING`` in a plan
+    over landings (:attr:`feederkit.landing.model.Landing.label`)."""
+    return part if landing is None else f"{part}/{landing}"
+
+
+def reported_pairs(
+    pairs: Iterable[PairWitness], rejected: Collection[str] = ()
+) -> list[PairWitness]:
+    """The pairs of members no plan can tell apart that a plan must report (exit 1).
+
+    The one rule for plans over landings (design.md, "Landings"; docs/landings.md), used by
+    ``plan``, ``changeover compile`` and the changeover commands alike; members are named
+    :func:`member_name`-wise, ``rejected`` names the landings the next station does not take:
+
+    * two **rejected** landings need not be told apart: both end in a reject result and the
+      controller recirculates the part either way, so the pair is left out;
+    * an **accepted and a rejected** landing that no plan tells apart leave no plan at all
+      (:func:`feederkit.plans.make.make_plan` raises PlanningError before planning);
+    * two **accepted** landings are reported like two parts of a mix (section 8.4), also
+      when they are the two sides of one part: the result then lists both landings, each
+      with its state and pose, so the controller knows the part but neither its side nor
+      the pose it lies in; the plan is still a correct plan, but the next station cannot
+      take the part as it is, which is a result the user must act on (a finer sensor, or
+      re-dropping the part).
+    """
+    return [w for w in pairs if not {w.part_a, w.part_b} <= set(rejected)]
+
+
+def accepted_lumps(plan: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """Pairs of members (:func:`member_name`) that an accepting result of ``plan`` lists
+    together, each pair once in the plan's part order. A reject result may list several
+    rejected landings: that lumps nothing (:func:`reported_pairs`)."""
+    checked = as_plan(plan)
+    order = {member_name(p.name, p.landing): k for k, p in enumerate(checked.parts)}
+    pairs: set[tuple[str, str]] = set()
+    for leaf in checked.leaves():
+        if leaf.reject:
+            continue
+        names = sorted(
+            {member_name(e.part, e.landing) for e in leaf.results}, key=order.__getitem__
+        )
+        pairs.update((a, b) for i, a in enumerate(names) for b in names[i + 1 :])
+    return sorted(pairs, key=lambda ab: (order[ab[0]], order[ab[1]]))
+
+
+def rejected_members(plan: Mapping[str, Any]) -> frozenset[str]:
+    """The landings (``PART/LANDING``) a plan file rejects: those its reject results name.
+
+    The plan file keeps no accept flag per member; a rejected landing's states end in reject
+    results only, and an accepted landing's never do (:func:`reported_pairs`)."""
+    return frozenset(
+        member_name(e.part, e.landing)
+        for leaf in as_plan(plan).leaves()
+        if leaf.reject
+        for e in leaf.results
+    )
+
+
+def landing_rows(plan: Mapping[str, Any], rejected: Collection[str]) -> list[dict[str, Any]]:
+    """The landings a plan over landings covers, in plan order (none for a plan of parts):
+    ``part``, ``landing``, ``share`` (the plan file's) and ``accept`` (``rejected`` names
+    the landings the next station does not take, ``PART/LANDING``)."""
+    return [
+        {
+            "part": p["name"],
+            "landing": p["landing"],
+            "share": p.get("share"),
+            "accept": member_name(p["name"], p["landing"]) not in rejected,
+        }
+        for p in plan.get("parts", [])
+        if p.get("landing") is not None
+    ]
+
+
+def plans_over_landings(
+    per_part: Sequence[Sequence[Landing]], landings_given: bool, accept_given: bool
+) -> bool:
+    """Whether a plan for parts with the landings ``per_part`` is made over landings.
+
+    design.md: "plans cover every landing unless told otherwise". When every part has one
+    landing (mirror-symmetric outlines) and neither the landings nor the accepted ones are
+    given, the plan over landings would be the plan of the parts themselves, so it is made
+    and written exactly so (no landing keys, as before landings existed); otherwise it is
+    made over landings, its parts and results naming them."""
+    return landings_given or accept_given or any(len(lands) > 1 for lands in per_part)
+
+
+def checked_landings(
+    source: str, landings: Sequence[Landing], warnings: list[str]
+) -> tuple[Landing, ...]:
+    """``landings`` when pushing can orient each one; a fragile mesh pose's warning is added
+    to ``warnings`` (once). InputError for a mesh pose on a round face, pointing to
+    ``--landings``."""
+    for x in landings:
+        if not x.name.startswith("pose-"):
+            continue
+        verdict = orientability(x.part, None)
+        if not verdict.orientable:
+            raise InputError(
+                f"{source}: landing {x.name} is not orientable by pushing: "
+                f"{verdict.reason}; choose the landings to plan with --landings"
+            )
+        fragile = fragile_warning(push_function(x.part))
+        if fragile is not None and fragile not in warnings:
+            warnings.append(fragile)
+    return tuple(landings)
+
+
+@dataclass(frozen=True)
+class LandingMix:
+    """A verified plan over landings: the landings' push functions and plan members (in plan
+    part order), the plan, and the pairs of landings it reports (:func:`reported_pairs`)."""
+
+    parts: tuple[PushFunction, ...]
+    members: tuple[PlanMember, ...]
+    made: MadePlan
+    witnesses: tuple[PairWitness, ...]
+
+    @property
+    def rejected(self) -> frozenset[str]:
+        """The landings (``PART/LANDING``) the plan rejects."""
+        return frozenset(
+            pf.part.name for pf, m in zip(self.parts, self.members, strict=True) if not m.accept
+        )
+
+
+def plan_landing_members(
+    landings: Sequence[Landing],
+    sensor: Sensor,
+    options: PlanningOptions | None = None,
+    *,
+    uncertainty: Uncertainty | None = None,
+    accept: Collection[str] | None = None,
+    part_shares: Sequence[float] | None = None,
+) -> LandingMix:
+    """Plan over ``landings`` (of one part or of several) as the members of one mix
+    (section 8.5): their shares and accept/reject from :func:`landing_members`, the plan
+    from :func:`plan_mix` (verified), the pairs no plan tells apart as
+    :func:`reported_pairs` reports them. The one path of ``plan`` and ``changeover
+    compile`` over landings. Raises as :func:`landing_members` and :func:`plan_mix` do."""
+    named = landing_members(landings, accept, part_shares)
+    pfs = tuple(push_function(x.part) for x in landings)
+    made, pairs = plan_mix(list(pfs), sensor, options, uncertainty=uncertainty, members=named)
+    rejected = {x.label for x, m in zip(landings, named, strict=True) if not m.accept}
+    return LandingMix(pfs, named, made, tuple(reported_pairs(pairs, rejected)))
+
+
 def strong_witnesses(
     machine: PushAlignMachine, lumped: Sequence[tuple[int, int]] = ()
 ) -> list[PairWitness]:
@@ -244,41 +407,55 @@ def compile_changeover(
 ) -> CompiledChangeover:
     """Plan, verify and store the changeover ``name`` for ``members`` (catalog parts).
 
-    ``shares`` are the parts' shares of the mix (normalised; None: equal). ``landings``
-    (``"all"`` or landing names) plans every part over its stored landings (docs/landings.md)
-    and ``accept`` names the landings the next station takes, the others ending in reject
-    results; with neither, each part is planned as stored (its imported outline), as before.
-    The changeover's ``parts`` and pairs are then the landings' (named ``PART/LANDING``).
+    Every landing of every part is planned for (design.md, "Landings"; docs/landings.md):
+    the revisions' stored landings, each one member of the mix, named ``PART/LANDING`` in
+    the changeover's ``parts`` and pairs. ``landings`` (``"all"`` or landing names, e.g.
+    ``("up",)``) picks them for every part; ``accept`` names the landings the next station
+    takes, the others ending in reject results. With neither, a mix whose parts have one
+    landing each (mirror-symmetric outlines) is planned as its parts, exactly as before
+    landings (:func:`plans_over_landings`). ``shares`` are the parts' shares of the mix
+    (normalised; None: equal), split among a part's landings by their probabilities.
 
     ``outputs`` gives the files to write with the changeover (its plan file, its report):
     they are written in full before the changeover is stored and put in place inside the
     store's transaction, so either the changeover is stored and its files written, or
     neither. ``uncertainty`` is the declared one (default ``Uncertainty()``). Raises
-    InputError for an existing name (unless ``replace``) or bad parts,
-    PlanningError when no plan meets the request, CheckFailed when the plan fails
-    verification.
+    InputError for an existing name (unless ``replace``), bad parts, a landing a part does
+    not have or an accepted name no landing has, PlanningError when no plan meets the
+    request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
+    plan fails verification.
     """
     if not replace and changeover_exists(catalog, name):
         raise InputError(f"a changeover named {name!r} already exists")
     loaded = load_parts([_source(m) for m in members], catalog=catalog)
     pfs = list(loaded.push_functions)
     revisions = loaded.revisions  # InputError for a part given as a file
-    if landings is None and accept is None:
-        made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty, weights=shares)
+    warnings = list(loaded.warnings)
+    per_part = [
+        checked_landings(
+            f"{n}@{r}",
+            select_landings(_stored_landings(catalog, n, r, pf), landings or "all"),
+            warnings,
+        )
+        for (n, r), pf in zip(revisions, pfs, strict=True)
+    ]
+    rejected: frozenset[str] = frozenset()
+    if plans_over_landings(per_part, landings is not None, accept is not None):
+        mix = plan_landing_members(
+            [x for lands in per_part for x in lands],
+            sensor,
+            options,
+            uncertainty=uncertainty,
+            accept=accept,
+            part_shares=shares,
+        )
+        pfs, made, witnesses, rejected = list(mix.parts), mix.made, mix.witnesses, mix.rejected
     else:
-        lands = [
-            x
-            for (n, r), pf in zip(revisions, pfs, strict=True)
-            for x in select_landings(_stored_landings(catalog, n, r, pf), landings or "all")
-        ]
-        named = landing_members(lands, accept, shares)
-        pfs = [push_function(x.part) for x in lands]
-        made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, members=named)
-        rejected = {x.label for x, m in zip(lands, named, strict=True) if not m.accept}
-        witnesses = [w for w in pairs if not {w.part_a, w.part_b} <= rejected]
-    warnings = [*loaded.warnings, *made.warnings, *stale_revisions(catalog, revisions)]
+        made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, weights=shares)
+        witnesses = tuple(pairs)
+    warnings += [*made.warnings, *stale_revisions(catalog, revisions)]
     compiled = CompiledChangeover(
-        name, tuple(revisions), tuple(pfs), made, tuple(witnesses), tuple(warnings)
+        name, tuple(revisions), tuple(pfs), made, tuple(witnesses), tuple(warnings), rejected
     )
     files = [] if outputs is None else list(outputs(compiled))
     with StagedFiles(files) as staged:

@@ -81,7 +81,9 @@ def cases(catalog: Path) -> Iterator[tuple[str, Callable[[], str]]]:
         sensor = tolerance_for([by_name[m] for m in members])
 
         def compiled(mix=mix, members=members, sensor=sensor) -> str:
-            c = compile_changeover(catalog, mix, members, sensor, replace=True, uncertainty=IDEAL)
+            c = compile_changeover(
+                catalog, mix, members, sensor, replace=True, uncertainty=IDEAL, landings=("up",)
+            )
             return plan_json(c.made.plan)
 
         yield f"changeover-{mix}.json", compiled
