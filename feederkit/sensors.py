@@ -340,10 +340,7 @@ class ToleranceSensor:
     def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
         if lo is None or hi is None:
             return 1.0
-        e = self.tolerance
-        d_lo, d_hi = span(diameter)
-        a, b = max(lo, d_lo - e), min(hi, d_hi + e)
-        return max(0.0, min(1.0, (b - a) / (d_hi - d_lo + 2.0 * e)))
+        return _uniform_share(lo, hi, span(diameter), self.tolerance)
 
     def uncovered_reading(
         self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
@@ -411,14 +408,11 @@ class ToleranceSensor:
         return _components(diameters, lambda d: self.reading_interval(d), closed=False)
 
     def reading_windows(self, diameters: Sequence[Diameter]) -> list[int] | None:
-        # Spans ascending at both ends (points, or snapped clusters, docs/conventions.md):
-        # the states a reading r can come from, lo - e < r < hi + e, are then a run.
-        spans = [span(d) for d in diameters]
-        n = len(spans)
-        if any(
-            spans[i][0] > spans[i + 1][0] or spans[i][1] > spans[i + 1][1] for i in range(n - 1)
-        ):
+        # The states a reading r can come from, lo - e < r < hi + e, are a run.
+        spans = _ascending_spans(diameters)
+        if spans is None:
             return None
+        n = len(spans)
         two = 2.0 * self.tolerance
         fuzz = 1e-9 * max(max((hi for _lo, hi in spans), default=1.0), two)
         out = []
@@ -436,14 +430,11 @@ class ToleranceSensor:
 
     def shared_reading_probability(self, diameters: Sequence[Diameter]) -> list[float] | None:
         # A reading orients exactly when it comes from one state alone: the part of the
-        # state's reading set that its neighbours in diameter order do not reach (spans
-        # ascending at both ends, as for the reading windows).
-        spans = [span(d) for d in diameters]
-        k = len(spans)
-        if any(
-            spans[i][0] > spans[i + 1][0] or spans[i][1] > spans[i + 1][1] for i in range(k - 1)
-        ):
+        # state's reading set that its neighbours in diameter order do not reach.
+        spans = _ascending_spans(diameters)
+        if spans is None:
             return None
+        k = len(spans)
         e = self.tolerance
         out = []
         for t, (d_lo, d_hi) in enumerate(spans):
@@ -544,8 +535,7 @@ class LedSensor:
         d_lo, d_hi = span(diameter)
         if d_hi - d_lo + 2.0 * e <= 0.0:
             return 1.0 if wlo < d_lo <= whi else 0.0
-        a, b = max(wlo, d_lo - e), min(whi, d_hi + e)
-        return max(0.0, min(1.0, (b - a) / (d_hi - d_lo + 2.0 * e)))
+        return _uniform_share(wlo, whi, (d_lo, d_hi), e)
 
     def uncovered_reading(
         self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
@@ -607,6 +597,28 @@ class LedSensor:
 
 SensorModel = NoSensor | ToleranceSensor | LedSensor
 """The concrete models (for type hints where a value, not the protocol, is meant)."""
+
+
+def _ascending_spans(diameters: Sequence[Diameter]) -> list[tuple[float, float]] | None:
+    """The diameters as intervals when both ends ascend (points, or snapped clusters,
+    docs/conventions.md), else None.
+
+    Only then are the states one reading can come from a run in this order, which the fast
+    paths :meth:`Sensor.reading_windows` and :meth:`Sensor.shared_reading_probability` use.
+    """
+    spans = [span(d) for d in diameters]
+    for (lo0, hi0), (lo1, hi1) in zip(spans, spans[1:], strict=False):
+        if lo0 > lo1 or hi0 > hi1:
+            return None
+    return spans
+
+
+def _uniform_share(lo: float, hi: float, diameter: tuple[float, float], e: float) -> float:
+    """The share of ``[lo, hi]`` in a state's widths ``[d_lo - e, d_hi + e]`` (readings
+    uniform over them: :meth:`Sensor.reading_probability`); the widths must not be empty."""
+    d_lo, d_hi = diameter
+    a, b = max(lo, d_lo - e), min(hi, d_hi + e)
+    return max(0.0, min(1.0, (b - a) / (d_hi - d_lo + 2.0 * e)))
 
 
 def _mask(positions: Sequence[int] | range, labels: Labels) -> int:

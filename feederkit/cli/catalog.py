@@ -44,35 +44,9 @@ from feederkit.cli.common import (
     print_json,
     progress_bar,
 )
-from feederkit.cli.importopts import (
-    AllowLargeOpt,
-    AllPartsOpt,
-    FlattenOpt,
-    HullOpt,
-    ImportTimeOpt,
-    LayerOpt,
-    MaxCrossingsOpt,
-    MaxEntitiesOpt,
-    MaxFacesOpt,
-    MaxHullFacesOpt,
-    MaxLoopsOpt,
-    MaxVerticesOpt,
-    PoseOpt,
-    SpaceOpt,
-    UnitsOpt,
-    import_options,
-)
+from feederkit.cli.importopts import takes_import_options, with_com
 from feederkit.errors import InputError
-from feederkit.importers import DEFAULT_FLATTEN_TOLERANCE
-from feederkit.importers.budget import (
-    DEFAULT_MAX_CROSSINGS,
-    DEFAULT_MAX_ENTITIES,
-    DEFAULT_MAX_FACES,
-    DEFAULT_MAX_HULL_FACES,
-    DEFAULT_MAX_LOOPS,
-    DEFAULT_MAX_VERTICES,
-    DEFAULT_TIME_LIMIT_S,
-)
+from feederkit.importers import ImportOptions
 from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
 
 RICH_TABLE_ROWS = 200
@@ -209,28 +183,15 @@ def cmd_init(
         )
 
 
+@takes_import_options
 def cmd_add(
     file: Annotated[Path, typer.Argument(help="Outline .json, .dxf, .stl, .obj or .ply file.")],
     name: Annotated[
         str | None, typer.Option("--name", help="Part name (default: from the file).")
     ] = None,
     revise: ReviseOpt = False,
-    units: UnitsOpt = None,
-    layer: LayerOpt = None,
-    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
-    hull_tolerance: HullOpt = None,
-    all_parts: AllPartsOpt = False,
-    pose: PoseOpt = None,
+    import_opts: ImportOptions = ImportOptions(),
     com: ComOpt = None,
-    allow_large: AllowLargeOpt = False,
-    space: SpaceOpt = "model",
-    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
-    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
-    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
-    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
-    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
-    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
-    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
     side_probability: SideOpt = DEFAULT_SIDE_PROBABILITY,
     catalog: CatalogOpt = None,
     wait: WaitOpt = DEFAULT_WAIT,
@@ -238,24 +199,7 @@ def cmd_add(
 ) -> None:
     """Import one file as a part with its landings; a changed file or changed options make a
     new revision (and say what changed), an unchanged one nothing."""
-    opts = import_options(
-        units,
-        layer,
-        flatten_tolerance,
-        hull_tolerance,
-        all_parts,
-        pose,
-        com,
-        allow_large,
-        space=space,
-        max_entities=max_entities,
-        max_vertices=max_vertices,
-        max_loops=max_loops,
-        max_crossings=max_crossings,
-        max_faces=max_faces,
-        max_hull_faces=max_hull_faces,
-        import_time_limit=import_time_limit,
-    )
+    opts = with_com(import_opts, com)
     check_side_probability(side_probability)
     _check_source_file(file)
     with opened(catalog, wait, create=True) as conn:
@@ -286,27 +230,14 @@ def _check_source_file(file: Path) -> None:
         raise InputError(f"{file}: cannot read the file ({exc.strerror})") from None
 
 
+@takes_import_options
 def cmd_import(
     directory: Annotated[
         Path, typer.Argument(help="Folder searched recursively for source files.")
     ],
     revise: ReviseOpt = False,
-    units: UnitsOpt = None,
-    layer: LayerOpt = None,
-    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
-    hull_tolerance: HullOpt = None,
-    all_parts: AllPartsOpt = False,
-    pose: PoseOpt = None,
+    import_opts: ImportOptions = ImportOptions(),
     com: ComOpt = None,
-    allow_large: AllowLargeOpt = False,
-    space: SpaceOpt = "model",
-    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
-    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
-    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
-    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
-    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
-    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
-    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
     side_probability: SideOpt = DEFAULT_SIDE_PROBABILITY,
     skip_bad: Annotated[
         bool,
@@ -318,24 +249,7 @@ def cmd_import(
 ) -> None:
     """Import every source file of a folder, with landings, in one transaction: all files or
     none (with --skip-bad: every good file, and each bad one named)."""
-    opts = import_options(
-        units,
-        layer,
-        flatten_tolerance,
-        hull_tolerance,
-        all_parts,
-        pose,
-        com,
-        allow_large,
-        space=space,
-        max_entities=max_entities,
-        max_vertices=max_vertices,
-        max_loops=max_loops,
-        max_crossings=max_crossings,
-        max_faces=max_faces,
-        max_hull_faces=max_hull_faces,
-        import_time_limit=import_time_limit,
-    )
+    opts = with_com(import_opts, com)
     check_side_probability(side_probability)
     item_column = TextColumn("{task.fields[item]}")
     with progress_bar(item_column, disable=not err_console.is_terminal) as bar:

@@ -5,12 +5,19 @@ import budgets, docs/import.md), the builder of :class:`~feederkit.importers.Imp
 and the printing of the importer's warnings (parts left out, frames skipped, gaps closed,
 units in doubt), so ``part analyze``, ``part plot``, ``lookalike``, ``plan`` and ``catalog``
 say the same thing about the same file.
+
+A command takes them all with :func:`takes_import_options`: it declares one parameter
+``import_opts: ImportOptions`` and gets the options (same names, defaults and help on every
+command) in its place.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from typing import Annotated
+import dataclasses
+import functools
+import inspect
+from collections.abc import Callable, Iterable
+from typing import Annotated, Any, TypeVar
 
 import typer
 
@@ -146,6 +153,81 @@ def import_options(
             seconds=import_time_limit,
         ),
     )
+
+
+def _option(name: str, annotation: Any, default: Any) -> inspect.Parameter:
+    return inspect.Parameter(
+        name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation
+    )
+
+
+IMPORT_PARAMETERS: tuple[inspect.Parameter, ...] = (
+    _option("units", UnitsOpt, None),
+    _option("layer", LayerOpt, None),
+    _option("space", SpaceOpt, "model"),
+    _option("all_parts", AllPartsOpt, False),
+    _option("pose", PoseOpt, None),
+    _option("flatten_tolerance", FlattenOpt, DEFAULT_FLATTEN_TOLERANCE),
+    _option("hull_tolerance", HullOpt, None),
+    _option("allow_large", AllowLargeOpt, False),
+    _option("max_entities", MaxEntitiesOpt, DEFAULT_MAX_ENTITIES),
+    _option("max_vertices", MaxVerticesOpt, DEFAULT_MAX_VERTICES),
+    _option("max_loops", MaxLoopsOpt, DEFAULT_MAX_LOOPS),
+    _option("max_crossings", MaxCrossingsOpt, DEFAULT_MAX_CROSSINGS),
+    _option("max_faces", MaxFacesOpt, DEFAULT_MAX_FACES),
+    _option("max_hull_faces", MaxHullFacesOpt, DEFAULT_MAX_HULL_FACES),
+    _option("import_time_limit", ImportTimeOpt, DEFAULT_TIME_LIMIT_S),
+)
+"""The import options as command parameters, in the order ``--help`` lists them; each
+default is the library's (:class:`~feederkit.importers.ImportOptions`, ``ImportLimits``)."""
+
+IMPORT_OPTS = "import_opts"
+"""The parameter of a command that :func:`takes_import_options` fills."""
+
+Command = TypeVar("Command", bound=Callable[..., Any])
+
+
+def takes_import_options(command: Command) -> Command:
+    """The command with its ``import_opts`` parameter replaced by :data:`IMPORT_PARAMETERS`.
+
+    Typer reads the new signature, so ``--help`` lists the shared options where
+    ``import_opts`` stood; a call (from typer or Python) turns them into one
+    :class:`~feederkit.importers.ImportOptions` (bad values: InputError, before the body
+    runs). The options and every parameter after them become keyword-only.
+    """
+    signature = inspect.signature(command, eval_str=True)
+    params = list(signature.parameters.values())
+    names = [p.name for p in params]
+    if IMPORT_OPTS not in names:
+        raise TypeError(f"{command.__name__} has no {IMPORT_OPTS!r} parameter")
+    taken = {p.name for p in IMPORT_PARAMETERS} & set(names)
+    if taken:
+        raise TypeError(f"{command.__name__} already has {', '.join(sorted(taken))}")
+    at = names.index(IMPORT_OPTS)
+    keyword = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in params[at + 1 :]]
+    new_signature = signature.replace(parameters=[*params[:at], *IMPORT_PARAMETERS, *keyword])
+
+    @functools.wraps(command)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        bound = new_signature.bind(*args, **kwargs)
+        bound.apply_defaults()
+        values = bound.arguments
+        chosen = {p.name: values.pop(p.name) for p in IMPORT_PARAMETERS}
+        values[IMPORT_OPTS] = import_options(**chosen)
+        return command(**values)
+
+    run.__signature__ = new_signature  # type: ignore[attr-defined]
+    run.__annotations__ = {p.name: p.annotation for p in new_signature.parameters.values()}
+    if new_signature.return_annotation is not inspect.Signature.empty:
+        run.__annotations__["return"] = new_signature.return_annotation
+    return run  # type: ignore[return-value]
+
+
+def with_com(options: ImportOptions, com: tuple[float, float] | None) -> ImportOptions:
+    """The options with a ``--com X Y`` given on the command line (None: as they are)."""
+    if com is None:
+        return options
+    return dataclasses.replace(options, com=(float(com[0]), float(com[1])))
 
 
 def print_import_warnings(source: str, warnings: Iterable[str]) -> None:

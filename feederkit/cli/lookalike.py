@@ -16,42 +16,16 @@ import typer
 from rich.table import Table
 
 from feederkit.cli.common import CatalogOpt, JsonOpt, console, err_console, print_json
-from feederkit.cli.importopts import (
-    AllowLargeOpt,
-    AllPartsOpt,
-    FlattenOpt,
-    HullOpt,
-    ImportTimeOpt,
-    LayerOpt,
-    MaxCrossingsOpt,
-    MaxEntitiesOpt,
-    MaxFacesOpt,
-    MaxHullFacesOpt,
-    MaxLoopsOpt,
-    MaxVerticesOpt,
-    PoseOpt,
-    SpaceOpt,
-    UnitsOpt,
-    import_options,
-    print_import_warnings,
-)
+from feederkit.cli.importopts import print_import_warnings, takes_import_options
 from feederkit.errors import InputError
-from feederkit.importers import DEFAULT_FLATTEN_TOLERANCE
-from feederkit.importers.budget import (
-    DEFAULT_MAX_CROSSINGS,
-    DEFAULT_MAX_ENTITIES,
-    DEFAULT_MAX_FACES,
-    DEFAULT_MAX_HULL_FACES,
-    DEFAULT_MAX_LOOPS,
-    DEFAULT_MAX_VERTICES,
-    DEFAULT_TIME_LIMIT_S,
-)
+from feederkit.importers import ImportOptions
 from feederkit.jsonio import write_text_atomic
 from feederkit.mix.lookalike import build_lookalike
 from feederkit.outline import outline_to_dict
 from feederkit.sources import load_part_with_warnings
 
 
+@takes_import_options
 def lookalike_command(
     source: Annotated[str, typer.Argument(help="An outline file, CAD file or catalog part name.")],
     keep: Annotated[
@@ -63,21 +37,7 @@ def lookalike_command(
     name: Annotated[str | None, typer.Option("--name", help="Name of the new part.")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the construction's choices.")] = 0,
     catalog: CatalogOpt = None,
-    units: UnitsOpt = None,
-    layer: LayerOpt = None,
-    space: SpaceOpt = "model",
-    all_parts: AllPartsOpt = False,
-    pose: PoseOpt = None,
-    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
-    hull_tolerance: HullOpt = None,
-    allow_large: AllowLargeOpt = False,
-    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
-    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
-    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
-    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
-    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
-    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
-    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
+    import_opts: ImportOptions = ImportOptions(),
     json_out: JsonOpt = False,
 ) -> None:
     """A non-similar part with the same push function (Theorem 4) or the same push-diameter
@@ -89,25 +49,7 @@ def lookalike_command(
         raise InputError(f"--keep must be push or push-diameter, got {keep!r}")
     if output is not None and output.suffix.lower() != ".json":
         raise InputError(f"{output}: the look-alike is written as an outline file (.json)")
-    opts = import_options(
-        units,
-        layer,
-        flatten_tolerance,
-        hull_tolerance,
-        all_parts,
-        pose,
-        None,
-        allow_large,
-        space=space,
-        max_entities=max_entities,
-        max_vertices=max_vertices,
-        max_loops=max_loops,
-        max_crossings=max_crossings,
-        max_faces=max_faces,
-        max_hull_faces=max_hull_faces,
-        import_time_limit=import_time_limit,
-    )
-    loaded = load_part_with_warnings(source, catalog=catalog, options=opts)
+    loaded = load_part_with_warnings(source, catalog=catalog, options=import_opts)
     print_import_warnings(source, loaded.warnings)
     part = loaded.part
     result = build_lookalike(part, keep, seed)
