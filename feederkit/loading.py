@@ -18,7 +18,7 @@ from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
-from feederkit.sources import load_part_with_warnings
+from feederkit.sources import load_parts_with_warnings
 
 
 @dataclass(frozen=True)
@@ -27,12 +27,14 @@ class LoadedParts:
 
     ``warnings``: one line each from the imports (prefixed with the SOURCE) and for fragile
     states; ``left_out``: one line per part that is not orientable by pushing (only when
-    such parts are left out rather than refused).
+    such parts are left out rather than refused); ``origins``: the SOURCE each push function
+    came from (a drawing read with ``all_parts`` gives several).
     """
 
     push_functions: tuple[PushFunction, ...]
     warnings: tuple[str, ...] = ()
     left_out: tuple[str, ...] = ()
+    origins: tuple[str, ...] = ()
 
     @property
     def names(self) -> list[str]:
@@ -63,7 +65,8 @@ def load_parts(
     """Load and check the parts named by ``sources`` (files or catalog ``NAME[@REV]``).
 
     ``catalog`` is the catalog for names (default: :func:`feederkit.catalog.resolve_catalog_path`);
-    ``options`` the CAD import's. A part not orientable by pushing is bad input unless
+    ``options`` the CAD import's (with ``all_parts``, every separate part of a drawing joins
+    the mix). A part not orientable by pushing is bad input unless
     ``leave_out_not_orientable``. Raises InputError for unreadable sources, unknown names,
     and a part named twice.
     """
@@ -71,24 +74,28 @@ def load_parts(
         raise InputError("no parts to plan for")
     db = None if catalog is None else str(Path(catalog))
     pfs: list[PushFunction] = []
+    origins: list[str] = []
     warnings: list[str] = []
     left_out: list[str] = []
     for source in sources:
-        loaded = load_part_with_warnings(source, catalog=db, options=options)
-        if not loaded.orientability.orientable:
-            line = f"{source}: not orientable by pushing: {loaded.orientability.reason}"
-            if not leave_out_not_orientable:
-                raise InputError(line)
-            left_out.append(line)
-            continue
-        warnings += [f"{source}: {w}" for w in loaded.warnings]
-        pf = push_function(loaded.part)
-        fragile = fragile_warning(pf)
-        if fragile is not None:
-            warnings.append(fragile)
-        pfs.append(pf)
+        every = load_parts_with_warnings(source, catalog=db, options=options)
+        for loaded in every:
+            where = source if len(every) == 1 else f"{source} ({loaded.part.name})"
+            if not loaded.orientability.orientable:
+                line = f"{where}: not orientable by pushing: {loaded.orientability.reason}"
+                if not leave_out_not_orientable:
+                    raise InputError(line)
+                left_out.append(line)
+                continue
+            warnings += [f"{where}: {w}" for w in loaded.warnings]
+            pf = push_function(loaded.part)
+            fragile = fragile_warning(pf)
+            if fragile is not None:
+                warnings.append(fragile)
+            pfs.append(pf)
+            origins.append(source)
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:
             raise InputError(f"the part {name!r} is named twice: a mix names each part once")
-    return LoadedParts(tuple(pfs), tuple(warnings), tuple(left_out))
+    return LoadedParts(tuple(pfs), tuple(warnings), tuple(left_out), tuple(origins))

@@ -65,17 +65,19 @@ def _from_catalog(source: str, com: Point | None, catalog: str | None) -> Loaded
     return LoadedPart(part, tuple(notes), verdict, f"catalog {db}")
 
 
-def load_part_with_warnings(
+def load_parts_with_warnings(
     source: str,
     *,
     com: Point | None = None,
     catalog: str | None = None,
     options: ImportOptions | None = None,
-) -> LoadedPart:
-    """Load one part from a SOURCE with the warnings of its import (unitless drawing, ...).
+) -> tuple[LoadedPart, ...]:
+    """Every part a SOURCE holds, with the warnings of its import (unitless drawing, ...).
 
-    ``options`` sets the CAD import (units, layers, tolerances, mesh pose); ``com`` overrides
-    the center of mass. Raises InputError naming the source when it is not a valid part.
+    A file gives one part, or every separate part of a drawing with ``options.all_parts``
+    (named ``NAME``, ``NAME-2``, ...); a catalog name gives its revision. ``options`` sets the
+    CAD import (units, layers, tolerances, mesh pose); ``com`` overrides the center of mass.
+    Raises InputError naming the source when it is not a valid part.
     """
     opts = options or ImportOptions()
     if com is not None:
@@ -87,13 +89,32 @@ def load_part_with_warnings(
         raise InputError(f"{source[:80]}: cannot be a file ({exc.strerror or exc})") from None
     if is_file:
         _, parts = import_parts(path, opts)
-        first = parts[0]
-        return LoadedPart(first.part, first.warnings, first.orientability, str(path))
+        return tuple(LoadedPart(p.part, p.warnings, p.orientability, str(path)) for p in parts)
     if exists:
         raise InputError(f"{source}: not a file")
     if not could_be_part_name(source):
         raise InputError(f"{source}: no such file")
-    return _from_catalog(source, opts.com, catalog)
+    return (_from_catalog(source, opts.com, catalog),)
+
+
+def load_part_with_warnings(
+    source: str,
+    *,
+    com: Point | None = None,
+    catalog: str | None = None,
+    options: ImportOptions | None = None,
+) -> LoadedPart:
+    """The one part a SOURCE holds (:func:`load_parts_with_warnings`), for the commands that
+    take a single outline: InputError when ``options.all_parts`` finds several, so that no
+    part is silently left out."""
+    loaded = load_parts_with_warnings(source, com=com, catalog=catalog, options=options)
+    if len(loaded) > 1:
+        names = ", ".join(x.part.name for x in loaded)
+        raise InputError(
+            f"{source}: holds {len(loaded)} separate parts ({names}) and this command takes "
+            "one: leave out --all-parts to take the largest"
+        )
+    return loaded[0]
 
 
 def load_part(

@@ -209,3 +209,19 @@ def test_low_margin_warning():
 def test_plan_from_dict_accepts_only_a_checked_plan():
     with pytest.raises(InputError, match="not a feederkit plan"):
         plan_from_dict([1, 2, 3])
+
+
+def test_a_strong_plans_margin_is_slack_beyond_its_declared_rotation_error():
+    from dataclasses import replace
+
+    from feederkit.plans.model import low_margin_words
+    from feederkit.uncertainty import Uncertainty
+
+    plan = read_plan(GOLDEN / "t-clip.sensorless.json")
+    m = plan.stats.min_margin_deg
+    assert m < 0.5
+    assert replace(plan, uncertainty=Uncertainty(1.0)).low_margin_warning() is None
+    words = replace(plan, uncertainty=Uncertainty(0.2)).low_margin_warning()
+    assert words is not None and "declared ±0.2°" in words
+    assert low_margin_words(None, 0.0) is None and low_margin_words(float("inf")) is None
+    assert low_margin_words(0.999) is not None and low_margin_words(0.5, 0.5) is None

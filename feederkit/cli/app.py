@@ -24,6 +24,12 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
 
     import typer
     from rich.markup import escape
+    from typer.exceptions import Abort
+
+    try:  # typer 0.2x carries its own click
+        from typer._click.exceptions import ClickException, NoArgsIsHelpError, UsageError
+    except ImportError:  # pragma: no cover - typer on the click package
+        from click.exceptions import ClickException, NoArgsIsHelpError, UsageError
 
     import feederkit
     from feederkit.catalog import set_busy_notifier
@@ -182,14 +188,32 @@ def write_crash_log(exc: BaseException, argv: list[str] | None) -> str | None:
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app and turn every error into one line on stderr and an exit code.
 
-    Usage errors (unknown options, missing arguments) exit with 2, as click does.
+    Usage errors (unknown options, missing arguments, bad values) are one line too, naming
+    the command's ``--help``, and exit with 2, as click does.
     """
     set_busy_notifier(_notify_busy)
     try:
-        _click_command().main(args=argv, prog_name="feederkit")
+        code = _click_command().main(args=argv, prog_name="feederkit", standalone_mode=False)
+        if isinstance(code, int) and code == EXIT_INTERRUPTED:
+            _say("interrupted")
+        return code if isinstance(code, int) else 0
     except FeederkitError as exc:
         _say(_oneline(exc))
         return exc.exit_code
+    except NoArgsIsHelpError as exc:  # ``feederkit`` or a group alone: its help
+        if exc.ctx is not None:
+            typer.echo(exc.ctx.get_help())
+        return 0
+    except UsageError as exc:
+        where = exc.ctx.command_path if exc.ctx is not None else "feederkit"
+        _say(f"{_oneline(exc.format_message())} (see {where} --help)")
+        return 2
+    except ClickException as exc:
+        _say(_oneline(exc.format_message()))
+        return exc.exit_code
+    except Abort:
+        _say("interrupted")
+        return EXIT_INTERRUPTED
     except SystemExit as exc:
         if exc.code is None:
             return 0

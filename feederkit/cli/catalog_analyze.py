@@ -98,8 +98,21 @@ def analyze_command(
         more = f" and {n - 5} more" if n > 5 else ""
         raise CheckFailed(
             f"{n} pair(s) of parts no plan can tell apart with this sensor: {named}{more}; "
-            "keep them out of one mix or use a finer sensor"
+            + _advice({w.kind for w in result.pairs})
         )
+
+
+def _advice(kinds: set[str]) -> str:
+    """What helps, by the witnesses' kinds: no sensor separates parts with the same
+    push-diameter function (Lemma 8), a finer one may separate the others."""
+    if kinds == {"same-push-diameter"}:
+        return "keep them out of one mix: no sensor tells them apart (same push-diameter function)"
+    if "same-push-diameter" in kinds:
+        return (
+            "keep them out of one mix; a finer sensor helps only the pairs whose push-diameter "
+            "functions differ"
+        )
+    return "keep them out of one mix or use a finer sensor"
 
 
 def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:

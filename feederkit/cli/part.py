@@ -24,36 +24,9 @@ from feederkit.cli.common import (
     err_console,
     print_json,
 )
-from feederkit.cli.importopts import (
-    AllowLargeOpt,
-    AllPartsOpt,
-    FlattenOpt,
-    HullOpt,
-    ImportTimeOpt,
-    LayerOpt,
-    MaxCrossingsOpt,
-    MaxEntitiesOpt,
-    MaxFacesOpt,
-    MaxHullFacesOpt,
-    MaxLoopsOpt,
-    MaxVerticesOpt,
-    PoseOpt,
-    SpaceOpt,
-    UnitsOpt,
-    import_options,
-    print_import_warnings,
-)
+from feederkit.cli.importopts import print_import_warnings, takes_import_options
 from feederkit.cli.part_plot import plot_command
-from feederkit.importers import DEFAULT_FLATTEN_TOLERANCE
-from feederkit.importers.budget import (
-    DEFAULT_MAX_CROSSINGS,
-    DEFAULT_MAX_ENTITIES,
-    DEFAULT_MAX_FACES,
-    DEFAULT_MAX_HULL_FACES,
-    DEFAULT_MAX_LOOPS,
-    DEFAULT_MAX_VERTICES,
-    DEFAULT_TIME_LIMIT_S,
-)
+from feederkit.importers import ImportOptions
 from feederkit.mechanics.analysis import (
     PartAnalysis,
     analysis_to_dict,
@@ -61,7 +34,7 @@ from feederkit.mechanics.analysis import (
     fragile_warning,
 )
 from feederkit.sensors import make_sensor
-from feederkit.sources import load_part_with_warnings
+from feederkit.sources import load_parts_with_warnings
 
 NEAR_LIST_MAX = 8
 """At most this many near-metastable edges are named in a warning line; the rest are counted."""
@@ -158,6 +131,7 @@ def _print_analysis(a: PartAnalysis) -> None:
 
 
 @part_app.command("analyze")
+@takes_import_options
 def analyze_command(
     sources: Annotated[
         list[str],
@@ -179,21 +153,7 @@ def analyze_command(
     noise: NoiseOpt = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
-    units: UnitsOpt = None,
-    layer: LayerOpt = None,
-    space: SpaceOpt = "model",
-    all_parts: AllPartsOpt = False,
-    pose: PoseOpt = None,
-    flatten_tolerance: FlattenOpt = DEFAULT_FLATTEN_TOLERANCE,
-    hull_tolerance: HullOpt = None,
-    allow_large: AllowLargeOpt = False,
-    max_entities: MaxEntitiesOpt = DEFAULT_MAX_ENTITIES,
-    max_vertices: MaxVerticesOpt = DEFAULT_MAX_VERTICES,
-    max_loops: MaxLoopsOpt = DEFAULT_MAX_LOOPS,
-    max_crossings: MaxCrossingsOpt = DEFAULT_MAX_CROSSINGS,
-    max_faces: MaxFacesOpt = DEFAULT_MAX_FACES,
-    max_hull_faces: MaxHullFacesOpt = DEFAULT_MAX_HULL_FACES,
-    import_time_limit: ImportTimeOpt = DEFAULT_TIME_LIMIT_S,
+    import_opts: ImportOptions = ImportOptions(),
 ) -> None:
     """Stable states, resting ranges, diameters, symmetry and (with a sensor) the Fig. 14 class."""
     given = sensorless or tolerance is not None or led_pitch is not None or noise is not None
@@ -202,29 +162,13 @@ def analyze_command(
         if given
         else None
     )
-    opts = import_options(
-        units,
-        layer,
-        flatten_tolerance,
-        hull_tolerance,
-        all_parts,
-        pose,
-        None,
-        allow_large,
-        space=space,
-        max_entities=max_entities,
-        max_vertices=max_vertices,
-        max_loops=max_loops,
-        max_crossings=max_crossings,
-        max_faces=max_faces,
-        max_hull_faces=max_hull_faces,
-        import_time_limit=import_time_limit,
-    )
     parts = []
     for src in sources:
-        loaded = load_part_with_warnings(src, com=com, catalog=catalog, options=opts)
-        print_import_warnings(src, loaded.warnings)
-        parts.append(loaded.part)
+        for loaded in load_parts_with_warnings(
+            src, com=com, catalog=catalog, options=import_opts
+        ):
+            print_import_warnings(src, loaded.warnings)
+            parts.append(loaded.part)
     analyses = [analyze_part(p, sensor) for p in parts]
     for a in analyses:
         for warning in (near_metastable_warning(a), fragile_warning(a.push)):

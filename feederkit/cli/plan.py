@@ -52,12 +52,14 @@ from feederkit.cli.common import (
     uncertainty_option,
     uncertainty_text,
 )
+from feederkit.cli.importopts import takes_import_options
 from feederkit.cli.plan_render import plan_tree, sensor_text, stats_table
 from feederkit.errors import CheckFailed, InputError
+from feederkit.importers import ImportOptions
 from feederkit.jsonio import write_files
 from feederkit.landing.plan import LandingPlan, landing_names, load_landings, plan_landings
 from feederkit.mechanics.push import push_function
-from feederkit.mix.changeover import plan_mix
+from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label
@@ -160,6 +162,7 @@ def _accepted_names(text: str | None, planned_names: set[str]) -> tuple[str, ...
     return names
 
 
+@takes_import_options
 def plan_command(
     sources: Annotated[
         list[str],
@@ -188,6 +191,7 @@ def plan_command(
     landings: LandingsOpt = None,
     accept: AcceptOpt = None,
     cell: CellOpt = None,
+    import_opts: ImportOptions = ImportOptions(),
 ) -> None:
     """Plan the shortest conditional sequence of push-align operations that orients the part(s).
 
@@ -208,11 +212,11 @@ def plan_command(
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
     with flag_words(terms):
         which = "all" if landings in (None, "all") else landing_names(landings)
-        found = load_landings(sources, catalog=catalog, which=which)
+        found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
     loaded = found.parts
     print_warnings(loaded.warnings)
     planned: LandingPlan | None = None
-    if landings is None and accept is None and not found.several:
+    if not plans_over_landings(found.landings, landings is not None, accept is not None):
         pfs = list(loaded.push_functions)
         with searching("planning and verifying", options.time_limit_s), flag_words():
             made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)

@@ -279,6 +279,31 @@ LOW_MARGIN_DEG = 1.0
 """Below this smallest margin no robot holds the plan's rotations: every output warns."""
 
 
+def low_margin_words(min_margin_deg: float | None, rotation_error_deg: float = 0.0) -> str | None:
+    """One line when a plan holds rotations off by less than :data:`LOW_MARGIN_DEG`: its
+    declared rotation error plus its smallest margin (None: no rotation, or enough).
+
+    >>> low_margin_words(0.5) is None, low_margin_words(0.5, 1.0) is None
+    (False, True)
+    """
+    m = min_margin_deg
+    if m is None or not math.isfinite(m):
+        return None
+    held = m + rotation_error_deg
+    if held >= LOW_MARGIN_DEG:
+        return None
+    if rotation_error_deg > 0.0:
+        return (
+            f"the plan holds rotation errors up to ±{held:.3g}° (declared ±{rotation_error_deg:g}° "
+            f"plus its smallest margin ±{m:.3g}°), below ±{LOW_MARGIN_DEG:g}°: a robot whose "
+            "rotations err by more will not follow the plan"
+        )
+    return (
+        f"the plan's smallest margin is ±{m:.3g}°, below ±{LOW_MARGIN_DEG:g}°: a robot "
+        "whose rotations err by more will not follow the plan"
+    )
+
+
 @dataclass(frozen=True)
 class Plan:
     """A plan: its sensor, its declared uncertainty, its parts (in order), the tree from
@@ -398,11 +423,8 @@ class Plan:
         return min(margins) if margins else None
 
     def low_margin_warning(self) -> str | None:
-        """A warning when the smallest margin is below LOW_MARGIN_DEG (None otherwise)."""
-        m = self.stats.min_margin_deg
-        if m is None or not math.isfinite(m) or m >= LOW_MARGIN_DEG:
-            return None
-        return (
-            f"the plan's smallest margin is ±{m:.3g}°, below ±{LOW_MARGIN_DEG:g}°: a robot "
-            "whose rotations err by more will not follow the plan"
-        )
+        """A warning when the plan holds rotation errors below LOW_MARGIN_DEG (None otherwise).
+
+        A strong plan's margins are slack beyond its declared rotation error (its outcome
+        sets already cover that error), so what it holds is the two together."""
+        return low_margin_words(self.stats.min_margin_deg, self.uncertainty.rotation_error_deg)
