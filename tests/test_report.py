@@ -247,7 +247,7 @@ def test_part_names_are_escaped_everywhere():
     assert "&lt;b&gt;&amp;&quot;x" in html
     doc = parse(html)
     assert not [t for t, _ in doc.tags if t in ("b", "i", "script", "u")]
-    assert f"Changeover report: {NASTY}" in "".join(doc.text)
+    assert f"Plan report: {NASTY}" in "".join(doc.text)
     assert all(f["data-part"] == NASTY for f in doc.with_class("final-pose"))
 
 
@@ -337,7 +337,7 @@ def test_per_part_section_has_a_state_table_and_an_embedded_plot():
 
 def test_symmetric_leaves_and_twins_are_reported():
     text = "".join(parse(render_report(rectangle_plan())).text)
-    assert "Oriented up to symmetry" in text and "rect: states s0, s2" in text
+    assert "Poses no plan tells apart" in text and "rect: states s0, s2" in text
     doc = parse(render_report(twin_plan()))
     pairs = doc.with_class("pair")
     assert len(pairs) == 1 and pairs[0]["data-source"] == "plan"  # one row, three witnesses

@@ -114,7 +114,7 @@ def test_part_names_render_as_text_in_the_browser(tmp_path):
     dom = parse(chromium(tmp_path, page, "--dump-dom").stdout)
     assert not [t for t, _ in dom.tags if t in ("b", "script")]
     text = "".join(dom.text)
-    assert f"Changeover report: {NASTY}" in text
+    assert f"Plan report: {NASTY}" in text
     assert {f["data-part"] for f in dom.with_class("final-pose")} == {NASTY}
 
 

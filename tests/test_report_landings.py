@@ -180,3 +180,20 @@ def test_the_whole_page_of_a_dag_plan():
     took = time.perf_counter() - start
     assert took < 10.0, f"{took:.2f} s"  # one part plot and the tree of ~300 distinct nodes
     assert len(doc.with_class("tree-node")) == len(list(plan.walk()))
+
+
+def test_a_strong_plans_leaf_is_not_called_wrong_for_states_only_uncertainty_brings(tmp_path):
+    """The d-washer's strong plan (1 degree) has a leaf that the nominal push reaches with
+    fewer states than it lists: the report says why, not that the plan is wrong."""
+    from feederkit.mechanics.push import push_function
+    from feederkit.plans.make import make_plan
+    from feederkit.reports import render_report
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.sources import load_part
+
+    washer = Path(__file__).resolve().parents[1] / "catalog" / "d-washer.json"
+    pf = push_function(load_part(str(washer)))
+    made = make_plan([pf], ToleranceSensor(0.3))
+    html = render_report(made.plan)
+    assert "On the nominal push (no rotation error)" in html
+    assert "Following the plan, the states that reach this leaf" not in html

@@ -82,8 +82,9 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
         '<h2>The plan</h2><p class="muted">Each box is a plan node with the states the part '
         "may be in, drawn on the fence. Each edge says the rotation the robot applies and the "
         "reading that leads there. Shaded boxes are the final poses: green one known pose, blue "
-        "poses alike up to symmetry, red parts the plan cannot tell apart, yellow a reject "
-        "leaf: landings the next station cannot take, recirculated or re-dropped.</p>"
+        "poses no plan tells apart (symmetric or nearly so), red parts the plan cannot tell "
+        "apart, yellow a reject leaf: landings the next station cannot take, recirculated or "
+        "re-dropped.</p>"
         f'<p class="counts">{esc(counts)}.</p>'
         f"{tree}</section>"
     )
@@ -159,7 +160,7 @@ def render_report(
     symmetric = [(p.node_id, p.node) for p in numbered if isinstance(p.node, Leaf)]
     body = "".join(
         [
-            f"<h1>Changeover report: {esc(names)}</h1>",
+            f"<h1>{'Changeover' if len(plan.parts) > 1 else 'Plan'} report: {esc(names)}</h1>",
             _banners(plan, report),
             mix_section(plan, draw),
             tree_section(numbered, tree_html(plan, numbered, trace, draw)),

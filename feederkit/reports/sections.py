@@ -284,7 +284,7 @@ def lookalike_section(
             for node_id, leaf in sym
         )
         body += (
-            "<p>Oriented up to symmetry (poses no plan tells apart; each is a correct answer):"
+            "<p>Poses no plan tells apart (symmetric or nearly so; each is a correct answer):"
             f"</p><ul>{items}</ul>"
         )
     return f'<section id="lookalikes"><h2>Parts the plan cannot tell apart</h2>{body}</section>'

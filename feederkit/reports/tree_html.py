@@ -166,7 +166,8 @@ def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: 
         head = f"done: {plan.parts[keys[0][0]].label} in state {keys[0][1]}"
         kind = "known"
     elif len(members) == 1:
-        head = f"done up to symmetry: {len(node.results)} poses that no plan tells apart"
+        label = plan.parts[next(iter(members))].label
+        head = f"done: {label}, one of {len(node.results)} poses that no plan tells apart"
         kind = "symmetric"
     else:
         what = "landings" if plan.over_landings else "parts"
@@ -175,11 +176,20 @@ def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: 
     note = ""
     reached = set(trace.states[place.node_id])
     if reached != set(keys):
-        got = ", ".join(f"{plan.parts[m].label} s{s}" for m, s in sorted(reached)) or "none"
-        note = (
-            f'<p class="warn">Following the plan, the states that reach this leaf are: '
-            f"{esc(got)}.</p>"
-        )
+        got = ", ".join(f"{plan.parts[m].label} s{s}" for m, s in sorted(reached))
+        if not plan.uncertainty.is_ideal:
+            # The trace follows the nominal push; a strong plan's leaf also lists the states
+            # that the declared uncertainty can bring here (design.md, "Uncertainty").
+            nominal = f"the states that reach it are {got}" if got else "no start reaches it"
+            note = (
+                f'<p class="muted">On the nominal push (no rotation error) {esc(nominal)}; '
+                "the leaf lists every state the declared uncertainty can bring here.</p>"
+            )
+        else:
+            note = (
+                f'<p class="warn">Following the plan, the states that reach this leaf are: '
+                f"{esc(got or 'none')}.</p>"
+            )
     attr, tag = _shared_tag(shared)
     return (
         f'<div class="tree-node result {kind}" data-node-id="{place.node_id}" '
