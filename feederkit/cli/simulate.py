@@ -133,7 +133,7 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
 
 def simulate_command(
     plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
-    trials: Annotated[int, typer.Option("--trials", help="Number of trials.")] = 100,
+    trials: Annotated[int, typer.Option("--trials", min=1, help="Number of trials.")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts and errors.")] = 0,
     ideal: Annotated[
         bool,

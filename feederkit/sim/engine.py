@@ -7,7 +7,8 @@ from types import ModuleType
 from feederkit.errors import InputError
 
 MISSING_MESSAGE = (
-    "the simulator needs MuJoCo: install feederkit[sim] (pip install 'feederkit[sim]')"
+    "the simulator needs MuJoCo: install feederkit[sim] (in a clone: "
+    "pip install -c requirements.lock -e '.[sim]')"
 )
 
 
