@@ -8,7 +8,12 @@ under 60 s. Two families of mixes: random convex 6- to 10-gons on one 60 x 40 mm
 convex 3- to 10-gons of 20-100 mm (as benchmarks/bench_mix.py: varied sizes, larger
 critical tolerances, so longer plans to prove).
 
-Run: ``python benchmarks/bench_design.py [--quick]``
+Each case reports wall and CPU seconds (the machine is shared: CPU time is the steadier
+figure). ``--baseline`` also builds each table with every search question answered by a
+whole plan (``planning.api.plan``, tie-breaks and all, as the table was first built) instead
+of the planner's length oracle alone, in the same run, and prints the ratio.
+
+Run: ``python benchmarks/bench_design.py [--quick] [--baseline]``
 """
 
 from __future__ import annotations
@@ -23,8 +28,9 @@ import time
 
 import numpy as np
 
+from feederkit.design import sensor as design_sensor
 from feederkit.design.sensor import design_tolerance
-from feederkit.design.steps import mix_breakpoints
+from feederkit.design.steps import LengthOracle, length_steps, mix_breakpoints, optimal_length
 from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
@@ -68,6 +74,34 @@ def varied_mix(count: int, seed: int = 1):
     return [varied_part(rng, f"p{i}") for i in range(count)]
 
 
+class WholePlanOracle(LengthOracle):
+    """The baseline: every question of the search answered by a whole plan."""
+
+    def __init__(self, pfs) -> None:
+        super().__init__(pfs)
+        self.pfs = list(pfs)
+
+    def length(self, tolerance: float) -> int:
+        return optimal_length(self.pfs, tolerance)
+
+    def within(self, tolerance: float, length: int) -> bool:
+        return self.length(tolerance) <= length
+
+
+def whole_plan_design(pfs):
+    """``design_tolerance`` with :class:`WholePlanOracle` in its length search."""
+    original = design_sensor.length_steps
+
+    def steps(pfs_, up_to, critical=None):
+        return length_steps(pfs_, up_to, oracle=WholePlanOracle(pfs_), critical=critical)
+
+    design_sensor.length_steps = steps
+    try:
+        return design_tolerance(pfs)
+    finally:
+        design_sensor.length_steps = original
+
+
 class GaveUp(Exception):
     """A case ran past its cap."""
 
@@ -77,12 +111,30 @@ def _alarm(signum, frame):
 
 
 CAP = 3.0
-"""A case is stopped after this many times its target (and counts as slow)."""
+"""A case is stopped after this many times its target in CPU seconds (and counts as slow)."""
+
+
+def timed(run, pfs, cap: float):
+    """``(design, wall s, CPU s)`` of ``run(pfs)``, or ``(None, ...)`` past ``cap`` CPU
+    seconds (CPU, not wall: on a shared machine other processes' load must not stop a case)."""
+    signal.signal(signal.SIGPROF, _alarm)
+    signal.setitimer(signal.ITIMER_PROF, cap)
+    wall, cpu = time.perf_counter(), time.process_time()
+    try:
+        design = run(pfs)
+    except GaveUp:
+        design = None
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0.0)
+    return design, time.perf_counter() - wall, time.process_time() - cpu
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the 20-part mixes only")
+    ap.add_argument(
+        "--baseline", action="store_true", help="also answer every question by a whole plan"
+    )
     args = ap.parse_args()
     cases = [
         ("20-part mix, 6-10-gons on one ellipse", lambda: ellipse_mix(20), 10.0),
@@ -93,40 +145,46 @@ def main() -> int:
             ("50-part mix, 6-10-gons on one ellipse", lambda: ellipse_mix(50), 60.0),
             ("50-part mix, 3-10-gons of 20-100 mm", lambda: varied_mix(50), 60.0),
         ]
+    extra = " baseline wall s | baseline CPU s | CPU ratio |" if args.baseline else ""
     print(
-        "| case | states | breakpoints | critical mm | steps (length) | s | target | |\n"
-        "| --- | ---: | ---: | ---: | --- | ---: | ---: | --- |"
+        "| case | states | breakpoints | critical mm | steps (length) | wall s | CPU s | target |"
+        f"{extra} |\n"
+        "| --- | ---: | ---: | ---: | --- | ---: | ---: | ---: |"
+        f"{' ---: | ---: | ---: |' if args.baseline else ''} --- |"
     )
     failed = 0
     for name, build, target in cases:
         pfs = build()
         states = sum(pf.n for pf in pfs)
-        signal.signal(signal.SIGALRM, _alarm)
-        signal.alarm(int(CAP * target))
-        t = time.perf_counter()
-        try:
-            design = design_tolerance(pfs)
-        except GaveUp:
+        breaks = len(mix_breakpoints(pfs))
+        design, wall, cpu = timed(design_tolerance, pfs, CAP * target)
+        if design is None:
             failed += 1
-            print(
-                f"| {name} | {states} | {len(mix_breakpoints(pfs))} | - | - | "
-                f"> {CAP * target:g} (gave up) | {target:g} | SLOW |",
-                flush=True,
+            row = (
+                f"| {name} | {states} | {breaks} | - | - | {wall:.1f} (gave up) | > {cpu:.0f} | "
+                f"{target:g} |"
             )
-            continue
-        finally:
-            signal.alarm(0)
-        wall = time.perf_counter() - t
-        lengths = ",".join(str(s.length) for s in design.steps)
-        x = design.critical_tolerance
-        ok = wall < target
-        failed += not ok
-        print(
-            f"| {name} | {states} | {len(mix_breakpoints(pfs))} | "
-            f"{'none' if x is None else f'{x:.4g}'} | {len(design.steps)} ({lengths}) | "
-            f"{wall:.2f} | {target:g} | {'ok' if ok else 'SLOW'} |",
-            flush=True,
-        )
+            verdict = "SLOW"
+        else:
+            lengths = ",".join(str(s.length) for s in design.steps)
+            x = design.critical_tolerance
+            ok = wall < target
+            failed += not ok
+            row = (
+                f"| {name} | {states} | {breaks} | {'none' if x is None else f'{x:.4g}'} | "
+                f"{len(design.steps)} ({lengths}) | {wall:.2f} | {cpu:.2f} | {target:g} |"
+            )
+            verdict = "ok" if ok else "SLOW"
+        if args.baseline:
+            base, bwall, bcpu = timed(whole_plan_design, pfs, 2 * CAP * target)
+            if base is None:
+                row += f" {bwall:.1f} (gave up) | > {bcpu:.0f} | - |"
+            else:
+                same = design is None or base.to_dict() == design.to_dict()
+                ratio = "-" if design is None else f"{bcpu / max(cpu, 1e-9):.2f}"
+                row += f" {bwall:.2f} | {bcpu:.2f} | {ratio}{'' if same else ' (TABLES DIFFER)'} |"
+                failed += not same
+        print(f"{row} {verdict} |", flush=True)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     print(f"peak memory {peak:.0f} MB")
     return 1 if failed else 0

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -324,10 +325,39 @@ def resolve_settings(
     return CellSettings(profile, sensor, r, tuple(overrides))
 
 
+def expectation_words(members: Sequence[Any]) -> str:
+    """What a plan's expected figures (operations, seconds) average over, in a few words.
+
+    ``members`` are the plan's parts (``PlanPart``: ``name``, ``landing``, ``share``). The
+    expectation is over the members' prior shares (the mix shares, times the landing
+    probabilities over landings; equal when the plan stores none) and, within a member,
+    over a start orientation drawn uniformly (each stable state weighted by its resting
+    range; docs/plans.md, "stats").
+    """
+    uniform = "uniform start orientation"
+    if len(members) == 1:
+        return uniform
+    landings = any(m.landing is not None for m in members)
+    if any(m.share is None for m in members):
+        return f"{'members' if landings else 'parts'} equally likely, {uniform}"
+    if not landings:
+        over = "mix shares"
+    elif len({m.name for m in members}) == 1:
+        over = "landing probabilities"
+    else:
+        over = "mix shares × landing probabilities"
+    return f"over the {over}, {uniform}"
+
+
 @dataclass(frozen=True)
 class CycleTime:
-    """Seconds per part of a plan in a cell, expected (uniform start, as the plan's
-    expected length) and in the worst case, and the parts per minute they give."""
+    """Seconds per part of a plan in a cell, expected and in the worst case, and the parts
+    per minute they give.
+
+    The expectation is the plan's expected length's (:func:`expectation_words`): over the
+    members' prior shares (mix shares, times the landing probabilities over landings) and a
+    uniform start orientation within each member; the worst case is the slowest path.
+    """
 
     expected_s: float
     worst_s: float

@@ -234,3 +234,52 @@ def test_cycle_time_follows_outcome_sets_under_uncertainty():
     t = cycle_time(made, timing(0.0, 1e12, 0.1, 100.0))
     assert t.expected_s == pytest.approx(made.result.expected_length, rel=1e-9)
     assert t.worst_s == pytest.approx(made.result.length, rel=1e-9)
+
+
+def _members(*rows):
+    from types import SimpleNamespace
+
+    return [SimpleNamespace(name=n, landing=landing, share=share) for n, landing, share in rows]
+
+
+@pytest.mark.parametrize(
+    ("rows", "words"),
+    [
+        ([("a", None, None)], "uniform start orientation"),
+        ([("a", None, None), ("b", None, None)], "parts equally likely, uniform start orientation"),
+        ([("a", None, 0.7), ("b", None, 0.3)], "over the mix shares, uniform start orientation"),
+        (
+            [("a", "up", 0.5), ("a", "down", 0.5)],
+            "over the landing probabilities, uniform start orientation",
+        ),
+        (
+            [("a", "up", 0.35), ("a", "down", 0.35), ("b", "up", 0.3)],
+            "over the mix shares × landing probabilities, uniform start orientation",
+        ),
+    ],
+)
+def test_the_expectation_is_named_for_what_it_averages_over(rows, words):
+    from feederkit.cell import expectation_words
+
+    assert expectation_words(_members(*rows)) == words
+
+
+def test_the_statistics_table_says_the_mix_shares_weigh_the_expectation(mix_plan):
+    from rich.console import Console
+
+    from feederkit.cli.plan_render import stats_table
+    from feederkit.plans.fileformat import as_plan
+
+    pfs = [
+        push_function(load_part(str(CATALOG / f"{n}.json")))
+        for n in ("quadrilateral", "rectangle-2x1")
+    ]
+    weighted = make_plan(pfs, ToleranceSensor(0.3), weights=[0.7, 0.3], certify=False)
+
+    def label(made):
+        console = Console(width=200, record=True)
+        console.print(stats_table(as_plan(made.plan)))
+        return next(ln for ln in console.export_text().splitlines() if "expected operations" in ln)
+
+    assert "(over the mix shares, uniform start orientation)" in label(weighted)
+    assert "(parts equally likely, uniform start orientation)" in label(mix_plan)

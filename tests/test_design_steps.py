@@ -9,23 +9,28 @@ checked by verifying a plan made for one tolerance under a smaller one.
 from __future__ import annotations
 
 import copy
+import math
 
 import numpy as np
 import pytest
 from mix_oracle import MixOracle, OraclePart
 from test_design_critical import random_pf
 
-from feederkit.design.critical import interval_probe, mix_critical_tolerance
+from feederkit.design.critical import MixCritical, interval_probe, mix_critical_tolerance
 from feederkit.design.steps import (
     Evaluation,
+    LengthOracle,
     length_steps,
     mix_breakpoints,
     optimal_length,
     plan_evaluation,
 )
+from feederkit.errors import CheckFailed
 from feederkit.plans.make import make_plan
+from feederkit.plans.strong import verify_strong
 from feederkit.plans.verify import verify_plan
 from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import Uncertainty
 
 
 def small_mix(seed: int, parts: int = 2):
@@ -121,8 +126,6 @@ def test_each_step_reports_the_verified_plan_at_its_right_end():
 
 
 def test_a_disagreeing_verified_plan_is_a_failed_check():
-    from feederkit.errors import CheckFailed
-
     pfs = small_mix(6)
 
     with pytest.raises(CheckFailed):
@@ -167,3 +170,108 @@ def test_the_critical_tolerance_ends_a_recognizable_step_and_names_its_plan():
     step = design.step_at(x)
     assert step is last
     assert f"expected {last.expected:.4g}" in design.answer()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_length_oracle_is_the_planners_length_at_every_interval(seed):
+    # The oracle reuses one machine for every tolerance and skips the plan tree; its
+    # lengths must be the whole planner's, and "fits in L" must mean exactly "L >= length".
+    pfs = small_mix(400 + seed, parts=3 if seed % 2 else 2)
+    oracle = LengthOracle(pfs)
+    breaks = mix_breakpoints(pfs)
+    for k in range(len(breaks) + 1):
+        e = interval_probe(breaks, k)
+        length = optimal_length(pfs, e)
+        assert oracle.length(e) == length, e
+        assert oracle.within(e, length) and not oracle.within(e, length - 1), e
+
+
+class StepOracle(LengthOracle):
+    """A monotone length with steps at given tolerances (no planning), counting questions."""
+
+    def __init__(self, pfs, rises):
+        super().__init__(pfs)
+        self.rises = sorted(rises)
+        self.asked = 0
+
+    def true_length(self, tolerance):
+        return 1 + sum(1 for r in self.rises if r < tolerance)
+
+    def length(self, tolerance):
+        self.asked += 1
+        return self.true_length(tolerance)
+
+    def within(self, tolerance, length):
+        self.asked += 1
+        return self.true_length(tolerance) <= length
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_search_finds_every_step_with_a_few_questions_per_step(seed):
+    # Hundreds of intervals, a few steps at random places (two may be adjacent): the
+    # search must end each step exactly there, asking O(log intervals) per step.
+    rng = np.random.default_rng(600 + seed)
+    pfs = [random_pf(rng, f"q{seed}p{i}") for i in range(8)]
+    breaks = mix_breakpoints(pfs)
+    assert len(breaks) > 300
+    picks = sorted(rng.choice(len(breaks), size=4, replace=False))
+    picks[1] = picks[0] + 1
+    oracle = StepOracle(pfs, [breaks[k] for k in picks])
+
+    def evaluate(e):
+        n = oracle.true_length(e)
+        return Evaluation(n, float(n))
+
+    steps = length_steps(pfs, None, oracle=oracle, evaluate=evaluate, critical=MixCritical(()))
+    assert [s.hi for s in steps] == [*oracle.rises, None]
+    assert [s.length for s in steps] == [1, 2, 3, 4, 5]
+    assert oracle.asked <= len(steps) * (2 * math.ceil(math.log2(len(breaks))) + 2)
+    assert oracle.asked < len(breaks) / 4
+
+
+def test_an_oracle_that_breaks_monotonicity_is_a_failed_check():
+    # Lengths that fall with the tolerance contradict the argument the search rests on:
+    # the verified plans must catch it, never a table built on it.
+    pfs = small_mix(8)
+
+    class Falling(LengthOracle):
+        def length(self, tolerance):
+            return 9
+
+        def within(self, tolerance, length):
+            return length >= 9
+
+    with pytest.raises(CheckFailed):
+        length_steps(pfs, None, oracle=Falling(pfs))
+
+
+def _verifies_under(data, uncertainty):
+    """Whether every start, outcome and reading of the plan file reaches its result: the
+    stated length may be stale (made for another sensor), so any length up to it will do."""
+    stated = data["stats"]["length"]
+    for length in range(1, stated + 1):
+        data["stats"]["length"] = length
+        try:
+            verify_strong(data, uncertainty)
+        except CheckFailed as exc:
+            if "worst path under the declared uncertainty" in str(exc):
+                continue
+            raise
+        return True
+    return False
+
+
+@pytest.mark.parametrize("seed", [500, 503, 505, 507])
+def test_a_strong_plan_for_a_larger_tolerance_works_for_a_smaller_one(seed):
+    # The monotonicity argument under a declared rotation error: the physical states'
+    # reading intervals shrink with the tolerance, the outcome sets do not change. (Mixes
+    # with a strong plan at the larger tolerance; 502, for one, has none.)
+    pfs = small_mix(seed)
+    uncertainty = Uncertainty(rotation_error_deg=1.0)
+    breaks = mix_breakpoints(pfs)
+    big = breaks[len(breaks) // 2]
+    made = make_plan(pfs, ToleranceSensor(big), uncertainty=uncertainty, certify=False)
+    for small in (breaks[0], big / 3.0):
+        data = copy.deepcopy(made.plan)
+        data["sensor"] = ToleranceSensor(small).to_dict()
+        assert _verifies_under(data, uncertainty), small

@@ -192,7 +192,7 @@ def _print_tolerance(design: ToleranceDesign) -> None:
     table = Table(title="optimal plan length by tolerance (each step holds on (lo, hi])")
     table.add_column("tolerance (mm)")
     table.add_column("length", justify="right")
-    table.add_column("expected (at hi)", justify="right")
+    table.add_column("expected (at hi; parts equally likely)", justify="right")
     for s in design.steps:
         hi = "..." if s.hi is None else f"{s.hi:.6g}"
         table.add_row(f"({s.lo:.6g}, {hi}]", str(s.length), f"{s.expected:.4f}")
@@ -205,7 +205,7 @@ def _print_pitches(design: PitchDesign) -> None:
     table.add_column("pitch (mm)", justify="right")
     table.add_column("recognizable")
     table.add_column("length", justify="right")
-    table.add_column("expected", justify="right")
+    table.add_column("expected (parts equally likely)", justify="right")
     table.add_column("pairs it cannot tell apart", overflow="fold")
     for row in design.rows:
         bad = ", ".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])

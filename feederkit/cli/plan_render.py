@@ -17,6 +17,7 @@ from rich.table import Table
 from rich.text import Text
 from rich.tree import Tree
 
+from feederkit.cell import expectation_words
 from feederkit.errors import InputError
 from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
@@ -152,10 +153,7 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
     t.add_column("what")
     t.add_column("value")
     t.add_row("length (worst case, first alignment counted)", str(s.length))
-    weighted = (
-        "uniform start, members weighted by share" if plan.parts[0].share else "uniform start"
-    )
-    t.add_row(f"expected operations ({weighted})", f"{s.expected_length:.4f}")
+    t.add_row(f"expected operations ({expectation_words(plan.parts)})", f"{s.expected_length:.4f}")
     margin = s.min_margin_deg
     shown = "no rotation" if margin is None else f"±{margin:.4f}°"
     if plan.low_margin_warning():

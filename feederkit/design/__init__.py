@@ -3,7 +3,7 @@
 - :mod:`~feederkit.design.critical`: exact critical tolerances of pairs and mixes (binary
   search over the breakpoints ``|d - d'| / 2`` with the exact pair test, Theorem 9);
 - :mod:`~feederkit.design.steps`: the optimal plan length as a step function of the
-  tolerance, with its exact breakpoints;
+  tolerance, with its exact breakpoints (``LengthOracle``: the planner's length alone);
 - :mod:`~feederkit.design.pitches`: LED arrays, pitch by pitch;
 - :mod:`~feederkit.design.sensor`: the ``design sensor`` answer (docs/design.md).
 """
@@ -23,9 +23,10 @@ from feederkit.design.sensor import (
     design_tolerance,
     report_design,
 )
-from feederkit.design.steps import LengthStep, length_steps, mix_breakpoints
+from feederkit.design.steps import LengthOracle, LengthStep, length_steps, mix_breakpoints
 
 __all__ = [
+    "LengthOracle",
     "LengthStep",
     "MixCritical",
     "PairCritical",

@@ -5,15 +5,42 @@ branching, through the order of the reading intervals' ends, which changes at th
 places): for a tolerance ``e`` the relation is ``|d_i - d_j| < 2e`` over the mix's states
 (:mod:`feederkit.design.critical`). So the length is constant on each interval
 ``(b_k, b_{k+1}]`` between consecutive breakpoints ``b = |d_i - d_j| / 2`` of the machine's
-diameters, and it is monotone: a plan for a larger tolerance also works for a smaller one
-(every reading it can then give is one it could give before), as long as the goal stays
-the same, which it does up to the mix's critical tolerance. The step function is found
-with one binary search per distinct length, not one plan per breakpoint: a range of
-intervals whose two ends have equal length is constant throughout.
+diameters.
+
+It is also monotone while the goal stays the same: a plan for a tolerance ``e`` works for
+every smaller ``e'``. Each state's reading interval ``(d - e', d + e')`` lies inside its
+interval at ``e``, so every reading the plan meets at ``e'`` is one it could meet at ``e``
+and lies in the same branches; the states consistent with it at ``e'`` are a subset of those
+at ``e``, and a plan that orients a set orients its subsets (the actions' images of a
+subset are subsets of the images). So the minimum worst-case length is non-decreasing in
+``e`` (the tests verify plans made at one tolerance under smaller ones, and compare the
+table with a plan at every interval). The goal, the inseparable pairs, depends on the
+tolerance too: up to the mix's critical tolerance no two parts are inseparable and one
+part's own inseparable states are its symmetric poses, which read alike at every
+tolerance; past a pair's critical tolerance its parts are inseparable, the plan need no
+longer tell them apart and may get shorter. The table is therefore searched in segments
+between the pairs' critical tolerances.
+
+Under a declared rotation error (strong plans) the same argument holds for the physical
+states' reading intervals ``(lo - e, hi + e)`` (the outcome sets do not depend on the
+sensor), provided the goal is the same at both tolerances: bisimilar pairs and the lumped
+near-symmetric pairs (docs/planning.md, "Strong plans") are decided with the sensor, so a
+strong-plan table must also split its segments where they change. This table is for the
+ideal model.
+
+The search: within a segment, the length at the first interval is proven by the planner's
+own AND/OR oracle (:class:`LengthOracle`, no plan tree built); then, for a known length
+``L``, monotonicity turns "how long is the plan here" into "is there a plan of at most
+``L`` operations here", which needs no proof that shorter plans fail. An exponential then
+binary search from the step's start finds its last interval (``O(log run)`` decisions, and
+the probes stay near the step, at its cheaper smaller tolerances); the next interval's
+length is the least ``L' > L`` that fits, at most the segment's last length. Each step's
+plan is then made and verified at its right end (:func:`plan_evaluation`), and must have
+the length the search found.
 
 The expected number of operations changes continuously inside an interval (reading
 probabilities depend on ``e``); each step reports it at the interval's right end, its
-largest (least accurate) tolerance. Plans are for the ideal model (no rotation error).
+largest (least accurate) tolerance.
 """
 
 from __future__ import annotations
@@ -21,18 +48,26 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from feederkit.design.critical import (
     MixCritical,
     breakpoints_of,
     interval_probe,
+    last_true,
     mix_critical_tolerance,
 )
 from feederkit.errors import CheckFailed
-from feederkit.machine import build_machine
+from feederkit.machine import Grouping, PushAlignMachine
+from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
-from feederkit.planning.api import plan
+from feederkit.planning.andor import WorstCase
+from feederkit.planning.api import goal_relation, plan
+from feederkit.planning.budget import Deadline
+from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.planning.reindex import by_diameter
 from feederkit.plans.make import make_plan
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
@@ -73,7 +108,12 @@ class Evaluation:
 
 def mix_breakpoints(pfs: Sequence[PushFunction]) -> tuple[float, ...]:
     """Where the read-alike relation of the mix's states changes (the machine's diameters)."""
-    diameters = [s.diameter for s in build_machine(list(pfs), uncertainty=IDEAL).states]
+    return machine_breakpoints(build_machine(list(pfs), uncertainty=IDEAL))
+
+
+def machine_breakpoints(machine: PushAlignMachine) -> tuple[float, ...]:
+    """:func:`mix_breakpoints` of an ideal machine already built."""
+    diameters = [s.diameter for s in machine.states]
     eps = 0.0  # the machine has already made equal diameters exactly equal
     return breakpoints_of(diameters, diameters, eps)
 
@@ -99,37 +139,78 @@ def plan_evaluation(pfs: Sequence[PushFunction], tolerance: float) -> Evaluation
 
 
 def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
-    """The proven minimum worst-case length at ``tolerance`` mm, from the planner alone.
-
-    The search's probes need only the length; the steps' own plans are made and verified
-    by :func:`plan_evaluation`.
-    """
+    """The proven minimum worst-case length at ``tolerance`` mm, from a whole plan (the
+    reference the tests hold :class:`LengthOracle` to)."""
     return plan(build_machine(list(pfs), ToleranceSensor(tolerance), uncertainty=IDEAL)).length
+
+
+class LengthOracle:
+    """The planner's minimum worst-case length of one mix at any tolerance, without a plan.
+
+    :func:`feederkit.planning.api.plan` proves the length (its AND/OR search, section 6.1,
+    from the first alignment's maximal reading sets) and then builds a plan tree with its
+    tie-breaks (margins, expected operations), which at large tolerances costs several times
+    the proof. The table's probes need only the length, and often only whether a length
+    fits: this asks the planner's own oracle (``make_oracle``, the ``auto`` method) those
+    questions on the same problem ``plan`` builds (states numbered by diameter, the goal
+    relation, exact reading branches, no margin floor). The ideal machine's states and
+    action maps do not depend on the sensor, so they are built and numbered once; only the
+    sensor, and with it the readings and the goal, change per tolerance. The oracle of the
+    last tolerance asked is kept, so repeated questions share its proven bounds.
+    """
+
+    def __init__(self, pfs: Sequence[PushFunction]) -> None:
+        self.machine = build_machine(list(pfs), uncertainty=IDEAL)
+        self._sorted, _old = by_diameter(self.machine)
+        self._last: tuple[float, Problem, WorstCase, list[int]] | None = None
+
+    def _search(self, tolerance: float) -> tuple[Problem, WorstCase, list[int]]:
+        if self._last is not None and self._last[0] == tolerance:
+            return self._last[1:]
+        self._last = None  # free the previous tolerance's memo first
+        machine = replace(self._sorted, sensor=ToleranceSensor(tolerance))
+        budget = Deadline()
+        problem = Problem(machine, Grouping.EXACT, 0.0, goal_relation(machine, budget))
+        roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+        worst = make_oracle(problem, "auto", budget)
+        self._last = (tolerance, problem, worst, roots)
+        return problem, worst, roots
+
+    def length(self, tolerance: float) -> int:
+        """The minimum worst-case number of operations at ``tolerance`` mm (as ``plan``'s)."""
+        problem, worst, roots = self._search(tolerance)
+        lengths = root_lengths(problem, worst, roots, "auto")
+        return 1 + max(lengths.values(), default=0)
+
+    def within(self, tolerance: float, length: int) -> bool:
+        """Whether some plan at ``tolerance`` mm takes at most ``length`` operations."""
+        if length < 1:
+            return False
+        _problem, worst, roots = self._search(tolerance)
+        return all(worst.within(r, length - 1) for r in roots)
 
 
 def length_steps(
     pfs: Sequence[PushFunction],
     up_to: float | None,
-    length_at: Callable[[float], int] | None = None,
+    oracle: LengthOracle | None = None,
     evaluate: Callable[[float], Evaluation] | None = None,
     critical: MixCritical | None = None,
 ) -> tuple[LengthStep, ...]:
     """The plan length's steps over tolerances ``(0, up_to]`` (None: every interval).
 
     ``up_to`` is rounded up to the end of its interval, so the last step is whole.
-    ``length_at`` gives the optimal length at one tolerance (default
-    :func:`optimal_length`), called about ``log2(#breakpoints)`` times per distinct length;
-    ``evaluate`` makes each step's verified plan at its right end (default
-    :func:`plan_evaluation`) and must agree with ``length_at``. ``critical``: the mix's
-    pairs' critical tolerances, if already known.
+    ``oracle`` answers the search's length questions (default :class:`LengthOracle` of the
+    mix); ``evaluate`` makes each step's verified plan at its right end (default
+    :func:`plan_evaluation`) and must agree with the search (else CheckFailed).
+    ``critical``: the mix's pairs' critical tolerances, if already known.
 
-    The length is monotone only while the goal stays the same: past a pair's critical
-    tolerance its parts become inseparable, the plan need no longer tell them apart and
-    may get shorter. The intervals are therefore searched in segments between the pairs'
-    critical tolerances, and steps never span two segments.
+    The intervals are searched in segments between the pairs' critical tolerances (the
+    goal changes there) and steps never span two segments; inside a segment the length is
+    monotone (the module's docstring).
     """
-    breaks = mix_breakpoints(pfs)
-    length_at = length_at or (lambda e: optimal_length(pfs, e))
+    oracle = oracle or LengthOracle(pfs)
+    breaks = machine_breakpoints(oracle.machine)
     evaluate = evaluate or (lambda e: plan_evaluation(pfs, e))
     critical = critical or mix_critical_tolerance(pfs)
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
@@ -145,51 +226,56 @@ def length_steps(
         0 if mix_x is None else len(breaks) + 1 if math.isinf(mix_x) else
         _first_at_or_above(breaks, mix_x) + 1
     )  # fmt: skip
-    memo: dict[int, int] = {}
-    verified: dict[int, Evaluation] = {}
+    fits: dict[tuple[int, int], bool] = {}
 
-    def made(k: int) -> Evaluation:
-        if k not in verified:
-            verified[k] = evaluate(interval_probe(breaks, k))
-            memo.setdefault(k, verified[k].length)
-        return verified[k]
-
-    def at(k: int) -> int:
-        if k not in memo:
-            memo[k] = length_at(interval_probe(breaks, k))
-        return memo[k]
-
-    def split(i: int, j: int, runs: list[tuple[int, int]]) -> None:
-        """Constant runs of intervals i..j (monotone lengths), by divide and conquer."""
-        if at(i) == at(j):
-            runs.append((i, j))
-        elif j == i + 1:
-            runs.extend([(i, i), (j, j)])
-        else:
-            mid = (i + j) // 2
-            split(i, mid, runs)
-            split(mid, j, runs)
+    def fit(k: int, length: int) -> bool:
+        if (k, length) not in fits:
+            fits[k, length] = oracle.within(interval_probe(breaks, k), length)
+        return fits[k, length]
 
     steps = []
     for first, end in zip(starts, [*starts[1:], last + 1], strict=True):
-        j_last = end - 1
-        made(j_last)  # a segment's last interval always ends a step (often the costliest plan)
-        runs: list[tuple[int, int]] = []
-        split(first, j_last, runs)
-        merged: list[list[int]] = []
-        for i, j in sorted(runs):
-            if merged and at(merged[-1][1]) == at(i) and merged[-1][1] >= i - 1:
-                merged[-1][1] = max(merged[-1][1], j)
-            else:
-                merged.append([i, j])
-        for i, j in merged:
-            ev = made(j)
-            if ev.length != at(j):
+        runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate)
+        for i, j, length, ev in runs:
+            if ev.length != length:
                 raise CheckFailed(
                     f"the verified plan at {interval_probe(breaks, j):g} mm has length "
-                    f"{ev.length}, the planner's proven minimum is {at(j)}"
+                    f"{ev.length}, the search over tolerances found {length}"
                 )
             lo = 0.0 if i == 0 else breaks[i - 1]
             hi = breaks[j] if j < len(breaks) else None
             steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < recognizable_below))
     return tuple(steps)
+
+
+def _segment_runs(
+    first: int,
+    j_last: int,
+    breaks: Sequence[float],
+    oracle: LengthOracle,
+    fit: Callable[[int, int], bool],
+    evaluate: Callable[[float], Evaluation],
+) -> list[tuple[int, int, int, Evaluation]]:
+    """The constant runs ``(i, j, length, verified plan at j)`` of intervals ``first..j_last``,
+    over which the length is non-decreasing."""
+    top = evaluate(interval_probe(breaks, j_last))  # the segment's last interval ends a step
+    runs = []
+    k = first
+    length = top.length if first == j_last else oracle.length(interval_probe(breaks, first))
+    while length < top.length and k < j_last:
+        # fit(k, length) holds, fit(j_last, length) does not: gallop, then bisect.
+        lo, step, hi = k, 1, j_last
+        while lo + step < j_last:
+            if not fit(lo + step, length):
+                hi = lo + step
+                break
+            lo += step
+            step *= 2
+        j = lo + 1 + last_true(hi - lo - 1, lambda d, lo=lo, n=length: fit(lo + 1 + d, n))
+        runs.append((k, j, length, evaluate(interval_probe(breaks, j))))
+        k = j + 1
+        # The length at k exceeds the last one and is at most the segment's last length.
+        below = range(length + 1, top.length) if k < j_last else ()
+        length = next((n for n in below if fit(k, n)), top.length)
+    runs.append((k, j_last, length, top))
+    return runs

@@ -84,7 +84,8 @@ def _steps_table(rows: Sequence[tuple[float, float | None, int, float]]) -> str:
     return (
         '<table class="design-steps"><caption>Optimal plan length against the sensor '
         "tolerance</caption><tr><th>tolerance</th><th>length (operations)</th>"
-        f"<th>expected operations</th></tr>{body}</table>"
+        "<th>expected operations at the upper end (parts equally likely, uniform start "
+        f"orientation)</th></tr>{body}</table>"
     )
 
 
@@ -98,7 +99,8 @@ def _pitch_table(rows: Sequence[Mapping[str, Any]]) -> str:
     )
     return (
         '<table class="design-steps"><caption>LED pitches, each decided on its own</caption>'
-        "<tr><th>pitch</th><th>recognizable</th><th>length</th><th>expected operations</th>"
+        "<tr><th>pitch</th><th>recognizable</th><th>length</th><th>expected operations "
+        "(parts equally likely, uniform start orientation)</th>"
         f"</tr>{body}</table>"
     )
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from feederkit.cell import expectation_words
 from feederkit.errors import InputError
 from feederkit.plans.model import Leaf, Plan
 from feederkit.reports.svgkit import esc, num
@@ -78,7 +79,9 @@ def stats_section(
         shown_margin = f"\u00b1{margin:.2g}\u00b0"  # never round a tiny margin to 0
     rows = [
         _row("worst-case length", f"{num(length)} push-align operations"),
-        _row("expected length", f"{num(expected)} operations"),
+        _row(
+            "expected length", f"{num(expected)} operations ({esc(expectation_words(plan.parts))})"
+        ),
         _row("smallest margin", esc(shown_margin)),
         _row("declared uncertainty", esc(plan.uncertainty_words())),
     ]
