@@ -24,6 +24,10 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
+OVERSHOOT_S = 2.0
+"""The small constant past a time limit that ``plan`` may take (the work after the last poll:
+the plan's statistics and renumbering); benchmarks/bench_deadline.py allows the same."""
+
 
 def near_round(n: int, noise: float, seed: int = 0, radius: float = 10.0):
     """An n-gon with every vertex's radius off by up to ``noise`` (relative): the states
@@ -140,6 +144,52 @@ def test_the_search_polls_its_deadline():
         w.within(1, 10**6)
 
 
+def _proven_refiner(machine, deadline: Deadline):
+    """A refiner over ``machine`` (numbered by diameter) whose root lengths are proven with
+    no limit, as ``plan`` has them when the tie-breaking stages begin; the refiner itself
+    runs under ``deadline``."""
+    from feederkit.planning.methods import make_oracle, root_lengths
+    from feederkit.planning.problem import Problem
+    from feederkit.planning.readings import maximal_sets
+    from feederkit.planning.refine import Refiner, child_masses
+    from feederkit.planning.reindex import by_diameter
+
+    problem = Problem(by_diameter(machine)[0])
+    branches = tuple(problem.readings.branches(problem.full))
+    worst = make_oracle(problem, "auto", Deadline())
+    roots = sorted(maximal_sets({b.mask for b in branches}))
+    k = max(root_lengths(problem, worst, roots, "auto", None).values())
+    masses = tuple(s.weight for s in problem.machine.states)
+    children = child_masses(problem, problem.full, masses, None, branches)
+    return Refiner(problem, worst, deadline), children, k
+
+
+@pytest.mark.xfail(
+    reason="needs Refiner.build and choose_worst('first') to poll their deadline "
+    "(feederkit/planning/refine.py); remove this marker with that change",
+    raises=AssertionError,
+    strict=True,
+)
+def test_the_tree_of_a_proven_length_polls_its_deadline():
+    # When the tie-breaking stages run out, plan() builds the tree taking the first action
+    # that keeps the proven length at each node, by FIRST_TREE_SHARE of the limit
+    # (docs/planning.md). With every length memoised nothing else polls the clock there:
+    # on the 50-part mix that build alone ran 8 CPU seconds past its share.
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    refiner, children, k = _proven_refiner(machine, Deadline(1e-9))
+    time.sleep(1e-4)
+    b, _pb, ms = next(c for c in children if not refiner.p.is_goal(c[0].mask))
+
+    def first(mask, masses, budget):
+        return refiner.choose_worst(mask, masses, budget, "first")
+
+    try:
+        refiner.build(b.mask, ms, k, first)
+    except Timeout:
+        return
+    raise AssertionError("the build ran past its deadline without stopping")
+
+
 # --- plan() answers within its limits ---------------------------------------------------
 
 
@@ -218,9 +268,11 @@ def test_a_memory_limit_stops_the_search_like_the_time_limit():
             0.6,
             IDEAL,
             marks=pytest.mark.xfail(
-                reason="known overshoot: 8.3 s for a 2 s limit in CI with both cores busy "
-                "(benchmarks/bench_deadline.py measures 0.81 s idle); a stage that does not "
-                "poll the deadline is still to be found",
+                reason="known overshoot (8.3 s for a 2 s limit in CI with both cores busy): "
+                "when the tie-breaking stages run out, the tree of the proven length "
+                "(Refiner.build, choose_worst 'first') does not poll its deadline; remove "
+                "this marker with that change (test_the_tree_of_a_proven_length_polls_its_"
+                "deadline)",
                 strict=False,
             ),
         ),
@@ -231,7 +283,7 @@ def test_the_issue_cases_answer_within_two_seconds_plus_a_constant(
 ):
     machine = build_machine(pfs(), ToleranceSensor(tolerance), uncertainty)
     result, took = _timed_plan(machine, time_limit_s=2.0)
-    assert took < 3 * 2.0 + 2.0, name
+    assert took < 2.0 + OVERSHOOT_S, name
     _answered(result)
     if uncertainty.is_ideal and not isinstance(result, PlanningError):
         check_plan(result)
@@ -323,3 +375,50 @@ def test_the_goal_fixpoint_polls_the_budget():
     machine = build_machine([near_round(40, 0.002)], ToleranceSensor(0.3), IDEAL)
     with pytest.raises(Timeout):
         inseparable_masks(machine, Deadline(1e-9).check)
+
+
+# --- the plan's statistics: the work after the last poll ---------------------------------
+
+
+def _plain_expected(machine, root) -> float:
+    """The expected number of operations by the definition (a part in each start state, every
+    branch tested for every state), memoised per node and state only."""
+    from feederkit.machine import members
+    from feederkit.planning.readings import reading_probability
+    from feederkit.planning.tree import Leaf
+
+    memo: dict = {}
+
+    def ops(node, state):
+        if isinstance(node, Leaf):
+            return 0.0
+        key = (id(node), state)
+        if key not in memo:
+            if node.action is None:
+                outs = [state]
+            else:
+                rot = node.action.representative
+                outs = members(machine.outcomes(state, rot))
+            total = 1.0
+            for t in outs:
+                for b, sub in node.branches:
+                    if b.mask >> t & 1:
+                        total += reading_probability(machine, b, t) * ops(sub, t) / len(outs)
+            memo[key] = total
+        return memo[key]
+
+    return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+
+
+@pytest.mark.parametrize("uncertainty", [IDEAL, Uncertainty()], ids=["ideal", "1 deg"])
+def test_the_expected_length_is_the_plain_one(uncertainty):
+    # The root of a mix has more reading branches than feederkit.planning.stats indexes
+    # (_INDEXED), its inner nodes fewer: both paths are taken.
+    from feederkit.planning.stats import _INDEXED, expected_operations
+
+    machine = build_machine(small_mix(6), ToleranceSensor(1.0), uncertainty)
+    result = plan(machine)
+    assert len(result.root.branches) > _INDEXED
+    plain = _plain_expected(machine, result.root)
+    assert expected_operations(machine, result.root) == pytest.approx(plain, rel=1e-12)
+    assert result.expected_length == pytest.approx(plain, rel=1e-12)

@@ -10,9 +10,9 @@ node, so shared subtrees cost once.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
-from feederkit.machine import PushAlignMachine
+from feederkit.machine import PushAlignMachine, ReadingBranch, members
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.readings import reading_probability
 from feederkit.planning.tree import Leaf, PlanTree, Step
@@ -89,6 +89,7 @@ def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], floa
         return _expected_sets(machine, root, cost)
     memo: dict[tuple[int, int], float] = {}
     probs: dict[tuple[float | None, float | None, int], float] = {}
+    holding = _Holding()
 
     def ops(node: PlanTree, state: int) -> float:
         if isinstance(node, Leaf):
@@ -100,13 +101,14 @@ def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], floa
         if node.action is not None:
             state = machine.successor(state, node.action.representative)
         total = cost(node)
-        for b, sub in node.branches:
-            if b.mask >> state & 1:
-                p = probs.get((b.lo, b.hi, state))
-                if p is None:
-                    p = probs[(b.lo, b.hi, state)] = reading_probability(machine, b, state)
-                if p > 0.0:
-                    total += p * ops(sub, state)
+        for b, sub in holding(node, state):
+            if not b.mask >> state & 1:
+                continue
+            p = probs.get((b.lo, b.hi, state))
+            if p is None:
+                p = probs[(b.lo, b.hi, state)] = reading_probability(machine, b, state)
+            if p > 0.0:
+                total += p * ops(sub, state)
         memo[key] = total
         return total
 
@@ -118,6 +120,8 @@ def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step],
     outcome set, shared equally (docs/planning.md); a part follows a branch with the
     probability that its reading falls in it."""
     memo: dict[tuple[int, int], float] = {}
+    probs: dict[tuple[float | None, float | None, int], float] = {}
+    holding = _Holding()
 
     def ops(node: PlanTree, state: int) -> float:
         if isinstance(node, Leaf):
@@ -129,16 +133,50 @@ def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step],
         if node.action is None:
             outs = [state]
         else:
-            out = machine.outcomes(state, node.action.representative)
-            outs = [t for t in range(machine.n) if out >> t & 1]
+            outs = members(machine.outcomes(state, node.action.representative))
         total = cost(node)
         for t in outs:
-            for b, sub in node.branches:
-                if b.mask >> t & 1:
-                    p = reading_probability(machine, b, t)
-                    if p > 0.0:
-                        total += p * ops(sub, t) / len(outs)
+            for b, sub in holding(node, t):
+                if not b.mask >> t & 1:
+                    continue
+                p = probs.get((b.lo, b.hi, t))
+                if p is None:
+                    p = probs[(b.lo, b.hi, t)] = reading_probability(machine, b, t)
+                if p > 0.0:
+                    total += p * ops(sub, t) / len(outs)
         memo[key] = total
         return total
 
     return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+
+
+_INDEXED = 16
+"""Nodes with more reading branches than this are indexed by state (:class:`_Holding`)."""
+
+
+class _Holding:
+    """Per node, the branches whose set holds a state, in the node's branch order.
+
+    Most nodes have a few branches, but the root and the nodes of a near-round part or a
+    large mix have hundreds and each state lies in one to three of them: those are indexed
+    once (by the members of each branch), so a statistic costs their branch members, not
+    states times branches. The sums keep the branch order: the figures are the same to the
+    last bit.
+    """
+
+    def __init__(self) -> None:
+        self._index: dict[int, dict[int, list[tuple[ReadingBranch, PlanTree]]]] = {}
+
+    def __call__(self, node: Step, state: int) -> Sequence[tuple[ReadingBranch, PlanTree]]:
+        """The node's branches holding ``state``, or (a node of few branches) all of them:
+        the caller tests the state's bit."""
+        if len(node.branches) <= _INDEXED:
+            return node.branches
+        index = self._index.get(id(node))
+        if index is None:
+            index = {}
+            for b, sub in node.branches:
+                for s in members(b.mask):
+                    index.setdefault(s, []).append((b, sub))
+            self._index[id(node)] = index
+        return index.get(state, [])
