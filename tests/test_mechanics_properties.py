@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from feederkit.hull import convex_hull
+from feederkit.hull import REL_LENGTH_TOL, convex_hull
 from feederkit.machine import build_machine, mask_of, overlap_ranges
 from feederkit.mechanics import (
     action_ranges,
@@ -145,7 +145,10 @@ def test_push_diameter_is_the_width_at_the_settled_state(poly, thetas) -> None:
         s = push(pf, theta)
         u = np.array([math.cos(math.radians(s.normal_deg)), math.sin(math.radians(s.normal_deg))])
         measured = float(np.ptp(pts @ u))  # width of the raw outline across the fence
-        assert push_diameter(pf, theta) == pytest.approx(measured, abs=1e-9)
+        # The contact hull drops vertices within its cleaning tolerance of an edge (hull.py),
+        # so the raw outline's width may differ by that much.
+        slack = 1e-9 + 2.0 * REL_LENGTH_TOL * part.size
+        assert push_diameter(pf, theta) == pytest.approx(measured, abs=slack)
         assert push_diameter(pf, theta) == pytest.approx(diameter(part, s.normal_deg), abs=1e-9)
 
 

@@ -141,6 +141,8 @@ def test_a_small_margin_is_warned_about(tri, capsys):
     src, plan = tri
 
     def shrink(d):
+        # A strong plan holds its declared rotation error plus its margin: 0.2 + 0.5 < 1.
+        d["uncertainty"]["rotation_error_deg"] = 0.2
         d["root"]["branches"][1]["next"]["margin_deg"] = 0.5
         d["stats"]["min_margin_deg"] = 0.5
 
