@@ -15,7 +15,7 @@ import typer
 from rich.table import Table
 
 from feederkit.cell import load_cell
-from feederkit.cli.common import CatalogOpt, JsonOpt, console, fail, print_json
+from feederkit.cli.common import CatalogOpt, JsonOpt, console, fail, print_json, print_warnings
 from feederkit.design.pitches import parse_pitches
 from feederkit.design.sensor import (
     MODEL_NOTE,
@@ -132,6 +132,7 @@ def sensor_command(
         design = design_pitches(pfs, values, noise=e, rotation_error_deg=r)
     else:
         design = design_tolerance(pfs, max_tolerance=max_tolerance, rotation_error_deg=r)
+    print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
     if plot is not None:
         from feederkit.design.plot import plot_design
 
@@ -144,8 +145,6 @@ def sensor_command(
             data["plot"] = str(plot)
         print_json(data)
     else:
-        for line in loaded.warnings:
-            console.print(f"warning: {line}", highlight=False, markup=False)
         if isinstance(design, ToleranceDesign):
             _print_tolerance(design)
         else:
