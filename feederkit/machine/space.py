@@ -25,6 +25,12 @@ from feederkit.sensors import Grouping, ReadingBranch
 _NUMPY_MIN_EVENTS = 256
 """Sets with at least this many action-range boundaries are swept with numpy."""
 
+_CELL_TABLE_MIN = 100
+"""Machines with fewer action-range boundaries in all keep the pure Python cells (faster)."""
+
+_CELL_TABLE_MAX = 10_000_000
+"""The most entries (cells times states, 4 bytes each) of :attr:`SearchSpace.cell_table`."""
+
 
 class SearchSpace:
     """A machine's sets of states, with the tables their queries share (built on first use).
@@ -82,6 +88,68 @@ class SearchSpace:
         mk = np.array([x for i in range(m.n) for x in m.outcomes_of[i]], dtype=np.int64)
         last = np.array([m.outcomes_of[i][-1] for i in range(m.n)], dtype=np.int64)
         return lo, st, mk, last
+
+    @cached_property
+    def cell_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """Every state's action-range starts sorted together (``bounds``, their ``owner``
+        states), the distinct start angles, and per cell between consecutive distinct
+        starts each state's target there (``targets[cell, state]``); None under outcome
+        sets, or when the machine has fewer than ``_CELL_TABLE_MIN`` boundaries or the table
+        would exceed ``_CELL_TABLE_MAX`` entries. A set's cells and
+        images (:meth:`cells_and_images`) are read off it."""
+        m = self.machine
+        if not m.deterministic or m.n == 0:
+            return None
+        count = sum(len(x) for x in m.starts)
+        if count < _CELL_TABLE_MIN or count * m.n > _CELL_TABLE_MAX:
+            return None
+        b = np.fromiter((x for i in range(m.n) for x in m.starts[i]), float)
+        own = np.fromiter((i for i in range(m.n) for _ in m.starts[i]), np.int64)
+        order = np.argsort(b, kind="stable")
+        bounds, owner = b[order], own[order]
+        distinct = np.unique(bounds)
+        mids = (distinct + np.append(distinct[1:], distinct[0] + 360.0)) / 2.0
+        mids = np.where(mids >= 360.0, mids - 360.0, mids)
+        targets = np.empty((len(distinct), m.n), dtype=np.int32)
+        for i in range(m.n):
+            at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
+            targets[:, i] = np.asarray(m.targets[i], dtype=np.int32)[at]
+        return bounds, owner, distinct, targets
+
+    def cells_and_images(self, mask: int) -> tuple[np.ndarray, np.ndarray, list[int]] | None:
+        """The set's cells (``lo``, ``hi`` arrays: consecutive boundaries of its members
+        more than ``ANGLE_EPS`` apart, as :func:`~feederkit.angles.cells_between` gives them)
+        and the image of each (the set's image at the cell's middle), vectorised.
+
+        None when the machine has outcome sets, or when some cell is within a few
+        ``ANGLE_EPS`` of the narrowest kept width (there the boundary clustering of
+        :meth:`overlap_cells` decides, and callers use it).
+        """
+        table = self.cell_table
+        if table is None or not mask:
+            return None
+        bounds, owner, distinct, targets = table
+        n = self.machine.n
+        inside = np.zeros(n, dtype=bool)
+        idx = members(mask)
+        inside[idx] = True
+        sb = bounds[inside[owner]]
+        lo = sb
+        hi = np.append(sb[1:], sb[0] + 360.0)
+        width = hi - lo
+        keep = width > ANGLE_EPS
+        if np.any(keep & (width <= 4.0 * ANGLE_EPS)):
+            return None
+        lo, hi = lo[keep], hi[keep]
+        mid = (lo + hi) / 2.0
+        mid = np.where(mid >= 360.0, mid - 360.0, mid)
+        at = np.searchsorted(distinct, mid, side="right") - 1
+        rows = targets[at][:, idx]
+        bits = np.zeros((len(lo), n), dtype=bool)
+        bits[np.arange(len(lo))[:, None], rows] = True
+        packed = np.packbits(bits, axis=1, bitorder="little")
+        images = [int.from_bytes(r.tobytes(), "little") for r in packed]
+        return lo, hi, images
 
     @cached_property
     def bisimilar(self) -> tuple[int, ...]:

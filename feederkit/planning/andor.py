@@ -6,6 +6,12 @@ operations that orient every state of ``mask`` (0 for a goal). The search is dep
 iterative deepening with memoised proven bounds per set (a set that failed with ``k`` steps
 is never retried with ``k``), so repeated sets and repeated depths cost nothing.
 
+Where readings carry no information (every set reachable from a set reads alike:
+:meth:`~feederkit.planning.readings.Readings.carries_no_information`) the AND/OR tree is a
+path, and the set's length is a shortest path over sets (section 4: breadth-first, or A*
+with each part's backchaining length as the bound, Goldberg 1993), which also proves every
+set on the path found and a lower bound for every set it met.
+
 References
 ----------
 Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient parts.
@@ -14,10 +20,18 @@ The International Journal of Robotics Research 18(10), section 6.1 (AND/OR searc
 
 from __future__ import annotations
 
+import heapq
+from dataclasses import replace
+
+from feederkit.angles import ActionRange
+from feederkit.machine import PushAlignMachine, members
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Act, Problem
 
 __all__ = ["Deadline", "Timeout", "WorstCase"]
+
+PAIR_BOUND_STATES = 64
+"""The pair lower bound is used on machines with at most this many states (n^2 / 2 pairs)."""
 
 
 class WorstCase:
@@ -33,7 +47,12 @@ class WorstCase:
         self.ub: dict[int, int] = {}
         self.choice: dict[int, tuple[int, Act]] = {}
         self.exact: dict[int, int] = {}
+        self.never: set[int] = set()
         self.deadline = deadline or Deadline(None)
+        self._quiet = getattr(problem, "carries_no_information", None)
+        self._chains: list[tuple[int, dict[int, int], object]] | None = None
+        self._pairs: list[list[int]] | None = None
+        self._pair_memo: dict[int, int] = {}
 
     def _known(self, mask: int, k: int) -> bool | None:
         """What the memo already says about ``within(mask, k)`` (None: search)."""
@@ -48,7 +67,127 @@ class WorstCase:
             return False
         if self.ub.get(mask, k + 1) <= k:
             return True
+        if mask in self.never:
+            return False
+        if self._quiet is not None and self._quiet(mask):
+            e = self.sensorless_length(mask)
+            return e is not None and e <= k
+        pb = self.pair_bound(mask)
+        if pb > k:
+            self.lb[mask] = max(self.lb.get(mask, 1), pb)
+            return False
         return None
+
+    def pair_bound(self, mask: int) -> int:
+        """A lower bound on the length of ``mask``: its hardest pair's length (a subset
+        needs no more operations). Only on the ideal model with readings, no margin floor
+        and at most ``PAIR_BOUND_STATES`` states (the pairs' lengths by the same search
+        on the pair sets, which are closed under actions and readings there); 0 otherwise."""
+        if self._pairs is None:
+            self._pairs = _pair_lengths(self.p, self.deadline)
+        if not self._pairs or mask & (mask - 1) == 0:
+            return 0
+        v = self._pair_memo.get(mask)
+        if v is None:
+            v = 0
+            table = self._pairs
+            idx = members(mask)
+            for a, i in enumerate(idx):
+                row = table[i]
+                for j in idx[a + 1 :]:
+                    if row[j] > v:
+                        v = row[j]
+            self._pair_memo[mask] = v
+        return v
+
+    def sensorless_length(self, mask: int) -> int | None:
+        """The length of a set no reading can split, by a shortest-path search over sets
+        (None: no plan orients it).
+
+        Every action then has one branch, its image, so the minimum worst-case length is a
+        shortest path to a goal (section 4): A* with :meth:`part_bound` as the heuristic,
+        breadth-first search where it is 0. Sets on the path found are proven with their
+        actions (``choice``, so a plan can be rebuilt); a set met at depth ``d`` of a search
+        of length ``L`` needs at least ``L - d``. Polls the deadline once per set expanded.
+        """
+        e = self.exact.get(mask)
+        if e is not None:
+            return e
+        if self.p.is_goal(mask):
+            return 0
+        choices = self.p.choices
+        # Without a margin floor a set's image containing it cannot help (lengths are
+        # monotone under subsets); with one every range counts (Choices.search_actions).
+        useful = self.p.min_margin == 0.0
+        bound = self.part_bound
+        parent: dict[int, tuple[int, tuple[float, float, int]] | None] = {mask: None}
+        met = {mask: 0}
+        # A* over sets (unit steps; the per-part bound is consistent: one operation lowers a
+        # part's backchaining length by at most one), ties to the deeper set.
+        heap = [(bound(mask), 0, mask)]
+        done: set[int] = set()
+        found = None
+        depth = 0
+        while heap:
+            _f, neg, cur = heapq.heappop(heap)
+            if cur in done:
+                continue
+            if self.p.is_goal(cur):
+                found, depth = cur, -neg
+                break
+            done.add(cur)
+            self.deadline.check()
+            g = 1 - neg
+            for cell in choices.cells(cur, useful):
+                img = cell[2]
+                old = met.get(img)
+                if old is not None and old <= g:
+                    continue
+                met[img] = g
+                parent[img] = (cur, cell)
+                heapq.heappush(heap, (g + bound(img), -g, img))
+        if found is None:
+            self.never.add(mask)
+            return None
+        # A set met at depth d needs at least depth - d (else ``mask`` would need fewer).
+        for t, d in met.items():
+            if depth - d > self.lb.get(t, 1) and t not in self.exact:
+                self.lb[t] = depth - d
+        step = found
+        k = 0
+        while True:
+            link = parent[step]
+            if link is None:
+                break
+            prev, cell = link
+            k += 1
+            act = choices.act(prev, cell, exact=not useful)
+            assert act is not None  # its one branch, the image, does not contain the set
+            self.exact[prev] = k
+            self.ub[prev] = min(self.ub.get(prev, k), k)
+            if prev not in self.choice or self.choice[prev][0] > k:
+                self.choice[prev] = (k, act)
+            step = prev
+        return depth
+
+    def part_bound(self, mask: int) -> int:
+        """A lower bound on the length of ``mask``: the largest, over the machine's parts,
+        of the backchaining length of its states of that part (Goldberg 1993; a subset needs
+        no more operations, and a part's states only reach states of that part). 0 for
+        parts that are not push functions (outcome sets, or goals other than symmetry)."""
+        if self._chains is None:
+            self._chains = _part_chains(self.p)
+        best = 0
+        for part, local, chain in self._chains:
+            sub = mask & part
+            if sub & (sub - 1):
+                m = 0
+                for i in members(sub):
+                    m |= 1 << local[i]
+                v = chain.length(m)  # type: ignore[attr-defined]
+                if best < v < float("inf"):
+                    best = int(v)
+        return best
 
     def within(self, mask: int, k: int) -> bool:
         """Whether ``mask`` can be oriented in at most ``k`` operations.
@@ -121,10 +260,73 @@ class WorstCase:
         e = self.exact.get(mask)
         if e is not None:
             return e
-        k = self.lb.get(mask, 1)
+        if self._quiet is not None and self._quiet(mask):
+            e = self.sensorless_length(mask)
+            if e is None:
+                raise ValueError("no plan orients the set")
+            if limit is not None and e > limit:
+                raise ValueError(f"no plan within {limit} operations")
+            return e
+        k = max(self.lb.get(mask, 1), self.pair_bound(mask))
         while not self.within(mask, k):
             k += 1
             if limit is not None and k > limit:
                 raise ValueError(f"no plan within {limit} operations")
         self.exact[mask] = k
         return k
+
+
+def _part_chains(problem: Problem) -> list[tuple[int, dict[int, int], object]]:
+    """Per part whose states form a push function with the goal its symmetry: the mask of
+    its states, their local numbers and the part's backchaining table."""
+    from feederkit.planning.sensorless import Backchain, push_circle  # sensorless imports us
+
+    machine = getattr(problem, "machine", None)
+    if not isinstance(machine, PushAlignMachine) or not machine.deterministic:
+        return []
+    out = []
+    for p in sorted({s.part for s in machine.states}):
+        idx = [i for i, s in enumerate(machine.states) if s.part == p]
+        local = {g: k for k, g in enumerate(idx)}
+        part = sum(1 << i for i in idx)
+        if any(t not in local for i in idx for t in machine.targets[i]):
+            continue
+        maps = tuple(
+            tuple(
+                ActionRange(r.lo, r.hi, local[t])
+                for r, t in zip(machine.action_maps[i], machine.targets[i], strict=True)
+            )
+            for i in idx
+        )
+        states = tuple(replace(machine.states[i], part=0) for i in idx)
+        sub = PushAlignMachine((machine.part_names[p],), states, maps, machine.sensor)
+        insep = tuple(sum(1 << local[j] for j in members(problem.insep[i] & part)) for i in idx)
+        circle = push_circle(sub, insep)
+        if circle is not None:
+            out.append((part, local, Backchain(circle)))
+    return out
+
+
+def _pair_lengths(problem: Problem, deadline: Deadline) -> list[list[int]]:
+    """Every pair's minimum worst-case length (``table[i][j]``), or [] where the pair bound
+    does not apply (see :meth:`WorstCase.pair_bound`)."""
+    machine = getattr(problem, "machine", None)
+    if (
+        not isinstance(machine, PushAlignMachine)
+        or not machine.deterministic
+        or problem.min_margin != 0.0
+        or getattr(problem, "sensorless", True)
+        or not 2 <= machine.n <= PAIR_BOUND_STATES
+    ):
+        return []
+    n = machine.n
+    # The AND/OR search on each pair set (its own memo; no pair bound inside): most pairs
+    # are told apart or merged by the first action it tries.
+    search = WorstCase(problem, deadline)
+    search._pairs = []
+    table = [[0] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(i + 1, n):
+            v = search.length((1 << i) | (1 << j))
+            table[i][j] = table[j][i] = v
+    return table

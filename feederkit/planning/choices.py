@@ -34,6 +34,8 @@ from feederkit.angles import ANGLE_EPS, cells_between, norm360
 from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
 from feederkit.planning.readings import Readings
 
+_DOMINATORS = 8
+"""The length view tests an image against this many smaller ones for dominance."""
 _NUMPY_MIN_BOUNDS = 256
 """Sets with at least this many action-range boundaries get their cells from numpy."""
 
@@ -150,16 +152,32 @@ class Choices:
             return cells
         best: dict[object, tuple[float, float, int]] = {}
         floor = 2.0 * self.min_margin
-        for cell in self.fixed_cells(mask):
-            lo, hi, img = cell
-            if hi - lo < floor:
-                continue
-            key: object = img
-            if self.distinct_maps:
-                key = self.targets(mask, OverlapRange(lo, hi, img))
-            old = best.get(key)
-            if old is None or _wider(cell, old):
-                best[key] = cell
+        fast = None if self.distinct_maps else self._space.cells_and_images(mask)
+        if fast is not None:
+            # The same cells and images as fixed_cells, from the machine's cell table.
+            los, his, imgs = fast
+            width = his - los
+            order = np.lexsort((-width,))  # widest first: the first per image is the widest
+            for k, lo, hi in zip(
+                order.tolist(), los[order].tolist(), his[order].tolist(), strict=True
+            ):
+                if hi - lo < floor:
+                    break
+                img = imgs[k]
+                old = best.get(img)
+                if old is None or _wider((lo, hi, img), old):
+                    best[img] = (lo, hi, img)
+        else:
+            for cell in self.fixed_cells(mask):
+                lo, hi, img = cell
+                if hi - lo < floor:
+                    continue
+                key: object = img
+                if self.distinct_maps:
+                    key = self.targets(mask, OverlapRange(lo, hi, img))
+                old = best.get(key)
+                if old is None or _wider(cell, old):
+                    best[key] = cell
         keyed = [(lo - hi, norm360((lo + hi) / 2.0), img, lo, hi) for lo, hi, img in best.values()]
         keyed.sort()
         cells = [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
@@ -205,15 +223,12 @@ class Choices:
         return self.lazy_actions(mask) if self.min_margin == 0.0 else iter(self.exact_actions(mask))
 
     def actions(self, mask: int) -> tuple[Act, ...]:
-        """Useful representative actions of a set (``cells``), most promising first (cached)."""
+        """Useful representative actions of a set (``lazy_actions``, all made; cached)."""
         acts = self._actions.get(mask)
-        if acts is not None:
-            return acts
-        out = [a for a in (self.act(mask, c) for c in self.cells(mask)) if a is not None]
-        # Cells come widest first, then by rotation; a stable sort keeps that among equals.
-        out.sort(key=_order)
-        acts = tuple(out)
-        self._actions[mask] = acts
+        if acts is None:
+            for _ in self.lazy_actions(mask):
+                pass
+            acts = self._actions[mask]
         return acts
 
     def lazy_actions(self, mask: int) -> Iterator[Act]:
@@ -221,6 +236,11 @@ class Choices:
 
         Smallest image first (a proxy for the smallest branches), then the widest; the
         search usually succeeds, or fails at a memoised depth, long before the last one.
+        An action whose image contains one of the first ``_DOMINATORS`` images is left
+        out (dominated): the branches of a subset lie inside the branches of the set (each
+        reading cell, or component, restricted), and a subset needs no more operations.
+        Testing against every earlier image costs more than it saves on sets with hundreds
+        of ranges.
         """
         done = self._actions.get(mask)
         if done is not None:
@@ -229,16 +249,24 @@ class Choices:
         state = self._lazy.get(mask)
         if state is None:
             cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
-            state = self._lazy[mask] = [cells, 0, []]
-        cells, _, made = state
+            state = self._lazy[mask] = [cells, 0, [], []]
+        cells, _, made, kept = state
         i = 0
         while True:
             if i < len(made):
                 yield made[i]
                 i += 1
             elif state[1] < len(cells):
-                act = self.act(mask, cells[state[1]])
+                cell = cells[state[1]]
                 state[1] += 1
+                img = cell[2]
+                # Sorted by size: only an earlier image can lie inside this one. Only the
+                # first few (smallest) are tried: they dominate most, and the test is cheap.
+                if any(k & img == k for k in kept):
+                    continue
+                if len(kept) < _DOMINATORS:
+                    kept.append(img)
+                act = self.act(mask, cell)
                 if act is not None:
                     made.append(act)
             else:
@@ -271,12 +299,6 @@ def spread(masses, outcomes) -> dict[int, float]:
         for t in ts:
             moved[t] = moved.get(t, 0.0) + share
     return moved
-
-
-def _order(a: Act) -> tuple[int, int]:
-    """Search order: the smallest largest branch first, then the fewest states in all."""
-    ch = a.children
-    return (ch[0].bit_count(), sum(c.bit_count() for c in ch) if len(ch) > 1 else 0)
 
 
 def _wider(a: tuple[float, float, int], b: tuple[float, float, int]) -> bool:

@@ -68,6 +68,12 @@ class Problem:
             self.readings,
         )
 
+    def carries_no_information(self, mask: int) -> bool:
+        """Whether no reading can split any set reachable from ``mask`` (readings then carry
+        no information: a sensorless problem inside a sensor-based one,
+        :meth:`~feederkit.planning.readings.Readings.carries_no_information`)."""
+        return self.readings.carries_no_information(mask)
+
     def is_goal(self, mask: int) -> bool:
         """Whether every pair of states in ``mask`` is inseparable (the set is oriented;
         :func:`feederkit.machine.is_goal`, memoised per set)."""

@@ -81,6 +81,68 @@ class Readings:
         self._open: dict[int, dict[int, float] | None] = {}
         self._tables: dict[int, list[tuple[ReadingBranch, list[int], list[float]]]] = {}
         self._prob: dict[tuple[float | None, float | None, int], float] = {}
+        self._quiet: tuple[int, tuple[int, ...]] | None = None
+
+    def _quiet_table(self) -> tuple[int, tuple[int, ...]]:
+        """The states whose reading closure carries no information, and their classes.
+
+        Two states *read alike* when they lie in the same exact reading cells of the whole
+        machine (the same reading set). A state is *quiet* when every state reachable from
+        it under every sequence of actions (every outcome) reads alike with it; ``alike[i]``
+        is the mask of states reading alike with ``i``. A set of quiet states of one class
+        (section 4's situation inside section 6's search) only ever meets sets that read
+        alike, so each of its actions has one branch: its image.
+        """
+        if self._quiet is not None:
+            return self._quiet
+        m = self.machine
+        n = m.n
+        key: list[list[int]] = [[] for _ in range(n)]
+        if not self.sensorless:
+            for c, b in enumerate(self._space.branches(m.all_states, Grouping.EXACT)):
+                for i in members(b.mask):
+                    key[i].append(c)
+        by_key: dict[tuple[int, ...], int] = {}
+        for i in range(n):
+            k = tuple(key[i])
+            by_key[k] = by_key.get(k, 0) | 1 << i
+        alike = tuple(by_key[tuple(key[i])] for i in range(n))
+        succ = [0] * n
+        for i in range(n):
+            for out in m.outcomes_of[i]:
+                succ[i] |= out
+        # The greatest set of states whose successors all read alike with them and are again
+        # in the set: then everything reachable reads alike (alike classes are equivalences).
+        quiet = 0
+        for i in range(n):
+            if succ[i] & ~alike[i] == 0:
+                quiet |= 1 << i
+        changed = True
+        while changed:
+            changed = False
+            for i in members(quiet):
+                if succ[i] & ~quiet:
+                    quiet &= ~(1 << i)
+                    changed = True
+        # Each class must give one branch under the problem's own branching (belt and
+        # braces: reading alike means one reading set, so every subset gives one branch).
+        for c in set(alike):
+            q = c & quiet
+            if q and (self.children(q) != (q,) or self.all_children(q) != (q,)):
+                quiet &= ~c
+        self._quiet = (quiet, alike)
+        return self._quiet
+
+    def carries_no_information(self, mask: int) -> bool:
+        """Whether no reading can split any set reachable from ``mask``: its members are
+        quiet and read alike (:meth:`_quiet_table`), so it is a sensorless problem."""
+        if not mask:
+            return False
+        quiet, alike = self._quiet_table()
+        if mask & ~quiet:
+            return False
+        low = (mask & -mask).bit_length() - 1
+        return mask & ~alike[low] == 0
 
     def branches(self, mask: int) -> tuple[ReadingBranch, ...]:
         """The reading branches of a set (cached)."""
@@ -100,7 +162,11 @@ class Readings:
         """Every distinct reading branch set of an image, largest first (cached)."""
         out = self._all.get(image)
         if out is None:
-            masks = {b.mask for b in self.branches(image)}
+            if self._cell_masks is not None:
+                # Exact branching: the whole machine's reading cells restricted to the image.
+                masks = self._restricted_cells(image)
+            else:
+                masks = {b.mask for b in self.branches(image)}
             out = tuple(sorted(masks, key=int.bit_count, reverse=True))
             self._all[image] = out
         return out

@@ -162,8 +162,16 @@ class Refiner:
         decide.
         """
         if self.p.min_margin == 0.0 and not self.p.sensorless:
-            return all(self.w.within(c, k) for c in self.p.readings.children(act.action.image))
+            return self.feasible_image(act.action.image, k)
         return all(self.w.within(c, k) for c in act.children)
+
+    def feasible_image(self, image: int, k: int) -> bool | None:
+        """:meth:`feasible` of an action with this image, from the image alone (its maximal
+        branches), before its exact branches are made; None when the exact branches decide
+        (a margin floor, or no sensor)."""
+        if self.p.min_margin == 0.0 and not self.p.sensorless:
+            return all(self.w.within(c, k) for c in self.p.readings.children(image))
+        return None
 
     def allowed(self, act: Act, k: int) -> bool:
         """Whether a plan of at most ``k`` operations keeping ``floor`` can start with ``act``."""
@@ -204,6 +212,8 @@ class Refiner:
                 m = (cell[1] - cell[0]) / 2.0
                 if m <= best or best >= cap:
                     break
+                if self.feasible_image(cell[2], k - 1) is False:
+                    continue  # decided without making the exact branches
                 act = self.p.choices.act(mask, cell, exact=True)
                 if not self.feasible(act, k - 1):
                     continue
@@ -266,6 +276,8 @@ class Refiner:
         for bound, _rot, cell in options:
             if bound > best[0] + _TIE:
                 break
+            if self.feasible_image(cell[2], k - 1) is False:
+                continue  # not allowed: decided before making the exact branches
             act = self.p.choices.act(mask, cell, exact=True)
             if not self.allowed(act, k):
                 continue
