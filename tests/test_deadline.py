@@ -164,12 +164,6 @@ def _proven_refiner(machine, deadline: Deadline):
     return Refiner(problem, worst, deadline), children, k
 
 
-@pytest.mark.xfail(
-    reason="needs Refiner.build and choose_worst('first') to poll their deadline "
-    "(feederkit/planning/refine.py); remove this marker with that change",
-    raises=AssertionError,
-    strict=True,
-)
 def test_the_tree_of_a_proven_length_polls_its_deadline():
     # When the tie-breaking stages run out, plan() builds the tree taking the first action
     # that keeps the proven length at each node, by FIRST_TREE_SHARE of the limit
@@ -267,14 +261,6 @@ def test_a_memory_limit_stops_the_search_like_the_time_limit():
             lambda: small_mix(50),
             0.6,
             IDEAL,
-            marks=pytest.mark.xfail(
-                reason="known overshoot (8.3 s for a 2 s limit in CI with both cores busy): "
-                "when the tie-breaking stages run out, the tree of the proven length "
-                "(Refiner.build, choose_worst 'first') does not poll its deadline; remove "
-                "this marker with that change (test_the_tree_of_a_proven_length_polls_its_"
-                "deadline)",
-                strict=False,
-            ),
         ),
     ],
 )

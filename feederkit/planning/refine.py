@@ -214,6 +214,7 @@ class Refiner:
                     break
                 if self.feasible_image(cell[2], k - 1) is False:
                     continue  # decided without making the exact branches
+                self.deadline.check()  # each action costs a reading split
                 act = self.p.choices.act(mask, cell, exact=True)
                 if not self.feasible(act, k - 1):
                     continue
@@ -278,6 +279,7 @@ class Refiner:
                 break
             if self.feasible_image(cell[2], k - 1) is False:
                 continue  # not allowed: decided before making the exact branches
+            self.deadline.check()
             act = self.p.choices.act(mask, cell, exact=True)
             if not self.allowed(act, k):
                 continue
@@ -356,7 +358,13 @@ class Refiner:
         ``"worst-time"`` the first action of :meth:`worst_seconds`.
         """
         if tie == "first":
-            for act in self.p.choices.exact_actions(mask):
+            # The problem's order (Choices.exact_actions), made one action at a time: the
+            # first allowed one usually comes early, and each costs a reading split.
+            for cell in self.p.choices.cells(mask, useful=False):
+                if self.feasible_image(cell[2], k - 1) is False:
+                    continue  # decided before making the exact branches
+                self.deadline.check()
+                act = self.p.choices.act(mask, cell, exact=True)
                 if self.allowed(act, k):
                     return act
             raise AssertionError("no feasible action within the proven length")
@@ -379,16 +387,32 @@ class Refiner:
         raise AssertionError("no feasible action within the proven length")
 
     def build(
-        self, mask: int, masses: Masses, k: int, chooser: Callable[[int, Masses, int], Act]
+        self,
+        mask: int,
+        masses: Masses,
+        k: int,
+        chooser: Callable[[int, Masses, int], Act],
+        shared: dict[tuple[int, int], Step] | None = None,
     ) -> Step | Leaf:
-        """The subtree orienting ``mask`` in at most ``k`` operations, actions from ``chooser``."""
+        """The subtree orienting ``mask`` in at most ``k`` operations, actions from ``chooser``.
+
+        ``shared`` (for a chooser that ignores the masses): one node per set and budget,
+        so equal subtrees are stored once (a DAG in memory)."""
         if self.p.is_goal(mask):
             return Leaf(mask)
+        if shared is not None:
+            hit = shared.get((mask, k))
+            if hit is not None:
+                return hit
+        self.deadline.check()
         act = chooser(mask, masses, k)
         subs = []
         for b, _pb, ms in child_masses(self.p, mask, masses, act):
-            subs.append((b, self.build(b.mask, ms, k - 1, chooser)))
-        return Step(act.action, tuple(subs))
+            subs.append((b, self.build(b.mask, ms, k - 1, chooser, shared)))
+        node = Step(act.action, tuple(subs))
+        if shared is not None:
+            shared[(mask, k)] = node
+        return node
 
 
 def _prefer(a: Act, b: Act | None) -> bool:
