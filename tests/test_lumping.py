@@ -29,13 +29,16 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.api import NoStrongPlan
 from feederkit.planning.lumping import (
-    Lumping,
+    LumpedGoal,
+    LumpingTry,
     candidate_pairs,
     kept_apart,
     lumped_goal,
     lumped_words,
+    try_lumping,
     unresolvable_pairs,
 )
+from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.tree import Leaf
@@ -58,16 +61,16 @@ def wired(monkeypatch):
     """The lumpings ``api.plan`` makes (over the diameter-sorted machine ``_plan`` sees),
     collected in the list: ``plan`` plans to the lumped goal when the inseparable goal
     leaves no strong plan (docs/planning.md)."""
-    real = api.lumped_goal
-    made: list[Lumping] = []
+    real = api.try_lumping
+    made: list[LumpedGoal] = []
 
-    def lumped_goal_(*args, **kwargs):
-        lump = real(*args, **kwargs)
-        if lump is not None:
-            made.append(lump)
-        return lump
+    def try_lumping_(*args, **kwargs):
+        tried = real(*args, **kwargs)
+        if tried.goal is not None:
+            made.append(tried.goal)
+        return tried
 
-    monkeypatch.setattr(api, "lumped_goal", lumped_goal_)
+    monkeypatch.setattr(api, "try_lumping", try_lumping_)
     return made
 
 
@@ -115,7 +118,7 @@ def test_the_near_symmetric_rectangle_plans_with_the_defaults_and_verifies(wired
 def test_without_lumping_the_rectangle_has_no_strong_plan(monkeypatch):
     """The defect itself, so the test above cannot pass by accident."""
     machine = build_machine([near_rectangle()], NoSensor(), Uncertainty())
-    monkeypatch.setattr(api, "lumped_goal", lambda *a, **k: None)
+    monkeypatch.setattr(api, "try_lumping", lambda *a, **k: LumpingTry(None))
     with pytest.raises(NoStrongPlan):
         api.plan(machine)
 
@@ -146,7 +149,10 @@ def test_the_sample_drawings_plan_with_the_defaults_and_verify(wired, name):
 
     _, parts = import_parts(SAMPLES / name, ImportOptions())
     pf = push_function(parts[0].part)
-    assert not api.strong_plan_exists(build_machine([pf], NoSensor(), Uncertainty()))
+    machine = build_machine([pf], NoSensor(), Uncertainty())
+    assert not api.strong_plan_exists(machine, PlanningOptions(lumping="none"))
+    assert api.strong_plan_exists(machine)
+    wired.clear()  # strong_plan_exists lumps as plan does: keep plan's lumping only
     made = make_plan([pf], NoSensor(), certify=False)
     verify_strong(made.plan)
     assert len(wired) == 1 and wired[0].pairs
@@ -183,7 +189,9 @@ APU_MOUNT_COM = [181.55967048403957, 125.61033879057555]
 def test_the_apu_mount_drawing_plans_with_the_defaults_and_verifies(wired, sensor):
     pf = push_function(make_part(make_outline("apu-mount", APU_MOUNT_HULL), APU_MOUNT_COM))
     machine = build_machine([pf], sensor, Uncertainty())
-    assert not api.strong_plan_exists(machine)
+    assert not api.strong_plan_exists(machine, PlanningOptions(lumping="none"))
+    assert api.strong_plan_exists(machine)  # as plan: up to its near-symmetric poses
+    wired.clear()
     made = make_plan([pf], sensor, certify=False)
     verify_strong(made.plan)
     _sorted, old = by_diameter(machine)
@@ -372,9 +380,14 @@ def test_every_pair_resolvable_does_not_make_the_set_solvable(wired):
 
 
 def test_lumping_gives_up_when_undecided():
+    """No set may be expanded (the roots check reaches the goal from the root itself in one
+    action, so a budget of one set would decide it)."""
     m = build_machine([near_rectangle()], NoSensor(), Uncertainty())
-    assert lumped_goal(m, max_sets=1) is None
-    assert unresolvable_pairs(Problem(m), max_sets=1) is None
+    assert lumped_goal(m, max_sets=0) is None
+    tried = try_lumping(m, max_sets=0)
+    assert tried.goal is None and not tried.decided
+    assert lumped_goal(m) is not None  # decided with room
+    assert unresolvable_pairs(Problem(m), max_sets=0) is None
 
 
 def test_a_pair_check_too_large_settles_for_the_pairs_nature_keeps_apart():
@@ -396,7 +409,7 @@ def test_the_words_name_a_few_pairs_and_count_the_rest():
 
 
 def test_renumbered_maps_masks_and_pairs_back():
-    lump = Lumping((0b010, 0b001, 0b000), ((0, 1),))
+    lump = LumpedGoal((0b010, 0b001, 0b000), ((0, 1),))
     back = lump.renumbered([2, 0, 1])  # new 0 was old 2, new 1 was old 0
     assert back.pairs == ((0, 2),)
     assert back.insep == (0b100, 0b000, 0b001)

@@ -38,6 +38,7 @@ from feederkit.cli.common import (
     JsonOpt,
     LandingsOpt,
     LedPitchOpt,
+    LumpingOpt,
     MemoryLimitOpt,
     MinMarginOpt,
     NoiseOpt,
@@ -237,6 +238,7 @@ def compile_command(
     time_limit: TimeLimitOpt = DEFAULT_TIME_LIMIT_S,
     memory_limit: MemoryLimitOpt = None,
     grouping: GroupingOpt = "exact",
+    lumping: LumpingOpt = "near-symmetric",
     output: PlanOutputOpt = None,
     report: ReportOpt = None,
     replace: Annotated[
@@ -268,7 +270,7 @@ def compile_command(
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
     sensor = settings.sensor
     options = cell_planning_options(
-        settings, objective, grouping, min_margin, time_limit, memory_limit
+        settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
     path = resolve_catalog_path(catalog)

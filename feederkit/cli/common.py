@@ -102,6 +102,17 @@ GroupingOpt = Annotated[
         help="exact (default) or components (the paper's rule).",
     ),
 ]
+LumpingOpt = Annotated[
+    str,
+    typer.Option(
+        "--lumping",
+        metavar="near-symmetric|any|none",
+        help="Which states that no strong plan tells apart a result may list together: "
+        "near-symmetric (default: poses whose outlines differ by at most 1 % of the part, "
+        "and parts of a mix), any (also poses that look different; the plan then does not "
+        "orient the part between them), none.",
+    ),
+]
 CatalogOpt = Annotated[
     Path | None,
     typer.Option(
@@ -187,6 +198,7 @@ FLAG_TERMS = (
     ("rotation error", "--rotation-error"),
     ("shape tolerance", "--shape-tolerance"),
     ("com tolerance", "--com-tolerance"),
+    ("lumping", "--lumping"),
 )
 """The library's words for what a command-line flag sets: a library message that names one
 is shown with the flag."""
@@ -396,6 +408,7 @@ def cell_planning_options(
     min_margin: float,
     time_limit: float | None,
     memory_limit: float | None = None,
+    lumping: str = "near-symmetric",
 ) -> PlanningOptions:
     """The command's :class:`PlanningOptions` with the cell's action costs (when the profile
     gives its timing); ``--objective time|worst-time`` without them is one line naming the
@@ -415,6 +428,7 @@ def cell_planning_options(
             time_limit_s=time_limit,
             memory_limit_mb=default_memory_limit() if memory_limit is None else memory_limit,
             costs=costs,
+            lumping=lumping,
         )
 
 

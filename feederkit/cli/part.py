@@ -164,9 +164,7 @@ def analyze_command(
     )
     parts = []
     for src in sources:
-        for loaded in load_parts_with_warnings(
-            src, com=com, catalog=catalog, options=import_opts
-        ):
+        for loaded in load_parts_with_warnings(src, com=com, catalog=catalog, options=import_opts):
             print_import_warnings(src, loaded.warnings)
             parts.append(loaded.part)
     analyses = [analyze_part(p, sensor) for p in parts]

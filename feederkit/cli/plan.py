@@ -28,6 +28,7 @@ from feederkit.cli.common import (
     GroupingOpt,
     LandingsOpt,
     LedPitchOpt,
+    LumpingOpt,
     MemoryLimitOpt,
     MinMarginOpt,
     NoiseOpt,
@@ -179,6 +180,7 @@ def plan_command(
     time_limit: TimeLimitOpt = DEFAULT_TIME_LIMIT_S,
     memory_limit: MemoryLimitOpt = None,
     grouping: GroupingOpt = "exact",
+    lumping: LumpingOpt = "near-symmetric",
     output: PlanOutputOpt = None,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the plan file's JSON on stdout.")
@@ -207,7 +209,7 @@ def plan_command(
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
     sensor = settings.sensor
     options = cell_planning_options(
-        settings, objective, grouping, min_margin, time_limit, memory_limit
+        settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
     with flag_words(terms):

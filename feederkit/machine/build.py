@@ -16,7 +16,7 @@ from feederkit.angles import ActionRange
 from feederkit.machine.model import MachineState, OutcomeRange, PushAlignMachine
 from feederkit.mechanics.actions import action_ranges
 from feederkit.mechanics.push import PushFunction, resting_widths
-from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, look_alike
 from feederkit.mechanics.uncertain import UncertainMechanics, action_map, uncertain_mechanics
 from feederkit.sensors import NoSensor, Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -132,7 +132,10 @@ def uncertain_machine(
     A state's ``members`` are its ideal stable states, ``state`` the first of them,
     ``diameter_range`` its reading interval (ends snapped outward, :func:`snap_intervals`) and its
     weight the resting ranges of the ideal states a first alignment can end in, each shared
-    equally among the physical states it may settle in (``destinations``).
+    equally among the physical states it may settle in (``destinations``). ``look_alike``
+    names the part's other physical states whose poses are near-congruent
+    (:func:`~feederkit.mechanics.symmetry.look_alike`: within ``NEAR_SYMMETRIC_REL`` of the
+    part's size), the pairs the planners' default lumping may list together.
     """
     offsets = []
     total = 0
@@ -151,11 +154,20 @@ def uncertain_machine(
         for i, dest in enumerate(mech.destinations):
             for t in dest:
                 weight[t] += widths[i] / 360.0 / share / len(dest)
+        alike = look_alike(pf, [s.members for s in mech.states])
         for s in mech.states:
             lo, hi = ends[k]
             k += 1
             states.append(
-                MachineState(p, s.members[0], (lo + hi) / 2.0, weight[s.id], (lo, hi), s.members)
+                MachineState(
+                    p,
+                    s.members[0],
+                    (lo + hi) / 2.0,
+                    weight[s.id],
+                    (lo, hi),
+                    s.members,
+                    look_alike=tuple(mech.states[t].members[0] for t in alike[s.id]),
+                )
             )
             ranges = []
             for a, b, targets in action_map(mech, s.id):

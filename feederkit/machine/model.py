@@ -38,7 +38,12 @@ class MachineState:
     ``reject`` marks a state of a member the next station cannot take (a rejected landing,
     design.md "Landings"): a set of only such states is a goal, a reject leaf
     (:attr:`feederkit.machine.space.SearchSpace.inseparable`). It travels with the state, so
-    renumbering the states keeps it.
+    renumbering the states keeps it. ``look_alike`` names (by ``state``) the other states of
+    the same part whose poses look like this one's to the next station (near-congruent
+    outlines, docs/planning.md "Near-symmetric states under uncertainty"): the only pairs of
+    one part a plan may list together when no strong plan resolves them. The machine build
+    records it under uncertainty; None (a machine built by hand, or the ideal model, where
+    nothing is lumped) records nothing, and then any pair may be lumped.
     """
 
     part: int
@@ -48,6 +53,7 @@ class MachineState:
     diameter_range: tuple[float, float] | None = None
     members: tuple[int, ...] = ()
     reject: bool = False
+    look_alike: tuple[int, ...] | None = None
 
     @property
     def sensed(self) -> Diameter:

@@ -146,12 +146,115 @@ class Symmetry:
         return max(1, round(360.0 / self.period_deg)) if self.period_deg > 0 else 1
 
 
+NEAR_SYMMETRIC_REL = 0.01
+"""Poses whose outlines differ by at most this share of the part's size look alike to the
+next station (:func:`pose_difference`): the near-symmetric poses a plan under uncertainty may
+list together (docs/planning.md, "Near-symmetric states under uncertainty")."""
+
+
+def _placed(pf: PushFunction, state: int) -> np.ndarray:
+    """The hull's vertices with the part resting in stable state ``state``: rotated by its
+    pose, on the fence line (y = 0) and centred along it."""
+    hull = np.asarray(pf.part.hull, dtype=float)
+    t = math.radians(pf.states[state].pose_deg)
+    rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    pts = hull @ rot.T
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    return pts - np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+
+
+def _normals(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A convex polygon's outward edge normals (counter-clockwise vertices ``p``), sorted in
+    [0, 2 pi), and the support vertex just past each (edge ``i``'s normal: vertex ``i + 1``)."""
+    e = np.roll(p, -1, axis=0) - p
+    ang = np.mod(np.arctan2(-e[:, 0], e[:, 1]), 2.0 * math.pi)
+    order = np.argsort(ang, kind="stable")
+    return ang[order], (order + 1) % len(p)
+
+
+def _support_gaps(polys: Sequence[np.ndarray], pairs: Sequence[tuple[int, int]]) -> np.ndarray:
+    """Per pair ``(a, b)`` of convex polygons with the same number of vertices (the poses of
+    one hull, counter-clockwise), the largest difference of their support functions,
+    exactly: the Hausdorff distance of the two regions (for convex sets it is the sup norm of
+    the support functions' difference).
+
+    Between consecutive edge normals of either polygon the difference is ``<w, u>``, ``w``
+    the difference of the two support vertices, so its largest magnitude on that arc is at
+    an end, or ``|w|`` when ``w`` (or ``-w``) points into the arc. All pairs at once: each
+    row's angles are offset by ``4 pi`` per row, so one sorted array serves every search.
+    """
+    tau = 2.0 * math.pi
+    if not pairs:
+        return np.zeros(0)
+    pts = np.asarray(polys, dtype=float)  # (poses, V, 2)
+    found = [_normals(p) for p in pts]
+    ns = np.array([f[0] for f in found])
+    vs = np.array([f[1] for f in found])
+    a = np.array([i for i, _j in pairs])
+    b = np.array([j for _i, j in pairs])
+    rows, v = len(pairs), pts.shape[1]
+    cuts = np.sort(np.concatenate([ns[a], ns[b]], axis=1), axis=1)  # (rows, 2V)
+    width = np.diff(np.concatenate([cuts, cuts[:, :1] + tau], axis=1), axis=1)
+    mid = cuts + width / 2.0
+    shift = 2.0 * tau * np.arange(rows)[:, None]
+
+    def support(side: np.ndarray) -> np.ndarray:
+        flat = (ns[side] + shift).ravel()
+        k = np.searchsorted(flat, (mid + shift).ravel(), side="right") - 1
+        k = k.reshape(rows, -1) - v * np.arange(rows)[:, None]
+        k = np.where(k < 0, v - 1, k)  # before a row's first normal: past its last
+        vert = np.take_along_axis(vs[side], k, axis=1)
+        return pts[side[:, None], vert]  # (rows, 2V, 2)
+
+    w = support(a) - support(b)
+    ends = np.stack([np.cos(cuts), np.sin(cuts)], axis=2)
+    nxt = np.roll(ends, -1, axis=1)
+    best = np.maximum(np.abs(np.sum(w * ends, axis=2)), np.abs(np.sum(w * nxt, axis=2)))
+    norm = np.hypot(w[..., 0], w[..., 1])
+    alpha = np.arctan2(w[..., 1], w[..., 0])
+    inside = (np.mod(alpha - cuts, tau) <= width) | (np.mod(alpha + math.pi - cuts, tau) <= width)
+    return np.max(np.where(inside, norm, best), axis=1)
+
+
+EXACT_CHUNK = 256
+"""Pairs per batch of :func:`_support_gaps` (bounds its arrays for many-vertex hulls)."""
+
+
+SUPPORT_GRID = 128
+""":func:`look_alike` first compares the poses' support functions at this many directions
+(a lower bound on :func:`pose_difference`), and computes the exact difference only for the
+pairs that bound leaves within reach."""
+
+
+def _grid_support(pts: np.ndarray) -> np.ndarray:
+    """The support function of the points at :data:`SUPPORT_GRID` directions (one at +y)."""
+    phi = math.pi / 2.0 + np.arange(SUPPORT_GRID) * (2.0 * math.pi / SUPPORT_GRID)
+    u = np.stack([np.cos(phi), np.sin(phi)], axis=1)
+    return np.max(pts @ u.T, axis=0)
+
+
+def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
+    """:func:`pose_difference` of every pair of stable states in ``pairs`` (mm), at once."""
+    if not pairs:
+        return np.zeros(0)
+    used = sorted({i for p in pairs for i in p})
+    index = {i: k for k, i in enumerate(used)}
+    polys = [_placed(pf, i) for i in used]
+    local = [(index[i], index[j]) for i, j in pairs]
+    parts = [
+        _support_gaps(polys, local[k : k + EXACT_CHUNK]) for k in range(0, len(local), EXACT_CHUNK)
+    ]
+    return np.concatenate(parts)
+
+
 def pose_difference(pf: PushFunction, a: int, b: int) -> float:
     """How far apart (mm) the part looks resting in stable states ``a`` and ``b``: the
     Hausdorff distance of its hull in the two poses on the fence, each resting on the fence
-    line and centred along it (the position along the fence is not observed). 0 for states
+    line and centred along it (the position along the fence is not observed), exact (the
+    largest difference of the two support functions, :func:`_support_gaps`). 0 for states
     that a symmetry of the hull maps onto each other (definitions 3, 6); small for the
-    near-symmetric states a plan under uncertainty may list together.
+    near-symmetric states a plan under uncertainty may list together. It is at least the
+    difference of the two diameters (the poses' heights above the fence).
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.part import make_part
@@ -160,18 +263,81 @@ def pose_difference(pf: PushFunction, a: int, b: int) -> float:
     >>> round(pose_difference(rect, 0, 2), 9), round(pose_difference(rect, 0, 1), 3)
     (0.0, 2.0)
     """
-    from shapely import Polygon, hausdorff_distance
+    return float(pose_differences(pf, [(a, b)])[0])
 
-    hull = np.asarray(pf.part.hull, dtype=float)
 
-    def placed(state: int) -> np.ndarray:
-        t = math.radians(pf.states[state].pose_deg)
-        rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
-        pts = hull @ rot.T
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        return pts - np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+def poses_difference(pf: PushFunction, g: Sequence[int], h: Sequence[int]) -> float:
+    """How far apart (mm) two sets of poses look (stable states ``g`` and ``h``, e.g. the
+    ideal members of two physical resting states): the Hausdorff distance of the sets under
+    :func:`pose_difference`, so each pose of either set is this close to one of the other.
+    :func:`look_alike` compares it with ``NEAR_SYMMETRIC_REL`` of the part's size.
+    """
+    pairs = [(i, j) for i in g for j in h]
+    d = pose_differences(pf, pairs).reshape(len(g), len(h))
+    return float(max(d.min(axis=1).max(), d.min(axis=0).max()))
 
-    return float(hausdorff_distance(Polygon(placed(a)), Polygon(placed(b))))
+
+def look_alike(
+    pf: PushFunction, groups: Sequence[Sequence[int]], rel: float = NEAR_SYMMETRIC_REL
+) -> tuple[tuple[int, ...], ...]:
+    """Per group of stable states (a physical resting state's ideal members, or one state),
+    the other groups whose poses look alike: every pose of either group lies within ``rel``
+    of the part's size (:func:`pose_difference`) of some pose of the other
+    (:func:`poses_difference` at most that). Symmetric; a group is not listed with itself.
+
+    Pairs whose support functions differ by more than the bound at one of
+    :data:`SUPPORT_GRID` directions (the height above the fence, the diameter, among them)
+    are never compared exactly: that difference is a lower bound on
+    :func:`pose_difference`.
+    """
+    tol = rel * pf.part.size
+    ideal = sorted({i for g in groups for i in g})
+    row = {i: k for k, i in enumerate(ideal)}
+    placed = [_placed(pf, i) for i in ideal]
+    grid = np.array([_grid_support(p) for p in placed])
+    bound = np.max(np.abs(grid[:, None, :] - grid[None, :, :]), axis=2)  # lower bounds
+
+    def reach(g: Sequence[int], h: Sequence[int]) -> bool:
+        """Every member of ``g`` has a pose of ``h`` within the lower bound's reach."""
+        return all(any(bound[row[x], row[y]] <= tol for y in h) for x in g)
+
+    pairs = [
+        (a, b)
+        for a in range(len(groups))
+        for b in range(a + 1, len(groups))
+        if reach(groups[a], groups[b]) and reach(groups[b], groups[a])
+    ]
+    todo = sorted(
+        {
+            (min(row[x], row[y]), max(row[x], row[y]))
+            for a, b in pairs
+            for x in groups[a]
+            for y in groups[b]
+            if x != y and bound[row[x], row[y]] <= tol
+        }
+    )
+    gaps = np.concatenate(
+        [np.zeros(0)]
+        + [
+            _support_gaps(placed, todo[k : k + EXACT_CHUNK])
+            for k in range(0, len(todo), EXACT_CHUNK)
+        ]
+    )
+    close = {p for p, d in zip(todo, gaps, strict=True) if d <= tol}
+
+    def near(x: int, y: int) -> bool:
+        i, j = row[x], row[y]
+        return i == j or (min(i, j), max(i, j)) in close
+
+    def covers(g: Sequence[int], h: Sequence[int]) -> bool:
+        return all(any(near(x, y) for y in h) for x in g)
+
+    out: list[list[int]] = [[] for _ in groups]
+    for a, b in pairs:
+        if covers(groups[a], groups[b]) and covers(groups[b], groups[a]):
+            out[a].append(b)
+            out[b].append(a)
+    return tuple(tuple(x) for x in out)
 
 
 def symmetry(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> Symmetry:

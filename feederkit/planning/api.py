@@ -26,10 +26,10 @@ from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, sea
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.lumping import lumped_goal
+from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
-from feederkit.planning.options import PlanningOptions
+from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage
@@ -56,7 +56,18 @@ must be built; after that the fallback answers."""
 
 
 class NoStrongPlan(PlanningError):
-    """No strong plan exists under the machine's declared uncertainty (design.md)."""
+    """No strong plan exists under the machine's declared uncertainty (design.md).
+
+    ``reason`` is the message without ``hint``, the clause (maybe empty) naming the
+    unresolvable pairs the lumping rule would not list together (docs/planning.md,
+    "Near-symmetric states under uncertainty"); callers that add to the message put the
+    hint last.
+    """
+
+    def __init__(self, reason: str, hint: str = "") -> None:
+        super().__init__(f"{reason}; {hint}" if hint else reason)
+        self.reason = reason
+        self.hint = hint
 
 
 def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
@@ -78,7 +89,9 @@ def strong_plan_exists(
     options: PlanningOptions | None = None,
     deadline: Deadline | None = None,
 ) -> bool:
-    """Whether some strong plan orients every state of ``machine`` (no margin floor).
+    """Whether some strong plan orients every state of ``machine`` (no margin floor), up to
+    inseparable states or, as :func:`plan` does, to the lumped goal that ``options.lumping``
+    allows (:func:`~feederkit.planning.lumping.try_lumping`).
 
     Decided by :func:`~feederkit.planning.solvable.unsolvable`; True when undecided (too
     many sets, or ``deadline`` passed), so a bisection over uncertainties on it errs toward
@@ -98,7 +111,12 @@ def strong_plan_exists(
         bad = unsolvable(problem, sorted(maximal_sets(every)), budget)
     except Timeout:
         return True
-    return bad is None or not bad
+    if bad is None or not bad:
+        return True
+    if options.lumping is Lumping.NONE:
+        return False
+    lumping = try_lumping(sorted_machine, options.grouping, budget, rule=options.lumping)
+    return lumping.goal is not None or not lumping.decided
 
 
 FIRST_LIMIT = 8
@@ -155,11 +173,16 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
     lumping = None
     try:
         root, optimal, length, lower = _plan(sorted_machine, options, budget)
-    except NoStrongPlan:
-        # Near-symmetric states (docs/planning.md): lump the pairs no strong plan resolves.
-        lumping = lumped_goal(sorted_machine, options.grouping, budget)
-        if lumping is None:
+    except NoStrongPlan as exc:
+        if options.lumping is Lumping.NONE:
             raise
+        # Near-symmetric states (docs/planning.md): lump the pairs no strong plan resolves
+        # that the rule allows (by default: poses that look alike).
+        tried = try_lumping(sorted_machine, options.grouping, budget, rule=options.lumping)
+        lumping = tried.goal
+        if lumping is None:
+            hint = unlike_words(sorted_machine, tried.unlike)
+            raise NoStrongPlan(exc.reason, hint) from None
         root, optimal, length, lower = _plan(sorted_machine, options, budget, lumping.insep)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
@@ -303,7 +326,9 @@ def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
     def chooser(mask, masses, k):
         return refiner.choose_worst(mask, masses, k, tie)
 
-    subs = [(b, refiner.build(b.mask, ms, horizon, chooser)) for b, _pb, ms in children]
+    # The first allowed action depends on the set and the budget only: share equal subtrees.
+    shared: dict | None = {} if tie == "first" else None
+    subs = [(b, refiner.build(b.mask, ms, horizon, chooser, shared)) for b, _pb, ms in children]
     return Step(None, tuple(subs))
 
 
@@ -327,6 +352,10 @@ def _check_margin(
 def _root_children(problem: Problem, root_branches, start_mass):
     """The root's branches with their probabilities and normalised masses."""
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
+
+
+TREE_RESERVE = 0.15
+"""The share of the time limit the fallback's last search leaves for building its tree."""
 
 
 def _fallback(
@@ -381,9 +410,17 @@ def _fallback(
     caps = sorted({k for k in near if k < cap}) + [cap]
     found = None
     last = Timeout(stop.reason)
+    # The last search keeps a reserve of the limit for the tree of what it finds: a plan
+    # found at the deadline with no time left to write it down is no answer.
+    reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
     for k in caps:
         rest = budget.remaining()
-        end = None if rest is None or k == cap else budget.end - rest * 2.0 / 3.0
+        if rest is None:
+            end = None
+        elif k == cap:
+            end = budget.end - min(reserve, rest / 2.0)
+        else:
+            end = budget.end - rest * 2.0 / 3.0
         anytime.deadline = Deadline(
             memory_mb=budget.memory_mb, end=end or budget.end, memory_base=budget.memory_base
         )

@@ -27,6 +27,13 @@ whose every pair some action merges while every action maps the three onto thems
 the smallest case), so :func:`lumped_goal` also checks the roots and gives up (None, the
 planner then keeps "no strong plan") when they stay unsolvable: conservative, never wrong.
 
+Which unresolvable pairs may be lumped is the caller's rule (:class:`~feederkit.planning.
+options.Lumping`): by default only pairs of one part whose poses look alike (the machine
+build records them in ``MachineState.look_alike``; the planners read the record, never
+geometry) and pairs of different parts; the others are left out of the goal (``unlike``),
+and when the roots stay unsolvable without them there is no strong plan. Leaving pairs out
+keeps the argument above: the goal only shrinks, a pair left out is simply not a goal.
+
 On the ideal model a plan always exists (docs/planning.md, "The goal"), so lumping is only
 for machines with outcome sets and only when the inseparable goal leaves no strong plan.
 docs/planning.md ("Near-symmetric states under uncertainty") says more.
@@ -38,8 +45,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from feederkit.errors import InputError
 from feederkit.machine import Grouping, PushAlignMachine, members, pair_outcomes
 from feederkit.planning.andor import Deadline, Timeout
+from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.solvable import MAX_SETS, solve
@@ -52,7 +61,7 @@ PAIR_SETS = 20_000
 
 
 @dataclass(frozen=True)
-class Lumping:
+class LumpedGoal:
     """The goal widened by the pairs no strong plan resolves.
 
     ``insep[i]``: the states ``i`` is lumped with (inseparable or unresolvable), the masks a
@@ -66,14 +75,14 @@ class Lumping:
     pairs: tuple[Pair, ...]
     exact: bool = True
 
-    def renumbered(self, old: Sequence[int]) -> Lumping:
+    def renumbered(self, old: Sequence[int]) -> LumpedGoal:
         """The same lumping over the original numbering (``old[new_index]``, as
         :func:`~feederkit.planning.reindex.by_diameter` returns it)."""
         masks = [0] * len(self.insep)
         for k, m in enumerate(self.insep):
             masks[old[k]] = sum(1 << old[j] for j in members(m))
         pairs = sorted((min(old[i], old[j]), max(old[i], old[j])) for i, j in self.pairs)
-        return Lumping(tuple(masks), tuple(pairs), self.exact)
+        return LumpedGoal(tuple(masks), tuple(pairs), self.exact)
 
     def in_leaves(self, root: PlanTree) -> tuple[Pair, ...]:
         """The lumped pairs that some leaf of the plan ``root`` reports together (the ones
@@ -184,42 +193,105 @@ def lumped(insep: Sequence[int], pairs: Sequence[Pair]) -> tuple[int, ...]:
     return tuple(masks)
 
 
-def lumped_goal(
+def _rule(value: Lumping | str) -> Lumping:
+    """``value`` as a :class:`Lumping` rule; anything else is bad input naming the choices."""
+    try:
+        return Lumping(value)
+    except ValueError:
+        choices = ", ".join(m.value for m in Lumping)
+        raise InputError(f"the lumping must be one of {choices}, got {value!r}") from None
+
+
+def may_lump(machine: PushAlignMachine, i: int, j: int, rule: Lumping | str) -> bool:
+    """Whether ``rule`` lets a plan list states ``i`` and ``j`` together (:class:`Lumping`).
+
+    ``near-symmetric``: states of different parts, or of one part when each names the other
+    in ``look_alike`` (a state that records nothing, built by hand, allows any).
+    """
+    rule = _rule(rule)
+    if rule is Lumping.NONE:
+        return False
+    if rule is Lumping.ANY:
+        return True
+    a, b = machine.states[i], machine.states[j]
+    if a.part != b.part:
+        return True
+    if a.look_alike is None or b.look_alike is None:
+        return True
+    return b.state in a.look_alike and a.state in b.look_alike
+
+
+@dataclass(frozen=True)
+class LumpingTry:
+    """What lumping made of a machine with no strong plan to its inseparable goal.
+
+    ``goal``: the lumped goal, when it gives every root reading set a strong plan (else
+    None); ``unlike``: the unresolvable pairs the rule left out (poses that do not look
+    alike), sorted; ``decided``: False when the search ran out of time or sets (``goal`` is
+    then None, and no strong plan may yet exist).
+    """
+
+    goal: LumpedGoal | None
+    unlike: tuple[Pair, ...] = ()
+    decided: bool = True
+
+
+def try_lumping(
     machine: PushAlignMachine,
     grouping: Grouping | str = Grouping.EXACT,
     deadline: Deadline | None = None,
     max_sets: int = MAX_SETS,
     pair_sets: int = PAIR_SETS,
-) -> Lumping | None:
-    """The lumped goal of ``machine`` when it gives every root reading set a strong plan.
-
-    The lumped pairs are :func:`unresolvable_pairs`; when deciding them all takes more than
-    ``pair_sets`` sets, the pairs :func:`kept_apart` finds (every one unresolvable, maybe
-    not all; ``Lumping.exact`` False). None when lumping does not help or cannot be
-    decided: the machine is ideal (a plan always exists there), no pair is lumped (the
-    set-level failure of the module docstring), the roots stay unsolvable under the lumped
-    goal, there are more than ``max_sets`` sets from the roots, or ``deadline`` passes. The
-    caller then keeps its "no strong plan".
-    """
-    if machine.deterministic or machine.n < 2:
-        return None
+    rule: Lumping | str = Lumping.NEAR_SYMMETRIC,
+) -> LumpingTry:
+    """The lumped goal of ``machine`` under ``rule`` (:func:`lumped_goal`), with the pairs the
+    rule left out and whether it was decided."""
+    rule = _rule(rule)
+    if machine.deterministic or machine.n < 2 or rule is Lumping.NONE:
+        return LumpingTry(None)
     problem = Problem(machine, grouping, 0.0)
     try:
         pairs = unresolvable_pairs(problem, deadline, pair_sets)
         exact = pairs is not None
         if pairs is None:
             pairs = tuple(sorted(kept_apart(problem, candidate_pairs(problem))))
+        unlike = tuple(p for p in pairs if not may_lump(machine, *p, rule))
+        pairs = tuple(p for p in pairs if may_lump(machine, *p, rule))
         if not pairs:
-            return None
+            return LumpingTry(None, unlike)
         goal = lumped(problem.insep, pairs)
         wide = Problem(machine, grouping, 0.0, goal)
         roots = sorted(maximal_sets(b.mask for b in wide.readings.branches(wide.full)))
         value = solve(wide, roots, deadline, max_sets)
     except Timeout:
-        return None
-    if value is None or any(value[r] == math.inf for r in roots):
-        return None
-    return Lumping(goal, pairs, exact)
+        return LumpingTry(None, decided=False)
+    if value is None:
+        return LumpingTry(None, unlike, decided=False)
+    if any(value[r] == math.inf for r in roots):
+        return LumpingTry(None, unlike)
+    return LumpingTry(LumpedGoal(goal, pairs, exact), unlike)
+
+
+def lumped_goal(
+    machine: PushAlignMachine,
+    grouping: Grouping | str = Grouping.EXACT,
+    deadline: Deadline | None = None,
+    max_sets: int = MAX_SETS,
+    pair_sets: int = PAIR_SETS,
+    rule: Lumping | str = Lumping.NEAR_SYMMETRIC,
+) -> LumpedGoal | None:
+    """The lumped goal of ``machine`` when it gives every root reading set a strong plan.
+
+    The lumped pairs are the :func:`unresolvable_pairs` that ``rule`` allows
+    (:func:`may_lump`); when deciding them all takes more than ``pair_sets`` sets, the
+    allowed pairs :func:`kept_apart` finds (every one unresolvable, maybe not all;
+    ``LumpedGoal.exact`` False). None when lumping does not help or cannot be decided: the
+    machine is ideal (a plan always exists there), the rule is ``none``, no pair is lumped
+    (the set-level failure of the module docstring, or only pairs the rule leaves out), the
+    roots stay unsolvable under the lumped goal, there are more than ``max_sets`` sets from
+    the roots, or ``deadline`` passes. The caller then keeps its "no strong plan".
+    """
+    return try_lumping(machine, grouping, deadline, max_sets, pair_sets, rule).goal
 
 
 WORDS_PAIRS = 4
@@ -234,6 +306,14 @@ def lumped_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
     if not pairs:
         return ""
     u = machine.uncertainty
+    return (
+        f"results list states together that no strong plan tells apart under "
+        f"rotation error {u.rotation_error_deg:g} deg ({_listed(machine, pairs)})"
+    )
+
+
+def _listed(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
+    """The first :data:`WORDS_PAIRS` pairs by name, and a count of the rest."""
 
     def name(i: int) -> str:
         s = machine.states[i]
@@ -243,18 +323,31 @@ def lumped_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
     listed = "; ".join(f"{name(i)} with {name(j)}" for i, j in pairs[:WORDS_PAIRS])
     if len(pairs) > WORDS_PAIRS:
         listed += f"; and {len(pairs) - WORDS_PAIRS} more pairs"
+    return listed
+
+
+def unlike_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
+    """One clause naming unresolvable pairs the default rule would not lump (poses that do
+    not look alike), for a "no strong plan" message (empty when none)."""
+    if not pairs:
+        return ""
     return (
-        f"results list states together that no strong plan tells apart under "
-        f"rotation error {u.rotation_error_deg:g} deg ({listed})"
+        f"no strong plan tells apart poses that do not look alike ({_listed(machine, pairs)}); "
+        "a plan that lists them together, leaving the part unoriented between them, may "
+        "exist with lumping 'any'"
     )
 
 
 __all__ = [
-    "Lumping",
+    "LumpedGoal",
+    "LumpingTry",
     "candidate_pairs",
     "kept_apart",
     "lumped",
     "lumped_goal",
     "lumped_words",
+    "may_lump",
+    "try_lumping",
+    "unlike_words",
     "unresolvable_pairs",
 ]

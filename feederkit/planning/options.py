@@ -22,7 +22,7 @@ from enum import StrEnum
 from feederkit.errors import InputError
 from feederkit.machine import Grouping
 
-__all__ = ["ActionCosts", "Grouping", "Method", "Objective", "PlanningOptions"]
+__all__ = ["ActionCosts", "Grouping", "Lumping", "Method", "Objective", "PlanningOptions"]
 
 
 class Objective(StrEnum):
@@ -117,6 +117,24 @@ class Method(StrEnum):
     BACKCHAIN = "backchain"
 
 
+class Lumping(StrEnum):
+    """Which states a plan may list together when no strong plan tells them apart (docs/planning.md,
+    "Near-symmetric states under uncertainty").
+
+    ``near-symmetric`` (the default): only poses of one part that look alike to the next
+    station (their outlines on the fence differ by at most 1 % of the part's size, as the
+    machine build records them), and states of different parts of a mix (reported as pairs
+    of the mix no plan tells apart); a part whose unresolvable states look different has
+    no strong plan. ``any``: every pair no strong plan resolves, even poses that look
+    different (the plan then does not orient the part apart in them, and says so).
+    ``none``: never; a plan orients every state up to inseparable ones, or there is none.
+    """
+
+    NEAR_SYMMETRIC = "near-symmetric"
+    ANY = "any"
+    NONE = "none"
+
+
 def _enum(kind: type[StrEnum], value: object, what: str) -> StrEnum:
     """``value`` as a member of ``kind``; anything else is bad input naming the choices."""
     try:
@@ -137,7 +155,8 @@ class PlanningOptions:
     many megabytes (None: no limit), answering as at the time limit; ``costs``: the seconds
     of an operation (:class:`ActionCosts`), needed by the ``time`` and ``worst-time``
     objectives; with the operation objectives it breaks ties among equal operation counts
-    toward less time.
+    toward less time; ``lumping``: which states no strong plan resolves a plan may list
+    together under uncertainty (:class:`Lumping`).
     """
 
     objective: Objective = Objective.WORST
@@ -147,10 +166,12 @@ class PlanningOptions:
     method: Method = Method.AUTO
     memory_limit_mb: float | None = None
     costs: ActionCosts | None = None
+    lumping: Lumping = Lumping.NEAR_SYMMETRIC
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         set_(self, "objective", _enum(Objective, self.objective, "objective"))
+        set_(self, "lumping", _enum(Lumping, self.lumping, "lumping"))
         set_(self, "grouping", _enum(Grouping, self.grouping, "reading grouping"))
         set_(self, "method", _enum(Method, self.method, "planning method"))
         m = self.min_margin_deg

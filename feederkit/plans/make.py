@@ -31,7 +31,7 @@ from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.symmetry import pose_difference
+from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline
@@ -134,9 +134,9 @@ def make_plan(
     try:
         result = plan_machine(machine, opts)
     except NoStrongPlan as exc:
-        raise PlanningError(
-            f"{exc}; {largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))}"
-        ) from None
+        largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
+        hint = f"; {exc.hint}" if exc.hint else ""
+        raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
     if unc.is_ideal:
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
         report = check_plan(data)
@@ -165,23 +165,19 @@ def make_plan(
     return MadePlan(data, result, report, tuple(warnings))
 
 
-NEAR_SYMMETRIC_REL = 0.01
-"""Lumped poses whose outlines differ by more than this share of the part's size are not
-called near-symmetric: the output says the plan does not orient them apart."""
-
-
 def _lump_shapes(
     machine: PushAlignMachine, pfs: Sequence[PushFunction], pairs: Sequence[tuple[int, int]]
 ) -> str:
-    """How alike the lumped poses of one part look (:func:`pose_difference`), in words: near
-    symmetry the user can accept, or a warning that the plan leaves them unoriented."""
+    """How alike the lumped poses of one part look (:func:`poses_difference`, the measure
+    the default lumping rule bounds by ``NEAR_SYMMETRIC_REL``), in words: near symmetry the
+    user can accept, or (lumping ``any``) a warning that the plan leaves them unoriented."""
     worst, size = 0.0, 1.0
     for i, j in pairs:
         a, b = machine.states[i], machine.states[j]
         if a.part != b.part:
             continue  # parts that behave alike: reported as pairs of the mix
         pf = pfs[a.part]
-        d = pose_difference(pf, a.state, b.state)
+        d = poses_difference(pf, a.ideal_states, b.ideal_states)
         if d / pf.part.size >= worst / size:
             worst, size = d, pf.part.size
     if worst == 0.0:
@@ -191,7 +187,7 @@ def _lump_shapes(
     if worst > NEAR_SYMMETRIC_REL * size:
         words += (
             ": not near-symmetric, so the plan does not orient them apart; a smaller "
-            "rotation error (--rotation-error) may"
+            "rotation error may"
         )
     return words
 
