@@ -157,7 +157,9 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
     margin = s.min_margin_deg
     shown = "no rotation" if margin is None else f"±{margin:.4f}°"
     if plan.low_margin_warning():
-        shown += " (below ±1°: no robot holds it)"
+        r = plan.uncertainty.rotation_error_deg
+        held = f"±{(margin or 0.0) + r:.2g}° with the declared ±{r:g}°, " if r > 0.0 else ""
+        shown += f" ({held}below ±1°: no robot holds it)"
     t.add_row("smallest margin", shown)
     t.add_row("declared uncertainty", plan.uncertainty_words())
     cert = s.certificate

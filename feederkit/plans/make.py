@@ -39,7 +39,7 @@ from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Certificate, PlanResult
 from feederkit.plans.fileformat import plan_to_dict
-from feederkit.plans.model import PlanMember, member_label
+from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.strong import (
     ideal_view,
     max_rotation_error_deg,
@@ -49,11 +49,6 @@ from feederkit.plans.strong import (
 from feederkit.plans.verify import VerificationReport, check_plan
 from feederkit.sensors import Sensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
-
-ROBOT_MARGIN_DEG = 1.0
-"""Below this smallest margin a plan relies on rotations more exact than a robot turns: a
-rotation error of the margin's size sends the part across an action range's boundary
-(section 3.2.2), so such a plan is flagged."""
 
 DIAMETER_DIGITS = 9
 """Diameters (mm) equal to this many decimals are one diameter: a regular polygon's states
@@ -68,17 +63,6 @@ class MadePlan:
     result: PlanResult
     report: VerificationReport
     warnings: tuple[str, ...] = ()
-
-
-def margin_warning(min_margin_deg: float) -> str | None:
-    """One line when a plan's smallest margin is below :data:`ROBOT_MARGIN_DEG`, else None."""
-    if not min_margin_deg < ROBOT_MARGIN_DEG:
-        return None
-    return (
-        f"the plan's smallest margin is \u00b1{min_margin_deg:.2g}\u00b0: no robot holds "
-        f"\u00b1{min_margin_deg:.2g}\u00b0, a rotation error that small can send the part to "
-        "another state; ask for a minimum margin or check the plan with feederkit simulate"
-    )
 
 
 BISECT_STEPS = 12
@@ -107,8 +91,9 @@ def make_plan(
     ``options`` default to ``PlanningOptions()``. ``uncertainty``
     defaults to ``Uncertainty()`` (rotation error 1 degree); ``IDEAL`` is the paper's model.
     ``certify=False`` skips the certificate (the plan file then has none; for callers that
-    re-plan many times, such as property tests). The result's ``warnings`` flag (on the
-    ideal model) a smallest margin below :data:`ROBOT_MARGIN_DEG` and a sensor that reads
+    re-plan many times, such as property tests). The result's ``warnings`` flag a plan that
+    holds rotation errors below ``LOW_MARGIN_DEG`` (its declared rotation error plus its
+    smallest margin, :func:`~feederkit.plans.model.low_margin_words`) and a sensor that reads
     every state alike. Raises InputError
     for bad options or a shape tolerance too large for a part, PlanningError when no plan
     meets the request (under uncertainty: naming the largest uncertainty with a strong
@@ -159,9 +144,11 @@ def make_plan(
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
-    margin = margin_warning(result.min_margin) if unc.is_ideal else None
+    margin = low_margin_words(result.min_margin, unc.rotation_error_deg)
     if margin is not None:
-        warnings.append(margin)
+        warnings.append(
+            f"{margin}; ask for a minimum margin or check the plan with feederkit simulate"
+        )
     return MadePlan(data, result, report, tuple(warnings))
 
 

@@ -299,8 +299,8 @@ def low_margin_words(min_margin_deg: float | None, rotation_error_deg: float = 0
             "rotations err by more will not follow the plan"
         )
     return (
-        f"the plan's smallest margin is ±{m:.3g}°, below ±{LOW_MARGIN_DEG:g}°: a robot "
-        "whose rotations err by more will not follow the plan"
+        f"the plan's smallest margin is ±{m:.2g}°, below ±{LOW_MARGIN_DEG:g}°: no robot holds "
+        f"±{m:.2g}°, and a robot whose rotations err by more will not follow the plan"
     )
 
 
