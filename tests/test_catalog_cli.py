@@ -285,6 +285,7 @@ def test_missing_catalog_for_reading(tmp_path, capsys):
     assert code == 2 and "no catalog there" in err
 
 
+@pytest.mark.slow  # three fresh interpreters; test_errors_boundary runs one by default
 def test_subprocess_exit_codes(tmp_path):
     cmd = [sys.executable, "-c", "from feederkit.cli.app import run; run()"]
     db = tmp_path / "c.db"

@@ -172,7 +172,9 @@ def test_isosceles_right_triangle():
     assert all(leaf.mask.bit_count() == 1 for leaf in _leaves(with_sensor.root))
 
 
-@pytest.mark.parametrize("n", range(5, 13))
+@pytest.mark.parametrize(
+    "n", [*range(5, 11), *(pytest.param(n, marks=pytest.mark.slow) for n in (11, 12))]
+)
 def test_offset_regular_polygon_needs_n(n):
     m = build_machine([regular(n)], uncertainty=IDEAL)
     r = plan(m)

@@ -10,6 +10,7 @@ rest of the page.
 from __future__ import annotations
 
 import base64
+import functools
 
 from feederkit.outline import Outline
 from feederkit.plans.model import PlanPart, push_function_of
@@ -47,6 +48,15 @@ def _states_table(index: int, entry: PlanPart, draw: Drawing) -> str:
     )
 
 
+@functools.lru_cache(maxsize=32)
+def _plot_uri(entry: PlanPart, outline: Outline | None) -> str:
+    """The member's part plot as a data URI. The plot is a pure function of the (frozen)
+    member and outline and costs about a second to draw, so a process that reports the same
+    parts again (a changeover's report, then its plan's) draws each once."""
+    svg = part_plot_bytes(push_function_of(entry), "svg", outline=outline)
+    return "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
+
+
 def part_section(
     index: int,
     entry: PlanPart,
@@ -56,9 +66,7 @@ def part_section(
 ) -> str:
     """One member (a part, or a part in one landing): its label, prior share (None: not
     given), stable-state table with poses, and its radius/push/push-diameter plot."""
-    pf = push_function_of(entry)
-    svg = part_plot_bytes(pf, "svg", outline=outline)
-    uri = "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
+    uri = _plot_uri(entry, outline)
     rev = f' <span class="muted">rev {esc(str(entry.revision))}</span>' if entry.revision else ""
     share_text = (
         "" if share is None else f' <span class="muted">share {num(100.0 * share, 3)}%</span>'
