@@ -1,4 +1,5 @@
-"""Test-wide settings: hypothesis profiles (derandomized under CI) and the ``slow`` marker.
+"""Test-wide settings: hypothesis profiles (derandomized unless HYPOTHESIS_PROFILE=dev), the
+``slow`` marker.
 
 The test directory is on ``sys.path`` through pytest's rootdir import mode, so helper modules
 (``shared``, ``fixtures_cad``, ``mix_oracle``) are imported by name. ``pytest`` runs the
@@ -19,4 +20,4 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.register_profile("dev", deadline=None)
-settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if os.environ.get("CI") else "dev"))
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
