@@ -82,7 +82,7 @@ class WorstCase:
         """A lower bound on the length of ``mask``: its hardest pair's length (a subset
         needs no more operations). Only on the ideal model with readings, no margin floor
         and at most ``PAIR_BOUND_STATES`` states (the pairs' lengths by the same search
-        on the pair sets, which are closed under actions and readings there); 0 otherwise."""
+        on each pair's reading branches); 0 otherwise."""
         if self._pairs is None:
             self._pairs = _pair_lengths(self.p, self.deadline)
         if not self._pairs or mask & (mask - 1) == 0:
@@ -321,12 +321,15 @@ def _pair_lengths(problem: Problem, deadline: Deadline) -> list[list[int]]:
         return []
     n = machine.n
     # The AND/OR search on each pair set (its own memo; no pair bound inside): most pairs
-    # are told apart or merged by the first action it tries.
+    # are told apart or merged by the first action it tries. A pair is bounded by its
+    # reading branches' lengths: a set the search meets has had its reading, and under
+    # the components rule a pair inside a larger component can still read apart alone.
     search = WorstCase(problem, deadline)
     search._pairs = []
+    children = problem.readings.children
     table = [[0] * n for _ in range(n)]
     for i in range(n):
         for j in range(i + 1, n):
-            v = search.length((1 << i) | (1 << j))
+            v = max(search.length(c) for c in children((1 << i) | (1 << j)))
             table[i][j] = table[j][i] = v
     return table
