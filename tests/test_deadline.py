@@ -408,3 +408,54 @@ def test_the_expected_length_is_the_plain_one(uncertainty):
     plain = _plain_expected(machine, result.root)
     assert expected_operations(machine, result.root) == pytest.approx(plain, rel=1e-12)
     assert result.expected_length == pytest.approx(plain, rel=1e-12)
+
+
+# --- the fallback's backchaining plan: an answer whenever one part can be oriented ---------
+
+
+def _hull_of_random_points(n: int, seed: int):
+    rng = random.Random(seed)
+    pts = []
+    for t in sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n)):
+        f = 30.0 * rng.uniform(0.7, 1.0)
+        pts.append((f * math.cos(t), f * math.sin(t)))
+    return push_function(make_part(make_outline(f"rand-{n}-{seed}", pts)))
+
+
+def test_the_backchaining_plan_has_one_step_per_operation_and_is_correct():
+    from feederkit.planning.api import _result, _sensorless_plan, goal_relation, tree_length
+    from feederkit.planning.problem import Problem
+    from feederkit.planning.reindex import by_diameter
+    from feederkit.planning.tree import Step
+
+    pf = _hull_of_random_points(50, 3)
+    machine, _old = by_diameter(build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL))
+    problem = Problem(machine, PlanningOptions().grouping, 0.0, goal_relation(machine, Deadline()))
+    root_branches = problem.readings.branches(problem.full)
+    root = _sensorless_plan(problem, root_branches, Deadline(), by_image=True)
+    steps, stack, seen = 0, [root], set()
+    while stack:
+        node = stack.pop()
+        if id(node) in seen or not isinstance(node, Step):
+            continue
+        seen.add(id(node))
+        steps += 1
+        stack.extend(child for _b, child in node.branches)
+    length = tree_length(root)
+    assert steps <= len(root_branches) * length  # a chain per root branch, not a tree
+    check_plan(_result(machine, root, False, None, 1, "worst", "exact"))
+
+
+@pytest.mark.slow
+def test_a_hard_part_with_a_sensor_gets_a_plan_within_its_limit():
+    from feederkit.plans.make import make_plan
+
+    pf = _hull_of_random_points(1000, 1)
+    sensor = ToleranceSensor(0.03 * pf.part.size)
+    result, took = _timed_plan(build_machine([pf], sensor, IDEAL), time_limit_s=10.0)
+    assert took < 10.0 + OVERSHOOT_S
+    assert not isinstance(result, PlanningError), result
+    assert result.length >= result.lower_bound
+    # The same plan through make_plan: verified on the model (every start and reading).
+    made = make_plan([pf], sensor, PlanningOptions(time_limit_s=10.0), uncertainty=IDEAL)
+    assert made.report.ok

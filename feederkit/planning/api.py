@@ -389,10 +389,17 @@ def _fallback(
         share = Deadline(
             memory_mb=budget.memory_mb, end=budget.end - rest / 2.0, memory_base=budget.memory_base
         )
-    try:
-        blind = _sensorless_plan(problem, root_branches, share)
+    try:  # the backchaining plan itself first: one step per operation
+        blind = _sensorless_plan(problem, root_branches, share, by_image=True)
     except Timeout:
         blind = None
+    if blind is not None:
+        try:  # the readings may shorten it
+            read = _sensorless_plan(problem, root_branches, share)
+        except Timeout:
+            read = None
+        if read is not None and tree_length(read) < tree_length(blind):
+            blind = read
     anytime = WorstCase(problem, budget)
     if stop.reason != "memory" and type(worst) is WorstCase:
         # What the exact search proved stays true (its exact lengths are left out: they
@@ -519,14 +526,19 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
     return Step(None, tuple((b, made[k]) for b, k in top))
 
 
-def _sensorless_plan(problem: Problem, root_branches, deadline: Deadline) -> Step | None:
+def _sensorless_plan(
+    problem: Problem, root_branches, deadline: Deadline, by_image: bool = False
+) -> Step | None:
     """A plan that takes the readings but chooses rotations by backchaining, or None.
 
     For one part's push machine (no margin floor), Goldberg's table says how many
     operations collapse any set with no sensor; each step takes a rotation that lowers
     that number, and a reading only leaves a subset, which needs no more. Never longer than
     the sensorless plan; its size grows with the distinct reading sets, so it is built
-    under ``deadline`` (Timeout).
+    under ``deadline`` (Timeout). ``by_image``: every reading branch of a step goes on with
+    the subplan of the step's whole image (a reading only leaves a subset of it, and a
+    subset of a goal set is a goal), so the plan has one step per operation: the
+    backchaining plan itself, readings followed but not used, for when the other runs out.
     """
     if problem.min_margin > 0.0:
         return None
@@ -541,7 +553,7 @@ def _sensorless_plan(problem: Problem, root_branches, deadline: Deadline) -> Ste
         k = chain.length(mask)
         lo, hi, img = next(c for c in problem.choices.cells(mask, False) if chain.length(c[2]) < k)
         return OverlapRange(lo, hi, img), [
-            (b, b.mask) for b in problem.readings.image_branches(img)
+            (b, img if by_image else b.mask) for b in problem.readings.image_branches(img)
         ]
 
     made = _dag([b.mask for b in root_branches], expand, deadline)
