@@ -154,11 +154,14 @@ class Backchain:
                 break
             d.append(nxt)
         self.table = d
+        self._state_pos = [circle.pos[c] for c in circle.cls]
+        self._lengths: dict[int, float] = {}
 
     def hull(self, mask: int) -> float:
         """Length of the shortest arc holding the set's classes (0: one class)."""
         t = self.c.period
-        pts = sorted({self.c.pos[self.c.cls[i]] for i in members(mask)})
+        pos = self._state_pos
+        pts = sorted({pos[i] for i in members(mask)})
         if len(pts) <= 1:
             return 0.0
         gap = max(b - a for a, b in zip(pts, pts[1:], strict=False))
@@ -166,12 +169,18 @@ class Backchain:
         return t - gap
 
     def length(self, mask: int) -> float:
-        """Minimum number of operations collapsing the set (inf: never)."""
-        h = self.hull(mask)
-        if h == 0.0:
-            return 0
-        k = bisect.bisect_left(self.table, h + ANGLE_EPS)
-        return k if k < len(self.table) else math.inf
+        """Minimum number of operations collapsing the set (inf: never; memoised: plans
+        built from the table ask for the same images many times)."""
+        v = self._lengths.get(mask)
+        if v is None:
+            h = self.hull(mask)
+            if h == 0.0:
+                v = 0
+            else:
+                k = bisect.bisect_left(self.table, h + ANGLE_EPS)
+                v = k if k < len(self.table) else math.inf
+            self._lengths[mask] = v
+        return v
 
 
 class BackchainWorst(WorstCase):
