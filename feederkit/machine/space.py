@@ -12,6 +12,7 @@ one per machine, once.
 
 from __future__ import annotations
 
+import bisect
 import weakref
 from functools import cached_property
 
@@ -41,6 +42,7 @@ class SearchSpace:
 
     def __init__(self, machine: PushAlignMachine) -> None:
         self._machine = weakref.ref(machine)
+        self._rows: dict[int, list[int]] = {}
 
     @property
     def machine(self) -> PushAlignMachine:
@@ -115,6 +117,31 @@ class SearchSpace:
             at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
             targets[:, i] = np.asarray(m.targets[i], dtype=np.int32)[at]
         return bounds, owner, distinct, targets
+
+    @cached_property
+    def _cell_starts(self) -> list[float] | None:
+        """The distinct start angles of :attr:`cell_table` as a list (for bisection)."""
+        table = self.cell_table
+        return None if table is None else table[2].tolist()
+
+    def targets_at(self, mask: int, rotation: float) -> list[int] | None:
+        """Each member's target (a state index, ascending members) under ``rotation``
+        (deg, in [0, 360)), read off :attr:`cell_table`; None without the table.
+
+        A row of the table holds between consecutive distinct starts of all states, so it
+        is the row of the cell that begins at or before ``rotation``: the same lookup as
+        :func:`~feederkit.machine.model.target_at` (the range starting at or before it; before the
+        first start, the last one, which wraps).
+        """
+        starts = self._cell_starts
+        if starts is None:
+            return None
+        at = bisect.bisect_right(starts, rotation) - 1
+        rows = self._rows
+        row = rows.get(at)
+        if row is None:
+            row = rows[at] = self.cell_table[3][at].tolist()  # type: ignore[index]
+        return [row[i] for i in members(mask)]
 
     def cells_and_images(self, mask: int) -> tuple[np.ndarray, np.ndarray, list[int]] | None:
         """The set's cells (``lo``, ``hi`` arrays: consecutive boundaries of its members

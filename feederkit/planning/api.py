@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import gc
 import math
+import time
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import replace
 
@@ -32,7 +33,7 @@ from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import Refiner, child_masses, stage
+from feederkit.planning.refine import Refiner, TieBudget, child_masses, stage
 from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import solve, unsolvable
@@ -53,6 +54,20 @@ the plan built when it stops."""
 FIRST_TREE_SHARE = 0.85
 """Where (as a share of the time limit) the tree of a proven length with no tie-breaking
 must be built; after that the fallback answers."""
+
+TIE_SHARE = 1.0
+"""The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
+may take this many times the CPU seconds of the length proof, plus ``TIE_GRACE_S``."""
+
+TIE_GRACE_S = 2.0
+"""CPU seconds the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof."""
+
+TIES_EXACT = "exact"
+"""``tie_breaks``: every tie-break of the objective was decided exactly."""
+TIES_MARGIN = "margin"
+"""``tie_breaks``: the largest margin is exact, the expected operations are not minimised."""
+TIES_NONE = "none"
+"""``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
 
 
 class NoStrongPlan(PlanningError):
@@ -172,7 +187,7 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
     sorted_machine, old = by_diameter(machine)
     lumping = None
     try:
-        root, optimal, length, lower = _plan(sorted_machine, options, budget)
+        root, optimal, length, lower, ties = _plan(sorted_machine, options, budget)
     except NoStrongPlan as exc:
         if options.lumping is Lumping.NONE:
             raise
@@ -183,12 +198,13 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
         if lumping is None:
             hint = unlike_words(sorted_machine, tried.unlike)
             raise NoStrongPlan(exc.reason, hint) from None
-        root, optimal, length, lower = _plan(sorted_machine, options, budget, lumping.insep)
+        root, optimal, length, lower, ties = _plan(sorted_machine, options, budget, lumping.insep)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
     result = _result(
         machine, root, optimal, length, lower, options.objective.value, options.grouping.value
     )
+    result = replace(result, tie_breaks=ties)
     if lumping is None:
         return result
     return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
@@ -226,8 +242,10 @@ def _plan(
     replaces the goal relation (the lumped one, :func:`~feederkit.planning.lumping.lumped_goal`).
 
     Returns the plan tree, whether it is proven optimal, its proven length (None when the
-    tree's own length is the answer) and a proven lower bound.
+    tree's own length is the answer), a proven lower bound and which tie-breaks are exact
+    (``TIES_EXACT``, ``TIES_MARGIN`` or ``TIES_NONE``).
     """
+    proof_start = time.process_time()
     objective = options.objective.value
     min_margin = options.min_margin_deg
     grouping = options.grouping
@@ -299,25 +317,36 @@ def _plan(
     length = 1 + max(lengths.values(), default=0)
     budget_ops = length - 1
     children = _root_children(problem, root_branches, start_mass)
-    refiner = Refiner(
-        problem, worst, exact_deadline, costs=options.costs, timed=objective == "time"
-    )
+    ties_deadline = exact_deadline
+    if objective == "worst":
+        # Tie-breaking must not dominate: a bounded multiple of the length proof's time.
+        spent = time.process_time() - proof_start
+        ties_deadline = TieBudget(exact_deadline, TIE_SHARE * spent + TIE_GRACE_S)
+    worst.deadline = ties_deadline
+    refiner = Refiner(problem, worst, ties_deadline, costs=options.costs, timed=objective == "time")
+    staged = False
     try:
         tie, horizon = stage(objective, refiner, every, budget_ops)
+        staged = True
         root = _build(refiner, children, horizon, tie)
-        complete = True
+        ties = TIES_EXACT
     except Timeout:
         # The lengths are proven; the tie-breaking stages ran out of time: the first
-        # action that keeps the proven length at each node, while time remains.
+        # action that keeps the proven length (and the margin decided or found so far) at
+        # each node, while time remains.
         worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
-        refiner.floor = -math.inf
+        ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
+        if not staged:
+            refiner.floor = refiner.floor_found if objective == "worst" else -math.inf
         try:
             root = _build(refiner, children, budget_ops, "first")
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc)
         complete = objective == "worst"
+    else:
+        complete = True
     shortest = objective in ("worst", "worst-time")
-    return root, complete, length if shortest else None, length
+    return root, complete, length if shortest else None, length, ties
 
 
 def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
@@ -446,13 +475,13 @@ def _fallback(
         root = _choice_plan(problem, anytime.choice, roots, root_branches, budget)
     except Timeout as exc:
         if blind is not None:
-            return blind, False, None, lower
+            return blind, False, None, lower, TIES_NONE
         reason = exc.reason if exc.reason == "memory" else stop.reason
         raise PlanningError(
             f"no plan found within {_out_of_budget(options, reason)} "
             f"(a plan needs at least {lower} operations)"
         ) from None
-    return root, False, None, lower
+    return root, False, None, lower, TIES_NONE
 
 
 def _dag(

@@ -158,6 +158,17 @@ class Choices:
             los, his, imgs = fast
             width = his - los
             order = np.lexsort((-width,))  # widest first: the first per image is the widest
+            ordered = width[order]
+            kept = int(np.count_nonzero(ordered >= floor))
+            if bool(np.all(ordered[1:kept] < ordered[: kept - 1])):
+                # No two widths alike: the first cell of each image is its widest, and the
+                # order of first cells is the final one (widest first).
+                pick = order[:kept]
+                seq = [imgs[k] for k in pick.tolist()]
+                first = dict(zip(reversed(seq), range(kept - 1, -1, -1), strict=True))
+                lo_l, hi_l = los[pick].tolist(), his[pick].tolist()
+                cells = [(lo_l[i], hi_l[i], seq[i]) for i in sorted(first.values())]
+                return self._keep_cells(mask, useful, cells)
             for k, lo, hi in zip(
                 order.tolist(), los[order].tolist(), his[order].tolist(), strict=True
             ):
@@ -180,9 +191,14 @@ class Choices:
                     best[key] = cell
         keyed = [(lo - hi, norm360((lo + hi) / 2.0), img, lo, hi) for lo, hi, img in best.values()]
         keyed.sort()
-        cells = [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
+        return self._keep_cells(mask, useful, [(lo, hi, img) for _w, _r, img, lo, hi in keyed])
+
+    def _keep_cells(
+        self, mask: int, useful: bool, cells: list[tuple[float, float, int]]
+    ) -> list[tuple[float, float, int]]:
+        """Cache the set's cells and its useful ones (without those whose image contains
+        the set); return the kind asked for."""
         self._cells[(mask, False)] = cells
-        # The useful ones: without those whose image contains the set.
         self._cells[(mask, True)] = [c for c in cells if c[2] & mask != mask]
         return self._cells[(mask, useful)]
 
@@ -281,7 +297,11 @@ class Choices:
         t = self._targets.get(key)
         if t is None:
             rep = sa.representative
-            t = tuple(self.machine.outcomes(i, rep) for i in members(mask))
+            row = self._space.targets_at(mask, rep)
+            if row is not None:
+                t = tuple(1 << j for j in row)
+            else:
+                t = tuple(self.machine.outcomes(i, rep) for i in members(mask))
             self._targets[key] = t
         return t
 

@@ -18,22 +18,35 @@ larger margin and the smaller rotation. With costs the actions of a set are one 
 distinct outcome with the cheapest rotation (then the widest) rather than the widest: the
 rotation a plan uses is still its range's middle.
 
-All the stages are exact searches over sets with a length budget: ``margin(mask, k)`` is
-the largest smallest margin of a plan of at most ``k`` operations (a max-min recursion
-memoised per set and budget); ``expected(mask, masses, k)`` the smallest expected number of
-operations (memoised per set, normalised masses and budget, with a branch-and-bound cut);
-``worst_seconds(mask, k)`` the fewest seconds of the slowest path (memoised per set and
-budget, cheapest action first).
+All the stages are exact searches over sets with a length budget: ``keeps(mask, k, m)``
+says whether a plan of at most ``k`` operations keeps every margin at least ``m`` (an AND/OR
+feasibility search, its bounds memoised per set and budget), and ``largest_floor`` raises
+``m`` over the margins plans have until the root branches cannot keep more;
+``expected(mask, masses, k)`` the smallest expected number of operations (memoised per set,
+normalised masses and budget, with a branch-and-bound cut); ``worst_seconds(mask, k)`` the
+fewest seconds of the slowest path (memoised per set and budget, cheapest action first).
+
+Without a margin floor of the problem's, margins are monotone under subsets: a subset's
+action-range boundaries are among the set's, so the set's cell around a rotation lies in
+one of the subset's cells (as wide or wider, its image inside the set's image), and each
+reading branch of a smaller image lies in one of the larger image's. A subset therefore
+keeps every margin the set keeps within the same budget, and the maximal reading branches
+decide a margin as they decide a length.
+
+The ``worst`` objective's stages run under a :class:`TieBudget` (``plan`` gives them a
+bounded multiple of the length proof's CPU time); out of it the plan keeps the proven
+length and the margin decided or found so far.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 
 from feederkit.angles import norm360
 from feederkit.machine import OverlapRange, ReadingBranch, members
-from feederkit.planning.andor import Deadline, WorstCase
+from feederkit.planning.andor import Deadline, Timeout, WorstCase
 from feederkit.planning.choices import spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
@@ -49,6 +62,48 @@ Value = tuple[float, float]
 """An expected figure and its tie-break: (operations, seconds), or (seconds, operations)
 with the time objective; seconds are 0 without action costs."""
 Cell = tuple[float, float, int]
+
+
+CPU_POLL_S = 0.005
+"""A :class:`TieBudget` reads the CPU clock at most this often (wall seconds)."""
+
+
+class TieBudget(Deadline):
+    """A stage's budget: ``outer``'s limits and at most ``cpu_s`` more CPU seconds.
+
+    The tie-breaking stages of the ``worst`` objective get a bounded multiple of what the
+    length proof took (docs/planning.md, "Which plan among the shortest"); CPU time rather
+    than wall time, so a busy machine does not change which plan comes out.
+    """
+
+    def __init__(self, outer: Deadline, cpu_s: float) -> None:
+        super().__init__(
+            memory_mb=outer.memory_mb,
+            end=outer.end,
+            start=outer.start,
+            memory_base=outer.memory_base,
+        )
+        self.cpu_end = time.process_time() + cpu_s
+        self._next_cpu = time.perf_counter()
+
+    @property
+    def limited(self) -> bool:
+        """Always: the CPU allowance is a limit."""
+        return True
+
+    def check(self) -> None:
+        """Raise Timeout once the CPU allowance or one of ``outer``'s limits has passed.
+
+        The CPU clock costs a system call (over a microsecond, ten times the wall clock):
+        it is read at most every ``CPU_POLL_S`` wall seconds, and one thread's CPU seconds
+        grow no faster than wall seconds, so the allowance is overrun by at most that.
+        """
+        now = time.perf_counter()
+        if now >= self._next_cpu:
+            self._next_cpu = now + CPU_POLL_S
+            if time.process_time() > self.cpu_end:
+                raise Timeout("time")
+        super().check()
 
 
 def child_masses(
@@ -106,12 +161,18 @@ class Refiner:
         self.w = worst
         self.deadline = deadline or Deadline(None)
         self.floor = -math.inf
+        self.floor_found = -math.inf
+        """The largest margin every root set is proven to keep so far (:meth:`largest_floor`):
+        what a plan keeps when the margin stage runs out of time."""
         self.costs = costs
         self.timed = timed
-        self._margin: dict[tuple[int, int], tuple[float, bool]] = {}
+        self._lo: dict[tuple[int, int], float] = {}
+        self._le: dict[tuple[int, int], float] = {}
+        self._lt: dict[tuple[int, int], float] = {}
         self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[Value, Act | None]] = {}
         self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
         self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
+        self._one: dict[tuple[int, float], tuple[Value, Act | None]] = {}
 
     def seconds(self, act: Act) -> float:
         """Seconds of the operation ``act`` (0 without action costs)."""
@@ -179,54 +240,113 @@ class Refiner:
             return False
         if self.floor == -math.inf:
             return True
-        return all(self.margin(c, k - 1, self.floor) >= self.floor for c in act.children)
+        return all(self.keeps(c, k - 1, self.floor) for c in self._deciding(act))
 
-    def margin(self, mask: int, k: int, cap: float = math.inf) -> float:
-        """``min(cap, g)``: g the largest smallest margin of plans for ``mask`` within ``k``.
+    def _deciding(self, act: Act) -> tuple[int, ...]:
+        """The branches of ``act`` whose margins decide whether it keeps a floor: its
+        maximal ones without a margin floor of the problem's (a subset keeps any margin
+        the set keeps, see :meth:`keeps`), else all of them."""
+        if self.p.min_margin == 0.0 and not self.p.sensorless:
+            return self.p.readings.children(act.action.image)
+        return act.children
 
-        A cap stops the search as soon as some plan keeps it (the callers only ask whether a
-        margin can be kept); memo entries remember whether they are exact or lower bounds.
+    def keeps(self, mask: int, k: int, x: float, strict: bool = False) -> bool:
+        """Whether some plan for ``mask`` within ``k`` keeps every margin at least ``x``
+        (above ``x`` when ``strict``): the feasibility form of the largest smallest margin.
+
+        Memoised per set and budget as bounds on that margin, each proven by a search: the
+        smallest margin of a plan found (``_lo``, a lower bound) and the margins no plan
+        reaches (``_le``: at most; ``_lt``: below), so probes at several margins share them.
+        A goal keeps any margin (it needs no action).
         """
         if self.p.is_goal(mask):
-            return cap
+            return True
         if k <= 0:
-            return -math.inf
+            return False
         key = (mask, k)
-        hit = self._margin.get(key)
-        if hit is not None:
-            v, exact = hit
-            if exact or v >= cap:
-                return min(v, cap)
+        lo = self._lo.get(key)
+        if lo is not None and (lo > x or (lo == x and not strict)):
+            return True
+        le = self._le.get(key)
+        if le is not None and (le < x or (le == x and strict)):
+            return False
+        lt = self._lt.get(key)
+        if lt is not None and lt <= x:
+            return False
         self.deadline.check()
-        best = -math.inf
-        if self.p.sensorless:
-            # One branch per action: walk the ranges widest first, no branch objects needed.
-            for lo, hi, img in self.p.choices.cells(mask, useful=False):
-                m = (hi - lo) / 2.0
-                if m <= best or best >= cap:
-                    break
-                if self.w.within(img, k - 1):
-                    best = max(best, self.margin(img, k - 1, min(m, cap)))
+        found = self._keeping_plan(mask, k, x, strict)
+        if found is not None:
+            self._lo[key] = found if lo is None else max(lo, found)
+            return True
+        if strict:
+            self._le[key] = x if le is None else min(le, x)
         else:
-            for cell in self.p.choices.cells(mask, useful=False):  # widest first
-                m = (cell[1] - cell[0]) / 2.0
-                if m <= best or best >= cap:
-                    break
-                if self.feasible_image(cell[2], k - 1) is False:
-                    continue  # decided without making the exact branches
+            self._lt[key] = x if lt is None else min(lt, x)
+        return False
+
+    def _keeping_plan(self, mask: int, k: int, x: float, strict: bool) -> float | None:
+        """The smallest margin of a plan for ``mask`` within ``k`` keeping ``x`` (as
+        :meth:`keeps` says), or None when there is none: the widest action first (its plan
+        then keeps the most), any plan at all (``x`` -inf) in the length search's order;
+        on the maximal reading branches without a margin floor (module docstring)."""
+        cells = self.p.choices.cells(mask, useful=False)  # widest first
+        if x == -math.inf:
+            # Any plan: the length search's order (smallest image first) finds one soonest;
+            # the margins it keeps are then raised (largest_floor).
+            cells = sorted(cells, key=_small_first)
+        for cell in cells:
+            m = (cell[1] - cell[0]) / 2.0
+            if m < x or (strict and m == x):
+                break
+            if self.p.sensorless:
+                # One branch per action, its image: no branch objects needed.
+                children: tuple[int, ...] = (cell[2],)
+                if not self.w.within(cell[2], k - 1):
+                    continue
+            elif self.p.min_margin == 0.0:
+                children = self.p.readings.children(cell[2])
+                if not all(self.w.within(c, k - 1) for c in children):
+                    continue
+            else:
                 self.deadline.check()  # each action costs a reading split
                 act = self.p.choices.act(mask, cell, exact=True)
                 if not self.feasible(act, k - 1):
                     continue
-                val = min(m, cap)
-                for c in act.children:
-                    val = self.margin(c, k - 1, val)
-                    if val <= best:
-                        break
-                best = max(best, val)
-        best = min(best, cap)
-        self._margin[key] = (best, best < cap)
-        return best
+                children = act.children
+            val = m
+            for c in children:
+                if not self.keeps(c, k - 1, x, strict):
+                    break
+                if not self.p.is_goal(c):
+                    val = min(val, self._lo[(c, k - 1)])
+            else:
+                return val
+        return None
+
+    def margin(self, mask: int, k: int) -> float:
+        """The largest smallest margin of plans for ``mask`` within ``k`` operations (inf
+        for a goal, -inf when no plan is that short)."""
+        return self.largest_floor([mask], k)
+
+    def largest_floor(self, masks: list[int], k: int) -> float:
+        """The largest ``m`` such that every set of ``masks`` has a plan within ``k`` whose
+        margins are all at least ``m`` (inf when all are goals, -inf when one has no plan).
+
+        Raised from below: while every set keeps a margin above ``m`` (:meth:`keeps`,
+        strict), ``m`` becomes the least smallest margin of the plans found; the first set
+        that cannot is at most ``m``, and every set keeps ``m``. Each step rises to a margin
+        some plan has, so there are few steps, and the probes share one memo.
+        """
+        open_ = sorted((r for r in masks if not self.p.is_goal(r)), key=lambda r: -r.bit_count())
+        if not open_:
+            return math.inf
+        x = -math.inf
+        while True:
+            for r in open_:
+                if not self.keeps(r, k, x, strict=True):
+                    return x
+            x = min(self._lo[(r, k)] for r in open_)
+            self.floor_found = max(self.floor_found, x)
 
     def expected(self, mask: int, masses: Masses, k: int) -> tuple[Value, Act | None]:
         """Fewest expected further operations (per unit mass) within ``k``, and the action.
@@ -236,6 +356,14 @@ class Refiner:
         """
         if self.p.is_goal(mask):
             return (0.0, 0.0), None
+        if k == 1:
+            # Every allowed action orients the set at once: one operation, so only ties
+            # (its seconds, margin, rotation) are left, and the masses do not matter.
+            one = self._one.get((mask, self.floor))
+            if one is None:
+                self.deadline.check()
+                one = self._one[(mask, self.floor)] = self._one_step(mask)
+            return one
         # Sensorless, a set has one path whatever its masses: its figure does not depend on them.
         weighed = len(masses) > 1 and not self.p.sensorless
         key = (mask, k, _key(masses) if weighed else ())
@@ -243,21 +371,6 @@ class Refiner:
         if hit is not None:
             return hit
         self.deadline.check()
-        if k == 1:
-            # Every allowed action orients the set at once: one operation, so only ties
-            # (its seconds, margin, rotation) are left.
-            acts = self.p.choices.exact_actions(mask)
-            if self.costs is not None:
-                acts = tuple(
-                    self.p.choices.act(mask, c, exact=True) for c in self.cells(mask, True)
-                )
-            for act in sorted(acts, key=lambda a: (self.seconds(a), -a.action.margin, a.rotation)):
-                if self.allowed(act, 1):
-                    out: tuple[Value, Act | None] = (self._step(act), act)
-                    self._exp[key] = out
-                    return out
-            self._exp[key] = ((math.inf, math.inf), None)
-            return (math.inf, math.inf), None
         best: Value = (math.inf, math.inf)
         best_act = None
         least = 1.0 if not self.timed else self.costs.least_s  # type: ignore[union-attr]
@@ -302,6 +415,25 @@ class Refiner:
         result = (best, best_act)
         self._exp[key] = result
         return result
+
+    def _one_step(self, mask: int) -> tuple[Value, Act | None]:
+        """:meth:`expected` within one operation: the first action (the cheapest, then the
+        larger margin, then the smaller rotation) that orients the set at once."""
+        if self.costs is None:
+            # Without costs the cells' own order is (larger margin, smaller rotation):
+            # make the exact branches only of the cells that can orient the set at once.
+            acts = (
+                self.p.choices.act(mask, c, exact=True)
+                for c in self.p.choices.cells(mask, useful=False)
+                if self.feasible_image(c[2], 0) is not False
+            )
+        else:
+            made = [self.p.choices.act(mask, c, exact=True) for c in self.cells(mask, True)]
+            acts = iter(sorted(made, key=lambda a: (self.seconds(a), -a.action.margin, a.rotation)))
+        for act in acts:
+            if self.allowed(act, 1):
+                return self._step(act), act
+        return (math.inf, math.inf), None
 
     def worst_seconds(self, mask: int, k: int) -> tuple[float, Act | None]:
         """Fewest seconds of the slowest path of a plan for ``mask`` within ``k``, and its
@@ -415,6 +547,12 @@ class Refiner:
         return node
 
 
+def _small_first(cell: Cell) -> tuple[int, float]:
+    """The length search's order of a set's cells (``Choices.lazy_actions``): the smallest
+    image first, then the widest."""
+    return (cell[2].bit_count(), cell[0] - cell[1])
+
+
 def _prefer(a: Act, b: Act | None) -> bool:
     """Between equally good actions: larger margin, then the smaller rotation."""
     if b is None:
@@ -447,11 +585,8 @@ def stage(objective: str, refiner: Refiner, every: list[int], budget: int) -> tu
     ``expected`` and ``time``: the expected figure within ``EXPECTED_HORIZON * budget``.
     """
     if objective == "worst":
-        # The smallest margin over the root branches; each only has to beat the least so far.
-        floor = math.inf
-        for r in sorted(every, key=lambda r: -r.bit_count()):
-            floor = refiner.margin(r, budget, floor)
-        refiner.floor = floor
+        # The smallest margin over the root branches, as large as it can be.
+        refiner.floor = refiner.largest_floor(every, budget)
         sensorless = refiner.p.sensorless and refiner.costs is None
         return ("rotation" if sensorless else "expected"), budget
     if objective == "worst-time":

@@ -77,7 +77,11 @@ class PlanResult:
     ``certificate`` (set by :func:`feederkit.plans.make.make_plan`) what the plan guarantees.
     ``lumped_pairs``: pairs some result lists together that are not inseparable, because
     no strong plan tells them apart or merges them under the declared uncertainty
-    (near-symmetric states, :mod:`feederkit.planning.lumping`).
+    (near-symmetric states, :mod:`feederkit.planning.lumping`). ``tie_breaks``: how far
+    the choice among plans of the proven length went (docs/planning.md, "Which plan among
+    the shortest"): ``"exact"`` every stage, ``"margin"`` the largest smallest margin but
+    not the fewest expected operations, ``"none"`` the margin found when the tie-breaking
+    budget ran out.
     """
 
     machine: PushAlignMachine
@@ -91,6 +95,7 @@ class PlanResult:
     grouping: str = "exact"
     certificate: Certificate | None = None
     lumped_pairs: tuple[tuple[int, int], ...] = ()
+    tie_breaks: str = "exact"
 
     @property
     def uncertainty(self) -> Uncertainty:

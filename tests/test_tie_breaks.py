@@ -1,0 +1,177 @@
+"""Choosing among shortest plans (docs/planning.md, "Which plan among the shortest").
+
+The largest smallest margin is decided by feasibility probes ("a plan within k keeping
+every margin >= m", ``Refiner.keeps``) on the maximal reading branches; here it is checked
+against the plain max-min recursion over every action and every branch set. The stages
+run under a budget bounded by the length proof's CPU time (``api.TIE_SHARE``,
+``api.TIE_GRACE_S``); out of it the plan keeps the proven length and says which
+tie-breaks are exact.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+
+import pytest
+from test_deadline import small_mix
+from test_planners import check_plan, random_convex
+
+import feederkit.planning.api as api
+from feederkit.machine import build_machine, members, search_space
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.planning.refine import Refiner, TieBudget
+from feederkit.planning.reindex import by_diameter
+from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
+
+
+def _machines():
+    yield "5-part mix at 2 mm", build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL)
+    yield "4-part mix at 1 mm", build_machine(small_mix(4), ToleranceSensor(1.0), IDEAL)
+    for seed in (1, 3, 4):
+        pf = random_convex(seed, 9)
+        m = build_machine([pf], ToleranceSensor(0.02 * pf.part.size), IDEAL)
+        yield f"random 9-gon #{seed} at 2%", m
+
+
+MACHINES = list(_machines())
+
+
+def _proven(machine):
+    """A refiner whose root lengths are proven, the root branches and their budget."""
+    problem = Problem(by_diameter(machine)[0])
+    worst = make_oracle(problem, "auto", Deadline())
+    every = sorted({b.mask for b in problem.readings.branches(problem.full)})
+    roots = sorted(maximal_sets(every))
+    k = max(root_lengths(problem, worst, roots, "auto", None).values())
+    return Refiner(problem, worst), every, k
+
+
+def _max_min(problem: Problem, mask: int, k: int, memo: dict) -> float:
+    """The largest smallest margin within ``k``: every action, every branch set."""
+    if problem.is_goal(mask):
+        return math.inf
+    if k <= 0:
+        return -math.inf
+    hit = memo.get((mask, k))
+    if hit is None:
+        hit = -math.inf
+        for act in problem.choices.exact_actions(mask):
+            v = act.action.margin
+            for c in act.children:
+                v = min(v, _max_min(problem, c, k - 1, memo))
+            hit = max(hit, v)
+        memo[(mask, k)] = hit
+    return hit
+
+
+@pytest.mark.parametrize(("name", "machine"), MACHINES, ids=[n for n, _ in MACHINES])
+def test_the_largest_margin_is_the_max_min_over_every_branch(name, machine):
+    refiner, every, k = _proven(machine)
+    memo: dict = {}
+    want = {r: _max_min(refiner.p, r, k, memo) for r in every}
+    for r in every:
+        assert refiner.margin(r, k) == want[r], name
+    assert refiner.largest_floor(every, k) == min(want.values())
+
+
+@pytest.mark.parametrize(("name", "machine"), MACHINES, ids=[n for n, _ in MACHINES])
+def test_keeps_answers_whether_a_margin_can_be_kept(name, machine):
+    refiner, every, k = _proven(machine)
+    memo: dict = {}
+    rng = random.Random(5)
+    exact = {r: _max_min(refiner.p, r, k, memo) for r in every}
+    values = sorted({v for v in exact.values() if math.isfinite(v)})
+    probes = rng.sample(values, min(4, len(values))) + [rng.uniform(0.0, 60.0) for _ in range(3)]
+    probes += [v + 1e-6 for v in probes[:2]]
+    for x in probes:
+        fresh = Refiner(refiner.p, refiner.w)  # its own margin memo
+        for r in every:
+            want = exact[r] >= x
+            assert refiner.keeps(r, k, x) == want, (name, r, x)  # one memo for every probe
+            assert refiner.keeps(r, k, x, strict=True) == (exact[r] > x), (name, r, x)
+            assert fresh.keeps(r, k, x) == want, (name, r, x)
+
+
+CASE = build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL)
+"""A mix whose first shortest plan keeps a smaller margin than the best one."""
+
+
+def _exact_plan():
+    return api.plan(CASE)
+
+
+def test_with_no_time_for_ties_the_plan_keeps_the_proven_length(monkeypatch):
+    exact = _exact_plan()
+    monkeypatch.setattr(api, "TIE_GRACE_S", -1.0)
+    monkeypatch.setattr(api, "TIE_SHARE", 0.0)
+    quick = api.plan(CASE)
+    check_plan(quick)
+    assert quick.optimal and quick.length == exact.length
+    assert quick.min_margin < exact.min_margin  # the first plan, not the widest
+    assert quick.tie_breaks == api.TIES_NONE
+    assert exact.tie_breaks == api.TIES_EXACT
+
+
+def test_out_of_time_in_the_expected_stage_the_margin_stays_exact(monkeypatch):
+    exact = _exact_plan()
+
+    def out_of_time(self, *args, **kwargs):
+        raise Timeout("time")
+
+    monkeypatch.setattr(Refiner, "expected", out_of_time)
+    partial = api.plan(CASE)
+    check_plan(partial)
+    assert partial.optimal and partial.length == exact.length
+    assert partial.min_margin == exact.min_margin
+    assert partial.expected_length > exact.expected_length + 1e-6
+    assert partial.tie_breaks == api.TIES_MARGIN
+
+
+def test_the_tie_budget_counts_cpu_seconds_not_waiting():
+    budget = TieBudget(Deadline(), 0.05)
+    budget.check()
+    time.sleep(0.08)  # waiting costs no CPU: still within the allowance
+    budget.check()
+    end = time.process_time() + 0.06
+    while time.process_time() < end:
+        pass
+    with pytest.raises(Timeout):
+        budget.check()
+    assert budget.limited
+
+
+def test_the_tie_budget_keeps_the_outer_deadline():
+    budget = TieBudget(Deadline(1e-6), 100.0)
+    time.sleep(1e-3)
+    with pytest.raises(Timeout):
+        budget.check()
+
+
+def test_targets_from_the_cell_table_are_the_machines_successors():
+    m = build_machine(small_mix(6), ToleranceSensor(1.0), IDEAL)
+    space = search_space(m)
+    assert space.cell_table is not None
+    rng = random.Random(2)
+    starts = sorted({x for s in m.starts for x in s})
+    for _ in range(500):
+        mask = rng.getrandbits(m.n) or 1
+        r = rng.choice([rng.uniform(0.0, 360.0), rng.choice(starts), 0.0])
+        assert space.targets_at(mask, r) == [m.successor(i, r) for i in members(mask)]
+
+
+def test_cells_from_the_cell_table_are_the_boundary_cells(monkeypatch):
+    m = build_machine(small_mix(6), ToleranceSensor(1.0), IDEAL)
+    rng = random.Random(3)
+    masks = [rng.getrandbits(m.n) or 1 for _ in range(200)]
+    fast = Problem(m).choices
+    got = [(fast.cells(x, False), fast.cells(x, True)) for x in masks]
+    # The same cells from the machine's boundaries (Choices.fixed_cells), one per image.
+    monkeypatch.setattr(search_space(m), "cells_and_images", lambda mask: None)
+    slow = Problem(m).choices
+    assert got == [(slow.cells(x, False), slow.cells(x, True)) for x in masks]
