@@ -448,9 +448,12 @@ def annotate_cycle_time(made: Any, settings: CellSettings) -> dict[str, Any] | N
     return cycle
 
 
-def cycle_time_text(cycle: dict[str, Any] | None, profile: str | None = None) -> str:
+def cycle_time_text(
+    cycle: dict[str, Any] | None, profile: str | None = None, *, name_profile: bool = True
+) -> str:
     """A ``cycle_time_dict`` in words, for terminal output and reports; ``profile`` names
-    the profile when there is no cycle time (``CellSettings.describe``)."""
+    the profile when there is no cycle time (``CellSettings.describe``); ``name_profile``
+    False leaves the profile out of a known cycle time (an output whose header names it)."""
     if cycle is None:
         where = f" ({profile})" if profile else ""
         return (
@@ -461,7 +464,8 @@ def cycle_time_text(cycle: dict[str, Any] | None, profile: str | None = None) ->
     rate = "" if ppm is None else f", {ppm:.1f} parts/min"
     worst = cycle.get("worst_parts_per_minute")
     worst_rate = "" if worst is None else f", {worst:.1f} parts/min"
+    where = f" (cell profile: {cycle['profile']})" if name_profile else ""
     return (
         f"cycle time: {cycle['expected_s']:.2f} s per part expected{rate}; "
-        f"{cycle['worst_s']:.2f} s at worst{worst_rate} (cell profile: {cycle['profile']})"
+        f"{cycle['worst_s']:.2f} s at worst{worst_rate}{where}"
     )

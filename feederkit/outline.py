@@ -217,7 +217,11 @@ def outline_to_dict(outline: Outline) -> dict[str, object]:
 
 def load_outline_json(path: str | os.PathLike[str]) -> Outline:
     """Load an outline file; unreadable or malformed files are bad input."""
-    return outline_from_dict(read_json(path, "file"), default_name=Path(path).stem)
+    data = read_json(path, "file")
+    try:
+        return outline_from_dict(data, default_name=Path(path).stem)
+    except InputError as exc:  # name the file the user gave, not only the outline's name
+        raise InputError(f"{os.fspath(path)}: {exc}") from None
 
 
 def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:

@@ -338,7 +338,7 @@ def test_the_command_line_refuses_unlike_poses_with_one_line_and_exit_1(tmp_path
     cut.write_text(json.dumps({"name": "cut", "vertices": pts}))
     assert main(["plan", str(cut), "--sensorless", "--landings", "up"]) == 1
     err = capsys.readouterr().err
-    assert err.startswith("error: no strong plan exists") and len(err.strip().splitlines()) == 1
+    assert err.startswith("result: no strong plan exists") and len(err.strip().splitlines()) == 1
 
 
 def test_the_command_line_plans_the_near_symmetric_part(tmp_path, capsys):

@@ -1,10 +1,11 @@
 """The ``feederkit`` command: registers each command group's module and is the one error boundary.
 
-Exit codes (design.md): 0 success, 1 a result the user must act on, 2 bad input or usage,
-130 interrupted (Ctrl-C), 70 a bug in feederkit. Errors are one clear line on stderr, never
-a traceback: feederkit's own errors carry their message; errors from the system (SQLite,
-files, numbers too large, input nested too deeply) are named with what to do. Anything else
-is a bug: one line says so and names the log file that holds the traceback.
+Exit codes (design.md): 0 success, 1 a result the user must act on (one ``result: ...`` line
+on stderr), 2 bad input or usage, 130 interrupted (Ctrl-C), 70 a bug in feederkit. Errors are
+one clear ``error: ...`` line on stderr, never a traceback: feederkit's own errors carry their
+message; errors from the system (SQLite, files, numbers too large, input nested too deeply)
+are named with what to do. Anything else is a bug: one line says so and names the log file
+that holds the traceback.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     import functools
     import importlib
     import os
+    import signal
     import sqlite3
     import tempfile
     import traceback
@@ -33,12 +35,17 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
 
     import feederkit
     from feederkit.catalog import set_busy_notifier
+    from feederkit.cli import helpstyle
     from feederkit.cli.common import err_console
     from feederkit.errors import FeederkitError
 except KeyboardInterrupt:
     sys.stderr.write("error: interrupted\n")
     raise SystemExit(130) from None
 
+helpstyle.apply()
+
+EXIT_RESULT = 1
+"""A result the user must act on (design.md): printed as ``result: ...``, not as an error."""
 EXIT_INTERRUPTED = 130
 EXIT_BUG = 70
 """``EX_SOFTWARE`` of sysexits.h: an internal error."""
@@ -120,6 +127,14 @@ def _say(message: str) -> None:
     )
 
 
+def _say_result(message: str) -> None:
+    """One line on stderr, ``result: ...``: an outcome the user must act on (exit 1, design.md),
+    not a fault in the input, so not ``error:``; on stderr so ``--json`` output stays clean."""
+    err_console.print(
+        f"[bold yellow]result:[/] {escape(message)}", highlight=False, soft_wrap=True, markup=True
+    )
+
+
 def _notify_busy(message: str) -> None:
     err_console.print(f"{message} ...", highlight=False, soft_wrap=True, markup=False)
 
@@ -198,7 +213,10 @@ def main(argv: list[str] | None = None) -> int:
             _say("interrupted")
         return code if isinstance(code, int) else 0
     except FeederkitError as exc:
-        _say(_oneline(exc))
+        if exc.exit_code == EXIT_RESULT:
+            _say_result(_oneline(exc))
+        else:
+            _say(_oneline(exc))
         return exc.exit_code
     except NoArgsIsHelpError as exc:  # ``feederkit`` or a group alone: its help
         if exc.ctx is not None:
@@ -240,8 +258,21 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def end_quietly_on_closed_pipe() -> None:
+    """A closed stdout (``feederkit plan PART | head -1``) ends feederkit as it ends ``cat``:
+    by SIGPIPE's default action, exit status 141 in the shell, nothing on stderr.
+
+    Python ignores SIGPIPE and raises BrokenPipeError instead, which click and rich turn
+    into exit 1: here that is a result the user must act on (design.md), so it must not be.
+    Only the console script does this; :func:`main` called in-process keeps Python's way.
+    """
+    if hasattr(signal, "SIGPIPE"):  # not on Windows
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+
+
 def run() -> None:
     """Console-script wrapper around :func:`main`."""
+    end_quietly_on_closed_pipe()
     try:
         code = main()
     except KeyboardInterrupt:  # Ctrl-C while printing the error itself

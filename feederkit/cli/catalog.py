@@ -41,6 +41,7 @@ from feederkit.cli.common import (
     JsonOpt,
     console,
     err_console,
+    plural,
     print_json,
     progress_bar,
 )
@@ -61,7 +62,7 @@ catalog_app = typer.Typer(
 
 ComOpt = Annotated[
     tuple[float, float] | None,
-    typer.Option("--com", help="Center of mass X Y (mm) in the outline's frame."),
+    typer.Option("--com", metavar="X Y", help="Center of mass X Y (mm) in the outline's frame."),
 ]
 ReviseOpt = Annotated[
     bool,
@@ -187,7 +188,8 @@ def cmd_init(
 def cmd_add(
     file: Annotated[Path, typer.Argument(help="Outline .json, .dxf, .stl, .obj or .ply file.")],
     name: Annotated[
-        str | None, typer.Option("--name", help="Part name (default: from the file).")
+        str | None,
+        typer.Option("--name", metavar="NAME", help="Part name (default: from the file)."),
     ] = None,
     revise: ReviseOpt = False,
     import_opts: ImportOptions = ImportOptions(),
@@ -251,6 +253,9 @@ def cmd_import(
     none (with --skip-bad: every good file, and each bad one named)."""
     opts = with_com(import_opts, com)
     check_side_probability(side_probability)
+    if not directory.is_dir():  # before the catalog is created: bad input leaves no file
+        what = "not a directory" if directory.exists() else "no such directory"
+        raise InputError(f"{directory}: {what}")
     item_column = TextColumn("{task.fields[item]}")
     with progress_bar(item_column, disable=not err_console.is_terminal) as bar:
         tasks: dict[str, Any] = {}
@@ -289,8 +294,8 @@ def cmd_import(
     }
     console.print(
         f"{counts['added']} added, {counts['revised']} revised, {counts['unchanged']} unchanged; "
-        f"{len(result.ignored)} other files ignored"
-        + (f"; {len(result.bad)} bad files skipped" if result.bad else ""),
+        f"{plural(len(result.ignored), 'other file')} ignored"
+        + (f"; {plural(len(result.bad), 'bad file')} skipped" if result.bad else ""),
         highlight=False,
     )
 
@@ -334,7 +339,7 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
         for p in parts
     ]
     sys.stdout.write(plain_table(headers, rows, right=(1, 3, 4, 5)))
-    sys.stdout.write(f"{len(parts)} parts\n")
+    sys.stdout.write(f"{plural(len(parts), 'part')}\n")
     sys.stdout.flush()
 
 
@@ -417,7 +422,8 @@ def landing_dict(x: Landing) -> dict[str, Any]:
 def _landing_line(x: Landing) -> str:
     same = f", same shape as {', '.join(x.merged)}" if x.merged else ""
     return (
-        f"{x.name}: probability {x.probability:.3f}, {len(x.part.hull)} hull vertices, "
+        f"{x.name}: probability {x.probability:.3f}, "
+        f"{plural(len(x.part.hull), 'hull vertex', 'hull vertices')}, "
         f"com ({x.part.com[0]:.4f}, {x.part.com[1]:.4f}) mm{same}"
     )
 
@@ -429,7 +435,8 @@ def _tol(value: float | None) -> str:
 def cmd_show(
     name: Annotated[str, typer.Argument(help="Part name (NAME@REV for one revision).")],
     revision: Annotated[
-        int | None, typer.Option("--revision", min=1, help="Revision (default latest).")
+        int | None,
+        typer.Option("--revision", min=1, metavar="N", help="Revision (default latest)."),
     ] = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
@@ -454,11 +461,11 @@ def cmd_show(
     rows = [
         ("source", f"{rev.source_path} ({rev.source_kind}, {rev.source_units})"),
         ("sha256", rev.source_sha256),
-        ("area", f"{rev.area:.3f} mm2, {len(rev.outline.holes)} holes"),
-        ("outline", f"{len(rev.outline.vertices)} vertices"),
+        ("area", f"{rev.area:.3f} mm2, {plural(len(rev.outline.holes), 'hole')}"),
+        ("outline", plural(len(rev.outline.vertices), "vertex", "vertices")),
         (
             "hull",
-            f"{len(rev.hull)} vertices (tolerance {_tol(rev.hull_tolerance)})",
+            f"{plural(len(rev.hull), 'vertex', 'vertices')} (tolerance {_tol(rev.hull_tolerance)})",
         ),
         ("com", f"({rev.com[0]:.4f}, {rev.com[1]:.4f}) mm"),
         (
@@ -510,16 +517,22 @@ def cmd_remove(
     if json_out:
         print_json({"removed": part, "revision": revision, "changeovers_removed": removed})
         return
-    extra = f" and changeover(s) {', '.join(removed)}" if removed else ""
+    extra = ""
+    if removed:
+        extra = f" and {'changeover' if len(removed) == 1 else 'changeovers'} {', '.join(removed)}"
     what = part if revision is None else f"{part} revision {revision}"
     console.print(f"removed {what}{extra}", highlight=False, markup=False)
 
 
 def cmd_export(
     name: Annotated[str, typer.Argument(help="Part name.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Outline file to write (.json).")],
+    output: Annotated[
+        Path,
+        typer.Option("-o", "--output", metavar="OUT.json", help="Outline file to write (.json)."),
+    ],
     revision: Annotated[
-        int | None, typer.Option("--revision", min=1, help="Revision (default latest).")
+        int | None,
+        typer.Option("--revision", min=1, metavar="N", help="Revision (default latest)."),
     ] = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,

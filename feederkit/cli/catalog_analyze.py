@@ -20,8 +20,10 @@ from feederkit.cli.common import (
     NoiseOpt,
     SensorlessOpt,
     ToleranceOpt,
+    add_name_column,
     console,
     err_console,
+    plural,
     print_json,
     progress_bar,
 )
@@ -97,7 +99,7 @@ def analyze_command(
         named = "; ".join(f"{w.part_a} & {w.part_b}" for w in result.pairs[:5])
         more = f" and {n - 5} more" if n > 5 else ""
         raise CheckFailed(
-            f"{n} pair(s) of parts no plan can tell apart with this sensor: {named}{more}; "
+            f"{plural(n, 'pair')} of parts no plan can tell apart with this sensor: {named}{more}; "
             + _advice({w.kind for w in result.pairs})
         )
 
@@ -127,14 +129,14 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
     )
     summary.add_row(
         "push functions",
-        f"{c['push_classes']} distinct; {c['parts_sharing_a_push_function']} parts share one "
-        f"({len(result.shared_push)} classes)",
+        f"{c['push_classes']} distinct; {plural(c['parts_sharing_a_push_function'], 'part')} "
+        f"share one ({plural(len(result.shared_push), 'class', 'classes')})",
     )
     summary.add_row(
         "push-diameter functions",
         f"{c['push_diameter_classes']} distinct; "
-        f"{c['parts_sharing_a_push_diameter_function']} parts share one "
-        f"({len(result.shared_push_diameter)} classes)",
+        f"{plural(c['parts_sharing_a_push_diameter_function'], 'part')} share one "
+        f"({plural(len(result.shared_push_diameter), 'class', 'classes')})",
     )
     if result.pairs is None:
         summary.add_row(
@@ -156,7 +158,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
             continue
         t = Table(title=title)
         t.add_column("class", justify="right")
-        t.add_column("parts (phase shift alpha from the first, deg)")
+        t.add_column("parts (phase shift alpha from the first, deg)", overflow="fold")
         for k, cls in enumerate(classes, 1):
             names = ", ".join(
                 f"{escape(result.names[m])} ({a:.4g})" if j else escape(result.names[m])
@@ -172,8 +174,8 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
 
 def _pairs_table(pairs: tuple[PairWitness, ...], pfs: list[PushFunction]) -> Table:
     t = Table(title="pairs no plan can tell apart (section 8.4)")
-    t.add_column("part A")
-    t.add_column("part B")
+    add_name_column(t, "part A")
+    add_name_column(t, "part B")
     t.add_column("inseparable states (A ~ B: edge, diameter mm)")
     t.add_column("why")
     for w in pairs:

@@ -50,9 +50,12 @@ from feederkit.cli.common import (
     ShapeToleranceOpt,
     TimeLimitOpt,
     ToleranceOpt,
+    add_name_column,
     cell_planning_options,
     cell_settings,
+    check_output_folders,
     console,
+    cycle_line,
     flag_words,
     plan_outputs,
     print_json,
@@ -204,8 +207,8 @@ def changeover_report(
 
 def _pairs_table(witnesses: list[PairWitness], pfs: list[PushFunction]) -> Table:
     t = Table(title="parts this plan orients but cannot tell apart (section 8.4, Corollary 7)")
-    t.add_column("part A")
-    t.add_column("part B")
+    add_name_column(t, "part A")
+    add_name_column(t, "part B")
     t.add_column("inseparable states (A ~ B)")
     t.add_column("why")
     for w in witnesses:
@@ -225,6 +228,7 @@ def compile_command(
         str,
         typer.Option(
             "--mix",
+            metavar="A[:SHARE],B,...",
             help="Catalog parts, comma-separated: A,B,C (NAME@REV pins one); A:0.7,B:0.2,C:0.1 "
             "gives their shares of the production (default equal; normalised).",
         ),
@@ -267,6 +271,7 @@ def compile_command(
     cannot be.
     """
     members, shares = parse_mix_shares(mix)
+    check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
     sensor = settings.sensor
     options = cell_planning_options(
@@ -341,7 +346,7 @@ def compile_command(
         )
         console.print(plan_tree(plan))
         console.print(stats_table(plan, compiled.made.report))
-        console.print(escape(cycle_time_text(cycle, settings.describe())), highlight=False)
+        console.print(escape(cycle_line(cycle)), highlight=False)
         if witnesses:
             console.print(_pairs_table(witnesses, pfs))
         console.print(f"stored changeover {name!r} in {path}", highlight=False, markup=False)
@@ -397,7 +402,9 @@ def list_command(json_out: JsonOpt = False, catalog: CatalogOpt = None) -> None:
         console.print("no changeovers in the catalog")
         return
     t = Table(title="changeovers")
-    for col in ("name", "parts", "sensor", "created", "by"):
+    add_name_column(t, "name")
+    add_name_column(t, "parts")
+    for col in ("sensor", "created", "by"):
         t.add_column(col, overflow="fold")
     for i in infos:
         t.add_row(
@@ -450,7 +457,9 @@ def remove_command(name: NameArg, catalog: CatalogOpt = None) -> None:
     console.print(f"removed changeover {name!r} from {path}", highlight=False, markup=False)
 
 
-OutputOpt = Annotated[Path, typer.Option("-o", "--output", help="Write the file here (atomic).")]
+OutputOpt = Annotated[
+    Path, typer.Option("-o", "--output", metavar="FILE", help="Write the file here (atomic).")
+]
 
 
 @changeover_app.command("export")

@@ -27,9 +27,10 @@ from rich.progress import (
     TextColumn,
     TimeElapsedColumn,
 )
+from rich.table import Table
 
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
-from feederkit.cell import CellSettings, load_cell, resolve_settings
+from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
 from feederkit.jsonio import OutputFile
 from feederkit.mechanics.push import PushFunction
@@ -99,7 +100,7 @@ GroupingOpt = Annotated[
     typer.Option(
         "--grouping",
         metavar="exact|components",
-        help="exact (default) or components (the paper's rule).",
+        help="exact, or components (the paper's rule).",
     ),
 ]
 LumpingOpt = Annotated[
@@ -169,7 +170,7 @@ ShapeToleranceOpt = Annotated[
     typer.Option(
         "--shape-tolerance",
         metavar="MM",
-        help="Every hull vertex lies within MM of its drawn position (default 0).",
+        help="Every hull vertex lies within MM of its drawn position.",
     ),
 ]
 ComToleranceOpt = Annotated[
@@ -177,7 +178,7 @@ ComToleranceOpt = Annotated[
     typer.Option(
         "--com-tolerance",
         metavar="MM",
-        help="The centre of mass lies within MM of its nominal position (default 0).",
+        help="The centre of mass lies within MM of its nominal position.",
     ),
 ]
 
@@ -202,6 +203,27 @@ FLAG_TERMS = (
 )
 """The library's words for what a command-line flag sets: a library message that names one
 is shown with the flag."""
+
+
+def plural(n: int, word: str, many: str | None = None) -> str:
+    """``n`` and the noun in the number it takes: ``1 part``, ``2 parts``, ``0 parts``;
+    ``many`` is the plural when it is not ``word + "s"`` (``1 vertex``, ``3 vertices``).
+
+    Every count printed for people goes through here, so no line reads "1 operations"."""
+    return f"{n} {word if n == 1 else (many or word + 's')}"
+
+
+def add_name_column(table: Table, header: str, **kwargs: Any) -> None:
+    """A table column of part names that shows every name whole: a name too long for the
+    column folds onto the next line instead of being cropped with "…" (a name with no spaces
+    would otherwise be cut, and a cut name is ambiguous in a mix)."""
+    table.add_column(header, overflow="fold", **kwargs)
+
+
+def add_count_column(table: Table, header: str) -> None:
+    """A right-aligned column of small numbers, no wider than its header's longest word (the
+    header wraps), so that the name columns keep the room."""
+    table.add_column(header, justify="right", max_width=max(len(w) for w in header.split()))
 
 
 def with_flags(message: str, terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> str:
@@ -286,9 +308,9 @@ def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | No
     if stats.get("optimal", True) or time_limit is None:
         return None
     return (
-        f"the time limit of {time_limit:g} s was reached: this plan has {stats['length']} "
-        f"operations and is not proven shortest; a plan needs at least {stats['lower_bound']} "
-        "(allow more time with --time-limit S)"
+        f"the time limit of {time_limit:g} s was reached: this plan has "
+        f"{plural(stats['length'], 'operation')} and is not proven shortest; a plan needs at "
+        f"least {stats['lower_bound']} (allow more time with --time-limit S)"
     )
 
 
@@ -321,6 +343,18 @@ def plan_outputs(
     return files
 
 
+def check_output_folders(output: Path | None, report: Path | None) -> None:
+    """Refuse ``-o`` and ``--report`` paths whose folder does not exist before any work is done
+    (a plan that took a minute must not be lost to a typo in a folder name)."""
+    for path, what in ((output, "plan file"), (report, "report")):
+        if path is None:
+            continue
+        folder = path.parent
+        if not folder.is_dir():
+            why = "is not a folder" if folder.exists() else "does not exist"
+            raise InputError(f"{path}: cannot write the {what}: the folder {folder} {why}")
+
+
 def print_written(output: Path | None, report: Path | None) -> None:
     """Say which files were written."""
     for path, what in ((output, "plan"), (report, "report")):
@@ -343,11 +377,15 @@ def fail(message: str, code: int = 2) -> None:
     raise err
 
 
-def progress_bar(*extra: Any, disable: bool = False) -> Progress:
+def progress_bar(*extra: Any, disable: bool | None = None) -> Progress:
     """The progress bar of long work: on stderr (``--json`` output stays clean), gone when done.
 
     ``extra`` columns follow the standard ones (description, bar, done of total, elapsed).
+    Shown only on a terminal (``disable=None``): redirected, it would leave an empty line
+    before the first message (an error's one line would no longer be the first).
     """
+    if disable is None:
+        disable = not err_console.is_terminal
     return Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -399,6 +437,12 @@ def cell_settings(
             noise=noise,
             rotation_error=rotation_error,
         )
+
+
+def cycle_line(cycle: dict[str, Any] | None) -> str:
+    """The cycle time in words for an output whose header already names the cell profile
+    (``cell profile: ...``, docs/cell.md): the profile is not named a second time."""
+    return cycle_time_text(cycle, name_profile=False)
 
 
 def cell_planning_options(

@@ -19,12 +19,15 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.cell import cycle_time_text, load_cell, resolve_settings
+from feederkit.cell import load_cell, resolve_settings
 from feederkit.cli.changeover import CellOpt, landings_text
 from feederkit.cli.common import (
+    add_name_column,
     console,
+    cycle_line,
     err_console,
     flag_words,
+    plural,
     print_json,
     progress_bar,
     uncertainty_text,
@@ -58,7 +61,7 @@ def analysis_table(rows: tuple[PartRow, ...], percent: float) -> Table:
         pad_edge=False,
         collapse_padding=True,
     )
-    t.add_column("part", no_wrap=True)
+    add_name_column(t, "part")
     for col in ("mm", "states", "diam.", "period", "class", "bound"):
         t.add_column(col, justify="right")
     for r in rows:
@@ -94,8 +97,8 @@ def plans_tables(plans: tuple[DemoPlan, ...]) -> tuple[Table, Table]:
         title="sensor plans; cert = certified rotation error, ideal = ideal-model length",
         **style,
     )
-    blind.add_column("part", overflow="fold")
-    sensed.add_column("part", overflow="fold")
+    add_name_column(blind, "part")
+    add_name_column(sensed, "part")
     for col in ("length", "expected", "margin"):
         blind.add_column(col, justify="right", no_wrap=True)
     for col in ("tol mm", "length", "exp.", "margin", "bound", "cert", "ideal"):
@@ -140,7 +143,7 @@ def print_changeover(say: Console, c: DemoChangeover) -> None:
     declared = uncertainty_text(compiled.plan.get("uncertainty"))
     say.print(f"  uncertainty: {escape(declared)}", highlight=False)
     if c.cycle_time is not None:
-        say.print(f"  {escape(cycle_time_text(c.cycle_time))}", highlight=False)
+        say.print(f"  {escape(cycle_line(c.cycle_time))}", highlight=False)
     for warning in compiled.warnings:
         say.print(f"  warning: {escape(warning)}", highlight=False)
     for w in compiled.witnesses:
@@ -167,9 +170,8 @@ def print_changeover(say: Console, c: DemoChangeover) -> None:
 
 def print_result(say: Console, result: DemoResult) -> None:
     """The demo's tables and notes, for people."""
-    head = (
-        f"[bold]feederkit demo[/]: {result.part_count} parts from {escape(str(result.source_dir))}"
-    )
+    parts = plural(result.part_count, "part")
+    head = f"[bold]feederkit demo[/]: {parts} from {escape(str(result.source_dir))}"
     if result.not_orientable:
         head += f"; not orientable by pushing: {escape(', '.join(result.not_orientable))}"
     say.print(head, highlight=False)
@@ -195,17 +197,21 @@ def demo_command(
         Path | None,
         typer.Option(
             "--catalog-dir",
+            metavar="DIR",
             help="Folder of part files to import (default: ./catalog, else the bundled one).",
         ),
     ] = None,
     output: Annotated[
         Path,
-        typer.Option("-o", "--output", help="Folder for the plan files and reports."),
+        typer.Option(
+            "-o", "--output", metavar="DIR", help="Folder for the plan files and reports."
+        ),
     ] = Path("demo-out"),
     percent: Annotated[
         float,
         typer.Option(
             "--tolerance-percent",
+            metavar="PERCENT",
             help="The diameter sensor's tolerance, in percent of the largest part's size.",
         ),
     ] = 1.0,

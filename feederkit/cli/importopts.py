@@ -43,26 +43,32 @@ UnitsOpt = Annotated[
     str | None,
     typer.Option(
         "--units",
+        metavar="UNIT",
         help="Units of the file's coordinates (mm, cm, m, in, ft, um): overrides the file.",
     ),
 ]
 LayerOpt = Annotated[
     list[str] | None,
-    typer.Option("--layer", help="DXF layer to read (repeat for several; default all)."),
+    typer.Option(
+        "--layer", metavar="NAME", help="DXF layer to read (repeat for several; default all)."
+    ),
 ]
 SpaceOpt = Annotated[
     str,
-    typer.Option("--space", help="DXF space to read: model (default) or paper."),
+    typer.Option("--space", metavar="model|paper", help="DXF space to read: model or paper."),
 ]
 FlattenOpt = Annotated[
     float,
-    typer.Option("--flatten-tolerance", min=1e-6, help="Largest curve-to-chord distance (mm)."),
+    typer.Option(
+        "--flatten-tolerance", min=1e-6, metavar="MM", help="Largest curve-to-chord distance (mm)."
+    ),
 ]
 HullOpt = Annotated[
     float | None,
     typer.Option(
         "--hull-tolerance",
         min=0.0,
+        metavar="MM",
         help=f"Hull simplification (mm); default {REL_HULL_TOLERANCE:g} of the part's size, at "
         f"most {DEFAULT_HULL_TOLERANCE}, for CAD files; exact for outline files.",
     ),
@@ -74,7 +80,8 @@ AllPartsOpt = Annotated[
     ),
 ]
 PoseOpt = Annotated[
-    int | None, typer.Option("--pose", min=0, help="Mesh resting pose K (0: the most probable).")
+    int | None,
+    typer.Option("--pose", min=0, metavar="K", help="Mesh resting pose K (0: the most probable)."),
 ]
 AllowLargeOpt = Annotated[
     bool, typer.Option("--allow-large", help=f"Read files over {DEFAULT_MAX_FILE_MB:g} MB.")
@@ -82,34 +89,50 @@ AllowLargeOpt = Annotated[
 MaxEntitiesOpt = Annotated[
     int,
     typer.Option(
-        "--max-entities", min=1, help="Import budget: DXF entities after block expansion."
+        "--max-entities",
+        min=1,
+        metavar="N",
+        help="Import budget: DXF entities after block expansion.",
     ),
 ]
 MaxVerticesOpt = Annotated[
     int,
-    typer.Option("--max-vertices", min=1, help="Import budget: vertices after flattening."),
+    typer.Option(
+        "--max-vertices", min=1, metavar="N", help="Import budget: vertices after flattening."
+    ),
 ]
 MaxLoopsOpt = Annotated[
-    int, typer.Option("--max-loops", min=1, help="Import budget: closed loops (parts and holes).")
+    int,
+    typer.Option(
+        "--max-loops", min=1, metavar="N", help="Import budget: closed loops (parts and holes)."
+    ),
 ]
 MaxCrossingsOpt = Annotated[
     int,
     typer.Option(
-        "--max-crossings", min=1, help="Import budget: pairs of DXF lines that may cross."
+        "--max-crossings",
+        min=1,
+        metavar="N",
+        help="Import budget: pairs of DXF lines that may cross.",
     ),
 ]
 MaxFacesOpt = Annotated[
-    int, typer.Option("--max-faces", min=1, help="Import budget: mesh triangles.")
+    int, typer.Option("--max-faces", min=1, metavar="N", help="Import budget: mesh triangles.")
 ]
 MaxHullFacesOpt = Annotated[
     int,
     typer.Option(
-        "--max-hull-faces", min=1, help="Import budget: faces of a mesh's convex hull (poses)."
+        "--max-hull-faces",
+        min=1,
+        metavar="N",
+        help="Import budget: faces of a mesh's convex hull (poses).",
     ),
 ]
 ImportTimeOpt = Annotated[
     float,
-    typer.Option("--import-time-limit", min=0.001, help="Import budget: wall time (s) per file."),
+    typer.Option(
+        "--import-time-limit", min=0.001, metavar="S", help="Import budget: wall time (s) per file."
+    ),
 ]
 
 

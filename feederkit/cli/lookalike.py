@@ -29,13 +29,23 @@ from feederkit.sources import load_part_with_warnings
 def lookalike_command(
     source: Annotated[str, typer.Argument(help="An outline file, CAD file or catalog part name.")],
     keep: Annotated[
-        str, typer.Option("--keep", help="What the look-alike keeps: push or push-diameter.")
+        str,
+        typer.Option(
+            "--keep",
+            metavar="push|push-diameter",
+            help="What the look-alike keeps: push or push-diameter.",
+        ),
     ],
     output: Annotated[
-        Path | None, typer.Option("-o", "--output", help="Outline file (.json) to write.")
+        Path | None,
+        typer.Option("-o", "--output", metavar="OUT.json", help="Outline file (.json) to write."),
     ] = None,
-    name: Annotated[str | None, typer.Option("--name", help="Name of the new part.")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the construction's choices.")] = 0,
+    name: Annotated[
+        str | None, typer.Option("--name", metavar="NAME", help="Name of the new part.")
+    ] = None,
+    seed: Annotated[
+        int, typer.Option("--seed", metavar="N", help="Seed of the construction's choices.")
+    ] = 0,
     catalog: CatalogOpt = None,
     import_opts: ImportOptions = ImportOptions(),
     json_out: JsonOpt = False,

@@ -22,6 +22,7 @@ from feederkit.cli.common import (
     ToleranceOpt,
     console,
     err_console,
+    plural,
     print_json,
 )
 from feederkit.cli.importopts import print_import_warnings, takes_import_options
@@ -81,8 +82,9 @@ def _print_analysis(a: PartAnalysis) -> None:
     tiny = 1e-9 * part.size
     console.print(
         f"[bold]{escape(part.name)}[/]{escape(rev)}: COM ({_num(part.com[0], 6, tiny)}, "
-        f"{_num(part.com[1], 6, tiny)}) mm, hull of {len(part.hull)} vertices, "
-        f"{pf.n} stable states",
+        f"{_num(part.com[1], 6, tiny)}) mm, hull of "
+        f"{plural(len(part.hull), 'vertex', 'vertices')}, "
+        f"{plural(pf.n, 'stable state')}",
         highlight=False,
     )
     near_edges = set(pf.near_metastable_edges)
@@ -143,7 +145,11 @@ def analyze_command(
     ],
     com: Annotated[
         tuple[float, float] | None,
-        typer.Option("--com", help="Center of mass X Y (mm) for every SOURCE, instead of its own."),
+        typer.Option(
+            "--com",
+            metavar="X Y",
+            help="Center of mass X Y (mm) for every SOURCE, instead of its own.",
+        ),
     ] = None,
     sensorless: Annotated[
         bool, typer.Option("--sensorless", help="Classify for no sensor (Fig. 14 classes 7, 8).")

@@ -21,11 +21,19 @@ from feederkit.sources import load_part_with_warnings
 def plot_command(
     source: Annotated[str, typer.Argument(help="An outline file, CAD file or catalog part name.")],
     output: Annotated[
-        Path, typer.Option("-o", "--output", help="The picture to write: FILE.png or FILE.svg.")
+        Path,
+        typer.Option(
+            "-o",
+            "--output",
+            metavar="FILE.png|svg",
+            help="The picture to write: FILE.png or FILE.svg.",
+        ),
     ],
     com: Annotated[
         tuple[float, float] | None,
-        typer.Option("--com", help="Center of mass X Y (mm), instead of the plate's centroid."),
+        typer.Option(
+            "--com", metavar="X Y", help="Center of mass X Y (mm), instead of the plate's centroid."
+        ),
     ] = None,
     catalog: CatalogOpt = None,
     import_opts: ImportOptions = ImportOptions(),

@@ -16,7 +16,7 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from feederkit.cell import annotate_cycle_time, cycle_time_text
+from feederkit.cell import annotate_cycle_time
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
     FLAG_TERMS,
@@ -42,7 +42,9 @@ from feederkit.cli.common import (
     ToleranceOpt,
     cell_planning_options,
     cell_settings,
+    check_output_folders,
     console,
+    cycle_line,
     flag_words,
     plan_outputs,
     print_json,
@@ -206,6 +208,7 @@ def plan_command(
     told apart (the plan is still written) or an accepted and a rejected landing cannot be.
     """
     terms = (*FLAG_TERMS, *LANDING_TERMS)
+    check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
     sensor = settings.sensor
     options = cell_planning_options(
@@ -216,16 +219,17 @@ def plan_command(
         which = "all" if landings in (None, "all") else landing_names(landings)
         found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
     loaded = found.parts
-    print_warnings(loaded.warnings)
     planned: LandingPlan | None = None
     if not plans_over_landings(found.landings, landings is not None, accept is not None):
+        print_warnings(loaded.warnings)
         pfs = list(loaded.push_functions)
         with searching("planning and verifying", options.time_limit_s), flag_words():
             made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
     else:
         every = found.all
         names = {x.name for x in every} | {m for x in every for m in x.merged}
-        taken = _accepted_names(accept, names)
+        taken = _accepted_names(accept, names)  # bad input: one line, before any warning
+        print_warnings(loaded.warnings)
         pfs = [push_function(x.part) for x in every]
         with searching("planning and verifying", options.time_limit_s), flag_words(terms):
             planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
@@ -247,7 +251,7 @@ def plan_command(
         console.print(_header(plan, sensor_given, words), highlight=False)
         console.print(plan_tree(plan))
         console.print(stats_table(plan, made.report))
-        console.print(escape(cycle_time_text(cycle, settings.describe())), highlight=False)
+        console.print(escape(cycle_line(cycle)), highlight=False)
         print_written(output, report)
     if planned is not None:
         lumps = landing_lumps(planned)

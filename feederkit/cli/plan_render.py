@@ -18,6 +18,7 @@ from rich.text import Text
 from rich.tree import Tree
 
 from feederkit.cell import expectation_words
+from feederkit.cli.common import add_count_column, add_name_column, plural
 from feederkit.errors import InputError
 from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
@@ -103,7 +104,9 @@ def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
     drawing grows with the distinct nodes; built without recursion.
     """
     plan = as_plan(plan)
-    tree = Tree(Text(f"plan: at most {plan.stats.length} push-align operations", style="bold"))
+    tree = Tree(
+        Text(f"plan: at most {plural(plan.stats.length, 'push-align operation')}", style="bold")
+    )
     uses = _uses(plan)
     names: dict[int, str] = {}
     stack: list[tuple[Tree, Step, int]] = [(tree, plan.root, 1)]
@@ -178,7 +181,7 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
         t.add_row("class bound", f"{s.class_bound} ({meets})")
     if report is not None:
         verdict = "passed" if report.ok else "FAILED"
-        t.add_row(verification_title(plan), f"{verdict}, {report.paths} paths")
+        t.add_row(verification_title(plan), f"{verdict}, {plural(report.paths, 'path')}")
     return t
 
 
@@ -226,13 +229,12 @@ def verification_table(report: VerificationReport, plan: Plan | None = None) -> 
         title += " " + verification_title(plan).removeprefix("verified ")
     t = Table(title=title)
     landings = any(p.landing is not None for p in report.parts)
-    cols = (
-        ["part", "landing", "starts", "paths", "rejects"]
-        if landings
-        else ["part", "starts", "paths"]
-    )
-    for col in (*cols, "worst operations", "failed starts"):
-        t.add_column(col)
+    add_name_column(t, "part")
+    if landings:
+        t.add_column("landing")
+    for col in ("starts", "paths", *(["rejects"] if landings else []), "worst operations"):
+        add_count_column(t, col)
+    add_count_column(t, "failed starts")
     for p in report.parts:
         failed = Text(str(p.failed_starts), style="bold red" if p.failed_starts else "green")
         head = [p.part, str(p.landing), str(p.starts), str(p.paths), str(p.rejects)]

@@ -7,12 +7,13 @@ is HTML only: ``-o`` must end in .html (print it to PDF from a browser).
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
-from feederkit.cli.common import console, progress_bar
+from feederkit.cli.common import console, plural, progress_bar
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import InputError
 from feederkit.jsonio import read_json
@@ -52,11 +53,14 @@ DEEP_JSON = 10_000
 
 def report_command(
     plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="The HTML file to write.")],
+    output: Annotated[
+        Path, typer.Option("-o", "--output", metavar="REPORT.html", help="The HTML file to write.")
+    ],
     seconds_per_op: Annotated[
         float | None,
         typer.Option(
             "--seconds-per-op",
+            metavar="S",
             help="Seconds per push-align operation: a flat cycle time instead of the plan's "
             "own (made with a cell profile, docs/cell.md).",
         ),
@@ -69,12 +73,18 @@ def report_command(
             help="Also run N trials in the MuJoCo model (feederkit[sim]); show the success rate.",
         ),
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Random seed of --simulate.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", metavar="N", help="Random seed of --simulate.")
+    ] = 0,
     max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
     """Write one self-contained HTML page: the mix, the plan as a tree, statistics, part plots."""
     check_report_path(output)
     data = load_plan(plan, max_plan_mb)
+    if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
+        raise InputError(
+            f"--seconds-per-op must be a positive number of seconds, got {seconds_per_op:g}"
+        )
     if simulate is not None and simulate < 1:
         raise InputError(f"--simulate must be a positive number of trials, got {simulate}")
     simulation = None if simulate is None else _simulate(data, simulate, seed)
@@ -87,7 +97,8 @@ def report_command(
     write_report(output, html)
     if simulation is not None:
         console.print(
-            f"simulated {simulation['successes']} successes in {simulation['trials']} trials",
+            f"simulated {plural(simulation['successes'], 'success', 'successes')} in "
+            f"{plural(simulation['trials'], 'trial')}",
             highlight=False,
             markup=False,
         )

@@ -40,7 +40,7 @@ def run_command(
     sources: Annotated[
         list[str] | None,
         typer.Argument(
-            metavar="[SOURCE]...",
+            metavar="SOURCE",
             help="Check and run these parts (outline or CAD files, catalog names); "
             "default: every part of the plan, from the hull and COM it records.",
             show_default=False,
@@ -104,7 +104,7 @@ def run_command(
                         "cannot take: recirculate or re-drop)"
                     )
                 console.print(
-                    f"all {report.paths} paths end in their result{tail}",
+                    f"{_every_path(report.paths)} in their result{tail}",
                     highlight=False,
                     markup=False,
                     soft_wrap=True,
@@ -127,6 +127,11 @@ def run_command(
         raise CheckFailed(failed[0].message)
     if not report.ok:
         raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
+
+
+def _every_path(n: int) -> str:
+    """``all 3 paths end`` (``the one path ends``)."""
+    return "the one path ends" if n == 1 else f"all {n} paths end"
 
 
 def _declared(plan: Plan) -> dict[str, Any]:

@@ -19,7 +19,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from feederkit.cli.common import console, err_console, print_json
+from feederkit.cli.common import add_name_column, console, err_console, plural, print_json
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
 from feederkit.sim.api import (
@@ -47,7 +47,8 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         f"{ff.text() if ff else '-'}"
     )
     console.print(
-        f"[bold]simulated[/] {escape(', '.join(s.parts))}: {st.trials} trials, seed {st.seed}, "
+        f"[bold]simulated[/] {escape(', '.join(s.parts))}: {plural(st.trials, 'trial')}, "
+        f"seed {st.seed}, "
         f"belt {st.belt_speed:g} m/s; declared uncertainty: {escape(declared)}; "
         f"{escape(sampled)}; contact: {escape(st.contact)}",
         highlight=False,
@@ -74,7 +75,9 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     )
     margin = "none (no rotations)" if s.min_margin_deg is None else f"{s.min_margin_deg:.3g} deg"
     table.add_row("plan's smallest margin", margin)
-    table.add_row("wall time", f"{s.wall_time_s:.2f} s ({s.pushes} push-align operations)")
+    table.add_row(
+        "wall time", f"{s.wall_time_s:.2f} s ({plural(s.pushes, 'push-align operation')})"
+    )
     console.print(table)
     if (
         s.min_margin_deg is not None
@@ -116,7 +119,10 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
             "sim",
         )
         for col in cols:
-            t.add_column(col)
+            if col == "part":
+                add_name_column(t, col)
+            else:
+                t.add_column(col)
         for m in s.push_misses[:SHOWN_ROWS]:
             t.add_row(
                 str(m.trial),
@@ -133,8 +139,12 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
 
 def simulate_command(
     plan: Annotated[Path, typer.Argument(help="A plan file (feederkit-plan JSON).")],
-    trials: Annotated[int, typer.Option("--trials", min=1, help="Number of trials.")] = 100,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts and errors.")] = 0,
+    trials: Annotated[
+        int, typer.Option("--trials", min=1, metavar="N", help="Number of trials.")
+    ] = 100,
+    seed: Annotated[
+        int, typer.Option("--seed", metavar="N", help="Seed of the random starts and errors.")
+    ] = 0,
     ideal: Annotated[
         bool,
         typer.Option(
@@ -227,7 +237,7 @@ def simulate_command(
         _print_summary(summary, data.uncertainty_words())
     if require_success is not None and summary.success_rate < require_success:
         raise CheckFailed(
-            f"{summary.successes} of {summary.trials} trials succeeded "
+            f"{summary.successes} of {plural(summary.trials, 'trial')} succeeded "
             f"({100 * summary.success_rate:.1f}%), below the required {100 * require_success:g}%"
         )
 
