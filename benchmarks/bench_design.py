@@ -31,10 +31,15 @@ import numpy as np
 from feederkit.design import sensor as design_sensor
 from feederkit.design.sensor import design_tolerance
 from feederkit.design.steps import LengthOracle, length_steps, mix_breakpoints, optimal_length
+from feederkit.design.strong import StrongLengthOracle, machine_breakpoints, strong_length_steps
 from feederkit.errors import InputError
+from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning.api import NoStrongPlan, plan
+from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import Uncertainty
 
 
 def ellipse_part(n: int, seed: int, name: str):
@@ -88,18 +93,39 @@ class WholePlanOracle(LengthOracle):
         return self.length(tolerance) <= length
 
 
-def whole_plan_design(pfs):
-    """``design_tolerance`` with :class:`WholePlanOracle` in its length search."""
-    original = design_sensor.length_steps
+class WholeStrongPlanOracle(StrongLengthOracle):
+    """The baseline under uncertainty: every question answered by a whole strong plan."""
+
+    def length(self, tolerance: float) -> int | None:
+        machine = build_machine(self.mix.pfs, ToleranceSensor(tolerance), self.mix.uncertainty)
+        try:
+            return plan(machine).length
+        except NoStrongPlan:
+            return None
+
+    def within(self, tolerance: float, length: int) -> bool:
+        got = self.length(tolerance)
+        return got is not None and got <= length
+
+
+def whole_plan_design(pfs, uncertainty: Uncertainty):
+    """``design_tolerance`` with every length question answered by a whole plan."""
+    original, strong = design_sensor.length_steps, design_sensor.strong_length_steps
 
     def steps(pfs_, up_to, critical=None):
         return length_steps(pfs_, up_to, oracle=WholePlanOracle(pfs_), critical=critical)
 
+    def strong_steps(mix, up_to, critical):
+        oracle = WholeStrongPlanOracle(mix)
+        return strong_length_steps(mix, up_to, critical, oracle=oracle)
+
     design_sensor.length_steps = steps
+    design_sensor.strong_length_steps = strong_steps
     try:
-        return design_tolerance(pfs)
+        return design_tolerance(pfs, uncertainty=uncertainty)
     finally:
         design_sensor.length_steps = original
+        design_sensor.strong_length_steps = strong
 
 
 class GaveUp(Exception):
@@ -135,7 +161,17 @@ def main() -> int:
     ap.add_argument(
         "--baseline", action="store_true", help="also answer every question by a whole plan"
     )
+    ap.add_argument(
+        "--rotation-error",
+        type=float,
+        default=1.0,
+        metavar="DEG",
+        help="the declared rotation error (default 1; 0: the ideal model)",
+    )
     args = ap.parse_args()
+    unc = Uncertainty(args.rotation_error)
+    model = "ideal model" if unc.is_ideal else "strong plans"
+    print(f"rotation error {unc.rotation_error_deg:g} deg ({model})")
     cases = [
         ("20-part mix, 6-10-gons on one ellipse", lambda: ellipse_mix(20), 10.0),
         ("20-part mix, 3-10-gons of 20-100 mm", lambda: varied_mix(20), 10.0),
@@ -156,8 +192,11 @@ def main() -> int:
     for name, build, target in cases:
         pfs = build()
         states = sum(pf.n for pf in pfs)
-        breaks = len(mix_breakpoints(pfs))
-        design, wall, cpu = timed(design_tolerance, pfs, CAP * target)
+        if unc.is_ideal:
+            breaks = len(mix_breakpoints(pfs))
+        else:
+            breaks = len(machine_breakpoints(build_machine(pfs, NoSensor(), unc)))
+        design, wall, cpu = timed(lambda p: design_tolerance(p, uncertainty=unc), pfs, CAP * target)
         if design is None:
             failed += 1
             row = (
@@ -166,7 +205,7 @@ def main() -> int:
             )
             verdict = "SLOW"
         else:
-            lengths = ",".join(str(s.length) for s in design.steps)
+            lengths = ",".join("-" if s.length is None else str(s.length) for s in design.steps)
             x = design.critical_tolerance
             ok = wall < target
             failed += not ok
@@ -176,7 +215,7 @@ def main() -> int:
             )
             verdict = "ok" if ok else "SLOW"
         if args.baseline:
-            base, bwall, bcpu = timed(whole_plan_design, pfs, 2 * CAP * target)
+            base, bwall, bcpu = timed(lambda p: whole_plan_design(p, unc), pfs, 2 * CAP * target)
             if base is None:
                 row += f" {bwall:.1f} (gave up) | > {bcpu:.0f} | - |"
             else:

@@ -49,7 +49,15 @@ def test_tolerance_design_json(capsys):
     for a, b in zip(rows, rows[1:], strict=False):
         assert a["tolerance_mm"][1] == b["tolerance_mm"][0] and a["length"] < b["length"]
     assert all(r["recognizable"] and 1.0 <= r["expected"] <= r["length"] for r in rows)
-    assert data["uncertainty"] == {"rotation_error_deg": 1.0, "applied": False}
+    assert data["uncertainty"] == {
+        "rotation_error_deg": 1.0,
+        "shape_tolerance_mm": 0.0,
+        "com_tolerance_mm": 0.0,
+        "applied": True,
+    }
+    assert data["model"].startswith("strong plans at the declared uncertainty (rotation error 1")
+    assert data["answer"].endswith("(strong plans, rotation error 1 deg, shape tolerance 0 mm, "
+                                   "COM tolerance 0 mm)")  # fmt: skip
     assert data["answer"].startswith(f"this mix is recognizable with a tolerance up to {x:.6g} mm")
 
 
@@ -58,7 +66,7 @@ def test_terminal_output_names_the_answer_and_the_profile(capsys):
     out = " ".join(capsys.readouterr().out.split())
     assert "this mix is recognizable with a tolerance up to" in out
     assert "the plan takes" in out and "cell profile: built-in defaults" in out
-    assert "rotation error 0 deg" in out
+    assert "rotation error ±0°, shape tolerance 0 mm, COM tolerance 0 mm (the ideal model)" in out
 
 
 @pytest.mark.parametrize("pitches", [None, "0.5,1"])

@@ -1,8 +1,10 @@
 """``feederkit design sensor SOURCE... | --mix A,B,...``: which sensor a product mix needs.
 
 A thin layer over :mod:`feederkit.design`: read the cell profile (``--cell FILE`` or
-``./feederkit.toml``) and the command line's overrides, load the parts, decide the critical
-tolerances (or each LED pitch), print the tables, the one-line answer and the profile used,
+``./feederkit.toml``) and the command line's overrides, with the declared uncertainty
+(``--rotation-error``, ``--shape-tolerance``, ``--com-tolerance``, as ``plan`` takes them),
+load the parts, decide the critical tolerances (or each LED pitch) for strong plans at that
+uncertainty, print the tables, the one-line answer, the profile and the uncertainty used,
 and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md).
 """
 
@@ -15,10 +17,21 @@ import typer
 from rich.table import Table
 
 from feederkit.cell import load_cell
-from feederkit.cli.common import CatalogOpt, JsonOpt, console, fail, print_json, print_warnings
+from feederkit.cli.common import (
+    CatalogOpt,
+    ComToleranceOpt,
+    JsonOpt,
+    ShapeToleranceOpt,
+    console,
+    fail,
+    flag_words,
+    print_json,
+    print_warnings,
+    uncertainty_option,
+    uncertainty_text,
+)
 from feederkit.design.pitches import parse_pitches
 from feederkit.design.sensor import (
-    MODEL_NOTE,
     PitchDesign,
     ToleranceDesign,
     design_pitches,
@@ -86,9 +99,12 @@ def sensor_command(
         typer.Option(
             "--rotation-error",
             metavar="DEG",
-            help="Robot rotation error, reported (the figures are for the ideal model).",
+            help="The robot's rotation is off by up to ±DEG (default: the cell profile's, 1; "
+            "0 with the tolerances 0: the ideal model).",
         ),
     ] = None,
+    shape_tolerance: ShapeToleranceOpt = 0.0,
+    com_tolerance: ComToleranceOpt = 0.0,
     cell: Annotated[
         Path | None,
         typer.Option("--cell", metavar="FILE", help="Cell profile (default ./feederkit.toml)."),
@@ -101,7 +117,8 @@ def sensor_command(
     json_out: JsonOpt = False,
 ) -> None:
     """The exact critical tolerance (or LED pitch) of a mix and its pairs (Theorem 9), and
-    the optimal plan length as a step function of the tolerance."""
+    the optimal plan length as a step function of the tolerance, for strong plans at the
+    declared uncertainty (``--rotation-error``, default 1 degree; all 0: the ideal model)."""
     names = list(sources or [])
     if mix is not None:
         if names:
@@ -113,6 +130,7 @@ def sensor_command(
     r = profile.robot.rotation_error_deg if rotation_error is None else rotation_error
     if not 0.0 <= r < 180.0:
         raise InputError(f"--rotation-error must be in [0, 180) degrees, got {r}")
+    uncertainty = uncertainty_option(r, shape_tolerance, com_tolerance)
     led = pitches is not None or profile.sensor.model == "led"
     if not led and noise is not None:
         raise InputError("--noise goes with --pitches (or a profile with an LED array)")
@@ -128,10 +146,11 @@ def sensor_command(
     loaded = load_parts(names, catalog=catalog)
     pfs = list(loaded.push_functions)
     design: ToleranceDesign | PitchDesign
-    if led:
-        design = design_pitches(pfs, values, noise=e, rotation_error_deg=r)
-    else:
-        design = design_tolerance(pfs, max_tolerance=max_tolerance, rotation_error_deg=r)
+    with flag_words():
+        if led:
+            design = design_pitches(pfs, values, noise=e, uncertainty=uncertainty)
+        else:
+            design = design_tolerance(pfs, max_tolerance=max_tolerance, uncertainty=uncertainty)
     print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
     if plot is not None:
         from feederkit.design.plot import plot_design
@@ -149,10 +168,13 @@ def sensor_command(
             _print_tolerance(design)
         else:
             _print_pitches(design)
+        model = "" if uncertainty.is_ideal else " (the figures are for strong plans)"
         console.print(
-            f"cell profile: {profile.source}; rotation error {r:g} deg ({MODEL_NOTE})",
+            f"cell profile: {profile.source}; uncertainty: "
+            f"{uncertainty_text(uncertainty.to_dict())}{model}",
             highlight=False,
             markup=False,
+            soft_wrap=True,
         )
         if plot is not None:
             console.print(f"wrote {plot}", highlight=False, markup=False, soft_wrap=True)
@@ -188,13 +210,16 @@ def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
 
 def _print_tolerance(design: ToleranceDesign) -> None:
     console.print(_pairs_table(design))
-    table = Table(title="optimal plan length by tolerance (each step holds on (lo, hi])")
+    what = "optimal plan length" if design.uncertainty.is_ideal else "optimal strong plan length"
+    table = Table(title=f"{what} by tolerance (each step holds on (lo, hi])")
     table.add_column("tolerance (mm)")
     table.add_column("length", justify="right")
     table.add_column("expected (at hi; parts equally likely)", justify="right")
     for s in design.steps:
         hi = "..." if s.hi is None else f"{s.hi:.6g}"
-        table.add_row(f"({s.lo:.6g}, {hi}]", str(s.length), f"{s.expected:.4f}")
+        length = "no strong plan" if s.length is None else str(s.length)
+        expected = "-" if s.expected is None else f"{s.expected:.4f}"
+        table.add_row(f"({s.lo:.6g}, {hi}]", length, expected)
     if design.steps:
         console.print(table)
 
@@ -210,6 +235,8 @@ def _print_pitches(design: PitchDesign) -> None:
         bad = ", ".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])
         if len(row.unrecognizable) > 3:
             bad += f" and {len(row.unrecognizable) - 3} more"
+        if row.no_plan is not None:
+            bad = row.no_plan
         table.add_row(
             f"{row.pitch:.6g}",
             "yes" if row.recognizable else "no",

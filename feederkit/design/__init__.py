@@ -4,8 +4,12 @@
   search over the breakpoints ``|d - d'| / 2`` with the exact pair test, Theorem 9);
 - :mod:`~feederkit.design.steps`: the optimal plan length as a step function of the
   tolerance, with its exact breakpoints (``LengthOracle``: the planner's length alone);
+- :mod:`~feederkit.design.strong`: the same for strong plans at a declared uncertainty
+  (breakpoints of diameter intervals, pairs decided by exact solvability, lengths in
+  segments of constant goal);
 - :mod:`~feederkit.design.pitches`: LED arrays, pitch by pitch;
-- :mod:`~feederkit.design.sensor`: the ``design sensor`` answer (docs/design.md).
+- :mod:`~feederkit.design.sensor`: the ``design sensor`` answer at the declared uncertainty
+  (docs/design.md).
 """
 
 from feederkit.design.critical import (
@@ -24,6 +28,13 @@ from feederkit.design.sensor import (
     report_design,
 )
 from feederkit.design.steps import LengthOracle, LengthStep, length_steps, mix_breakpoints
+from feederkit.design.strong import (
+    StrongLengthOracle,
+    StrongMix,
+    strong_length_steps,
+    strong_mix_critical,
+    strong_pair_critical,
+)
 
 __all__ = [
     "LengthOracle",
@@ -32,6 +43,8 @@ __all__ = [
     "PairCritical",
     "PitchDesign",
     "PitchRow",
+    "StrongLengthOracle",
+    "StrongMix",
     "ToleranceDesign",
     "design_pitches",
     "design_tolerance",
@@ -43,4 +56,7 @@ __all__ = [
     "parse_pitches",
     "pitch_rows",
     "report_design",
+    "strong_length_steps",
+    "strong_mix_critical",
+    "strong_pair_critical",
 ]

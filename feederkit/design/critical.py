@@ -1,5 +1,8 @@
 """Critical tolerances: the largest sensor tolerance at which parts can still be told apart.
 
+On the ideal model (all uncertainty bounds zero); :mod:`feederkit.design.strong` decides
+them for strong plans at a declared uncertainty with the same search.
+
 With a tolerance sensor of tolerance ``e`` two states of diameters ``d`` and ``d'`` read
 alike iff ``|d - d'| < 2e`` (design.md's open interval). The read-alike relation, and so
 everything decided from it (distinguishability, definition 11 and Theorem 9; the plan

@@ -4,7 +4,9 @@ Beam grids of different pitches are not nested (beams at multiples of 0.3 mm are
 of those at multiples of 0.2 mm), so recognizability and plan length need not be monotone in
 the pitch: each pitch in the list is decided on its own with the exact pair test
 (:func:`feederkit.mix.pairs.unrecognizable_pairs`) and, when the mix is recognizable, a
-verified optimal plan (:func:`feederkit.plans.make.make_plan`).
+verified optimal plan (:func:`feederkit.plans.make.make_plan`). Under a declared uncertainty
+each pitch is decided for strong plans (:func:`feederkit.design.strong.strong_pitch`: pairs
+of parts with bisimilar states, then a verified strong plan, or "no strong plan").
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from feederkit.design.strong import StrongMix, strong_pitch
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import unrecognizable_pairs
@@ -26,6 +29,8 @@ class PitchRow:
     """One LED pitch (mm): whether the mix is recognizable with it and, if so, its plan.
 
     ``unrecognizable``: the pairs of parts (names) that this pitch cannot tell apart.
+    ``no_plan``: why there is no plan although every pair reads apart (under a declared
+    uncertainty: no strong plan exists at this pitch), else None.
     """
 
     pitch: float
@@ -33,14 +38,16 @@ class PitchRow:
     unrecognizable: tuple[tuple[str, str], ...]
     length: int | None = None
     expected: float | None = None
+    no_plan: str | None = None
 
     @property
     def recognizable(self) -> bool:
-        """Whether every pair of parts is distinguishable with this pitch."""
-        return not self.unrecognizable
+        """Whether a (strong) plan recognizes the mix with this pitch."""
+        return not self.unrecognizable and self.no_plan is None
 
     def to_dict(self) -> dict[str, object]:
-        """``{"pitch_mm", "noise_mm", "recognizable", "length", "expected", "unrecognizable"}``."""
+        """``{"pitch_mm", "noise_mm", "recognizable", "length", "expected", "unrecognizable",
+        "no_plan"}``."""
         return {
             "pitch_mm": self.pitch,
             "noise_mm": self.noise,
@@ -48,12 +55,21 @@ class PitchRow:
             "length": self.length,
             "expected": self.expected,
             "unrecognizable": [list(p) for p in self.unrecognizable],
+            "no_plan": self.no_plan,
         }
 
 
-def pitch_row(pfs: Sequence[PushFunction], pitch: float, noise: float) -> PitchRow:
-    """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix."""
+def pitch_row(
+    pfs: Sequence[PushFunction], pitch: float, noise: float, mix: StrongMix | None = None
+) -> PitchRow:
+    """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix
+    (for strong plans at ``mix``'s uncertainty when given)."""
     sensor = LedSensor(pitch, noise)
+    if mix is not None:
+        got = strong_pitch(mix, sensor)
+        if got.unrecognizable or got.no_plan is not None:
+            return PitchRow(pitch, noise, got.unrecognizable, no_plan=got.no_plan)
+        return PitchRow(pitch, noise, (), got.length, got.expected)
     bad = tuple((w.part_a, w.part_b) for w in unrecognizable_pairs(list(pfs), sensor))
     if bad:
         return PitchRow(pitch, noise, bad)
@@ -62,10 +78,14 @@ def pitch_row(pfs: Sequence[PushFunction], pitch: float, noise: float) -> PitchR
 
 
 def pitch_rows(
-    pfs: Sequence[PushFunction], pitches: Sequence[float], noise: float
+    pfs: Sequence[PushFunction],
+    pitches: Sequence[float],
+    noise: float,
+    mix: StrongMix | None = None,
 ) -> tuple[PitchRow, ...]:
-    """Every pitch of the list, ascending, each decided on its own."""
-    return tuple(pitch_row(pfs, p, noise) for p in sorted(set(pitches)))
+    """Every pitch of the list, ascending, each decided on its own (for strong plans at
+    ``mix``'s uncertainty when given, else on the ideal model)."""
+    return tuple(pitch_row(pfs, p, noise, mix) for p in sorted(set(pitches)))
 
 
 def parse_pitches(text: str) -> tuple[float, ...]:

@@ -48,16 +48,23 @@ def _tolerance(ax, design: ToleranceDesign) -> None:
                 transform=ax.transAxes)  # fmt: skip
         return
     top = steps[-1].hi if steps[-1].hi is not None else 2.0 * steps[-1].lo
-    for k, s in enumerate(steps):
+    drawn = False
+    for s in steps:
         hi = s.hi if s.hi is not None else top
-        ax.hlines(s.length, s.lo, hi, colors="C0", label="length (worst case)" if k == 0 else None)
+        if s.length is None or s.expected is None:  # no strong plan on this step
+            ax.axvspan(s.lo, hi, color="C3", alpha=0.15, label="no strong plan")
+            continue
+        ax.hlines(s.length, s.lo, hi, colors="C0", label=None if drawn else "length (worst case)")
         ax.plot([hi], [s.length], "o", color="C0")  # the closed right end
-        ax.plot([hi], [s.expected], "x", color="C1", label="expected, at the step's end"
-                if k == 0 else None)  # fmt: skip
+        ax.plot([hi], [s.expected], "x", color="C1", label=None if drawn else
+                "expected, at the step's end")  # fmt: skip
+        drawn = True
     x = design.critical_tolerance
     if x is not None:
         ax.axvline(x, color="C3", linestyle="--", label=f"critical tolerance {x:.4g} mm")
-    ax.set_xlabel("sensor tolerance (mm)")
+    u = design.uncertainty
+    ax.set_xlabel("sensor tolerance (mm)" + ("" if u.is_ideal else
+                  f"; strong plans, rotation error {u.rotation_error_deg:g} deg"))  # fmt: skip
     ax.set_title("optimal plan length by sensor tolerance (" + ", ".join(design.parts[:4])
                  + (", ..." if len(design.parts) > 4 else "") + ")")  # fmt: skip
 

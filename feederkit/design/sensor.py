@@ -3,9 +3,9 @@
 For a tolerance sensor: every pair's exact critical tolerance and the mix's (the largest
 tolerance at which it is recognizable, section 8.5 and Theorem 9), and the optimal plan
 length as a step function of the tolerance up to it. For an LED array: the same, pitch by
-pitch. Figures are for the ideal model (no rotation error); the cell's rotation error is
-carried to the output so a strong-plan model can be applied later (design.md,
-"Uncertainty").
+pitch. Every figure is for strong plans at the declared uncertainty (design.md,
+"Uncertainty"; :mod:`feederkit.design.strong`); with all three bounds zero it is the ideal
+model, decided by :mod:`feederkit.design.critical` and :mod:`feederkit.design.steps`.
 """
 
 from __future__ import annotations
@@ -17,10 +17,30 @@ from typing import Any
 from feederkit.design.critical import MixCritical, PairCritical, mix_critical_tolerance
 from feederkit.design.pitches import PitchRow, pitch_rows
 from feederkit.design.steps import BREAKPOINT_REL_EPS, LengthStep, length_steps
+from feederkit.design.strong import (
+    StrongMix,
+    strong_length_steps,
+    strong_mix_critical,
+    uncertainty_words,
+)
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 MODEL_NOTE = "ideal model: plans assume no rotation error"
+"""The model note of the ideal model (all three bounds zero)."""
+
+
+def model_note(uncertainty: Uncertainty) -> str:
+    """Which model the figures are for, in words."""
+    if uncertainty.is_ideal:
+        return MODEL_NOTE
+    return f"strong plans at the declared uncertainty ({uncertainty_words(uncertainty)})"
+
+
+def uncertainty_dict(uncertainty: Uncertainty) -> dict[str, object]:
+    """The output's ``uncertainty``: design.md's three bounds, applied to every figure."""
+    return {**uncertainty.to_dict(), "applied": True}
 
 
 def _check_mix(pfs: Sequence[PushFunction]) -> None:
@@ -43,17 +63,37 @@ def _pairs_words(pairs: Sequence[PairCritical], limit: int = 5) -> str:
 
 @dataclass(frozen=True)
 class ToleranceDesign:
-    """The critical tolerances of a mix and its plan length's steps up to the mix's."""
+    """The critical tolerances of a mix and its plan length's steps up to the mix's, at the
+    declared ``uncertainty``."""
 
     parts: tuple[str, ...]
     critical: MixCritical
     steps: tuple[LengthStep, ...]
-    rotation_error_deg: float = 0.0
+    uncertainty: Uncertainty = IDEAL
+
+    @property
+    def plan_limit(self) -> LengthStep | None:
+        """The first step below the pairs' critical tolerance where the plan does not
+        recognize the mix (no strong plan there, or one that lists two parts together):
+        the mix is recognizable only up to its start. None when there is no such step."""
+        x = self.critical.critical_tolerance
+        if x is None:
+            return None
+        top = x * (1.0 - BREAKPOINT_REL_EPS)
+        return next((s for s in self.steps if s.lo < top and not s.recognizable), None)
 
     @property
     def critical_tolerance(self) -> float | None:
-        """The largest tolerance (mm) at which the mix is recognizable; None: no tolerance."""
-        return self.critical.critical_tolerance
+        """The largest tolerance (mm) up to which the mix is recognizable; None: none.
+
+        The pairs' (every pair distinguishable, section 8.5), lowered to the start of
+        :attr:`plan_limit` when strong plans fail below it (docs/design.md).
+        """
+        x = self.critical.critical_tolerance
+        limit = self.plan_limit
+        if x is None or limit is None:
+            return x
+        return limit.lo if limit.lo > 0.0 else None
 
     @property
     def recognizable(self) -> bool:
@@ -68,22 +108,34 @@ class ToleranceDesign:
                 return s
         return None
 
+    def _model_words(self) -> str:
+        u = self.uncertainty
+        return "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+
     def answer(self) -> str:
-        """The design in one line."""
+        """The design in one line, naming the uncertainty it is for."""
         x = self.critical_tolerance
         if x is None:
-            return "no tolerance makes this mix recognizable: no sensor separates " + _pairs_words(
-                self.critical.inseparable
+            limit = self.plan_limit
+            if self.critical.inseparable or limit is None:
+                text = "no tolerance makes this mix recognizable: no sensor separates "
+                return text + _pairs_words(self.critical.inseparable) + self._model_words()
+            where = "at any tolerance" if limit.hi is None else f"up to {limit.hi:.6g} mm"
+            return (
+                f"no tolerance makes this mix recognizable: {_limit_words(limit)} {where}"
+                + self._model_words()
             )
         step = self.step_at(x)
         text = f"this mix is recognizable with a tolerance up to {x:.6g} mm"
-        if step is not None:
+        if step is not None and step.length is not None and step.expected is not None:
             text += (
                 f"; with it the plan takes {step.length} operations (expected {step.expected:.4g})"
             )
         elif self.steps and self.steps[-1].hi is not None:
             text += f" (plan lengths tabulated up to {self.steps[-1].hi:.6g} mm only)"
-        return text
+        if self.plan_limit is not None:
+            text += "; above it " + _limit_words(self.plan_limit)
+        return text + self._model_words()
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON of ``design sensor --json`` for a tolerance sensor (docs/design.md)."""
@@ -93,29 +145,45 @@ class ToleranceDesign:
             "critical_tolerance_mm": self.critical_tolerance,
             "pairs": [p.to_dict() for p in self.critical.pairs],
             "lengths": [s.to_dict() for s in self.steps],
-            "uncertainty": {"rotation_error_deg": self.rotation_error_deg, "applied": False},
-            "model": MODEL_NOTE,
+            "uncertainty": uncertainty_dict(self.uncertainty),
+            "model": model_note(self.uncertainty),
             "answer": self.answer(),
         }
+
+
+def _uncertainty(uncertainty: Uncertainty | None) -> Uncertainty:
+    if uncertainty is None:
+        return IDEAL
+    if not isinstance(uncertainty, Uncertainty):
+        raise InputError(f"the uncertainty must be an Uncertainty, got {uncertainty!r}")
+    return uncertainty
 
 
 def design_tolerance(
     pfs: Sequence[PushFunction],
     *,
     max_tolerance: float | None = None,
-    rotation_error_deg: float = 0.0,
+    uncertainty: Uncertainty | None = None,
 ) -> ToleranceDesign:
-    """Critical tolerances and length steps; the steps reach the mix's critical tolerance,
-    or ``max_tolerance`` (mm) when given (beyond the critical one the mix is not recognized,
-    its plans end in results that name several parts)."""
+    """Critical tolerances and length steps at ``uncertainty`` (default the ideal model);
+    the steps reach the mix's critical tolerance, or ``max_tolerance`` (mm) when given
+    (beyond the critical one the mix is not recognized, its plans end in results that name
+    several parts). InputError for a shape tolerance too large for a part."""
     _check_mix(pfs)
     if max_tolerance is not None and not max_tolerance > 0.0:
         raise InputError(f"--max-tolerance must be a positive number of mm, got {max_tolerance}")
-    critical = mix_critical_tolerance(pfs)
-    up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
-    steps = length_steps(pfs, up_to, critical=critical) if up_to is not None else ()
+    unc = _uncertainty(uncertainty)
     names = tuple(pf.part.name for pf in pfs)
-    return ToleranceDesign(names, critical, steps, rotation_error_deg)
+    if unc.is_ideal:
+        critical = mix_critical_tolerance(pfs)
+        up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
+        steps = length_steps(pfs, up_to, critical=critical) if up_to is not None else ()
+        return ToleranceDesign(names, critical, steps, unc)
+    mix = StrongMix(pfs, unc)
+    critical = strong_mix_critical(mix)
+    up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
+    steps = strong_length_steps(mix, up_to, critical) if up_to is not None else ()
+    return ToleranceDesign(names, critical, steps, unc)
 
 
 @dataclass(frozen=True)
@@ -126,7 +194,7 @@ class PitchDesign:
     noise: float
     rows: tuple[PitchRow, ...]
     critical: MixCritical
-    rotation_error_deg: float = 0.0
+    uncertainty: Uncertainty = IDEAL
 
     @property
     def critical_pitch(self) -> float | None:
@@ -139,23 +207,29 @@ class PitchDesign:
         """Whether some pitch of the list makes the mix recognizable."""
         return self.critical_pitch is not None
 
+    def _model_words(self) -> str:
+        u = self.uncertainty
+        return "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+
     def answer(self) -> str:
-        """The design in one line."""
+        """The design in one line, naming the uncertainty it is for."""
         y = self.critical_pitch
         if y is None:
             text = "no LED pitch in the list makes this mix recognizable"
+            worst = sorted({p for r in self.rows for p in r.unrecognizable})
             if self.critical.inseparable:
                 text += ": no sensor separates " + _pairs_words(self.critical.inseparable)
-            else:
-                worst = sorted({p for r in self.rows for p in r.unrecognizable})
+            elif worst:
                 text += ": it cannot tell apart " + ", ".join(f"{a} and {b}" for a, b in worst[:5])
                 text += "; try finer pitches"
-            return text
+            else:
+                text += ": no strong plan exists with any of them"
+            return text + self._model_words()
         row = next(r for r in self.rows if r.pitch == y)
         return (
             f"this mix is recognizable with an LED pitch of {y:.6g} mm "
             f"(noise {self.noise:.6g} mm); with it the plan takes {row.length} operations "
-            f"(expected {row.expected:.4g})"
+            f"(expected {row.expected:.4g})" + self._model_words()
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -168,8 +242,8 @@ class PitchDesign:
             "pitches": [r.to_dict() for r in self.rows],
             "critical_tolerance_mm": self.critical.critical_tolerance,
             "pairs": [p.to_dict() for p in self.critical.pairs],
-            "uncertainty": {"rotation_error_deg": self.rotation_error_deg, "applied": False},
-            "model": MODEL_NOTE,
+            "uncertainty": uncertainty_dict(self.uncertainty),
+            "model": model_note(self.uncertainty),
             "answer": self.answer(),
         }
 
@@ -179,25 +253,42 @@ def design_pitches(
     pitches: Sequence[float],
     *,
     noise: float = 0.0,
-    rotation_error_deg: float = 0.0,
+    uncertainty: Uncertainty | None = None,
 ) -> PitchDesign:
-    """Each pitch decided on its own (:mod:`feederkit.design.pitches`), and the pairs' exact
-    critical tolerances, which name the pairs no sensor can separate."""
+    """Each pitch decided on its own at ``uncertainty`` (default the ideal model;
+    :mod:`feederkit.design.pitches`), and the pairs' exact critical tolerances, which name
+    the pairs no sensor can separate."""
     _check_mix(pfs)
     if not pitches:
         raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5")
     if noise < 0.0:
         raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
-    rows = pitch_rows(pfs, pitches, noise)
+    unc = _uncertainty(uncertainty)
     names = tuple(pf.part.name for pf in pfs)
-    return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs), rotation_error_deg)
+    if unc.is_ideal:
+        rows = pitch_rows(pfs, pitches, noise)
+        return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs), unc)
+    mix = StrongMix(pfs, unc)
+    rows = pitch_rows(pfs, pitches, noise, mix=mix)
+    return PitchDesign(names, noise, rows, strong_mix_critical(mix), unc)
 
 
 def report_design(
-    pfs: Sequence[PushFunction], rotation_error_deg: float = 0.0
+    pfs: Sequence[PushFunction], uncertainty: Uncertainty | float | None = None
 ) -> dict[str, Any] | None:
-    """The sensor design a changeover report shows (``ToleranceDesign.to_dict``), or None for
-    a single part (nothing to tell apart)."""
+    """The sensor design a changeover report shows (``ToleranceDesign.to_dict``) at the
+    changeover's ``uncertainty`` (its plan file's; a number is a rotation error in degrees
+    with exact shapes; None the ideal model), or None for a single part (nothing to tell
+    apart)."""
     if len(pfs) < 2:
         return None
-    return design_tolerance(list(pfs), rotation_error_deg=rotation_error_deg).to_dict()
+    if isinstance(uncertainty, int | float):
+        uncertainty = Uncertainty(float(uncertainty), 0.0, 0.0)
+    return design_tolerance(list(pfs), uncertainty=uncertainty).to_dict()
+
+
+def _limit_words(step: LengthStep) -> str:
+    """Why a step's plan does not recognize the mix."""
+    if step.length is None:
+        return "no strong plan exists"
+    return "the strong plan lists states of two parts together"

@@ -25,8 +25,9 @@ Under a declared rotation error (strong plans) the same argument holds for the p
 states' reading intervals ``(lo - e, hi + e)`` (the outcome sets do not depend on the
 sensor), provided the goal is the same at both tolerances: bisimilar pairs and the lumped
 near-symmetric pairs (docs/planning.md, "Strong plans") are decided with the sensor, so a
-strong-plan table must also split its segments where they change. This table is for the
-ideal model.
+strong-plan table also splits its segments where they change. This module is the ideal
+model's table; :mod:`feederkit.design.strong` builds the strong one from the same search
+(:func:`_segment_runs`).
 
 The search: within a segment, the length at the first interval is proven by the planner's
 own AND/OR oracle (:class:`LengthOracle`, no plan tree built); then, for a known length
@@ -49,6 +50,7 @@ import bisect
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 from feederkit.design.critical import (
     MixCritical,
@@ -79,13 +81,14 @@ class LengthStep:
 
     ``expected``: the expected number of operations of the optimal plan at ``hi`` (at twice
     ``lo`` when unbounded). ``recognizable``: whether the mix is recognizable there (else
-    the plan's results lump parts that no plan can tell apart at these tolerances).
+    the plan's results lump parts that no plan can tell apart at these tolerances). Under a
+    declared uncertainty ``length`` and ``expected`` are None where no strong plan exists.
     """
 
     lo: float
     hi: float | None
-    length: int
-    expected: float
+    length: int | None
+    expected: float | None
     recognizable: bool = True
 
     def to_dict(self) -> dict[str, object]:
@@ -100,10 +103,13 @@ class LengthStep:
 
 @dataclass(frozen=True)
 class Evaluation:
-    """The optimal plan's worst-case and expected number of operations at one tolerance."""
+    """The optimal plan's worst-case and expected number of operations at one tolerance;
+    ``mixes_parts``: its results list states of two parts together (lumped pairs of a strong
+    plan), so it does not recognize the mix."""
 
     length: int
     expected: float
+    mixes_parts: bool = False
 
 
 def mix_breakpoints(pfs: Sequence[PushFunction]) -> tuple[float, ...]:
@@ -142,6 +148,15 @@ def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
     """The proven minimum worst-case length at ``tolerance`` mm, from a whole plan (the
     reference the tests hold :class:`LengthOracle` to)."""
     return plan(build_machine(list(pfs), ToleranceSensor(tolerance), uncertainty=IDEAL)).length
+
+
+class StrongOracle(Protocol):
+    """What the length search asks (:class:`LengthOracle`; the strong plans' one is
+    :class:`feederkit.design.strong.StrongLengthOracle`)."""
+
+    def length(self, tolerance: float) -> int | None: ...
+
+    def within(self, tolerance: float, length: int) -> bool: ...
 
 
 class LengthOracle:
@@ -190,6 +205,17 @@ class LengthOracle:
         return all(worst.within(r, length - 1) for r in roots)
 
 
+def recognizable_below(breaks: Sequence[float], critical: MixCritical) -> int:
+    """The first interval index at which the mix is no longer recognizable: interval ``k`` is
+    recognizable iff its right end is at most the mix's critical tolerance."""
+    mix_x = critical.critical_tolerance
+    if mix_x is None:
+        return 0
+    if math.isinf(mix_x):
+        return len(breaks) + 1
+    return _first_at_or_above(breaks, mix_x) + 1
+
+
 def length_steps(
     pfs: Sequence[PushFunction],
     up_to: float | None,
@@ -221,11 +247,7 @@ def length_steps(
         if p.critical_tolerance is not None and not math.isinf(p.critical_tolerance)
     }
     starts = sorted({0} | {c for c in changes if 0 < c <= last})
-    mix_x = critical.critical_tolerance
-    recognizable_below = (
-        0 if mix_x is None else len(breaks) + 1 if math.isinf(mix_x) else
-        _first_at_or_above(breaks, mix_x) + 1
-    )  # fmt: skip
+    below = recognizable_below(breaks, critical)
     fits: dict[tuple[int, int], bool] = {}
 
     def fit(k: int, length: int) -> bool:
@@ -244,7 +266,7 @@ def length_steps(
                 )
             lo = 0.0 if i == 0 else breaks[i - 1]
             hi = breaks[j] if j < len(breaks) else None
-            steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < recognizable_below))
+            steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < below))
     return tuple(steps)
 
 
@@ -252,7 +274,7 @@ def _segment_runs(
     first: int,
     j_last: int,
     breaks: Sequence[float],
-    oracle: LengthOracle,
+    oracle: LengthOracle | StrongOracle,
     fit: Callable[[int, int], bool],
     evaluate: Callable[[float], Evaluation],
 ) -> list[tuple[int, int, int, Evaluation]]:

@@ -1,0 +1,521 @@
+"""Sensor design under a declared uncertainty: the figures of strong plans (design.md,
+"Uncertainty"; docs/design.md).
+
+Under a rotation error, shape or COM tolerance the machine's states are physical resting
+states with diameter *intervals* ``[lo, hi]`` and their action ranges lead to outcome sets
+(:func:`feederkit.machine.build.build_machine`); none of that depends on the sensor. A
+tolerance sensor reads such a state anywhere in the open ``(lo - e, hi + e)``, so two states
+read alike iff ``max(lo_i - hi_j, lo_j - hi_i) < 2e``
+(:meth:`feederkit.sensors.ToleranceSensor.can_read_alike`): the relation changes exactly at
+the *breakpoints* ``e = max(lo_i - hi_j, lo_j - hi_i) / 2`` of the pairs whose intervals
+have a gap (for exact diameters ``|d_i - d_j| / 2``, the ideal model's). At a breakpoint the
+two still read apart.
+
+- Two parts are distinguishable by strong plans when some strong plan ends, for every
+  outcome and reading, in results that hold states of one part only (:func:`separable`).
+  A state of the one bisimilar to a state of the other (:mod:`feederkit.machine.inseparable`)
+  rules it out, but is not needed to: nature may keep two states apart, reading alike, by
+  picking outcomes without mirroring every run (such pairs are not bisimilar, and the
+  planner lumps them, docs/planning.md). So the pair test is the exact solvability of the
+  two parts' states of the mix machine (:func:`sub_machine`, with the mix's own intervals)
+  for the goal "one part". It is monotone in ``e`` (the goal does not depend on it, and a
+  strong plan at ``e`` works at every smaller tolerance: below), and the critical tolerance
+  is found by a binary search over the pair's breakpoints, as on the ideal model
+  (:mod:`feederkit.design.critical`).
+- The plan length is monotone in ``e`` while the planner's goal is the same
+  (:mod:`feederkit.design.steps`): the bisimilar pairs and, when no strong plan reaches
+  them, the lumped pairs no strong plan resolves (docs/planning.md, "Near-symmetric states
+  under uncertainty"). Both are monotone chains: bisimilarity grows with ``e``; with the
+  bisimilar goal fixed, a strong plan at ``e`` works at every smaller tolerance, so
+  solvability only fails and the unresolvable pairs only grow as ``e`` grows. Their
+  change points are found by bisection on equality (a chain equal at two intervals is
+  constant between them), first for the bisimilar relation, then for the whole goal within
+  each of its segments; the length search runs segment by segment. Where no strong plan
+  exists the step says so (length None) instead of a length.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+from feederkit.angles import ActionRange
+from feederkit.design.critical import (
+    MixCritical,
+    PairCritical,
+    interval_probe,
+    last_true,
+)
+from feederkit.design.steps import (
+    Evaluation,
+    LengthStep,
+    _first_at_or_above,
+    _segment_runs,
+    recognizable_below,
+)
+from feederkit.errors import CheckFailed
+from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
+from feederkit.machine.build import build_machine
+from feederkit.machine.inseparable import inseparable_masks
+from feederkit.mechanics.push import PushFunction
+from feederkit.mix.pairs import PairWitness, distinguishable
+from feederkit.planning.andor import WorstCase
+from feederkit.planning.api import FIRST_LIMIT, goal_relation, strong_plan_exists
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.lumping import kept_apart, try_lumping
+from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.options import Lumping
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.planning.reindex import by_diameter
+from feederkit.planning.solvable import unsolvable
+from feederkit.plans.make import make_plan
+from feederkit.sensors import NoSensor, Sensor, ToleranceSensor, span
+from feederkit.uncertainty import Uncertainty, check_for_part
+
+Span = tuple[float, float]
+
+
+def interval_gap(x: Span, y: Span) -> float:
+    """How far apart two diameter intervals are (negative or zero when they meet): they read
+    alike under a tolerance ``e`` iff the gap is below ``2e``."""
+    return max(x[0] - y[1], y[0] - x[1])
+
+
+def gap_breakpoints(spans_a: Sequence[Span], spans_b: Sequence[Span]) -> tuple[float, ...]:
+    """The sorted distinct ``gap / 2`` over the pairs of an interval of a and one of b whose
+    gap is positive: the tolerances at which their read-alike relation changes."""
+    return tuple(
+        sorted({g / 2.0 for x in spans_a for y in spans_b if (g := interval_gap(x, y)) > 0})
+    )
+
+
+def sub_machine(machine: PushAlignMachine, parts: Sequence[int]) -> PushAlignMachine:
+    """The states of ``parts`` (in that order of parts) of a mix machine, as a machine.
+
+    A part's outcomes are its own states, so the parts' states with their action maps
+    (outcome masks renumbered) are closed; intervals, weights and records stay the mix's.
+    """
+    keep = [i for p in parts for i, s in enumerate(machine.states) if s.part == p]
+    new = {old: k for k, old in enumerate(keep)}
+    part_of = {p: k for k, p in enumerate(parts)}
+
+    def moved(r: ActionRange | OutcomeRange) -> OutcomeRange:
+        out = 0
+        for t in members(_mask(r)):
+            out |= 1 << new[t]
+        return OutcomeRange(r.lo, r.hi, out)
+
+    states = tuple(replace(machine.states[i], part=part_of[machine.states[i].part]) for i in keep)
+    maps = tuple(tuple(moved(r) for r in machine.action_maps[i]) for i in keep)
+    return PushAlignMachine(
+        part_names=tuple(machine.part_names[p] for p in parts),
+        states=states,
+        action_maps=maps,
+        sensor=machine.sensor,
+        uncertainty=machine.uncertainty,
+    )
+
+
+def _mask(r: ActionRange | OutcomeRange) -> int:
+    return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
+
+
+class StrongMix:
+    """The mix machine at a declared uncertainty (built once, without a sensor) and its
+    two-part sub-machines, for the pair tests."""
+
+    def __init__(self, pfs: Sequence[PushFunction], uncertainty: Uncertainty) -> None:
+        for pf in pfs:
+            check_for_part(uncertainty, pf.part)
+        self.pfs = list(pfs)
+        self.uncertainty = uncertainty
+        self.machine = build_machine(self.pfs, NoSensor(), uncertainty)
+
+    def pair(self, a: int, b: int) -> PushAlignMachine:
+        """Parts ``a`` and ``b`` (states of a first) of the mix machine."""
+        return sub_machine(self.machine, (a, b))
+
+
+NO_STRONG_PLAN = "no strong plan exists at the declared uncertainty"
+
+STRONG_REASON = "no strong plan tells their resting states apart under {what}"
+
+
+def uncertainty_words(u: Uncertainty) -> str:
+    """The declared uncertainty in words (design.md's three bounds)."""
+    return (
+        f"rotation error {u.rotation_error_deg:g} deg, shape tolerance "
+        f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
+    )
+
+
+def bisimilar_cross_pairs(machine: PushAlignMachine, tolerance: float) -> list[tuple[int, int]]:
+    """The bisimilar (state of part 0, state of part 1) pairs of a two-part machine under a
+    tolerance sensor, as machine indices."""
+    masks = inseparable_masks(replace(machine, sensor=ToleranceSensor(tolerance)))
+    first = [i for i, s in enumerate(machine.states) if s.part == 0]
+    return [(i, j) for i in first for j in members(masks[i]) if machine.states[j].part == 1]
+
+
+def separable(machine: PushAlignMachine, tolerance: float) -> bool:
+    """Whether a strong plan tells the two parts of a two-part machine apart under a
+    tolerance sensor: one whose every result holds states of one part only.
+
+    Decided exactly (:func:`~feederkit.planning.solvable.unsolvable`) on the goal "every
+    pair of one part's states" (orienting each part is not asked); a bisimilar cross pair,
+    or one nature keeps apart (:func:`kept_cross_pairs`), answers no at once. Undecided
+    (more sets than the solver explores) counts as no, so a critical tolerance is never
+    overstated.
+    """
+    if bisimilar_cross_pairs(machine, tolerance):
+        return False
+    problem = _one_part_problem(machine, tolerance)
+    if kept_cross_pairs(problem):
+        return False
+    roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+    try:
+        bad = unsolvable(problem, roots, Deadline())
+    except Timeout:
+        return False
+    return bad is not None and not bad
+
+
+def _one_part_problem(machine: PushAlignMachine, tolerance: float) -> Problem:
+    """The two-part machine under a tolerance sensor, numbered by diameter, with the goal
+    "every pair of one part's states"."""
+    ordered, _old = by_diameter(replace(machine, sensor=ToleranceSensor(tolerance)))
+    part_mask = [0, 0]
+    for i, s in enumerate(ordered.states):
+        part_mask[s.part] |= 1 << i
+    goal = tuple(part_mask[s.part] for s in ordered.states)
+    return Problem(ordered, Grouping.EXACT, 0.0, goal)
+
+
+def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
+    """The cross pairs nature can keep apart for ever, reading alike
+    (:func:`~feederkit.planning.lumping.kept_apart`): when there is one, some first reading
+    holds both states of it, and no strong plan separates the parts (a cheap, sound no).
+    Monotone in the tolerance (a greatest fixpoint over read-alike pairs)."""
+    m = problem.machine
+    sensed = [s.sensed for s in m.states]
+    pairs = [
+        (i, j)
+        for i in range(m.n)
+        for j in range(i + 1, m.n)
+        if m.states[i].part != m.states[j].part and m.sensor.can_read_alike(sensed[i], sensed[j])
+    ]
+    return kept_apart(problem, pairs)
+
+
+def _no_kept_cross_pair(machine: PushAlignMachine, tolerance: float) -> bool:
+    return not bisimilar_cross_pairs(machine, tolerance) and not kept_cross_pairs(
+        _one_part_problem(machine, tolerance)
+    )
+
+
+def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
+    """The critical tolerance of parts ``a`` and ``b`` of the mix for strong plans: the
+    largest tolerance at which a strong plan tells them apart (:func:`separable`).
+
+    Binary search over the pair's breakpoints (the module docstring): separability is
+    monotone in the tolerance (a strong plan at one tolerance works at every smaller one,
+    its goal being the same, and bisimilar cross pairs only grow). The search first finds
+    the last interval without a bisimilar cross pair, then without a cross pair nature keeps
+    apart (both fixpoints over pairs, cheap, monotone and necessary), and solves there; only
+    when that fails does it search the intervals below with the solver.
+    """
+    m = mix.pair(a, b)
+    spans = [span(s.sensed) for s in m.states]
+    sa = [x for x, s in zip(spans, m.states, strict=True) if s.part == 0]
+    sb = [x for x, s in zip(spans, m.states, strict=True) if s.part == 1]
+    breaks = gap_breakpoints(sa, sb)
+    # Separable implies no bisimilar cross pair, which is cheap to test and monotone too:
+    # its last interval bounds the answer, and is most often the answer itself.
+    k = last_true(len(breaks), lambda k: not bisimilar_cross_pairs(m, breaks[k]))
+    if k >= 0 and not _no_kept_cross_pair(m, breaks[k]):
+        k = last_true(k, lambda k: _no_kept_cross_pair(m, breaks[k]))
+    if k >= 0 and not separable(m, breaks[k]):
+        k = last_true(k, lambda k: separable(m, breaks[k]))
+    pa, pb = mix.pfs[a], mix.pfs[b]
+    if k >= 0:
+        return PairCritical(pa.part.name, pb.part.name, breaks[k])
+    probe = interval_probe(breaks, 0)
+    pairs = bisimilar_cross_pairs(m, probe)
+    ideal = distinguishable(pa, pb, ToleranceSensor(probe), index_a=a, index_b=b)
+    if ideal is not None and ideal.kind == "same-push-diameter":
+        reason, kind = ideal.reason, ideal.kind
+    else:
+        reason = STRONG_REASON.format(what=uncertainty_words(mix.uncertainty))
+        kind = "uncertainty"
+    witness = PairWitness(
+        part_a=pa.part.name,
+        part_b=pb.part.name,
+        states_a=tuple(m.states[i].state for i, _ in pairs),
+        states_b=tuple(m.states[j].state for _, j in pairs),
+        reason=reason,
+        kind=kind,
+        index_a=a,
+        index_b=b,
+    )
+    return PairCritical(pa.part.name, pb.part.name, None, witness)
+
+
+def strong_mix_critical(mix: StrongMix) -> MixCritical:
+    """Every pair's critical tolerance for strong plans, in part order, and so the mix's."""
+    n = len(mix.pfs)
+    return MixCritical(
+        tuple(strong_pair_critical(mix, i, j) for i in range(n) for j in range(i + 1, n))
+    )
+
+
+Goal = tuple[int, ...] | None
+"""The planner's goal masks at one tolerance (None: no strong plan exists there)."""
+
+KEPT_SEARCHES = 4
+"""Searches (per tolerance: problem, oracle, roots) the strong oracle keeps."""
+
+
+class StrongLengthOracle:
+    """The planner's minimum worst-case length of a mix at any tolerance under a declared
+    uncertainty, without a plan tree, and the goal it plans for.
+
+    As :class:`feederkit.design.steps.LengthOracle`, on the uncertain machine (built and
+    numbered by diameter once; only the sensor changes): the goal is what
+    :func:`feederkit.planning.api.plan` uses with the default lumping, the bisimilar
+    relation, or, when no strong plan reaches it, the lumped goal of
+    :func:`~feederkit.planning.lumping.try_lumping` (None when neither has a strong plan).
+    """
+
+    def __init__(self, mix: StrongMix) -> None:
+        self.mix = mix
+        self.machine = mix.machine
+        self._sorted, _old = by_diameter(self.machine)
+        self._bisimilar: dict[float, tuple[int, ...]] = {}
+        self._goals: dict[float, Goal] = {}
+        self._searches: OrderedDict[
+            tuple[float, tuple[int, ...]], tuple[Problem, WorstCase, list[int]]
+        ] = OrderedDict()
+
+    def at(self, tolerance: float) -> PushAlignMachine:
+        """The sorted machine with a tolerance sensor of ``tolerance`` mm."""
+        return replace(self._sorted, sensor=ToleranceSensor(tolerance))
+
+    def bisimilar(self, tolerance: float) -> tuple[int, ...]:
+        """The bisimilar relation (masks, sorted numbering) at ``tolerance`` mm."""
+        if tolerance not in self._bisimilar:
+            self._bisimilar[tolerance] = goal_relation(self.at(tolerance), Deadline())
+        return self._bisimilar[tolerance]
+
+    def _problem(self, tolerance: float, goal: tuple[int, ...]):
+        key = (tolerance, goal)
+        found = self._searches.get(key)
+        if found is not None:
+            self._searches.move_to_end(key)
+            return found
+        problem = Problem(self.at(tolerance), Grouping.EXACT, 0.0, goal)
+        roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+        worst = make_oracle(problem, "auto", Deadline())
+        self._searches[key] = (problem, worst, roots)
+        while len(self._searches) > KEPT_SEARCHES:
+            self._searches.popitem(last=False)
+        return problem, worst, roots
+
+    def goal(self, tolerance: float) -> Goal:
+        """The planner's goal at ``tolerance`` mm (the class docstring)."""
+        if tolerance in self._goals:
+            return self._goals[tolerance]
+        base = self.bisimilar(tolerance)
+        problem, worst, roots = self._problem(tolerance, base)
+        goal: Goal = base
+        if not all(worst.within(r, FIRST_LIMIT - 1) for r in roots):
+            try:
+                bad = unsolvable(problem, roots, Deadline())
+            except Timeout:
+                bad = None
+            if bad:
+                tried = try_lumping(self.at(tolerance), Grouping.EXACT, Deadline(),
+                                    rule=Lumping.NEAR_SYMMETRIC)  # fmt: skip
+                goal = tried.goal.insep if tried.goal is not None else None
+        self._goals[tolerance] = goal
+        return goal
+
+    def length(self, tolerance: float) -> int | None:
+        """The minimum worst-case number of operations of a strong plan at ``tolerance`` mm
+        (as ``plan``'s), or None when there is none."""
+        goal = self.goal(tolerance)
+        if goal is None:
+            return None
+        problem, worst, roots = self._problem(tolerance, goal)
+        try:
+            lengths = root_lengths(problem, worst, roots, "auto", 4 * problem.n + 4)
+        except ValueError:
+            return None
+        return 1 + max(lengths.values(), default=0)
+
+    def within(self, tolerance: float, length: int) -> bool:
+        """Whether some strong plan at ``tolerance`` mm takes at most ``length`` operations."""
+        goal = self.goal(tolerance)
+        if goal is None or length < 1:
+            return False
+        _problem, worst, roots = self._problem(tolerance, goal)
+        return all(worst.within(r, length - 1) for r in roots)
+
+
+def machine_breakpoints(machine: PushAlignMachine) -> tuple[float, ...]:
+    """Where the read-alike relation of a machine's states (diameter intervals) changes."""
+    spans = [span(s.sensed) for s in machine.states]
+    return gap_breakpoints(spans, spans)
+
+
+def chain_changes(first: int, last: int, value: Callable[[int], object]) -> set[int]:
+    """Every ``k`` in ``(first, last]`` with ``value(k) != value(k - 1)``, for a ``value``
+    that is a monotone chain on ``first..last`` (equal at two intervals: constant between),
+    by bisection: ``O(changes * log(last - first))`` calls."""
+    out: set[int] = set()
+    stack = [(first, last)]
+    while stack:
+        lo, hi = stack.pop()
+        if hi <= lo or value(lo) == value(hi):
+            continue
+        if hi == lo + 1:
+            out.add(hi)
+            continue
+        mid = (lo + hi) // 2
+        stack.extend(((mid, hi), (lo, mid)))
+    return out
+
+
+def goal_segments(
+    oracle: StrongLengthOracle, breaks: Sequence[float], last: int
+) -> list[tuple[int, int]]:
+    """The runs ``(first, last)`` of intervals ``0..last`` with one goal each: the bisimilar
+    relation's segments, each split where the lumped goal changes (module docstring)."""
+
+    def probe(k: int) -> float:
+        return interval_probe(breaks, k)
+
+    cuts = sorted(chain_changes(0, last, lambda k: oracle.bisimilar(probe(k))))
+    starts = set([0, *cuts])
+    for s, e in zip([0, *cuts], [*(c - 1 for c in cuts), last], strict=True):
+        starts |= chain_changes(s, e, lambda k: oracle.goal(probe(k)))
+    ordered = sorted(starts)
+    return list(zip(ordered, [*(c - 1 for c in ordered[1:]), last], strict=True))
+
+
+def strong_evaluation(
+    pfs: Sequence[PushFunction], uncertainty: Uncertainty, tolerance: float
+) -> Evaluation:
+    """Length and expected length of the verified optimal strong plan at ``tolerance`` mm,
+    and whether it lists states of two parts together (then it does not recognize the mix)."""
+    sensor = ToleranceSensor(tolerance)
+    result = make_plan(list(pfs), sensor, uncertainty=uncertainty, certify=False).result
+    states = result.machine.states
+    mixed = any(states[i].part != states[j].part for i, j in result.lumped_pairs)
+    return Evaluation(result.length, result.expected_length, mixed)
+
+
+def strong_length_steps(
+    mix: StrongMix,
+    up_to: float | None,
+    critical: MixCritical,
+    oracle: StrongLengthOracle | None = None,
+    evaluate: Callable[[float], Evaluation] | None = None,
+) -> tuple[LengthStep, ...]:
+    """The strong plan length's steps over tolerances ``(0, up_to]`` (None: every interval),
+    as :func:`feederkit.design.steps.length_steps` on the ideal model, segment by segment of
+    constant goal; a segment with no strong plan is one step of length None."""
+    oracle = oracle or StrongLengthOracle(mix)
+    breaks = machine_breakpoints(oracle.machine)
+    evaluate = evaluate or (lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e))
+    last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
+    below = recognizable_below(breaks, critical)
+    fits: dict[tuple[int, int], bool] = {}
+
+    def fit(k: int, length: int) -> bool:
+        if (k, length) not in fits:
+            fits[k, length] = oracle.within(interval_probe(breaks, k), length)
+        return fits[k, length]
+
+    steps = []
+    for first, j_last in goal_segments(oracle, breaks, last):
+        lo = 0.0 if first == 0 else breaks[first - 1]
+        if oracle.goal(interval_probe(breaks, first)) is None:
+            hi = breaks[j_last] if j_last < len(breaks) else None
+            steps.append(LengthStep(lo, hi, None, None, False))
+            continue
+        for i, j, length, ev in _segment_runs(first, j_last, breaks, oracle, fit, evaluate):
+            if ev.length != length:
+                raise CheckFailed(
+                    f"the verified strong plan at {interval_probe(breaks, j):g} mm has length "
+                    f"{ev.length}, the search over tolerances found {length}"
+                )
+            lo = 0.0 if i == 0 else breaks[i - 1]
+            hi = breaks[j] if j < len(breaks) else None
+            ok = j < below and not ev.mixes_parts
+            steps.append(LengthStep(lo, hi, ev.length, ev.expected, ok))
+    return tuple(steps)
+
+
+@dataclass(frozen=True)
+class StrongPitch:
+    """One LED pitch under a declared uncertainty: the pairs of parts with bisimilar states,
+    and the verified strong plan's length and expected length (None: no strong plan)."""
+
+    unrecognizable: tuple[tuple[str, str], ...]
+    length: int | None
+    expected: float | None
+    no_plan: str | None = None
+
+
+def strong_pitch(mix: StrongMix, sensor: Sensor) -> StrongPitch:
+    """Decide one LED array (``sensor``) for strong plans: bisimilar cross pairs of the mix
+    machine, then (when there are none) a verified strong plan, whose results must not list
+    two parts together."""
+    machine = replace(mix.machine, sensor=sensor)
+    masks = inseparable_masks(machine)
+    states = machine.states
+    names = machine.part_names
+    bad = sorted(
+        {
+            (states[i].part, states[j].part)
+            for i in range(machine.n)
+            for j in members(masks[i])
+            if states[i].part < states[j].part
+        }
+    )
+    if bad:
+        return StrongPitch(tuple((names[a], names[b]) for a, b in bad), None, None)
+    if not strong_plan_exists(machine):
+        return StrongPitch((), None, None, NO_STRONG_PLAN)
+    result = make_plan(mix.pfs, sensor, uncertainty=mix.uncertainty, certify=False).result
+    rs = result.machine.states
+    lumped = sorted(
+        {
+            (min(rs[i].part, rs[j].part), max(rs[i].part, rs[j].part))
+            for i, j in result.lumped_pairs
+            if rs[i].part != rs[j].part
+        }
+    )
+    return StrongPitch(
+        tuple((names[a], names[b]) for a, b in lumped), result.length, result.expected_length
+    )
+
+
+__all__ = [
+    "StrongLengthOracle",
+    "StrongMix",
+    "StrongPitch",
+    "chain_changes",
+    "gap_breakpoints",
+    "goal_segments",
+    "interval_gap",
+    "machine_breakpoints",
+    "strong_evaluation",
+    "strong_length_steps",
+    "strong_mix_critical",
+    "strong_pair_critical",
+    "strong_pitch",
+    "sub_machine",
+]
