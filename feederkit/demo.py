@@ -33,6 +33,7 @@ from feederkit.mix.lookalike import build_lookalike
 from feederkit.plans.fileformat import plan_json
 from feederkit.plans.make import make_plan
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor
+from feederkit.uncertainty import Uncertainty
 
 PAPER_MIX = ("isosceles-right-triangle", "octagon")
 """Figs. 18 and 27: the parts the paper orients and recognizes with one plan."""
@@ -313,12 +314,12 @@ def _report(compiled: CompiledChangeover) -> str:
     from feederkit.design import report_design
     from feederkit.reports import render_report
 
-    rotation = (compiled.plan.get("uncertainty") or {}).get("rotation_error_deg", 0.0)
+    u = compiled.plan.get("uncertainty")
     return render_report(
         compiled.plan,
         unrecognizable=[w.to_dict() for w in compiled.witnesses],
         outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
-        design=report_design(compiled.parts, rotation),
+        design=report_design(compiled.parts, Uncertainty.from_dict(u) if u else None),
     )
 
 

@@ -327,6 +327,26 @@ def test_the_sensor_design_table_and_plot():
         render_report(triangle_plan(), design={"sensor_model": "magic"})
 
 
+def test_a_design_step_with_no_strong_plan_is_named_and_left_out_of_the_plot():
+    design = {
+        "sensor_model": "tolerance",
+        "critical_tolerance_mm": None,
+        "pairs": [],
+        "lengths": [
+            {"tolerance_mm": [0.0, 0.25], "length": None, "expected": None},
+            {"tolerance_mm": [0.25, 0.5], "length": 3, "expected": 2.25},
+        ],
+        "answer": "no tolerance makes this mix recognizable",
+    }
+    doc = parse(render_report(triangle_plan(), design=design))
+    assert "no strong plan" in "".join(doc.text)
+    lines = [a for t, a in doc.tags if t == "line" and a.get("stroke") == "#0072b2"]
+    assert len(lines) == 1  # the step with a plan only
+    design["lengths"] = design["lengths"][:1]
+    doc = parse(render_report(triangle_plan(), design=design))
+    assert not [a for t, a in doc.tags if t == "svg" and "design-plot" in a.get("class", "")]
+
+
 def test_per_part_section_has_a_state_table_and_an_embedded_plot():
     doc = parse(render_report(rectangle_plan()))
     assert len(doc.with_class("stable-state")) == 4

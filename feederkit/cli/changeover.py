@@ -81,6 +81,7 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import plan_json
+from feederkit.uncertainty import Uncertainty
 
 changeover_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -195,8 +196,8 @@ def changeover_report(
     from feederkit.design import report_design
     from feederkit.reports import render_report
 
-    rotation = (plan.get("uncertainty") or {}).get("rotation_error_deg", 0.0)
-    design = report_design(pfs, rotation)
+    u = plan.get("uncertainty")
+    design = report_design(pfs, Uncertainty.from_dict(u) if u else None)
     return render_report(
         plan,
         unrecognizable=[w.to_dict() for w in witnesses],

@@ -74,11 +74,15 @@ def _pairs_table(pairs: Sequence[Mapping[str, Any]]) -> str:
     )
 
 
-def _steps_table(rows: Sequence[tuple[float, float | None, int, float]]) -> str:
+def _steps_table(rows: Sequence[tuple[float, float | None, int | None, float | None]]) -> str:
     body = "".join(
         f"<tr><td>{num(lo, 6)} &lt; tolerance &le; "
         f"{'&infin;' if hi is None else num(hi, 6)} mm</td>"
-        f"<td>{length}</td><td>{num(expected, 4)}</td></tr>"
+        + (
+            '<td colspan="2">no strong plan</td></tr>'
+            if length is None
+            else f"<td>{length}</td><td>{num(expected, 4)}</td></tr>"
+        )
         for lo, hi, length, expected in rows
     )
     return (
@@ -106,10 +110,12 @@ def _pitch_table(rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def _step_plot(
-    rows: Sequence[tuple[float, float | None, int, float]], critical: float | None
+    rows: Sequence[tuple[float, float | None, int | None, float | None]], critical: float | None
 ) -> str:
     """Plan length (y) against tolerance (x) as an SVG step plot; the critical tolerance as
-    a dashed line."""
+    a dashed line. Steps with no strong plan are left out of the plot (the table names
+    them)."""
+    rows = [r for r in rows if r[2] is not None]
     if not rows:
         return ""
     ends = [hi for _lo, hi, _n, _e in rows if hi is not None]
