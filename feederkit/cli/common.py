@@ -39,6 +39,7 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import plan_json
 from feederkit.sensors import Sensor, make_sensor
 from feederkit.uncertainty import Uncertainty
+from feederkit.words import plural
 
 console = Console()
 err_console = Console(stderr=True)
@@ -203,14 +204,6 @@ FLAG_TERMS = (
 )
 """The library's words for what a command-line flag sets: a library message that names one
 is shown with the flag."""
-
-
-def plural(n: int, word: str, many: str | None = None) -> str:
-    """``n`` and the noun in the number it takes: ``1 part``, ``2 parts``, ``0 parts``;
-    ``many`` is the plural when it is not ``word + "s"`` (``1 vertex``, ``3 vertices``).
-
-    Every count printed for people goes through here, so no line reads "1 operations"."""
-    return f"{n} {word if n == 1 else (many or word + 's')}"
 
 
 def add_name_column(table: Table, header: str, **kwargs: Any) -> None:

@@ -39,6 +39,7 @@ from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import solve, unsolvable
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.tree import Leaf, PlanResult, Step
+from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
 """With a time limit, the share of it kept for finding some plan when the exact search fails."""
@@ -479,7 +480,7 @@ def _fallback(
         reason = exc.reason if exc.reason == "memory" else stop.reason
         raise PlanningError(
             f"no plan found within {_out_of_budget(options, reason)} "
-            f"(a plan needs at least {lower} operations)"
+            f"(a plan needs at least {plural(lower, 'operation')})"
         ) from None
     return root, False, None, lower, TIES_NONE
 

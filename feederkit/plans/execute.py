@@ -20,6 +20,7 @@ from feederkit.mechanics.push import StableState, push, rotation_after
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, ResultEntry, Step, member_label, push_function_of
 from feederkit.sensors import Sensor
+from feederkit.words import plural
 
 ReadingChoice = Literal["nominal", "low", "high"] | Sequence[float | None]
 
@@ -145,10 +146,6 @@ def entry_dict(e: ResultEntry) -> dict[str, Any]:
     return out
 
 
-def _ops(k: int) -> str:
-    return f"{k} operation" if k == 1 else f"{k} operations"
-
-
 def leaf_entries(leaf: Leaf) -> tuple[tuple[str, int, float], ...]:
     """A leaf's entries as ``(part, state, pose_deg)``."""
     return tuple((e.part, e.state, e.pose_deg) for e in leaf.results)
@@ -199,22 +196,23 @@ def finish(
         return Trace(name, start, steps, state.id, state.pose_deg, (), False, msg, landing=landing)
     result = leaf.results
     ok = leaf.accepts(name, state.id, landing)
+    ops = plural(len(steps), "operation")
     if ok and leaf.reject:
         side = "" if landing is None else f" (landing {landing})"
         msg = (
-            f"{head}: reject{side} after {_ops(len(steps))}, resting in state {state.id} "
+            f"{head}: reject{side} after {ops}, resting in state {state.id} "
             f"(edge {state.edge}): the next station cannot take it; recirculate or re-drop"
         )
     elif ok:
         msg = (
-            f"{head}: oriented in {_ops(len(steps))}, state {state.id} (edge {state.edge}), "
+            f"{head}: oriented in {ops}, state {state.id} (edge {state.edge}), "
             f"pose {state.pose_deg:.6g} deg"
         )
     else:
         listed = ", ".join(entry_text(e) for e in result)
         said = "rejects" if leaf.reject else "says"
         msg = (
-            f"{head}: ends in state {state.id} (edge {state.edge}) after {_ops(len(steps))}, "
+            f"{head}: ends in state {state.id} (edge {state.edge}) after {ops}, "
             f"but the plan's result {said} {listed} [{path_text(steps)}]"
         )
     return Trace(

@@ -56,6 +56,7 @@ from feederkit.plans.model import (
 )
 from feederkit.sensors import Grouping, Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty, max_shape_tolerance
+from feederkit.words import plural
 
 if TYPE_CHECKING:
     from feederkit.machine import PushAlignMachine
@@ -268,7 +269,7 @@ def plan_from_result(
     root = _tree(result, parts, members)
     size = file_nodes(root)
     if size > MAX_FILE_NODES:
-        found = f"the plan found ({result.length} operations"
+        found = f"the plan found ({plural(result.length, 'operation')}"
         if not result.optimal:
             found += f", not proven optimal; a plan needs at least {result.lower_bound}"
         raise PlanningError(

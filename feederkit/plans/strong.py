@@ -50,6 +50,7 @@ from feederkit.plans.verify import PartCheck, VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
+from feederkit.words import plural
 
 MAX_ROTATION_ERROR_DEG = 90.0
 """The certificate of a plan with no rotation: every error design.md allows (below 90)."""
@@ -301,7 +302,7 @@ def verify_strong(
     if overall != stated:
         raise CheckFailed(
             f"the plan's length is {stated}, but its worst path under the declared uncertainty "
-            f"takes {overall} operations"
+            f"takes {plural(overall, 'operation')}"
         )
     clash = reject_clash(plan)
     if clash is not None:

@@ -38,6 +38,7 @@ from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, Step, member_label, push_function_of
 from feederkit.sensors import Sensor
+from feederkit.words import plural
 
 ANGLE_EPS_DEG = 1e-7
 """An overlap range is taken this much inside its ends (deg): the planner's ranges end exactly
@@ -457,8 +458,8 @@ def verify_plan(
             check, failed = _PartSearch(plan, p).run()
             if check.worst_operations > length:
                 problems.append(
-                    f"part {check.part!r}: a run takes {check.worst_operations} operations, but "
-                    f"the plan's length is {length}"
+                    f"part {check.part!r}: a run takes "
+                    f"{plural(check.worst_operations, 'operation')}, but the plan's length is {length}"
                 )
             checks.append(check)
             failures += failed
