@@ -459,7 +459,8 @@ def verify_plan(
             if check.worst_operations > length:
                 problems.append(
                     f"part {check.part!r}: a run takes "
-                    f"{plural(check.worst_operations, 'operation')}, but the plan's length is {length}"
+                    f"{plural(check.worst_operations, 'operation')}, "
+                    f"but the plan's length is {length}"
                 )
             checks.append(check)
             failures += failed
