@@ -116,8 +116,25 @@ def max_shape_tolerance(part: Part) -> float:
     return smallest_hull_edge(part) / 2.0
 
 
+def com_clearance(part: Part) -> float:
+    """Distance (mm) from the part's COM to its hull's boundary: the bound on the COM
+    tolerance (a COM displaced that far could leave the part, which no real part does).
+
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> round(com_clearance(make_part(make_outline("sq", [(0, 0), (4, 0), (4, 4), (0, 4)]))), 9)
+    2.0
+    """
+    h = np.asarray(part.hull, dtype=float)
+    d = np.roll(h, -1, axis=0) - h
+    c = np.asarray(part.com, dtype=float) - h
+    cross = np.abs(d[:, 0] * c[:, 1] - d[:, 1] * c[:, 0])
+    return float((cross / np.hypot(d[:, 0], d[:, 1])).min())
+
+
 def check_for_part(unc: Uncertainty, part: Part) -> Uncertainty:
-    """Return ``unc`` if its shape tolerance is below half ``part``'s smallest hull edge.
+    """Return ``unc`` if its shape tolerance is below half ``part``'s smallest hull edge and
+    its COM tolerance below the COM's distance to the hull's boundary.
 
     Raises InputError naming the part and both lengths otherwise.
     """
@@ -127,6 +144,12 @@ def check_for_part(unc: Uncertainty, part: Part) -> Uncertainty:
             f"{part.name}: shape tolerance {unc.shape_tolerance_mm:g} mm must be below half the "
             f"smallest hull edge ({limit:.4g} mm)"
         )
+    clearance = com_clearance(part)
+    if unc.com_tolerance_mm >= clearance:
+        raise InputError(
+            f"{part.name}: COM tolerance {unc.com_tolerance_mm:g} mm must be below the COM's "
+            f"distance to the hull's boundary ({clearance:.4g} mm)"
+        )
     return unc
 
 
@@ -135,6 +158,7 @@ __all__ = [
     "IDEAL",
     "Uncertainty",
     "check_for_part",
+    "com_clearance",
     "max_shape_tolerance",
     "smallest_hull_edge",
 ]

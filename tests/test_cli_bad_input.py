@@ -27,6 +27,8 @@ CASES = [
     ["plan", PART, "--noise", "0.1"],
     ["plan", PART, "--rotation-error", "200"],
     ["plan", PART, "--shape-tolerance", "-1"],
+    ["plan", PART, "--shape-tolerance", "1e9"],
+    ["plan", PART, "--com-tolerance", "1e9"],
     ["plan", PART, "--landings", "sideways"],
     ["plan", PART, "--accept", "pose-9"],
     ["plan", PART, "--objective", "fastest"],

@@ -66,6 +66,7 @@ from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label
+from feederkit.uncertainty import check_for_part
 
 
 def pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -> str:
@@ -219,6 +220,9 @@ def plan_command(
         which = "all" if landings in (None, "all") else landing_names(landings)
         found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
     loaded = found.parts
+    with flag_words(terms):  # bad input: one line, before any warning about the parts
+        for part in [pf.part for pf in loaded.push_functions] + [x.part for x in found.all]:
+            check_for_part(uncertainty, part)
     planned: LandingPlan | None = None
     if not plans_over_landings(found.landings, landings is not None, accept is not None):
         print_warnings(loaded.warnings)
