@@ -459,3 +459,16 @@ def test_a_hard_part_with_a_sensor_gets_a_plan_within_its_limit():
     # The same plan through make_plan: verified on the model (every start and reading).
     made = make_plan([pf], sensor, PlanningOptions(time_limit_s=10.0), uncertainty=IDEAL)
     assert made.report.ok
+
+
+def test_a_plan_that_meets_its_proven_bound_is_optimal_however_it_was_found():
+    from feederkit.planning.api import _result
+
+    pf = _hull_of_random_points(50, 3)
+    machine = build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL)
+    exact = plan(machine)
+    found = _result(machine, exact.root, False, None, exact.length, "worst", "exact")
+    assert found.optimal and found.lower_bound == exact.length
+    # One operation short of the bound proves nothing; the expected objective neither.
+    assert not _result(machine, exact.root, False, None, exact.length - 1, "worst", "e").optimal
+    assert not _result(machine, exact.root, False, None, exact.length, "expected", "e").optimal

@@ -599,10 +599,15 @@ def _proven(worst: WorstCase, mask: int) -> int:
 def _result(
     machine, root: Step, optimal: bool, length: int | None, lower: int, objective, grouping
 ) -> PlanResult:
-    """The result with its statistics; ``length`` (when given) must be the tree's own."""
+    """The result with its statistics; ``length`` (when given) must be the tree's own.
+
+    A plan that meets its proven lower bound is optimal for the ``worst`` objective however
+    it was found (a time-limited search may stop with one)."""
     real = tree_length(root)
     if length is not None and real != length:
         raise AssertionError(f"plan length {real} differs from the proven optimum {length}")
+    if objective == "worst" and real <= lower:
+        optimal = True
     return PlanResult(
         machine=machine,
         root=root,
