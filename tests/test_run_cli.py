@@ -61,6 +61,17 @@ def test_corrupted_action_fails_all(tri, capsys):
     assert "the plan failed" in err
 
 
+def test_a_failed_strong_check_shows_no_table_of_zero_counts(tri, capsys):
+    src, plan = tri  # a strong plan (rotation error 1 degree by default)
+    _corrupt(plan, lambda d: d["root"]["branches"][1]["next"].update(action_deg=0.0))
+    assert main(["run", str(plan), src, "--all"]) == 1
+    out = capsys.readouterr().out
+    assert "starts" not in out and "declared uncertainty" in out
+    assert main(["run", str(plan), src, "--all", "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert not report["ok"] and report["parts"] == [] and report["problems"]
+
+
 def test_corrupted_interval_stops_the_run(tri, capsys):
     src, plan = tri
     _corrupt(plan, lambda d: d["root"]["branches"][0].update(reading=[0.8, 0.9]))

@@ -94,7 +94,8 @@ def run_command(
         if json_out:
             print_json({**report.to_dict(), **_declared(plan), "warnings": warnings})
         else:
-            console.print(verification_table(report, plan))
+            if report.parts:  # a failed strong check has no counts, only its first problem
+                console.print(verification_table(report, plan))
             if report.ok:
                 rejects = sum(p.rejects for p in report.parts)
                 tail = ""

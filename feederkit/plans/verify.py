@@ -514,8 +514,8 @@ def verify_declared(
     except CheckFailed as exc:
         unc = plan.uncertainty_words()
         problems.append(f"at the declared uncertainty ({unc}): {exc}")
-        checks = tuple(PartCheck(plan.parts[p].name, 0, 0, 0, 0) for p in indices)
-        return VerificationReport(checks, (), tuple(problems))
+        # The strong check stops at the first failing path: no per-part counts to report.
+        return VerificationReport((), (), tuple(problems))
     checks = tuple(c for c in strong.parts if (c.part, c.landing) in names)
     return VerificationReport(checks, (), tuple(problems))
 
