@@ -169,17 +169,56 @@ def separable(machine: PushAlignMachine, tolerance: float) -> bool:
     (more sets than the solver explores) counts as no, so a critical tolerance is never
     overstated.
     """
-    if bisimilar_cross_pairs(machine, tolerance):
-        return False
-    problem = _one_part_problem(machine, tolerance)
-    if kept_cross_pairs(problem):
-        return False
-    roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
-    try:
-        bad = unsolvable(problem, roots, Deadline())
-    except Timeout:
-        return False
-    return bad is not None and not bad
+    return _PairProbes(machine).separable(tolerance)
+
+
+class _PairProbes:
+    """The pair tests of one two-part machine, each computed once per tolerance: the
+    bisimilar cross pairs, the one-part problem, the kept cross pairs and the exact solve
+    are pure in the tolerance, and the binary searches of :func:`strong_pair_critical`
+    ask several of them at the same tolerances."""
+
+    def __init__(self, machine: PushAlignMachine) -> None:
+        self.machine = machine
+        self._bisimilar: dict[float, list[tuple[int, int]]] = {}
+        self._problems: dict[float, Problem] = {}
+        self._unkept: dict[float, bool] = {}
+        self._separable: dict[float, bool] = {}
+
+    def bisimilar(self, tolerance: float) -> list[tuple[int, int]]:
+        if tolerance not in self._bisimilar:
+            self._bisimilar[tolerance] = bisimilar_cross_pairs(self.machine, tolerance)
+        return self._bisimilar[tolerance]
+
+    def problem(self, tolerance: float) -> Problem:
+        if tolerance not in self._problems:
+            self._problems[tolerance] = _one_part_problem(self.machine, tolerance)
+        return self._problems[tolerance]
+
+    def no_kept_cross_pair(self, tolerance: float) -> bool:
+        """No bisimilar cross pair and none nature keeps apart (cheap necessary tests)."""
+        if tolerance not in self._unkept:
+            self._unkept[tolerance] = not self.bisimilar(tolerance) and not kept_cross_pairs(
+                self.problem(tolerance)
+            )
+        return self._unkept[tolerance]
+
+    def separable(self, tolerance: float) -> bool:
+        """:func:`separable` at ``tolerance``."""
+        if tolerance not in self._separable:
+            self._separable[tolerance] = self.no_kept_cross_pair(tolerance) and self._solve(
+                tolerance
+            )
+        return self._separable[tolerance]
+
+    def _solve(self, tolerance: float) -> bool:
+        problem = self.problem(tolerance)
+        roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+        try:
+            bad = unsolvable(problem, roots, Deadline())
+        except Timeout:
+            return False
+        return bad is not None and not bad
 
 
 def _one_part_problem(machine: PushAlignMachine, tolerance: float) -> Problem:
@@ -209,12 +248,6 @@ def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
     return kept_apart(problem, pairs)
 
 
-def _no_kept_cross_pair(machine: PushAlignMachine, tolerance: float) -> bool:
-    return not bisimilar_cross_pairs(machine, tolerance) and not kept_cross_pairs(
-        _one_part_problem(machine, tolerance)
-    )
-
-
 def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
     """The critical tolerance of parts ``a`` and ``b`` of the mix for strong plans: the
     largest tolerance at which a strong plan tells them apart (:func:`separable`).
@@ -233,16 +266,17 @@ def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
     breaks = gap_breakpoints(sa, sb)
     # Separable implies no bisimilar cross pair, which is cheap to test and monotone too:
     # its last interval bounds the answer, and is most often the answer itself.
-    k = last_true(len(breaks), lambda k: not bisimilar_cross_pairs(m, breaks[k]))
-    if k >= 0 and not _no_kept_cross_pair(m, breaks[k]):
-        k = last_true(k, lambda k: _no_kept_cross_pair(m, breaks[k]))
-    if k >= 0 and not separable(m, breaks[k]):
-        k = last_true(k, lambda k: separable(m, breaks[k]))
+    probes = _PairProbes(m)
+    k = last_true(len(breaks), lambda k: not probes.bisimilar(breaks[k]))
+    if k >= 0 and not probes.no_kept_cross_pair(breaks[k]):
+        k = last_true(k, lambda k: probes.no_kept_cross_pair(breaks[k]))
+    if k >= 0 and not probes.separable(breaks[k]):
+        k = last_true(k, lambda k: probes.separable(breaks[k]))
     pa, pb = mix.pfs[a], mix.pfs[b]
     if k >= 0:
         return PairCritical(pa.part.name, pb.part.name, breaks[k])
     probe = interval_probe(breaks, 0)
-    pairs = bisimilar_cross_pairs(m, probe)
+    pairs = probes.bisimilar(probe)
     ideal = distinguishable(pa, pb, ToleranceSensor(probe), index_a=a, index_b=b)
     if ideal is not None and ideal.kind == "same-push-diameter":
         reason, kind = ideal.reason, ideal.kind
