@@ -54,14 +54,15 @@ def random_pf(rng: np.random.Generator, name: str, size: tuple[float, float] = (
             return pf
 
 
-def reference_critical(test, top: float) -> float | None:
-    """Largest tolerance where ``test`` holds, by bisection on floats (None: not even at 1e-9)."""
+def reference_critical(test, top: float, rel: float = REL) -> float | None:
+    """Largest tolerance where ``test`` holds, by bisection on floats to ``rel`` of the
+    answer (None: not even at 1e-9)."""
     lo = 1e-9
     if not test(lo):
         return None
     hi = top
     assert not test(hi)
-    while hi - lo > REL * hi:
+    while hi - lo > rel * hi:
         mid = (lo + hi) / 2.0
         if test(mid):
             lo = mid

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from test_design_critical import random_pf
+from test_design_critical import reference_critical as bisect_critical
 from test_lumping_policy import chamfered, near_rectangle
 
 import feederkit.cli.app as app_module
@@ -108,19 +109,9 @@ def strong_test(pf_a, pf_b, unc=ONE_DEG):
 
 
 def reference_critical(test, top: float) -> float | None:
-    """Largest tolerance where ``test`` holds, by bisection on floats (None: not at 1e-9)."""
-    lo = 1e-9
-    if not test(lo):
-        return None
-    hi = top
-    assert not test(hi)
-    while hi - lo > REL * hi:
-        mid = (lo + hi) / 2.0
-        if test(mid):
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    """Largest tolerance where ``test`` holds, by bisection on floats (test_design_critical's
+    reference, to ``REL``: each probe here is a strong-plan solve)."""
+    return bisect_critical(test, top, REL)
 
 
 def cross_breakpoints(machine) -> tuple[float, ...]:
