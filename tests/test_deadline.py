@@ -202,7 +202,7 @@ def _answered(result) -> None:
         assert "limit" in str(result) and "\n" not in str(result)
         return
     assert result.lower_bound <= result.length
-    assert result.optimal or result.lower_bound == result.length
+    assert result.optimal or result.lower_bound < result.length  # at its bound: optimal
 
 
 def test_a_near_round_part_with_a_coarse_sensor_answers_in_time():
@@ -442,7 +442,7 @@ def test_the_backchaining_plan_has_one_step_per_operation_and_is_correct():
         steps += 1
         stack.extend(child for _b, child in node.branches)
     length = tree_length(root)
-    assert steps <= len(root_branches) * length  # a chain per root branch, not a tree
+    assert steps <= length + 1  # the root and one chain, not a tree
     check_plan(_result(machine, root, False, None, 1, "worst", "exact"))
 
 

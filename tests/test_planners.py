@@ -101,8 +101,17 @@ def check_plan(result) -> int:
             return max(branch.lo, d - e) < min(branch.hi, d + e)
         return any(sensor.consistent(d, r) for r in _reading_points(machine, branch))
 
+    seen: set[tuple[int, int, int]] = set()
+
     def run(node, state, ops):
         nonlocal longest
+        # A plan is a DAG in memory: a node met again in the same state at the same depth
+        # runs the same way (without this, a chain whose branches share one subplan has
+        # exponentially many paths).
+        key = (id(node), state, ops)
+        if key in seen:
+            return
+        seen.add(key)
         if isinstance(node, Leaf):
             assert node.mask >> state & 1, "the leaf does not list the true state"
             for j in members(node.mask):

@@ -384,6 +384,10 @@ def _root_children(problem: Problem, root_branches, start_mass):
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
 
 
+READ_SHARE = 0.25
+"""With a time limit, the share of what is left after the backchaining plan that the plan
+following the readings (whose tree grows with the reading sets) may take."""
+
 TREE_RESERVE = 0.15
 """The share of the time limit the fallback's last search leaves for building its tree."""
 
@@ -400,7 +404,8 @@ def _fallback(
     """Some plan when the exact search ran out of its budget, with the lower bound it proved.
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
-    part, no margin floor; with readings within half of what is left), then a depth-first
+    part, no margin floor: one chain of the whole set; the plan that follows the readings
+    within ``READ_SHARE`` of what is left, when it is shorter), then a depth-first
     search (the greedy action order of ``Choices.lazy_actions``, on an explicit stack) for
     something shorter; the tree follows the actions that proved it. A reading set the search never
     met lies inside one it did (its "witness"), and without a margin floor it follows the
@@ -412,17 +417,19 @@ def _fallback(
         problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
         del worst
         gc.collect()
+    try:  # the backchaining plan itself first: one chain, one step per operation
+        blind = _sensorless_plan(problem, root_branches, budget, by_image=True)
+    except Timeout:
+        blind = None
     rest = budget.remaining()
     share = budget
     if rest is not None and not problem.sensorless:
-        # With readings its tree can be large: keep half of the rest for the search.
+        # With readings its tree can be large: keep most of the rest for the search.
         share = Deadline(
-            memory_mb=budget.memory_mb, end=budget.end - rest / 2.0, memory_base=budget.memory_base
+            memory_mb=budget.memory_mb,
+            end=budget.end - rest * (1.0 - READ_SHARE),
+            memory_base=budget.memory_base,
         )
-    try:  # the backchaining plan itself first: one step per operation
-        blind = _sensorless_plan(problem, root_branches, share, by_image=True)
-    except Timeout:
-        blind = None
     if blind is not None:
         try:  # the readings may shorten it
             read = _sensorless_plan(problem, root_branches, share)
@@ -565,10 +572,11 @@ def _sensorless_plan(
     operations collapse any set with no sensor; each step takes a rotation that lowers
     that number, and a reading only leaves a subset, which needs no more. Never longer than
     the sensorless plan; its size grows with the distinct reading sets, so it is built
-    under ``deadline`` (Timeout). ``by_image``: every reading branch of a step goes on with
-    the subplan of the step's whole image (a reading only leaves a subset of it, and a
-    subset of a goal set is a goal), so the plan has one step per operation: the
-    backchaining plan itself, readings followed but not used, for when the other runs out.
+    under ``deadline`` (Timeout). ``by_image``: the backchaining plan of the whole set
+    itself, readings followed but not used, for when the other runs out: every root branch
+    and every reading branch of a step goes on with the subplan of the step's whole image
+    (a reading only leaves a subset of it, and a subset of a goal set is a goal), so the
+    plan is one chain, one step per operation.
     """
     if problem.min_margin > 0.0:
         return None
@@ -586,8 +594,14 @@ def _sensorless_plan(
             (b, img if by_image else b.mask) for b in problem.readings.image_branches(img)
         ]
 
-    made = _dag([b.mask for b in root_branches], expand, deadline)
-    return Step(None, tuple((b, made[b.mask]) for b in root_branches))
+    if by_image:
+        # One chain for every reading: the whole set's rotations send each branch (a
+        # subset) inside the same images, so the plan has one step per operation.
+        keys = {b.mask: b.mask if problem.is_goal(b.mask) else problem.full for b in root_branches}
+    else:
+        keys = {b.mask: b.mask for b in root_branches}
+    made = _dag(list(keys.values()), expand, deadline)
+    return Step(None, tuple((b, made[keys[b.mask]]) for b in root_branches))
 
 
 def _proven(worst: WorstCase, mask: int) -> int:

@@ -24,16 +24,21 @@ class Leaf:
     mask: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Step:
     """One push-align operation and its branches on the reading.
 
     ``action`` is None at the root; ``branches`` pair each reading branch (its ``mask`` is
-    the set of states consistent with the reading) with the subtree that follows.
+    the set of states consistent with the reading) with the subtree that follows. Equal
+    subplans are often one object (a plan is a DAG in memory), so the repr names only the
+    action and the number of branches: written out as a tree it can grow exponentially.
     """
 
     action: OverlapRange | None
     branches: tuple[tuple[ReadingBranch, Step | Leaf], ...]
+
+    def __repr__(self) -> str:
+        return f"Step(action={self.action!r}, branches=<{len(self.branches)}>)"
 
 
 PlanTree = Step | Leaf
