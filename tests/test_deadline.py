@@ -18,10 +18,11 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.andor import WorstCase
-from feederkit.planning.api import plan
+from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Deadline, Timeout, rss_mb
 from feederkit.planning.options import PlanningOptions
-from feederkit.sensors import ToleranceSensor
+from feederkit.planning.sensorless import Backchain, push_circle
+from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
 OVERSHOOT_S = 2.0
@@ -472,3 +473,19 @@ def test_a_plan_that_meets_its_proven_bound_is_optimal_however_it_was_found():
     # One operation short of the bound proves nothing; the expected objective neither.
     assert not _result(machine, exact.root, False, None, exact.length - 1, "worst", "e").optimal
     assert not _result(machine, exact.root, False, None, exact.length, "expected", "e").optimal
+
+
+def test_readings_that_carry_nothing_give_the_backchaining_optimum_at_once():
+    # 35 states whose widths all read alike at 3 % of the size: one reading fits every
+    # state, so nature can withhold all information and backchaining is exact (methods.
+    # readings_carry_nothing); before, the search ran to its limit and proved a bound of 2.
+    pf = near_round(64, 0.01)
+    machine = build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL)
+    result, took = _timed_plan(machine, time_limit_s=20.0)
+    assert took < 10.0
+    assert result.optimal and result.length == result.lower_bound
+    blind = build_machine([pf], NoSensor(), IDEAL)
+    circle = push_circle(blind, goal_relation(blind, Deadline()))
+    full = (1 << blind.n) - 1
+    assert result.length == 1 + Backchain(circle).length(full)  # the sensorless optimum
+    assert check_plan(result) == result.length

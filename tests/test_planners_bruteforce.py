@@ -235,6 +235,18 @@ def test_component_branching_lengths_agree(seed, n, rel):
     _compare(seed, n, rel, components=True)
 
 
+@settings(
+    max_examples=100,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+@given(st.integers(0, 10**9), st.integers(3, 10), st.floats(0.1, 1.0))
+def test_coarse_sensor_lengths_agree(seed, n, rel):
+    # Coarse sensors: often one reading fits every state, and the planner answers with
+    # backchaining (methods.readings_carry_nothing); the brute force still follows readings.
+    _compare(seed, n, rel)
+
+
 def test_the_own_planner_knows_the_triangle():
     own = OwnPart([(0, 0), (1, 0), (0, 1)], (1 / 3, 1 / 3))
     assert own.ok and own.n == 3

@@ -35,7 +35,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, TieBudget, child_masses, stage
 from feederkit.planning.reindex import by_diameter, remap_tree
-from feederkit.planning.sensorless import Backchain, push_circle
+from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import solve, unsolvable
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.tree import Leaf, PlanResult, Step
@@ -317,6 +317,16 @@ def _plan(
         raise _no_strong_plan(machine, undecided=not exact) from None
     length = 1 + max(lengths.values(), default=0)
     budget_ops = length - 1
+    if objective == "worst" and isinstance(worst, BackchainWorst) and not problem.sensorless:
+        # The readings carry nothing (methods.readings_carry_nothing): the backchaining plan
+        # of the whole set is a shortest plan (its rotations the widest that shorten the
+        # set), and any plan that follows the readings grows a tree of every reading set.
+        try:
+            chain = _sensorless_plan(problem, root_branches, budget, by_image=True)
+        except Timeout as exc:
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
+        if chain is not None and tree_length(chain) == length:
+            return chain, True, length, length, TIES_NONE
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline
     if objective == "worst":
@@ -605,8 +615,11 @@ def _sensorless_plan(
 
 
 def _proven(worst: WorstCase, mask: int) -> int:
+    """A proven lower bound on the set's operations (exact for backchaining)."""
     if worst.p.is_goal(mask):
         return 0
+    if isinstance(worst, BackchainWorst):
+        return worst.length(mask)
     return worst.exact.get(mask, worst.lb.get(mask, 1))
 
 

@@ -4,8 +4,9 @@
 - ``bottom-up``: the bottom-to-top dynamic programme (section 6.4);
 - ``bfs``: breadth-first search over sets, sensorless (section 4);
 - ``backchain``: Goldberg's backchaining, sensorless one-part push machines (section 4);
-- ``auto``: backchaining where it applies (sensorless, one part, no margin floor, the ideal
-  model), else AND/OR search.
+- ``auto``: backchaining where it applies (one part, no margin floor, the ideal model, and
+  sensorless or with readings that carry no information: :func:`readings_carry_nothing`),
+  else AND/OR search.
 
 Under uncertainty (outcome sets) every method but backchaining searches sets of states with
 the union image and the bisimulation goal, so each finds the minimum worst-case length of a
@@ -17,17 +18,50 @@ Every method yields the same lengths; the tie-breaking stages then query the ora
 from __future__ import annotations
 
 from feederkit.errors import InputError
+from feederkit.machine import Grouping, search_space
 from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.bottomup import bottom_up_lengths
 from feederkit.planning.problem import Problem
 from feederkit.planning.sensorless import Backchain, BackchainWorst, bfs_length, push_circle
 
 
+def readings_carry_nothing(problem: Problem) -> bool:
+    """Whether one reading is consistent with every state (a reading set holds them all).
+
+    Then the readings never tell a plan anything nature cannot withhold: whatever set a
+    plan holds, nature may answer that reading, so every set needs as many operations as
+    without a sensor (Goldberg's sensorless length is a lower bound), and the sensorless
+    plan reaches it. A coarse sensor on a near-round part is the typical case.
+
+    >>> from feederkit.machine import build_machine
+    >>> from feederkit.mechanics import push_function
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> from feederkit.planning.api import goal_relation
+    >>> from feederkit.planning.budget import Deadline
+    >>> from feederkit.planning.options import Grouping
+    >>> from feederkit.sensors import ToleranceSensor
+    >>> from feederkit.uncertainty import IDEAL
+    >>> box = push_function(make_part(make_outline("box", [(0, 0), (10, 0), (10, 6), (0, 6)])))
+    >>> def carry_nothing(tolerance):
+    ...     m = build_machine([box], ToleranceSensor(tolerance), IDEAL)
+    ...     problem = Problem(m, Grouping.EXACT, 0.0, goal_relation(m, Deadline()))
+    ...     return readings_carry_nothing(problem)
+    >>> carry_nothing(0.5), carry_nothing(3.0)  # widths 6 and 10 read alike from 2 mm on
+    (False, True)
+    """
+    full = problem.full
+    # Exact reading branching whatever the plan's grouping: a component holding every state
+    # says nothing about one reading (its subsets' components may split), a reading set does.
+    exact = search_space(problem.machine).branches(full, Grouping.EXACT)
+    return any(b.mask == full for b in exact)
+
+
 def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
     """The worst-case length oracle for ``method`` (backchaining when it applies)."""
     if method in ("auto", "backchain"):
         circle = None
-        if problem.sensorless and problem.min_margin == 0.0:
+        if problem.min_margin == 0.0 and (problem.sensorless or readings_carry_nothing(problem)):
             circle = push_circle(problem.machine, problem.insep)
         if circle is not None:
             return BackchainWorst(problem, Backchain(circle), deadline)

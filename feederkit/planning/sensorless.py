@@ -31,6 +31,8 @@ import math
 from collections import deque
 from dataclasses import dataclass
 
+import numpy as np
+
 from feederkit.angles import ANGLE_EPS, norm360
 from feederkit.machine import PushAlignMachine, members
 from feederkit.planning.andor import Deadline, WorstCase
@@ -121,6 +123,10 @@ def push_circle(machine: PushAlignMachine, insep: tuple[int, ...]) -> PushCircle
     return PushCircle(period, tuple(cls), pos, tuple(left[:shift]), tuple(right[:shift]))
 
 
+_NUMPY_HULL_MIN = 24
+"""Sets with this many states or more get their hull from numpy (a Python loop below)."""
+
+
 class Backchain:
     """Goldberg's backchaining table ``D_k`` and the minimum length of any set of states."""
 
@@ -155,11 +161,23 @@ class Backchain:
             d.append(nxt)
         self.table = d
         self._state_pos = [circle.pos[c] for c in circle.cls]
+        # The states in the order of their positions, for the vectorised hull of big sets.
+        self._order = np.argsort(np.asarray(self._state_pos), kind="stable")
+        self._sorted_pos = np.asarray(self._state_pos)[self._order]
         self._lengths: dict[int, float] = {}
 
     def hull(self, mask: int) -> float:
         """Length of the shortest arc holding the set's classes (0: one class)."""
         t = self.c.period
+        if mask.bit_count() >= _NUMPY_HULL_MIN:
+            n = len(self._state_pos)
+            raw = np.frombuffer(mask.to_bytes((n + 7) // 8, "little"), dtype=np.uint8)
+            inside = np.unpackbits(raw, bitorder="little")[:n].astype(bool)
+            at = self._sorted_pos[inside[self._order]]  # ascending; equal positions: gaps 0
+            if at[-1] == at[0]:
+                return 0.0
+            gap = max(float(np.max(np.diff(at))), float(at[0] + t - at[-1]))
+            return t - gap
         pos = self._state_pos
         pts = sorted({pos[i] for i in members(mask)})
         if len(pts) <= 1:
