@@ -112,12 +112,13 @@ def whole_plan_design(pfs, uncertainty: Uncertainty):
     """``design_tolerance`` with every length question answered by a whole plan."""
     original, strong = design_sensor.length_steps, design_sensor.strong_length_steps
 
-    def steps(pfs_, up_to, critical=None):
-        return length_steps(pfs_, up_to, oracle=WholePlanOracle(pfs_), critical=critical)
+    def steps(pfs_, up_to, critical=None, clock=None):
+        oracle = WholePlanOracle(pfs_)
+        return length_steps(pfs_, up_to, oracle=oracle, critical=critical, clock=clock)
 
-    def strong_steps(mix, up_to, critical):
+    def strong_steps(mix, up_to, critical, clock=None):
         oracle = WholeStrongPlanOracle(mix)
-        return strong_length_steps(mix, up_to, critical, oracle=oracle)
+        return strong_length_steps(mix, up_to, critical, oracle=oracle, clock=clock)
 
     design_sensor.length_steps = steps
     design_sensor.strong_length_steps = strong_steps

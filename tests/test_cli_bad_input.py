@@ -49,6 +49,7 @@ CASES = [
     ["run", PLAN, "--start-deg", "10", "--all"],
     ["design", "sensor"],
     ["design", "sensor", "no-such-part"],
+    ["design", "sensor", PART, PART, "--time-limit", "0"],
     ["catalog", "list"],
     ["catalog", "add", "no-such-part.json"],
     ["catalog", "import", "/nonexistent-feederkit"],

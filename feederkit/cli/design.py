@@ -5,13 +5,16 @@ A thin layer over :mod:`feederkit.design`: read the cell profile (``--cell FILE`
 (``--rotation-error``, ``--shape-tolerance``, ``--com-tolerance``, as ``plan`` takes them),
 load the parts, decide the critical tolerances (or each LED pitch) for strong plans at that
 uncertainty, print the tables, the one-line answer, the profile and the uncertainty used,
-and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md).
+and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md). While
+it runs, a progress bar on stderr (on a terminal only, so ``--json`` output stays clean)
+shows the pairs decided, then the length table; past ``--time-limit`` it stops with one
+line saying what was decided (exit 1), never a partial design.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -27,9 +30,11 @@ from feederkit.cli.common import (
     flag_words,
     print_json,
     print_warnings,
+    progress_bar,
     uncertainty_option,
     uncertainty_text,
 )
+from feederkit.design.limit import DesignTimeout, check_time_limit
 from feederkit.design.pitches import parse_pitches
 from feederkit.design.sensor import (
     PitchDesign,
@@ -46,6 +51,13 @@ design_app = typer.Typer(
     help="Choose the cell: which sensor a product mix needs.",
     no_args_is_help=True,
 )
+
+DEFAULT_DESIGN_TIME_LIMIT_S = 300.0
+"""``design sensor``'s time limit unless ``--time-limit`` is given. Longer than ``plan``'s
+60 s: a design has no anytime answer (at the limit all its work is lost, not a best plan
+kept), it is run once per changeover, and a 50-part mix of the benchmark takes over a
+minute at the default rotation error; five minutes still stop a mix that would run for
+hours (docs/design.md, "Time limit")."""
 
 SHOWN_PAIRS = 10
 """Pairs listed on the terminal (the lowest critical tolerances); --json lists every pair."""
@@ -113,6 +125,15 @@ def sensor_command(
         Path | None,
         typer.Option("--plot", metavar="FILE.png|svg", help="Also draw the lengths here."),
     ] = None,
+    time_limit: Annotated[
+        float,
+        typer.Option(
+            "--time-limit",
+            metavar="S",
+            help="Seconds; past them the design stops with one line saying what it decided "
+            "(exit 1), never a partial table.",
+        ),
+    ] = DEFAULT_DESIGN_TIME_LIMIT_S,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -142,15 +163,40 @@ def sensor_command(
             raise InputError(f"--noise must be zero or a positive number of mm, got {e}")
     if plot is not None and plot.suffix.lower() not in (".png", ".svg"):
         raise InputError(f"{plot}: the plot is written as .png or .svg")
+    with flag_words():
+        check_time_limit(time_limit)
 
     loaded = load_parts(names, catalog=catalog)
     pfs = list(loaded.push_functions)
     design: ToleranceDesign | PitchDesign
-    with flag_words():
-        if led:
-            design = design_pitches(pfs, values, noise=e, uncertainty=uncertainty)
-        else:
-            design = design_tolerance(pfs, max_tolerance=max_tolerance, uncertainty=uncertainty)
+    with progress_bar() as bar, flag_words():
+        tasks: dict[str, Any] = {}
+
+        def progress(what: str, done: int, total: int) -> None:
+            if what not in tasks:
+                tasks[what] = bar.add_task(what, total=total)
+            bar.update(tasks[what], completed=done, total=total)
+
+        try:
+            if led:
+                design = design_pitches(
+                    pfs,
+                    values,
+                    noise=e,
+                    uncertainty=uncertainty,
+                    time_limit_s=time_limit,
+                    progress=progress,
+                )
+            else:
+                design = design_tolerance(
+                    pfs,
+                    max_tolerance=max_tolerance,
+                    uncertainty=uncertainty,
+                    time_limit_s=time_limit,
+                    progress=progress,
+                )
+        except DesignTimeout as exc:
+            raise DesignTimeout(f"{exc}; allow more time with --time-limit S") from None
     print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
     if plot is not None:
         from feederkit.design.plot import plot_design

@@ -9,7 +9,9 @@
   segments of constant goal);
 - :mod:`~feederkit.design.pitches`: LED arrays, pitch by pitch;
 - :mod:`~feederkit.design.sensor`: the ``design sensor`` answer at the declared uncertainty
-  (docs/design.md).
+  (docs/design.md);
+- :mod:`~feederkit.design.limit`: its time limit (exact or nothing: ``DesignTimeout``) and
+  progress callback.
 """
 
 from feederkit.design.critical import (
@@ -19,6 +21,7 @@ from feederkit.design.critical import (
     pair_breakpoints,
     pair_critical_tolerance,
 )
+from feederkit.design.limit import DesignTimeout
 from feederkit.design.pitches import PitchRow, parse_pitches, pitch_rows
 from feederkit.design.sensor import (
     PitchDesign,
@@ -37,6 +40,7 @@ from feederkit.design.strong import (
 )
 
 __all__ = [
+    "DesignTimeout",
     "LengthOracle",
     "LengthStep",
     "MixCritical",

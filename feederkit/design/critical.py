@@ -23,6 +23,7 @@ import bisect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from feederkit.design.limit import PAIRS, DesignClock
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.pairs import PairWitness, distinguishable
@@ -100,7 +101,9 @@ class PairCritical:
         return out
 
 
-def pair_critical_tolerance(pf_a: PushFunction, pf_b: PushFunction) -> PairCritical:
+def pair_critical_tolerance(
+    pf_a: PushFunction, pf_b: PushFunction, clock: DesignClock | None = None
+) -> PairCritical:
     """The exact critical tolerance of two parts, by binary search over their breakpoints.
 
     Interval ``k`` of the breakpoints is tested at its right end with the exact pair test
@@ -108,8 +111,10 @@ def pair_critical_tolerance(pf_a: PushFunction, pf_b: PushFunction) -> PairCriti
     last breakpoint every cross pair reads alike, so the pair is never distinguishable there.
     A Hausdorff bound starts the search: while some state of one part is farther than ``2e``
     from every state of the other, no inseparable pair can exist (every state of each part
-    is in one, see :mod:`feederkit.mix.pairs`).
+    is in one, see :mod:`feederkit.mix.pairs`). ``clock`` is polled before each pair test
+    (:mod:`feederkit.design.limit`).
     """
+    clock = clock or DesignClock()
     breaks = pair_breakpoints(pf_a, pf_b)
     da = [s.diameter for s in pf_a.states]
     db = [s.diameter for s in pf_b.states]
@@ -122,7 +127,10 @@ def pair_critical_tolerance(pf_a: PushFunction, pf_b: PushFunction) -> PairCriti
     sure = bisect.bisect_right(breaks, hausdorff / 2.0) - 1 if hausdorff > eps else -1
 
     def ok(k: int) -> bool:
-        return k <= sure or distinguishable(pf_a, pf_b, ToleranceSensor(breaks[k])) is None
+        if k <= sure:
+            return True
+        clock.check()
+        return distinguishable(pf_a, pf_b, ToleranceSensor(breaks[k])) is None
 
     k = last_true(len(breaks), ok)
     name_a, name_b = pf_a.part.name, pf_b.part.name
@@ -163,11 +171,18 @@ class MixCritical:
         return tuple(p for p in self.pairs if p.critical_tolerance == c)
 
 
-def mix_critical_tolerance(pfs: Sequence[PushFunction]) -> MixCritical:
-    """Every pair's exact critical tolerance, in part order, and so the mix's."""
-    pairs = [
-        pair_critical_tolerance(pfs[i], pfs[j])
-        for i in range(len(pfs))
-        for j in range(i + 1, len(pfs))
-    ]
+def mix_critical_tolerance(
+    pfs: Sequence[PushFunction], clock: DesignClock | None = None
+) -> MixCritical:
+    """Every pair's exact critical tolerance, in part order, and so the mix's; ``clock``
+    (:mod:`feederkit.design.limit`) is polled and told of each pair decided."""
+    clock = clock or DesignClock()
+    n = len(pfs)
+    clock.begin(PAIRS, n * (n - 1) // 2)
+    pairs = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            clock.check()
+            pairs.append(pair_critical_tolerance(pfs[i], pfs[j], clock))
+            clock.advance()
     return MixCritical(tuple(pairs))

@@ -15,6 +15,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from feederkit.design.limit import PITCHES, DesignClock
 from feederkit.design.strong import StrongMix, strong_pitch
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
@@ -60,20 +61,26 @@ class PitchRow:
 
 
 def pitch_row(
-    pfs: Sequence[PushFunction], pitch: float, noise: float, mix: StrongMix | None = None
+    pfs: Sequence[PushFunction],
+    pitch: float,
+    noise: float,
+    mix: StrongMix | None = None,
+    clock: DesignClock | None = None,
 ) -> PitchRow:
     """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix
-    (for strong plans at ``mix``'s uncertainty when given)."""
+    (for strong plans at ``mix``'s uncertainty when given), within ``clock``'s limit."""
+    clock = clock or DesignClock()
     sensor = LedSensor(pitch, noise)
     if mix is not None:
-        got = strong_pitch(mix, sensor)
+        got = strong_pitch(mix, sensor, clock)
         if got.unrecognizable or got.no_plan is not None:
             return PitchRow(pitch, noise, got.unrecognizable, no_plan=got.no_plan)
         return PitchRow(pitch, noise, (), got.length, got.expected)
     bad = tuple((w.part_a, w.part_b) for w in unrecognizable_pairs(list(pfs), sensor))
     if bad:
         return PitchRow(pitch, noise, bad)
-    result = make_plan(list(pfs), sensor, uncertainty=IDEAL).result
+    clock.check()
+    result = clock.plan(lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=IDEAL)).result
     return PitchRow(pitch, noise, (), result.length, result.expected_length)
 
 
@@ -82,10 +89,20 @@ def pitch_rows(
     pitches: Sequence[float],
     noise: float,
     mix: StrongMix | None = None,
+    clock: DesignClock | None = None,
 ) -> tuple[PitchRow, ...]:
     """Every pitch of the list, ascending, each decided on its own (for strong plans at
-    ``mix``'s uncertainty when given, else on the ideal model)."""
-    return tuple(pitch_row(pfs, p, noise, mix) for p in sorted(set(pitches)))
+    ``mix``'s uncertainty when given, else on the ideal model); ``clock``
+    (:mod:`feederkit.design.limit`) is polled and told of each pitch decided."""
+    clock = clock or DesignClock()
+    ordered = sorted(set(pitches))
+    clock.begin(PITCHES, len(ordered))
+    rows = []
+    for p in ordered:
+        clock.check()
+        rows.append(pitch_row(pfs, p, noise, mix, clock))
+        clock.advance()
+    return tuple(rows)
 
 
 def parse_pitches(text: str) -> tuple[float, ...]:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from feederkit.design.critical import MixCritical, PairCritical, mix_critical_tolerance
+from feederkit.design.limit import DesignClock, Progress
 from feederkit.design.pitches import PitchRow, pitch_rows
 from feederkit.design.steps import BREAKPOINT_REL_EPS, LengthStep, length_steps
 from feederkit.design.strong import (
@@ -25,6 +26,7 @@ from feederkit.design.strong import (
 )
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
+from feederkit.planning.budget import Timeout
 from feederkit.uncertainty import IDEAL, Uncertainty
 
 MODEL_NOTE = "ideal model: plans assume no rotation error"
@@ -164,25 +166,47 @@ def design_tolerance(
     *,
     max_tolerance: float | None = None,
     uncertainty: Uncertainty | None = None,
+    time_limit_s: float | None = None,
+    progress: Progress | None = None,
 ) -> ToleranceDesign:
     """Critical tolerances and length steps at ``uncertainty`` (default the ideal model);
     the steps reach the mix's critical tolerance, or ``max_tolerance`` (mm) when given
     (beyond the critical one the mix is not recognized, its plans end in results that name
-    several parts). InputError for a shape tolerance too large for a part."""
+    several parts). InputError for a shape tolerance too large for a part.
+
+    ``time_limit_s``: seconds (None: no limit); past it DesignTimeout, a PlanningError
+    naming what was decided, never a partial design (:mod:`feederkit.design.limit`).
+    ``progress(what, done, total)`` is told of each pair, goal probe and run of the table.
+    """
     _check_mix(pfs)
     if max_tolerance is not None and not max_tolerance > 0.0:
         raise InputError(f"--max-tolerance must be a positive number of mm, got {max_tolerance}")
     unc = _uncertainty(uncertainty)
+    clock = DesignClock(time_limit_s, progress)
+    try:
+        return _design_tolerance(pfs, max_tolerance, unc, clock)
+    except Timeout:
+        raise clock.timeout() from None
+
+
+def _design_tolerance(
+    pfs: Sequence[PushFunction],
+    max_tolerance: float | None,
+    unc: Uncertainty,
+    clock: DesignClock,
+) -> ToleranceDesign:
     names = tuple(pf.part.name for pf in pfs)
     if unc.is_ideal:
-        critical = mix_critical_tolerance(pfs)
+        critical = mix_critical_tolerance(pfs, clock)
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
-        steps = length_steps(pfs, up_to, critical=critical) if up_to is not None else ()
+        steps = (
+            length_steps(pfs, up_to, critical=critical, clock=clock) if up_to is not None else ()
+        )
         return ToleranceDesign(names, critical, steps, unc)
     mix = StrongMix(pfs, unc)
-    critical = strong_mix_critical(mix)
+    critical = strong_mix_critical(mix, clock)
     up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
-    steps = strong_length_steps(mix, up_to, critical) if up_to is not None else ()
+    steps = strong_length_steps(mix, up_to, critical, clock=clock) if up_to is not None else ()
     return ToleranceDesign(names, critical, steps, unc)
 
 
@@ -254,23 +278,30 @@ def design_pitches(
     *,
     noise: float = 0.0,
     uncertainty: Uncertainty | None = None,
+    time_limit_s: float | None = None,
+    progress: Progress | None = None,
 ) -> PitchDesign:
     """Each pitch decided on its own at ``uncertainty`` (default the ideal model;
     :mod:`feederkit.design.pitches`), and the pairs' exact critical tolerances, which name
-    the pairs no sensor can separate."""
+    the pairs no sensor can separate. ``time_limit_s`` and ``progress`` as for
+    :func:`design_tolerance`."""
     _check_mix(pfs)
     if not pitches:
         raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5")
     if noise < 0.0:
         raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
     unc = _uncertainty(uncertainty)
+    clock = DesignClock(time_limit_s, progress)
     names = tuple(pf.part.name for pf in pfs)
-    if unc.is_ideal:
-        rows = pitch_rows(pfs, pitches, noise)
-        return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs), unc)
-    mix = StrongMix(pfs, unc)
-    rows = pitch_rows(pfs, pitches, noise, mix=mix)
-    return PitchDesign(names, noise, rows, strong_mix_critical(mix), unc)
+    try:
+        if unc.is_ideal:
+            rows = pitch_rows(pfs, pitches, noise, clock=clock)
+            return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs, clock), unc)
+        mix = StrongMix(pfs, unc)
+        rows = pitch_rows(pfs, pitches, noise, mix=mix, clock=clock)
+        return PitchDesign(names, noise, rows, strong_mix_critical(mix, clock), unc)
+    except Timeout:
+        raise clock.timeout() from None
 
 
 def report_design(

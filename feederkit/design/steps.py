@@ -59,6 +59,7 @@ from feederkit.design.critical import (
     last_true,
     mix_critical_tolerance,
 )
+from feederkit.design.limit import LENGTHS, DesignClock
 from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, PushAlignMachine
 from feederkit.machine.build import build_machine
@@ -136,12 +137,18 @@ def _first_at_or_above(breaks: Sequence[float], x: float) -> int:
     return bisect.bisect_left(breaks, x - BREAKPOINT_REL_EPS * abs(x))
 
 
-def plan_evaluation(pfs: Sequence[PushFunction], tolerance: float) -> Evaluation:
+def plan_evaluation(
+    pfs: Sequence[PushFunction], tolerance: float, clock: DesignClock | None = None
+) -> Evaluation:
     """Length and expected length of the verified optimal plan at ``tolerance`` mm (no
-    certificate: the table needs neither its rotation error nor its shape tolerance)."""
+    certificate: the table needs neither its rotation error nor its shape tolerance),
+    within what is left of ``clock``'s limit (:meth:`DesignClock.plan`)."""
     sensor = ToleranceSensor(tolerance)
-    result = make_plan(list(pfs), sensor, uncertainty=IDEAL, certify=False).result
-    return Evaluation(result.length, result.expected_length)
+    clock = clock or DesignClock()
+    made = clock.plan(
+        lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=IDEAL, certify=False)
+    )
+    return Evaluation(made.result.length, made.result.expected_length)
 
 
 def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
@@ -171,10 +178,12 @@ class LengthOracle:
     relation, exact reading branches, no margin floor). The ideal machine's states and
     action maps do not depend on the sensor, so they are built and numbered once; only the
     sensor, and with it the readings and the goal, change per tolerance. The oracle of the
-    last tolerance asked is kept, so repeated questions share its proven bounds.
+    last tolerance asked is kept, so repeated questions share its proven bounds. Every
+    search polls ``deadline`` (default: none) and raises Timeout when it passes.
     """
 
-    def __init__(self, pfs: Sequence[PushFunction]) -> None:
+    def __init__(self, pfs: Sequence[PushFunction], deadline: Deadline | None = None) -> None:
+        self.deadline = deadline or Deadline()
         self.machine = build_machine(list(pfs), uncertainty=IDEAL)
         self._sorted, _old = by_diameter(self.machine)
         self._last: tuple[float, Problem, WorstCase, list[int]] | None = None
@@ -184,7 +193,7 @@ class LengthOracle:
             return self._last[1:]
         self._last = None  # free the previous tolerance's memo first
         machine = replace(self._sorted, sensor=ToleranceSensor(tolerance))
-        budget = Deadline()
+        budget = self.deadline
         problem = Problem(machine, Grouping.EXACT, 0.0, goal_relation(machine, budget))
         roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
         worst = make_oracle(problem, "auto", budget)
@@ -222,6 +231,7 @@ def length_steps(
     oracle: LengthOracle | None = None,
     evaluate: Callable[[float], Evaluation] | None = None,
     critical: MixCritical | None = None,
+    clock: DesignClock | None = None,
 ) -> tuple[LengthStep, ...]:
     """The plan length's steps over tolerances ``(0, up_to]`` (None: every interval).
 
@@ -229,17 +239,21 @@ def length_steps(
     ``oracle`` answers the search's length questions (default :class:`LengthOracle` of the
     mix); ``evaluate`` makes each step's verified plan at its right end (default
     :func:`plan_evaluation`) and must agree with the search (else CheckFailed).
-    ``critical``: the mix's pairs' critical tolerances, if already known.
+    ``critical``: the mix's pairs' critical tolerances, if already known. ``clock``
+    (:mod:`feederkit.design.limit`): the time limit every search polls (the default
+    oracle's and plans'), told of each run of intervals decided.
 
     The intervals are searched in segments between the pairs' critical tolerances (the
     goal changes there) and steps never span two segments; inside a segment the length is
     monotone (the module's docstring).
     """
-    oracle = oracle or LengthOracle(pfs)
+    clock = clock or DesignClock()
+    oracle = oracle or LengthOracle(pfs, clock.deadline)
     breaks = machine_breakpoints(oracle.machine)
-    evaluate = evaluate or (lambda e: plan_evaluation(pfs, e))
-    critical = critical or mix_critical_tolerance(pfs)
+    evaluate = evaluate or (lambda e: plan_evaluation(pfs, e, clock))
+    critical = critical or mix_critical_tolerance(pfs, clock)
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
+    clock.begin(LENGTHS, last + 1)
     # Interval k is recognizable for a pair iff its right end is at most the pair's critical.
     changes = {
         _first_at_or_above(breaks, p.critical_tolerance) + 1
@@ -252,12 +266,13 @@ def length_steps(
 
     def fit(k: int, length: int) -> bool:
         if (k, length) not in fits:
+            clock.check()
             fits[k, length] = oracle.within(interval_probe(breaks, k), length)
         return fits[k, length]
 
     steps = []
     for first, end in zip(starts, [*starts[1:], last + 1], strict=True):
-        runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate)
+        runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate, clock)
         for i, j, length, ev in runs:
             if ev.length != length:
                 raise CheckFailed(
@@ -277,12 +292,16 @@ def _segment_runs(
     oracle: LengthOracle | StrongOracle,
     fit: Callable[[int, int], bool],
     evaluate: Callable[[float], Evaluation],
+    clock: DesignClock | None = None,
 ) -> list[tuple[int, int, int, Evaluation]]:
     """The constant runs ``(i, j, length, verified plan at j)`` of intervals ``first..j_last``,
-    over which the length is non-decreasing."""
+    over which the length is non-decreasing; ``clock`` is polled and told of each run."""
+    clock = clock or DesignClock()
+    clock.check()
     top = evaluate(interval_probe(breaks, j_last))  # the segment's last interval ends a step
     runs = []
     k = first
+    clock.check()
     length = top.length if first == j_last else oracle.length(interval_probe(breaks, first))
     while length < top.length and k < j_last:
         # fit(k, length) holds, fit(j_last, length) does not: gallop, then bisect.
@@ -294,10 +313,13 @@ def _segment_runs(
             lo += step
             step *= 2
         j = lo + 1 + last_true(hi - lo - 1, lambda d, lo=lo, n=length: fit(lo + 1 + d, n))
+        clock.check()
         runs.append((k, j, length, evaluate(interval_probe(breaks, j))))
+        clock.advance(j + 1 - k)
         k = j + 1
         # The length at k exceeds the last one and is at most the segment's last length.
         below = range(length + 1, top.length) if k < j_last else ()
         length = next((n for n in below if fit(k, n)), top.length)
     runs.append((k, j_last, length, top))
+    clock.advance(j_last + 1 - k)
     return runs

@@ -47,6 +47,7 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
 )
+from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
 from feederkit.design.steps import (
     Evaluation,
     LengthStep,
@@ -62,7 +63,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness, distinguishable
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import FIRST_LIMIT, goal_relation, strong_plan_exists
-from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.budget import Deadline
 from feederkit.planning.lumping import kept_apart, try_lumping
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.options import Lumping
@@ -151,10 +152,13 @@ def uncertainty_words(u: Uncertainty) -> str:
     )
 
 
-def bisimilar_cross_pairs(machine: PushAlignMachine, tolerance: float) -> list[tuple[int, int]]:
+def bisimilar_cross_pairs(
+    machine: PushAlignMachine, tolerance: float, deadline: Deadline | None = None
+) -> list[tuple[int, int]]:
     """The bisimilar (state of part 0, state of part 1) pairs of a two-part machine under a
-    tolerance sensor, as machine indices."""
-    masks = inseparable_masks(replace(machine, sensor=ToleranceSensor(tolerance)))
+    tolerance sensor, as machine indices; the fixpoint polls ``deadline`` (default none)."""
+    check = None if deadline is None else deadline.check
+    masks = inseparable_masks(replace(machine, sensor=ToleranceSensor(tolerance)), check)
     first = [i for i, s in enumerate(machine.states) if s.part == 0]
     return [(i, j) for i in first for j in members(masks[i]) if machine.states[j].part == 1]
 
@@ -167,7 +171,8 @@ def separable(machine: PushAlignMachine, tolerance: float) -> bool:
     pair of one part's states" (orienting each part is not asked); a bisimilar cross pair,
     or one nature keeps apart (:func:`kept_cross_pairs`), answers no at once. Undecided
     (more sets than the solver explores) counts as no, so a critical tolerance is never
-    overstated.
+    overstated. No time limit here; :func:`strong_pair_critical` takes one, and a test cut
+    short by it raises Timeout, never answers no.
     """
     return _PairProbes(machine).separable(tolerance)
 
@@ -176,10 +181,13 @@ class _PairProbes:
     """The pair tests of one two-part machine, each computed once per tolerance: the
     bisimilar cross pairs, the one-part problem, the kept cross pairs and the exact solve
     are pure in the tolerance, and the binary searches of :func:`strong_pair_critical`
-    ask several of them at the same tolerances."""
+    ask several of them at the same tolerances. Every test polls ``deadline`` (default
+    none); one it stops raises Timeout and records nothing, so no timed-out test is ever
+    remembered as "not separable"."""
 
-    def __init__(self, machine: PushAlignMachine) -> None:
+    def __init__(self, machine: PushAlignMachine, deadline: Deadline | None = None) -> None:
         self.machine = machine
+        self.deadline = deadline or Deadline()
         self._bisimilar: dict[float, list[tuple[int, int]]] = {}
         self._problems: dict[float, Problem] = {}
         self._unkept: dict[float, bool] = {}
@@ -187,7 +195,10 @@ class _PairProbes:
 
     def bisimilar(self, tolerance: float) -> list[tuple[int, int]]:
         if tolerance not in self._bisimilar:
-            self._bisimilar[tolerance] = bisimilar_cross_pairs(self.machine, tolerance)
+            self.deadline.check()
+            self._bisimilar[tolerance] = bisimilar_cross_pairs(
+                self.machine, tolerance, self.deadline
+            )
         return self._bisimilar[tolerance]
 
     def problem(self, tolerance: float) -> Problem:
@@ -198,6 +209,7 @@ class _PairProbes:
     def no_kept_cross_pair(self, tolerance: float) -> bool:
         """No bisimilar cross pair and none nature keeps apart (cheap necessary tests)."""
         if tolerance not in self._unkept:
+            self.deadline.check()
             self._unkept[tolerance] = not self.bisimilar(tolerance) and not kept_cross_pairs(
                 self.problem(tolerance)
             )
@@ -206,6 +218,7 @@ class _PairProbes:
     def separable(self, tolerance: float) -> bool:
         """:func:`separable` at ``tolerance``."""
         if tolerance not in self._separable:
+            self.deadline.check()
             self._separable[tolerance] = self.no_kept_cross_pair(tolerance) and self._solve(
                 tolerance
             )
@@ -217,13 +230,10 @@ class _PairProbes:
         # A short strong plan, when there is one, is found by the planner's depth-first
         # length search long before the exact fixpoint has explored every reachable set
         # (as :func:`feederkit.planning.api.plan` does); only a failure needs the fixpoint.
-        worst = make_oracle(problem, "auto", Deadline())
+        worst = make_oracle(problem, "auto", self.deadline)
         if all(worst.within(r, FIRST_LIMIT - 1) for r in roots):
             return True
-        try:
-            bad = unsolvable(problem, roots, Deadline())
-        except Timeout:
-            return False
+        bad = unsolvable(problem, roots, self.deadline)  # Timeout propagates: not a "no"
         return bad is not None and not bad
 
 
@@ -254,7 +264,9 @@ def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
     return kept_apart(problem, pairs)
 
 
-def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
+def strong_pair_critical(
+    mix: StrongMix, a: int, b: int, clock: DesignClock | None = None
+) -> PairCritical:
     """The critical tolerance of parts ``a`` and ``b`` of the mix for strong plans: the
     largest tolerance at which a strong plan tells them apart (:func:`separable`).
 
@@ -263,8 +275,10 @@ def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
     its goal being the same, and bisimilar cross pairs only grow). The search first finds
     the last interval without a bisimilar cross pair, then without a cross pair nature keeps
     apart (both fixpoints over pairs, cheap, monotone and necessary), and solves there; only
-    when that fails does it search the intervals below with the solver.
+    when that fails does it search the intervals below with the solver. Every test polls
+    ``clock``'s deadline (:mod:`feederkit.design.limit`).
     """
+    clock = clock or DesignClock()
     m = mix.pair(a, b)
     spans = [span(s.sensed) for s in m.states]
     sa = [x for x, s in zip(spans, m.states, strict=True) if s.part == 0]
@@ -272,7 +286,7 @@ def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
     breaks = gap_breakpoints(sa, sb)
     # Separable implies no bisimilar cross pair, which is cheap to test and monotone too:
     # its last interval bounds the answer, and is most often the answer itself.
-    probes = _PairProbes(m)
+    probes = _PairProbes(m, clock.deadline)
     k = last_true(len(breaks), lambda k: not probes.bisimilar(breaks[k]))
     if k >= 0 and not probes.no_kept_cross_pair(breaks[k]):
         k = last_true(k, lambda k: probes.no_kept_cross_pair(breaks[k]))
@@ -302,12 +316,19 @@ def strong_pair_critical(mix: StrongMix, a: int, b: int) -> PairCritical:
     return PairCritical(pa.part.name, pb.part.name, None, witness)
 
 
-def strong_mix_critical(mix: StrongMix) -> MixCritical:
-    """Every pair's critical tolerance for strong plans, in part order, and so the mix's."""
+def strong_mix_critical(mix: StrongMix, clock: DesignClock | None = None) -> MixCritical:
+    """Every pair's critical tolerance for strong plans, in part order, and so the mix's;
+    ``clock`` (:mod:`feederkit.design.limit`) is polled and told of each pair decided."""
+    clock = clock or DesignClock()
     n = len(mix.pfs)
-    return MixCritical(
-        tuple(strong_pair_critical(mix, i, j) for i in range(n) for j in range(i + 1, n))
-    )
+    clock.begin(PAIRS, n * (n - 1) // 2)
+    pairs = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            clock.check()
+            pairs.append(strong_pair_critical(mix, i, j, clock))
+            clock.advance()
+    return MixCritical(tuple(pairs))
 
 
 Goal = tuple[int, ...] | None
@@ -326,10 +347,13 @@ class StrongLengthOracle:
     :func:`feederkit.planning.api.plan` uses with the default lumping, the bisimilar
     relation, or, when no strong plan reaches it, the lumped goal of
     :func:`~feederkit.planning.lumping.try_lumping` (None when neither has a strong plan).
+    Every search polls ``deadline`` (default none) and raises Timeout when it passes; a
+    goal is recorded only when decided.
     """
 
-    def __init__(self, mix: StrongMix) -> None:
+    def __init__(self, mix: StrongMix, deadline: Deadline | None = None) -> None:
         self.mix = mix
+        self.deadline = deadline or Deadline()
         self.machine = mix.machine
         self._sorted, _old = by_diameter(self.machine)
         self._bisimilar: dict[float, tuple[int, ...]] = {}
@@ -345,7 +369,7 @@ class StrongLengthOracle:
     def bisimilar(self, tolerance: float) -> tuple[int, ...]:
         """The bisimilar relation (masks, sorted numbering) at ``tolerance`` mm."""
         if tolerance not in self._bisimilar:
-            self._bisimilar[tolerance] = goal_relation(self.at(tolerance), Deadline())
+            self._bisimilar[tolerance] = goal_relation(self.at(tolerance), self.deadline)
         return self._bisimilar[tolerance]
 
     def _problem(self, tolerance: float, goal: tuple[int, ...]):
@@ -356,7 +380,7 @@ class StrongLengthOracle:
             return found
         problem = Problem(self.at(tolerance), Grouping.EXACT, 0.0, goal)
         roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
-        worst = make_oracle(problem, "auto", Deadline())
+        worst = make_oracle(problem, "auto", self.deadline)
         self._searches[key] = (problem, worst, roots)
         while len(self._searches) > KEPT_SEARCHES:
             self._searches.popitem(last=False)
@@ -370,13 +394,12 @@ class StrongLengthOracle:
         problem, worst, roots = self._problem(tolerance, base)
         goal: Goal = base
         if not all(worst.within(r, FIRST_LIMIT - 1) for r in roots):
-            try:
-                bad = unsolvable(problem, roots, Deadline())
-            except Timeout:
-                bad = None
+            bad = unsolvable(problem, roots, self.deadline)
             if bad:
-                tried = try_lumping(self.at(tolerance), Grouping.EXACT, Deadline(),
+                tried = try_lumping(self.at(tolerance), Grouping.EXACT, self.deadline,
                                     rule=Lumping.NEAR_SYMMETRIC)  # fmt: skip
+                # try_lumping answers "undecided" when the deadline passes: not a goal.
+                self.deadline.check()
                 goal = tried.goal.insep if tried.goal is not None else None
         self._goals[tolerance] = goal
         return goal
@@ -409,18 +432,28 @@ def machine_breakpoints(machine: PushAlignMachine) -> tuple[float, ...]:
     return gap_breakpoints(spans, spans)
 
 
-def chain_changes(first: int, last: int, value: Callable[[int], object]) -> set[int]:
+def chain_changes(
+    first: int,
+    last: int,
+    value: Callable[[int], object],
+    settled: Callable[[int], None] | None = None,
+) -> set[int]:
     """Every ``k`` in ``(first, last]`` with ``value(k) != value(k - 1)``, for a ``value``
     that is a monotone chain on ``first..last`` (equal at two intervals: constant between),
-    by bisection: ``O(changes * log(last - first))`` calls."""
+    by bisection: ``O(changes * log(last - first))`` calls. ``settled(n)`` is told each
+    time ``n`` more of the ``last - first`` neighbouring pairs are decided."""
     out: set[int] = set()
     stack = [(first, last)]
     while stack:
         lo, hi = stack.pop()
         if hi <= lo or value(lo) == value(hi):
+            if settled is not None and hi > lo:
+                settled(hi - lo)
             continue
         if hi == lo + 1:
             out.add(hi)
+            if settled is not None:
+                settled(1)
             continue
         mid = (lo + hi) // 2
         stack.extend(((mid, hi), (lo, mid)))
@@ -428,29 +461,45 @@ def chain_changes(first: int, last: int, value: Callable[[int], object]) -> set[
 
 
 def goal_segments(
-    oracle: StrongLengthOracle, breaks: Sequence[float], last: int
+    oracle: StrongLengthOracle,
+    breaks: Sequence[float],
+    last: int,
+    clock: DesignClock | None = None,
 ) -> list[tuple[int, int]]:
     """The runs ``(first, last)`` of intervals ``0..last`` with one goal each: the bisimilar
-    relation's segments, each split where the lumped goal changes (module docstring)."""
+    relation's segments, each split where the lumped goal changes (module docstring).
+    ``clock`` is polled before each probe and told of the neighbouring intervals decided
+    (``2 * last`` in all: each pair once per chain)."""
+    clock = clock or DesignClock()
+    clock.begin(GOALS, 2 * last)
 
     def probe(k: int) -> float:
+        clock.check()
         return interval_probe(breaks, k)
 
-    cuts = sorted(chain_changes(0, last, lambda k: oracle.bisimilar(probe(k))))
+    cuts = sorted(chain_changes(0, last, lambda k: oracle.bisimilar(probe(k)), clock.advance))
+    clock.advance(len(cuts))  # the pairs across a cut: no goal chain spans them
     starts = set([0, *cuts])
     for s, e in zip([0, *cuts], [*(c - 1 for c in cuts), last], strict=True):
-        starts |= chain_changes(s, e, lambda k: oracle.goal(probe(k)))
+        starts |= chain_changes(s, e, lambda k: oracle.goal(probe(k)), clock.advance)
     ordered = sorted(starts)
     return list(zip(ordered, [*(c - 1 for c in ordered[1:]), last], strict=True))
 
 
 def strong_evaluation(
-    pfs: Sequence[PushFunction], uncertainty: Uncertainty, tolerance: float
+    pfs: Sequence[PushFunction],
+    uncertainty: Uncertainty,
+    tolerance: float,
+    clock: DesignClock | None = None,
 ) -> Evaluation:
     """Length and expected length of the verified optimal strong plan at ``tolerance`` mm,
-    and whether it lists states of two parts together (then it does not recognize the mix)."""
+    and whether it lists states of two parts together (then it does not recognize the mix),
+    within what is left of ``clock``'s limit (:meth:`DesignClock.plan`)."""
     sensor = ToleranceSensor(tolerance)
-    result = make_plan(list(pfs), sensor, uncertainty=uncertainty, certify=False).result
+    clock = clock or DesignClock()
+    result = clock.plan(
+        lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=uncertainty, certify=False)
+    ).result
     states = result.machine.states
     mixed = any(states[i].part != states[j].part for i, j in result.lumped_pairs)
     return Evaluation(result.length, result.expected_length, mixed)
@@ -462,30 +511,39 @@ def strong_length_steps(
     critical: MixCritical,
     oracle: StrongLengthOracle | None = None,
     evaluate: Callable[[float], Evaluation] | None = None,
+    clock: DesignClock | None = None,
 ) -> tuple[LengthStep, ...]:
     """The strong plan length's steps over tolerances ``(0, up_to]`` (None: every interval),
     as :func:`feederkit.design.steps.length_steps` on the ideal model, segment by segment of
-    constant goal; a segment with no strong plan is one step of length None."""
-    oracle = oracle or StrongLengthOracle(mix)
+    constant goal; a segment with no strong plan is one step of length None. ``clock``
+    (:mod:`feederkit.design.limit`): the time limit every search polls (the default
+    oracle's and plans'), told of the goal search's probes and of each run decided."""
+    clock = clock or DesignClock()
+    oracle = oracle or StrongLengthOracle(mix, clock.deadline)
     breaks = machine_breakpoints(oracle.machine)
-    evaluate = evaluate or (lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e))
+    evaluate = evaluate or (lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e, clock))
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     below = recognizable_below(breaks, critical)
     fits: dict[tuple[int, int], bool] = {}
 
     def fit(k: int, length: int) -> bool:
         if (k, length) not in fits:
+            clock.check()
             fits[k, length] = oracle.within(interval_probe(breaks, k), length)
         return fits[k, length]
 
     steps = []
-    for first, j_last in goal_segments(oracle, breaks, last):
+    segments = goal_segments(oracle, breaks, last, clock)
+    clock.begin(LENGTHS, last + 1)
+    for first, j_last in segments:
         lo = 0.0 if first == 0 else breaks[first - 1]
         if oracle.goal(interval_probe(breaks, first)) is None:
             hi = breaks[j_last] if j_last < len(breaks) else None
             steps.append(LengthStep(lo, hi, None, None, False))
+            clock.advance(j_last + 1 - first)
             continue
-        for i, j, length, ev in _segment_runs(first, j_last, breaks, oracle, fit, evaluate):
+        runs = _segment_runs(first, j_last, breaks, oracle, fit, evaluate, clock)
+        for i, j, length, ev in runs:
             if ev.length != length:
                 raise CheckFailed(
                     f"the verified strong plan at {interval_probe(breaks, j):g} mm has length "
@@ -509,12 +567,13 @@ class StrongPitch:
     no_plan: str | None = None
 
 
-def strong_pitch(mix: StrongMix, sensor: Sensor) -> StrongPitch:
+def strong_pitch(mix: StrongMix, sensor: Sensor, clock: DesignClock | None = None) -> StrongPitch:
     """Decide one LED array (``sensor``) for strong plans: bisimilar cross pairs of the mix
     machine, then (when there are none) a verified strong plan, whose results must not list
-    two parts together."""
+    two parts together; every search polls ``clock``'s deadline."""
+    clock = clock or DesignClock()
     machine = replace(mix.machine, sensor=sensor)
-    masks = inseparable_masks(machine)
+    masks = inseparable_masks(machine, clock.check)
     states = machine.states
     names = machine.part_names
     bad = sorted(
@@ -527,9 +586,13 @@ def strong_pitch(mix: StrongMix, sensor: Sensor) -> StrongPitch:
     )
     if bad:
         return StrongPitch(tuple((names[a], names[b]) for a, b in bad), None, None)
-    if not strong_plan_exists(machine):
+    exists = strong_plan_exists(machine, deadline=clock.deadline)
+    clock.check()  # it answers True when its deadline passed: not a decision
+    if not exists:
         return StrongPitch((), None, None, NO_STRONG_PLAN)
-    result = make_plan(mix.pfs, sensor, uncertainty=mix.uncertainty, certify=False).result
+    result = clock.plan(
+        lambda opts: make_plan(mix.pfs, sensor, opts, uncertainty=mix.uncertainty, certify=False)
+    ).result
     rs = result.machine.states
     lumped = sorted(
         {

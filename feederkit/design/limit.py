@@ -1,0 +1,159 @@
+"""The time limit of a sensor design, and its progress (docs/design.md, "Time limit").
+
+A design is exact or it is nothing: a critical tolerance decided on a search cut short would
+be understated, a length table cut short would stop at a step that is not the last. So a
+design runs under one :class:`~feederkit.planning.budget.Deadline`: every loop of the design
+polls it (per pair, per probe of the binary searches, per step of the table), every planner
+search it calls gets it (the inseparability fixpoints, the AND/OR length oracle, the exact
+solver, the verified plans through their own time limit), and a search that runs out raises
+:class:`~feederkit.planning.budget.Timeout` through every cache (a probe that timed out is
+never recorded as "not separable"). The design's entry points turn it into
+:class:`DesignTimeout`, one line saying what was decided; no half-computed design is ever
+returned.
+
+Progress is a plain callback (no terminal library here): ``progress(what, done, total)``
+each time a pair, a probe of the goal search, a run of the table or a pitch is decided.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+from feederkit.errors import InputError, PlanningError
+from feederkit.planning.api import FALLBACK_SHARE, TIES_EXACT
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.options import PlanningOptions
+from feederkit.plans.make import MadePlan
+
+Progress = Callable[[str, int, int], None]
+"""``progress(what, done, total)``: ``done`` of ``total`` items of the stage ``what`` decided."""
+
+PAIRS = "deciding the pairs' critical tolerances"
+GOALS = "finding where the planner's goal changes"
+LENGTHS = "tabulating the plan lengths"
+PITCHES = "deciding the LED pitches"
+
+_NOUNS = {
+    PAIRS: "pairs",
+    GOALS: "steps of the length table's goal search",
+    LENGTHS: "tolerance intervals of the length table",
+    PITCHES: "LED pitches",
+}
+
+
+class DesignTimeout(PlanningError):
+    """The sensor design did not finish within its time limit (nothing partial is returned).
+
+    A :class:`~feederkit.errors.PlanningError` (exit 1), as ``plan``'s "no plan found within
+    the time limit".
+    """
+
+
+def check_time_limit(seconds: float | None) -> float | None:
+    """``seconds`` as a float; InputError unless None or a positive finite number (the
+    planner's wording, :class:`~feederkit.planning.options.PlanningOptions`)."""
+    if seconds is None:
+        return None
+    if (
+        isinstance(seconds, bool)
+        or not isinstance(seconds, int | float)
+        or not (math.isfinite(seconds) and seconds > 0.0)
+    ):
+        raise InputError(f"the time limit must be a positive number of seconds, got {seconds}")
+    return float(seconds)
+
+
+class DesignClock:
+    """One design's deadline (``time_limit_s`` seconds from now; None: none) and where it
+    stands: the stage running, how much of it is decided, the stages finished.
+
+    Mutable on purpose (it counts as the design runs); a design makes its own.
+    """
+
+    def __init__(self, time_limit_s: float | None = None, progress: Progress | None = None):
+        self.time_limit_s = check_time_limit(time_limit_s)
+        self.deadline = Deadline(self.time_limit_s)
+        self._progress = progress
+        self.stage: str | None = None
+        self.done = 0
+        self.total = 0
+        self.finished: list[tuple[str, int]] = []
+
+    def check(self) -> None:
+        """Raise Timeout once the time limit has passed."""
+        self.deadline.check()
+
+    def begin(self, stage: str, total: int) -> None:
+        """Start ``stage`` of ``total`` items (the previous stage is finished)."""
+        if self.stage is not None:
+            self.finished.append((self.stage, self.total))
+        self.stage, self.done, self.total = stage, 0, total
+        self._report()
+
+    def advance(self, count: int = 1) -> None:
+        """``count`` more items of the stage decided."""
+        self.done = min(self.total, self.done + count)
+        self._report()
+
+    def _report(self) -> None:
+        if self._progress is not None and self.stage is not None:
+            self._progress(self.stage, self.done, self.total)
+
+    def timeout(self) -> DesignTimeout:
+        """The one-line error of a design stopped at the limit, naming what was decided."""
+        decided = [f"all {t} {_NOUNS[s]}" for s, t in self.finished]
+        if self.stage is not None:
+            decided.append(f"{self.done} of {self.total} {_NOUNS[self.stage]}")
+        if not decided:
+            decided = ["nothing yet"]
+        what = " and ".join(filter(None, (", ".join(decided[:-1]), decided[-1])))
+        return DesignTimeout(
+            f"the sensor design did not finish within the time limit of "
+            f"{self.time_limit_s:g} s (it decided {what}); no partial design is given"
+        )
+
+    def plan(self, make: Callable[[PlanningOptions | None], MadePlan]) -> MadePlan:
+        """``make(options)`` (a verified plan) within what is left of the limit.
+
+        Unlimited: ``make(None)``, the planner's defaults. Limited: the planner gets the time
+        left as its own limit, and any answer that may come from its budget rather than from
+        the search is a Timeout here: a plan not proven optimal, and a PlanningError or
+        tie-breaks left undecided once the planner's exact stages may have used up their
+        share of it (``1 - FALLBACK_SHARE``: its fallback answers then, and the expected
+        number of operations would not be the unlimited design's).
+        """
+        if self.time_limit_s is None:
+            return make(None)
+        self.check()
+        left = self.deadline.remaining() or 0.0
+        if left <= 0.0:
+            raise Timeout("time")
+        exact_end = time.perf_counter() + (1.0 - FALLBACK_SHARE) * left
+        try:
+            made = make(PlanningOptions(time_limit_s=left))
+        except PlanningError:
+            # After its exact stages ran out the planner's fallback may give up early.
+            if time.perf_counter() >= exact_end or self.deadline.expired():
+                raise Timeout("time") from None
+            raise
+        result = made.result
+        if not result.optimal:
+            raise Timeout("time")
+        if result.tie_breaks != TIES_EXACT and time.perf_counter() >= exact_end:
+            raise Timeout("time")
+        self.check()
+        return made
+
+
+__all__ = [
+    "GOALS",
+    "LENGTHS",
+    "PAIRS",
+    "PITCHES",
+    "DesignClock",
+    "DesignTimeout",
+    "Progress",
+    "check_time_limit",
+]

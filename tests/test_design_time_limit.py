@@ -1,0 +1,368 @@
+"""``design sensor``'s time limit and progress (docs/design.md, "Time limit").
+
+A design is exact or nothing: past the limit it raises DesignTimeout (one line naming what
+was decided) within a small overshoot, a search cut short never becomes an answer (cut at
+any poll, a design either times out or equals the unlimited one), and an unlimited run, or
+one that finishes within its limit, is the design of today byte for byte.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import time
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+from shared import one_line_error
+
+import feederkit.cli.app as app_module
+import feederkit.cli.common as cli_common
+from feederkit.cli import design as design_cli
+from feederkit.cli.app import main
+from feederkit.design import strong
+from feederkit.design.critical import mix_critical_tolerance
+from feederkit.design.limit import (
+    GOALS,
+    LENGTHS,
+    PAIRS,
+    PITCHES,
+    DesignClock,
+    DesignTimeout,
+)
+from feederkit.design.sensor import design_pitches, design_tolerance
+from feederkit.design.steps import length_steps
+from feederkit.design.strong import (
+    StrongLengthOracle,
+    StrongMix,
+    _PairProbes,
+    strong_length_steps,
+    strong_mix_critical,
+)
+from feederkit.errors import InputError, PlanningError
+from feederkit.loading import load_parts
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.lumping import LumpingTry
+from feederkit.sensors import LedSensor
+from feederkit.uncertainty import IDEAL, Uncertainty
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+MIX = [str(CATALOG / f"{n}.json") for n in ("quadrilateral", "rectangle-2x1", "l-bracket")]
+ONE_DEGREE = Uncertainty(1.0, 0.0, 0.0)
+
+OVERSHOOT_S = 1.5
+"""How far past its limit a design may stop (the work after the last poll: the planner's own
+overshoot, test_deadline.py, and the verification of a plan found at the deadline)."""
+
+
+def ellipse_mix(count: int):
+    """Random 6- to 10-gons on one 60 x 40 mm ellipse (benchmarks/bench_design.py): similar
+    parts whose plans near the critical tolerance take minutes to prove."""
+    out = []
+    for s in range(count):
+        rng = random.Random(100 + s)
+        n = random.Random(s).randint(6, 10)
+        angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
+        pts = [(30 * math.cos(t), 20 * math.sin(t)) for t in angles]
+        out.append(push_function(make_part(make_outline(f"mix-{s}", pts))))
+    return out
+
+
+@pytest.fixture(scope="module")
+def catalog_mix():
+    return list(load_parts(MIX).push_functions)
+
+
+def _timed_out(run, limit: float) -> tuple[DesignTimeout, list[str]]:
+    """Run ``run(time_limit_s, progress)``, which must time out within the overshoot; the
+    error and the stages it reported."""
+    stages: list[str] = []
+
+    def progress(what: str, done: int, total: int) -> None:
+        assert 0 <= done <= total
+        if not stages or stages[-1] != what:
+            stages.append(what)
+
+    start = time.perf_counter()
+    with pytest.raises(DesignTimeout) as info:
+        run(limit, progress)
+    took = time.perf_counter() - start
+    assert took <= limit + OVERSHOOT_S, f"stopped {took - limit:.2f} s past the limit"
+    message = str(info.value)
+    assert "\n" not in message and isinstance(info.value, PlanningError)
+    assert message.startswith(
+        f"the sensor design did not finish within the time limit of {limit:g} s"
+    )
+    assert message.endswith("no partial design is given")
+    return info.value, stages
+
+
+def test_a_hard_mix_stops_at_the_limit_while_deciding_pairs():
+    pfs = ellipse_mix(6)  # 15 pairs, seconds of exact solves at 1 degree
+    err, stages = _timed_out(
+        lambda t, p: design_tolerance(pfs, uncertainty=ONE_DEGREE, time_limit_s=t, progress=p), 0.4
+    )
+    assert stages == [PAIRS]
+    assert " of 15 pairs)" in str(err)
+
+
+def test_a_hard_mix_stops_at_the_limit_in_a_verified_plan():
+    # The ideal model: the pairs take milliseconds, the first plan of the table (at the
+    # critical tolerance) minutes; the planner stops at the time left.
+    pfs = ellipse_mix(5)
+    err, stages = _timed_out(
+        lambda t, p: design_tolerance(pfs, uncertainty=IDEAL, time_limit_s=t, progress=p), 1.0
+    )
+    assert stages[0] == PAIRS
+    if stages[-1] == LENGTHS:  # the pairs done (they always are, unless the machine crawls)
+        assert "all 10 pairs and 0 of " in str(err) and "intervals of the length table" in str(err)
+
+
+def test_a_hard_mix_stops_at_the_limit_in_the_goal_search():
+    pfs = ellipse_mix(3)  # strong plans: the goal search alone takes seconds
+    err, stages = _timed_out(
+        lambda t, p: design_tolerance(pfs, uncertainty=ONE_DEGREE, time_limit_s=t, progress=p), 1.0
+    )
+    assert stages[0] == PAIRS and set(stages) <= {PAIRS, GOALS, LENGTHS}
+    if GOALS in stages:
+        assert "all 3 pairs" in str(err)
+
+
+def test_pitches_stop_at_the_limit():
+    pfs = ellipse_mix(6)
+    err, stages = _timed_out(
+        lambda t, p: design_pitches(
+            pfs, [0.1, 0.5, 1.0, 2.0], uncertainty=ONE_DEGREE, time_limit_s=t, progress=p
+        ),
+        0.3,
+    )
+    assert stages[0] == PITCHES
+
+
+class CutAt(Deadline):
+    """A deadline that passes at its ``polls``-th check: a cut at an exact point of the work."""
+
+    def __init__(self, polls: int) -> None:
+        super().__init__()
+        self.left = polls
+
+    def check(self) -> None:
+        self.left -= 1
+        if self.left < 0:
+            raise Timeout("time")
+
+
+def test_a_cut_at_any_poll_times_out_or_gives_the_unlimited_design(catalog_mix):
+    """Caches survive cuts (one mix machine for every cut) and never hold a cut answer: the
+    reference is computed on a machine of its own."""
+    mix = StrongMix(catalog_mix, ONE_DEGREE)
+    fresh = StrongMix(catalog_mix, ONE_DEGREE)
+    critical = strong_mix_critical(fresh)
+    steps = strong_length_steps(fresh, critical.critical_tolerance, critical)
+    outcomes = []
+    for polls in (0, 3, 30, 300, 3000, 10**6):
+        clock = DesignClock()
+        clock.deadline = CutAt(polls)
+        try:
+            got = strong_mix_critical(mix, clock)
+            got_steps = strong_length_steps(mix, got.critical_tolerance, got, clock=clock)
+        except Timeout:
+            outcomes.append("cut")
+            continue
+        assert got == critical and got_steps == steps
+        outcomes.append("same")
+    assert outcomes[0] == "cut" and outcomes[-1] == "same"
+
+
+def test_a_cut_on_the_ideal_model_times_out_or_gives_the_unlimited_design(catalog_mix):
+    critical = mix_critical_tolerance(catalog_mix)
+    steps = length_steps(catalog_mix, critical.critical_tolerance, critical=critical)
+    outcomes = []
+    for polls in (0, 3, 30, 300, 10**6):
+        clock = DesignClock()
+        clock.deadline = CutAt(polls)
+        try:
+            got = mix_critical_tolerance(catalog_mix, clock)
+            x = got.critical_tolerance
+            got_steps = length_steps(catalog_mix, x, critical=got, clock=clock)
+        except Timeout:
+            outcomes.append("cut")
+            continue
+        assert got == critical and got_steps == steps
+        outcomes.append("same")
+    assert outcomes[0] == "cut" and outcomes[-1] == "same"
+
+
+class PassesWhenTold(Deadline):
+    """A deadline that passes when ``passed`` is set (a search's end, simulated)."""
+
+    passed = False
+
+    def check(self) -> None:
+        if self.passed:
+            raise Timeout("time")
+
+
+class NeverWithin:
+    """A length oracle that finds no short plan (so the exact solver is asked)."""
+
+    def within(self, mask: int, length: int) -> bool:
+        return False
+
+
+def _solver_runs_out(deadline: PassesWhenTold):
+    def unsolvable(problem, roots, budget=None, max_sets=None):
+        assert budget is deadline
+        deadline.passed = True
+        raise Timeout("time")
+
+    return unsolvable
+
+
+def test_a_pair_test_cut_short_raises_and_is_not_remembered(catalog_mix, monkeypatch):
+    mix = StrongMix(catalog_mix, ONE_DEGREE)
+    machine = mix.pair(0, 1)
+    tolerance = strong_mix_critical(mix).pairs[0].critical_tolerance
+    assert _PairProbes(machine).separable(tolerance)
+    expired = _PairProbes(machine, Deadline(end=time.perf_counter() - 1.0))
+    with pytest.raises(Timeout):
+        expired.separable(tolerance)
+    # The exact solver is cut short: that is no "not separable".
+    deadline = PassesWhenTold()
+    probes = _PairProbes(machine, deadline)
+    monkeypatch.setattr(strong, "make_oracle", lambda problem, method, budget: NeverWithin())
+    monkeypatch.setattr(strong, "unsolvable", _solver_runs_out(deadline))
+    with pytest.raises(Timeout):
+        probes.separable(tolerance)
+    assert tolerance not in probes._separable
+    monkeypatch.undo()
+    deadline.passed = False
+    assert probes.separable(tolerance)
+
+
+def test_a_goal_cut_short_raises_and_is_not_remembered(catalog_mix, monkeypatch):
+    mix = StrongMix(catalog_mix, ONE_DEGREE)
+    tolerance = 0.5
+    expected = StrongLengthOracle(mix).goal(tolerance)
+    deadline = PassesWhenTold()
+    oracle = StrongLengthOracle(mix, deadline)
+    monkeypatch.setattr(strong, "make_oracle", lambda problem, method, budget: NeverWithin())
+    monkeypatch.setattr(strong, "unsolvable", _solver_runs_out(deadline))
+    with pytest.raises(Timeout):
+        oracle.goal(tolerance)
+    # Lumping answers "undecided" (no goal) when its deadline passes: no "no strong plan".
+    deadline.passed = False
+    monkeypatch.setattr(strong, "unsolvable", lambda problem, roots, budget=None: [roots[0]])
+
+    def try_lumping(machine, grouping, budget, rule):
+        deadline.passed = True
+        return LumpingTry(None, decided=False)
+
+    monkeypatch.setattr(strong, "try_lumping", try_lumping)
+    with pytest.raises(Timeout):
+        oracle.goal(tolerance)
+    assert not oracle._goals
+    monkeypatch.undo()
+    deadline.passed = False
+    assert oracle.goal(tolerance) == expected
+
+
+def test_a_strong_plan_search_cut_short_is_not_an_answer(catalog_mix, monkeypatch):
+    mix = StrongMix(catalog_mix, ONE_DEGREE)
+    clock = DesignClock()
+    clock.deadline = passing = PassesWhenTold()
+
+    def exists(machine, options=None, deadline=None):
+        assert deadline is passing
+        passing.passed = True
+        return True  # what it answers when its deadline passes
+
+    monkeypatch.setattr(strong, "strong_plan_exists", exists)
+    with pytest.raises(Timeout):
+        strong.strong_pitch(mix, LedSensor(1.0), clock)
+
+
+@pytest.mark.parametrize("uncertainty", [IDEAL, ONE_DEGREE], ids=["ideal", "1deg"])
+def test_within_the_limit_the_design_is_the_unlimited_one(catalog_mix, uncertainty):
+    seen: dict[str, list[tuple[int, int]]] = {}
+
+    def progress(what: str, done: int, total: int) -> None:
+        seen.setdefault(what, []).append((done, total))
+
+    plain = design_tolerance(catalog_mix, uncertainty=uncertainty)
+    timed = design_tolerance(catalog_mix, uncertainty=uncertainty, time_limit_s=60.0,
+                             progress=progress)  # fmt: skip
+    assert json.dumps(timed.to_dict()) == json.dumps(plain.to_dict())
+    order = [PAIRS, LENGTHS] if uncertainty.is_ideal else [PAIRS, GOALS, LENGTHS]
+    assert list(seen) == order
+    for calls in seen.values():
+        dones = [d for d, _ in calls]
+        assert dones == sorted(dones) and calls[-1][0] == calls[-1][1]
+    assert seen[PAIRS][-1] == (3, 3)
+    pitches = design_pitches(catalog_mix, [1.0], uncertainty=uncertainty)
+    limited = design_pitches(catalog_mix, [1.0], uncertainty=uncertainty, time_limit_s=60.0)
+    assert json.dumps(limited.to_dict()) == json.dumps(pitches.to_dict())
+
+
+@pytest.mark.parametrize("limit", [0, -1.0, math.nan, math.inf, True])
+def test_a_bad_time_limit_is_input_error(catalog_mix, limit):
+    with pytest.raises(InputError, match="time limit must be a positive number of seconds"):
+        design_tolerance(catalog_mix, time_limit_s=limit)
+
+
+# The command line.
+
+
+@pytest.fixture
+def in_tmp(tmp_path, monkeypatch):
+    """The command on the app, run from an empty folder (no stray profile or catalog)."""
+    group = app_module._click_command()
+    if "design" not in getattr(group, "commands", {}):
+        design_cli.register(app_module.app)
+        app_module._click_command.cache_clear()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
+    return tmp_path
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan"])
+def test_cli_bad_time_limit_is_one_line_exit_2(capsys, in_tmp, value):
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--time-limit", value])
+    assert err.startswith("error: the time limit must be a positive number of seconds")
+    assert "(--time-limit)" in err
+
+
+def test_cli_timeout_is_one_line_exit_1(capsys, in_tmp):
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--time-limit", "0.001"], code=1)
+    assert err.startswith(
+        "result: the sensor design did not finish within the time limit of 0.001 s"
+    )
+    assert " of 3 pairs" in err and err.rstrip().endswith("allow more time with --time-limit S")
+    assert not list(in_tmp.iterdir())
+
+
+def test_cli_json_stays_clean_with_the_progress_bar_shown(capsys, in_tmp, monkeypatch):
+    monkeypatch.setattr(
+        cli_common, "err_console", Console(stderr=True, force_terminal=True, width=120)
+    )
+    assert main(["design", "sensor", *MIX, "--json"]) == 0
+    captured = capsys.readouterr()
+    data = json.loads(captured.out)
+    assert data["sensor_model"] == "tolerance" and data["critical_tolerance_mm"] > 0
+    assert "pairs' critical tolerances" in captured.err  # the bar was drawn, on stderr
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("uncertainty", [IDEAL, ONE_DEGREE], ids=["ideal", "1deg"])
+def test_the_benchmark_ellipse_mix_stops_at_the_limit(uncertainty):
+    """The benchmark's 20-part ellipse mix (minutes uncapped, and gigabytes) stops in time."""
+    pfs = ellipse_mix(20)
+    _timed_out(
+        lambda t, p: design_tolerance(pfs, uncertainty=uncertainty, time_limit_s=t, progress=p),
+        5.0,
+    )
