@@ -24,7 +24,7 @@ from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import Refiner, TieBudget
+from feederkit.planning.refine import Refiner, TieBudget, child_masses
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
@@ -175,3 +175,70 @@ def test_cells_from_the_cell_table_are_the_boundary_cells(monkeypatch):
     monkeypatch.setattr(search_space(m), "cells_and_images", lambda mask: None)
     slow = Problem(m).choices
     assert got == [(slow.cells(x, False), slow.cells(x, True)) for x in masks]
+
+
+def test_open_probabilities_from_neighbours_are_the_whole_images():
+    # Readings.open_probability works per (previous, state, next) triple; the sensor's
+    # closed form over the whole image must give the same floats.
+    m = by_diameter(build_machine(small_mix(6), ToleranceSensor(1.5), IDEAL))[0]
+    problem = Problem(m)
+    readings = problem.readings
+    sensor = m.sensor
+    rng = random.Random(4)
+    checked = 0
+    for _ in range(300):
+        image = rng.getrandbits(m.n) & rng.getrandbits(m.n) or 1 << rng.randrange(m.n)
+        got = readings.open_probability(image)
+        idx = members(image)
+        if any(problem.insep[i] & image for i in idx):
+            assert got is None
+            continue
+        whole = sensor.shared_reading_probability([m.states[i].sensed for i in idx])
+        assert got == dict(zip(idx, whole, strict=True))
+        checked += 1
+    assert checked > 100
+
+
+def _fewest_expected(problem, mask, masses, k, floor, memo) -> float:
+    """The fewest expected operations within ``k`` keeping ``floor``: every action, every
+    branch set, the margins by the max-min recursion (no feasibility probes)."""
+    if problem.is_goal(mask):
+        return 0.0
+    if k <= 0:
+        return math.inf
+    best = math.inf
+    for act in problem.choices.exact_actions(mask):
+        if act.action.margin < floor:
+            continue
+        if any(_max_min(problem, c, k - 1, memo) < floor for c in act.children):
+            continue
+        val = 1.0
+        for b, pb, ms in child_masses(problem, mask, masses, act):
+            if pb > 0.0:
+                val += pb * _fewest_expected(problem, b.mask, ms, k - 1, floor, memo)
+        best = min(best, val)
+    return best
+
+
+DEEPER = [("6-part mix at 3 mm", build_machine(small_mix(6), ToleranceSensor(3.0), IDEAL))]
+"""Root branches of three further operations: the expected stage recurses below its
+two-operation shortcut."""
+
+
+@pytest.mark.parametrize(
+    ("name", "machine"), MACHINES + DEEPER, ids=[n for n, _ in MACHINES + DEEPER]
+)
+def test_the_expected_stage_is_the_fewest_expected_operations_keeping_the_floor(name, machine):
+    refiner, every, k = _proven(machine)
+    refiner.floor = refiner.largest_floor(every, k)
+    problem = refiner.p
+    start = tuple(s.weight for s in problem.machine.states)
+    branches = tuple(problem.readings.branches(problem.full))
+    children = child_masses(problem, problem.full, start, None, branches)
+    # The branches that need every operation (the deepest searches), at most four of them.
+    deep = [c for c in children if not refiner.w.within(c[0].mask, k - 1)][:4]
+    assert deep
+    memo: dict = {}
+    for b, _pb, ms in deep:
+        want = _fewest_expected(problem, b.mask, ms, k, refiner.floor, memo)
+        assert refiner.expected(b.mask, ms, k)[0][0] == pytest.approx(want, abs=1e-9), name

@@ -131,10 +131,11 @@ def child_masses(
         ]
     else:
         table = problem.readings.branch_table(act.action.image)
+    get = moved.get
     for b, idx, probs in table:
-        ws = [moved.get(s, 0.0) * p for s, p in zip(idx, probs, strict=True)]
+        ws = [get(s, 0.0) * p for s, p in zip(idx, probs, strict=True)]
         total = sum(ws)
-        norm = tuple(w / total if total > 0.0 else 1.0 / len(idx) for w in ws)
+        norm = tuple([w / total for w in ws]) if total > 0.0 else (1.0 / len(idx),) * len(idx)
         out.append((b, total, norm))
     return out
 
@@ -166,6 +167,8 @@ class Refiner:
         what a plan keeps when the margin stage runs out of time."""
         self.costs = costs
         self.timed = timed
+        self._monotone = problem.min_margin == 0.0 and not problem.sensorless
+        """Margins and lengths are monotone under subsets: the maximal branches decide."""
         self._lo: dict[tuple[int, int], float] = {}
         self._le: dict[tuple[int, int], float] = {}
         self._lt: dict[tuple[int, int], float] = {}
@@ -242,6 +245,14 @@ class Refiner:
             return True
         return all(self.keeps(c, k - 1, self.floor) for c in self._deciding(act))
 
+    def _keeps_floor(self, act: Act, k: int) -> bool:
+        """:meth:`allowed` of an action already known :meth:`feasible` within ``k - 1``."""
+        if act.action.margin < self.floor:
+            return False
+        if self.floor == -math.inf:
+            return True
+        return all(self.keeps(c, k - 1, self.floor) for c in self._deciding(act))
+
     def _deciding(self, act: Act) -> tuple[int, ...]:
         """The branches of ``act`` whose margins decide whether it keeps a floor: its
         maximal ones without a margin floor of the problem's (a subset keeps any margin
@@ -273,6 +284,9 @@ class Refiner:
         lt = self._lt.get(key)
         if lt is not None and lt <= x:
             return False
+        if self._short(mask, k):
+            self._lt[key] = -math.inf
+            return False
         self.deadline.check()
         found = self._keeping_plan(mask, k, x, strict)
         if found is not None:
@@ -283,6 +297,16 @@ class Refiner:
         else:
             self._lt[key] = x if lt is None else min(lt, x)
         return False
+
+    def _short(self, mask: int, k: int) -> bool:
+        """Whether the length search has already proven that ``mask`` needs more than ``k``
+        operations (its exact lengths, lower bounds and hardest pairs, no search): then no
+        plan within ``k`` keeps any margin."""
+        w = self.w
+        e = w.exact.get(mask)
+        if e is not None:
+            return e > k
+        return w.lb.get(mask, 1) > k or mask in w.never or w.pair_bound(mask) > k
 
     def _keeping_plan(self, mask: int, k: int, x: float, strict: bool) -> float | None:
         """The smallest margin of a plan for ``mask`` within ``k`` keeping ``x`` (as
@@ -305,7 +329,9 @@ class Refiner:
                     continue
             elif self.p.min_margin == 0.0:
                 children = self.p.readings.children(cell[2])
-                if not all(self.w.within(c, k - 1) for c in children):
+                # Keeping x needs a plan within k - 1: with a margin to keep the probes
+                # below decide alone; any plan at all is the length search's question.
+                if x == -math.inf and not all(self.w.within(c, k - 1) for c in children):
                     continue
             else:
                 self.deadline.check()  # each action costs a reading split
@@ -379,8 +405,7 @@ class Refiner:
             if (cell[1] - cell[0]) / 2.0 >= self.floor:
                 # Every branch not yet oriented needs at least one more operation.
                 sa = OverlapRange(*cell)
-                act0 = Act(sa, ())
-                step = self._step(act0)[0]
+                step = 1.0 if self.costs is None else self._step(Act(sa, ()))[0]
                 bound = step + least * self._open_mass(mask, masses, sa)
                 options.append((bound, sa.representative, cell))
         options.sort(key=lambda o: (o[0], o[1]))
@@ -390,12 +415,23 @@ class Refiner:
         for bound, _rot, cell in options:
             if bound > best[0] + _TIE:
                 break
-            if self.feasible_image(cell[2], k - 1) is False:
-                continue  # not allowed: decided before making the exact branches
-            self.deadline.check()
-            act = self.p.choices.act(mask, cell, exact=True)
-            if not self.allowed(act, k):
-                continue
+            if self._monotone and self.floor > -math.inf:
+                # Keeping the floor within k - 1 needs a plan within k - 1: the margin probes
+                # on the maximal branches decide alone, before the exact branches are made.
+                if not all(
+                    self.keeps(c, k - 1, self.floor) for c in self.p.readings.children(cell[2])
+                ):
+                    continue
+                self.deadline.check()
+                act = self.p.choices.act(mask, cell, exact=True)
+            else:
+                by_image = self.feasible_image(cell[2], k - 1)
+                if by_image is False:
+                    continue  # not allowed: decided before making the exact branches
+                self.deadline.check()
+                act = self.p.choices.act(mask, cell, exact=True)
+                if not (self._keeps_floor(act, k) if by_image else self.allowed(act, k)):
+                    continue
             if shortcut:
                 val = (bound, 0.0)  # each open branch then takes exactly one more operation
             else:
@@ -422,10 +458,11 @@ class Refiner:
         if self.costs is None:
             # Without costs the cells' own order is (larger margin, smaller rotation):
             # make the exact branches only of the cells that can orient the set at once.
+            # The margin floor and the image are asked first (``allowed`` asks them too).
             acts = (
                 self.p.choices.act(mask, c, exact=True)
                 for c in self.p.choices.cells(mask, useful=False)
-                if self.feasible_image(c[2], 0) is not False
+                if (c[1] - c[0]) / 2.0 >= self.floor and self.feasible_image(c[2], 0) is not False
             )
         else:
             made = [self.p.choices.act(mask, c, exact=True) for c in self.cells(mask, True)]
@@ -538,9 +575,15 @@ class Refiner:
                 return hit
         self.deadline.check()
         act = chooser(mask, masses, k)
-        subs = []
-        for b, _pb, ms in child_masses(self.p, mask, masses, act):
-            subs.append((b, self.build(b.mask, ms, k - 1, chooser, shared)))
+        table = self.p.readings.branch_table(act.action.image)
+        if all(self.p.is_goal(b.mask) for b, _idx, _probs in table):
+            # Every branch is oriented: leaves, whose masses nothing reads.
+            subs = [(b, Leaf(b.mask)) for b, _idx, _probs in table]
+        else:
+            subs = [
+                (b, self.build(b.mask, ms, k - 1, chooser, shared))
+                for b, _pb, ms in child_masses(self.p, mask, masses, act)
+            ]
         node = Step(act.action, tuple(subs))
         if shared is not None:
             shared[(mask, k)] = node

@@ -102,8 +102,8 @@ def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], floa
             state = machine.successor(state, node.action.representative)
         total = cost(node)
         for b, sub in holding(node, state):
-            if not b.mask >> state & 1:
-                continue
+            if not b.mask >> state & 1 or isinstance(sub, Leaf):
+                continue  # a leaf adds p * 0.0: nothing
             p = probs.get((b.lo, b.hi, state))
             if p is None:
                 p = probs[(b.lo, b.hi, state)] = reading_probability(machine, b, state)
@@ -137,8 +137,8 @@ def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step],
         total = cost(node)
         for t in outs:
             for b, sub in holding(node, t):
-                if not b.mask >> t & 1:
-                    continue
+                if not b.mask >> t & 1 or isinstance(sub, Leaf):
+                    continue  # a leaf adds p * 0.0 / len(outs): nothing
                 p = probs.get((b.lo, b.hi, t))
                 if p is None:
                     p = probs[(b.lo, b.hi, t)] = reading_probability(machine, b, t)
