@@ -12,7 +12,8 @@ length, the smallest margin, the expected operations (``repr``), ``tie_breaks``,
 ``optimal``, the lower bound, and the plan's nodes in a canonical walk (structurally equal
 subplans numbered once, in the order a depth-first walk meets them, so how the planner
 shares nodes in memory does not show). The tie-breaking budget is lifted
-(``api.TIE_SHARE``), so a busy machine does not change a plan.
+(``api.TIE_SHARE``), so every tie-break is compared in full (a change that makes the
+stages poll less would otherwise move where a budget of polls cuts them).
 """
 
 from __future__ import annotations

@@ -3,9 +3,9 @@
 The largest smallest margin is decided by feasibility probes ("a plan within k keeping
 every margin >= m", ``Refiner.keeps``) on the maximal reading branches; here it is checked
 against the plain max-min recursion over every action and every branch set. The stages
-run under a budget bounded by the length proof's CPU time (``api.TIE_SHARE``,
-``api.TIE_GRACE_S``); out of it the plan keeps the proven length and says which
-tie-breaks are exact.
+run under a budget of work bounded by the length proof's (``api.TIE_SHARE``,
+``api.TIE_GRACE_POLLS``), so a machine gives the same plan however fast the computer; out
+of it the plan keeps the proven length and says which tie-breaks are exact.
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ from test_planners import check_plan, random_convex
 
 import feederkit.planning.api as api
 from feederkit.machine import build_machine, members, search_space
-from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import Refiner, TieBudget, child_masses
+from feederkit.planning.refine import Refiner, child_masses
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
@@ -108,7 +108,7 @@ def _exact_plan():
 
 def test_with_no_time_for_ties_the_plan_keeps_the_proven_length(monkeypatch):
     exact = _exact_plan()
-    monkeypatch.setattr(api, "TIE_GRACE_S", -1.0)
+    monkeypatch.setattr(api, "TIE_GRACE_POLLS", -1)
     monkeypatch.setattr(api, "TIE_SHARE", 0.0)
     quick = api.plan(CASE)
     check_plan(quick)
@@ -133,24 +133,84 @@ def test_out_of_time_in_the_expected_stage_the_margin_stays_exact(monkeypatch):
     assert partial.tie_breaks == api.TIES_MARGIN
 
 
-def test_the_tie_budget_counts_cpu_seconds_not_waiting():
-    budget = TieBudget(Deadline(), 0.05)
+def test_the_tie_budget_counts_polls_not_seconds():
+    budget = WorkBudget(Deadline(), 3)
     budget.check()
-    time.sleep(0.08)  # waiting costs no CPU: still within the allowance
+    time.sleep(0.05)  # time passing is no work
     budget.check()
-    end = time.process_time() + 0.06
-    while time.process_time() < end:
-        pass
+    budget.check()
     with pytest.raises(Timeout):
         budget.check()
-    assert budget.limited
+    assert budget.limited and budget.polls == 4
 
 
 def test_the_tie_budget_keeps_the_outer_deadline():
-    budget = TieBudget(Deadline(1e-6), 100.0)
+    budget = WorkBudget(Deadline(1e-6), 10**9)
     time.sleep(1e-3)
     with pytest.raises(Timeout):
         budget.check()
+
+
+def _tie_polls(monkeypatch) -> tuple[int, int]:
+    """The length proof's polls and the tie-breaking stages' polls of planning ``CASE``."""
+    seen: list[WorkBudget] = []
+
+    class Recording(WorkBudget):
+        def __init__(self, outer: Deadline, polls: float) -> None:
+            super().__init__(outer, polls)
+            seen.append(self)
+            self.proof = outer.polls
+
+    with monkeypatch.context() as m:
+        m.setattr(api, "WorkBudget", Recording)
+        api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
+    (budget,) = seen
+    return budget.proof, budget.polls
+
+
+def test_a_plan_cut_short_in_its_tie_breaks_is_the_same_on_a_slow_computer(monkeypatch):
+    # Give the stages half the polls they need: the expected stage is cut short. Burning CPU
+    # at every poll (a slow or busy computer) must not change where it stops.
+    proof, needed = _tie_polls(monkeypatch)
+    assert needed > 20
+    monkeypatch.setattr(api, "TIE_SHARE", 0.0)
+    monkeypatch.setattr(api, "TIE_GRACE_POLLS", needed // 2)
+    fast = api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
+    check = WorkBudget.check
+
+    def slow_check(self) -> None:
+        end = time.process_time() + 2e-4
+        while time.process_time() < end:
+            pass
+        check(self)
+
+    monkeypatch.setattr(WorkBudget, "check", slow_check)
+    slow = api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
+    assert fast.tie_breaks != api.TIES_EXACT
+    assert (slow.tie_breaks, slow.min_margin, slow.expected_length) == (
+        fast.tie_breaks,
+        fast.min_margin,
+        fast.expected_length,
+    )
+    assert slow.root == fast.root
+
+
+def test_the_tie_budget_does_not_depend_on_what_an_earlier_plan_cached(monkeypatch):
+    # A second plan of the same machine object finds its tables built: the length proof
+    # must poll as often, or the tie budget (and so the plan) would change.
+    machine = build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL)
+    seen: list[int] = []
+
+    class Recording(WorkBudget):
+        def __init__(self, outer: Deadline, polls: float) -> None:
+            super().__init__(outer, polls)
+            seen.append(outer.polls)
+
+    monkeypatch.setattr(api, "WorkBudget", Recording)
+    first = api.plan(machine)
+    second = api.plan(machine)
+    assert seen[0] == seen[1] > 0
+    assert first.root == second.root
 
 
 def test_targets_from_the_cell_table_are_the_machines_successors():

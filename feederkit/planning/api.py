@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import gc
 import math
-import time
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import replace
 
@@ -26,14 +25,14 @@ from feederkit.errors import InputError, PlanningError
 from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
-from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import Refiner, TieBudget, child_masses, stage
+from feederkit.planning.refine import Refiner, child_masses, stage
 from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import solve, unsolvable
@@ -56,12 +55,17 @@ FIRST_TREE_SHARE = 0.85
 """Where (as a share of the time limit) the tree of a proven length with no tie-breaking
 must be built; after that the fallback answers."""
 
-TIE_SHARE = 1.0
+TIE_SHARE = 5.0
 """The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
-may take this many times the CPU seconds of the length proof, plus ``TIE_GRACE_S``."""
+may poll their budget this many times as often as the length proof did, plus
+``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
+the same machine gives the same plan on any computer and under any load. A tie-breaking
+poll costs a fifth to a half of a proof's (benchmarks/bench_planners.py), so this is
+about one to two times the proof's time."""
 
-TIE_GRACE_S = 2.0
-"""CPU seconds the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof."""
+TIE_GRACE_POLLS = 10_000
+"""Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (one to
+two seconds on the benchmark machine)."""
 
 TIES_EXACT = "exact"
 """``tie_breaks``: every tie-break of the objective was decided exactly."""
@@ -246,7 +250,6 @@ def _plan(
     tree's own length is the answer), a proven lower bound and which tie-breaks are exact
     (``TIES_EXACT``, ``TIES_MARGIN`` or ``TIES_NONE``).
     """
-    proof_start = time.process_time()
     objective = options.objective.value
     min_margin = options.min_margin_deg
     grouping = options.grouping
@@ -330,9 +333,9 @@ def _plan(
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline
     if objective == "worst":
-        # Tie-breaking must not dominate: a bounded multiple of the length proof's time.
-        spent = time.process_time() - proof_start
-        ties_deadline = TieBudget(exact_deadline, TIE_SHARE * spent + TIE_GRACE_S)
+        # Tie-breaking must not dominate: a bounded multiple of the length proof's work.
+        allowance = TIE_SHARE * exact_deadline.polls + TIE_GRACE_POLLS
+        ties_deadline = WorkBudget(exact_deadline, allowance)
     worst.deadline = ties_deadline
     refiner = Refiner(problem, worst, ties_deadline, costs=options.costs, timed=objective == "time")
     staged = False

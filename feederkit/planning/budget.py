@@ -70,6 +70,7 @@ class Deadline:
             self.memory_base = min(rss_mb(), memory_mb)
         self._next_memory = now
         self._limited = self.end is not None or memory_mb is not None
+        self.polls = 0  # how often check() was called: the work done under this budget
 
     @property
     def limited(self) -> bool:
@@ -78,6 +79,7 @@ class Deadline:
 
     def check(self) -> None:
         """Raise Timeout once the deadline or the memory limit has passed."""
+        self.polls += 1
         if not self._limited:
             return
         now = time.perf_counter()
@@ -113,6 +115,43 @@ class Deadline:
             base = self.memory_base
             memory = base + memory_share * (self.memory_mb - base)
         return Deadline(memory_mb=memory, end=end, start=self.start, memory_base=base)
+
+
+class WorkBudget(Deadline):
+    """``outer``'s limits and at most ``polls`` more polls of this budget.
+
+    A budget of work rather than of time: the searches poll once per node they expand, so
+    the same input stops at the same node on any machine and under any load, and gives the
+    same plan (the tie-breaking stages of ``plan``, docs/planning.md, "Which plan among the
+    shortest"). ``outer``'s wall-clock deadline and memory limit still hold.
+
+    >>> budget = WorkBudget(Deadline(), 2)
+    >>> budget.check(); budget.check()
+    >>> budget.check()
+    Traceback (most recent call last):
+    ...
+    feederkit.planning.budget.Timeout: time
+    """
+
+    def __init__(self, outer: Deadline, polls: float) -> None:
+        super().__init__(
+            memory_mb=outer.memory_mb,
+            end=outer.end,
+            start=outer.start,
+            memory_base=outer.memory_base,
+        )
+        self.allowance = polls
+
+    @property
+    def limited(self) -> bool:
+        """Always: the allowance of polls is a limit."""
+        return True
+
+    def check(self) -> None:
+        """Raise Timeout past the allowance of polls or one of ``outer``'s limits."""
+        super().check()
+        if self.polls > self.allowance:
+            raise Timeout("time")
 
 
 UNLIMITED = Deadline()

@@ -33,20 +33,20 @@ reading branch of a smaller image lies in one of the larger image's. A subset th
 keeps every margin the set keeps within the same budget, and the maximal reading branches
 decide a margin as they decide a length.
 
-The ``worst`` objective's stages run under a :class:`TieBudget` (``plan`` gives them a
-bounded multiple of the length proof's CPU time); out of it the plan keeps the proven
-length and the margin decided or found so far.
+The ``worst`` objective's stages run under a
+:class:`~feederkit.planning.budget.WorkBudget` (``plan`` gives them a bounded multiple of
+the length proof's polls, so the same machine gives the same plan anywhere); out of it the
+plan keeps the proven length and the margin decided or found so far.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 
 from feederkit.angles import norm360
 from feederkit.machine import OverlapRange, ReadingBranch, members
-from feederkit.planning.andor import Deadline, Timeout, WorstCase
+from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.choices import spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
@@ -62,48 +62,6 @@ Value = tuple[float, float]
 """An expected figure and its tie-break: (operations, seconds), or (seconds, operations)
 with the time objective; seconds are 0 without action costs."""
 Cell = tuple[float, float, int]
-
-
-CPU_POLL_S = 0.005
-"""A :class:`TieBudget` reads the CPU clock at most this often (wall seconds)."""
-
-
-class TieBudget(Deadline):
-    """A stage's budget: ``outer``'s limits and at most ``cpu_s`` more CPU seconds.
-
-    The tie-breaking stages of the ``worst`` objective get a bounded multiple of what the
-    length proof took (docs/planning.md, "Which plan among the shortest"); CPU time rather
-    than wall time, so a busy machine does not change which plan comes out.
-    """
-
-    def __init__(self, outer: Deadline, cpu_s: float) -> None:
-        super().__init__(
-            memory_mb=outer.memory_mb,
-            end=outer.end,
-            start=outer.start,
-            memory_base=outer.memory_base,
-        )
-        self.cpu_end = time.process_time() + cpu_s
-        self._next_cpu = time.perf_counter()
-
-    @property
-    def limited(self) -> bool:
-        """Always: the CPU allowance is a limit."""
-        return True
-
-    def check(self) -> None:
-        """Raise Timeout once the CPU allowance or one of ``outer``'s limits has passed.
-
-        The CPU clock costs a system call (over a microsecond, ten times the wall clock):
-        it is read at most every ``CPU_POLL_S`` wall seconds, and one thread's CPU seconds
-        grow no faster than wall seconds, so the allowance is overrun by at most that.
-        """
-        now = time.perf_counter()
-        if now >= self._next_cpu:
-            self._next_cpu = now + CPU_POLL_S
-            if time.process_time() > self.cpu_end:
-                raise Timeout("time")
-        super().check()
 
 
 def child_masses(
