@@ -113,6 +113,29 @@ def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, mon
     one_line_error(capsys, ["changeover", "report", "nope", "-o", str(html), "--catalog", str(db)])
 
 
+def test_a_design_past_its_limit_leaves_the_report_without_it(db, tmp_path, capsys, monkeypatch):
+    import feederkit.design.sensor
+    import feederkit.reports
+
+    got: list = []
+
+    def fake_report(plan, *, unrecognizable, outlines, design=None):
+        got.append(design)
+        return "<p>report</p>"
+
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
+    monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 1e-9)
+    html = tmp_path / "fig27.html"
+    cap = ok(capsys, ["changeover", "report", "fig27", "-o", str(html), "--catalog", str(db)])
+    assert got == [None] and html.read_text() == "<p>report</p>"
+    (line,) = [w for w in cap.err.splitlines() if "sensor design" in w]
+    assert line.startswith("warning: ") and "1e-09 s" in line and "--time-limit" in line
+    monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 60.0)
+    ok(capsys, ["changeover", "report", "fig27", "-o", str(html), "--catalog", str(db)])
+    assert got[1] is not None and got[1]["sensor_model"] == "tolerance"
+
+
 def test_remove_deletes_one_changeover_and_keeps_the_parts(db, capsys):
     ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
     cap = ok(capsys, ["changeover", "remove", "fig27", "--catalog", str(db)])

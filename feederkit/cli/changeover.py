@@ -194,10 +194,22 @@ def changeover_report(
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`feederkit.design.report_design`; docs/reports.md)."""
     from feederkit.design import report_design
+    from feederkit.design import sensor as sensor_design
+    from feederkit.design.limit import DesignTimeout
     from feederkit.reports import render_report
 
     u = plan.get("uncertainty")
-    design = report_design(pfs, Uncertainty.from_dict(u) if u else None)
+    limit = sensor_design.REPORT_DESIGN_LIMIT_S
+    try:
+        design = report_design(pfs, Uncertainty.from_dict(u) if u else None, limit)
+    except DesignTimeout:
+        design = None
+        print_warnings(
+            [
+                f"the report leaves out the sensor design: not decided within {limit:g} s "
+                "(feederkit design sensor --time-limit S decides it)"
+            ]
+        )
     return render_report(
         plan,
         unrecognizable=[w.to_dict() for w in witnesses],

@@ -304,18 +304,25 @@ def design_pitches(
         raise clock.timeout() from None
 
 
+REPORT_DESIGN_LIMIT_S = 60.0
+"""Seconds a changeover report gives its sensor design (``feederkit design sensor`` has its
+own ``--time-limit``): a report must come out even for a mix whose design takes minutes."""
+
+
 def report_design(
-    pfs: Sequence[PushFunction], uncertainty: Uncertainty | float | None = None
+    pfs: Sequence[PushFunction],
+    uncertainty: Uncertainty | float | None = None,
+    time_limit_s: float | None = REPORT_DESIGN_LIMIT_S,
 ) -> dict[str, Any] | None:
     """The sensor design a changeover report shows (``ToleranceDesign.to_dict``) at the
     changeover's ``uncertainty`` (its plan file's; a number is a rotation error in degrees
     with exact shapes; None the ideal model), or None for a single part (nothing to tell
-    apart)."""
+    apart). DesignTimeout past ``time_limit_s`` (the report then goes without it)."""
     if len(pfs) < 2:
         return None
     if isinstance(uncertainty, int | float):
         uncertainty = Uncertainty(float(uncertainty), 0.0, 0.0)
-    return design_tolerance(list(pfs), uncertainty=uncertainty).to_dict()
+    return design_tolerance(list(pfs), uncertainty=uncertainty, time_limit_s=time_limit_s).to_dict()
 
 
 def _limit_words(step: LengthStep) -> str:
