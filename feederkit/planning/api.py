@@ -60,7 +60,7 @@ TIE_SHARE = 5.0
 may poll their budget this many times as often as the length proof did, plus
 ``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
 the same machine gives the same plan on any computer and under any load. A tie-breaking
-poll costs a fifth to a half of a proof's (benchmarks/bench_planners.py), so this is
+poll costs a third to a fifth of a proof's (benchmarks/bench_tie_budget.py), so this is
 about one to two times the proof's time."""
 
 TIE_GRACE_POLLS = 10_000
