@@ -50,6 +50,7 @@ CASES = [
     ["design", "sensor"],
     ["design", "sensor", "no-such-part"],
     ["design", "sensor", PART, PART, "--time-limit", "0"],
+    ["design", "sensor", PART, PART, "--memory-limit", "0"],
     ["catalog", "list"],
     ["catalog", "add", "no-such-part.json"],
     ["catalog", "import", "/nonexistent-feederkit"],

@@ -46,7 +46,7 @@ from feederkit.loading import load_parts
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.budget import Deadline, Timeout, rss_mb
 from feederkit.planning.lumping import LumpingTry
 from feederkit.sensors import LedSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -315,6 +315,28 @@ def test_a_bad_time_limit_is_input_error(catalog_mix, limit):
         design_tolerance(catalog_mix, time_limit_s=limit)
 
 
+@pytest.mark.parametrize("limit", [0, -1.0, math.nan, math.inf, True])
+def test_a_bad_memory_limit_is_input_error(catalog_mix, limit):
+    with pytest.raises(InputError, match="memory limit must be a positive number of MB"):
+        design_tolerance(catalog_mix, memory_limit_mb=limit)
+
+
+@pytest.mark.parametrize("uncertainty", [IDEAL, ONE_DEGREE], ids=["ideal", "1deg"])
+def test_a_memory_limit_below_the_process_stops_the_design_naming_it(catalog_mix, uncertainty):
+    with pytest.raises(DesignTimeout) as info:
+        design_tolerance(catalog_mix, uncertainty=uncertainty, memory_limit_mb=1.0)
+    text = str(info.value)
+    assert "within the memory limit of 1 MB" in text and "0 of 3 pairs" in text
+    assert "\n" not in text
+
+
+def test_a_memory_limit_with_room_gives_the_unlimited_design(catalog_mix):
+    # Only a memory limit: the planner's searches get it too (DesignClock.plan), answers alike.
+    plain = design_tolerance(catalog_mix, uncertainty=ONE_DEGREE)
+    roomy = design_tolerance(catalog_mix, uncertainty=ONE_DEGREE, memory_limit_mb=rss_mb() + 4000)
+    assert json.dumps(roomy.to_dict()) == json.dumps(plain.to_dict())
+
+
 # The command line.
 
 
@@ -343,6 +365,15 @@ def test_cli_timeout_is_one_line_exit_1(capsys, in_tmp):
         "result: the sensor design did not finish within the time limit of 0.001 s"
     )
     assert " of 3 pairs" in err and err.rstrip().endswith("allow more time with --time-limit S")
+    assert not list(in_tmp.iterdir())
+
+
+def test_cli_memory_limit_is_one_line(capsys, in_tmp):
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--memory-limit", "1"], code=1)
+    assert err.startswith("result: the sensor design did not finish within the memory limit")
+    assert err.rstrip().endswith("allow more memory with --memory-limit MB")
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--memory-limit", "-5"])
+    assert err.startswith("error: the memory limit must be a positive number of MB")
     assert not list(in_tmp.iterdir())
 
 

@@ -26,6 +26,7 @@ from feederkit.cli.common import (
     JsonOpt,
     ShapeToleranceOpt,
     console,
+    default_memory_limit,
     fail,
     flag_words,
     print_json,
@@ -34,7 +35,7 @@ from feederkit.cli.common import (
     uncertainty_option,
     uncertainty_text,
 )
-from feederkit.design.limit import DesignTimeout, check_time_limit
+from feederkit.design.limit import DesignTimeout, check_memory_limit, check_time_limit
 from feederkit.design.pitches import parse_pitches
 from feederkit.design.sensor import (
     PitchDesign,
@@ -134,6 +135,15 @@ def sensor_command(
             "(exit 1), never a partial table.",
         ),
     ] = DEFAULT_DESIGN_TIME_LIMIT_S,
+    memory_limit: Annotated[
+        float | None,
+        typer.Option(
+            "--memory-limit",
+            metavar="MB",
+            help="Stop when the process holds this many megabytes, with one line as at the "
+            "time limit (default: half the machine's memory).",
+        ),
+    ] = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -163,8 +173,11 @@ def sensor_command(
             raise InputError(f"--noise must be zero or a positive number of mm, got {e}")
     if plot is not None and plot.suffix.lower() not in (".png", ".svg"):
         raise InputError(f"{plot}: the plot is written as .png or .svg")
+    if memory_limit is None:
+        memory_limit = default_memory_limit()
     with flag_words():
         check_time_limit(time_limit)
+        check_memory_limit(memory_limit)
 
     loaded = load_parts(names, catalog=catalog)
     pfs = list(loaded.push_functions)
@@ -186,6 +199,7 @@ def sensor_command(
                     uncertainty=uncertainty,
                     time_limit_s=time_limit,
                     progress=progress,
+                    memory_limit_mb=memory_limit,
                 )
             else:
                 design = design_tolerance(
@@ -194,9 +208,12 @@ def sensor_command(
                     uncertainty=uncertainty,
                     time_limit_s=time_limit,
                     progress=progress,
+                    memory_limit_mb=memory_limit,
                 )
         except DesignTimeout as exc:
-            raise DesignTimeout(f"{exc}; allow more time with --time-limit S") from None
+            memory = "memory limit" in str(exc)
+            more = "memory with --memory-limit MB" if memory else "time with --time-limit S"
+            raise DesignTimeout(f"{exc}; allow more {more}") from None
     print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
     if plot is not None:
         from feederkit.design.plot import plot_design

@@ -65,16 +65,37 @@ def check_time_limit(seconds: float | None) -> float | None:
     return float(seconds)
 
 
+def check_memory_limit(megabytes: float | None) -> float | None:
+    """``megabytes`` as a float; InputError unless None or a positive finite number (the
+    planner's wording, :class:`~feederkit.planning.options.PlanningOptions`)."""
+    if megabytes is None:
+        return None
+    if (
+        isinstance(megabytes, bool)
+        or not isinstance(megabytes, int | float)
+        or not (math.isfinite(megabytes) and megabytes > 0.0)
+    ):
+        raise InputError(f"the memory limit must be a positive number of MB, got {megabytes}")
+    return float(megabytes)
+
+
 class DesignClock:
-    """One design's deadline (``time_limit_s`` seconds from now; None: none) and where it
-    stands: the stage running, how much of it is decided, the stages finished.
+    """One design's budget (``time_limit_s`` seconds from now and a process size of
+    ``memory_limit_mb``; None: no such limit) and where it stands: the stage running, how
+    much of it is decided, the stages finished.
 
     Mutable on purpose (it counts as the design runs); a design makes its own.
     """
 
-    def __init__(self, time_limit_s: float | None = None, progress: Progress | None = None):
+    def __init__(
+        self,
+        time_limit_s: float | None = None,
+        progress: Progress | None = None,
+        memory_limit_mb: float | None = None,
+    ):
         self.time_limit_s = check_time_limit(time_limit_s)
-        self.deadline = Deadline(self.time_limit_s)
+        self.memory_limit_mb = check_memory_limit(memory_limit_mb)
+        self.deadline = Deadline(self.time_limit_s, self.memory_limit_mb)
         self._progress = progress
         self.stage: str | None = None
         self.done = 0
@@ -82,7 +103,7 @@ class DesignClock:
         self.finished: list[tuple[str, int]] = []
 
     def check(self) -> None:
-        """Raise Timeout once the time limit has passed."""
+        """Raise Timeout once the time limit or the memory limit has passed."""
         self.deadline.check()
 
     def begin(self, stage: str, total: int) -> None:
@@ -101,46 +122,56 @@ class DesignClock:
         if self._progress is not None and self.stage is not None:
             self._progress(self.stage, self.done, self.total)
 
-    def timeout(self) -> DesignTimeout:
-        """The one-line error of a design stopped at the limit, naming what was decided."""
+    def timeout(self, reason: str = "time") -> DesignTimeout:
+        """The one-line error of a design stopped at the limit ``reason`` names (``Timeout``'s:
+        "time" or "memory"), naming what was decided."""
         decided = [f"all {t} {_NOUNS[s]}" for s, t in self.finished]
         if self.stage is not None:
             decided.append(f"{self.done} of {self.total} {_NOUNS[self.stage]}")
         if not decided:
             decided = ["nothing yet"]
         what = " and ".join(filter(None, (", ".join(decided[:-1]), decided[-1])))
+        if reason == "memory" and self.memory_limit_mb is not None:
+            limit = f"the memory limit of {self.memory_limit_mb:g} MB"
+        else:
+            limit = f"the time limit of {self.time_limit_s:g} s"
         return DesignTimeout(
-            f"the sensor design did not finish within the time limit of "
-            f"{self.time_limit_s:g} s (it decided {what}); no partial design is given"
+            f"the sensor design did not finish within {limit} (it decided {what}); "
+            "no partial design is given"
         )
 
     def plan(self, make: Callable[[PlanningOptions | None], MadePlan]) -> MadePlan:
         """``make(options)`` (a verified plan) within what is left of the limit.
 
         Unlimited: ``make(None)``, the planner's defaults. Limited: the planner gets the time
-        left as its own limit, and any answer that may come from its budget rather than from
-        the search is a Timeout here: a plan not proven optimal, and a PlanningError or
-        tie-breaks left undecided once the planner's exact stages may have used up their
-        share of it (``1 - FALLBACK_SHARE``: its fallback answers then, and the expected
-        number of operations would not be the unlimited design's).
+        left and the memory limit as its own, and any answer that may come from its budget
+        rather than from the search is a Timeout here: a plan not proven optimal, and a
+        PlanningError or tie-breaks left undecided once the planner's exact stages may have
+        used up their share of the time (``1 - FALLBACK_SHARE``: its fallback answers then,
+        and the expected number of operations would not be the unlimited design's).
         """
-        if self.time_limit_s is None:
+        if self.time_limit_s is None and self.memory_limit_mb is None:
             return make(None)
         self.check()
-        left = self.deadline.remaining() or 0.0
-        if left <= 0.0:
+        left = self.deadline.remaining()
+        if left is not None and left <= 0.0:
             raise Timeout("time")
-        exact_end = time.perf_counter() + (1.0 - FALLBACK_SHARE) * left
+        exact_end = (
+            math.inf if left is None else time.perf_counter() + (1.0 - FALLBACK_SHARE) * left
+        )
+        # Out of time once the exact stages' share has passed; otherwise the memory ran out.
+        stopped = "time" if self.memory_limit_mb is None else "memory"
+        options = PlanningOptions(time_limit_s=left, memory_limit_mb=self.memory_limit_mb)
         try:
-            made = make(PlanningOptions(time_limit_s=left))
+            made = make(options)
         except PlanningError:
             # After its exact stages ran out the planner's fallback may give up early.
             if time.perf_counter() >= exact_end or self.deadline.expired():
-                raise Timeout("time") from None
+                raise Timeout("time" if time.perf_counter() >= exact_end else stopped) from None
             raise
         result = made.result
         if not result.optimal:
-            raise Timeout("time")
+            raise Timeout("time" if time.perf_counter() >= exact_end else stopped)
         if result.tie_breaks != TIES_EXACT and time.perf_counter() >= exact_end:
             raise Timeout("time")
         self.check()
@@ -155,5 +186,6 @@ __all__ = [
     "DesignClock",
     "DesignTimeout",
     "Progress",
+    "check_memory_limit",
     "check_time_limit",
 ]

@@ -168,25 +168,27 @@ def design_tolerance(
     uncertainty: Uncertainty | None = None,
     time_limit_s: float | None = None,
     progress: Progress | None = None,
+    memory_limit_mb: float | None = None,
 ) -> ToleranceDesign:
     """Critical tolerances and length steps at ``uncertainty`` (default the ideal model);
     the steps reach the mix's critical tolerance, or ``max_tolerance`` (mm) when given
     (beyond the critical one the mix is not recognized, its plans end in results that name
     several parts). InputError for a shape tolerance too large for a part.
 
-    ``time_limit_s``: seconds (None: no limit); past it DesignTimeout, a PlanningError
-    naming what was decided, never a partial design (:mod:`feederkit.design.limit`).
+    ``time_limit_s``: seconds (None: no limit), ``memory_limit_mb``: the process's size
+    (None: no limit); past either DesignTimeout, a PlanningError naming the limit and what
+    was decided, never a partial design (:mod:`feederkit.design.limit`).
     ``progress(what, done, total)`` is told of each pair, goal probe and run of the table.
     """
     _check_mix(pfs)
     if max_tolerance is not None and not max_tolerance > 0.0:
         raise InputError(f"--max-tolerance must be a positive number of mm, got {max_tolerance}")
     unc = _uncertainty(uncertainty)
-    clock = DesignClock(time_limit_s, progress)
+    clock = DesignClock(time_limit_s, progress, memory_limit_mb)
     try:
         return _design_tolerance(pfs, max_tolerance, unc, clock)
-    except Timeout:
-        raise clock.timeout() from None
+    except Timeout as exc:
+        raise clock.timeout(exc.reason) from None
 
 
 def _design_tolerance(
@@ -280,18 +282,19 @@ def design_pitches(
     uncertainty: Uncertainty | None = None,
     time_limit_s: float | None = None,
     progress: Progress | None = None,
+    memory_limit_mb: float | None = None,
 ) -> PitchDesign:
     """Each pitch decided on its own at ``uncertainty`` (default the ideal model;
     :mod:`feederkit.design.pitches`), and the pairs' exact critical tolerances, which name
-    the pairs no sensor can separate. ``time_limit_s`` and ``progress`` as for
-    :func:`design_tolerance`."""
+    the pairs no sensor can separate. ``time_limit_s``, ``memory_limit_mb`` and
+    ``progress`` as for :func:`design_tolerance`."""
     _check_mix(pfs)
     if not pitches:
         raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5")
     if noise < 0.0:
         raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
     unc = _uncertainty(uncertainty)
-    clock = DesignClock(time_limit_s, progress)
+    clock = DesignClock(time_limit_s, progress, memory_limit_mb)
     names = tuple(pf.part.name for pf in pfs)
     try:
         if unc.is_ideal:
@@ -300,8 +303,8 @@ def design_pitches(
         mix = StrongMix(pfs, unc)
         rows = pitch_rows(pfs, pitches, noise, mix=mix, clock=clock)
         return PitchDesign(names, noise, rows, strong_mix_critical(mix, clock), unc)
-    except Timeout:
-        raise clock.timeout() from None
+    except Timeout as exc:
+        raise clock.timeout(exc.reason) from None
 
 
 REPORT_DESIGN_LIMIT_S = 60.0
