@@ -330,6 +330,20 @@ def test_a_memory_limit_below_the_process_stops_the_design_naming_it(catalog_mix
     assert "\n" not in text
 
 
+@pytest.mark.parametrize(
+    ("time_s", "memory_mb", "reason", "words"),
+    [
+        (3.0, 5.0, "memory", "the memory limit of 5 MB"),
+        (3.0, 5.0, "time", "the time limit of 3 s"),
+        (None, 5.0, "time", "the memory limit of 5 MB"),  # the only limit there is
+        (3.0, None, "memory", "the time limit of 3 s"),
+    ],
+)
+def test_the_timeout_names_the_limit_that_stopped_it(time_s, memory_mb, reason, words):
+    text = str(DesignClock(time_s, None, memory_mb).timeout(reason))
+    assert f"did not finish within {words} (it decided nothing yet)" in text
+
+
 def test_a_memory_limit_with_room_gives_the_unlimited_design(catalog_mix):
     # Only a memory limit: the planner's searches get it too (DesignClock.plan), answers alike.
     plain = design_tolerance(catalog_mix, uncertainty=ONE_DEGREE)

@@ -131,10 +131,15 @@ class DesignClock:
         if not decided:
             decided = ["nothing yet"]
         what = " and ".join(filter(None, (", ".join(decided[:-1]), decided[-1])))
-        if reason == "memory" and self.memory_limit_mb is not None:
+        memory = self.memory_limit_mb is not None and (
+            reason == "memory" or self.time_limit_s is None
+        )
+        if memory:
             limit = f"the memory limit of {self.memory_limit_mb:g} MB"
-        else:
+        elif self.time_limit_s is not None:
             limit = f"the time limit of {self.time_limit_s:g} s"
+        else:
+            limit = "its limits"
         return DesignTimeout(
             f"the sensor design did not finish within {limit} (it decided {what}); "
             "no partial design is given"
