@@ -35,7 +35,7 @@ from feederkit.cli.common import (
     uncertainty_option,
     uncertainty_text,
 )
-from feederkit.design.limit import DesignTimeout, check_memory_limit, check_time_limit
+from feederkit.design.limit import DesignTimeout, check_limits
 from feederkit.design.pitches import parse_pitches
 from feederkit.design.sensor import (
     PitchDesign,
@@ -176,8 +176,7 @@ def sensor_command(
     if memory_limit is None:
         memory_limit = default_memory_limit()
     with flag_words():
-        check_time_limit(time_limit)
-        check_memory_limit(memory_limit)
+        check_limits(time_limit, memory_limit)
 
     loaded = load_parts(names, catalog=catalog)
     pfs = list(loaded.push_functions)
@@ -211,9 +210,9 @@ def sensor_command(
                     memory_limit_mb=memory_limit,
                 )
         except DesignTimeout as exc:
-            memory = "memory limit" in str(exc)
-            more = "memory with --memory-limit MB" if memory else "time with --time-limit S"
-            raise DesignTimeout(f"{exc}; allow more {more}") from None
+            hints = {"memory": "memory with --memory-limit MB", "time": "time with --time-limit S"}
+            more = hints[exc.reason]
+            raise DesignTimeout(f"{exc}; allow more {more}", exc.reason) from None
     print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
     if plot is not None:
         from feederkit.design.plot import plot_design

@@ -21,7 +21,7 @@ import math
 import time
 from collections.abc import Callable
 
-from feederkit.errors import InputError, PlanningError
+from feederkit.errors import PlanningError
 from feederkit.planning.api import FALLBACK_SHARE, TIES_EXACT
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
@@ -44,39 +44,26 @@ _NOUNS = {
 
 
 class DesignTimeout(PlanningError):
-    """The sensor design did not finish within its time limit (nothing partial is returned).
+    """The sensor design did not finish within its time or memory limit (nothing partial is
+    returned); ``reason`` says which ("time" or "memory", as ``Timeout``'s).
 
     A :class:`~feederkit.errors.PlanningError` (exit 1), as ``plan``'s "no plan found within
     the time limit".
     """
 
-
-def check_time_limit(seconds: float | None) -> float | None:
-    """``seconds`` as a float; InputError unless None or a positive finite number (the
-    planner's wording, :class:`~feederkit.planning.options.PlanningOptions`)."""
-    if seconds is None:
-        return None
-    if (
-        isinstance(seconds, bool)
-        or not isinstance(seconds, int | float)
-        or not (math.isfinite(seconds) and seconds > 0.0)
-    ):
-        raise InputError(f"the time limit must be a positive number of seconds, got {seconds}")
-    return float(seconds)
+    def __init__(self, message: str, reason: str = "time") -> None:
+        super().__init__(message)
+        self.reason = reason
 
 
-def check_memory_limit(megabytes: float | None) -> float | None:
-    """``megabytes`` as a float; InputError unless None or a positive finite number (the
-    planner's wording, :class:`~feederkit.planning.options.PlanningOptions`)."""
-    if megabytes is None:
-        return None
-    if (
-        isinstance(megabytes, bool)
-        or not isinstance(megabytes, int | float)
-        or not (math.isfinite(megabytes) and megabytes > 0.0)
-    ):
-        raise InputError(f"the memory limit must be a positive number of MB, got {megabytes}")
-    return float(megabytes)
+def check_limits(
+    seconds: float | None, megabytes: float | None
+) -> tuple[float | None, float | None]:
+    """The time limit (s) and memory limit (MB) as floats, each None for none; InputError in
+    the planner's words unless positive finite numbers (validated once, by
+    :class:`~feederkit.planning.options.PlanningOptions`)."""
+    options = PlanningOptions(time_limit_s=seconds, memory_limit_mb=megabytes)
+    return options.time_limit_s, options.memory_limit_mb
 
 
 class DesignClock:
@@ -93,8 +80,7 @@ class DesignClock:
         progress: Progress | None = None,
         memory_limit_mb: float | None = None,
     ):
-        self.time_limit_s = check_time_limit(time_limit_s)
-        self.memory_limit_mb = check_memory_limit(memory_limit_mb)
+        self.time_limit_s, self.memory_limit_mb = check_limits(time_limit_s, memory_limit_mb)
         self.deadline = Deadline(self.time_limit_s, self.memory_limit_mb)
         self._progress = progress
         self.stage: str | None = None
@@ -142,7 +128,8 @@ class DesignClock:
             limit = "its limits"
         return DesignTimeout(
             f"the sensor design did not finish within {limit} (it decided {what}); "
-            "no partial design is given"
+            "no partial design is given",
+            "memory" if memory else "time",
         )
 
     def plan(self, make: Callable[[PlanningOptions | None], MadePlan]) -> MadePlan:
@@ -191,6 +178,5 @@ __all__ = [
     "DesignClock",
     "DesignTimeout",
     "Progress",
-    "check_memory_limit",
-    "check_time_limit",
+    "check_limits",
 ]
