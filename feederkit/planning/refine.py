@@ -199,9 +199,7 @@ class Refiner:
         """Whether a plan of at most ``k`` operations keeping ``floor`` can start with ``act``."""
         if act.action.margin < self.floor or not self.feasible(act, k - 1):
             return False
-        if self.floor == -math.inf:
-            return True
-        return all(self.keeps(c, k - 1, self.floor) for c in self._deciding(act))
+        return self._keeps_floor(act, k)
 
     def _keeps_floor(self, act: Act, k: int) -> bool:
         """:meth:`allowed` of an action already known :meth:`feasible` within ``k - 1``."""
