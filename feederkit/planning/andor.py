@@ -21,6 +21,7 @@ The International Journal of Robotics Research 18(10), section 6.1 (AND/OR searc
 from __future__ import annotations
 
 import heapq
+from collections.abc import Iterator
 from dataclasses import replace
 
 from feederkit.angles import ActionRange
@@ -201,7 +202,7 @@ class WorstCase:
             return known
         self.deadline.check()
         # frame: [mask, k, actions, act or None, index of the next child]
-        stack: list[list] = [[mask, k, self.p.choices.search_actions(mask), None, 0]]
+        stack: list[list] = [[mask, k, self.actions_of(mask), None, 0]]
         result = False
         while stack:
             f = stack[-1]
@@ -220,7 +221,7 @@ class WorstCase:
                     if known is None:
                         f[3], f[4] = act, ci
                         self.deadline.check()
-                        stack.append([c, fk - 1, self.p.choices.search_actions(c), None, 0])
+                        stack.append([c, fk - 1, self.actions_of(c), None, 0])
                         pushed = True
                         break
                     if not known:
@@ -249,6 +250,11 @@ class WorstCase:
                 else:
                     parent[3] = None  # the parent's action failed: its next action
         return result
+
+    def actions_of(self, mask: int) -> Iterator[Act]:
+        """The actions :meth:`within` tries for a set, in order: every one the length search
+        needs (``Choices.search_actions``); a restricted search overrides it."""
+        return self.p.choices.search_actions(mask)
 
     def length(self, mask: int, limit: int | None = None) -> int:
         """The minimum worst-case number of operations for ``mask`` (iterative deepening).

@@ -16,6 +16,7 @@ Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import math
 from collections.abc import Callable, Hashable, Iterable
@@ -25,6 +26,7 @@ from feederkit.errors import InputError, PlanningError
 from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
+from feederkit.planning.beam import beam_plan
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
@@ -397,6 +399,10 @@ def _root_children(problem: Problem, root_branches, start_mass):
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
 
 
+BEAM_SHARE = 0.6
+"""The share of the fallback's time (after the backchaining plan) the widening beams may take
+before the AND/OR search looks for a plan at the bound."""
+
 READ_SHARE = 0.25
 """With a time limit, the share of what is left after the backchaining plan that the plan
 following the readings (whose tree grows with the reading sets) may take."""
@@ -460,6 +466,29 @@ def _fallback(
     cap = min(2 * problem.n + 1, FALLBACK_MAX_OPERATIONS)
     if blind is not None:
         cap = tree_length(blind) - 2  # look only for something shorter
+    # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
+    # BEAM_SHARE of what is left; what they find is where the search below starts.
+    # A plan in hand needs time for its tree and statistics: the beams and the search after
+    # them stop a reserve of the limit before it.
+    reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
+    rest = budget.remaining()
+    beam_end = None if rest is None else budget.end - max(rest * (1.0 - BEAM_SHARE), reserve)
+    seed = worst if stop.reason != "memory" and type(worst) is WorstCase else None
+    beamed = beam_plan(
+        problem,
+        roots,
+        seed,
+        Deadline(memory_mb=budget.memory_mb, end=beam_end, memory_base=budget.memory_base),
+        cap,
+        lower - 1,
+    )
+    if beamed is not None:
+        search, best = beamed
+        with contextlib.suppress(Timeout):  # its tree now: a plan in hand, shorter than blind
+            blind = _choice_plan(problem, search.choice, roots, root_branches, budget)
+        anytime.ub.update(search.ub)
+        anytime.choice.update(search.choice)
+        cap = best - 1  # the search below looks only for something shorter
     # With a deadline, lengths at the proven bound and one above it first (each with a third
     # of the time left), then the generous cap: a plan within one operation of the bound
     # when the search finds one, some plan else.
@@ -468,12 +497,21 @@ def _fallback(
     found = None
     last = Timeout(stop.reason)
     # The last search keeps a reserve of the limit for the tree of what it finds: a plan
-    # found at the deadline with no time left to write it down is no answer.
-    reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
-    for k in caps:
+    # found at the deadline with no time left to write it down is no answer. With a plan in
+    # hand every search keeps the whole reserve, and a shorter plan's tree half of it.
+    tree_budget = budget
+    if blind is not None and budget.end is not None:
+        tree_budget = Deadline(
+            memory_mb=budget.memory_mb,
+            end=budget.end - reserve / 2.0,
+            memory_base=budget.memory_base,
+        )
+    for k in caps if cap >= max(lower - 1, 1) else ():
         rest = budget.remaining()
         if rest is None:
             end = None
+        elif blind is not None:
+            end = budget.end - max(reserve, rest * 2.0 / 3.0 if k < cap else 0.0)
         elif k == cap:
             end = budget.end - min(reserve, rest / 2.0)
         else:
@@ -492,8 +530,8 @@ def _fallback(
     try:
         if found is None:
             raise last
-        anytime.deadline = budget
-        root = _choice_plan(problem, anytime.choice, roots, root_branches, budget)
+        anytime.deadline = tree_budget
+        root = _choice_plan(problem, anytime.choice, roots, root_branches, tree_budget)
     except Timeout as exc:
         if blind is not None:
             return blind, False, None, lower, TIES_NONE
@@ -545,9 +583,17 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
     """The plan that follows a search's ``choice`` table (the action that proved each set)."""
 
     def witness_of(mask: int, supersets) -> int:
-        if problem.is_goal(mask) or mask in choice:
+        # The set itself or a searched set containing it, whichever has the shorter plan: a
+        # set's own entry may be a longer plan than the one its parent's bound counted on.
+        if problem.is_goal(mask):
             return mask
-        return next(c for c in supersets if mask & c == mask)
+        own = choice.get(mask)
+        best = mask
+        bound = own[0] if own is not None else None
+        for c in supersets:
+            if mask & c == mask and c in choice and (bound is None or choice[c][0] < bound):
+                best, bound = c, choice[c][0]
+        return best
 
     def expand(key):
         mask, witness = key

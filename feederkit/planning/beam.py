@@ -1,0 +1,136 @@
+"""Anytime plans by beam search over sets: the AND/OR search restricted to a set's few best
+actions, widened until the time runs out or the plan meets its proven lower bound.
+
+When the exact search (section 6.1) cannot prove a length in time, some plan is still
+wanted, and a short one. The same depth-first iterative deepening of
+:class:`~feederkit.planning.andor.WorstCase` is run with only the ``width`` actions of each
+set whose reading branches are smallest (the largest branch, then their total): a plan
+it finds is a plan, and the restricted space is small enough to search to depth 10 in
+seconds where the full one is not. Widths double; each one looks only for a plan shorter
+than the best so far, so the answer improves toward the bound (greedy best-first AND/OR
+search with a beam, as in heuristic search over AND/OR graphs; Nilsson 1980, chapter 3).
+
+A restricted failure proves nothing about the machine, so a search's own lower bounds stay
+in that search; its plans (``ub`` and ``choice``) carry over to the next, wider one.
+
+References
+----------
+Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient parts.
+The International Journal of Robotics Research 18(10), section 6.1 (AND/OR search).
+Nilsson, N. J. (1980). Principles of Artificial Intelligence. Tioga, chapter 3 (AND/OR
+graph search).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from feederkit.planning.andor import WorstCase
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.problem import Act, Problem
+
+FIRST_WIDTH = 4
+"""The first search tries this many actions per set; each next one twice as many."""
+
+
+def branch_key(act: Act) -> tuple[int, int]:
+    """The beam's order of a set's actions: the smallest largest branch, then the fewest
+    states over all branches (the most a reading can tell apart)."""
+    sizes = [c.bit_count() for c in act.children]
+    return max(sizes), sum(sizes)
+
+
+class BeamSearch(WorstCase):
+    """:class:`~feederkit.planning.andor.WorstCase` over the ``width`` best actions of each
+    set (:func:`branch_key`). ``within`` answers for that restricted space: True is a plan,
+    False only that this beam has none."""
+
+    def __init__(self, problem: Problem, width: int, deadline: Deadline | None = None) -> None:
+        super().__init__(problem, deadline)
+        self.width = width
+        self.cut = False
+        """Whether some set met had more actions than the beam keeps (False: the search
+        was exhaustive, and its failures are proofs)."""
+        self._beam: dict[int, tuple[Act, ...]] = {}
+
+    def actions_of(self, mask: int) -> Iterator[Act]:
+        acts = self._beam.get(mask)
+        if acts is None:
+            choices = self.p.choices
+            exact = self.p.min_margin > 0.0  # margins are not monotone: every branch counts
+            every = choices.exact_actions(mask) if exact else choices.actions(mask)
+            if len(every) > self.width:
+                self.cut = True
+            acts = self._beam[mask] = tuple(sorted(every, key=branch_key)[: self.width])
+        return iter(acts)
+
+
+def beam_plan(
+    problem: Problem,
+    roots: list[int],
+    seed: WorstCase | None,
+    deadline: Deadline,
+    cap: int,
+    lower: int = 1,
+) -> tuple[BeamSearch, int] | None:
+    """The shortest plan the widening beams found for every root within ``cap`` operations:
+    a search whose ``choice`` table holds it, and its largest root length; None when none
+    was found before ``deadline`` passed.
+
+    ``seed``, when given, is an exact search of the same problem: its proven bounds and
+    plans start every beam. Stops early when a plan meets ``lower`` (a proven bound on the
+    largest root length) or a beam was exhaustive. Every entry of a beam's ``choice`` is a
+    plan of its set within its bound, so each wider beam starts from the last one's.
+    """
+    best: int | None = None
+    target = cap
+    beam = _beam(problem, FIRST_WIDTH, deadline, seed, None)
+    while target >= max(lower, 1):
+        try:
+            lengths = _lengths(beam, roots, target)
+        except Timeout:
+            break
+        if lengths is not None:
+            best = max(lengths)
+            target = best - 1  # the same beam (its failures still hold), for a shorter plan
+        elif beam.cut:
+            beam = _beam(problem, 2 * beam.width, deadline, seed, beam)
+        else:
+            break  # exhaustive: no plan within the target exists
+    return None if best is None else (beam, best)
+
+
+def _beam(
+    problem: Problem,
+    width: int,
+    deadline: Deadline,
+    seed: WorstCase | None,
+    last: BeamSearch | None,
+) -> BeamSearch:
+    """A beam of ``width`` starting from the exact search's bounds and the last beam's plans."""
+    beam = BeamSearch(problem, width, deadline)
+    if seed is not None:
+        beam.lb.update(seed.lb)
+        beam.never.update(seed.never)
+    for known in (seed, last):
+        if known is not None:
+            beam.ub.update(known.ub)
+            beam.choice.update(known.choice)
+    return beam
+
+
+def _lengths(beam: BeamSearch, roots: list[int], target: int) -> list[int] | None:
+    """Each root's length in the beam by iterative deepening, hardest roots first; None as
+    soon as one needs more than ``target``."""
+    out = []
+    for r in sorted(roots, key=lambda m: -beam.lb.get(m, 1)):
+        if beam.p.is_goal(r):
+            out.append(0)
+            continue
+        k = max(1, beam.lb.get(r, 1))
+        while k <= target and not beam.within(r, k):
+            k += 1
+        if k > target:
+            return None
+        out.append(k)
+    return out
