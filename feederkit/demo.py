@@ -128,7 +128,8 @@ class DemoChangeover:
     report_path: Path | None
     lookalike: bool = False
     note: str | None = None
-    """Why the demo planned otherwise than asked (an accept list no plan can keep)."""
+    """Why the demo planned or reported otherwise than asked (an accept list no plan can
+    keep, a sensor design not decided in the report's time)."""
     landings_planned: tuple[str, ...] | None = None
     """The landings planned when not every one (``--landings``)."""
 
@@ -308,18 +309,24 @@ def add_lookalike(catalog: Path, pfs: list[PushFunction]) -> DemoMix | None:
     return DemoMix("lookalike-pair", members, lookalike=True)
 
 
-def _report(compiled: CompiledChangeover) -> str:
+def _report(compiled: CompiledChangeover, notes: list[str]) -> str:
     """The changeover's HTML report (the report library's), naming the pairs no plan tells
-    apart, with the mix's sensor design (:func:`feederkit.design.report_design`)."""
-    from feederkit.design import report_design
+    apart, with the mix's sensor design when it is decided in time
+    (:func:`feederkit.design.report_design_or_warning`; else its warning goes to ``notes``)."""
+    from feederkit.design import report_design_or_warning
     from feederkit.reports import render_report
 
     u = compiled.plan.get("uncertainty")
+    design, warning = report_design_or_warning(
+        compiled.parts, Uncertainty.from_dict(u) if u else None
+    )
+    if warning is not None:
+        notes.append(warning)
     return render_report(
         compiled.plan,
         unrecognizable=[w.to_dict() for w in compiled.witnesses],
         outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
-        design=report_design(compiled.parts, Uncertainty.from_dict(u) if u else None),
+        design=design,
     )
 
 
@@ -338,13 +345,14 @@ def compile_demo_changeover(
     loaded = load_parts(list(mix.members), catalog=catalog)
     sensor = demo_sensor(list(loaded.push_functions), percent)
     plan_path, report_path = folder / f"{mix.name}.json", folder / f"{mix.name}.html"
+    report_notes: list[str] = []
 
     def outputs(c: CompiledChangeover) -> list[OutputFile]:
         if cell is not None:
             annotate_cycle_time(c.made, cell)  # before the plan is written and stored
         files = [OutputFile(plan_path, plan_json(c.plan), "plan file")]
         if report:
-            files.append(OutputFile(report_path, _report(c), "report"))
+            files.append(OutputFile(report_path, _report(c, report_notes), "report"))
         return files
 
     def compiled(accept: tuple[str, ...] | None) -> CompiledChangeover:
@@ -366,7 +374,10 @@ def compile_demo_changeover(
         if mix.accept is None:
             raise
         note = f"every landing accepted: {exc}"
+        report_notes.clear()
         done = compiled(None)
+    if report_notes:
+        note = "; ".join(x for x in (note, *report_notes) if x)
     return DemoChangeover(
         done,
         mix.members,

@@ -270,3 +270,35 @@ def test_a_changeover_shows_its_cycle_time_with_a_profile(tmp_path: Path) -> Non
     assert stats["expected_length"] <= cycle["expected_s"]
     assert cycle["worst_s"] <= 1.0 + (stats["length"] - 1) * 4.0 + 1e-9
     assert json.loads((tmp_path / "fig27.json").read_text())["stats"]["cycle_time"] == cycle
+
+
+def test_a_design_past_the_reports_limit_leaves_the_demo_report_without_it(
+    tmp_path: Path, monkeypatch
+) -> None:
+    import feederkit.design.sensor
+    import feederkit.reports
+    from feederkit.catalog import add_outline, open_catalog
+    from feederkit.demo import DemoMix, compile_demo_changeover
+    from feederkit.sources import load_part
+
+    got: list = []
+
+    def fake_report(plan, *, unrecognizable, outlines, design=None):
+        got.append(design)
+        return "<p>report</p>"
+
+    monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
+    catalog = tmp_path / "demo.db"
+    open_catalog(catalog, create=True).close()
+    for name in ("isosceles-right-triangle", "octagon"):
+        add_outline(catalog, load_part(str(ROOT / "catalog" / f"{name}.json")).outline, name=name)
+    mix = DemoMix("fig27", ("isosceles-right-triangle", "octagon"))
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 1e-9)
+    c = compile_demo_changeover(catalog, mix, tmp_path / "a", 1.0)
+    assert got == [None] and c.report_path is not None and c.report_path.is_file()
+    assert c.note is not None and "leaves out the sensor design" in c.note and "1e-09 s" in c.note
+    monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 60.0)
+    c = compile_demo_changeover(catalog, mix, tmp_path / "b", 1.0)
+    assert got[1] is not None and got[1]["sensor_model"] == "tolerance" and c.note is None

@@ -193,23 +193,13 @@ def changeover_report(
     """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`feederkit.design.report_design`; docs/reports.md)."""
-    from feederkit.design import report_design
-    from feederkit.design import sensor as sensor_design
-    from feederkit.design.limit import DesignTimeout
+    from feederkit.design import report_design_or_warning
     from feederkit.reports import render_report
 
     u = plan.get("uncertainty")
-    limit = sensor_design.REPORT_DESIGN_LIMIT_S
-    try:
-        design = report_design(pfs, Uncertainty.from_dict(u) if u else None, limit)
-    except DesignTimeout:
-        design = None
-        print_warnings(
-            [
-                f"the report leaves out the sensor design: not decided within {limit:g} s "
-                "(feederkit design sensor --time-limit S decides it)"
-            ]
-        )
+    design, warning = report_design_or_warning(pfs, Uncertainty.from_dict(u) if u else None)
+    if warning is not None:
+        print_warnings([warning])
     return render_report(
         plan,
         unrecognizable=[w.to_dict() for w in witnesses],

@@ -29,6 +29,7 @@ from feederkit.design.sensor import (
     design_pitches,
     design_tolerance,
     report_design,
+    report_design_or_warning,
 )
 from feederkit.design.steps import LengthOracle, LengthStep, length_steps, mix_breakpoints
 from feederkit.design.strong import (
@@ -60,6 +61,7 @@ __all__ = [
     "parse_pitches",
     "pitch_rows",
     "report_design",
+    "report_design_or_warning",
     "strong_length_steps",
     "strong_mix_critical",
     "strong_pair_critical",

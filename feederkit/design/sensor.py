@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from feederkit.design.critical import MixCritical, PairCritical, mix_critical_tolerance
-from feederkit.design.limit import DesignClock, Progress
+from feederkit.design.limit import DesignClock, DesignTimeout, Progress
 from feederkit.design.pitches import PitchRow, pitch_rows
 from feederkit.design.steps import BREAKPOINT_REL_EPS, LengthStep, length_steps
 from feederkit.design.strong import (
@@ -320,12 +320,28 @@ def report_design(
     """The sensor design a changeover report shows (``ToleranceDesign.to_dict``) at the
     changeover's ``uncertainty`` (its plan file's; a number is a rotation error in degrees
     with exact shapes; None the ideal model), or None for a single part (nothing to tell
-    apart). DesignTimeout past ``time_limit_s`` (the report then goes without it)."""
+    apart). DesignTimeout past ``time_limit_s`` (:func:`report_design_or_warning`)."""
     if len(pfs) < 2:
         return None
     if isinstance(uncertainty, int | float):
         uncertainty = Uncertainty(float(uncertainty), 0.0, 0.0)
     return design_tolerance(list(pfs), uncertainty=uncertainty, time_limit_s=time_limit_s).to_dict()
+
+
+def report_design_or_warning(
+    pfs: Sequence[PushFunction], uncertainty: Uncertainty | float | None = None
+) -> tuple[dict[str, Any] | None, str | None]:
+    """:func:`report_design` within ``REPORT_DESIGN_LIMIT_S``, or None with the one warning a
+    report gives when the design is not decided by then: a report is written with the
+    section or without it, never not at all (docs/reports.md)."""
+    time_limit_s = REPORT_DESIGN_LIMIT_S
+    try:
+        return report_design(pfs, uncertainty, time_limit_s), None
+    except DesignTimeout:
+        return None, (
+            f"the report leaves out the sensor design: not decided within {time_limit_s:g} s "
+            "(feederkit design sensor --time-limit S decides it)"
+        )
 
 
 def _limit_words(step: LengthStep) -> str:
