@@ -39,6 +39,7 @@ from feederkit.planning.reindex import by_diameter, remap_tree
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import solve, unsolvable
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
+from feederkit.planning.subsets import subset_lower_bound
 from feederkit.planning.tree import Leaf, PlanResult, Step
 from feederkit.words import plural
 
@@ -399,9 +400,10 @@ def _root_children(problem: Problem, root_branches, start_mass):
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
 
 
-BEAM_SHARE = 0.6
-"""The share of the fallback's time (after the backchaining plan) the widening beams may take
-before the AND/OR search looks for a plan at the bound."""
+BEAM_SHARE = 0.5
+"""The share of the fallback's time (after the backchaining plan) the widening beams may take,
+never into the tree's reserve; the hardest subsets' lower bound and the AND/OR search for a
+plan at the bound get the rest."""
 
 READ_SHARE = 0.25
 """With a time limit, the share of what is left after the backchaining plan that the plan
@@ -466,12 +468,12 @@ def _fallback(
     cap = min(2 * problem.n + 1, FALLBACK_MAX_OPERATIONS)
     if blind is not None:
         cap = tree_length(blind) - 2  # look only for something shorter
-    # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
-    # BEAM_SHARE of what is left; what they find is where the search below starts.
-    # A plan in hand needs time for its tree and statistics: the beams and the search after
-    # them stop a reserve of the limit before it.
+    # A plan in hand needs time for its tree and statistics: the searches below stop a
+    # reserve of the limit before it.
     reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
     rest = budget.remaining()
+    # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
+    # BEAM_SHARE of what is left; what they find is where the search below starts.
     beam_end = None if rest is None else budget.end - max(rest * (1.0 - BEAM_SHARE), reserve)
     seed = worst if stop.reason != "memory" and type(worst) is WorstCase else None
     beamed = beam_plan(
@@ -489,6 +491,16 @@ def _fallback(
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
+    if blind is not None and budget.end is not None:
+        # The bound, from the hardest subsets of the roots (feederkit.planning.subsets), up to
+        # half the reserve (no tree to build, only the statistics of the plan in hand): a
+        # closer bound tells how good that plan is, and ends the search below when met.
+        subsets = Deadline(
+            memory_mb=budget.memory_mb,
+            end=budget.end - reserve / 2.0,
+            memory_base=budget.memory_base,
+        )
+        lower = 1 + subset_lower_bound(problem, roots, lower - 1, subsets, tree_length(blind) - 1)
     # With a deadline, lengths at the proven bound and one above it first (each with a third
     # of the time left), then the generous cap: a plan within one operation of the bound
     # when the search finds one, some plan else.
