@@ -60,12 +60,13 @@ def interval_probe(breaks: Sequence[float], k: int) -> float:
     return 2.0 * breaks[-1] if breaks else 1.0
 
 
-def last_true(count: int, test: Callable[[int], bool]) -> int:
+def last_true(count: int, test: Callable[[int], bool], known: int = -1) -> int:
     """The largest ``k`` in ``[0, count)`` with ``test(k)``, for a test true then false; -1 if none.
 
-    Binary search: ``ceil(log2(count + 1))`` calls of ``test``.
+    Binary search: ``ceil(log2(count - known))`` calls of ``test``; ``known``: an index
+    where ``test`` is already known to hold (-1: none).
     """
-    lo, hi = -1, count  # test(lo) is true (or lo = -1), test(hi) false (or hi = count)
+    lo, hi = known, count  # test(lo) is true (or lo = -1), test(hi) false (or hi = count)
     while hi - lo > 1:
         mid = (lo + hi) // 2
         if test(mid):
@@ -73,6 +74,16 @@ def last_true(count: int, test: Callable[[int], bool]) -> int:
         else:
             hi = mid
     return lo
+
+
+def last_true_top_first(count: int, test: Callable[[int], bool], known: int = -1) -> int:
+    """:func:`last_true`, asking ``test(count - 1)`` first: one call when the test holds on
+    the whole range, one more than the binary search otherwise."""
+    if known >= count - 1:
+        return count - 1
+    if test(count - 1):
+        return count - 1
+    return last_true(count - 1, test, known)
 
 
 @dataclass(frozen=True)

@@ -36,9 +36,12 @@ two still read apart.
 
 from __future__ import annotations
 
+import bisect
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import reduce
+from operator import or_
 
 from feederkit.angles import ActionRange
 from feederkit.design.critical import (
@@ -46,6 +49,7 @@ from feederkit.design.critical import (
     PairCritical,
     interval_probe,
     last_true,
+    last_true_top_first,
 )
 from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
 from feederkit.design.steps import (
@@ -264,6 +268,43 @@ def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
     return kept_apart(problem, pairs)
 
 
+def outcomes_cover_parts(machine: PushAlignMachine) -> bool:
+    """Whether every state's outcomes (over all its action ranges) are all of its part's
+    states: some rotation sends it to each resting state of its part."""
+    part_mask: dict[int, int] = {}
+    for i, s in enumerate(machine.states):
+        part_mask[s.part] = part_mask.get(s.part, 0) | 1 << i
+    return all(
+        reduce(or_, machine.outcomes_of[i], 0) == part_mask[s.part]
+        for i, s in enumerate(machine.states)
+    )
+
+
+def apart_up_to(
+    machine: PushAlignMachine,
+    spans_a: Sequence[Span],
+    spans_b: Sequence[Span],
+    breaks: Sequence[float],
+) -> int:
+    """The last index of ``breaks`` at which a two-part machine has no bisimilar cross
+    pair because some state of one part reads apart from every state of the other
+    (a directed Hausdorff gap of at least ``2e``), or -1.
+
+    Bisimilar states match each other's outcomes with bisimilar ones
+    (:func:`~feederkit.machine.inseparable.inseparable_masks`), so when every state's
+    outcomes cover its part (:func:`outcomes_cover_parts`) one bisimilar cross pair gives
+    every state of both parts a partner of the other that reads alike.
+    """
+    if not spans_a or not spans_b or not outcomes_cover_parts(machine):
+        return -1
+    far = max(
+        max(min(interval_gap(x, y) for y in spans_b) for x in spans_a),
+        max(min(interval_gap(x, y) for x in spans_a) for y in spans_b),
+    )
+    # b <= far / 2 iff 2 b <= far (both halvings exact): every such b reads that state apart.
+    return bisect.bisect_right(breaks, far / 2.0) - 1
+
+
 def strong_pair_critical(
     mix: StrongMix, a: int, b: int, clock: DesignClock | None = None
 ) -> PairCritical:
@@ -273,7 +314,8 @@ def strong_pair_critical(
     Binary search over the pair's breakpoints (the module docstring): separability is
     monotone in the tolerance (a strong plan at one tolerance works at every smaller one,
     its goal being the same, and bisimilar cross pairs only grow). The search first finds
-    the last interval without a bisimilar cross pair, then without a cross pair nature keeps
+    the last interval without a bisimilar cross pair (the last breakpoint's is asked first,
+    and none below :func:`apart_up_to` is asked), then without a cross pair nature keeps
     apart (both fixpoints over pairs, cheap, monotone and necessary), and solves there; only
     when that fails does it search the intervals below with the solver. Every test polls
     ``clock``'s deadline (:mod:`feederkit.design.limit`).
@@ -285,9 +327,11 @@ def strong_pair_critical(
     sb = [x for x, s in zip(spans, m.states, strict=True) if s.part == 1]
     breaks = gap_breakpoints(sa, sb)
     # Separable implies no bisimilar cross pair, which is cheap to test and monotone too:
-    # its last interval bounds the answer, and is most often the answer itself.
+    # its last interval bounds the answer, and is most often the answer itself. That
+    # interval is most often the last breakpoint's, so it is asked first.
     probes = _PairProbes(m, clock.deadline)
-    k = last_true(len(breaks), lambda k: not probes.bisimilar(breaks[k]))
+    apart = apart_up_to(m, sa, sb, breaks)
+    k = last_true_top_first(len(breaks), lambda k: not probes.bisimilar(breaks[k]), apart)
     if k >= 0 and not probes.no_kept_cross_pair(breaks[k]):
         k = last_true(k, lambda k: probes.no_kept_cross_pair(breaks[k]))
     if k >= 0 and not probes.separable(breaks[k]):
