@@ -422,15 +422,18 @@ def _fallback(
     options: PlanningOptions,
     stop: Timeout,
 ):
-    """Some plan when the exact search ran out of its budget, with the lower bound it proved.
+    """Some plan when the exact search ran out of its budget, with the lower bound proven.
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
-    within ``READ_SHARE`` of what is left, when it is shorter), then a depth-first
-    search (the greedy action order of ``Choices.lazy_actions``, on an explicit stack) for
-    something shorter; the tree follows the actions that proved it. A reading set the search never
-    met lies inside one it did (its "witness"), and without a margin floor it follows the
-    witness's rotations. PlanningError when neither finds a plan in time.
+    within ``READ_SHARE`` of what is left, when it is shorter); the widening beams
+    (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
+    shorter; with a plan in hand, the hardest subsets' bound
+    (:func:`~feederkit.planning.subsets.subset_lower_bound`); then a depth-first search (the
+    greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
+    shorter still. A tree follows the actions that proved it; a reading set the searches
+    never met lies inside one they did (its "witness"), and follows the witness's
+    rotations. PlanningError when none finds a plan in time.
     """
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
     if stop.reason == "memory":
@@ -471,6 +474,13 @@ def _fallback(
     # A plan in hand needs time for its tree and statistics: the searches below stop a
     # reserve of the limit before it.
     reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
+    tree_budget = budget  # where a tree must be built by once a plan is in hand
+    if budget.end is not None:
+        tree_budget = Deadline(
+            memory_mb=budget.memory_mb,
+            end=budget.end - reserve / 2.0,
+            memory_base=budget.memory_base,
+        )
     rest = budget.remaining()
     # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
     # BEAM_SHARE of what is left; what they find is where the search below starts.
@@ -487,7 +497,7 @@ def _fallback(
     if beamed is not None:
         search, best = beamed
         with contextlib.suppress(Timeout):  # its tree now: a plan in hand, shorter than blind
-            blind = _choice_plan(problem, search.choice, roots, root_branches, budget)
+            blind = _choice_plan(problem, search.choice, roots, root_branches, tree_budget)
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
@@ -495,12 +505,8 @@ def _fallback(
         # The bound, from the hardest subsets of the roots (feederkit.planning.subsets), up to
         # half the reserve (no tree to build, only the statistics of the plan in hand): a
         # closer bound tells how good that plan is, and ends the search below when met.
-        subsets = Deadline(
-            memory_mb=budget.memory_mb,
-            end=budget.end - reserve / 2.0,
-            memory_base=budget.memory_base,
-        )
-        lower = 1 + subset_lower_bound(problem, roots, lower - 1, subsets, tree_length(blind) - 1)
+        goal = tree_length(blind) - 1
+        lower = 1 + subset_lower_bound(problem, roots, lower - 1, tree_budget, goal)
     # With a deadline, lengths at the proven bound and one above it first (each with a third
     # of the time left), then the generous cap: a plan within one operation of the bound
     # when the search finds one, some plan else.
@@ -511,13 +517,8 @@ def _fallback(
     # The last search keeps a reserve of the limit for the tree of what it finds: a plan
     # found at the deadline with no time left to write it down is no answer. With a plan in
     # hand every search keeps the whole reserve, and a shorter plan's tree half of it.
-    tree_budget = budget
-    if blind is not None and budget.end is not None:
-        tree_budget = Deadline(
-            memory_mb=budget.memory_mb,
-            end=budget.end - reserve / 2.0,
-            memory_base=budget.memory_base,
-        )
+    if blind is None:
+        tree_budget = budget
     for k in caps if cap >= max(lower - 1, 1) else ():
         rest = budget.remaining()
         if rest is None:
