@@ -27,8 +27,10 @@ from pathlib import Path
 import shapely
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import bench_planners as bp  # noqa: E402
+from shared import small_mix  # noqa: E402  (tests/test_deadline.py's mix)
 
 import feederkit.planning.api as api  # noqa: E402
 from feederkit.errors import PlanningError  # noqa: E402
@@ -52,18 +54,6 @@ def random_part(seed: int, n: int):
     pts = [(30 * r * math.cos(t), 20 * r * math.sin(t)) for r, t in zip(radii, angles, strict=True)]
     hull = shapely.MultiPoint(pts).convex_hull.exterior.coords[:-1]
     return push_function(make_part(make_outline(f"random-{seed}", hull)))
-
-
-def small_mix(count: int, seed: int = 100):
-    """tests/test_deadline.py's mix: random convex 6-10-gons on a 60 x 40 mm ellipse."""
-    out = []
-    for s in range(count):
-        rng = random.Random(seed + s)
-        n = rng.randint(6, 10)
-        angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
-        pts = [(30 * math.cos(t), 20 * math.sin(t)) for t in angles]
-        out.append(push_function(make_part(make_outline(f"mix-{s}", pts))))
-    return out
 
 
 def cases(quick: bool):

@@ -1,9 +1,26 @@
-"""Helpers several test files use: a plan file's part entry, and the one-line CLI error check."""
+"""Helpers several test files use: a plan file's part entry, the one-line CLI error check, and
+the planners' random mix (also benchmarks/dump_plans.py's)."""
 
 from __future__ import annotations
 
-from feederkit.mechanics.push import push_function
-from feederkit.part import Part
+import math
+import random
+
+from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.outline import make_outline
+from feederkit.part import Part, make_part
+
+
+def small_mix(count: int, seed: int = 100) -> list[PushFunction]:
+    """Random convex 6-10-gons on a 60 x 40 mm ellipse."""
+    out = []
+    for s in range(count):
+        rng = random.Random(seed + s)
+        n = rng.randint(6, 10)
+        angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
+        pts = [(30 * math.cos(t), 20 * math.sin(t)) for t in angles]
+        out.append(push_function(make_part(make_outline(f"mix-{s}", pts))))
+    return out
 
 
 def plan_part_entry(part: Part, revision: str | None = None) -> dict:

@@ -10,6 +10,7 @@ import time
 from dataclasses import dataclass
 
 import pytest
+from shared import small_mix
 from test_planners import check_plan
 
 from feederkit.errors import InputError, PlanningError
@@ -40,18 +41,6 @@ def near_round(n: int, noise: float, seed: int = 0, radius: float = 10.0):
         a = 2.0 * math.pi * k / n
         pts.append((r * math.cos(a), r * math.sin(a)))
     return push_function(make_part(make_outline(f"round-{n}-{seed}", pts)))
-
-
-def small_mix(count: int, seed: int = 100):
-    """Random convex 6-10-gons on a 60 x 40 mm ellipse (the benchmarks' mixes)."""
-    out = []
-    for s in range(count):
-        rng = random.Random(seed + s)
-        n = rng.randint(6, 10)
-        angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
-        pts = [(30 * math.cos(t), 20 * math.sin(t)) for t in angles]
-        out.append(push_function(make_part(make_outline(f"mix-{s}", pts))))
-    return out
 
 
 # --- the budget itself ----------------------------------------------------------------
