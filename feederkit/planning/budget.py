@@ -116,6 +116,16 @@ class Deadline:
             memory = base + memory_share * (self.memory_mb - base)
         return Deadline(memory_mb=memory, end=end, start=self.start, memory_base=base)
 
+    def ending(self, end: float | None) -> Deadline:
+        """This budget's memory limit with the deadline ``end`` (a :func:`time.perf_counter`
+        instant; None keeps this one's): a stage that must stop early."""
+        return Deadline(
+            memory_mb=self.memory_mb,
+            end=self.end if end is None else end,
+            start=self.start,
+            memory_base=self.memory_base,
+        )
+
 
 class WorkBudget(Deadline):
     """``outer``'s limits and at most ``polls`` more polls of this budget.

@@ -71,10 +71,13 @@ class SubsetBound:
         while best <= goal and len(inside) < min(MAX_STATES, len(idx)):
             rest = [x for x in idx if not sub >> x & 1]
             rest.sort(key=lambda x: -sum(self.pair(min(x, y), max(x, y)) for y in inside))
-            for x in rest[:CANDIDATES]:  # a superset needs at least as many operations
+            tried = []
+            for x in rest[:CANDIDATES]:
                 grown = sub | 1 << x
+                # A superset needs at least as many operations: its search starts there.
                 self.search.lb[grown] = max(self.search.lb.get(grown, 1), best)
-            best, x = max((self.length(sub | 1 << x), x) for x in rest[:CANDIDATES])
+                tried.append((self.length(grown), x))
+            best, x = max(tried)
             sub |= 1 << x
             inside.append(x)
         return best
