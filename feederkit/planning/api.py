@@ -449,11 +449,7 @@ def _fallback(
     share = budget
     if rest is not None and not problem.sensorless:
         # With readings its tree can be large: keep most of the rest for the search.
-        share = Deadline(
-            memory_mb=budget.memory_mb,
-            end=budget.end - rest * (1.0 - READ_SHARE),
-            memory_base=budget.memory_base,
-        )
+        share = budget.ending(budget.end - rest * (1.0 - READ_SHARE))
     if blind is not None:
         try:  # the readings may shorten it
             read = _sensorless_plan(problem, root_branches, share)
@@ -476,11 +472,7 @@ def _fallback(
     reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
     tree_budget = budget  # where a tree must be built by once a plan is in hand
     if budget.end is not None:
-        tree_budget = Deadline(
-            memory_mb=budget.memory_mb,
-            end=budget.end - reserve / 2.0,
-            memory_base=budget.memory_base,
-        )
+        tree_budget = budget.ending(budget.end - reserve / 2.0)
     rest = budget.remaining()
     # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
     # BEAM_SHARE of what is left; what they find is where the search below starts.
@@ -490,14 +482,16 @@ def _fallback(
         problem,
         roots,
         seed,
-        Deadline(memory_mb=budget.memory_mb, end=beam_end, memory_base=budget.memory_base),
+        budget.ending(beam_end),
         cap,
         lower - 1,
     )
     if beamed is not None:
         search, best = beamed
-        with contextlib.suppress(Timeout):  # its tree now: a plan in hand, shorter than blind
-            blind = _choice_plan(problem, search.choice, roots, root_branches, tree_budget)
+        # Its tree now, under the whole budget: a plan in hand (shorter than blind) beats none,
+        # though its statistics may then run past the limit by one walk of the tree.
+        with contextlib.suppress(Timeout):
+            blind = _choice_plan(problem, search.choice, roots, root_branches, budget)
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
@@ -529,9 +523,7 @@ def _fallback(
             end = budget.end - min(reserve, rest / 2.0)
         else:
             end = budget.end - rest * 2.0 / 3.0
-        anytime.deadline = Deadline(
-            memory_mb=budget.memory_mb, end=end or budget.end, memory_base=budget.memory_base
-        )
+        anytime.deadline = budget.ending(end)
         try:
             if all(anytime.within(r, k) for r in roots):
                 found = k
