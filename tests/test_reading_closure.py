@@ -156,7 +156,9 @@ def test_the_two_landing_octagon_mix_plans_fast_and_optimal():
     assert result.optimal and result.length == 8
 
 
-MACHINES = [(4, 0.0), (6, 0.0), (8, 0.0)]
+MACHINES = [(4, 0.0), (6, 0.0), (8, 0.0), (4, 1.0), (6, 1.0), (8, 2.0)]
+"""(k, rotation error in deg): the ideal machines have one target per range, the others
+outcome sets (read off ``SearchSpace.set_cell_table``)."""
 
 
 @pytest.mark.parametrize(("k", "err"), MACHINES)
@@ -167,6 +169,8 @@ def test_vectorised_cells_match_fixed_cells(k, err, monkeypatch):
     # Small machines keep the pure Python cells: build the table for them too.
     monkeypatch.setattr(space_module, "_CELL_TABLE_MIN", 0)
     vars(space).pop("cell_table", None)
+    vars(space).pop("set_cell_table", None)
+    assert machine.deterministic == (err == 0.0)
     rng = random.Random(k)
     for t in range(60):
         mask = machine.all_states if t == 0 else rng.getrandbits(machine.n) or 1

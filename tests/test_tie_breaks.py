@@ -27,7 +27,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import ToleranceSensor
-from feederkit.uncertainty import IDEAL
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 
 def _machines():
@@ -225,8 +225,12 @@ def test_targets_from_the_cell_table_are_the_machines_successors():
         assert space.targets_at(mask, r) == [m.successor(i, r) for i in members(mask)]
 
 
-def test_cells_from_the_cell_table_are_the_boundary_cells(monkeypatch):
-    m = build_machine(small_mix(6), ToleranceSensor(1.0), IDEAL)
+@pytest.mark.parametrize("rotation_error", [0.0, 1.0])
+def test_cells_from_the_cell_table_are_the_boundary_cells(rotation_error, monkeypatch):
+    unc = IDEAL if rotation_error == 0.0 else Uncertainty(rotation_error_deg=rotation_error)
+    m = build_machine(small_mix(6), ToleranceSensor(1.0), unc)
+    space = search_space(m)
+    assert (space.cell_table if m.deterministic else space.set_cell_table) is not None
     rng = random.Random(3)
     masks = [rng.getrandbits(m.n) or 1 for _ in range(200)]
     fast = Problem(m).choices

@@ -105,18 +105,33 @@ class SearchSpace:
         count = sum(len(x) for x in m.starts)
         if count < _CELL_TABLE_MIN or count * m.n > _CELL_TABLE_MAX:
             return None
-        b = np.fromiter((x for i in range(m.n) for x in m.starts[i]), float)
-        own = np.fromiter((i for i in range(m.n) for _ in m.starts[i]), np.int64)
-        order = np.argsort(b, kind="stable")
-        bounds, owner = b[order], own[order]
-        distinct = np.unique(bounds)
-        mids = (distinct + np.append(distinct[1:], distinct[0] + 360.0)) / 2.0
-        mids = np.where(mids >= 360.0, mids - 360.0, mids)
+        bounds, owner, distinct, mids = _sorted_bounds(m)
         targets = np.empty((len(distinct), m.n), dtype=np.int32)
         for i in range(m.n):
             at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
             targets[:, i] = np.asarray(m.targets[i], dtype=np.int32)[at]
         return bounds, owner, distinct, targets
+
+    @cached_property
+    def set_cell_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """:attr:`cell_table` under outcome sets: the same ``bounds``, ``owner`` and distinct
+        starts, and per cell each state's outcome set there (``outcomes[cell, state]``, a
+        mask); None for a deterministic machine, more than 62 states (masks in a signed
+        64-bit word), or a table over ``_CELL_TABLE_MAX`` entries. Kept for small machines
+        too: the sweep over outcome sets costs about twice as much on a two-part machine of
+        36 boundaries."""
+        m = self.machine
+        if m.deterministic or not 0 < m.n <= 62:
+            return None
+        count = sum(len(x) for x in m.starts)
+        if count * m.n > _CELL_TABLE_MAX:
+            return None
+        bounds, owner, distinct, mids = _sorted_bounds(m)
+        outcomes = np.empty((len(distinct), m.n), dtype=np.int64)
+        for i in range(m.n):
+            at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
+            outcomes[:, i] = np.asarray(m.outcomes_of[i], dtype=np.int64)[at]
+        return bounds, owner, distinct, outcomes
 
     @cached_property
     def _cell_starts(self) -> list[float] | None:
@@ -148,11 +163,15 @@ class SearchSpace:
         more than ``ANGLE_EPS`` apart, as :func:`~feederkit.angles.cells_between` gives them)
         and the image of each (the set's image at the cell's middle), vectorised.
 
-        None when the machine has outcome sets, or when some cell is within a few
+        Under outcome sets the image is the union of the members' outcome sets
+        (:attr:`set_cell_table`). None without a table, or when some cell is within a few
         ``ANGLE_EPS`` of the narrowest kept width (there the boundary clustering of
         :meth:`overlap_cells` decides, and callers use it).
         """
         table = self.cell_table
+        sets = table is None
+        if sets:
+            table = self.set_cell_table
         if table is None or not mask:
             return None
         bounds, owner, distinct, targets = table
@@ -172,6 +191,8 @@ class SearchSpace:
         mid = np.where(mid >= 360.0, mid - 360.0, mid)
         at = np.searchsorted(distinct, mid, side="right") - 1
         rows = targets[at][:, idx]
+        if sets:
+            return lo, hi, np.bitwise_or.reduce(rows, axis=1).tolist()
         bits = np.zeros((len(lo), n), dtype=bool)
         bits[np.arange(len(lo))[:, None], rows] = True
         packed = np.packbits(bits, axis=1, bitorder="little")
@@ -258,6 +279,18 @@ class SearchSpace:
         idx = members(mask)
         states = self.machine.states
         return self.machine.sensor.split([states[i].sensed for i in idx], grouping, idx)
+
+
+def _sorted_bounds(m: PushAlignMachine) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every state's action-range starts sorted together, their owner states, the distinct
+    starts and the middle of each cell between consecutive distinct starts (in [0, 360))."""
+    b = np.fromiter((x for i in range(m.n) for x in m.starts[i]), float)
+    own = np.fromiter((i for i in range(m.n) for _ in m.starts[i]), np.int64)
+    order = np.argsort(b, kind="stable")
+    distinct = np.unique(b)
+    mids = (distinct + np.append(distinct[1:], distinct[0] + 360.0)) / 2.0
+    mids = np.where(mids >= 360.0, mids - 360.0, mids)
+    return b[order], own[order], distinct, mids
 
 
 _spaces: dict[int, SearchSpace] = {}
