@@ -8,7 +8,8 @@ uncertainty, print the tables, the one-line answer, the profile and the uncertai
 and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md). While
 it runs, a progress bar on stderr (on a terminal only, so ``--json`` output stays clean)
 shows the pairs decided, then the length table; past ``--time-limit`` it stops with one
-line saying what was decided (exit 1), never a partial design.
+line saying what was decided (exit 1), after printing the pairs' table when every pair was
+decided (a tolerance sensor's design without its length table).
 """
 
 from __future__ import annotations
@@ -132,7 +133,7 @@ def sensor_command(
             "--time-limit",
             metavar="S",
             help="Seconds; past them the design stops with one line saying what it decided "
-            "(exit 1), never a partial table.",
+            "(exit 1), printing the pairs' table when every pair was decided.",
         ),
     ] = DEFAULT_DESIGN_TIME_LIMIT_S,
     memory_limit: Annotated[
@@ -208,6 +209,7 @@ def sensor_command(
                     time_limit_s=time_limit,
                     progress=progress,
                     memory_limit_mb=memory_limit,
+                    partial=True,
                 )
         except DesignTimeout as exc:
             hints = {"memory": "memory with --memory-limit MB", "time": "time with --time-limit S"}
@@ -241,6 +243,8 @@ def sensor_command(
         if plot is not None:
             console.print(f"wrote {plot}", highlight=False, markup=False, soft_wrap=True)
         console.print(design.answer(), highlight=False, markup=False, soft_wrap=True)
+    if isinstance(design, ToleranceDesign) and not design.complete:
+        fail(f"{design.answer()}; allow more with --time-limit S or --memory-limit MB", code=1)
     if not design.recognizable:
         fail(design.answer(), code=1)
 

@@ -108,12 +108,14 @@ class DesignClock:
         if self._progress is not None and self.stage is not None:
             self._progress(self.stage, self.done, self.total)
 
-    def timeout(self, reason: str = "time") -> DesignTimeout:
+    def timeout(self, reason: str = "time", partial: bool = False) -> DesignTimeout:
         """The one-line error of a design stopped at the limit ``reason`` names (``Timeout``'s:
-        "time" or "memory"), naming what was decided."""
+        "time" or "memory"), naming what was decided; ``partial``: for a design given
+        without its length table."""
         decided = [f"all {t} {_NOUNS[s]}" for s, t in self.finished]
         if self.stage is not None:
-            decided.append(f"{self.done} of {self.total} {_NOUNS[self.stage]}")
+            done = "all" if self.done == self.total > 0 else f"{self.done} of"
+            decided.append(f"{done} {self.total} {_NOUNS[self.stage]}")
         if not decided:
             decided = ["nothing yet"]
         what = " and ".join(filter(None, (", ".join(decided[:-1]), decided[-1])))
@@ -126,9 +128,9 @@ class DesignClock:
             limit = f"the time limit of {self.time_limit_s:g} s"
         else:
             limit = "its limits"
+        tail = "the length table is left out" if partial else "no partial design is given"
         return DesignTimeout(
-            f"the sensor design did not finish within {limit} (it decided {what}); "
-            "no partial design is given",
+            f"the sensor design did not finish within {limit} (it decided {what}); {tail}",
             "memory" if memory else "time",
         )
 

@@ -33,7 +33,8 @@ def plot_design(design: ToleranceDesign | PitchDesign, path: str | Path) -> Path
             _pitches(ax, design)
         ax.set_ylabel("operations")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper left")
+        if ax.get_legend_handles_labels()[0]:  # none when there is no step to draw
+            ax.legend(loc="upper left")
         fig.tight_layout()
         fig.savefig(out)
     finally:
@@ -44,8 +45,9 @@ def plot_design(design: ToleranceDesign | PitchDesign, path: str | Path) -> Path
 def _tolerance(ax, design: ToleranceDesign) -> None:
     steps = design.steps
     if not steps:
-        ax.text(0.5, 0.5, "no tolerance makes this mix recognizable", ha="center",
-                transform=ax.transAxes)  # fmt: skip
+        words = ("no tolerance makes this mix recognizable" if design.complete
+                 else "the length table was not built within the limit")  # fmt: skip
+        ax.text(0.5, 0.5, words, ha="center", transform=ax.transAxes)
         return
     top = steps[-1].hi if steps[-1].hi is not None else 2.0 * steps[-1].lo
     drawn = False

@@ -72,6 +72,14 @@ class ToleranceDesign:
     critical: MixCritical
     steps: tuple[LengthStep, ...]
     uncertainty: Uncertainty = IDEAL
+    stopped: str | None = None
+    """A partial design (``design_tolerance(..., partial=True)`` at its limit): why the
+    length table is missing, every pair being decided; None for a whole design."""
+
+    @property
+    def complete(self) -> bool:
+        """Whether the length table was built (the design is not partial)."""
+        return self.stopped is None
 
     @property
     def plan_limit(self) -> LengthStep | None:
@@ -92,6 +100,9 @@ class ToleranceDesign:
         :attr:`plan_limit` when strong plans fail below it (docs/design.md).
         """
         x = self.critical.critical_tolerance
+        if self.stopped is not None and not self.uncertainty.is_ideal:
+            # Strong plans may fail below the pairs' tolerance: undecided without the table.
+            return None
         limit = self.plan_limit
         if x is None or limit is None:
             return x
@@ -117,6 +128,17 @@ class ToleranceDesign:
     def answer(self) -> str:
         """The design in one line, naming the uncertainty it is for."""
         x = self.critical_tolerance
+        pairs_x = self.critical.critical_tolerance
+        if self.stopped is not None and pairs_x is not None:
+            if x is not None:  # the ideal model: the pairs' tolerance is the mix's
+                text = f"this mix is recognizable with a tolerance up to {x:.6g} mm"
+            else:
+                text = (
+                    f"every pair of this mix is told apart up to {pairs_x:.6g} mm, so no "
+                    "larger tolerance recognizes it; whether one strong plan does up to it "
+                    "was not decided"
+                )
+            return f"{text}{self._model_words()}; {self.stopped}"
         if x is None:
             limit = self.plan_limit
             if self.critical.inseparable or limit is None:
@@ -147,6 +169,8 @@ class ToleranceDesign:
             "critical_tolerance_mm": self.critical_tolerance,
             "pairs": [p.to_dict() for p in self.critical.pairs],
             "lengths": [s.to_dict() for s in self.steps],
+            "complete": self.complete,
+            "stopped": self.stopped,
             "uncertainty": uncertainty_dict(self.uncertainty),
             "model": model_note(self.uncertainty),
             "answer": self.answer(),
@@ -169,6 +193,7 @@ def design_tolerance(
     time_limit_s: float | None = None,
     progress: Progress | None = None,
     memory_limit_mb: float | None = None,
+    partial: bool = False,
 ) -> ToleranceDesign:
     """Critical tolerances and length steps at ``uncertainty`` (default the ideal model);
     the steps reach the mix's critical tolerance, or ``max_tolerance`` (mm) when given
@@ -177,8 +202,11 @@ def design_tolerance(
 
     ``time_limit_s``: seconds (None: no limit), ``memory_limit_mb``: the process's size
     (None: no limit); past either DesignTimeout, a PlanningError naming the limit and what
-    was decided, never a partial design (:mod:`feederkit.design.limit`).
-    ``progress(what, done, total)`` is told of each pair, goal probe and run of the table.
+    was decided (:mod:`feederkit.design.limit`). With ``partial``, a limit passed after
+    every pair is decided gives the design without its length table instead
+    (:attr:`ToleranceDesign.stopped` says why; under uncertainty its critical tolerance is
+    then undecided, the pairs' bounding it from above). ``progress(what, done, total)`` is
+    told of each pair, goal probe and run of the table.
     """
     _check_mix(pfs)
     if max_tolerance is not None and not max_tolerance > 0.0:
@@ -186,7 +214,7 @@ def design_tolerance(
     unc = _uncertainty(uncertainty)
     clock = DesignClock(time_limit_s, progress, memory_limit_mb)
     try:
-        return _design_tolerance(pfs, max_tolerance, unc, clock)
+        return _design_tolerance(pfs, max_tolerance, unc, clock, partial)
     except Timeout as exc:
         raise clock.timeout(exc.reason) from None
 
@@ -196,20 +224,32 @@ def _design_tolerance(
     max_tolerance: float | None,
     unc: Uncertainty,
     clock: DesignClock,
+    partial: bool = False,
 ) -> ToleranceDesign:
     names = tuple(pf.part.name for pf in pfs)
     if unc.is_ideal:
         critical = mix_critical_tolerance(pfs, clock)
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
-        steps = (
-            length_steps(pfs, up_to, critical=critical, clock=clock) if up_to is not None else ()
-        )
-        return ToleranceDesign(names, critical, steps, unc)
-    mix = StrongMix(pfs, unc)
-    critical = strong_mix_critical(mix, clock)
-    up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
-    steps = strong_length_steps(mix, up_to, critical, clock=clock) if up_to is not None else ()
-    return ToleranceDesign(names, critical, steps, unc)
+
+        def table() -> tuple[LengthStep, ...]:
+            return length_steps(pfs, up_to, critical=critical, clock=clock)
+    else:
+        mix = StrongMix(pfs, unc)
+        critical = strong_mix_critical(mix, clock)
+        up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
+
+        def table() -> tuple[LengthStep, ...]:
+            return strong_length_steps(mix, up_to, critical, clock=clock)
+
+    if up_to is None:
+        return ToleranceDesign(names, critical, (), unc)
+    try:
+        return ToleranceDesign(names, critical, table(), unc)
+    except Timeout as exc:
+        if not partial:
+            raise
+        stopped = str(clock.timeout(exc.reason, partial=True))
+        return ToleranceDesign(names, critical, (), unc, stopped)
 
 
 @dataclass(frozen=True)
