@@ -105,12 +105,7 @@ class SearchSpace:
         count = sum(len(x) for x in m.starts)
         if count < _CELL_TABLE_MIN or count * m.n > _CELL_TABLE_MAX:
             return None
-        bounds, owner, distinct, mids = _sorted_bounds(m)
-        targets = np.empty((len(distinct), m.n), dtype=np.int32)
-        for i in range(m.n):
-            at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
-            targets[:, i] = np.asarray(m.targets[i], dtype=np.int32)[at]
-        return bounds, owner, distinct, targets
+        return _per_cell(m, m.targets, np.int32)
 
     @cached_property
     def set_cell_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
@@ -126,12 +121,7 @@ class SearchSpace:
         count = sum(len(x) for x in m.starts)
         if count * m.n > _CELL_TABLE_MAX:
             return None
-        bounds, owner, distinct, mids = _sorted_bounds(m)
-        outcomes = np.empty((len(distinct), m.n), dtype=np.int64)
-        for i in range(m.n):
-            at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
-            outcomes[:, i] = np.asarray(m.outcomes_of[i], dtype=np.int64)[at]
-        return bounds, owner, distinct, outcomes
+        return _per_cell(m, m.outcomes_of, np.int64)
 
     @cached_property
     def _cell_starts(self) -> list[float] | None:
@@ -281,16 +271,23 @@ class SearchSpace:
         return self.machine.sensor.split([states[i].sensed for i in idx], grouping, idx)
 
 
-def _sorted_bounds(m: PushAlignMachine) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _per_cell(
+    m: PushAlignMachine, values: tuple[list[int], ...], dtype: type
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every state's action-range starts sorted together, their owner states, the distinct
-    starts and the middle of each cell between consecutive distinct starts (in [0, 360))."""
+    starts, and per cell between consecutive distinct starts each state's value of its range
+    there (``values[state][range]``: a target, or an outcome mask)."""
     b = np.fromiter((x for i in range(m.n) for x in m.starts[i]), float)
     own = np.fromiter((i for i in range(m.n) for _ in m.starts[i]), np.int64)
     order = np.argsort(b, kind="stable")
     distinct = np.unique(b)
     mids = (distinct + np.append(distinct[1:], distinct[0] + 360.0)) / 2.0
     mids = np.where(mids >= 360.0, mids - 360.0, mids)
-    return b[order], own[order], distinct, mids
+    rows = np.empty((len(distinct), m.n), dtype=dtype)
+    for i in range(m.n):
+        at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
+        rows[:, i] = np.asarray(values[i], dtype=dtype)[at]
+    return b[order], own[order], distinct, rows
 
 
 _spaces: dict[int, SearchSpace] = {}
