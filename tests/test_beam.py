@@ -101,6 +101,21 @@ def test_a_passed_deadline_leaves_no_beam_plan():
     assert beam_plan(problem, roots, None, Deadline(0.0), 2 * machine.n + 1) is None
 
 
+def test_a_first_plan_may_take_until_its_own_deadline():
+    # The beams' deadline has passed, the first plan's has not: one plan, and no search for
+    # a shorter one (what a later deadline for the first plan alone allows).
+    machine = _random_part_machine()
+    problem, branches, roots = _problem(machine)
+    cap = 2 * machine.n + 1
+    found = beam_plan(problem, roots, None, Deadline(0.0), cap, 1, Deadline())
+    assert found is not None
+    search, best = found
+    first = BeamSearch(problem, 4)  # the first beam's plan, not a shorter one
+    assert best == max(next(k for k in range(1, cap + 1) if first.within(r, k)) for r in roots)
+    root = _choice_plan(problem, search.choice, roots, branches, Deadline())
+    assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == 1 + best
+
+
 def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(monkeypatch):
     machine = _random_part_machine()
     exact = plan(machine)

@@ -18,10 +18,12 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning import api
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
-from feederkit.planning.budget import Deadline, Timeout, rss_mb
+from feederkit.planning.budget import Checkpoint, Deadline, Timeout, rss_mb
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -81,6 +83,75 @@ def test_a_share_keeps_the_start_of_the_budget():
     assert share.memory_mb == pytest.approx(base + 0.8 * (1000.0 - base))
     assert share.memory_base == base
     assert Deadline().until(0.5).end is None
+
+
+def test_a_checkpoint_goes_on_only_when_on_course():
+    # ``first`` has passed: the first poll asks once; on course, the later end holds.
+    later = time.perf_counter() + 3600.0
+    asked = []
+    on = Checkpoint(Deadline(), time.perf_counter() - 1.0, later, lambda: asked.append(1) or True)
+    on.check()
+    on.check()
+    assert asked == [1] and on.end == later and not on.handed_over
+    off = Checkpoint(Deadline(), time.perf_counter() - 1.0, later, lambda: False)
+    for _ in range(2):  # once handed over, it stays over
+        with pytest.raises(Timeout):
+            off.check()
+    assert off.handed_over and off.end < later
+    # go_on: past the question (the exact search proved every root), the later end at once.
+    early = Checkpoint(Deadline(), time.perf_counter() - 1.0, later, lambda: False)
+    early.go_on()
+    early.check()
+    assert early.end == later and not early.handed_over
+    # No judge yet (the stages before the search of the roots' lengths): it goes on.
+    unjudged = Checkpoint(Deadline(), time.perf_counter() - 1.0, later)
+    unjudged.check()
+    assert unjudged.end == later and not unjudged.handed_over
+
+
+def test_the_exact_search_is_on_course_with_its_share_of_roots_proven():
+    machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
+    problem = Problem(machine, "exact", 0.0, goal_relation(machine, Deadline()))
+    roots = [r for r in range(1, 1 << machine.n) if not problem.is_goal(r)][:10]
+    worst = WorstCase(problem)
+    assert not api._on_course(problem, worst, roots)
+    need = math.ceil(api.EXACT_CHECK_SHARE * len(roots))
+    for r in roots[: need - 1]:
+        worst.exact[r] = 1
+    assert not api._on_course(problem, worst, roots)
+    worst.exact[roots[need - 1]] = 1
+    assert api._on_course(problem, worst, roots)
+
+
+def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(monkeypatch):
+    # The checkpoint at once (share 0) and never on course; the exact search never ends on
+    # its own (it polls until stopped): the fallback starts with nearly the whole limit, not
+    # FALLBACK_SHARE of it, and answers with a verified plan.
+    machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
+    exact = plan(machine)
+    monkeypatch.setattr(api, "EXACT_CHECK_SHARE", 0.0)
+    monkeypatch.setattr(api, "_on_course", lambda *_args: False)
+    budgets = []
+
+    def endless(problem, worst, *_args, **_kwargs):
+        budgets.append(worst.deadline)
+        while True:
+            worst.deadline.check()
+
+    monkeypatch.setattr(api, "root_lengths", endless)
+    left = []
+    real = api._fallback
+
+    def spy(problem, worst, roots, root_branches, budget, *args):
+        left.append(budget.remaining())
+        return real(problem, worst, roots, root_branches, budget, *args)
+
+    monkeypatch.setattr(api, "_fallback", spy)
+    result = plan(machine, PlanningOptions(time_limit_s=60.0))
+    assert len(budgets) == 1 and budgets[0].handed_over
+    assert left and left[0] > 0.9 * 60.0 > api.FALLBACK_SHARE * 60.0
+    assert check_plan(result) == result.length >= exact.length
+    assert result.lower_bound <= exact.length
 
 
 @pytest.mark.parametrize("bad", [0.0, -5.0, math.inf, math.nan, True, "100"])

@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 
 from feederkit.errors import PlanningError
-from feederkit.planning.api import FALLBACK_SHARE, TIES_EXACT
+from feederkit.planning.api import EXACT_CHECK_SHARE, FALLBACK_SHARE, TIES_EXACT
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.make import MadePlan
@@ -141,8 +141,9 @@ class DesignClock:
         left and the memory limit as its own, and any answer that may come from its budget
         rather than from the search is a Timeout here: a plan not proven optimal, and a
         PlanningError or tie-breaks left undecided once the planner's exact stages may have
-        used up their share of the time (``1 - FALLBACK_SHARE``: its fallback answers then,
-        and the expected number of operations would not be the unlimited design's).
+        handed the time to its fallback (from ``EXACT_CHECK_SHARE`` of their share
+        ``1 - FALLBACK_SHARE`` on: the fallback answers then, and the expected number of
+        operations would not be the unlimited design's).
         """
         if self.time_limit_s is None and self.memory_limit_mb is None:
             return make(None)
@@ -151,9 +152,11 @@ class DesignClock:
         if left is not None and left <= 0.0:
             raise Timeout("time")
         exact_end = (
-            math.inf if left is None else time.perf_counter() + (1.0 - FALLBACK_SHARE) * left
+            math.inf
+            if left is None
+            else time.perf_counter() + EXACT_CHECK_SHARE * (1.0 - FALLBACK_SHARE) * left
         )
-        # Out of time once the exact stages' share has passed; otherwise the memory ran out.
+        # Out of time once the exact stages may have handed over; otherwise the memory ran out.
         stopped = "time" if self.memory_limit_mb is None else "memory"
         options = PlanningOptions(time_limit_s=left, memory_limit_mb=self.memory_limit_mb)
         try:

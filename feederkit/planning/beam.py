@@ -72,10 +72,12 @@ def beam_plan(
     deadline: Deadline,
     cap: int,
     lower: int = 1,
+    first: Deadline | None = None,
 ) -> tuple[BeamSearch, int] | None:
     """The shortest plan the widening beams found for every root within ``cap`` operations:
     a search whose ``choice`` table holds it, and its largest root length; None when none
-    was found before ``deadline`` passed.
+    was found in time: before ``first`` passed (when given: the deadline for a first plan,
+    later than ``deadline``), else ``deadline``; a shorter one only before ``deadline``.
 
     ``seed``, when given, is an exact search of the same problem: its proven bounds and
     plans start every beam. Stops early when a plan meets ``lower`` (a proven bound on the
@@ -84,7 +86,7 @@ def beam_plan(
     """
     best: int | None = None
     target = cap
-    beam = _beam(problem, FIRST_WIDTH, deadline, seed, None)
+    beam = _beam(problem, FIRST_WIDTH, deadline if first is None else first, seed, None)
     while target >= max(lower, 1):
         try:
             lengths = _lengths(beam, roots, target)
@@ -93,8 +95,9 @@ def beam_plan(
         if lengths is not None:
             best = max(lengths)
             target = best - 1  # the same beam (its failures still hold), for a shorter plan
+            beam.deadline = deadline  # a plan in hand: shorter ones within ``deadline`` only
         elif beam.cut:
-            beam = _beam(problem, 2 * beam.width, deadline, seed, beam)
+            beam = _beam(problem, 2 * beam.width, beam.deadline, seed, beam)
         else:
             break  # exhaustive: no plan within the target exists
     return None if best is None else (beam, best)

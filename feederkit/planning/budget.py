@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import resource
 import time
+from collections.abc import Callable
 
 MEMORY_POLL_S = 0.02
 """``check`` reads the resident set size at most this often (seconds)."""
@@ -125,6 +126,67 @@ class Deadline:
             start=self.start,
             memory_base=self.memory_base,
         )
+
+
+class Checkpoint(Deadline):
+    """``outer``'s limits, ending at ``first`` (a :func:`time.perf_counter` instant) unless
+    ``on_course()``, asked once when ``first`` passes, says True: then at ``end``.
+
+    A stage that may not finish in its share gives the rest of it back early: the exact
+    search of ``plan`` stops at ``first`` when it is not on course to finish by ``end``,
+    and the fallback gets the time. ``on_course`` may be set after the budget is made
+    (None when ``first`` passes: on course, nothing is judged yet); :meth:`go_on` moves the
+    end to ``end`` at once (the stage is past what ``on_course`` judges). ``handed_over``
+    tells whether it stopped at ``first``.
+
+    >>> now = time.perf_counter()
+    >>> budget = Checkpoint(Deadline(), now - 1.0, now + 60.0)
+    >>> budget.on_course = lambda: False
+    >>> budget.check()
+    Traceback (most recent call last):
+    ...
+    feederkit.planning.budget.Timeout: time
+    >>> budget.handed_over
+    True
+    """
+
+    def __init__(
+        self,
+        outer: Deadline,
+        first: float,
+        end: float | None,
+        on_course: Callable[[], bool] | None = None,
+    ) -> None:
+        super().__init__(
+            memory_mb=outer.memory_mb,
+            end=first,
+            start=outer.start,
+            memory_base=outer.memory_base,
+        )
+        self.later = end
+        self.on_course = on_course
+        self.handed_over = False
+
+    def go_on(self) -> None:
+        """The end is ``end`` from now on (no question asked at ``first``)."""
+        if self.later is not None:
+            self.end, self.later = self.later, None
+
+    def check(self) -> None:
+        """Raise Timeout past the deadline (``first``, or ``end`` once on course) or the
+        memory limit."""
+        try:
+            super().check()
+        except Timeout as exc:
+            if exc.reason != "time" or self.later is None:
+                raise
+            if self.on_course is not None and not self.on_course():
+                self.later = None
+                self.handed_over = True
+                raise
+            self.go_on()
+            self.polls -= 1  # one poll, checked again against the later end
+            super().check()
 
 
 class WorkBudget(Deadline):
