@@ -411,3 +411,34 @@ def test_the_benchmark_ellipse_mix_stops_at_the_limit(uncertainty):
         lambda t, p: design_tolerance(pfs, uncertainty=uncertainty, time_limit_s=t, progress=p),
         5.0,
     )
+
+
+@pytest.mark.parametrize(("wait_s", "answers"), [(0.0, True), (0.35, False)])
+def test_a_plan_whose_ties_are_undecided_counts_only_before_the_fallback_may_answer(
+    wait_s, answers
+):
+    # The planner's exact search may hand the time to its fallback from EXACT_CHECK_SHARE of
+    # its share on (planning.budget.Checkpoint): a plan with undecided tie-breaks returned
+    # after that may be the fallback's, so it stops the design instead of answering.
+    from types import SimpleNamespace
+
+    from feederkit.design import limit as limit_module
+    from feederkit.planning.api import TIES_NONE
+
+    limit_s = 1.0
+    assert wait_s == 0.0 or wait_s > (
+        limit_module.EXACT_CHECK_SHARE * (1.0 - limit_module.FALLBACK_SHARE) * limit_s
+    )
+    made = SimpleNamespace(result=SimpleNamespace(optimal=True, tie_breaks=TIES_NONE))
+
+    def make(options):
+        assert options is not None and options.time_limit_s <= limit_s
+        time.sleep(wait_s)
+        return made
+
+    clock = DesignClock(limit_s)
+    if answers:
+        assert clock.plan(make) is made
+    else:
+        with pytest.raises(Timeout):
+            clock.plan(make)
