@@ -45,7 +45,8 @@ _NOUNS = {
 
 class DesignTimeout(PlanningError):
     """The sensor design did not finish within its time or memory limit (nothing partial is
-    returned); ``reason`` says which ("time" or "memory", as ``Timeout``'s).
+    returned: a partial design, when asked for, is a ``ToleranceDesign`` whose ``stopped``
+    holds this message); ``reason`` says which ("time" or "memory", as ``Timeout``'s).
 
     A :class:`~feederkit.errors.PlanningError` (exit 1), as ``plan``'s "no plan found within
     the time limit".
