@@ -10,6 +10,22 @@ from dataclasses import dataclass
 ANGLE_EPS = 1e-7
 """Angles closer than this (degrees) are the same angle."""
 
+WIDTH_QUANTUM_DEG = 1e-9
+"""Widths of rotation ranges are compared in whole multiples of this (degrees) when a plan
+chooses among ranges: the mirror-image ranges of a symmetric part differ only by rounding,
+and rounding differs between machines (numpy's vectorised trigonometry), so their margins
+count as equal and the smaller rotation decides, the same plan everywhere."""
+
+
+def width_key(width: float) -> int:
+    """A range's width (deg) in whole ``WIDTH_QUANTUM_DEG``, to order ranges by (the larger
+    key the wider; rounded half to even, as ``numpy.rint`` of ``width * 1e9``).
+
+    >>> width_key(51.430321637587525) == width_key(51.43032163758751)
+    True
+    """
+    return round(width * 1e9)
+
 
 def norm360(a: float) -> float:
     """The angle in [0, 360)."""

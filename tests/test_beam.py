@@ -74,6 +74,20 @@ def test_the_first_beam_plan_is_a_plan_and_widening_reaches_the_optimum(seed, n,
     assert 1 + best == optimum
     root = _choice_plan(problem, search.choice, roots, branches, Deadline())
     assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == optimum
+    # One node per witness: every set below the root follows a chosen set's own subplan.
+    assert _distinct_steps(root) - 1 <= len(search.choice)
+
+
+def _distinct_steps(root) -> int:
+    """The distinct operations of a plan (each shared node once)."""
+    seen, stack = set(), [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen or not hasattr(node, "branches"):
+            continue
+        seen.add(id(node))
+        stack.extend(sub for _b, sub in node.branches)
+    return len(seen)
 
 
 def _random_part_machine(seed: int = 3, n: int = 10, rel: float = 0.08):

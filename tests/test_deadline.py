@@ -4,6 +4,8 @@ would otherwise run for minutes (docs/planning.md, "Time and memory limits")."""
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import math
 import random
 import time
@@ -549,3 +551,62 @@ def test_readings_that_carry_nothing_give_the_backchaining_optimum_at_once():
     full = (1 << blind.n) - 1
     assert result.length == 1 + Backchain(circle).length(full)  # the sensorless optimum
     assert check_plan(result) == result.length
+
+
+def _cyclic_garbage(run) -> int:
+    """How many objects ``run()`` leaves that only the cyclic collector can free."""
+    gc.collect()
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        run()
+        return gc.collect()
+    finally:
+        if was:
+            gc.enable()
+
+
+@pytest.mark.parametrize(
+    "case",
+    ["exact, ideal model", "fallback, under uncertainty"],
+)
+def test_a_plan_leaves_its_search_tables_to_reference_counting(case):
+    # The planner pauses the cyclic collector (budget.collector_paused): a cycle through its
+    # tables (a closure over the search stored on its own budget, a Timeout kept with its
+    # traceback) would leave them all to the next collection, seconds of it on a large mix.
+    if case.startswith("exact"):
+        machine = build_machine(small_mix(12), ToleranceSensor(1.2), IDEAL)
+        options = PlanningOptions()
+    else:
+        machine = build_machine(small_mix(20), ToleranceSensor(3.0), Uncertainty())
+        options = PlanningOptions(time_limit_s=1.5)
+
+    def run() -> None:
+        with contextlib.suppress(PlanningError):
+            plan(machine, options)
+
+    assert gc.isenabled()
+    assert _cyclic_garbage(run) < 2000
+    assert gc.isenabled()  # restored
+
+
+def test_the_goal_fixpoint_of_a_plan_serves_the_machine_it_was_asked_of():
+    # The planner numbers states by diameter; its bisimilar states (the longest step before
+    # a search) are handed back to the caller's machine, and the other way round.
+    from feederkit.machine import PushAlignMachine, search_space
+    from feederkit.machine.inseparable import inseparable_masks
+    from feederkit.planning.reindex import by_diameter
+
+    machine = build_machine(small_mix(8), ToleranceSensor(1.5), Uncertainty())
+    assert by_diameter(machine)[0] is not machine  # the case the sharing is for
+    plan(machine)
+    assert "bisimilar" in vars(search_space(machine))
+    assert search_space(machine).bisimilar == inseparable_masks(machine)
+    fresh = PushAlignMachine(
+        machine.part_names, machine.states, machine.action_maps, machine.sensor, machine.uncertainty
+    )
+    assert search_space(fresh).bisimilar  # the caller's first, then the planner's numbering
+    sorted_machine, old = by_diameter(fresh)
+    api.share_bisimilar(fresh, sorted_machine, old)
+    assert "bisimilar" in vars(search_space(sorted_machine))
+    assert search_space(sorted_machine).bisimilar == inseparable_masks(sorted_machine)

@@ -809,27 +809,26 @@ def max_rotation_error(
     ``BOUNDARY_EPS_DEG`` (closer than that counts as touching). Exact for the model (the
     cells); 0 when even an exact rotation leaves the set; at most 90.
     """
-    best = 90.0
+    best = 90.0  # the smallest state's distance so far (before the boundary allowance)
+    ends = {v for cell in mech.cells for v in (cell.lo, cell.hi)}
     for s in states:
         allowed = assumed[s] if assumed is not None else outcome_set(mech, s, action_deg)
         x0, y0 = _window(mech, s, action_deg, 0.0)
-        ends = {v for cell in mech.cells for v in (cell.lo, cell.hi)}
         dist = sorted({norm360(e - y0) for e in ends} | {norm360(x0 - e) for e in ends} | {0.0})
         dist = [d for d in dist if d < best] + [best]
-        limit = best
         for k, d in enumerate(dist[:-1]):
             nxt = dist[k + 1]
             if not fence_outcomes(mech, x0 - d, y0 + d) <= allowed:
-                limit = d
+                best = d
                 break
             mid = (d + nxt) / 2.0
             if not fence_outcomes(mech, x0 - mid, y0 + mid) <= allowed:
-                limit = d
+                best = d
                 break
-        # A window within BOUNDARY_EPS_DEG of a cell's end counts as on it (both sides'
-        # outcomes), so the supremum the model can honour stops that far short.
-        best = min(best, limit if limit >= 90.0 else max(0.0, limit - BOUNDARY_EPS_DEG))
-    return best
+    # A window within BOUNDARY_EPS_DEG of a cell's end counts as on it (both sides'
+    # outcomes), so the supremum the model can honour stops that far short. Taken once, of
+    # the smallest distance, so the result is the same however the states are grouped.
+    return best if best >= 90.0 else max(0.0, best - BOUNDARY_EPS_DEG)
 
 
 def max_shape_tolerance(

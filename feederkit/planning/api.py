@@ -28,15 +28,21 @@ from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, sea
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
-from feederkit.planning.budget import Checkpoint, Deadline, Timeout, WorkBudget
+from feederkit.planning.budget import (
+    Checkpoint,
+    Deadline,
+    Timeout,
+    WorkBudget,
+    collector_paused,
+)
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import make_oracle, root_lengths
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.refine import Refiner, child_masses, stage
-from feederkit.planning.reindex import by_diameter, remap_tree
+from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
+from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import solve, unsolvable
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
@@ -171,13 +177,21 @@ def _limit(machine: PushAlignMachine) -> int:
     return 4 * machine.n + 4
 
 
-def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> PlanResult:
+def plan(
+    machine: PushAlignMachine,
+    options: PlanningOptions | None = None,
+    *,
+    budget: Deadline | None = None,
+) -> PlanResult:
     """A plan orienting every state of ``machine`` (up to inseparable states).
 
     The plan has the minimum worst-case number of operations (sections 4 and 6) among plans
     whose rotations all keep a margin above ``ANGLE_EPS / 2`` (narrower cells are not
     physical: docs/conventions.md), ties broken as :mod:`feederkit.planning.refine` says;
-    ``options`` default to :class:`PlanningOptions` ``()``.
+    ``options`` default to :class:`PlanningOptions` ``()``. ``budget`` is the deadline and
+    memory limit to plan under when a caller keeps part of the options' limits for its own
+    work after the plan (a command's verification and file); by default the options' limits
+    from now. Messages name the options' limits.
 
     Raises InputError for bad options and PlanningError when no plan keeps the minimum
     margin (naming the largest margin that works) or none is found within the time limit.
@@ -195,11 +209,21 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
     if not isinstance(options, PlanningOptions):
         raise InputError(f"the planning options must be PlanningOptions, got {options!r}")
     # The one budget of this call: every stage below polls it (docs/planning.md).
-    budget = Deadline(options.time_limit_s, options.memory_limit_mb)
+    if budget is None:
+        budget = Deadline(options.time_limit_s, options.memory_limit_mb)
     if machine.n == 0:
         raise InputError("the machine has no states")
+    with collector_paused():
+        return _plan_machine(machine, options, budget)
+
+
+def _plan_machine(
+    machine: PushAlignMachine, options: PlanningOptions, budget: Deadline
+) -> PlanResult:
+    """:func:`plan` with its options checked and its budget made."""
     # Plan with the states numbered by diameter (readings then pick runs of bits).
     sorted_machine, old = by_diameter(machine)
+    share_bisimilar(machine, sorted_machine, old)
     lumping = None
     try:
         root, optimal, length, lower, ties = _plan(sorted_machine, options, budget)
@@ -214,6 +238,7 @@ def plan(machine: PushAlignMachine, options: PlanningOptions | None = None) -> P
             hint = unlike_words(sorted_machine, tried.unlike)
             raise NoStrongPlan(exc.reason, hint) from None
         root, optimal, length, lower, ties = _plan(sorted_machine, options, budget, lumping.insep)
+    share_bisimilar(machine, sorted_machine, old)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
     result = _result(
@@ -310,13 +335,14 @@ def _plan(
         try:
             _check_margin(problem, roots, min_margin, exact_deadline)
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
     if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
         worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
     checkpoint = exact_deadline if isinstance(exact_deadline, Checkpoint) else None
     if checkpoint is not None:
         # Judged while the roots' lengths are searched (the stages before go on).
         checkpoint.on_course = lambda: _on_course(problem, worst, roots)
+    stopped = None
     try:
         try:
             lengths = root_lengths(problem, worst, roots, method, limit)
@@ -330,10 +356,17 @@ def _plan(
                 worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
             lengths = root_lengths(problem, worst, roots, method, _limit(machine))
     except Timeout as exc:
-        return _fallback(problem, worst, roots, root_branches, budget, options, exc)
+        stopped = exc.reason
     except ValueError:
         exact = method in ("bfs", "bottom-up") or known is not None
         raise _no_strong_plan(machine, undecided=not exact) from None
+    finally:
+        if checkpoint is not None:
+            # The question is asked while the lengths are searched only; its closure holds
+            # the search, which holds the checkpoint: a cycle only the collector would free.
+            checkpoint.on_course = None
+    if stopped is not None:
+        return _fallback(problem, worst, roots, root_branches, budget, options, stopped)
     if checkpoint is not None:
         checkpoint.go_on()  # every root's length is proven: the rest of the share is ours
     length = 1 + max(lengths.values(), default=0)
@@ -345,7 +378,7 @@ def _plan(
         try:
             chain = _sensorless_plan(problem, root_branches, budget, by_image=True)
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         if chain is not None and tree_length(chain) == length:
             return chain, True, length, length, TIES_NONE
     children = _root_children(problem, root_branches, start_mass)
@@ -369,11 +402,11 @@ def _plan(
         worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
         ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
         if not staged:
-            refiner.floor = refiner.floor_found if objective == "worst" else -math.inf
+            refiner.floor = tie_floor(refiner.floor_found) if objective == "worst" else -math.inf
         try:
             root = _build(refiner, children, budget_ops, "first")
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc)
+            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         complete = objective == "worst"
     else:
         complete = True
@@ -469,9 +502,10 @@ def _fallback(
     root_branches,
     budget: Deadline,
     options: PlanningOptions,
-    stop: Timeout,
+    stop: str,
 ):
-    """Some plan when the exact search ran out of its budget, with the lower bound proven.
+    """Some plan when the exact search ran out of its budget (``stop``: the Timeout's reason),
+    with the lower bound proven.
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
@@ -483,9 +517,13 @@ def _fallback(
     shorter still. A tree follows the actions that proved it; a reading set the searches
     never met lies inside one they did (its "witness"), and follows the witness's
     rotations. PlanningError when none finds a plan in time.
+
+    No Timeout is kept past its ``except`` block: its traceback holds the frames of the
+    search, and a frame holding it would make the searches' tables cyclic garbage that only
+    the collector (paused while planning) could free.
     """
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
-    if stop.reason == "memory":
+    if stop == "memory":
         # Let the exact search's tables go: the fallback starts from a fresh problem.
         problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
         del worst
@@ -507,7 +545,7 @@ def _fallback(
         if read is not None and tree_length(read) < tree_length(blind):
             blind = read
     anytime = WorstCase(problem, budget)
-    if stop.reason != "memory" and type(worst) is WorstCase:
+    if stop != "memory" and type(worst) is WorstCase:
         # What the exact search proved stays true (its exact lengths are left out: they
         # may come without the action that proves them).
         anytime.lb.update(worst.lb)
@@ -518,7 +556,7 @@ def _fallback(
         cap = tree_length(blind) - 2  # look only for something shorter
     # A plan in hand needs time for its tree and statistics: the searches below stop a
     # reserve of the limit before it.
-    reserve = 0.0 if options.time_limit_s is None else TREE_RESERVE * options.time_limit_s
+    reserve = 0.0 if budget.end is None else TREE_RESERVE * (budget.end - budget.start)
     tree_budget = budget  # where a tree must be built by once a plan is in hand
     if budget.end is not None:
         tree_budget = budget.ending(budget.end - reserve / 2.0)
@@ -526,7 +564,7 @@ def _fallback(
     # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
     # BEAM_SHARE of what is left; what they find is where the search below starts.
     beam_end = None if rest is None else budget.end - max(rest * (1.0 - BEAM_SHARE), reserve)
-    seed = worst if stop.reason != "memory" and type(worst) is WorstCase else None
+    seed = worst if stop != "memory" and type(worst) is WorstCase else None
     # With no plan in hand a first one may take until FIRST_PLAN_RESERVE before the limit
     # (what is left then builds its tree).
     first = None
@@ -569,7 +607,7 @@ def _fallback(
     near = (lower - 1, lower) if budget.end is not None else ()
     caps = sorted({k for k in near if k < cap}) + [cap]
     found = None
-    last = Timeout(stop.reason)
+    last = stop  # the reason the last search stopped
     # The last search keeps a reserve of the limit for the tree of what it finds: a plan
     # found at the deadline with no time left to write it down is no answer. With a plan in
     # hand every search keeps the whole reserve, and a shorter plan's tree half of it.
@@ -593,22 +631,24 @@ def _fallback(
                 found = k
                 break
         except Timeout as exc:
-            last = exc
-            if exc.reason == "memory":
+            last = exc.reason
+            if last == "memory":
                 break
-    try:
-        if found is None:
-            raise last
+    root = None
+    if found is not None:
         anytime.deadline = tree_budget
-        root = _choice_plan(problem, anytime.choice, roots, root_branches, tree_budget)
-    except Timeout as exc:
+        try:
+            root = _choice_plan(problem, anytime.choice, roots, root_branches, tree_budget)
+        except Timeout as exc:
+            last = exc.reason
+    if root is None:
         if blind is not None:
             return blind, False, None, lower, TIES_NONE
-        reason = exc.reason if exc.reason == "memory" else stop.reason
+        reason = last if last == "memory" else stop
         raise PlanningError(
             f"no plan found within {_out_of_budget(options, reason)} "
             f"(a plan needs at least {plural(lower, 'operation')})"
-        ) from None
+        )
     return root, False, None, lower, TIES_NONE
 
 
@@ -649,7 +689,16 @@ def _dag(
 
 
 def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:
-    """The plan that follows a search's ``choice`` table (the action that proved each set)."""
+    """The plan that follows a search's ``choice`` table (the action that proved each set).
+
+    A reading set the search did not choose for lies inside one it did (its witness: a
+    searched superset, or the set itself, whichever has the shorter plan) and follows the
+    witness's subplan itself: the witness's rotation sends the set inside the witness's
+    image, each reading then leaves a subset of one of the image's branches, and a subset
+    of a goal is a goal. So the plan has one node per witness, not one per reading set met
+    (the 50-part mix at 3 % under 1 degree: about a tenth of the nodes), and every consumer
+    (verification, certificate, file, drawing) walks that much less.
+    """
 
     def witness_of(mask: int, supersets) -> int:
         # The set itself or a searched set containing it, whichever has the shorter plan: a
@@ -664,29 +713,17 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
                 best, bound = c, choice[c][0]
         return best
 
-    def expand(key):
-        mask, witness = key
-        if problem.is_goal(mask):
-            return Leaf(mask)
+    def expand(witness: int):
+        if problem.is_goal(witness):
+            return Leaf(witness)
         _k, act = choice[witness]
-        if witness != mask:
-            # Follow the witness's rotation: the set's range holding it (any rotation in it
-            # sends the set inside the witness's image).
-            # A subset's boundaries are among the witness's, so the rotation lies strictly
-            # inside one of the subset's cells between real boundaries (Choices.fixed_cells):
-            # its margin is the one every member has, never a merged range's.
-            action = problem.choices.range_at(mask, act.action.representative)
-            if action is None:
-                raise AssertionError("a witness's rotation lies on a boundary of its subset")
-        else:
-            action = act.action
         subs = [
-            (b, (b.mask, witness_of(b.mask, act.children)))
-            for b in problem.readings.image_branches(action.image)
+            (b, witness_of(b.mask, act.children))
+            for b in problem.readings.image_branches(act.action.image)
         ]
-        return action, subs
+        return act.action, subs
 
-    top = [(b, (b.mask, witness_of(b.mask, roots))) for b in root_branches]
+    top = [(b, witness_of(b.mask, roots)) for b in root_branches]
     made = _dag([k for _b, k in top], expand, deadline)
     return Step(None, tuple((b, made[k]) for b, k in top))
 

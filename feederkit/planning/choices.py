@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from feederkit.angles import ANGLE_EPS, cells_between, norm360
+from feederkit.angles import ANGLE_EPS, cells_between, norm360, width_key
 from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
 from feederkit.planning.readings import Readings
 
@@ -130,15 +130,6 @@ class Choices:
         self._fixed[mask] = out
         return out
 
-    def range_at(self, mask: int, rotation: float) -> OverlapRange | None:
-        """The set's cell holding ``rotation`` (deg) strictly inside, or None (a rotation on
-        or within ``ANGLE_EPS`` of a boundary)."""
-        r = norm360(rotation)
-        for lo, hi, img in self.fixed_cells(mask):
-            if lo < r < hi or lo < r + 360.0 < hi:
-                return OverlapRange(lo, hi, img)
-        return None
-
     def cells(self, mask: int, useful: bool = True) -> list[tuple[float, float, int]]:
         """The set's overlap ranges as ``(lo, hi, image)``, widest first (cached).
 
@@ -157,23 +148,23 @@ class Choices:
             # The same cells and images as fixed_cells, from the machine's cell table.
             los, his, imgs = fast
             width = his - los
-            order = np.lexsort((-width,))  # widest first: the first per image is the widest
-            ordered = width[order]
-            kept = int(np.count_nonzero(ordered >= floor))
-            if bool(np.all(ordered[1:kept] < ordered[: kept - 1])):
+            keep = np.flatnonzero(width >= floor)
+            key = np.rint(width[keep] * 1e9)  # width_key, vectorised
+            by_width = np.argsort(-key, kind="stable")  # widest first
+            order = keep[by_width]
+            kept = len(order)
+            ordered = key[by_width]
+            if bool(np.all(ordered[1:] < ordered[:-1])):
                 # No two widths alike: the first cell of each image is its widest, and the
                 # order of first cells is the final one (widest first).
-                pick = order[:kept]
-                seq = [imgs[k] for k in pick.tolist()]
+                seq = [imgs[k] for k in order.tolist()]
                 first = dict(zip(reversed(seq), range(kept - 1, -1, -1), strict=True))
-                lo_l, hi_l = los[pick].tolist(), his[pick].tolist()
+                lo_l, hi_l = los[order].tolist(), his[order].tolist()
                 cells = [(lo_l[i], hi_l[i], seq[i]) for i in sorted(first.values())]
                 return self._keep_cells(mask, useful, cells)
             for k, lo, hi in zip(
                 order.tolist(), los[order].tolist(), his[order].tolist(), strict=True
             ):
-                if hi - lo < floor:
-                    break
                 img = imgs[k]
                 old = best.get(img)
                 if old is None or _wider((lo, hi, img), old):
@@ -189,7 +180,10 @@ class Choices:
                 old = best.get(key)
                 if old is None or _wider(cell, old):
                     best[key] = cell
-        keyed = [(lo - hi, norm360((lo + hi) / 2.0), img, lo, hi) for lo, hi, img in best.values()]
+        keyed = [
+            (-width_key(hi - lo), norm360((lo + hi) / 2.0), img, lo, hi)
+            for lo, hi, img in best.values()
+        ]
         keyed.sort()
         return self._keep_cells(mask, useful, [(lo, hi, img) for _w, _r, img, lo, hi in keyed])
 
@@ -323,7 +317,7 @@ def spread(masses, outcomes) -> dict[int, float]:
 
 def _wider(a: tuple[float, float, int], b: tuple[float, float, int]) -> bool:
     """The wider cell first (larger margin), then the smaller representative rotation."""
-    wa, wb = a[1] - a[0], b[1] - b[0]
+    wa, wb = width_key(a[1] - a[0]), width_key(b[1] - b[0])
     if wa != wb:
         return wa > wb
     return norm360((a[0] + a[1]) / 2.0) < norm360((b[0] + b[1]) / 2.0)

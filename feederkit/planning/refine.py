@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from feederkit.angles import norm360
+from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.choices import spread
@@ -169,7 +169,7 @@ class Refiner:
             sa = OverlapRange(lo, hi, img)
             rot = sa.representative
             k: object = self.p.choices.targets(mask, sa) if by_map else img
-            rank = (costs.seconds(rot), lo - hi, norm360(rot), cell)
+            rank = (costs.seconds(rot), -width_key(hi - lo), norm360(rot), cell)
             old = best.get(k)
             if old is None or rank[:3] < old[:3]:
                 best[k] = rank
@@ -546,6 +546,13 @@ class Refiner:
         return node
 
 
+def tie_floor(margin: float) -> float:
+    """The margin floor a plan keeps once ``margin`` is the largest smallest margin: widths
+    within ``WIDTH_QUANTUM_DEG`` of it count as keeping it (:func:`~feederkit.angles.width_key`),
+    so a mirror-image range a rounding below it stays a choice on every machine."""
+    return margin - WIDTH_QUANTUM_DEG if math.isfinite(margin) else margin
+
+
 def _small_first(cell: Cell) -> tuple[int, float]:
     """The length search's order of a set's cells (``Choices.lazy_actions``): the smallest
     image first, then the widest."""
@@ -556,8 +563,10 @@ def _prefer(a: Act, b: Act | None) -> bool:
     """Between equally good actions: larger margin, then the smaller rotation."""
     if b is None:
         return True
-    if a.action.margin != b.action.margin:
-        return a.action.margin > b.action.margin
+    wa = width_key(a.action.hi - a.action.lo)
+    wb = width_key(b.action.hi - b.action.lo)
+    if wa != wb:
+        return wa > wb
     return a.rotation < b.rotation
 
 
@@ -585,7 +594,7 @@ def stage(objective: str, refiner: Refiner, every: list[int], budget: int) -> tu
     """
     if objective == "worst":
         # The smallest margin over the root branches, as large as it can be.
-        refiner.floor = refiner.largest_floor(every, budget)
+        refiner.floor = tie_floor(refiner.largest_floor(every, budget))
         sensorless = refiner.p.sensorless and refiner.costs is None
         return ("rotation" if sensorless else "expected"), budget
     if objective == "worst-time":

@@ -14,6 +14,7 @@ from feederkit.machine import (
     PushAlignMachine,
     ReadingBranch,
     members,
+    search_space,
 )
 from feederkit.planning.tree import Leaf, PlanTree, Step
 
@@ -41,6 +42,28 @@ def by_diameter(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[int]]
         machine.part_names, states, maps, machine.sensor, machine.uncertainty
     )
     return sorted_machine, old
+
+
+def share_bisimilar(
+    machine: PushAlignMachine, sorted_machine: PushAlignMachine, old: list[int]
+) -> None:
+    """Give each of the two numberings of one machine (``old[new_index]``, from
+    :func:`by_diameter`) the other's bisimilar states when only one has them: the fixpoint
+    (:attr:`~feederkit.machine.space.SearchSpace.bisimilar`) is the longest step before a
+    search, and callers ask it of the machine they hold (a mix's pairs after its plan)."""
+    if sorted_machine is machine:
+        return
+    a, b = vars(search_space(machine)), vars(search_space(sorted_machine))
+    if "bisimilar" in a and "bisimilar" not in b:
+        new = [0] * len(old)
+        for k, i in enumerate(old):
+            new[i] = k
+        b["bisimilar"] = tuple(remap_mask(a["bisimilar"][i], new) for i in old)
+    elif "bisimilar" in b and "bisimilar" not in a:
+        out = [0] * len(old)
+        for k, i in enumerate(old):
+            out[i] = remap_mask(b["bisimilar"][k], old)
+        a["bisimilar"] = tuple(out)
 
 
 def remap_mask(mask: int, old: list[int]) -> int:
@@ -82,4 +105,6 @@ def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
         nodes[id(n)] = out
         return out
 
-    return convert(node)
+    out = convert(node)
+    nodes.clear()  # ``convert`` refers to itself (a cycle the collector frees): not its memo
+    return out

@@ -112,7 +112,12 @@ def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], floa
         memo[key] = total
         return total
 
-    return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+    total = sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+    # ``ops`` refers to itself (a cycle the collector frees), not its tables.
+    memo.clear()
+    probs.clear()
+    holding.clear()
+    return total
 
 
 def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step], float]) -> float:
@@ -147,7 +152,12 @@ def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step],
         memo[key] = total
         return total
 
-    return sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+    total = sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
+    # ``ops`` refers to itself (a cycle the collector frees), not its tables.
+    memo.clear()
+    probs.clear()
+    holding.clear()
+    return total
 
 
 _INDEXED = 16
@@ -166,6 +176,10 @@ class _Holding:
 
     def __init__(self) -> None:
         self._index: dict[int, dict[int, list[tuple[ReadingBranch, PlanTree]]]] = {}
+
+    def clear(self) -> None:
+        """Forget the indexes (their nodes' statistics are done)."""
+        self._index.clear()
 
     def __call__(self, node: Step, state: int) -> Sequence[tuple[ReadingBranch, PlanTree]]:
         """The node's branches holding ``state``, or (a node of few branches) all of them:

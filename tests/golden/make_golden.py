@@ -3,10 +3,11 @@
 The plans are made on the ideal model (zero uncertainty), the paper's, whose output the
 structural refactor had to keep byte-identical. Run by hand only
 (``.venv/bin/python tests/golden/make_golden.py``), when a change of the plans is intended;
-``tests/test_golden_plans.py`` regenerates every case through the library
-and asserts the same bytes. The cases: every part of ``catalog/`` sensorless and with a
-tolerance sensor of 1 % of its size (as ``feederkit demo`` plans them), one LED array, and
-the demo's changeovers (the changeover compiler on a catalog imported from ``catalog/``).
+``tests/test_golden_plans.py`` regenerates every case through the library and asserts the
+same file (floats to their rounding). The cases: every part of ``catalog/`` sensorless and
+with a tolerance sensor of 1 % of its size (as ``feederkit demo`` plans them), one LED
+array, and the demo's changeovers (the changeover compiler on a catalog imported from
+``catalog/``).
 """
 
 from __future__ import annotations
