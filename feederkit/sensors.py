@@ -122,6 +122,14 @@ class Sensor(Protocol):
         """
         ...
 
+    def branch_reach(self, diameter: Diameter) -> tuple[float, float] | None:
+        """Bounds on the branches a state of this diameter can follow: a branch ``[lo, hi]``
+        with ``hi`` below the first or ``lo`` above the second holds none of its readings
+        (:meth:`reads_into` is false, :meth:`reading_probability` is 0), so a verifier
+        indexing a node's branches by interval need look no further. None without a sensor.
+        """
+        ...
+
     def consistent(self, diameter: Diameter, reading: float) -> bool:
         """Whether a state of this diameter can produce ``reading`` (mm)."""
         ...
@@ -232,6 +240,9 @@ class NoSensor:
     def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
         return None
 
+    def branch_reach(self, diameter: Diameter) -> tuple[float, float] | None:
+        return None
+
     def consistent(self, diameter: Diameter, reading: float) -> bool:
         return True
 
@@ -304,6 +315,11 @@ class ToleranceSensor:
     def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
         lo, hi = span(diameter)
         return max(0.0, lo - self.tolerance), hi + self.tolerance
+
+    def branch_reach(self, diameter: Diameter) -> tuple[float, float] | None:
+        # reads_into and a positive share both need lo < d_hi + e and hi > d_lo - e.
+        lo, hi = span(diameter)
+        return lo - self.tolerance, hi + self.tolerance
 
     def consistent(self, diameter: Diameter, reading: float) -> bool:
         if not isinstance(diameter, tuple):
@@ -497,6 +513,15 @@ class LedSensor:
     def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
         c0, c1 = self.counts(diameter)
         return c0 * self.pitch, c1 * self.pitch
+
+    def branch_reach(self, diameter: Diameter) -> tuple[float, float] | None:
+        # reads_into: the branch holds a count c0..c1 (within READING_EPS of the pitch); a
+        # positive share: its widths (lo, hi + pitch] meet [d_lo - e, d_hi + e].
+        c0, c1 = self.counts(diameter)
+        p, e = self.pitch, self.noise
+        slack = 2.0 * READING_EPS * p
+        d_lo, d_hi = span(diameter)
+        return min(c0 * p - slack, d_lo - e - p), max(c1 * p + slack, d_hi + e)
 
     def consistent(self, diameter: Diameter, reading: float) -> bool:
         c0, c1 = self.counts(diameter)

@@ -14,6 +14,7 @@ import copy
 import dataclasses
 import io
 import json
+import re
 import time
 from pathlib import Path
 
@@ -157,6 +158,20 @@ def test_a_dag_is_drawn_once_per_distinct_node():
     drawing = console.file.getvalue()
     assert "shared subplan S1" in drawing and "the shared subplan S1 (drawn above)" in drawing
     assert drawing.count("\n") < 10 * file_nodes(plan.root)
+
+
+def test_a_drawing_past_its_line_limit_stops_and_says_what_it_left_out():
+    plan = layered(30, width=4)
+    console = Console(file=io.StringIO(), width=200)
+    console.print(plan_tree(plan, max_lines=60))
+    drawing = console.file.getvalue()
+    before, note = drawing.split("the drawing stops after", 1)
+    assert len(before.splitlines()) < 100  # 60 labels (a few results wrap), not ~500
+    left = re.search(r"(\d+) more operations", " ".join(note.split()))
+    assert left is not None and 0 < int(left.group(1)) < 121  # 121 distinct steps in all
+    whole = Console(file=io.StringIO(), width=200)
+    whole.print(plan_tree(plan))
+    assert "the drawing stops" not in whole.file.getvalue()
 
 
 def test_a_strong_dag_verifies_at_its_declared_uncertainty():

@@ -80,7 +80,7 @@ from feederkit.mix.changeover import (
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.fileformat import plan_json
+from feederkit.plans.fileformat import as_plan, plan_json
 from feederkit.uncertainty import Uncertainty
 
 changeover_app = typer.Typer(
@@ -347,8 +347,9 @@ def compile_command(
             f"uncertainty: {uncertainty_text(plan.get('uncertainty'))}",
             highlight=False,
         )
-        console.print(plan_tree(plan))
-        console.print(stats_table(plan, compiled.made.report))
+        view = as_plan(plan)  # the file's object read once, for the drawing and the table
+        console.print(plan_tree(view))
+        console.print(stats_table(view, compiled.made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)
         if witnesses:
             console.print(_pairs_table(witnesses, pfs))
@@ -446,8 +447,9 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
         f"{escape(info.created_by)}",
         highlight=False,
     )
-    console.print(plan_tree(co.plan))
-    console.print(stats_table(co.plan))
+    view = as_plan(co.plan)
+    console.print(plan_tree(view))
+    console.print(stats_table(view))
     cycle = co.plan["stats"].get("cycle_time")
     console.print(escape(cycle_time_text(cycle, "as compiled")), highlight=False)
 

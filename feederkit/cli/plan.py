@@ -64,6 +64,7 @@ from feederkit.landing.plan import LandingPlan, landing_names, load_landings, pl
 from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
+from feederkit.plans.fileformat import as_plan
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label
 from feederkit.uncertainty import check_for_part
@@ -253,8 +254,9 @@ def plan_command(
         words = None if planned is None else _landings_text(planned)
         console.print(escape(settings.describe()), highlight=False)
         console.print(_header(plan, sensor_given, words), highlight=False)
-        console.print(plan_tree(plan))
-        console.print(stats_table(plan, made.report))
+        view = as_plan(plan)  # the file's object read once, for the drawing and the table
+        console.print(plan_tree(view))
+        console.print(stats_table(view, made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)
         print_written(output, report)
     if planned is not None:

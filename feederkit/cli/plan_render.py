@@ -96,12 +96,19 @@ def _op_text(step: Step, number: int) -> Text:
     return t
 
 
-def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
+PLAN_TREE_LINES = 1000
+"""The terminal drawing of a plan stops after this many lines: a plan of a large mix can
+have tens of thousands, which no one reads in a terminal and which take longer to draw than
+the plan took to make. The plan file holds it whole; ``feederkit report`` draws it."""
+
+
+def plan_tree(plan: Plan | Mapping[str, Any], max_lines: int = PLAN_TREE_LINES) -> Tree:
     """The plan as a tree: operations, rotations and margins, reading intervals, results.
 
     A chain of single-branch operations stays flat; a shared subplan (the file's
     ``"nodes"``) is drawn once, with a letter, and named by it in its other places, so the
-    drawing grows with the distinct nodes; built without recursion.
+    drawing grows with the distinct nodes; built without recursion. After ``max_lines``
+    lines the drawing stops, and its last line says how much of the plan it left out.
     """
     plan = as_plan(plan)
     tree = Tree(
@@ -109,42 +116,65 @@ def plan_tree(plan: Plan | Mapping[str, Any]) -> Tree:
     )
     uses = _uses(plan)
     names: dict[int, str] = {}
+    drawn: set[int] = set()
+    lines = 0
+
+    def add(parent: Tree, label: Text, node: object = None) -> Tree:
+        nonlocal lines
+        lines += 1
+        if node is not None:
+            drawn.add(id(node))
+        return parent.add(label)
+
     stack: list[tuple[Tree, Step, int]] = [(tree, plan.root, 1)]
-    while stack:
+    while stack and lines < max_lines:
         parent, step, number = stack.pop()
         if uses.get(id(step), 0) > 1:
             if id(step) in names:
-                parent.add(
-                    Text(f"the shared subplan {names[id(step)]} (drawn above)", style="cyan")
+                add(
+                    parent,
+                    Text(f"the shared subplan {names[id(step)]} (drawn above)", style="cyan"),
                 )
                 continue
             names[id(step)] = f"S{len(names) + 1}"
-            parent = parent.add(Text(f"shared subplan {names[id(step)]}:", style="cyan"))
+            parent = add(parent, Text(f"shared subplan {names[id(step)]}:", style="cyan"))
         while len(step.branches) == 1:  # a chain of single-branch operations
             (b,) = step.branches
             label = _op_text(step, number)
             if b.reading is not None:
                 label.append(f", {_interval(b.reading)}", style="yellow")
-            parent.add(label)
+            add(parent, label, step)
             if isinstance(b.next, Leaf):
-                parent.add(_result_text(b.next, plan))
+                add(parent, _result_text(b.next, plan), b.next)
                 break
             if uses.get(id(b.next), 0) > 1:
                 stack.append((parent, b.next, number + 1))
                 break
             step, number = b.next, number + 1
         else:
-            op = parent.add(_op_text(step, number))
+            op = add(parent, _op_text(step, number), step)
             later = []
             for b in step.branches:
                 line = Text(_interval(b.reading), style="yellow")
                 if isinstance(b.next, Leaf):
                     line.append(" → ")
                     line.append_text(_result_text(b.next, plan))
-                    op.add(line)
+                    add(op, line, b.next)
                 else:
-                    later.append((op.add(line), b.next, number + 1))
+                    later.append((add(op, line), b.next, number + 1))
             stack.extend(reversed(later))
+    if stack:
+        every = [n for n, _number in plan.walk()]
+        ops = sum(1 for n in every if isinstance(n, Step) and id(n) not in drawn)
+        results = sum(1 for n in every if isinstance(n, Leaf) and id(n) not in drawn)
+        tree.add(
+            Text(
+                f"... the drawing stops after {lines} lines: {plural(ops, 'more operation')} "
+                f"and {plural(results, 'more result')} are in the plan file (feederkit run "
+                "PLAN --all walks every path; feederkit report draws the whole plan)",
+                style="cyan",
+            )
+        )
     return tree
 
 

@@ -34,7 +34,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
-from feederkit.planning.budget import Deadline
+from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Certificate, PlanResult
@@ -100,6 +100,31 @@ def make_plan(
     plan; or an accepted and a rejected member no plan can tell apart), and CheckFailed when
     the plan fails verification.
     """
+    # Planning, verification and certificate build tables of many small objects without
+    # cycles: the cyclic collector would only rescan them (collector_paused).
+    with collector_paused():
+        return _make_plan(
+            push_functions,
+            sensor,
+            options,
+            uncertainty=uncertainty,
+            certify=certify,
+            members=members,
+            weights=weights,
+        )
+
+
+def _make_plan(
+    push_functions: Sequence[PushFunction],
+    sensor: Sensor,
+    options: PlanningOptions | None,
+    *,
+    uncertainty: Uncertainty | None,
+    certify: bool,
+    members: Sequence[PlanMember] | None,
+    weights: Sequence[float] | None,
+) -> MadePlan:
+    """:func:`make_plan`'s work."""
     opts = PlanningOptions() if options is None else options
     if not isinstance(opts, PlanningOptions):
         raise InputError(f"the planning options must be PlanningOptions, got {opts!r}")
@@ -117,7 +142,7 @@ def make_plan(
     if rejected:
         _check_rejects_separable(machine, named)
     try:
-        result = plan_machine(machine, opts)
+        result = plan_machine(machine, opts, budget=_planner_budget(opts, started, certify))
     except NoStrongPlan as exc:
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
@@ -125,20 +150,28 @@ def make_plan(
     if unc.is_ideal:
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
         report = check_plan(data)
-        ideal_length = result.length
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
         report = verify_strong(data)
-        ideal_length = _ideal_length(ideal, opts, started) if certify else None
+    notes: list[str] = []
     if certify:
-        cert = Certificate(
-            max_rotation_error_deg=max_rotation_error_deg(data),
-            max_shape_tolerance_mm=max_shape_tolerance_mm(data),
-            ideal_length=ideal_length,
-        )
+        cert, cut = _certificate(data, unc, opts, started)
+        if not unc.is_ideal:
+            cert = replace(cert, ideal_length=_ideal_length(ideal, opts, started))
+        else:
+            cert = replace(cert, ideal_length=result.length)
         data["stats"]["certificate"] = cert.to_dict()
         result = replace(result, certificate=cert)
+        if cut:
+            what = f"{' and '.join(cut)} bound" + (
+                "s are the declared values" if len(cut) > 1 else " is the declared value"
+            )
+            notes.append(
+                f"the time limit of {opts.time_limit_s:g} s left no time for the whole "
+                f"certificate: its {what}, which the verification proved, not the largest "
+                "the plan holds (allow more time with --time-limit S)"
+            )
     diameters = sorted({round(s.diameter, DIAMETER_DIGITS) for pf in pfs for s in pf.states})
     warnings = sensor_warnings(sensor, diameters)
     lumped = lumped_words(result.machine, result.lumped_pairs)
@@ -149,7 +182,56 @@ def make_plan(
         warnings.append(
             f"{margin}; ask for a minimum margin or check the plan with feederkit simulate"
         )
-    return MadePlan(data, result, report, tuple(warnings))
+    return MadePlan(data, result, report, tuple(warnings + notes))
+
+
+POST_SHARE = 0.15
+"""With a time limit, the share of it a certified plan keeps after the planner: the plan file
+and its verification (always made) and the certificate (its largest rotation error and shape
+tolerance, then the ideal length, each only while time is left). The limit is the command's,
+so the planner gets the rest; ``certify=False`` callers (a design's many plans, under their
+own clock) give the planner the whole limit."""
+
+
+OUTPUT_SHARE = 0.05
+"""With a time limit, the share of it the certificate (whose ideal length may take all the
+time left) leaves to the caller for writing and showing the plan."""
+
+
+def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
+    """The planner's budget: the options' time limit from ``started`` less, when certifying,
+    ``POST_SHARE`` of it (at least a tenth of the limit is left to plan), and their memory
+    limit."""
+    limit = options.time_limit_s
+    if limit is None:
+        return Deadline(None, options.memory_limit_mb)
+    left = _left(options, started) or 0.0
+    keep = POST_SHARE * limit if certify else 0.0
+    return Deadline(max(left - keep, 0.1 * limit), options.memory_limit_mb)
+
+
+def _certificate(
+    data: dict[str, Any], declared: Uncertainty, options: PlanningOptions, started: float
+) -> tuple[Certificate, list[str]]:
+    """The plan's largest rotation error and shape tolerance (the certificate without its
+    ideal length), each within what is left of the time limit; one that runs out states the
+    declared value, which the verification proved. Also the names of those cut short."""
+    cut: list[str] = []
+    figures: list[float] = []
+    for name, figure, given in (
+        ("rotation", max_rotation_error_deg, declared.rotation_error_deg),
+        ("shape", max_shape_tolerance_mm, declared.shape_tolerance_mm),
+    ):
+        left = _left(options, started, OUTPUT_SHARE)
+        try:
+            figures.append(
+                figure(data, deadline=None if left is None else Deadline(max(left, 0.0)))
+            )
+        except Timeout:
+            figures.append(given)
+            cut.append(name)
+    rotation, shape = figures
+    return Certificate(rotation, shape, None), cut
 
 
 def _lump_shapes(
@@ -179,18 +261,19 @@ def _lump_shapes(
     return words
 
 
-def _left(options: PlanningOptions, started: float) -> float | None:
-    """Seconds left of the options' time limit since ``started`` (None: no limit)."""
+def _left(options: PlanningOptions, started: float, keep: float = 0.0) -> float | None:
+    """Seconds left of the options' time limit since ``started``, less ``keep`` of the limit
+    (None: no limit)."""
     if options.time_limit_s is None:
         return None
-    return options.time_limit_s - (time.monotonic() - started)
+    return (1.0 - keep) * options.time_limit_s - (time.monotonic() - started)
 
 
 def _ideal_length(ideal: PushAlignMachine, options: PlanningOptions, started: float) -> int | None:
     """The optimal length on the ideal model (the certificate's ``ideal_length``), within
-    what is left of the time limit; None when no time is left, or when the ideal model
-    cannot meet the options (e.g. a margin floor it cannot keep)."""
-    left = _left(options, started)
+    what is left of the time limit less ``OUTPUT_SHARE`` of it; None when no time is left,
+    or when the ideal model cannot meet the options (e.g. a margin floor it cannot keep)."""
+    left = _left(options, started, OUTPUT_SHARE)
     if left is not None and left <= 0.0:
         return None
     opts = options if left is None else replace(options, time_limit_s=left)

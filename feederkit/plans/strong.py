@@ -27,6 +27,7 @@ file names a physical state by its ideal members (docs/planning.md, "Results").
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -43,6 +44,7 @@ from feederkit.mechanics.uncertain import (
     outcome_set,
     uncertain_mechanics,
 )
+from feederkit.planning.budget import Deadline
 from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
 from feederkit.plans.execute import rounding_inset
 from feederkit.plans.model import PlanPart, member_label, push_function_of
@@ -154,7 +156,14 @@ def strong_model(
 
 
 class _Run:
-    """Every path of every start through one plan, memoised per (node, state)."""
+    """Every path of every start through one plan, memoised per (node, state).
+
+    Each node's branches are indexed by their reading intervals once, so a state's branches
+    are found by bisection (a node of a large mix has hundreds of branches and a state reads
+    into a few); where a node's own outcomes and branches of a state are asked again (the
+    length, the handled states, the expected length, the rotation certificate) they come from
+    a memo.
+    """
 
     def __init__(self, plan: Mapping[str, Any], model: StrongModel) -> None:
         self.model = model
@@ -164,6 +173,13 @@ class _Run:
         self._paths: dict[tuple[int, State], int] = {}
         self.rejected: dict[tuple[int, State], int] = {}
         self._handles: dict[tuple[int, State], bool] = {}
+        self._outcomes: dict[tuple[int, State], list[State]] = {}
+        self._follow: dict[tuple[int, State], list[Mapping[str, Any]] | str] = {}
+        self._index: dict[int, _BranchIndex] = {}
+        # The ideal verifier's rounding policy: touching open ends do not overlap.
+        self._sensors = [
+            model.sensor.narrowed(rounding_inset(m.part.size)) for m in model.mechanics
+        ]
 
     def node(self, node: Mapping[str, Any]) -> Mapping[str, Any]:
         """A node with a shared-subplan reference resolved."""
@@ -181,32 +197,74 @@ class _Run:
         a = node.get("action_deg")
         if a is None:
             return [x]
+        key = (id(node), x)
+        hit = self._outcomes.get(key)
+        if hit is None:
+            p, s = x
+            hit = [(p, t) for t in sorted(outcome_set(self.model.mechanics[p], s, float(a)))]
+            self._outcomes[key] = hit
+        return hit
+
+    def branches_of(
+        self, node: Mapping[str, Any], x: State, sensor: Sensor | None = None
+    ) -> list[Mapping[str, Any]] | None:
+        """The node's branches a resting state ``x`` may read into under ``sensor`` (default:
+        the verifier's, narrowed by rounding), in the node's order: a superset, those whose
+        interval comes within the sensor's reach of the state's reading set. None when the
+        node has no readings (every branch is followed)."""
+        index = self._index.get(id(node))
+        if index is None:
+            index = self._index[id(node)] = _BranchIndex(node["branches"])
+        if index.blind or not self.model.sensor.informative:
+            return None
         p, s = x
-        return [(p, t) for t in sorted(outcome_set(self.model.mechanics[p], s, float(a)))]
+        sensor = self._sensors[p] if sensor is None else sensor
+        reach = sensor.branch_reach(self.model.diameters[p][s])
+        if reach is None:
+            return index.withreading
+        return index.within(*reach)
+
+    def follows(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]] | None:
+        """:meth:`follow`, None where it fails."""
+        key = (id(node), x)
+        hit = self._follow.get(key)
+        if hit is None:
+            hit = self._follow[key] = self._follow_uncached(node, x)
+        return None if isinstance(hit, float) else hit
 
     def follow(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]]:
         """The branches resting state ``x`` can follow; CheckFailed when a reading it can
         give is in none."""
-        p, s = x
-        diam = self.model.diameters[p][s]
-        branches = node["branches"]
-        # The ideal verifier's rounding policy: touching open ends do not overlap.
-        sensor = self.model.sensor.narrowed(rounding_inset(self.model.mechanics[p].part.size))
-        if not sensor.informative or all(b["reading"] is None for b in branches):
-            return [b["next"] for b in branches]
-        ivs = [tuple(b["reading"]) for b in branches if b["reading"] is not None]
-        miss = sensor.uncovered_reading(diam, ivs)
-        if miss is not None:
+        key = (id(node), x)
+        hit = self._follow.get(key)
+        if hit is None:
+            hit = self._follow[key] = self._follow_uncached(node, x)
+        if isinstance(hit, float):
+            p, s = x
+            diam = self.model.diameters[p][s]
             raise CheckFailed(
                 f"{self.model.label(p)}: physical state {s} (diameter {diam[0]:.6g} to "
-                f"{diam[1]:.6g} mm) can read {miss:.6g} mm, which no branch after rotation "
+                f"{diam[1]:.6g} mm) can read {hit:.6g} mm, which no branch after rotation "
                 f"{node.get('action_deg')} holds"
             )
-        return [
-            b["next"]
-            for b in branches
-            if b["reading"] is not None and sensor.reads_into(diam, *b["reading"])
-        ]
+        return hit
+
+    def _follow_uncached(
+        self, node: Mapping[str, Any], x: State
+    ) -> list[Mapping[str, Any]] | float:
+        """:meth:`follow` computed: the next nodes, or a reading no branch holds."""
+        near = self.branches_of(node, x)
+        if near is None:
+            return [b["next"] for b in node["branches"]]
+        p, s = x
+        diam = self.model.diameters[p][s]
+        sensor = self._sensors[p]
+        # Branches out of reach hold none of the state's readings: leaving them out changes
+        # neither the uncovered reading found nor the branches followed.
+        miss = sensor.uncovered_reading(diam, [b["reading"] for b in near])
+        if miss is not None:
+            return float(miss)
+        return [b["next"] for b in near if sensor.reads_into(diam, *b["reading"])]
 
     def named(self, leaf: Mapping[str, Any], x: State) -> bool:
         """Whether a leaf names state ``x``: every ideal member of it, for its part and
@@ -263,11 +321,36 @@ class _Run:
 
     def settles(self, node: Mapping[str, Any], y: State) -> bool:
         """Whether a part resting in ``y`` after ``node``'s rotation is handled from there."""
-        try:
-            nexts = self.follow(node, y)
-        except CheckFailed:
-            return False
+        nexts = self.follows(node, y)
         return bool(nexts) and all(self.handles(n, y) for n in nexts)
+
+
+class _BranchIndex:
+    """A node's branches with a reading, sorted by interval, for :meth:`_Run.branches_of`.
+
+    Exact reading cells (and the components rule's intervals) come in reading order with
+    both ends ascending; then the branches meeting ``[lo, hi]`` are one run found by
+    bisection. Otherwise (a hand-written file) every branch is a candidate.
+    """
+
+    def __init__(self, branches: Sequence[Mapping[str, Any]]) -> None:
+        with_reading = [b for b in branches if b["reading"] is not None]
+        self.blind = not with_reading
+        self.withreading = with_reading
+        ends = [(float(b["reading"][0]), float(b["reading"][1])) for b in with_reading]
+        self._los = [a for a, _b in ends]
+        self._his = [b for _a, b in ends]
+        self._sorted = all(
+            a0 <= a1 and b0 <= b1 for (a0, b0), (a1, b1) in zip(ends, ends[1:], strict=False)
+        )
+
+    def within(self, lo: float, hi: float) -> list[Mapping[str, Any]]:
+        """The branches whose interval meets ``[lo, hi]`` (all of them when unsorted)."""
+        if not self._sorted:
+            return self.withreading
+        first = bisect.bisect_left(self._his, lo)  # the first whose upper end reaches lo
+        last = bisect.bisect_right(self._los, hi)  # past the last that starts by hi
+        return self.withreading[first:last]
 
 
 def verify_strong(
@@ -372,6 +455,7 @@ def expected_operations(
     run = _Run(plan, model)
     sensor = model.sensor
     memo: dict[tuple[int, State], float] = {}
+    open_steps: dict[tuple[int, State], list[tuple[float, Any, State]]] = {}
 
     def continuations(node: Mapping[str, Any], x: State) -> list[tuple[float, Any, State]]:
         """(probability, next node, state) of every continuation of ``x`` at a step."""
@@ -379,11 +463,14 @@ def expected_operations(
         branches = node["branches"]
         out = []
         for y in outs:
-            if not sensor.informative or all(b["reading"] is None for b in branches):
+            near = run.branches_of(node, y, sensor)
+            if near is None:
                 out.append((1.0 / len(outs), run.node(branches[0]["next"]), y))
                 continue
             diam = model.diameters[y[0]][y[1]]
-            for b in branches:
+            # A branch out of the state's reach has probability 0: leaving it out changes no
+            # term of the (exactly rounded) sum.
+            for b in near:
                 pr = sensor.reading_probability(diam, *b["reading"])
                 if pr > 0.0:
                     out.append((pr / len(outs), run.node(b["next"]), y))
@@ -405,11 +492,15 @@ def expected_operations(
                 if (id(node), x) in memo:
                     stack.pop()
                     continue
-                steps = [c for c in continuations(node, x) if "result" not in c[1]]
+                steps = open_steps.get((id(node), x))
+                if steps is None:
+                    steps = [c for c in continuations(node, x) if "result" not in c[1]]
+                    open_steps[(id(node), x)] = steps
                 missing = [(n, y) for _pr, n, y in steps if (id(n), y) not in memo]
                 if missing:
                     stack.extend(missing)
                     continue
+                del open_steps[(id(node), x)]
                 memo[(id(node), x)] = 1.0 + math.fsum(pr * memo[(id(n), y)] for pr, n, y in steps)
                 stack.pop()
             expected += shares[p] * weight[s] * memo[(id(root), (p, s))]
@@ -433,45 +524,66 @@ def strong_holds(
 
 
 def max_rotation_error_deg(
-    plan: Mapping[str, Any], *, parts: Sequence[PushFunction] | None = None
+    plan: Mapping[str, Any],
+    *,
+    parts: Sequence[PushFunction] | None = None,
+    deadline: Deadline | None = None,
 ) -> float:
     """The largest rotation error (deg, a supremum) under which ``plan`` as written still
     succeeds: per action node, ``max_rotation_error`` over the states that reach it, allowed
-    to end in the states its subtree handles; the minimum over the nodes."""
+    to end in the states its subtree handles; the minimum over the nodes.
+
+    Each (node, state) pair is taken once, however many paths lead there: the states
+    reaching a node are propagated down the plan's DAG, each node handling only the states
+    new to it. Timeout when ``deadline`` passes first (a minimum over some nodes is no
+    bound)."""
+    deadline = deadline or Deadline()
     model = strong_model(plan, parts=parts)
     run = _Run(plan, model)
     best = MAX_ROTATION_ERROR_DEG
-    all_states = list(model.states())
-    stack: list[tuple[Mapping[str, Any], frozenset[State]]] = [
-        (run.node(plan["root"]), frozenset(all_states))
-    ]
-    seen: set[tuple[int, frozenset[State]]] = set()
-    while stack:
-        node, reach = stack.pop()
-        if (id(node), reach) in seen or "result" in node:
+    root = run.node(plan["root"])
+    nodes: dict[int, Mapping[str, Any]] = {id(root): root}
+    reached: dict[int, set[State]] = {}
+    pending: dict[int, set[State]] = {id(root): set(model.states())}
+    work = [id(root)]
+    # Per (node, part): the part's states the node's subtree handles after its rotation.
+    handled: dict[tuple[int, int], frozenset[int]] = {}
+    while work:
+        deadline.check()
+        key = work.pop()
+        new = pending.pop(key)
+        node = nodes[key]
+        if "result" in node:
             continue
-        seen.add((id(node), reach))
+        reached.setdefault(key, set()).update(new)
         a = node.get("action_deg")
         if a is not None:
-            ok = [y for y in all_states if run.settles(node, y)]
-            for p, mech in enumerate(model.mechanics):
-                here = [s for q, s in reach if q == p]
-                if not here:
-                    continue
-                allowed = frozenset(s for q, s in ok if q == p)
+            by_part: dict[int, list[int]] = {}
+            for p, s in new:
+                by_part.setdefault(p, []).append(s)
+            for p, here in sorted(by_part.items()):
+                mech = model.mechanics[p]
+                allowed = handled.get((key, p))
+                if allowed is None:
+                    allowed = frozenset(
+                        st.id for st in mech.states if run.settles(node, (p, st.id))
+                    )
+                    handled[(key, p)] = allowed
+                here.sort()
                 r = max_rotation_error(mech, here, float(a), dict.fromkeys(here, allowed))
                 best = min(best, r)
-        after = {y for x in reach for y in run.outcomes(node, x)}
-        nexts: dict[int, tuple[Mapping[str, Any], set[State]]] = {}
-        for y in after:
-            try:
-                follow = run.follow(node, y)
-            except CheckFailed:
-                continue
-            for nxt in follow:
+        for y in {y for x in new for y in run.outcomes(node, x)}:
+            for nxt in run.follows(node, y) or ():
                 n = run.node(nxt)
-                nexts.setdefault(id(n), (n, set()))[1].add(y)
-        stack.extend((n, frozenset(ys)) for n, ys in nexts.values())
+                k = id(n)
+                if y in reached.get(k, ()):
+                    continue
+                bucket = pending.get(k)
+                if bucket is None:
+                    nodes[k] = n
+                    bucket = pending[k] = set()
+                    work.append(k)
+                bucket.add(y)
     return best
 
 
@@ -480,17 +592,22 @@ def max_shape_tolerance_mm(
     *,
     parts: Sequence[PushFunction] | None = None,
     rel_tol: float = SHAPE_REL_TOL,
+    deadline: Deadline | None = None,
 ) -> float:
     """The largest shape tolerance (mm) under which ``plan`` still verifies at its declared
     rotation error and COM tolerance: a bisection re-verifying the plan (outcome sets and
     reading intervals grow with the tolerance) to ``rel_tol`` of the bound, half the parts'
-    smallest hull edge. Returns the lower end of the final bracket, where the plan holds."""
+    smallest hull edge. Returns the lower end of the final bracket, where the plan holds.
+    The plan failing one step above the declared tolerance ends the bisection there.
+    Timeout when ``deadline`` passes first (checked before each re-verification)."""
+    deadline = deadline or Deadline()
     declared = declared_uncertainty(plan)
     pfs = list(parts) if parts is not None else _parts(plan)
     vib = 0.0 if declared.is_ideal else None
     limit = min(shape_tolerance_limit(pf.part) for pf in pfs)
 
     def holds(t: float) -> bool:
+        deadline.check()
         unc = Uncertainty(declared.rotation_error_deg, t, declared.com_tolerance_mm)
         return strong_holds(plan, unc, vibration_mm=vib, parts=pfs)
 
@@ -498,6 +615,14 @@ def max_shape_tolerance_mm(
     hi = limit * (1.0 - 1e-9)
     if holds(hi):
         return hi
+    # Holding is monotone in the tolerance (the bisection's premise): failing at the last
+    # midpoint a bisection that never holds would try, every midpoint fails and the bracket
+    # closes on ``lo``, so one re-verification answers where there would be a dozen.
+    last, top = lo, hi
+    while top - lo > rel_tol * limit:
+        last = top = (lo + top) / 2.0
+    if last > lo and not holds(last):
+        return lo
     while hi - lo > rel_tol * limit:
         mid = (lo + hi) / 2.0
         lo, hi = (mid, hi) if holds(mid) else (lo, mid)
@@ -528,18 +653,18 @@ def ideal_view(result: PlanResult, ideal: PushAlignMachine) -> PlanResult:
         return out
 
     nodes: dict[int, PlanTree] = {}
-    order: list[PlanTree] = []
-    stack: list[PlanTree] = [result.root]
-    while stack:  # post-order without recursion
-        n = stack.pop()
-        order.append(n)
-        if isinstance(n, Step):
-            stack.extend(sub for _b, sub in n.branches)
-    for n in reversed(order):
+    # Post-order without recursion, each distinct node once (a DAG's paths can be many more).
+    stack: list[tuple[PlanTree, bool]] = [(result.root, False)]
+    while stack:
+        n, ready = stack.pop()
         if id(n) in nodes:
             continue
         if isinstance(n, Leaf):
             nodes[id(n)] = Leaf(mask(n.mask))
+            continue
+        if not ready:
+            stack.append((n, True))
+            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
             continue
         action = n.action
         if action is not None:
