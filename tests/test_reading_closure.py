@@ -209,3 +209,28 @@ def test_the_length_view_leaves_out_dominated_actions():
             assert not any(a != first and a & first == first for a in images)
             pruned += sum(c[2] != first and c[2] & first == first for c in cells)
     assert pruned > 0
+
+
+@pytest.mark.parametrize("err", [1.0, 3.0])
+def test_cells_of_a_large_uncertain_machine_come_from_its_outcome_lists(err):
+    # Beyond 62 states the outcome sets do not fit a word: the table keeps each state's
+    # outcomes as indices (SearchSpace.outcome_cell_table), and must give the same cells and
+    # images as the sweep.
+    from shared import small_mix
+
+    machine = build_machine(small_mix(16), ToleranceSensor(1.0), Uncertainty(err))
+    assert machine.n > 62 and not machine.deterministic
+    problem = Problem(machine)
+    space = problem.choices._space
+    assert space.set_cell_table is None and space.outcome_cell_table is not None
+    rng = random.Random(int(err))
+    for t in range(80):
+        if t == 0:
+            mask = machine.all_states
+        else:
+            keep = rng.choice([0.05, 0.2, 0.6])
+            mask = sum(1 << i for i in range(machine.n) if rng.random() < keep) or 1
+        fast = space.cells_and_images(mask)
+        assert fast is not None
+        got = list(zip(fast[0].tolist(), fast[1].tolist(), fast[2], strict=True))
+        assert got == problem.choices.fixed_cells(mask)

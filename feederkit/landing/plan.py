@@ -35,7 +35,7 @@ from feederkit.mix.changeover import accepted_lumps, checked_landings, plan_land
 from feederkit.mix.changeover import landing_members as landing_members  # re-exported
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.fileformat import plan_from_dict
+from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.make import MadePlan
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import Uncertainty
@@ -115,24 +115,11 @@ class LandingPlan:
         return LandingResult(x.part_name, x.name, int(entry["state"]), float(entry["pose_deg"]))
 
     def leaves(self) -> tuple[LandingLeaf, ...]:
-        """Every result leaf of the plan (pre-order) with its entries resolved."""
-        plan = plan_from_dict(self.made.plan)
+        """Every distinct result leaf of the plan (pre-order) with its entries resolved,
+        read off the verified plan file's object (:func:`result_nodes`)."""
         return tuple(
-            LandingLeaf(
-                tuple(
-                    self.resolve(
-                        {
-                            "part": e.part,
-                            "landing": e.landing,
-                            "state": e.state,
-                            "pose_deg": e.pose_deg,
-                        }
-                    )
-                    for e in leaf.results
-                ),
-                leaf.reject,
-            )
-            for leaf in plan.leaves()
+            LandingLeaf(tuple(self.resolve(e) for e in node["result"]), node.get("reject") is True)
+            for node in result_nodes(self.made.plan)
         )
 
 

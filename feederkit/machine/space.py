@@ -32,6 +32,10 @@ _CELL_TABLE_MIN = 100
 _CELL_TABLE_MAX = 10_000_000
 """The most entries (cells times states, 4 bytes each) of :attr:`SearchSpace.cell_table`."""
 
+_OUTCOME_TABLE_BYTES = 64_000_000
+"""The largest :attr:`SearchSpace.outcome_cell_table` (cells times states times the largest
+outcome set, 2 bytes each)."""
+
 
 class SearchSpace:
     """A machine's sets of states, with the tables their queries share (built on first use).
@@ -124,6 +128,25 @@ class SearchSpace:
         return _per_cell(m, m.outcomes_of, np.int64)
 
     @cached_property
+    def outcome_cell_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """:attr:`set_cell_table` for machines of more than 62 states, whose outcome sets do
+        not fit a word: per cell each state's outcome set as up to ``K`` state indices
+        (``outcomes[cell, state, :]``, -1 beyond its outcomes; ``K`` the largest outcome set
+        of the machine); None for a deterministic machine, 62 states or fewer, or a table
+        over ``_OUTCOME_TABLE_BYTES``. A large mix under uncertainty then gets its sets'
+        cells and images from numpy, as a small one does (the sweep in Python was two
+        fifths of the anytime search on a 50-part mix)."""
+        m = self.machine
+        if m.deterministic or m.n <= 62:
+            return None
+        k = max(x.bit_count() for xs in m.outcomes_of for x in xs)
+        cells = len({x for xs in m.starts for x in xs})
+        if cells * m.n * k * 2 > _OUTCOME_TABLE_BYTES:
+            return None
+        lists = tuple([members(x) + [-1] * (k - x.bit_count()) for x in xs] for xs in m.outcomes_of)
+        return _per_cell(m, lists, np.int16)
+
+    @cached_property
     def _cell_starts(self) -> list[float] | None:
         """The distinct start angles of :attr:`cell_table` as a list (for bisection)."""
         table = self.cell_table
@@ -154,14 +177,17 @@ class SearchSpace:
         and the image of each (the set's image at the cell's middle), vectorised.
 
         Under outcome sets the image is the union of the members' outcome sets
-        (:attr:`set_cell_table`). None without a table, or when some cell is within a few
-        ``ANGLE_EPS`` of the narrowest kept width (there the boundary clustering of
-        :meth:`overlap_cells` decides, and callers use it).
+        (:attr:`set_cell_table`, or :attr:`outcome_cell_table` beyond 62 states). None
+        without a table, or when some cell is within a few ``ANGLE_EPS`` of the narrowest
+        kept width (there the boundary clustering of :meth:`overlap_cells` decides, and
+        callers use it).
         """
+        kind = "targets"
         table = self.cell_table
-        sets = table is None
-        if sets:
-            table = self.set_cell_table
+        if table is None:
+            kind, table = "masks", self.set_cell_table
+        if table is None:
+            kind, table = "lists", self.outcome_cell_table
         if table is None or not mask:
             return None
         bounds, owner, distinct, targets = table
@@ -180,12 +206,16 @@ class SearchSpace:
         mid = (lo + hi) / 2.0
         mid = np.where(mid >= 360.0, mid - 360.0, mid)
         at = np.searchsorted(distinct, mid, side="right") - 1
-        rows = targets[at][:, idx]
-        if sets:
+        rows = targets[np.ix_(at, idx)]
+        if kind == "masks":
             return lo, hi, np.bitwise_or.reduce(rows, axis=1).tolist()
-        bits = np.zeros((len(lo), n), dtype=bool)
+        if kind == "lists":
+            # Each member's outcomes side by side; -1 (no outcome) marks a spare column.
+            rows = rows.reshape(len(lo), -1).astype(np.int64)
+            rows[rows < 0] = n
+        bits = np.zeros((len(lo), n + 1), dtype=bool)
         bits[np.arange(len(lo))[:, None], rows] = True
-        packed = np.packbits(bits, axis=1, bitorder="little")
+        packed = np.packbits(bits[:, :n], axis=1, bitorder="little")
         images = [int.from_bytes(r.tobytes(), "little") for r in packed]
         return lo, hi, images
 
@@ -272,21 +302,26 @@ class SearchSpace:
 
 
 def _per_cell(
-    m: PushAlignMachine, values: tuple[list[int], ...], dtype: type
+    m: PushAlignMachine, values: tuple[list, ...], dtype: type
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every state's action-range starts sorted together, their owner states, the distinct
     starts, and per cell between consecutive distinct starts each state's value of its range
-    there (``values[state][range]``: a target, or an outcome mask)."""
+    there (``values[state][range]``: a target, an outcome mask, or an outcome set's state
+    indices padded to one length)."""
     b = np.fromiter((x for i in range(m.n) for x in m.starts[i]), float)
     own = np.fromiter((i for i in range(m.n) for _ in m.starts[i]), np.int64)
     order = np.argsort(b, kind="stable")
     distinct = np.unique(b)
     mids = (distinct + np.append(distinct[1:], distinct[0] + 360.0)) / 2.0
     mids = np.where(mids >= 360.0, mids - 360.0, mids)
-    rows = np.empty((len(distinct), m.n), dtype=dtype)
+    rows: np.ndarray | None = None
     for i in range(m.n):
         at = np.searchsorted(np.asarray(m.starts[i]), mids, side="right") - 1
-        rows[:, i] = np.asarray(values[i], dtype=dtype)[at]
+        per_range = np.asarray(values[i], dtype=dtype)
+        if rows is None:
+            rows = np.empty((len(distinct), m.n, *per_range.shape[1:]), dtype=dtype)
+        rows[:, i] = per_range[at]
+    assert rows is not None
     return b[order], own[order], distinct, rows
 
 

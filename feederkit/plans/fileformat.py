@@ -164,6 +164,27 @@ def _reading(machine: PushAlignMachine, branch: Any) -> tuple[float, float] | No
     return (min(b.lo for b in split), max(b.hi for b in split))
 
 
+def result_nodes(plan: Mapping[str, Any]) -> Iterator[Mapping[str, Any]]:
+    """Every distinct result NODE of a plan file's object (a shared subplan's once, its
+    ``"ref"`` resolved), in pre-order, without building the :class:`Plan` model: for a
+    caller that only reads the results of a plan it made (a large mix's plan has tens of
+    thousands of nodes, and the model takes seconds to check). The object is trusted."""
+    shared = plan.get("nodes") or {}
+    seen: set[int] = set()
+    stack = [plan["root"]]
+    while stack:
+        node = stack.pop()
+        while "ref" in node:
+            node = shared[node["ref"]]
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if "result" in node:
+            yield node
+        else:
+            stack.extend(b["next"] for b in reversed(node["branches"]))
+
+
 def file_nodes(root: Node) -> int:
     """How many nodes the plan file of this tree holds: each distinct step once (a shared
     one in ``"nodes"``), and each leaf once per place (leaves are written in place).

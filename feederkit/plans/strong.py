@@ -395,7 +395,7 @@ def verify_strong(
         )
     if uncertainty is None:
         pfs = list(parts) if parts is not None else _parts(plan)
-        expected = expected_operations(plan, model, pfs)
+        expected = expected_operations(plan, model, pfs, run)
         given = plan["stats"]["expected_length"]
         if abs(given - expected) > EXPECTED_REL_TOL * max(1.0, expected):
             raise CheckFailed(
@@ -444,15 +444,19 @@ def member_shares(plan: Mapping[str, Any]) -> list[float]:
 
 
 def expected_operations(
-    plan: Mapping[str, Any], model: StrongModel, parts: Sequence[PushFunction]
+    plan: Mapping[str, Any],
+    model: StrongModel,
+    parts: Sequence[PushFunction],
+    run: _Run | None = None,
 ) -> float:
     """The expected number of operations of a strong plan on the uncertain model, as the
     planner defines it (docs/planning.md): a part starts in each physical state with the
     resting ranges of the ideal states a first alignment can end there (each shared equally
     among its destinations) times its member's share; a rotation by ``action_deg`` shares a
     state's mass equally among its outcome set; a branch keeps the probability that the
-    state's reading falls in it. Memoised per (node, state), without recursion."""
-    run = _Run(plan, model)
+    state's reading falls in it. Memoised per (node, state), without recursion; ``run``, a
+    walk of the same plan and model (the verification's), lends its indexes and memos."""
+    run = _Run(plan, model) if run is None else run
     sensor = model.sensor
     memo: dict[tuple[int, State], float] = {}
     open_steps: dict[tuple[int, State], list[tuple[float, Any, State]]] = {}
