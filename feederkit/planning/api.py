@@ -44,7 +44,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
-from feederkit.planning.solvable import solve, unsolvable
+from feederkit.planning.solvable import solve, unsolvable, unsolvable_by_pairs
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.subsets import subset_lower_bound
 from feederkit.planning.tree import Leaf, PlanResult, Step
@@ -144,7 +144,8 @@ def strong_plan_exists(
         insep = goal_relation(sorted_machine, budget)
         problem = Problem(sorted_machine, options.grouping, 0.0, insep)
         every = sorted({b.mask for b in problem.readings.branches(problem.full)})
-        bad = unsolvable(problem, sorted(maximal_sets(every)), budget)
+        roots = sorted(maximal_sets(every))
+        bad = unsolvable_by_pairs(problem, roots, budget) or unsolvable(problem, roots, budget)
     except Timeout:
         return True
     if bad is None or not bad:
@@ -162,9 +163,13 @@ operations before deciding whether a strong plan exists at all (:func:`_decide`)
 
 def _decide(problem: Problem, roots, deadline: Deadline, machine: PushAlignMachine):
     """Every reachable set's length (``solve``), raising NoStrongPlan when a root has none;
-    None when undecided (too many sets, or out of time)."""
+    None when undecided (too many sets, or out of time). A root holding a pair no strong plan
+    orients (``unsolvable_by_pairs``, quick) has none, whatever its own sets."""
+    free = problem.with_margin(0.0)
     try:
-        known = solve(problem.with_margin(0.0), roots, deadline)
+        if unsolvable_by_pairs(free, roots, deadline):
+            raise _no_strong_plan(machine)
+        known = solve(free, roots, deadline)
     except Timeout:
         return None
     if known is not None and any(known[r] == math.inf for r in roots):
@@ -595,6 +600,18 @@ def _fallback(
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
+    if blind is None and not problem.machine.deterministic:
+        # No plan in hand under uncertainty: perhaps none exists. A root holding a pair no
+        # strong plan orients has none (solvable.unsolvable_by_pairs: quick where the roots'
+        # own sets are too many); half of what is left decides it, when it can.
+        rest = budget.remaining()
+        share = budget if rest is None else budget.ending(budget.end - rest / 2.0)
+        try:
+            bad = unsolvable_by_pairs(problem.with_margin(0.0), roots, share)
+        except Timeout:
+            bad = None
+        if bad:
+            raise _no_strong_plan(problem.machine)
     if blind is not None and budget.end is not None:
         # The bound, from the hardest subsets of the roots (feederkit.planning.subsets), up to
         # half the reserve (no tree to build, only the statistics of the plan in hand): a

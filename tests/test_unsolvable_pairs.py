@@ -1,0 +1,70 @@
+"""Whether a strong plan exists, decided by pairs (``solvable.unsolvable_by_pairs``).
+
+A subset of a solvable set is solvable, so a root reading set holding a pair of states that
+no strong plan orients has no strong plan: the pairs' sets are few and small, where the
+roots' own reachable sets can be too many to explore in time. Checked against the exact
+least fixpoint over the roots' sets (``solvable.unsolvable``), and the planner's answer when
+its length search cannot finish.
+"""
+
+from __future__ import annotations
+
+import pytest
+from test_strong_plans import random_pf
+
+from feederkit.machine import build_machine
+from feederkit.planning import api
+from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
+from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.planning.solvable import unsolvable, unsolvable_by_pairs
+from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import Uncertainty
+
+CASES = [(1.0, 0.1), (2.0, 0.2), (4.0, None), (3.0, 0.4)]
+"""(rotation error in deg, sensor tolerance in mm or None for no sensor)."""
+
+
+def _two_parts(seed: int, rotation: float, tolerance: float | None):
+    sensor = NoSensor() if tolerance is None else ToleranceSensor(tolerance)
+    pfs = [random_pf(8000 + seed), random_pf(9000 + seed)]
+    return build_machine(pfs, sensor, Uncertainty(rotation))
+
+
+def _roots(problem: Problem) -> list[int]:
+    return sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+
+
+@pytest.mark.parametrize("seed", range(0, 40, 2))
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+def test_roots_the_pairs_refuse_have_no_strong_plan(seed, rotation, tolerance):
+    problem = Problem(_two_parts(seed, rotation, tolerance))
+    roots = _roots(problem)
+    by_pairs = unsolvable_by_pairs(problem, roots)
+    assert by_pairs is not None
+    assert set(by_pairs) <= set(unsolvable(problem, roots))  # sound: never a solvable root
+
+
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+def test_a_pair_no_strong_plan_orients_is_found(rotation, tolerance):
+    # Seed 18: a pair of the two parts' states that every action leaves reading alike.
+    problem = Problem(_two_parts(18, rotation, tolerance))
+    roots = _roots(problem)
+    assert unsolvable_by_pairs(problem, roots) == unsolvable(problem, roots) != []
+
+
+def test_the_planner_says_no_strong_plan_when_its_search_cannot_finish(monkeypatch):
+    # The length search is made to run out at once; without the pair test the answer was
+    # "no plan found within the time limit", now it is that no strong plan exists.
+    machine = _two_parts(18, 1.0, 0.1)
+
+    def out_of_time(*args, **kwargs):
+        raise api.Timeout("time")
+
+    monkeypatch.setattr(api, "root_lengths", out_of_time)
+    monkeypatch.setattr(api, "beam_plan", lambda *args, **kwargs: None)
+    options = PlanningOptions(time_limit_s=30.0, lumping="none")
+    with pytest.raises(NoStrongPlan, match="no strong plan exists"):
+        plan(machine, options)
+    assert not strong_plan_exists(machine, options)
