@@ -44,7 +44,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
-from feederkit.planning.solvable import solve, unsolvable, unsolvable_by_pairs
+from feederkit.planning.solvable import decide, unsolvable, unsolvable_by_pairs
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.subsets import subset_lower_bound
 from feederkit.planning.tree import Leaf, PlanResult, Step
@@ -145,7 +145,7 @@ def strong_plan_exists(
         problem = Problem(sorted_machine, options.grouping, 0.0, insep)
         every = sorted({b.mask for b in problem.readings.branches(problem.full)})
         roots = sorted(maximal_sets(every))
-        bad = unsolvable_by_pairs(problem, roots, budget) or unsolvable(problem, roots, budget)
+        bad = unsolvable(problem, roots, budget)
     except Timeout:
         return True
     if bad is None or not bad:
@@ -162,17 +162,14 @@ operations before deciding whether a strong plan exists at all (:func:`_decide`)
 
 
 def _decide(problem: Problem, roots, deadline: Deadline, machine: PushAlignMachine):
-    """Every reachable set's length (``solve``), raising NoStrongPlan when a root has none;
-    None when undecided (too many sets, or out of time). A root holding a pair no strong plan
-    orients (``unsolvable_by_pairs``, quick) has none, whatever its own sets."""
-    free = problem.with_margin(0.0)
+    """Every reachable set's length (``solvable.decide``), raising NoStrongPlan when a root
+    has none; None when undecided (too many sets, or out of time), or when a root's pair
+    decided it and the sets were not explored."""
     try:
-        if unsolvable_by_pairs(free, roots, deadline):
-            raise _no_strong_plan(machine)
-        known = solve(free, roots, deadline)
+        bad, known = decide(problem.with_margin(0.0), roots, deadline)
     except Timeout:
         return None
-    if known is not None and any(known[r] == math.inf for r in roots):
+    if bad:
         raise _no_strong_plan(machine)
     return known
 
