@@ -174,7 +174,7 @@ class _Run:
         self.rejected: dict[tuple[int, State], int] = {}
         self._handles: dict[tuple[int, State], bool] = {}
         self._outcomes: dict[tuple[int, State], list[State]] = {}
-        self._follow: dict[tuple[int, State], list[Mapping[str, Any]] | str] = {}
+        self._follow: dict[tuple[int, State], list[Mapping[str, Any]] | float] = {}
         self._index: dict[int, _BranchIndex] = {}
         # The ideal verifier's rounding policy: touching open ends do not overlap.
         self._sensors = [
@@ -602,8 +602,9 @@ def max_shape_tolerance_mm(
     rotation error and COM tolerance: a bisection re-verifying the plan (outcome sets and
     reading intervals grow with the tolerance) to ``rel_tol`` of the bound, half the parts'
     smallest hull edge. Returns the lower end of the final bracket, where the plan holds.
-    The plan failing one step above the declared tolerance ends the bisection there.
-    Timeout when ``deadline`` passes first (checked before each re-verification)."""
+    A plan that fails at the smallest midpoint the bisection could try ends it at once (the
+    declared tolerance). Timeout when ``deadline`` passes first (checked before each
+    re-verification)."""
     deadline = deadline or Deadline()
     declared = declared_uncertainty(plan)
     pfs = list(parts) if parts is not None else _parts(plan)
