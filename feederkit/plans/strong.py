@@ -47,6 +47,7 @@ from feederkit.mechanics.uncertain import (
 from feederkit.planning.budget import Deadline
 from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
 from feederkit.plans.execute import rounding_inset
+from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.model import PlanPart, member_label, push_function_of
 from feederkit.plans.verify import PartCheck, VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
@@ -408,24 +409,12 @@ def verify_strong(
 
 def reject_clash(plan: Mapping[str, Any]) -> tuple[str, str | None] | None:
     """A member (part, landing) listed both in a reject leaf and in an accept leaf (None:
-    there is none); each distinct node of the file once."""
-    shared = plan.get("nodes") or {}
+    there is none); each distinct result node of the file once (:func:`result_nodes`)."""
     rejected: set[tuple[str, str | None]] = set()
     accepted: set[tuple[str, str | None]] = set()
-    seen: set[int] = set()
-    stack = [plan["root"]]
-    while stack:
-        node = stack.pop()
-        while "ref" in node:
-            node = shared[node["ref"]]
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if "result" in node:
-            into = rejected if node.get("reject") is True else accepted
-            into.update((e["part"], e.get("landing")) for e in node["result"])
-        else:
-            stack.extend(b["next"] for b in node["branches"])
+    for node in result_nodes(plan):
+        into = rejected if node.get("reject") is True else accepted
+        into.update((e["part"], e.get("landing")) for e in node["result"])
     both = [m for m in rejected if m in accepted]
     return min(both, key=str) if both else None
 
