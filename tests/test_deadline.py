@@ -581,8 +581,9 @@ def test_a_plan_leaves_its_search_tables_to_reference_counting(case):
         with contextlib.suppress(PlanningError):
             plan(machine, options)
 
+    run()  # imports and first-use caches make some garbage once
     assert gc.isenabled()
-    assert _cyclic_garbage(run) < 2000
+    assert _cyclic_garbage(run) < 50  # it was 640,000 through the checkpoint; 24 per plan
     assert gc.isenabled()  # restored
 
 

@@ -7,6 +7,8 @@ Nothing else depends on the numbering.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from feederkit.machine import (
     ActionRange,
     OutcomeRange,
@@ -80,7 +82,6 @@ def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
     Shared subtrees stay shared (each node is converted once).
     """
     masks: dict[int, int] = {}
-    nodes: dict[int, PlanTree] = {}
 
     def mask(m: int) -> int:
         out = masks.get(m)
@@ -88,23 +89,31 @@ def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
             out = masks[m] = remap_mask(m, old)
         return out
 
-    def convert(n: PlanTree) -> PlanTree:
-        hit = nodes.get(id(n))
-        if hit is not None:
-            return hit
-        if isinstance(n, Leaf):
-            out: PlanTree = Leaf(mask(n.mask))
-        else:
-            action = n.action
-            if action is not None:
-                action = OverlapRange(action.lo, action.hi, mask(action.image))
-            subs = tuple(
-                (ReadingBranch(b.lo, b.hi, mask(b.mask)), convert(s)) for b, s in n.branches
-            )
-            out = Step(action, subs)
-        nodes[id(n)] = out
-        return out
+    return map_masks(node, mask)
 
-    out = convert(node)
-    nodes.clear()  # ``convert`` refers to itself (a cycle the collector frees): not its memo
-    return out
+
+def map_masks(node: PlanTree, mask: Callable[[int], int]) -> PlanTree:
+    """The plan with every mask (leaves, action images, reading branches) replaced by
+    ``mask`` of it: each distinct node converted once, children first, without recursion
+    (a plan's DAG can have far more paths than nodes, and more levels than Python's stack)."""
+    nodes: dict[int, PlanTree] = {}
+    stack: list[tuple[PlanTree, bool]] = [(node, False)]
+    while stack:
+        n, ready = stack.pop()
+        if id(n) in nodes:
+            continue
+        if isinstance(n, Leaf):
+            nodes[id(n)] = Leaf(mask(n.mask))
+            continue
+        if not ready:
+            stack.append((n, True))
+            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
+            continue
+        action = n.action
+        if action is not None:
+            action = OverlapRange(action.lo, action.hi, mask(action.image))
+        subs = tuple(
+            (ReadingBranch(b.lo, b.hi, mask(b.mask)), nodes[id(sub)]) for b, sub in n.branches
+        )
+        nodes[id(n)] = Step(action, subs)
+    return nodes[id(node)]

@@ -84,80 +84,58 @@ def _node_seconds(node: Step, costs: ActionCosts) -> float:
 
 
 def _expected(machine: PushAlignMachine, root: Step, cost: Callable[[Step], float]) -> float:
-    """The expectation of the summed ``cost`` of the operations a part goes through."""
-    if not machine.deterministic:
-        return _expected_sets(machine, root, cost)
-    memo: dict[tuple[int, int], float] = {}
-    probs: dict[tuple[float | None, float | None, int], float] = {}
-    holding = _Holding()
+    """The expectation of the summed ``cost`` of the operations a part goes through.
 
-    def ops(node: PlanTree, state: int) -> float:
+    With outcome sets a state's mass moves to its outcome set, shared equally
+    (docs/planning.md); a part follows a branch with the probability that its reading falls
+    in it."""
+    walk = _Expectation(machine, cost)
+    return sum(s.weight * walk.ops(root, i) for i, s in enumerate(machine.states))
+
+
+class _Expectation:
+    """The expected summed cost from each (node, state) of one plan, memoised.
+
+    A class rather than a recursive closure: a closure that calls itself is a reference
+    cycle, and its memo would wait for the cyclic collector (paused while planning,
+    ``budget.collector_paused``)."""
+
+    def __init__(self, machine: PushAlignMachine, cost: Callable[[Step], float]) -> None:
+        self.machine = machine
+        self.cost = cost
+        self.memo: dict[tuple[int, int], float] = {}
+        self.probs: dict[tuple[float | None, float | None, int], float] = {}
+        self.holding = _Holding()
+
+    def ops(self, node: PlanTree, state: int) -> float:
+        """The expected summed cost from ``node`` on, for a part resting in ``state`` before
+        it (0 at a leaf)."""
         if isinstance(node, Leaf):
             return 0.0
         key = (id(node), state)
-        hit = memo.get(key)
+        hit = self.memo.get(key)
         if hit is not None:
             return hit
-        if node.action is not None:
-            state = machine.successor(state, node.action.representative)
-        total = cost(node)
-        for b, sub in holding(node, state):
-            if not b.mask >> state & 1 or isinstance(sub, Leaf):
-                continue  # a leaf adds p * 0.0: nothing
-            p = probs.get((b.lo, b.hi, state))
-            if p is None:
-                p = probs[(b.lo, b.hi, state)] = reading_probability(machine, b, state)
-            if p > 0.0:
-                total += p * ops(sub, state)
-        memo[key] = total
-        return total
-
-    total = sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
-    # ``ops`` refers to itself (a cycle the collector frees), not its tables.
-    memo.clear()
-    probs.clear()
-    holding.clear()
-    return total
-
-
-def _expected_sets(machine: PushAlignMachine, root: Step, cost: Callable[[Step], float]) -> float:
-    """``_expected`` when actions have outcome sets: a state's mass moves to its
-    outcome set, shared equally (docs/planning.md); a part follows a branch with the
-    probability that its reading falls in it."""
-    memo: dict[tuple[int, int], float] = {}
-    probs: dict[tuple[float | None, float | None, int], float] = {}
-    holding = _Holding()
-
-    def ops(node: PlanTree, state: int) -> float:
-        if isinstance(node, Leaf):
-            return 0.0
-        key = (id(node), state)
-        hit = memo.get(key)
-        if hit is not None:
-            return hit
+        m = self.machine
         if node.action is None:
             outs = [state]
+        elif m.deterministic:
+            outs = [m.successor(state, node.action.representative)]
         else:
-            outs = members(machine.outcomes(state, node.action.representative))
-        total = cost(node)
+            outs = members(m.outcomes(state, node.action.representative))
+        total = self.cost(node)
+        probs = self.probs
         for t in outs:
-            for b, sub in holding(node, t):
+            for b, sub in self.holding(node, t):
                 if not b.mask >> t & 1 or isinstance(sub, Leaf):
-                    continue  # a leaf adds p * 0.0 / len(outs): nothing
+                    continue  # a leaf adds p * 0.0: nothing
                 p = probs.get((b.lo, b.hi, t))
                 if p is None:
-                    p = probs[(b.lo, b.hi, t)] = reading_probability(machine, b, t)
+                    p = probs[(b.lo, b.hi, t)] = reading_probability(m, b, t)
                 if p > 0.0:
-                    total += p * ops(sub, t) / len(outs)
-        memo[key] = total
+                    total += p * self.ops(sub, t) / len(outs)
+        self.memo[key] = total
         return total
-
-    total = sum(s.weight * ops(root, i) for i, s in enumerate(machine.states))
-    # ``ops`` refers to itself (a cycle the collector frees), not its tables.
-    memo.clear()
-    probs.clear()
-    holding.clear()
-    return total
 
 
 _INDEXED = 16
@@ -176,10 +154,6 @@ class _Holding:
 
     def __init__(self) -> None:
         self._index: dict[int, dict[int, list[tuple[ReadingBranch, PlanTree]]]] = {}
-
-    def clear(self) -> None:
-        """Forget the indexes (their nodes' statistics are done)."""
-        self._index.clear()
 
     def __call__(self, node: Step, state: int) -> Sequence[tuple[ReadingBranch, PlanTree]]:
         """The node's branches holding ``state``, or (a node of few branches) all of them:

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from feederkit.errors import CheckFailed, InputError
-from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, members
+from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import snap_intervals
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
@@ -45,7 +45,8 @@ from feederkit.mechanics.uncertain import (
     uncertain_mechanics,
 )
 from feederkit.planning.budget import Deadline
-from feederkit.planning.tree import Leaf, PlanResult, PlanTree, Step
+from feederkit.planning.reindex import map_masks
+from feederkit.planning.tree import PlanResult, Step
 from feederkit.plans.execute import rounding_inset
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.model import PlanPart, member_label, push_function_of
@@ -646,28 +647,7 @@ def ideal_view(result: PlanResult, ideal: PushAlignMachine) -> PlanResult:
             masks[m] = out
         return out
 
-    nodes: dict[int, PlanTree] = {}
-    # Post-order without recursion, each distinct node once (a DAG's paths can be many more).
-    stack: list[tuple[PlanTree, bool]] = [(result.root, False)]
-    while stack:
-        n, ready = stack.pop()
-        if id(n) in nodes:
-            continue
-        if isinstance(n, Leaf):
-            nodes[id(n)] = Leaf(mask(n.mask))
-            continue
-        if not ready:
-            stack.append((n, True))
-            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
-            continue
-        action = n.action
-        if action is not None:
-            action = OverlapRange(action.lo, action.hi, mask(action.image))
-        subs = tuple(
-            (ReadingBranch(b.lo, b.hi, mask(b.mask)), nodes[id(sub)]) for b, sub in n.branches
-        )
-        nodes[id(n)] = Step(action, subs)
-    root = nodes[id(result.root)]
+    root = map_masks(result.root, mask)
     assert isinstance(root, Step)
     return PlanResult(
         machine=ideal,
