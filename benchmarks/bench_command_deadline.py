@@ -10,7 +10,8 @@ the terminal. Each case writes its parts as outline files (as a user would have 
 the command in a fresh process and reads the plan file back. Per case: the limit, the
 command's wall seconds from process start and the overshoot (wall - T), peak memory, the
 plan's length and proven bound, whether the certificate was cut (its figures are then the
-declared values, and a warning says so), and the plan file's distinct nodes.
+declared values, and a warning says so), and the plan's nodes as the file reads back
+(each operation once, each result per place: ``Plan.walk``).
 
 The baseline in the same run is Python's start with feederkit's command line imported
 (``feederkit --help``): the part of the overshoot no planner can remove. Exit code 1 when
@@ -112,7 +113,8 @@ def timed(args: list[str], timeout: float) -> tuple[float, float, int, str]:
 
 
 def file_nodes(path: Path) -> int:
-    """The plan file's distinct nodes (each shared node once)."""
+    """The plan's nodes as the file reads back: each operation once (a shared one too), each
+    result per place (``Plan.walk``)."""
     return sum(1 for _node in read_plan(path).walk())
 
 
@@ -184,7 +186,7 @@ def main(argv: list[str]) -> int:
                 flush=True,
             )
             rows.append((name, r, over))
-    print("\n| case | wall s | over s | peak MB | file nodes | answer |")
+    print("\n| case | wall s | over s | peak MB | plan nodes | answer |")
     print("| --- |" + " ---: |" * 4 + " --- |")
     for name, r, over in rows:
         if "error" in r:

@@ -16,7 +16,8 @@ from shared import small_mix
 from test_planners import check_plan
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import build_machine
+from feederkit.machine import PushAlignMachine, build_machine, search_space
+from feederkit.machine.inseparable import inseparable_masks
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -26,6 +27,7 @@ from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Checkpoint, Deadline, Timeout, rss_mb
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
+from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -590,10 +592,6 @@ def test_a_plan_leaves_its_search_tables_to_reference_counting(case):
 def test_the_goal_fixpoint_of_a_plan_serves_the_machine_it_was_asked_of():
     # The planner numbers states by diameter; its bisimilar states (the longest step before
     # a search) are handed back to the caller's machine, and the other way round.
-    from feederkit.machine import PushAlignMachine, search_space
-    from feederkit.machine.inseparable import inseparable_masks
-    from feederkit.planning.reindex import by_diameter
-
     machine = build_machine(small_mix(8), ToleranceSensor(1.5), Uncertainty())
     assert by_diameter(machine)[0] is not machine  # the case the sharing is for
     plan(machine)

@@ -223,24 +223,18 @@ class _Run:
         sensor = self._sensors[p] if sensor is None else sensor
         reach = sensor.branch_reach(self.model.diameters[p][s])
         if reach is None:
-            return index.withreading
+            return index.with_reading
         return index.within(*reach)
 
     def follows(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]] | None:
         """:meth:`follow`, None where it fails."""
-        key = (id(node), x)
-        hit = self._follow.get(key)
-        if hit is None:
-            hit = self._follow[key] = self._follow_uncached(node, x)
+        hit = self._followed(node, x)
         return None if isinstance(hit, float) else hit
 
     def follow(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]]:
         """The branches resting state ``x`` can follow; CheckFailed when a reading it can
         give is in none."""
-        key = (id(node), x)
-        hit = self._follow.get(key)
-        if hit is None:
-            hit = self._follow[key] = self._follow_uncached(node, x)
+        hit = self._followed(node, x)
         if isinstance(hit, float):
             p, s = x
             diam = self.model.diameters[p][s]
@@ -249,6 +243,15 @@ class _Run:
                 f"{diam[1]:.6g} mm) can read {hit:.6g} mm, which no branch after rotation "
                 f"{node.get('action_deg')} holds"
             )
+        return hit
+
+    def _followed(self, node: Mapping[str, Any], x: State) -> list[Mapping[str, Any]] | float:
+        """:meth:`follow` memoised per (node, state): the next nodes, or a reading no branch
+        holds."""
+        key = (id(node), x)
+        hit = self._follow.get(key)
+        if hit is None:
+            hit = self._follow[key] = self._follow_uncached(node, x)
         return hit
 
     def _follow_uncached(
@@ -338,7 +341,7 @@ class _BranchIndex:
     def __init__(self, branches: Sequence[Mapping[str, Any]]) -> None:
         with_reading = [b for b in branches if b["reading"] is not None]
         self.blind = not with_reading
-        self.withreading = with_reading
+        self.with_reading = with_reading
         ends = [(float(b["reading"][0]), float(b["reading"][1])) for b in with_reading]
         self._los = [a for a, _b in ends]
         self._his = [b for _a, b in ends]
@@ -349,10 +352,10 @@ class _BranchIndex:
     def within(self, lo: float, hi: float) -> list[Mapping[str, Any]]:
         """The branches whose interval meets ``[lo, hi]`` (all of them when unsorted)."""
         if not self._sorted:
-            return self.withreading
+            return self.with_reading
         first = bisect.bisect_left(self._his, lo)  # the first whose upper end reaches lo
         last = bisect.bisect_right(self._los, hi)  # past the last that starts by hi
-        return self.withreading[first:last]
+        return self.with_reading[first:last]
 
 
 def verify_strong(
