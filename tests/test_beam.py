@@ -138,7 +138,7 @@ def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(mo
     def out_of_time(*_args, **_kwargs):
         raise Timeout("time")
 
-    monkeypatch.setattr(api, "root_lengths", out_of_time)
+    monkeypatch.setattr(api, "longest_root", out_of_time)
     calls = []
     real = api.beam_plan
 
@@ -168,14 +168,14 @@ def test_a_mix_the_exact_search_cannot_finish_gets_a_verified_plan(monkeypatch):
     from feederkit.plans.make import make_plan
     from feederkit.uncertainty import Uncertainty
 
-    real = api.root_lengths
+    real = api.longest_root
 
     def exact_runs_out(problem, *args, **kwargs):
         if not problem.machine.deterministic:
             raise Timeout("time")
         return real(problem, *args, **kwargs)
 
-    monkeypatch.setattr(api, "root_lengths", exact_runs_out)
+    monkeypatch.setattr(api, "longest_root", exact_runs_out)
     pfs = mix(20)
     sensor = ToleranceSensor(0.05 * max(pf.part.size for pf in pfs))
     made = make_plan(pfs, sensor, PlanningOptions(time_limit_s=40.0), uncertainty=Uncertainty())

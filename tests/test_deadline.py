@@ -125,6 +125,11 @@ def test_the_exact_search_is_on_course_with_its_share_of_roots_proven():
     assert not api._on_course(problem, worst, roots)
     worst.exact[roots[need - 1]] = 1
     assert api._on_course(problem, worst, roots)
+    # A root that fits within the longest so far counts as one whose length is proven.
+    del worst.exact[roots[need - 1]]
+    assert not api._on_course(problem, worst, roots)
+    worst.ub[roots[need - 1]] = 2
+    assert api._on_course(problem, worst, roots)
 
 
 def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(monkeypatch):
@@ -142,7 +147,7 @@ def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(
         while True:
             worst.deadline.check()
 
-    monkeypatch.setattr(api, "root_lengths", endless)
+    monkeypatch.setattr(api, "longest_root", endless)
     left = []
     real = api._fallback
 
@@ -213,7 +218,7 @@ def _proven_refiner(machine, deadline: Deadline):
     """A refiner over ``machine`` (numbered by diameter) whose root lengths are proven with
     no limit, as ``plan`` has them when the tie-breaking stages begin; the refiner itself
     runs under ``deadline``."""
-    from feederkit.planning.methods import make_oracle, root_lengths
+    from feederkit.planning.methods import longest_root, make_oracle
     from feederkit.planning.problem import Problem
     from feederkit.planning.readings import maximal_sets
     from feederkit.planning.refine import Refiner, child_masses
@@ -223,7 +228,7 @@ def _proven_refiner(machine, deadline: Deadline):
     branches = tuple(problem.readings.branches(problem.full))
     worst = make_oracle(problem, "auto", Deadline())
     roots = sorted(maximal_sets({b.mask for b in branches}))
-    k = max(root_lengths(problem, worst, roots, "auto", None).values())
+    k = longest_root(problem, worst, roots, "auto", None)
     masses = tuple(s.weight for s in problem.machine.states)
     children = child_masses(problem, problem.full, masses, None, branches)
     return Refiner(problem, worst, deadline), children, k

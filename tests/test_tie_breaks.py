@@ -21,7 +21,7 @@ from test_planners import check_plan, random_convex
 import feederkit.planning.api as api
 from feederkit.machine import build_machine, members, search_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
-from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses
@@ -48,7 +48,7 @@ def _proven(machine):
     worst = make_oracle(problem, "auto", Deadline())
     every = sorted({b.mask for b in problem.readings.branches(problem.full)})
     roots = sorted(maximal_sets(every))
-    k = max(root_lengths(problem, worst, roots, "auto", None).values())
+    k = longest_root(problem, worst, roots, "auto", None)
     return Refiner(problem, worst), every, k
 
 

@@ -62,7 +62,7 @@ def test_the_planner_says_no_strong_plan_when_its_search_cannot_finish(monkeypat
     def out_of_time(*args, **kwargs):
         raise api.Timeout("time")
 
-    monkeypatch.setattr(api, "root_lengths", out_of_time)
+    monkeypatch.setattr(api, "longest_root", out_of_time)
     monkeypatch.setattr(api, "beam_plan", lambda *args, **kwargs: None)
     options = PlanningOptions(time_limit_s=30.0, lumping="none")
     with pytest.raises(NoStrongPlan, match="no strong plan exists"):

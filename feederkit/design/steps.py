@@ -67,7 +67,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Deadline
-from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
@@ -203,8 +203,7 @@ class LengthOracle:
     def length(self, tolerance: float) -> int:
         """The minimum worst-case number of operations at ``tolerance`` mm (as ``plan``'s)."""
         problem, worst, roots = self._search(tolerance)
-        lengths = root_lengths(problem, worst, roots, "auto")
-        return 1 + max(lengths.values(), default=0)
+        return 1 + longest_root(problem, worst, roots, "auto")
 
     def within(self, tolerance: float, length: int) -> bool:
         """Whether some plan at ``tolerance`` mm takes at most ``length`` operations."""

@@ -69,7 +69,7 @@ from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import FIRST_LIMIT, goal_relation, strong_plan_exists
 from feederkit.planning.budget import Deadline
 from feederkit.planning.lumping import kept_apart, try_lumping
-from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
@@ -456,10 +456,10 @@ class StrongLengthOracle:
             return None
         problem, worst, roots = self._problem(tolerance, goal)
         try:
-            lengths = root_lengths(problem, worst, roots, "auto", 4 * problem.n + 4)
+            longest = longest_root(problem, worst, roots, "auto", 4 * problem.n + 4)
         except ValueError:
             return None
-        return 1 + max(lengths.values(), default=0)
+        return 1 + longest
 
     def within(self, tolerance: float, length: int) -> bool:
         """Whether some strong plan at ``tolerance`` mm takes at most ``length`` operations."""

@@ -37,7 +37,7 @@ from feederkit.planning.budget import (
 )
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
-from feederkit.planning.methods import make_oracle, root_lengths
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
@@ -347,7 +347,7 @@ def _plan(
     stopped = None
     try:
         try:
-            lengths = root_lengths(problem, worst, roots, method, limit)
+            longest = longest_root(problem, worst, roots, method, limit)
         except ValueError:
             if machine.deterministic or known is not None or method in ("bfs", "bottom-up"):
                 raise
@@ -356,7 +356,7 @@ def _plan(
             known = _decide(problem, roots, exact_deadline, machine)
             if known is not None and min_margin == 0.0:
                 worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
-            lengths = root_lengths(problem, worst, roots, method, _limit(machine))
+            longest = longest_root(problem, worst, roots, method, _limit(machine))
     except Timeout as exc:
         stopped = exc.reason
     except ValueError:
@@ -371,7 +371,7 @@ def _plan(
         return _fallback(problem, worst, roots, root_branches, budget, options, stopped)
     if checkpoint is not None:
         checkpoint.go_on()  # every root's length is proven: the rest of the share is ours
-    length = 1 + max(lengths.values(), default=0)
+    length = 1 + longest
     budget_ops = length - 1
     if objective == "worst" and isinstance(worst, BackchainWorst) and not problem.sensorless:
         # The readings carry nothing (methods.readings_carry_nothing): the backchaining plan
@@ -431,10 +431,12 @@ def _exact_budget(budget: Deadline) -> Deadline:
 
 def _on_course(problem: Problem, worst: WorstCase, roots: list[int]) -> bool:
     """Whether the exact search is on course to finish in its share: at least
-    ``EXACT_CHECK_SHARE`` of the roots have a proven length (asked when that share of its
-    time has passed; it proves them one after the other)."""
+    ``EXACT_CHECK_SHARE`` of the roots have a proven length or fit within the longest so far
+    (asked when that share of its time has passed; it proves them one after the other,
+    :func:`~feederkit.planning.methods.longest_root`)."""
     exact = getattr(worst, "exact", {})
-    done = sum(1 for r in roots if problem.is_goal(r) or r in exact)
+    fits = getattr(worst, "ub", {})
+    done = sum(1 for r in roots if problem.is_goal(r) or r in exact or r in fits)
     return done >= EXACT_CHECK_SHARE * len(roots)
 
 

@@ -72,20 +72,29 @@ def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
     return WorstCase(problem, deadline)
 
 
-def root_lengths(
+def longest_root(
     problem: Problem, worst: WorstCase, roots: list[int], method: str, limit: int | None = None
-) -> dict[int, int]:
-    """Minimum worst-case operations after the first alignment, per root branch mask.
+) -> int:
+    """The largest minimum worst-case number of operations after the first alignment over
+    the root branch masks: a plan's length is one more (section 6.1).
 
-    Lengths found by another algorithm are recorded in ``worst`` as exact values. ``limit``
-    caps the AND/OR search (ValueError beyond it).
+    Only the largest matters, so the AND/OR search proves it hardest first (the largest
+    root) and then asks of every other root only whether it fits within the largest so
+    far (``within``), deepening where one does not: a root that fits is proven by the
+    first action that works, without refuting every shorter budget as iterative deepening
+    of each root would. Lengths found by another algorithm are recorded in ``worst`` as
+    exact values. ``limit`` caps the AND/OR search (ValueError beyond it).
     """
-    if method == "bfs":
-        out = {r: bfs_length(problem, r, worst.deadline) for r in roots}
-    elif method == "bottom-up":
-        out = bottom_up_lengths(problem, roots, worst.deadline)
-    else:
-        return {r: worst.length(r, limit) for r in roots}
-    for r, v in out.items():
-        worst.exact[r] = v
-    return out
+    if method in ("bfs", "bottom-up"):
+        if method == "bfs":
+            out = {r: bfs_length(problem, r, worst.deadline) for r in roots}
+        else:
+            out = bottom_up_lengths(problem, roots, worst.deadline)
+        worst.exact.update(out)
+        return max(out.values(), default=0)
+    best = 0
+    for r in sorted(roots, key=int.bit_count, reverse=True):
+        if best and worst.within(r, best):
+            continue
+        best = worst.length(r, limit)
+    return best
