@@ -20,11 +20,10 @@ import contextlib
 import gc
 import math
 import time
-from collections.abc import Callable, Hashable, Iterable
 from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch, search_space
+from feederkit.machine import OverlapRange, PushAlignMachine, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
@@ -39,6 +38,8 @@ from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping, PlanningOptions
+from feederkit.planning.pairwise import applies as pairwise_applies
+from feederkit.planning.pairwise import pairwise_plan
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
@@ -47,7 +48,7 @@ from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import decide, unsolvable, unsolvable_by_pairs
 from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.subsets import subset_lower_bound
-from feederkit.planning.tree import Leaf, PlanResult, Step
+from feederkit.planning.tree import Leaf, PlanResult, Step, build_dag
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -493,6 +494,10 @@ statistics and renumbering walk that tree once more after them (the 50-part mix 
 under 1 degree: the answer 2.6-4.5 s past a 60 s limit without this; 1.5 left the 20-part
 mix at 5 % under 10 s no time for the subsets' bound)."""
 
+PAIRWISE_SHARE = 0.3
+"""With a time limit and no plan in hand, the share of what is left that the plan telling
+the states apart one pair at a time may take (the ideal model only)."""
+
 FIRST_PLAN_RESERVE = 2.0
 """With no plan in hand, the widening beams look for a first one until this many tree
 reserves (``TREE_RESERVE``) before the limit, past their ``BEAM_SHARE``; shorter ones only
@@ -513,8 +518,9 @@ def _fallback(
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
-    within ``READ_SHARE`` of what is left, when it is shorter); the widening beams
-    (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
+    within ``READ_SHARE`` of what is left, when it is shorter); else, on the ideal model, the
+    plan that tells the states apart one pair at a time (within ``PAIRWISE_SHARE``); the
+    widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
     shorter; with a plan in hand, the hardest subsets' bound
     (:func:`~feederkit.planning.subsets.subset_lower_bound`); then a depth-first search (the
     greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
@@ -548,6 +554,18 @@ def _fallback(
             read = None
         if read is not None and tree_length(read) < tree_length(blind):
             blind = read
+    if blind is None and pairwise_applies(problem):
+        # On the ideal model a plan always exists: the pairs told apart one at a time
+        # (feederkit.planning.pairwise), within PAIRWISE_SHARE of what is left; the searches
+        # below then look for something shorter.
+        rest = budget.remaining()
+        share = budget if rest is None else budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE))
+        try:
+            told = pairwise_plan(problem, root_branches, share)
+        except Timeout:
+            told = None
+        if told is not None and tree_length(told) <= FALLBACK_MAX_OPERATIONS:
+            blind = told
     anytime = WorstCase(problem, budget)
     if stop != "memory" and type(worst) is WorstCase:
         # What the exact search proved stays true (its exact lengths are left out: they
@@ -668,42 +686,6 @@ def _fallback(
     return root, False, None, lower, TIES_NONE
 
 
-def _dag(
-    keys: Iterable[Hashable],
-    expand: Callable[[Hashable], Leaf | tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]],
-    deadline: Deadline,
-) -> dict[Hashable, Step | Leaf]:
-    """The plan nodes of ``keys`` and everything below, built on an explicit stack.
-
-    ``expand(key)`` is a Leaf or a node's action with its (branch, child key) pairs; equal
-    keys share one node (the tree is a DAG in memory). The keys must not lead back to
-    themselves (each expansion gets closer to a goal), and no depth meets Python's
-    recursion limit.
-    """
-    made: dict[Hashable, Step | Leaf] = {}
-    pending: dict[Hashable, tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]] = {}
-    stack: list[tuple[Hashable, bool]] = [(k, False) for k in keys]
-    while stack:
-        key, ready = stack.pop()
-        if key in made:
-            continue
-        if ready:
-            action, subs = pending.pop(key)
-            made[key] = Step(action, tuple((b, made[c]) for b, c in subs))
-            continue
-        if key in pending:
-            continue
-        deadline.check()
-        node = expand(key)
-        if isinstance(node, Leaf):
-            made[key] = node
-            continue
-        pending[key] = node
-        stack.append((key, True))
-        stack.extend((c, False) for _b, c in node[1] if c not in made)
-    return made
-
-
 def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:
     """The plan that follows a search's ``choice`` table (the action that proved each set).
 
@@ -740,7 +722,7 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
         return act.action, subs
 
     top = [(b, witness_of(b.mask, roots)) for b in root_branches]
-    made = _dag([k for _b, k in top], expand, deadline)
+    made = build_dag([k for _b, k in top], expand, deadline)
     return Step(None, tuple((b, made[k]) for b, k in top))
 
 
@@ -781,7 +763,7 @@ def _sensorless_plan(
         keys = {b.mask: b.mask if problem.is_goal(b.mask) else problem.full for b in root_branches}
     else:
         keys = {b.mask: b.mask for b in root_branches}
-    made = _dag(list(keys.values()), expand, deadline)
+    made = build_dag(list(keys.values()), expand, deadline)
     return Step(None, tuple((b, made[keys[b.mask]]) for b in root_branches))
 
 

@@ -8,12 +8,14 @@ inseparable); all its states are correct answers.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from feederkit.machine import OverlapRange, PushAlignMachine, ReadingBranch
 
 if TYPE_CHECKING:
+    from feederkit.planning.budget import Deadline
     from feederkit.uncertainty import Uncertainty
 
 
@@ -42,6 +44,42 @@ class Step:
 
 
 PlanTree = Step | Leaf
+
+
+def build_dag(
+    keys: Iterable[Hashable],
+    expand: Callable[[Hashable], Leaf | tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]],
+    deadline: Deadline,
+) -> dict[Hashable, Step | Leaf]:
+    """The plan nodes of ``keys`` and everything below, built on an explicit stack.
+
+    ``expand(key)`` is a Leaf or a node's action with its (branch, child key) pairs; equal
+    keys share one node (the tree is a DAG in memory). The keys must not lead back to
+    themselves (each expansion gets closer to a goal), and no depth meets Python's
+    recursion limit.
+    """
+    made: dict[Hashable, Step | Leaf] = {}
+    pending: dict[Hashable, tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]] = {}
+    stack: list[tuple[Hashable, bool]] = [(k, False) for k in keys]
+    while stack:
+        key, ready = stack.pop()
+        if key in made:
+            continue
+        if ready:
+            action, subs = pending.pop(key)
+            made[key] = Step(action, tuple((b, made[c]) for b, c in subs))
+            continue
+        if key in pending:
+            continue
+        deadline.check()
+        node = expand(key)
+        if isinstance(node, Leaf):
+            made[key] = node
+            continue
+        pending[key] = node
+        stack.append((key, True))
+        stack.extend((c, False) for _b, c in node[1] if c not in made)
+    return made
 
 
 @dataclass(frozen=True)
