@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import random
 from pathlib import Path
 
 import pytest
@@ -28,6 +29,7 @@ from feederkit.plans import (
     verify_plan,
     write_plan,
 )
+from feederkit.plans.model import ResultEntry
 from feederkit.uncertainty import IDEAL
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
@@ -225,3 +227,19 @@ def test_a_strong_plans_margin_is_slack_beyond_its_declared_rotation_error():
     assert words is not None and "declared ±0.2°" in words
     assert low_margin_words(None, 0.0) is None and low_margin_words(float("inf")) is None
     assert low_margin_words(0.999) is not None and low_margin_words(0.5, 0.5) is None
+
+
+@pytest.mark.parametrize("count", [3, 8, 40])
+def test_held_by_is_every_branch_whose_closed_interval_holds_the_reading(count):
+    # Overlapping closed intervals that share endpoints, with many branches (found by
+    # arrays) and few (one at a time): the same indices, in order, as Branch.holds.
+    rng = random.Random(count)
+    ends = sorted(round(rng.uniform(0.0, 50.0), 1) for _ in range(count + 1))
+    spans = [(ends[k], ends[min(k + rng.randint(1, 2), count)]) for k in range(count)]
+    branches = tuple(
+        Branch(span, Leaf((ResultEntry("p", k, 0.0),))) for k, span in enumerate(spans)
+    )
+    step = Step(10.0, 1.0, branches)
+    readings = [*ends, *(rng.uniform(-5.0, 55.0) for _ in range(200)), None]
+    for r in readings:
+        assert step.held_by(r) == tuple(k for k, b in enumerate(branches) if b.holds(r))

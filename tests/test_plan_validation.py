@@ -9,14 +9,21 @@ from __future__ import annotations
 
 import copy
 import json
+import random
 from pathlib import Path
 
 import pytest
 
+from feederkit.angles import norm360
 from feederkit.errors import CheckFailed, InputError
 from feederkit.plans import check_plan, plan_from_dict, verify_plan
 from feederkit.plans.model import Step, push_function_of
-from feederkit.plans.verify import candidate_readings, rotation_outcomes
+from feederkit.plans.verify import (
+    ANGLE_EPS_DEG,
+    candidate_readings,
+    resting_arcs,
+    rotation_outcomes,
+)
 from feederkit.sensors import ToleranceSensor
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
@@ -121,6 +128,38 @@ def test_rotation_outcomes_are_every_state_the_range_meets():
     step = Step(0.0, 179.0, ())
     assert {t.id for t in rotation_outcomes(pf, s.normal_deg, step)} == {t.id for t in pf.states}
     assert rotation_outcomes(pf, s.normal_deg, Step(0.0, 0.0, ())) == [s]
+
+
+def _arcs_meet(t0: float, width: float, rng: tuple[float, float]) -> bool:
+    """The reference: whether the open arc (t0, t0 + width) meets the open range, compared
+    once a turn apart each way, one range at a time."""
+    lo = norm360(rng[0])
+    hi = lo + (rng[1] - rng[0])
+    t0 = norm360(t0)
+    return any(max(t0, lo + 360.0 * k) < min(t0 + width, hi + 360.0 * k) for k in (-1, 0, 1))
+
+
+@pytest.mark.parametrize("name", ["quadrilateral.sensorless.json", "t-clip.tolerance.json"])
+def test_rotation_outcomes_match_the_arc_test_range_by_range(name):
+    plan = plan_from_dict(load(GOLDEN / name))
+    pf = push_function_of(plan.parts[0])
+    rng = random.Random(7)
+    arcs = resting_arcs(pf)
+    for _ in range(400):
+        s = rng.choice(pf.states)
+        action, margin = rng.uniform(-400.0, 400.0), rng.choice([1e-3, 0.5, 5.0, 40.0, 179.0])
+        # also arcs that start or end exactly on a range's boundary
+        if rng.random() < 0.3:
+            edge = rng.choice(rng.choice(pf.states).resting_range_deg)
+            action = s.normal_deg - edge - margin + ANGLE_EPS_DEG
+        step = Step(action, margin, ())
+        t0 = s.normal_deg - action - margin + ANGLE_EPS_DEG
+        width = 2.0 * (margin - ANGLE_EPS_DEG)
+        want = {t.id for t in pf.states if _arcs_meet(t0, width, t.resting_range_deg)}
+        got = rotation_outcomes(pf, s.normal_deg, step, arcs)
+        assert {t.id for t in got} - {got[0].id} <= want
+        assert want <= {t.id for t in got}
+        assert got == rotation_outcomes(pf, s.normal_deg, step)
 
 
 def test_a_hand_edited_diameter_fails_verification():

@@ -24,6 +24,8 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+import numpy as np
+
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
@@ -203,14 +205,31 @@ class Step:
         return self.action_deg - self.margin_deg, self.action_deg + self.margin_deg
 
     def held_by(self, reading: float | None) -> tuple[int, ...]:
-        """The indices of the branches that hold ``reading`` (:meth:`Branch.holds`)."""
-        return tuple(k for k, b in enumerate(self.branches) if b.holds(reading))
+        """The indices of the branches that hold ``reading`` (:meth:`Branch.holds`), in order.
+
+        A step with many branches compares the reading with arrays of their ends (the
+        same closed comparisons, made once per step and reading instead of per branch).
+        """
+        if reading is None or len(self.branches) < _INDEXED_BRANCHES:
+            return tuple(k for k, b in enumerate(self.branches) if b.holds(reading))
+        table = self.__dict__.get("_ends")
+        if table is None:
+            inf = math.inf
+            lo = np.array([-inf if b.reading is None else b.reading[0] for b in self.branches])
+            hi = np.array([inf if b.reading is None else b.reading[1] for b in self.branches])
+            table = (lo, hi)
+            object.__setattr__(self, "_ends", table)
+        lo, hi = table
+        return tuple(((lo <= reading) & (reading <= hi)).nonzero()[0].tolist())
 
     def follow(self, reading: float | None) -> int | None:
         """The first branch that holds ``reading``; None: a foreign part or a sensor fault."""
         held = self.held_by(reading)
         return held[0] if held else None
 
+
+_INDEXED_BRANCHES = 8
+"""Steps with at least this many branches find the ones holding a reading by arrays."""
 
 Node = Step | Leaf
 

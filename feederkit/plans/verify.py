@@ -31,6 +31,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+import numpy as np
+
 from feederkit.angles import angle_close, norm360
 from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
@@ -163,27 +165,42 @@ def candidate_readings(sensor: Sensor, step: Step, diameter: float) -> list[floa
     return [r for r in out if sensor.consistent(diameter, r)]
 
 
-def _arcs_meet(t0: float, width: float, rng: tuple[float, float]) -> bool:
-    """Whether the open arc ``(t0, t0 + width)`` meets the open range ``(lo, hi)`` (deg)."""
-    lo = norm360(rng[0])
-    hi = lo + (rng[1] - rng[0])
-    t0 = norm360(t0)
-    return any(max(t0, lo + 360.0 * k) < min(t0 + width, hi + 360.0 * k) for k in (-1, 0, 1))
+_TURNS = np.array([[-360.0], [0.0], [360.0]])
+"""A turn back, none and a turn forward: the shifts an arc and a range are compared at."""
 
 
-def rotation_outcomes(pf: PushFunction, normal_deg: float, step: Step) -> list[StableState]:
+def resting_arcs(pf: PushFunction) -> tuple[np.ndarray, np.ndarray]:
+    """Each state's resting range (start in [0, 360), end) shifted by each of ``_TURNS``:
+    two arrays of shape (3, states), columns in the order of ``pf.states``, the table
+    :func:`rotation_outcomes` meets an arc against."""
+    lo = np.array([norm360(s.resting_range_deg[0]) for s in pf.states], dtype=float)
+    width = np.array([s.resting_range_deg[1] - s.resting_range_deg[0] for s in pf.states])
+    return lo + _TURNS, lo + width + _TURNS
+
+
+def rotation_outcomes(
+    pf: PushFunction,
+    normal_deg: float,
+    step: Step,
+    arcs: tuple[np.ndarray, np.ndarray] | None = None,
+) -> list[StableState]:
     """Every state a rotation in the step's overlap range leads the state of ``normal_deg`` to.
 
-    The rotated fence orientations ``normal - (action ± margin)`` form one arc; the part
-    settles in every state whose resting range meets it (section 3.1).
+    The rotated fence orientations ``normal - (action ± margin)`` form one open arc; the
+    part settles in every state whose open resting range meets it (section 3.1), the arc
+    and the range compared once a turn apart each way. ``arcs``: :func:`resting_arcs` of
+    ``pf``, when the caller keeps it.
     """
     assert step.action_deg is not None and step.margin_deg is not None
     nominal = push(pf, rotation_after(normal_deg, step.action_deg))
     width = 2.0 * (step.margin_deg - ANGLE_EPS_DEG)
     if width <= 0.0:
         return [nominal]
-    t0 = normal_deg - step.action_deg - step.margin_deg + ANGLE_EPS_DEG
-    met = [s for s in pf.states if _arcs_meet(t0, width, s.resting_range_deg)]
+    lo, hi = resting_arcs(pf) if arcs is None else arcs
+    t0 = norm360(normal_deg - step.action_deg - step.margin_deg + ANGLE_EPS_DEG)
+    t1 = t0 + width
+    hit = (np.maximum(t0, lo) < np.minimum(t1, hi)).any(axis=0)
+    met = [pf.states[i] for i in hit.nonzero()[0].tolist()]
     return met if nominal in met else [nominal, *met]
 
 
@@ -201,6 +218,7 @@ class _PartSearch:
         # Readings are those of the rebuilt part's true diameters, not the file's listed
         # (snapped) values: every reading a state can really give must lie in a branch.
         self.diameter = {s.id: s.diameter for s in self.pf.states}
+        self.arcs = resting_arcs(self.pf)
         self.memo: dict[tuple[int, int], _Outcome] = {}
 
     def after_push(self, node: Step, number: int, state: StableState) -> _Outcome:
@@ -233,7 +251,7 @@ class _PartSearch:
                         failure = _Failure(reading, b, branch.reading, (), state, nxt)
                     continue
                 assert nxt.action_deg is not None
-                for s2 in rotation_outcomes(self.pf, state.normal_deg, nxt):
+                for s2 in rotation_outcomes(self.pf, state.normal_deg, nxt, self.arcs):
                     sub = self.after_push(nxt, number + 1, s2)
                     paths += sub.paths
                     rejects += sub.rejects
