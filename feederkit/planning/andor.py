@@ -52,6 +52,7 @@ class WorstCase:
         self.deadline = deadline or Deadline(None)
         self._quiet = getattr(problem, "carries_no_information", None)
         self._chains: list[tuple[int, dict[int, int], object]] | None = None
+        self._chain_of: dict[int, tuple[int, dict[int, int], object]] = {}
         self._pairs: list[list[int]] | None = None
         self._pair_memo: dict[int, int] = {}
 
@@ -178,8 +179,14 @@ class WorstCase:
         parts that are not push functions (outcome sets, or goals other than symmetry)."""
         if self._chains is None:
             self._chains = _part_chains(self.p)
+            self._chain_of = {i: c for c in self._chains for i in c[1]}
+        chains = self._chains
+        if mask.bit_count() < len(chains):
+            # Fewer states than parts (a large mix): only the parts the set meets.
+            chain_of = self._chain_of
+            chains = list({id(c): c for i in members(mask) if (c := chain_of.get(i))}.values())
         best = 0
-        for part, local, chain in self._chains:
+        for part, local, chain in chains:
             sub = mask & part
             if sub & (sub - 1):
                 m = 0

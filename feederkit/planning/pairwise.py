@@ -38,7 +38,7 @@ PAIR_CANDIDATES = 64
 """A set picks the pair it tracks among at most this many pairs of neighbouring states (by
 diameter, the likeliest to read alike), the one with the shortest plan."""
 
-SCORED = 16
+SCORED = 4
 """Of the rotations that start a shortest plan of the tracked pair, this many with the
 smallest images are weighed by what their reading sets still need."""
 
