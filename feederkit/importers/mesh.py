@@ -12,11 +12,10 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
-import trimesh
-from scipy.spatial import ConvexHull
 
 from feederkit.errors import InputError
 from feederkit.hull import convex_hull
@@ -24,6 +23,9 @@ from feederkit.importers.budget import MAX_COORD_MM, Budget, ImportLimits
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
 from feederkit.importers.plausible import size_warnings
 from feederkit.outline import make_outline, unit_scale
+
+if TYPE_CHECKING:
+    import trimesh
 
 DOWN = np.array([0.0, 0.0, -1.0])
 
@@ -84,6 +86,8 @@ def load_mesh(
     path: Path, units: str | None, budget: Budget | None = None
 ) -> tuple[trimesh.Trimesh, str, list[str]]:
     """Read one mesh file, scaled to mm; refuse files with no triangles or broken coordinates."""
+    import trimesh  # on first use: importing it costs every command about a second
+
     budget = budget or Budget(ImportLimits(), str(path))
     notes: list[str] = []
     unit_name = units or "mm"
@@ -125,6 +129,8 @@ def load_mesh(
 
 def open_edges(mesh: trimesh.Trimesh) -> int:
     """Edges of the surface that only one triangle uses: the border of its holes."""
+    import trimesh  # on first use: importing it costs every command about a second
+
     return len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
 
 
@@ -149,6 +155,8 @@ def winding_number(mesh: trimesh.Trimesh, point: np.ndarray) -> float:
 
 def _closed(body: trimesh.Trimesh) -> trimesh.Trimesh | None:
     """The body as a closed volume with outward normals (small holes filled), or None."""
+    import trimesh  # on first use: importing it costs every command about a second
+
     if body.is_watertight and body.is_volume:
         return body
     fixed = body.copy()
@@ -236,6 +244,8 @@ def hull_face_count(mesh: trimesh.Trimesh, limit: int) -> int:
     refuse a 20,000-section cylinder before qhull, whose time on many cocircular points,
     and trimesh's hull post-processing (quadratic in the faces), would run for minutes.
     """
+    from scipy.spatial import ConvexHull  # on first use, as trimesh
+
     pts = np.asarray(mesh.vertices, dtype=float)
     for a, b in ((0, 1), (1, 2), (0, 2)):
         ring = shapely.convex_hull(shapely.multipoints(pts[:, [a, b]]))
@@ -274,6 +284,8 @@ class RestingPose:
 
 def resting_poses(s: Solid) -> list[RestingPose]:
     """Stable resting poses of the solid on a plane, most probable first (ties by normal)."""
+    import trimesh  # on first use: importing it costs every command about a second
+
     hull = s.mesh.convex_hull
     com = s.com if s.com is not None else np.asarray(hull.center_mass, dtype=float)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
