@@ -29,6 +29,7 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
+from feederkit.plans.make import _planner_budget
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -610,3 +611,14 @@ def test_the_goal_fixpoint_of_a_plan_serves_the_machine_it_was_asked_of():
     api.share_bisimilar(fresh, sorted_machine, old)
     assert "bisimilar" in vars(search_space(sorted_machine))
     assert search_space(sorted_machine).bisimilar == inseparable_masks(sorted_machine)
+
+
+@pytest.mark.parametrize(
+    ("limit", "certify", "planner_s"),
+    [(60.0, True, 51.0), (10.0, True, 7.5), (4.0, True, 3.0), (10.0, False, 10.0)],
+)
+def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, certify, planner_s):
+    # 15 % of the limit, or 2.5 s where that is more, up to a quarter of the limit.
+    budget = _planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify)
+    assert budget.end is not None
+    assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)

@@ -193,6 +193,14 @@ so the planner gets the rest; ``certify=False`` callers (a design's many plans, 
 own clock) give the planner the whole limit."""
 
 
+POST_MIN_S = 2.5
+"""With a time limit, at least this many seconds (up to ``POST_MAX_SHARE`` of the limit) are
+kept after the planner, however short the limit: verifying, certifying and writing a plan
+of 50,000 nodes takes about 3 s, which 15 % of a 10 s limit does not hold."""
+
+POST_MAX_SHARE = 0.25
+"""The most of a short time limit ``POST_MIN_S`` may take from the planner."""
+
 OUTPUT_SHARE = 0.05
 """With a time limit, the share of it the certificate (whose ideal length may take all the
 time left) leaves to the caller for writing and showing the plan."""
@@ -200,13 +208,13 @@ time left) leaves to the caller for writing and showing the plan."""
 
 def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
     """The planner's budget: the options' time limit from ``started`` less, when certifying,
-    ``POST_SHARE`` of it (at least a tenth of the limit is left to plan), and their memory
-    limit."""
+    ``POST_SHARE`` of it or ``POST_MIN_S`` (at most ``POST_MAX_SHARE`` of it), whichever is
+    more (at least a tenth of the limit is left to plan), and their memory limit."""
     limit = options.time_limit_s
     if limit is None:
         return Deadline(None, options.memory_limit_mb)
     left = _left(options, started) or 0.0
-    keep = POST_SHARE * limit if certify else 0.0
+    keep = max(POST_SHARE * limit, min(POST_MIN_S, POST_MAX_SHARE * limit)) if certify else 0.0
     return Deadline(max(left - keep, 0.1 * limit), options.memory_limit_mb)
 
 
