@@ -40,9 +40,13 @@ class WorstCase:
 
     ``lb`` and ``ub`` are proven bounds per set; ``choice`` keeps, per set, the action that
     first proved the smallest bound (with that bound), so some plan can always be rebuilt.
+    ``pair_bound=False``: no hardest-pair bound (:meth:`pair_bound` answers 0), for searches
+    that are themselves about pairs.
     """
 
-    def __init__(self, problem: Problem, deadline: Deadline | None = None) -> None:
+    def __init__(
+        self, problem: Problem, deadline: Deadline | None = None, pair_bound: bool = True
+    ) -> None:
         self.p = problem
         self.lb: dict[int, int] = {}
         self.ub: dict[int, int] = {}
@@ -53,7 +57,8 @@ class WorstCase:
         self._quiet = getattr(problem, "carries_no_information", None)
         self._chains: list[tuple[int, dict[int, int], object]] | None = None
         self._chain_of: dict[int, tuple[int, dict[int, int], object]] = {}
-        self._pairs: list[list[int]] | None = None
+        # None: the pairs' lengths are searched when first asked (``pair_bound``); []: none.
+        self._pairs: list[list[int]] | None = None if pair_bound else []
         self._pair_memo: dict[int, int] = {}
 
     def _known(self, mask: int, k: int) -> bool | None:
@@ -337,8 +342,7 @@ def _pair_lengths(problem: Problem, deadline: Deadline) -> list[list[int]]:
     # are told apart or merged by the first action it tries. A pair is bounded by its
     # reading branches' lengths: a set the search meets has had its reading, and under
     # the components rule a pair inside a larger component can still read apart alone.
-    search = WorstCase(problem, deadline)
-    search._pairs = []
+    search = WorstCase(problem, deadline, pair_bound=False)
     children = problem.readings.children
     table = [[0] * n for _ in range(n)]
     for i in range(n):

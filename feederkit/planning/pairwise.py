@@ -61,13 +61,14 @@ def pairwise_plan(problem: Problem, root_branches, deadline: Deadline) -> Step |
     """
     if not applies(problem):
         return None
-    pairs = WorstCase(problem, deadline)
-    pairs._pairs = []  # each pair's own search: no table of every pair's length first
+    pairs = WorstCase(problem, deadline, pair_bound=False)  # each pair's own search
     insep = problem.insep
     choices = problem.choices
     readings = problem.readings
 
-    cap = 4 * problem.n + 4  # a pair that is not inseparable has a plan (section 7)
+    # A pair that is not inseparable has a plan (section 7); the cap guards against a goal
+    # relation that is not closed under actions (a lumped one), where one may not.
+    cap = 4 * problem.n + 4
 
     def pair_length(pair: int) -> int:
         try:
@@ -128,8 +129,8 @@ def pairwise_plan(problem: Problem, root_branches, deadline: Deadline) -> Step |
             x = (lo + hi) / 2.0
             x = x - 360.0 if x >= 360.0 else x
             at = bisect.bisect_right(starts, x) - 1  # -1: the last cell, which wraps
-            if not (x < ends[at] or x + 360.0 < ends[at]):
-                continue  # the set's cell is not inside one of the pair's
+            if not (x + 360.0 < ends[at] if at < 0 else x < ends[at]):
+                continue  # between the pair's cells (one no wider than ANGLE_EPS)
             if works[at] is not None:
                 going.append((img.bit_count(), lo - hi, OverlapRange(lo, hi, img), *works[at]))
         if not going:

@@ -39,8 +39,8 @@ class SubsetBound:
     def __init__(self, problem: Problem, deadline: Deadline, cap: int) -> None:
         self.p = problem
         self.cap = cap
-        self.search = WorstCase(problem, deadline)
-        self.search._pairs = []  # no pair bound inside: the pairs are ours
+        # No pair bound inside: the pairs are ours.
+        self.search = WorstCase(problem, deadline, pair_bound=False)
         self._pair: dict[tuple[int, int], int] = {}
 
     def length(self, mask: int) -> int:
