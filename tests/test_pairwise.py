@@ -1,7 +1,8 @@
 """The plan that tells the states apart one pair at a time (``feederkit.planning.pairwise``):
 run from every start and every reading by test_planners' executor it is a plan, never
-shorter than the independent exhaustive planner's optimum (test_planners_bruteforce), on one
-part, on mixes and on a part over both landings; and the fallback answers with it when the
+shorter than the independent exhaustive planner's optimum (test_planners_bruteforce, through
+test_beam's cases) on one part, nor than the planner's on mixes, without a sensor and over
+both landings; and the fallback answers with it when the
 exact search and the beams find nothing."""
 
 from __future__ import annotations
@@ -10,10 +11,10 @@ import math
 import random
 
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_beam import _case
 from test_planners import check_plan
-from test_planners_bruteforce import Degenerate, OwnPart, own_length, polygon
 
 from feederkit.errors import PlanningError
 from feederkit.landing.model import landings_of_outline
@@ -54,22 +55,18 @@ def _convex(seed: int, n: int, name: str):
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
-@given(st.integers(0, 10**9), st.integers(3, 10), st.floats(0.0, 0.08))
+@given(st.integers(0, 10**9), st.integers(3, 10), st.floats(0.002, 0.08))
 def test_one_part_gets_a_plan_never_shorter_than_the_optimum(seed, n, rel):
-    pts, com = polygon(seed, n)
-    own = OwnPart(pts, com)
-    assume(own.ok and own.n >= 2)
-    size = max(max(p[i] for p in pts) - min(p[i] for p in pts) for i in (0, 1))
-    tol = rel * size
-    assume(min(abs(abs(a - b) - 2 * tol) for a in own.diam for b in own.diam) > 1e-6 * size)
-    try:
-        optimum = own_length(own, tol)
-    except Degenerate:
-        assume(False)
-    pf = push_function(make_part(make_outline("random", pts), com))
-    sensor = ToleranceSensor(tol) if tol > 0 else NoSensor()
-    result = _pairwise(build_machine([pf], sensor, uncertainty=IDEAL))
+    machine, optimum = _case(seed, n, rel)  # the exhaustive planner's optimum
+    result = _pairwise(machine)
     assert check_plan(result) == result.length >= optimum
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_one_part_without_a_sensor_gets_a_plan(seed):
+    machine = build_machine([push_function(_convex(seed, 9, "blind"))], NoSensor(), IDEAL)
+    result = _pairwise(machine)
+    assert check_plan(result) == result.length >= plan(machine).length
 
 
 @pytest.mark.parametrize(("count", "rel"), [(2, 0.01), (3, 0.03), (5, 0.05), (8, 0.02), (12, 0.05)])
