@@ -85,16 +85,16 @@ def longest_root(
     of each root would. Lengths found by another algorithm are recorded in ``worst`` as
     exact values. ``limit`` caps the AND/OR search (ValueError beyond it).
     """
-    if method in ("bfs", "bottom-up"):
-        if method == "bfs":
-            out = {r: bfs_length(problem, r, worst.deadline) for r in roots}
-        else:
-            out = bottom_up_lengths(problem, roots, worst.deadline)
-        worst.exact.update(out)
-        return max(out.values(), default=0)
-    best = 0
-    for r in sorted(roots, key=int.bit_count, reverse=True):
-        if best and worst.within(r, best):
-            continue
-        best = worst.length(r, limit)
-    return best
+    if method == "bfs":
+        out = {r: bfs_length(problem, r, worst.deadline) for r in roots}
+    elif method == "bottom-up":
+        out = bottom_up_lengths(problem, roots, worst.deadline)
+    else:
+        best = 0
+        for r in sorted(roots, key=int.bit_count, reverse=True):
+            if best and worst.within(r, best):
+                continue
+            best = worst.length(r, limit)
+        return best
+    worst.exact.update(out)
+    return max(out.values(), default=0)
