@@ -173,6 +173,19 @@ def test_a_certificate_out_of_time_states_the_declared_values_and_says_so(monkey
     assert made.plan["root"] == full.plan["root"]
 
 
+def test_the_certificate_leaves_the_time_its_plan_needs_to_be_written(monkeypatch):
+    # Writing and showing the plan takes time per node of its file: a plan whose output
+    # would take the whole limit gets no certificate search at all (declared values).
+    unc = Uncertainty(1.0, 0.01)
+    options = PlanningOptions(time_limit_s=30.0)
+    monkeypatch.setattr(make_module, "OUTPUT_S_PER_NODE", 30.0)
+    made = make_plan([random_pf(7000)], ToleranceSensor(0.2), options, uncertainty=unc)
+    cert = made.plan["stats"]["certificate"]
+    assert cert["max_rotation_error_deg"] == 1.0 and cert["max_shape_tolerance_mm"] == 0.01
+    assert cert["ideal_length"] is None
+    assert any("no time for the whole certificate" in w for w in made.warnings)
+
+
 def test_a_plan_under_a_callers_budget_names_the_options_limit():
     machine = build_machine([random_pf(7100), random_pf(7101)], NoSensor(), Uncertainty(1.0))
     with pytest.raises(PlanningError, match="time limit of 30 s"):

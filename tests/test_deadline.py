@@ -24,12 +24,12 @@ from feederkit.part import make_part
 from feederkit.planning import api
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
-from feederkit.planning.budget import Checkpoint, Deadline, Timeout, rss_mb
+from feederkit.planning.budget import Checkpoint, Deadline, Timeout, WorkBudget, rss_mb
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
-from feederkit.plans.make import _planner_budget
+from feederkit.plans.make import POST_S_PER_NODE, _planner_budget
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -88,6 +88,32 @@ def test_a_share_keeps_the_start_of_the_budget():
     assert share.memory_mb == pytest.approx(base + 0.8 * (1000.0 - base))
     assert share.memory_base == base
     assert Deadline().until(0.5).end is None
+
+
+def test_committed_nodes_bring_every_share_of_a_budget_forward():
+    # The caller's work per plan node (the file, its verification) comes out of the
+    # planner's time: each share, checkpoint and work budget carries the cost per node.
+    d = Deadline(10.0, per_node_s=0.01)
+    end = d.end
+    d.commit(100)
+    assert d.end == pytest.approx(end - 1.0, abs=1e-9)
+    share = d.until(0.5)
+    assert share.per_node_s == 0.01
+    checkpoint = Checkpoint(share, time.perf_counter() + 1.0, share.end)
+    assert isinstance(checkpoint.later, float)
+    later = checkpoint.later
+    checkpoint.commit(50)
+    assert checkpoint.later == pytest.approx(later - 0.5, abs=1e-9)
+    work = WorkBudget(checkpoint, 10)
+    assert work.per_node_s == 0.01 and d.ending(None).per_node_s == 0.01
+    # Without a cost per node, or without a deadline, nothing moves.
+    free = Deadline(10.0)
+    end = free.end
+    free.commit(10**6)
+    assert free.end == end
+    unlimited = Deadline(per_node_s=1.0)
+    unlimited.commit(10)
+    assert unlimited.end is None
 
 
 def test_a_checkpoint_goes_on_only_when_on_course():
@@ -253,6 +279,60 @@ def test_the_tree_of_a_proven_length_polls_its_deadline():
     except Timeout:
         return
     raise AssertionError("the build ran past its deadline without stopping")
+
+
+def test_the_tree_build_shares_equal_subtrees_and_commits_each_distinct_node():
+    # The expected-operations chooser reads the masses, so the same subtree is chosen again
+    # on many paths: it is built as one object, and the deadline is told of each distinct
+    # step's branches once (what the plan file will hold).
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    budget = Deadline(3600.0, per_node_s=1e-6)
+    refiner, children, k = _proven_refiner(machine, budget)
+    refiner.floor = -math.inf
+    end = budget.end
+
+    def expected(mask, masses, left):
+        return refiner.choose_worst(mask, masses, left, "expected")
+
+    trees = [refiner.build(b.mask, ms, k, expected) for b, _pb, ms in children]
+    steps: dict[int, object] = {}
+    stack = list(trees)
+    while stack:
+        node = stack.pop()
+        if hasattr(node, "branches") and id(node) not in steps:
+            steps[id(node)] = node
+            stack.extend(c for _b, c in node.branches)
+    keys = [
+        (n.action, tuple((b, c if not hasattr(c, "branches") else id(c)) for b, c in n.branches))
+        for n in steps.values()
+    ]
+    assert len(set(keys)) == len(keys)  # no two distinct objects for one subtree
+    branches = sum(len(n.branches) for n in steps.values())
+    assert branches > 0
+    assert end - budget.end == pytest.approx(branches * 1e-6, rel=1e-6)
+
+
+def test_a_plan_too_large_for_its_file_time_gives_way_to_a_smaller_one(monkeypatch):
+    # A cost per node so high that the tie-broken tree cannot be written in the time left:
+    # plan() answers with a smaller tree of the proven length, sooner.
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    full = plan(machine, PlanningOptions())
+    calls: list[str] = []
+    real = api._build
+
+    def build(refiner, children, horizon, tie):
+        calls.append(tie)
+        return real(refiner, children, horizon, tie)
+
+    monkeypatch.setattr(api, "_build", build)
+    budget = Deadline(30.0, per_node_s=2.0)
+    start = time.perf_counter()
+    small = plan(machine, PlanningOptions(time_limit_s=30.0), budget=budget)
+    assert time.perf_counter() - start < 10.0
+    assert calls and calls[0] == "expected"  # tried, ran out on its own size
+    assert full.tie_breaks == "exact" and small.tie_breaks != "exact"
+    assert small.length == full.length
+    check_plan(small)
 
 
 # --- plan() answers within its limits ---------------------------------------------------
@@ -622,3 +702,5 @@ def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, c
     budget = _planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify)
     assert budget.end is not None
     assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)
+    # Certified, the plan's own size counts too: its file and verification per node.
+    assert budget.per_node_s == (POST_S_PER_NODE if certify else 0.0)

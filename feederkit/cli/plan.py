@@ -91,12 +91,14 @@ def pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -
 def landing_lumps(planned: LandingPlan) -> set[tuple[str, str]]:
     """Pairs of landings (in words, in plan order) that an accepting result lists together;
     a reject result may list several rejected landings."""
-    order = [member_label(x.part_name, x.name) for x in planned.landings]
+    order: dict[str, int] = {}
+    for k, x in enumerate(planned.landings):
+        order.setdefault(member_label(x.part_name, x.name), k)
     lumped: set[tuple[str, str]] = set()
     for leaf in planned.leaves():
         if leaf.reject:
             continue
-        names = sorted({member_label(r.part, r.landing) for r in leaf}, key=order.index)
+        names = sorted({member_label(r.part, r.landing) for r in leaf}, key=order.__getitem__)
         lumped |= {(a, b) for k, a in enumerate(names) for b in names[k + 1 :]}
     return lumped
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 from feederkit.catalog import default_catalog_path, get_revision, landings_for
@@ -98,12 +99,31 @@ class LandingPlan:
         (:func:`feederkit.mix.changeover.accepted_lumps`)."""
         return accepted_lumps(self.made.plan)
 
+    @cached_property
+    def _by_name(self) -> dict[tuple[str, str | None], int]:
+        """The index of the first landing of each (part, landing) (made once: a large
+        plan's results name tens of thousands of entries)."""
+        out: dict[tuple[str, str | None], int] = {}
+        for k, x in enumerate(self.landings):
+            out.setdefault((x.part_name, x.name), k)
+        return out
+
+    @cached_property
+    def _by_label(self) -> dict[str, int]:
+        """The index of the first landing of each label (``PART/LANDING``)."""
+        out: dict[str, int] = {}
+        for k, x in enumerate(self.landings):
+            out.setdefault(x.label, k)
+        return out
+
     def landing_of(self, part: str, landing: str | None = None) -> Landing:
         """The landing ``landing`` of ``part`` (or, with one argument, the one labelled
         ``PART/LANDING``); InputError when the plan has none."""
-        for x in self.landings:
-            if (x.part_name, x.name) == (part, landing) or (landing is None and x.label == part):
-                return x
+        found = [k for k in (self._by_name.get((part, landing)),) if k is not None]
+        if landing is None and part in self._by_label:
+            found.append(self._by_label[part])
+        if found:
+            return self.landings[min(found)]
         shown = part if landing is None else f"{part}/{landing}"
         raise InputError(f"the plan has no landing {shown!r}")
 

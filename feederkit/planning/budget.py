@@ -52,7 +52,10 @@ class Deadline:
     ``seconds`` counts from now, or ``end`` gives the :func:`time.perf_counter` instant
     itself (shares of one budget keep its start). ``memory_base`` is what the process held
     when the budget began (read now unless given): shares of the memory are shares of the
-    growth from it to the limit.
+    growth from it to the limit. ``per_node_s`` is what the caller needs after the planner
+    per plan node it is handed (writing and verifying the plan file): a planner that makes
+    a node says so (:meth:`commit`) and its deadline comes that much earlier, so a large plan
+    leaves time for its own file.
     """
 
     def __init__(
@@ -63,8 +66,10 @@ class Deadline:
         end: float | None = None,
         start: float | None = None,
         memory_base: float | None = None,
+        per_node_s: float = 0.0,
     ) -> None:
         now = time.perf_counter()
+        self.per_node_s = per_node_s
         self.start = now if start is None else start
         self.end = end if end is not None or seconds is None else now + seconds
         self.memory_mb = memory_mb
@@ -102,6 +107,12 @@ class Deadline:
             return True
         return False
 
+    def commit(self, nodes: int) -> None:
+        """A planner has made ``nodes`` more plan nodes: the deadline moves ``per_node_s``
+        earlier for each (nothing without a deadline or a cost per node)."""
+        if self.end is not None and self.per_node_s:
+            self.end -= nodes * self.per_node_s
+
     def remaining(self) -> float | None:
         """Seconds left (never negative; None: no deadline)."""
         if self.end is None:
@@ -117,7 +128,13 @@ class Deadline:
         if self.memory_mb is not None and self.memory_base is not None:
             base = self.memory_base
             memory = base + memory_share * (self.memory_mb - base)
-        return Deadline(memory_mb=memory, end=end, start=self.start, memory_base=base)
+        return Deadline(
+            memory_mb=memory,
+            end=end,
+            start=self.start,
+            memory_base=base,
+            per_node_s=self.per_node_s,
+        )
 
     def ending(self, end: float | None) -> Deadline:
         """This budget's memory limit with the deadline ``end`` (a :func:`time.perf_counter`
@@ -127,6 +144,7 @@ class Deadline:
             end=self.end if end is None else end,
             start=self.start,
             memory_base=self.memory_base,
+            per_node_s=self.per_node_s,
         )
 
 
@@ -164,10 +182,17 @@ class Checkpoint(Deadline):
             end=first,
             start=outer.start,
             memory_base=outer.memory_base,
+            per_node_s=outer.per_node_s,
         )
         self.later = end
         self.on_course = on_course
         self.handed_over = False
+
+    def commit(self, nodes: int) -> None:
+        """:meth:`Deadline.commit`, for the later end too."""
+        super().commit(nodes)
+        if self.later is not None:
+            self.later -= nodes * self.per_node_s
 
     def go_on(self) -> None:
         """The end is ``end`` from now on (no question asked at ``first``)."""
@@ -213,6 +238,7 @@ class WorkBudget(Deadline):
             end=outer.end,
             start=outer.start,
             memory_base=outer.memory_base,
+            per_node_s=outer.per_node_s,
         )
         self.allowance = polls
 

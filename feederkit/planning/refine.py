@@ -134,6 +134,9 @@ class Refiner:
         self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
         self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
         self._one: dict[tuple[int, float], tuple[Value, Act | None]] = {}
+        self._nodes: dict[tuple[object, ...], Step] = {}
+        """The distinct steps :meth:`build` made, by action and branches (children that are
+        steps by identity: they are distinct already)."""
 
     def seconds(self, act: Act) -> float:
         """Seconds of the operation ``act`` (0 without action costs)."""
@@ -521,8 +524,11 @@ class Refiner:
     ) -> Step | Leaf:
         """The subtree orienting ``mask`` in at most ``k`` operations, actions from ``chooser``.
 
-        ``shared`` (for a chooser that ignores the masses): one node per set and budget,
-        so equal subtrees are stored once (a DAG in memory)."""
+        ``shared`` (for a chooser that ignores the masses): one node per set and budget.
+        Either way equal subtrees are one object (a DAG in memory: a chooser that reads the
+        masses makes the same subtree on many paths), and each new node's branches are
+        committed to the deadline (:meth:`~feederkit.planning.budget.Deadline.commit`):
+        the plan file holds a node per branch of each distinct step."""
         if self.p.is_goal(mask):
             return Leaf(mask)
         if shared is not None:
@@ -540,7 +546,11 @@ class Refiner:
                 (b, self.build(b.mask, ms, k - 1, chooser, shared))
                 for b, _pb, ms in child_masses(self.p, mask, masses, act)
             ]
-        node = Step(act.action, tuple(subs))
+        key = (act.action, tuple((b, c if isinstance(c, Leaf) else id(c)) for b, c in subs))
+        node = self._nodes.get(key)
+        if node is None:
+            node = self._nodes[key] = Step(act.action, tuple(subs))
+            self.deadline.commit(len(subs))
         if shared is not None:
             shared[(mask, k)] = node
         return node

@@ -537,6 +537,11 @@ def plan_to_dict(
     return out
 
 
+_ONE_LINE = json.JSONEncoder(allow_nan=False)
+"""The encoder of one-line values, made once: ``json.dumps`` with an option makes a new one
+per call, which dominated writing a plan of tens of thousands of results."""
+
+
 def _one_line(value: object) -> str | None:
     """The text of a value written on one line, or None when it is spread over lines.
 
@@ -546,13 +551,13 @@ def _one_line(value: object) -> str | None:
     if isinstance(value, dict):
         plain = all(not isinstance(v, dict | list) for v in value.values())
         if (plain and len(value) <= 4) or not value:
-            return json.dumps(value, allow_nan=False)
+            return _ONE_LINE.encode(value)
         return None
     if isinstance(value, list | tuple):
         if not value or all(not isinstance(v, dict | list | tuple) for v in value):
-            return json.dumps(value, allow_nan=False)
+            return _ONE_LINE.encode(value)
         return None
-    return json.dumps(value, allow_nan=False)
+    return _ONE_LINE.encode(value)
 
 
 def plan_json(plan: Plan | Mapping[str, Any]) -> str:
@@ -809,16 +814,24 @@ Member = tuple[str, str | None]
 """A plan member as results name it: (part name, landing)."""
 
 
-def _check_leaf(
-    c: _Checker, node: dict[str, Any], where: str, parts: Mapping[Member, PlanPart]
-) -> Leaf:
+class _Members:
+    """The plan's members as a leaf check asks them, made once per plan: the part names and
+    each member's state ids (a large mix's plan has tens of thousands of result entries)."""
+
+    def __init__(self, parts: Mapping[Member, PlanPart]) -> None:
+        self.parts = parts
+        self.names = {name for name, _ in parts}
+        self.ids = {key: {s.id for s in p.states} for key, p in parts.items()}
+
+
+def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) -> Leaf:
     entries = c.lst(node["result"], f"{where} result")
     if not entries:
         raise c.fail(f"{where} has an empty result")
     reject = node.get("reject", False)
     if not isinstance(reject, bool):
         raise c.fail(f"{where} 'reject' must be true or false, got {_shown(reject)}")
-    names = {name for name, _ in parts}
+    parts, names = known.parts, known.names
     out = []
     for e in entries:
         ed = c.obj(e, f"{where} result entry")
@@ -837,7 +850,7 @@ def _check_leaf(
                 f"landing {listed}"
             )
         sid = c.int_(c.key(ed, "state", f"{where} result entry"), f"{where} result state")
-        if all(s.id != sid for s in member.states):
+        if sid not in known.ids[(part, landing)]:
             raise c.fail(f"{where} names state {sid}, which part {member.label!r} does not list")
         pose = c.num(c.key(ed, "pose_deg", f"{where} result entry"), f"{where} result pose_deg")
         out.append(ResultEntry(part, sid, pose, landing))
@@ -899,6 +912,7 @@ def _check_tree(
     node) must be at most ``max_depth``; every table entry must be used.
     """
     graph = _Graph(c, table)
+    known = _Members(parts)
     if isinstance(root, dict) and "ref" in root:
         raise c.fail("the root is written in place, not as a reference")
     on_path: set[int] = set()
@@ -922,7 +936,7 @@ def _check_tree(
                     raise c.fail(
                         "the root must be an operation (the first alignment), not a result"
                     )
-                built[key], below[key] = _check_leaf(c, node, where, parts), 0
+                built[key], below[key] = _check_leaf(c, node, where, known), 0
                 continue
             action, margin, branches = _check_step_fields(c, node, where, depth, sensorless)
             resolved = []

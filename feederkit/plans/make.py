@@ -38,7 +38,7 @@ from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Certificate, PlanResult
-from feederkit.plans.fileformat import plan_to_dict
+from feederkit.plans.fileformat import plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.strong import (
     ideal_view,
@@ -156,9 +156,10 @@ def _make_plan(
         report = verify_strong(data)
     notes: list[str] = []
     if certify:
-        cert, cut = _certificate(data, unc, opts, started)
+        output_s = _output_s(data)
+        cert, cut = _certificate(data, unc, opts, started, output_s)
         if not unc.is_ideal:
-            cert = replace(cert, ideal_length=_ideal_length(ideal, opts, started))
+            cert = replace(cert, ideal_length=_ideal_length(ideal, opts, started, output_s))
         else:
             cert = replace(cert, ideal_length=result.length)
         data["stats"]["certificate"] = cert.to_dict()
@@ -203,7 +204,19 @@ POST_MAX_SHARE = 0.25
 
 OUTPUT_SHARE = 0.05
 """With a time limit, the share of it the certificate (whose ideal length may take all the
-time left) leaves to the caller for writing and showing the plan."""
+time left) leaves to the caller for writing and showing the plan, besides
+``OUTPUT_S_PER_NODE`` per node of the plan file."""
+
+POST_S_PER_NODE = 1.5e-4
+"""Seconds per node of the plan file (a distinct step, and each result in place) of the work
+after the planner: the file, its verification and the command's output. The planner's
+deadline comes this much earlier per node it makes (``Deadline.per_node_s``), so a large
+plan leaves time for its own file. Measured: 5.3 s for the 44,000 nodes of a 100-part mix's
+plan (1.2e-4 s per node; ``benchmarks/bench_command_deadline.py``)."""
+
+OUTPUT_S_PER_NODE = 7e-5
+"""Of ``POST_S_PER_NODE``, what comes after the certificate: writing the file, reading it
+back and drawing it (2.5 s of the 5.3 s above)."""
 
 
 def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
@@ -215,22 +228,31 @@ def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> 
         return Deadline(None, options.memory_limit_mb)
     left = _left(options, started) or 0.0
     keep = max(POST_SHARE * limit, min(POST_MIN_S, POST_MAX_SHARE * limit)) if certify else 0.0
-    return Deadline(max(left - keep, 0.1 * limit), options.memory_limit_mb)
+    return Deadline(
+        max(left - keep, 0.1 * limit),
+        options.memory_limit_mb,
+        per_node_s=POST_S_PER_NODE if certify else 0.0,
+    )
 
 
 def _certificate(
-    data: dict[str, Any], declared: Uncertainty, options: PlanningOptions, started: float
+    data: dict[str, Any],
+    declared: Uncertainty,
+    options: PlanningOptions,
+    started: float,
+    output_s: float = 0.0,
 ) -> tuple[Certificate, list[str]]:
     """The plan's largest rotation error and shape tolerance (the certificate without its
-    ideal length), each within what is left of the time limit; one that runs out states the
-    declared value, which the verification proved. Also the names of those cut short."""
+    ideal length), each within what is left of the time limit less ``output_s`` seconds (for
+    writing and showing the plan); one that runs out states the declared value, which the
+    verification proved. Also the names of those cut short."""
     cut: list[str] = []
     figures: list[float] = []
     for name, figure, given in (
         ("rotation", max_rotation_error_deg, declared.rotation_error_deg),
         ("shape", max_shape_tolerance_mm, declared.shape_tolerance_mm),
     ):
-        left = _left(options, started, OUTPUT_SHARE)
+        left = _left(options, started, OUTPUT_SHARE, output_s)
         try:
             figures.append(
                 figure(data, deadline=None if left is None else Deadline(max(left, 0.0)))
@@ -269,19 +291,30 @@ def _lump_shapes(
     return words
 
 
-def _left(options: PlanningOptions, started: float, keep: float = 0.0) -> float | None:
+def _left(
+    options: PlanningOptions, started: float, keep: float = 0.0, keep_s: float = 0.0
+) -> float | None:
     """Seconds left of the options' time limit since ``started``, less ``keep`` of the limit
-    (None: no limit)."""
+    and ``keep_s`` seconds (None: no limit)."""
     if options.time_limit_s is None:
         return None
-    return (1.0 - keep) * options.time_limit_s - (time.monotonic() - started)
+    return (1.0 - keep) * options.time_limit_s - keep_s - (time.monotonic() - started)
 
 
-def _ideal_length(ideal: PushAlignMachine, options: PlanningOptions, started: float) -> int | None:
+def _output_s(data: dict[str, Any]) -> float:
+    """Seconds the caller needs to write and show the plan file's object ``data``:
+    ``OUTPUT_S_PER_NODE`` per node (each shared step once, each result in place)."""
+    return OUTPUT_S_PER_NODE * (len(data.get("nodes") or {}) + sum(1 for _ in result_nodes(data)))
+
+
+def _ideal_length(
+    ideal: PushAlignMachine, options: PlanningOptions, started: float, output_s: float = 0.0
+) -> int | None:
     """The optimal length on the ideal model (the certificate's ``ideal_length``), within
-    what is left of the time limit less ``OUTPUT_SHARE`` of it; None when no time is left,
-    or when the ideal model cannot meet the options (e.g. a margin floor it cannot keep)."""
-    left = _left(options, started, OUTPUT_SHARE)
+    what is left of the time limit less ``OUTPUT_SHARE`` of it and ``output_s`` seconds; None
+    when no time is left, or when the ideal model cannot meet the options (e.g. a margin
+    floor it cannot keep)."""
+    left = _left(options, started, OUTPUT_SHARE, output_s)
     if left is not None and left <= 0.0:
         return None
     opts = options if left is None else replace(options, time_limit_s=left)
