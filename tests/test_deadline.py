@@ -29,7 +29,8 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
-from feederkit.plans.make import POST_S_PER_NODE, _planner_budget
+from feederkit.planning.stats import node_states
+from feederkit.plans.make import POST_S_PER_PAIR, _planner_budget
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -93,25 +94,35 @@ def test_a_share_keeps_the_start_of_the_budget():
 def test_committed_nodes_bring_every_share_of_a_budget_forward():
     # The caller's work per plan node (the file, its verification) comes out of the
     # planner's time: each share, checkpoint and work budget carries the cost per node.
-    d = Deadline(10.0, per_node_s=0.01)
+    d = Deadline(10.0, per_pair_s=0.01)
     end = d.end
     d.commit(100)
     assert d.end == pytest.approx(end - 1.0, abs=1e-9)
     share = d.until(0.5)
-    assert share.per_node_s == 0.01
+    assert share.per_pair_s == 0.01
     checkpoint = Checkpoint(share, time.perf_counter() + 1.0, share.end)
     assert isinstance(checkpoint.later, float)
     later = checkpoint.later
     checkpoint.commit(50)
     assert checkpoint.later == pytest.approx(later - 0.5, abs=1e-9)
     work = WorkBudget(checkpoint, 10)
-    assert work.per_node_s == 0.01 and d.ending(None).per_node_s == 0.01
+    assert work.per_pair_s == 0.01 and d.ending(None).per_pair_s == 0.01
+    # A grace: the first seconds of committed pairs are free, on the copy only.
+    graced = Deadline(10.0, per_pair_s=1.0)
+    copy = graced.with_grace(3.0)
+    end = copy.end
+    copy.commit(2)
+    assert copy.end == end and copy.grace_s == pytest.approx(1.0)
+    copy.commit(2)
+    assert copy.end == pytest.approx(end - 1.0, abs=1e-9) and graced.end == end
+    with pytest.raises(Timeout):
+        copy.commit(20)  # past its end now
     # Without a cost per node, or without a deadline, nothing moves.
     free = Deadline(10.0)
     end = free.end
     free.commit(10**6)
     assert free.end == end
-    unlimited = Deadline(per_node_s=1.0)
+    unlimited = Deadline(per_pair_s=1.0)
     unlimited.commit(10)
     assert unlimited.end is None
 
@@ -284,9 +295,9 @@ def test_the_tree_of_a_proven_length_polls_its_deadline():
 def test_the_tree_build_shares_equal_subtrees_and_commits_each_distinct_node():
     # The expected-operations chooser reads the masses, so the same subtree is chosen again
     # on many paths: it is built as one object, and the deadline is told of each distinct
-    # step's branches once (what the plan file will hold).
+    # step's (node, state) pairs once (what verifying the plan walks).
     machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
-    budget = Deadline(3600.0, per_node_s=1e-6)
+    budget = Deadline(3600.0, per_pair_s=1e-6)
     refiner, children, k = _proven_refiner(machine, budget)
     refiner.floor = -math.inf
     end = budget.end
@@ -307,16 +318,18 @@ def test_the_tree_build_shares_equal_subtrees_and_commits_each_distinct_node():
         for n in steps.values()
     ]
     assert len(set(keys)) == len(keys)  # no two distinct objects for one subtree
-    branches = sum(len(n.branches) for n in steps.values())
-    assert branches > 0
-    assert end - budget.end == pytest.approx(branches * 1e-6, rel=1e-6)
+    pairs = sum(b.mask.bit_count() for n in steps.values() for b, _c in n.branches)
+    assert pairs > 0
+    assert end - budget.end == pytest.approx(pairs * 1e-6, rel=1e-6)
 
 
-def test_a_plan_too_large_for_its_file_time_gives_way_to_a_smaller_one(monkeypatch):
-    # A cost per node so high that the tie-broken tree cannot be written in the time left:
-    # plan() answers with a smaller tree of the proven length, sooner.
+def test_a_plan_too_large_to_verify_in_time_gives_way_to_a_smaller_one(monkeypatch):
+    # A cost per (node, state) pair so high that the tie-broken tree (318 pairs) cannot be
+    # verified in the time left: plan() answers with a smaller tree of the proven length
+    # (the fallback's, 235 pairs), sooner; higher still, with none.
     machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
     full = plan(machine, PlanningOptions())
+    assert node_states(full.root) == 318
     calls: list[str] = []
     real = api._build
 
@@ -325,14 +338,36 @@ def test_a_plan_too_large_for_its_file_time_gives_way_to_a_smaller_one(monkeypat
         return real(refiner, children, horizon, tie)
 
     monkeypatch.setattr(api, "_build", build)
-    budget = Deadline(30.0, per_node_s=2.0)
+    budget = Deadline(30.0, per_pair_s=0.1)
     start = time.perf_counter()
     small = plan(machine, PlanningOptions(time_limit_s=30.0), budget=budget)
     assert time.perf_counter() - start < 10.0
     assert calls and calls[0] == "expected"  # tried, ran out on its own size
     assert full.tie_breaks == "exact" and small.tie_breaks != "exact"
     assert small.length == full.length
+    assert node_states(small.root) * 0.1 < 30.0 < node_states(full.root) * 0.1
     check_plan(small)
+    with pytest.raises(PlanningError, match="no plan found within the time limit"):
+        plan(machine, PlanningOptions(time_limit_s=30.0), budget=Deadline(30.0, per_pair_s=1.0))
+    assert time.perf_counter() - start < 20.0
+
+
+def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
+    # The plan in hand's verification comes out of the fallback's time; a plan that
+    # replaces it commits only the difference, and none gives everything back.
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    full = plan(machine, PlanningOptions())
+    budget = Deadline(3600.0, per_pair_s=0.01)
+    end = budget.end
+    held = api._Held(budget)
+    held.hold(full.root)
+    assert end - budget.end == pytest.approx(0.01 * node_states(full.root), abs=1e-9)
+    one = full.root.branches[0][1]
+    smaller = api.Step(None, ((full.root.branches[0][0], one),))
+    held.hold(smaller)
+    assert end - budget.end == pytest.approx(0.01 * node_states(smaller), abs=1e-9)
+    held.hold(None)
+    assert budget.end == pytest.approx(end, abs=1e-9)
 
 
 # --- plan() answers within its limits ---------------------------------------------------
@@ -695,12 +730,12 @@ def test_the_goal_fixpoint_of_a_plan_serves_the_machine_it_was_asked_of():
 
 @pytest.mark.parametrize(
     ("limit", "certify", "planner_s"),
-    [(60.0, True, 51.0), (10.0, True, 7.5), (4.0, True, 3.0), (10.0, False, 10.0)],
+    [(60.0, True, 51.0), (10.0, True, 8.5), (4.0, True, 3.0), (10.0, False, 10.0)],
 )
 def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, certify, planner_s):
-    # 15 % of the limit, or 2.5 s where that is more, up to a quarter of the limit.
+    # 15 % of the limit, or 1.5 s where that is more, up to a quarter of the limit.
     budget = _planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify)
     assert budget.end is not None
     assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)
     # Certified, the plan's own size counts too: its file and verification per node.
-    assert budget.per_node_s == (POST_S_PER_NODE if certify else 0.0)
+    assert budget.per_pair_s == (POST_S_PER_PAIR if certify else 0.0)

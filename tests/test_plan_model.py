@@ -243,3 +243,20 @@ def test_held_by_is_every_branch_whose_closed_interval_holds_the_reading(count):
     readings = [*ends, *(rng.uniform(-5.0, 55.0) for _ in range(200)), None]
     for r in readings:
         assert step.held_by(r) == tuple(k for k, b in enumerate(branches) if b.holds(r))
+
+
+@pytest.mark.parametrize("count", [3, 8, 40])
+def test_meeting_is_every_branch_whose_interval_meets_the_readings(count):
+    # The branches a state whose readings lie in [lo, hi] may follow: by arrays for many
+    # branches, one at a time for few, the same indices as the closed-interval test.
+    rng = random.Random(100 + count)
+    ends = sorted(round(rng.uniform(0.0, 50.0), 1) for _ in range(count + 1))
+    spans = [(ends[k], ends[min(k + rng.randint(1, 2), count)]) for k in range(count)]
+    branches = tuple(
+        Branch(span, Leaf((ResultEntry("p", k, 0.0),))) for k, span in enumerate(spans)
+    )
+    step = Step(10.0, 1.0, branches)
+    for _ in range(200):
+        a, b = sorted(rng.choice([*ends, rng.uniform(-5.0, 55.0)]) for _ in range(2))
+        want = tuple(k for k, (x, y) in enumerate(spans) if x <= b and a <= y)
+        assert step.meeting(a, b) == want

@@ -46,9 +46,14 @@ from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.solvable import decide, unsolvable, unsolvable_by_pairs
-from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
+from feederkit.planning.stats import (
+    expected_operations,
+    node_states,
+    tree_length,
+    tree_min_margin,
+)
 from feederkit.planning.subsets import subset_lower_bound
-from feederkit.planning.tree import Leaf, PlanResult, Step, build_dag
+from feederkit.planning.tree import Leaf, PlanResult, Step, build_dag, root_step
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -449,8 +454,9 @@ def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
 
     # The first allowed action depends on the set and the budget only: share equal subtrees.
     shared: dict | None = {} if tie == "first" else None
+    refiner.new_tree()
     subs = [(b, refiner.build(b.mask, ms, horizon, chooser, shared)) for b, _pb, ms in children]
-    return Step(None, tuple(subs))
+    return root_step(subs, refiner.deadline)
 
 
 def _check_margin(
@@ -494,7 +500,7 @@ statistics and renumbering walk that tree once more after them (the 50-part mix 
 under 1 degree: the answer 2.6-4.5 s past a 60 s limit without this; 1.5 left the 20-part
 mix at 5 % under 10 s no time for the subsets' bound)."""
 
-PAIRWISE_SHARE = 0.3
+PAIRWISE_SHARE = 0.7
 """With a time limit and no plan in hand, the share of what is left that the plan telling
 the states apart one pair at a time may take (the ideal model only)."""
 
@@ -502,6 +508,12 @@ FIRST_PLAN_RESERVE = 2.0
 """With no plan in hand, the widening beams look for a first one until this many tree
 reserves (``TREE_RESERVE``) before the limit, past their ``BEAM_SHARE``; shorter ones only
 within it."""
+
+FIRST_PLAN_GRACE_S = 1.5
+"""With no plan in hand, the first this many seconds of the first plan's verification are
+not committed to the budget (:meth:`~feederkit.planning.budget.Deadline.with_grace`): a plan
+a little late beats none (the command then answers at most this much past its limit); one
+later still is dropped like one too slow to find."""
 
 
 def _fallback(
@@ -538,12 +550,14 @@ def _fallback(
         problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
         del worst
         gc.collect()
+    # Each plan below is built under a copy of the budget (its nodes' verification
+    # committed there while it is built) and held, once made, by ``held`` on the budget.
     try:  # the backchaining plan itself first: one chain, one step per operation
-        blind = _sensorless_plan(problem, root_branches, budget, by_image=True)
+        blind = _sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
     except Timeout:
         blind = None
     rest = budget.remaining()
-    share = budget
+    share = budget.ending(None)
     if rest is not None and not problem.sensorless:
         # With readings its tree can be large: keep most of the rest for the search.
         share = budget.ending(budget.end - rest * (1.0 - READ_SHARE))
@@ -554,18 +568,23 @@ def _fallback(
             read = None
         if read is not None and tree_length(read) < tree_length(blind):
             blind = read
+    held = _Held(budget)  # the plan in hand's verification comes out of the time left
+    held.hold(blind)
     if blind is None and pairwise_applies(problem):
         # On the ideal model a plan always exists: the pairs told apart one at a time
         # (feederkit.planning.pairwise), within PAIRWISE_SHARE of what is left; the searches
         # below then look for something shorter.
         rest = budget.remaining()
-        share = budget if rest is None else budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE))
+        share = budget
+        if rest is not None:
+            share = _graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)), None)
         try:
             told = pairwise_plan(problem, root_branches, share)
         except Timeout:
             told = None
         if told is not None and tree_length(told) <= FALLBACK_MAX_OPERATIONS:
             blind = told
+            held.hold(blind)
     anytime = WorstCase(problem, budget)
     if stop != "memory" and type(worst) is WorstCase:
         # What the exact search proved stays true (its exact lengths are left out: they
@@ -579,9 +598,7 @@ def _fallback(
     # A plan in hand needs time for its tree and statistics: the searches below stop a
     # reserve of the limit before it.
     reserve = 0.0 if budget.end is None else TREE_RESERVE * (budget.end - budget.start)
-    tree_budget = budget  # where a tree must be built by once a plan is in hand
-    if budget.end is not None:
-        tree_budget = budget.ending(budget.end - reserve / 2.0)
+    gap = reserve / 2.0  # the tree of a plan found must be built by this long before the end
     rest = budget.remaining()
     # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
     # BEAM_SHARE of what is left; what they find is where the search below starts.
@@ -607,13 +624,14 @@ def _fallback(
         # though its statistics may then run past the limit by one walk of the tree.
         built = time.perf_counter()
         with contextlib.suppress(Timeout):
-            blind = _choice_plan(problem, search.choice, roots, root_branches, budget)
+            blind = _choice_plan(
+                problem, search.choice, roots, root_branches, _graced(budget, blind)
+            )
+            held.hold(blind)
             # Its statistics and renumbering after the searches below cost up to about as
             # much as building it: they stop WALK_SHARE of that before the limit, when more
             # than the reserve's half.
-            walk = WALK_SHARE * (time.perf_counter() - built)
-            if budget.end is not None and walk > reserve / 2.0:
-                tree_budget = budget.ending(budget.end - walk)
+            gap = max(gap, WALK_SHARE * (time.perf_counter() - built))
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
@@ -629,6 +647,9 @@ def _fallback(
             bad = None
         if bad:
             raise _no_strong_plan(problem.machine)
+    # Where a tree must be built by once a plan is in hand; read after the plan in hand's
+    # pairs are committed (``held``), which brought the budget's end forward.
+    tree_budget = budget if budget.end is None else budget.ending(budget.end - gap)
     if blind is not None and budget.end is not None:
         # The bound, from the hardest subsets of the roots (feederkit.planning.subsets), up to
         # half the reserve (no tree to build, only the statistics of the plan in hand): a
@@ -670,9 +691,16 @@ def _fallback(
                 break
     root = None
     if found is not None:
+        # The shorter plan replaces the one in hand: only its own pairs count.
+        held.hold(None)
+        if budget.end is not None and blind is not None:
+            tree_budget = budget.ending(budget.end - gap)
         anytime.deadline = tree_budget
         try:
-            root = _choice_plan(problem, anytime.choice, roots, root_branches, tree_budget)
+            root = _choice_plan(
+                problem, anytime.choice, roots, root_branches, _graced(tree_budget, blind)
+            )
+            held.hold(root)
         except Timeout as exc:
             last = exc.reason
     if root is None:
@@ -684,6 +712,28 @@ def _fallback(
             f"(a plan needs at least {plural(lower, 'operation')})"
         )
     return root, False, None, lower, TIES_NONE
+
+
+def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
+    """A copy of ``budget`` to build a plan under; with no plan ``in_hand``, the first
+    ``FIRST_PLAN_GRACE_S`` of its verification free (a plan a little late beats none)."""
+    return budget.with_grace(0.0 if in_hand is not None else FIRST_PLAN_GRACE_S)
+
+
+class _Held:
+    """The (node, state) pairs of the plan in hand, committed to the fallback's budget
+    (:meth:`~feederkit.planning.budget.Deadline.commit`): its verification and file come out
+    of the time left, and a plan that replaces it gives its pairs back."""
+
+    def __init__(self, budget: Deadline) -> None:
+        self.budget = budget
+        self.pairs = 0
+
+    def hold(self, root: Step | None) -> None:
+        """``root`` is the plan in hand now (None: none)."""
+        pairs = 0 if root is None else node_states(root)
+        self.budget.commit(pairs - self.pairs)
+        self.pairs = pairs
 
 
 def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:
@@ -723,7 +773,7 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
 
     top = [(b, witness_of(b.mask, roots)) for b in root_branches]
     made = build_dag([k for _b, k in top], expand, deadline)
-    return Step(None, tuple((b, made[k]) for b, k in top))
+    return root_step(((b, made[k]) for b, k in top), deadline)
 
 
 def _sensorless_plan(
@@ -764,7 +814,7 @@ def _sensorless_plan(
     else:
         keys = {b.mask: b.mask for b in root_branches}
     made = build_dag(list(keys.values()), expand, deadline)
-    return Step(None, tuple((b, made[keys[b.mask]]) for b in root_branches))
+    return root_step(((b, made[keys[b.mask]]) for b in root_branches), deadline)
 
 
 def _proven(worst: WorstCase, mask: int) -> int:

@@ -52,10 +52,11 @@ class Deadline:
     ``seconds`` counts from now, or ``end`` gives the :func:`time.perf_counter` instant
     itself (shares of one budget keep its start). ``memory_base`` is what the process held
     when the budget began (read now unless given): shares of the memory are shares of the
-    growth from it to the limit. ``per_node_s`` is what the caller needs after the planner
-    per plan node it is handed (writing and verifying the plan file): a planner that makes
-    a node says so (:meth:`commit`) and its deadline comes that much earlier, so a large plan
-    leaves time for its own file.
+    growth from it to the limit. ``per_pair_s`` is what the caller needs after the planner
+    per (node, state) pair of the plan it is handed, a state that can reach a node
+    (verifying the plan walks each pair once; writing it grows with them): a planner that
+    makes nodes says how many pairs (:meth:`commit`) and its deadline comes that much
+    earlier, so a large plan leaves time for its own verification and file.
     """
 
     def __init__(
@@ -66,10 +67,12 @@ class Deadline:
         end: float | None = None,
         start: float | None = None,
         memory_base: float | None = None,
-        per_node_s: float = 0.0,
+        per_pair_s: float = 0.0,
+        grace_s: float = 0.0,
     ) -> None:
         now = time.perf_counter()
-        self.per_node_s = per_node_s
+        self.per_pair_s = per_pair_s
+        self.grace_s = grace_s
         self.start = now if start is None else start
         self.end = end if end is not None or seconds is None else now + seconds
         self.memory_mb = memory_mb
@@ -107,11 +110,28 @@ class Deadline:
             return True
         return False
 
-    def commit(self, nodes: int) -> None:
-        """A planner has made ``nodes`` more plan nodes: the deadline moves ``per_node_s``
-        earlier for each (nothing without a deadline or a cost per node)."""
-        if self.end is not None and self.per_node_s:
-            self.end -= nodes * self.per_node_s
+    def commit(self, pairs: int) -> None:
+        """A planner has made plan nodes with ``pairs`` more (node, state) pairs (fewer when
+        negative: a plan it no longer holds): the deadline moves ``per_pair_s`` earlier for
+        each (nothing without a deadline or a cost), past the first ``grace_s`` seconds of
+        them, and Timeout is raised when that end has passed (a tree's last nodes need no
+        poll after them to stop it)."""
+        if self.end is not None and self.per_pair_s:
+            cost = pairs * self.per_pair_s
+            if cost > 0.0 and self.grace_s > 0.0:
+                free = min(cost, self.grace_s)
+                self.grace_s -= free
+                cost -= free
+            self.end -= cost
+            if pairs > 0 and time.perf_counter() > self.end:
+                raise Timeout("time")
+
+    def with_grace(self, seconds: float) -> Deadline:
+        """A copy of this budget whose first ``seconds`` of committed pairs are free: a plan
+        built under it may be verified that much past the end (:meth:`commit`)."""
+        out = self.ending(None)
+        out.grace_s = seconds
+        return out
 
     def remaining(self) -> float | None:
         """Seconds left (never negative; None: no deadline)."""
@@ -133,7 +153,7 @@ class Deadline:
             end=end,
             start=self.start,
             memory_base=base,
-            per_node_s=self.per_node_s,
+            per_pair_s=self.per_pair_s,
         )
 
     def ending(self, end: float | None) -> Deadline:
@@ -144,7 +164,7 @@ class Deadline:
             end=self.end if end is None else end,
             start=self.start,
             memory_base=self.memory_base,
-            per_node_s=self.per_node_s,
+            per_pair_s=self.per_pair_s,
         )
 
 
@@ -182,17 +202,19 @@ class Checkpoint(Deadline):
             end=first,
             start=outer.start,
             memory_base=outer.memory_base,
-            per_node_s=outer.per_node_s,
+            per_pair_s=outer.per_pair_s,
         )
         self.later = end
         self.on_course = on_course
         self.handed_over = False
 
-    def commit(self, nodes: int) -> None:
-        """:meth:`Deadline.commit`, for the later end too."""
-        super().commit(nodes)
+    def commit(self, pairs: int) -> None:
+        """:meth:`Deadline.commit` for both ends; a passed end is left to :meth:`check`,
+        which asks whether the stage is on course."""
+        if self.end is not None and self.per_pair_s:
+            self.end -= pairs * self.per_pair_s
         if self.later is not None:
-            self.later -= nodes * self.per_node_s
+            self.later -= pairs * self.per_pair_s
 
     def go_on(self) -> None:
         """The end is ``end`` from now on (no question asked at ``first``)."""
@@ -238,7 +260,7 @@ class WorkBudget(Deadline):
             end=outer.end,
             start=outer.start,
             memory_base=outer.memory_base,
-            per_node_s=outer.per_node_s,
+            per_pair_s=outer.per_pair_s,
         )
         self.allowance = polls
 

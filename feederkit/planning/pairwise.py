@@ -32,7 +32,7 @@ from feederkit.machine import Grouping, OverlapRange, members
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.budget import Deadline
 from feederkit.planning.problem import Problem
-from feederkit.planning.tree import Leaf, Step, build_dag
+from feederkit.planning.tree import Leaf, Step, build_dag, root_step
 
 PAIR_CANDIDATES = 64
 """A set picks the pair it tracks among at most this many pairs of neighbouring states (by
@@ -168,7 +168,7 @@ def pairwise_plan(problem: Problem, root_branches, deadline: Deadline) -> Step |
         made = build_dag([k for _b, k in top], expand, deadline)
     except _Stuck:
         return None
-    return Step(None, tuple((b, made[k]) for b, k in top))
+    return root_step(((b, made[k]) for b, k in top), deadline)
 
 
 class _Stuck(Exception):

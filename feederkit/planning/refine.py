@@ -50,7 +50,7 @@ from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.choices import spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
-from feederkit.planning.tree import Leaf, Step
+from feederkit.planning.tree import Leaf, Step, branch_pairs
 
 EXPECTED_HORIZON = 2
 """``objective="expected"`` searches plans of at most this many times the minimum length."""
@@ -514,6 +514,11 @@ class Refiner:
                 return act
         raise AssertionError("no feasible action within the proven length")
 
+    def new_tree(self) -> None:
+        """Forget the steps :meth:`build` made: the next tree commits each of its own
+        distinct steps to the deadline it is built under (one tree per deadline)."""
+        self._nodes = {}
+
     def build(
         self,
         mask: int,
@@ -527,8 +532,8 @@ class Refiner:
         ``shared`` (for a chooser that ignores the masses): one node per set and budget.
         Either way equal subtrees are one object (a DAG in memory: a chooser that reads the
         masses makes the same subtree on many paths), and each new node's branches are
-        committed to the deadline (:meth:`~feederkit.planning.budget.Deadline.commit`):
-        the plan file holds a node per branch of each distinct step."""
+        committed to the deadline (:meth:`~feederkit.planning.budget.Deadline.commit`): its
+        verification walks each (node, state) pair of each distinct step once."""
         if self.p.is_goal(mask):
             return Leaf(mask)
         if shared is not None:
@@ -550,7 +555,7 @@ class Refiner:
         node = self._nodes.get(key)
         if node is None:
             node = self._nodes[key] = Step(act.action, tuple(subs))
-            self.deadline.commit(len(subs))
+            self.deadline.commit(branch_pairs(subs))
         if shared is not None:
             shared[(mask, k)] = node
         return node

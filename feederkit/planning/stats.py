@@ -30,6 +30,30 @@ def tree_length(node: PlanTree, _memo: dict[int, int] | None = None) -> int:
     return hit
 
 
+def node_states(root: PlanTree) -> int:
+    """How many (node, state) pairs a plan has: over its distinct steps, the states of each
+    branch (those that can reach the node below it). Verifying a plan walks each pair once,
+    so this measures the work after the planner (``Deadline.commit``); without recursion.
+
+    >>> from feederkit.machine import ReadingBranch
+    >>> leaf = Leaf(0b11)
+    >>> node_states(Step(None, ((ReadingBranch(1.0, 2.0, 0b11), leaf),)))
+    2
+    """
+    seen: set[int] = set()
+    stack: list[PlanTree] = [root]
+    total = 0
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Leaf) or id(node) in seen:
+            continue
+        seen.add(id(node))
+        for b, sub in node.branches:
+            total += b.mask.bit_count()
+            stack.append(sub)
+    return total
+
+
 def tree_min_margin(node: PlanTree, _memo: dict[int, float] | None = None) -> float:
     """Smallest margin of the subtree's actions (inf when it has none)."""
     if isinstance(node, Leaf):

@@ -46,6 +46,21 @@ class Step:
 PlanTree = Step | Leaf
 
 
+def branch_pairs(branches: Iterable[tuple[ReadingBranch, object]]) -> int:
+    """The (node, state) pairs a step's branches add to a plan: the states of each branch,
+    those that can reach the node below it (what verifying the plan walks, and what a
+    planner commits to its deadline: :meth:`~feederkit.planning.budget.Deadline.commit`)."""
+    return sum(b.mask.bit_count() for b, _c in branches)
+
+
+def root_step(branches: Iterable[tuple[ReadingBranch, Step | Leaf]], deadline: Deadline) -> Step:
+    """The plan's root (the first alignment, no rotation) over ``branches``, its pairs
+    committed to ``deadline``."""
+    node = Step(None, tuple(branches))
+    deadline.commit(branch_pairs(node.branches))
+    return node
+
+
 def build_dag(
     keys: Iterable[Hashable],
     expand: Callable[[Hashable], Leaf | tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]],
@@ -56,7 +71,9 @@ def build_dag(
     ``expand(key)`` is a Leaf or a node's action with its (branch, child key) pairs; equal
     keys share one node (the tree is a DAG in memory). The keys must not lead back to
     themselves (each expansion gets closer to a goal), and no depth meets Python's
-    recursion limit.
+    recursion limit. Each step's (node, state) pairs are committed to ``deadline``
+    (:meth:`~feederkit.planning.budget.Deadline.commit`): a plan too large to verify in the
+    time left stops like one too slow to build.
     """
     made: dict[Hashable, Step | Leaf] = {}
     pending: dict[Hashable, tuple[OverlapRange, list[tuple[ReadingBranch, Hashable]]]] = {}
@@ -68,6 +85,7 @@ def build_dag(
         if ready:
             action, subs = pending.pop(key)
             made[key] = Step(action, tuple((b, made[c]) for b, c in subs))
+            deadline.commit(branch_pairs(subs))
             continue
         if key in pending:
             continue

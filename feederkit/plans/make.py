@@ -194,7 +194,7 @@ so the planner gets the rest; ``certify=False`` callers (a design's many plans, 
 own clock) give the planner the whole limit."""
 
 
-POST_MIN_S = 2.5
+POST_MIN_S = 1.5
 """With a time limit, at least this many seconds (up to ``POST_MAX_SHARE`` of the limit) are
 kept after the planner, however short the limit: verifying, certifying and writing a plan
 of 50,000 nodes takes about 3 s, which 15 % of a 10 s limit does not hold."""
@@ -207,16 +207,19 @@ OUTPUT_SHARE = 0.05
 time left) leaves to the caller for writing and showing the plan, besides
 ``OUTPUT_S_PER_NODE`` per node of the plan file."""
 
-POST_S_PER_NODE = 1.5e-4
-"""Seconds per node of the plan file (a distinct step, and each result in place) of the work
-after the planner: the file, its verification and the command's output. The planner's
-deadline comes this much earlier per node it makes (``Deadline.per_node_s``), so a large
-plan leaves time for its own file. Measured: 5.3 s for the 44,000 nodes of a 100-part mix's
-plan (1.2e-4 s per node; ``benchmarks/bench_command_deadline.py``)."""
+POST_S_PER_PAIR = 4e-5
+"""Seconds per (node, state) pair of a plan (a state that can reach a node) of the work after
+the planner: the file, its verification and the command's output. The planner's deadline
+comes this much earlier per pair of the nodes it makes (``Deadline.per_pair_s``), so a large
+plan leaves time for its own verification and file. Measured about 3.2e-5 s on two plans
+(``python benchmarks/bench_command_deadline.py``): a 100-part mix's under 1 degree, 164,000
+pairs in 5.3 s, and a 1000-point outline's over both landings on the ideal model, 265,000
+pairs in 8.5 s."""
 
 OUTPUT_S_PER_NODE = 7e-5
-"""Of ``POST_S_PER_NODE``, what comes after the certificate: writing the file, reading it
-back and drawing it (2.5 s of the 5.3 s above)."""
+"""Seconds per node of the plan file (each shared step once, each result in place) of what
+comes after the certificate: writing the file, reading it back and drawing it (2.5 s for the
+44,000 nodes of the 100-part mix's plan above)."""
 
 
 def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
@@ -231,7 +234,7 @@ def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> 
     return Deadline(
         max(left - keep, 0.1 * limit),
         options.memory_limit_mb,
-        per_node_s=POST_S_PER_NODE if certify else 0.0,
+        per_pair_s=POST_S_PER_PAIR if certify else 0.0,
     )
 
 

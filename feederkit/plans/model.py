@@ -212,15 +212,32 @@ class Step:
         """
         if reading is None or len(self.branches) < _INDEXED_BRANCHES:
             return tuple(k for k, b in enumerate(self.branches) if b.holds(reading))
-        table = self.__dict__.get("_ends")
+        lo, hi = self._ends()
+        return tuple(((lo <= reading) & (reading <= hi)).nonzero()[0].tolist())
+
+    def meeting(self, lo: float, hi: float) -> tuple[int, ...]:
+        """The indices of the branches whose reading interval meets the closed ``[lo, hi]``
+        (a branch without one meets every interval), in order: the only ones a state whose
+        readings lie in ``[lo, hi]`` can follow (``Sensor.branch_reach``)."""
+        if len(self.branches) < _INDEXED_BRANCHES:
+            return tuple(
+                k
+                for k, b in enumerate(self.branches)
+                if b.reading is None or (b.reading[0] <= hi and lo <= b.reading[1])
+            )
+        ends_lo, ends_hi = self._ends()
+        return tuple(((ends_lo <= hi) & (lo <= ends_hi)).nonzero()[0].tolist())
+
+    def _ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """The branches' reading intervals' ends as two arrays (made once per step)."""
+        table = self.__dict__.get("_ends_table")
         if table is None:
             inf = math.inf
             lo = np.array([-inf if b.reading is None else b.reading[0] for b in self.branches])
             hi = np.array([inf if b.reading is None else b.reading[1] for b in self.branches])
             table = (lo, hi)
-            object.__setattr__(self, "_ends", table)
-        lo, hi = table
-        return tuple(((lo <= reading) & (reading <= hi)).nonzero()[0].tolist())
+            object.__setattr__(self, "_ends_table", table)
+        return table
 
     def follow(self, reading: float | None) -> int | None:
         """The first branch that holds ``reading``; None: a foreign part or a sensor fault."""

@@ -231,7 +231,7 @@ class _PartSearch:
         key = (id(node), state.id)
         hit = self.memo.get(key)
         if hit is not None:
-            return replace(hit, worst=number + hit.worst)
+            return _Outcome(hit.paths, number + hit.worst, hit.failure, hit.rejects)
         paths, worst, failure, rejects = 0, number, None, 0
         explored: set[int] = set()
         for reading in candidate_readings(self.sensor, node, self.diameter[state.id]):
@@ -396,10 +396,14 @@ def _branch_probabilities(sensor: Sensor, step: Step, diameter: float) -> list[f
             if k is not None:
                 out[k] += sensor.reading_probability(diameter, r, r)
         return out
-    return [
-        0.0 if b.reading is None else sensor.reading_probability(diameter, *b.reading)
-        for b in step.branches
-    ]
+    out = [0.0] * len(step.branches)
+    reach = sensor.branch_reach(diameter)
+    near = range(len(step.branches)) if reach is None else step.meeting(*reach)
+    for k in near:
+        b = step.branches[k]
+        if b.reading is not None:
+            out[k] = sensor.reading_probability(diameter, *b.reading)
+    return out
 
 
 def expected_operations(plan: Plan) -> float:
