@@ -84,7 +84,11 @@ def size_of(outline: dict) -> float:
 def feederkit() -> list[str]:
     """The command, from this checkout's environment."""
     exe = Path(sys.executable).with_name("feederkit")
-    return [str(exe)] if exe.exists() else [sys.executable, "-m", "feederkit.cli.app"]
+    return (
+        [str(exe)]
+        if exe.exists()
+        else [sys.executable, "-c", "from feederkit.cli.app import run; run()"]
+    )
 
 
 WRAP = r"""

@@ -16,7 +16,6 @@ Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 
 
 from __future__ import annotations
 
-import contextlib
 import gc
 import math
 import time
@@ -623,15 +622,18 @@ def _fallback(
         # Its tree now, under the whole budget: a plan in hand (shorter than blind) beats none,
         # though its statistics may then run past the limit by one walk of the tree.
         built = time.perf_counter()
-        with contextlib.suppress(Timeout):
+        held.hold(None)  # the plan in hand gives way to it: only its own pairs count
+        try:
             blind = _choice_plan(
                 problem, search.choice, roots, root_branches, _graced(budget, blind)
             )
-            held.hold(blind)
             # Its statistics and renumbering after the searches below cost up to about as
             # much as building it: they stop WALK_SHARE of that before the limit, when more
             # than the reserve's half.
             gap = max(gap, WALK_SHARE * (time.perf_counter() - built))
+        except Timeout:
+            pass  # the plan in hand, if any, stays
+        held.hold(blind)
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
