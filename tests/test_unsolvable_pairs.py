@@ -9,11 +9,13 @@ its length search cannot finish.
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from test_strong_plans import random_pf
 
 from feederkit.machine import build_machine
-from feederkit.planning import api
+from feederkit.planning import api, solvable
 from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
@@ -68,3 +70,47 @@ def test_the_planner_says_no_strong_plan_when_its_search_cannot_finish(monkeypat
     with pytest.raises(NoStrongPlan, match="no strong plan exists"):
         plan(machine, options)
     assert not strong_plan_exists(machine, options)
+
+
+def _every_pair_refused(problem: Problem, roots: list[int]) -> bool:
+    """The plain check: some pair inside some root has no strong plan (solve over all)."""
+    pairs = set()
+    for r in roots:
+        idx = [k for k in range(problem.n) if r >> k & 1]
+        for i, a in enumerate(idx):
+            for b in idx[i + 1 :]:
+                pair = (1 << a) | (1 << b)
+                if not problem.is_goal(pair):
+                    pairs.add(pair)
+    value = solvable.solve(problem, sorted(pairs))
+    assert value is not None
+    return any(value[p] == math.inf for p in pairs)
+
+
+@pytest.mark.parametrize("seed", range(12, 24, 2))
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+def test_the_neighbours_first_give_the_verdict_of_every_pair(
+    seed, rotation, tolerance, monkeypatch
+):
+    # The diameter neighbours are asked first; when one of their pairs is refused, the
+    # other pairs are never asked (one solve), else every pair is (a second, larger one).
+    problem = Problem(_two_parts(seed, rotation, tolerance))
+    roots = _roots(problem)
+    want = _every_pair_refused(problem, roots)
+    exact = set(unsolvable(problem, roots))
+    calls: list[int] = []
+    real = solvable.solve
+
+    def counted(*args, **kwargs):
+        calls.append(len(args[1]))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(solvable, "solve", counted)
+    got = unsolvable_by_pairs(problem, roots)
+    assert got is not None and bool(got) == want
+    assert set(got) <= exact  # sound: never a solvable root
+    assert len(calls) in (1, 2)
+    if len(calls) == 1:
+        assert got  # the neighbours decided it
+    else:
+        assert calls[1] >= calls[0]

@@ -98,8 +98,9 @@ under 1 degree needs 16,520)."""
 def decide(
     problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
 ) -> tuple[list[int] | None, dict[int, float] | None]:
-    """The roots no strong plan orients (empty: every root has one; None: undecided) and,
-    when the roots' own sets were all explored, every reachable set's length (:func:`solve`).
+    """Roots no strong plan orients (empty: every root has one; None: undecided; when the
+    pairs decide it, some of them) and, when the roots' own sets were all explored, every
+    reachable set's length (:func:`solve`).
 
     Cheapest first: the roots' sets when they are few (``QUICK_SETS``); then their pairs
     (:func:`unsolvable_by_pairs`, within half the time left and ``PAIR_CHECK_SETS`` sets):
@@ -137,25 +138,52 @@ def unsolvable(
 def unsolvable_by_pairs(
     problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
 ) -> list[int] | None:
-    """The roots holding a pair of states that no strong plan orients: a subset of a solvable
+    """Roots holding a pair of states that no strong plan orients: a subset of a solvable
     set is solvable, so these roots are not (empty: every pair is; that proves nothing of the
     roots themselves); None when undecided (too many sets, or ``deadline``).
 
     Two states reach few sets (their images' reading branches), so :func:`solve` over every
     pair inside a root is quick where the roots' own reachable sets are too many to explore:
     on a 50-part mix at 3 mm under 1 degree 10,809 pairs and 16,520 sets in 6 s decide that
-    30 of 96 roots hold one, where the roots' own sets did not finish in 120 s.
+    30 of 96 roots hold one, where the roots' own sets did not finish in 120 s. The
+    neighbours in diameter are asked first (``NEIGHBOUR_PAIRS``): when one of those pairs
+    has no strong plan, the roots holding such a pair are the answer (some of the roots
+    with none, not necessarily all). Both landings of a 20-part mix at 5 % under 1 degree:
+    0.28 s instead of 3.2 s.
     """
+    bad = _bad_pairs(problem, _pairs_within(problem, roots, NEIGHBOUR_PAIRS), deadline, max_sets)
+    if bad is not None and not bad:
+        bad = _bad_pairs(problem, _pairs_within(problem, roots, None), deadline, max_sets)
+    if bad is None:
+        return None
+    return [r for r in roots if any(pair & r == pair for pair in bad)]
+
+
+def _pairs_within(problem: Problem, roots: list[int], reach: int | None) -> list[int]:
+    """The pairs of states inside a root that are not a goal: each state with the next
+    ``reach`` of its root (None: every other state), as bit masks."""
     pairs: set[int] = set()
     for r in roots:
         idx = members(r)
         for k, a in enumerate(idx):
-            for b in idx[k + 1 :]:
+            for b in idx[k + 1 : None if reach is None else k + 1 + reach]:
                 pair = (1 << a) | (1 << b)
                 if not problem.is_goal(pair):
                     pairs.add(pair)
-    value = solve(problem, sorted(pairs), deadline, max_sets)
+    return sorted(pairs)
+
+
+def _bad_pairs(
+    problem: Problem, pairs: list[int], deadline: Deadline | None, max_sets: int
+) -> list[int] | None:
+    """The ``pairs`` no strong plan orients (:func:`solve`); None when undecided."""
+    value = solve(problem, pairs, deadline, max_sets)
     if value is None:
         return None
-    bad = [pair for pair in pairs if value[pair] == math.inf]
-    return [r for r in roots if any(pair & r == pair for pair in bad)]
+    return [pair for pair in pairs if value[pair] == math.inf]
+
+
+NEIGHBOUR_PAIRS = 1
+""":func:`unsolvable_by_pairs` first asks only each state and the next this many of its root
+(in the machine's order: by diameter in the planners), the pairs most alike; the sets they
+reach are a few of all pairs' (the problem keeps their actions for the full check after)."""
