@@ -84,7 +84,10 @@ TimeLimitOpt = Annotated[
     typer.Option(
         "--time-limit",
         metavar="S",
-        help="Seconds; then the best plan found (optimal: false) and a proven lower bound.",
+        help=(
+            "Seconds for the plan, its verification and its file (a --report is drawn after);"
+            " then the best plan found (optimal: false) and a proven lower bound."
+        ),
     ),
 ]
 MemoryLimitOpt = Annotated[
