@@ -15,13 +15,14 @@ import random
 import time
 
 import pytest
-from test_deadline import small_mix
+from test_deadline import near_round, small_mix
 from test_planners import check_plan, random_convex
 
 import feederkit.planning.api as api
 from feederkit.machine import build_machine, members, search_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.methods import longest_root, make_oracle
+from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses
@@ -306,3 +307,39 @@ def test_the_expected_stage_is_the_fewest_expected_operations_keeping_the_floor(
     for b, _pb, ms in deep:
         want = _fewest_expected(problem, b.mask, ms, k, refiner.floor, memo)
         assert refiner.expected(b.mask, ms, k)[0][0] == pytest.approx(want, abs=1e-9), name
+
+
+def test_a_command_says_when_the_choice_among_shortest_plans_was_cut(monkeypatch):
+    # make_plan warns when the tie-breaks stopped early: before the largest margin (the
+    # plan may hold less rotation error than another of the same length) or after it.
+    from feederkit.plans.make import make_plan
+
+    pfs = small_mix(5)
+    options = PlanningOptions(time_limit_s=60.0)
+    exact = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
+    assert not any("choice among shortest plans" in w for w in exact.warnings)
+    monkeypatch.setattr(api, "TIE_GRACE_POLLS", -1)
+    monkeypatch.setattr(api, "TIE_SHARE", 0.0)
+    quick = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
+    assert quick.result.tie_breaks == api.TIES_NONE
+    (line,) = [w for w in quick.warnings if "choice among shortest plans" in w]
+    assert "not proven the largest" in line and "\n" not in line
+    monkeypatch.undo()
+
+    def out_of_time(self, *args, **kwargs):
+        raise Timeout("time")
+
+    monkeypatch.setattr(Refiner, "expected", out_of_time)
+    partial = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
+    assert partial.result.tie_breaks == api.TIES_MARGIN
+    assert any("not the fewest expected operations" in w for w in partial.warnings)
+
+
+def test_the_backchaining_plan_is_no_tie_break_cut_short():
+    # Readings that carry nothing: the backchaining chain is the answer, no warning.
+    from feederkit.plans.make import make_plan
+
+    pf = near_round(64, 0.01)  # 35 states, all reading alike at 3 %
+    made = make_plan([pf], ToleranceSensor(0.03 * pf.part.size), uncertainty=IDEAL)
+    assert made.result.tie_breaks == api.TIES_CHAIN
+    assert not any("choice among shortest plans" in w for w in made.warnings)

@@ -94,6 +94,9 @@ TIES_MARGIN = "margin"
 """``tie_breaks``: the largest margin is exact, the expected operations are not minimised."""
 TIES_NONE = "none"
 """``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
+TIES_CHAIN = "backchain"
+"""``tie_breaks``: the backchaining plan of a set whose readings carry nothing (its
+rotations the widest that shorten the set; no tie-break searched, none cut short)."""
 
 
 class NoStrongPlan(PlanningError):
@@ -387,7 +390,7 @@ def _plan(
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         if chain is not None and tree_length(chain) == length:
-            return chain, True, length, length, TIES_NONE
+            return chain, True, length, length, TIES_CHAIN
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline
     if objective == "worst":

@@ -142,7 +142,8 @@ class PlanResult:
     the choice among plans of the proven length went (docs/planning.md, "Which plan among
     the shortest"): ``"exact"`` every stage, ``"margin"`` the largest smallest margin but
     not the fewest expected operations, ``"none"`` the margin found when the tie-breaking
-    budget ran out.
+    budget ran out, ``"backchain"`` the backchaining plan where readings carry nothing (no
+    tie-break searched).
     """
 
     machine: PushAlignMachine

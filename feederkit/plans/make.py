@@ -178,6 +178,9 @@ def _make_plan(
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
+    cut = _ties_cut_words(result, opts)
+    if cut is not None:
+        warnings.append(cut)
     margin = low_margin_words(result.min_margin, unc.rotation_error_deg)
     if margin is not None:
         warnings.append(
@@ -265,6 +268,28 @@ def _certificate(
             cut.append(name)
     rotation, shape = figures
     return Certificate(rotation, shape, None), cut
+
+
+def _ties_cut_words(result: PlanResult, options: PlanningOptions) -> str | None:
+    """One line when a plan of proven length stopped choosing among the shortest plans
+    (``PlanResult.tie_breaks``; the time limit or the tie-breaking budget ended it): the
+    largest smallest margin, or the fewest expected operations, was not found."""
+    if not result.optimal or options.objective.value != "worst":
+        return None
+    words = f"a plan of {result.length} operations"
+    if result.tie_breaks == "margin":
+        return (
+            f"the choice among shortest plans stopped at {words} with the largest margin, "
+            "not the fewest expected operations (allow more time with --time-limit S)"
+        )
+    if result.tie_breaks == "none" and math.isfinite(result.min_margin):
+        return (
+            f"the choice among shortest plans stopped at {words} whose smallest margin, "
+            f"±{result.min_margin:.4g}° of slack beyond the declared uncertainty, is not "
+            "proven the largest; another may keep more slack (allow more time with "
+            "--time-limit S)"
+        )
+    return None
 
 
 def _lump_shapes(
