@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from feederkit.machine import PushAlignMachine, ReadingBranch, members
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.readings import reading_probability
-from feederkit.planning.tree import Leaf, PlanTree, Step
+from feederkit.planning.tree import Leaf, PlanTree, Step, branch_pairs
 
 
 def tree_length(node: PlanTree, _memo: dict[int, int] | None = None) -> int:
@@ -48,9 +48,8 @@ def node_states(root: PlanTree) -> int:
         if isinstance(node, Leaf) or id(node) in seen:
             continue
         seen.add(id(node))
-        for b, sub in node.branches:
-            total += b.mask.bit_count()
-            stack.append(sub)
+        total += branch_pairs(node.branches)
+        stack.extend(sub for _b, sub in node.branches)
     return total
 
 
