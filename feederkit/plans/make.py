@@ -199,8 +199,9 @@ own clock) give the planner the whole limit."""
 
 POST_MIN_S = 1.5
 """With a time limit, at least this many seconds (up to ``POST_MAX_SHARE`` of the limit) are
-kept after the planner, however short the limit: verifying, certifying and writing a plan
-of 50,000 nodes takes about 3 s, which 15 % of a 10 s limit does not hold."""
+kept after the planner, however short the limit: what the work after it costs whatever the
+plan's size (the plan's own verification and file are committed by the planner as it builds
+the plan, ``POST_S_PER_PAIR``)."""
 
 POST_MAX_SHARE = 0.25
 """The most of a short time limit ``POST_MIN_S`` may take from the planner."""
