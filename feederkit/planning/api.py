@@ -385,8 +385,8 @@ def _plan(
         # The readings carry nothing (methods.readings_carry_nothing): the backchaining plan
         # of the whole set is a shortest plan (its rotations the widest that shorten the
         # set), and any plan that follows the readings grows a tree of every reading set.
-        try:
-            chain = _sensorless_plan(problem, root_branches, budget, by_image=True)
+        try:  # under a copy: a chain too large to verify leaves its commits behind
+            chain = _sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         if chain is not None and tree_length(chain) == length:
