@@ -368,6 +368,10 @@ def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
     assert end - budget.end == pytest.approx(0.01 * node_states(smaller), abs=1e-9)
     held.hold(None)
     assert budget.end == pytest.approx(end, abs=1e-9)
+    # A plan made is kept whatever it costs: holding it never raises, even past the end.
+    late = Deadline(0.0, per_pair_s=1.0)
+    api._Held(late).hold(full.root)
+    assert late.expired()
 
 
 # --- plan() answers within its limits ---------------------------------------------------

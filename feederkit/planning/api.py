@@ -737,7 +737,7 @@ class _Held:
     def hold(self, root: Step | None) -> None:
         """``root`` is the plan in hand now (None: none)."""
         pairs = 0 if root is None else node_states(root)
-        self.budget.commit(pairs - self.pairs)
+        self.budget.commit(pairs - self.pairs, stop=False)  # the plan is made: keep it
         self.pairs = pairs
 
 

@@ -110,12 +110,13 @@ class Deadline:
             return True
         return False
 
-    def commit(self, pairs: int) -> None:
+    def commit(self, pairs: int, stop: bool = True) -> None:
         """A planner has made plan nodes with ``pairs`` more (node, state) pairs (fewer when
         negative: a plan it no longer holds): the deadline moves ``per_pair_s`` earlier for
         each (nothing without a deadline or a cost), past the first ``grace_s`` seconds of
-        them, and Timeout is raised when that end has passed (a tree's last nodes need no
-        poll after them to stop it)."""
+        them. With ``stop``, Timeout is raised when that end has passed (a tree's last nodes
+        need no poll after them to stop it); without, the end only moves (a plan already
+        made and kept)."""
         if self.end is not None and self.per_pair_s:
             cost = pairs * self.per_pair_s
             if cost > 0.0 and self.grace_s > 0.0:
@@ -123,7 +124,7 @@ class Deadline:
                 self.grace_s -= free
                 cost -= free
             self.end -= cost
-            if pairs > 0 and time.perf_counter() > self.end:
+            if stop and pairs > 0 and time.perf_counter() > self.end:
                 raise Timeout("time")
 
     def with_grace(self, seconds: float) -> Deadline:
@@ -208,9 +209,9 @@ class Checkpoint(Deadline):
         self.on_course = on_course
         self.handed_over = False
 
-    def commit(self, pairs: int) -> None:
+    def commit(self, pairs: int, stop: bool = True) -> None:
         """:meth:`Deadline.commit` for both ends; a passed end is left to :meth:`check`,
-        which asks whether the stage is on course."""
+        which asks whether the stage is on course (``stop`` has no effect here)."""
         if self.end is not None and self.per_pair_s:
             self.end -= pairs * self.per_pair_s
         if self.later is not None:
