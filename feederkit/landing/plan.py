@@ -119,11 +119,11 @@ class LandingPlan:
     def landing_of(self, part: str, landing: str | None = None) -> Landing:
         """The landing ``landing`` of ``part`` (or, with one argument, the one labelled
         ``PART/LANDING``); InputError when the plan has none."""
-        found = [k for k in (self._by_name.get((part, landing)),) if k is not None]
-        if landing is None and part in self._by_label:
-            found.append(self._by_label[part])
-        if found:
-            return self.landings[min(found)]
+        # The first landing either way, as a scan of the landings in order would find.
+        by_label = self._by_label.get(part) if landing is None else None
+        hits = [k for k in (self._by_name.get((part, landing)), by_label) if k is not None]
+        if hits:
+            return self.landings[min(hits)]
         shown = part if landing is None else f"{part}/{landing}"
         raise InputError(f"the plan has no landing {shown!r}")
 
