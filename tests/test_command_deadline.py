@@ -6,8 +6,6 @@ limit")."""
 from __future__ import annotations
 
 import json
-import math
-import random
 import subprocess
 import sys
 import time
@@ -21,22 +19,21 @@ SLACK_S = 2.5
 first plan's grace (``FIRST_PLAN_GRACE_S``, not needed by this case)."""
 
 
-def _mix(folder: Path, count: int) -> list[str]:
-    """bench_command_deadline.mix: random convex 6-10-gons on a 60 x 40 mm ellipse."""
+def _mix(folder: Path, count: int, monkeypatch) -> list[str]:
+    """The benchmark's mix (bench_command_deadline.mix) written as outline files."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_command_deadline import mix
+
     paths = []
-    for s in range(count):
-        n = random.Random(s).randint(6, 10)
-        rng = random.Random(100 + s)
-        angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n))
-        pts = [[30 * math.cos(t), 20 * math.sin(t)] for t in angles]
-        path = folder / f"{s:03d}-mix-{s}.json"
-        path.write_text(json.dumps({"name": f"mix-{s}", "units": "mm", "vertices": pts}))
+    for s, outline in enumerate(mix(count)):
+        path = folder / f"{s:03d}-{outline['name']}.json"
+        path.write_text(json.dumps(outline))
         paths.append(str(path))
     return paths
 
 
 @pytest.mark.slow  # about 10 s
-def test_a_large_optimal_plan_gives_way_to_one_the_limit_can_verify(tmp_path):
+def test_a_large_optimal_plan_gives_way_to_one_the_limit_can_verify(tmp_path, monkeypatch):
     # The 100-part mix at 0.5 % under 1 degree: its exact tie-breaks make a 47,000-node plan
     # whose file, verification and output take about 5 s after the planner; under a 10 s
     # limit the command ended 4-6 s late with it. Now the plan's verification is committed
@@ -44,7 +41,7 @@ def test_a_large_optimal_plan_gives_way_to_one_the_limit_can_verify(tmp_path):
     # length is written in time.
     out = tmp_path / "plan.json"
     command = [sys.executable, "-c", "from feederkit.cli.app import run; run()"]
-    args = [*command, "plan", *_mix(tmp_path, 100)]
+    args = [*command, "plan", *_mix(tmp_path, 100, monkeypatch)]
     args += ["--tolerance", "0.3", "--landings", "up", "--time-limit", f"{LIMIT_S:g}"]
     start = time.perf_counter()
     proc = subprocess.run([*args, "-o", str(out)], capture_output=True, text=True, timeout=120)
