@@ -210,10 +210,9 @@ class Step:
         A step with many branches compares the reading with arrays of their ends (the
         same closed comparisons, made once per step and reading instead of per branch).
         """
-        if reading is None or len(self.branches) < _INDEXED_BRANCHES:
+        if reading is None:
             return tuple(k for k, b in enumerate(self.branches) if b.holds(reading))
-        lo, hi = self._ends()
-        return tuple(((lo <= reading) & (reading <= hi)).nonzero()[0].tolist())
+        return self.meeting(reading, reading)  # Branch.holds's closed test, one point
 
     def meeting(self, lo: float, hi: float) -> tuple[int, ...]:
         """The indices of the branches whose reading interval meets the closed ``[lo, hi]``
