@@ -49,6 +49,7 @@ from feederkit.plans.strong import (
 from feederkit.plans.verify import VerificationReport, check_plan
 from feederkit.sensors import Sensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
+from feederkit.words import plural
 
 DIAMETER_DIGITS = 9
 """Diameters (mm) equal to this many decimals are one diameter: a regular polygon's states
@@ -277,7 +278,7 @@ def _ties_cut_words(result: PlanResult, options: PlanningOptions) -> str | None:
     largest smallest margin, or the fewest expected operations, was not found."""
     if not result.optimal or options.objective.value != "worst":
         return None
-    words = f"a plan of {result.length} operations"
+    words = f"a plan of {plural(result.length, 'operation')}"
     if result.tie_breaks == "margin":
         return (
             f"the choice among shortest plans stopped at {words} with the largest margin, "
