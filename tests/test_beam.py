@@ -16,7 +16,7 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning import api
 from feederkit.planning.api import _choice_plan, _result, goal_relation, plan
-from feederkit.planning.beam import BeamSearch, beam_plan, branch_key
+from feederkit.planning.beam import BeamSearch, _depth, beam_plan, branch_key
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
@@ -108,6 +108,40 @@ def test_the_beam_keeps_the_actions_with_the_smallest_branches():
     assert beam.cut == (len(every) > 2)
 
 
+def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):
+    # Before the first plan the targets are the bound, then 1, 2, 4, ... more than the last;
+    # after it each target is one less than the best plan so far; a plan found within a
+    # target is never longer than it, and its tree is as long as the lengths say.
+    from feederkit.planning import beam as beam_module
+
+    machine = _random_part_machine(seed=1, n=10, rel=0.2)  # a plan of 6 in the first beam
+    problem, branches, roots = _problem(machine)
+    calls = []
+    real = beam_module._lengths
+
+    def spy(beam, roots_, target):
+        out = real(beam, roots_, target)
+        calls.append((target, out, dict(beam.choice)))
+        return out
+
+    monkeypatch.setattr(beam_module, "_lengths", spy)
+    found = beam_plan(problem, roots, None, Deadline(), 2 * machine.n + 1)
+    assert found is not None
+    firsts = [t for t, out, _c in calls[: next(i for i, c in enumerate(calls) if c[1]) + 1]]
+    assert firsts == [1, 2, 4, 8]
+    best = None
+    for target, out, _choice in calls:
+        if best is not None:
+            assert target <= best - 1
+        if out is not None:
+            assert max(out) <= target
+            best = max(out)
+    assert found[1] == best
+    root = _choice_plan(problem, found[0].choice, roots, branches, Deadline())
+    assert tree_length(root) <= 1 + best
+    assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == tree_length(root)
+
+
 def test_a_passed_deadline_leaves_no_beam_plan():
     machine = _random_part_machine()
     problem, _branches, roots = _problem(machine)
@@ -124,8 +158,10 @@ def test_a_first_plan_may_take_until_its_own_deadline():
     found = beam_plan(problem, roots, None, Deadline(0.0), cap, 1, Deadline())
     assert found is not None
     search, best = found
-    first = BeamSearch(problem, 4)  # the first beam's plan, not a shorter one
-    assert best == max(next(k for k in range(1, cap + 1) if first.within(r, k)) for r in roots)
+    # The first beam's plan, found depth-first within the cap, not a shorter one.
+    first = BeamSearch(problem, 4)
+    assert all(first.within(r, cap) for r in roots)
+    assert best == max(_depth(first, r, {}) for r in roots)
     root = _choice_plan(problem, search.choice, roots, branches, Deadline())
     assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == 1 + best
 

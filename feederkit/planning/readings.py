@@ -66,6 +66,11 @@ class Readings:
         self._window = (machine.sensor.reading_windows(self._diam) or []) if exact else []
         self._cell_masks: list[int] | None = None
         self._cell_span: list[tuple[int, int]] = []
+        self._runs = False
+        self._span_begin: list[int] = []
+        self._span_end: list[int] = []
+        """Whether each state's reading cells are one run of consecutive cells: the
+        branches of an image are then the cliques of intervals (:meth:`_interval_cliques`)."""
         if exact and not self.sensorless:
             cells = self._space.branches(full, Grouping.EXACT)
             self._cell_masks = [b.mask for b in cells]
@@ -75,6 +80,9 @@ class Readings:
                     span[i][0] = min(span[i][0], c)
                     span[i][1] = max(span[i][1], c + 1)
             self._cell_span = [(a, b) for a, b in span]
+            self._runs = _cells_are_runs(self._cell_masks, self._cell_span)
+            self._span_begin = [a for a, _b in self._cell_span]
+            self._span_end = [b for _a, b in self._cell_span]
         self._branches: dict[int, tuple[ReadingBranch, ...]] = {}
         self._maximal: dict[int, tuple[int, ...]] = {}
         self._all: dict[int, tuple[int, ...]] = {}
@@ -184,6 +192,8 @@ class Readings:
         if out is None:
             if self._window:
                 out = self._window_runs(image)
+            elif self._runs:
+                out = self._interval_cliques(image)
             elif self._cell_masks is not None:
                 out = maximal_sets(self._restricted_cells(image))
             else:
@@ -212,6 +222,42 @@ class Readings:
         if len(runs) > 1:
             runs.sort(key=int.bit_count, reverse=True)
         return tuple(runs)
+
+    def _interval_cliques(self, image: int) -> tuple[int, ...]:
+        """The maximal reading branches of an image when each state's reading cells are a
+        run (``_cell_span``): the maximal cliques of those intervals, by one sweep.
+
+        Sweeping the cells in order, the states read together form the set of runs begun
+        and not yet ended; just before a run ends, after a run began since the last end,
+        that set is maximal (no run left out meets both the last begun and the ending one),
+        and every maximal set is met so (the interval graphs' maximal cliques, Gilmore and
+        Hoffman 1964). Largest first, then along the reading axis. The same sets as
+        :func:`maximal_sets` of ``_restricted_cells``, in O(m log m) for m states instead of
+        a look at every cell and every pair of sets.
+        """
+        idx = members(image)
+        if len(idx) == 1:
+            return (image,)
+        begin, end = self._span_begin, self._span_end
+        begins = sorted(idx, key=begin.__getitem__)
+        out = []
+        active = 0
+        grew = False
+        j = 0
+        last = len(begins)
+        for e in sorted(idx, key=end.__getitem__):
+            stop = end[e]
+            while j < last and begin[begins[j]] < stop:
+                active |= 1 << begins[j]
+                j += 1
+                grew = True
+            if grew:
+                out.append(active)
+                grew = False
+            active ^= 1 << e
+        if len(out) > 1:
+            out.sort(key=int.bit_count, reverse=True)
+        return tuple(out)
 
     def _restricted_cells(self, image: int) -> set[int]:
         """The image's states in each reading cell of the whole machine that meets it."""
@@ -296,3 +342,19 @@ class Readings:
 
 
 _UNSET = object()
+
+
+def _cells_are_runs(cell_masks: list[int], span: list[tuple[int, int]]) -> bool:
+    """Whether every state lies in exactly the cells of its span: each state's reading set
+    is one run of consecutive cells (true of interval reading sets; checked, not assumed)."""
+    delta = [0] * (len(cell_masks) + 1)
+    for i, (a, b) in enumerate(span):
+        if a < b:
+            delta[a] ^= 1 << i
+            delta[b] ^= 1 << i
+    inside = 0
+    for c, mask in enumerate(cell_masks):
+        inside ^= delta[c]
+        if inside != mask:
+            return False
+    return True

@@ -1,0 +1,85 @@
+"""The maximal reading branches of a set by the interval sweep (``Readings._interval_cliques``)
+against the readings themselves: at every reading the set's states can give, the states that
+can give it, the maximal ones kept (an independent brute force over the sensor's reading
+intervals). The sweep serves the machines whose diameters are intervals in no common order,
+where the sensor's reading windows do not apply: both landings of a random outline under a
+rotation error."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from feederkit.landing.model import landings_of_outline
+from feederkit.machine import Grouping, build_machine, members
+from feederkit.mechanics import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.readings import Readings, _cells_are_runs
+from feederkit.planning.reindex import by_diameter
+from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import Uncertainty
+
+
+def _both_landings_machine(tolerance: float):
+    """Both landings of the hull of 200 points at random radii 21-30 mm, under 1 degree."""
+    rng = random.Random(4)
+    pts = []
+    for t in sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(200)):
+        f = 30.0 * rng.uniform(0.7, 1.0)
+        pts.append((f * math.cos(t), f * math.sin(t)))
+    part = make_part(make_outline("random-200", pts))
+    pfs = [push_function(x.part) for x in landings_of_outline(part)]
+    machine = build_machine(pfs, ToleranceSensor(tolerance), Uncertainty(1.0))
+    return by_diameter(machine)[0]
+
+
+@pytest.fixture(scope="module", params=[0.02, 0.1, 0.585, 1.5])
+def readings(request):
+    machine = _both_landings_machine(request.param)
+    out = Readings(machine, Grouping.EXACT, (0,) * machine.n)
+    # The sweep's own case: no reading windows, every state's cells one run.
+    assert not out._window and out._runs
+    return out
+
+
+def _brute_force_maximal(readings: Readings, image: int) -> set[int]:
+    """The maximal sets of the image's states that can give one reading: each state's
+    reading set is an open interval; between consecutive ends the states that can read
+    there are fixed, so one probe per gap finds every such set."""
+    sensor = readings.machine.sensor
+    spans = {i: sensor.reading_interval(readings.machine.states[i].sensed) for i in members(image)}
+    ends = sorted({x for lo_hi in spans.values() for x in lo_hi})
+    sets = set()
+    for a, b in zip(ends, ends[1:], strict=False):
+        x = (a + b) / 2.0
+        s = sum(1 << i for i, (lo, hi) in spans.items() if lo < x < hi)
+        if s:
+            sets.add(s)
+    return {s for s in sets if not any(s != o and s & o == s for o in sets)}
+
+
+@settings(max_examples=150, deadline=None)
+@given(data=st.data())
+def test_the_sweep_finds_the_maximal_sets_that_read_alike(readings, data):
+    n = readings.machine.n
+    image = data.draw(st.integers(1, (1 << n) - 1))
+    got = readings.children(image)
+    assert set(got) == _brute_force_maximal(readings, image)
+    assert len(got) == len(set(got))
+    assert [c.bit_count() for c in got] == sorted((c.bit_count() for c in got), reverse=True)
+
+
+def test_the_whole_machine_reads_as_its_reading_cells(readings):
+    full = readings.machine.all_states
+    assert set(readings.children(full)) == _brute_force_maximal(readings, full)
+
+
+def test_cells_that_skip_a_state_are_not_runs():
+    # State 0 in cells 0 and 2 but not 1: its span (0, 3) is not what the cells hold.
+    assert not _cells_are_runs([0b01, 0b10, 0b01], [(0, 3), (1, 2)])
+    assert _cells_are_runs([0b01, 0b11, 0b10], [(0, 2), (1, 3)])
