@@ -87,9 +87,11 @@ def beam_plan(
     best: int | None = None
     target = cap
     beam = _beam(problem, FIRST_WIDTH, deadline if first is None else first, seed, None)
-    # Until a plan is in hand, deepen by growing steps: the bound, one more, three more,
-    # seven more, ... (a short plan where one is near, a long one soon where none is).
-    aim, step = max(lower, 1, *(beam.lb.get(r, 1) for r in roots)), 1
+    # Until a plan is in hand, each beam deepens by growing steps: the bound, one more,
+    # three more, seven more, ... (a short plan where one is near, a long one soon where
+    # none is).
+    start = max(lower, 1, *(beam.lb.get(r, 1) for r in roots))
+    aim, step = start, 1
     while target >= max(lower, 1):
         reach = target if best is not None else min(aim, target)
         try:
@@ -104,6 +106,7 @@ def beam_plan(
             aim, step = reach + step, 2 * step
         elif beam.cut:
             beam = _beam(problem, 2 * beam.width, beam.deadline, seed, beam)
+            aim, step = start, 1
         else:
             break  # exhaustive: no plan within the target exists
     return None if best is None else (beam, best)

@@ -67,10 +67,10 @@ class Readings:
         self._cell_masks: list[int] | None = None
         self._cell_span: list[tuple[int, int]] = []
         self._runs = False
-        self._span_begin: list[int] = []
-        self._span_end: list[int] = []
         """Whether each state's reading cells are one run of consecutive cells: the
         branches of an image are then the cliques of intervals (:meth:`_interval_cliques`)."""
+        self._span_begin: list[int] = []
+        self._span_end: list[int] = []
         if exact and not self.sensorless:
             cells = self._space.branches(full, Grouping.EXACT)
             self._cell_masks = [b.mask for b in cells]
