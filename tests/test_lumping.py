@@ -24,6 +24,7 @@ from feederkit.machine import (
     inseparable,
     members,
 )
+from feederkit.machine.inseparable import kept_apart
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -31,8 +32,6 @@ from feederkit.planning.api import NoStrongPlan
 from feederkit.planning.lumping import (
     LumpedGoal,
     LumpingTry,
-    candidate_pairs,
-    kept_apart,
     lumped_goal,
     lumped_words,
     try_lumping,
@@ -41,6 +40,7 @@ from feederkit.planning.lumping import (
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
+from feederkit.planning.solvable import candidate_pairs
 from feederkit.planning.tree import Leaf
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import verify_strong
@@ -303,7 +303,7 @@ def test_lumped_pairs_are_exactly_those_no_strong_plan_resolves(seed):
     expect = {p for p in alike if not solvable((1 << p[0]) | (1 << p[1]))}
     assert set(got) == expect
     assert not set(got) & insep
-    assert kept_apart(problem, sorted(alike)) <= expect  # the cheap pass is sound
+    assert kept_apart(problem.machine, sorted(alike)) <= expect  # the cheap pass is sound
     # The lumped goal: given exactly when the roots are solvable under it.
     lump = lumped_goal(m)
     roots = children(m.all_states)

@@ -4,7 +4,9 @@ A subset of a solvable set is solvable, so a root reading set holding a pair of 
 no strong plan orients has no strong plan: the pairs' sets are few and small, where the
 roots' own reachable sets can be too many to explore in time. Checked against the exact
 least fixpoint over the roots' sets (``solvable.unsolvable``), and the planner's answer when
-its length search cannot finish.
+its length search cannot finish. Before the pairs' searches, the pairs nature can keep
+apart (``machine.inseparable.kept_apart``) answer at once: checked against a plain fixpoint
+written here and against the exact answer.
 """
 
 from __future__ import annotations
@@ -14,7 +16,8 @@ import math
 import pytest
 from test_strong_plans import random_pf
 
-from feederkit.machine import build_machine
+from feederkit.machine import OutcomeRange, build_machine
+from feederkit.machine.inseparable import kept_apart
 from feederkit.planning import api, solvable
 from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
 from feederkit.planning.options import PlanningOptions
@@ -106,6 +109,8 @@ def test_the_neighbours_first_give_the_verdict_of_every_pair(
         return real(*args, **kwargs)
 
     monkeypatch.setattr(solvable, "solve", counted)
+    # The pairs' searches alone: no pair is taken as kept apart beforehand.
+    monkeypatch.setattr(solvable, "kept_apart", lambda *_a: set())
     got = unsolvable_by_pairs(problem, roots)
     assert got is not None and bool(got) == want
     assert set(got) <= exact  # sound: never a solvable root
@@ -114,3 +119,75 @@ def test_the_neighbours_first_give_the_verdict_of_every_pair(
         assert got  # the neighbours decided it
     else:
         assert calls[1] >= calls[0]
+
+
+def _kept_apart_by_definition(machine, goal) -> set[tuple[int, int]]:
+    """The greatest relation of pairs that can read alike, are not a goal, and for every
+    rotation (one per cell of all the machine's action boundaries) have some outcome of each
+    making a different pair again in it: repeated until nothing changes."""
+    n = machine.n
+    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
+    mids = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+
+    def out(i, a):
+        for r in machine.action_maps[i]:
+            if 0 < (a - r.lo) % 360 < r.hi - r.lo:
+                t = r.targets if isinstance(r, OutcomeRange) else 1 << r.target
+                return [k for k in range(n) if t >> k & 1]
+        raise AssertionError
+
+    sensor = machine.sensor
+    rel = {
+        (i, j)
+        for i in range(n)
+        for j in range(i + 1, n)
+        if not goal[i] >> j & 1
+        and sensor.can_read_alike(machine.states[i].sensed, machine.states[j].sensed)
+    }
+    while True:
+        keep = {
+            (i, j)
+            for i, j in rel
+            if all(
+                any(x != y and (min(x, y), max(x, y)) in rel for x in out(i, a) for y in out(j, a))
+                for a in mids
+            )
+        }
+        if keep == rel:
+            return rel
+        rel = keep
+
+
+@pytest.mark.parametrize("seed", range(0, 40, 3))
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+def test_the_kept_pairs_are_the_greatest_such_relation_and_refuse_only_unsolvable_roots(
+    seed, rotation, tolerance
+):
+    problem = Problem(_two_parts(seed, rotation, tolerance))
+    machine = problem.machine
+    got = kept_apart(machine, solvable.candidate_pairs(problem))
+    assert got == _kept_apart_by_definition(machine, problem.insep)
+    roots = _roots(problem)
+    held = {r for r in roots if any(r >> i & 1 and r >> j & 1 for i, j in got)}
+    assert set(solvable.holding_kept_pairs(roots, got)) == held
+    assert held <= set(unsolvable(problem, roots))  # sound: never a solvable root
+
+
+def test_kept_pairs_answer_before_any_search(monkeypatch):
+    # Seed 18: a pair of the two parts' states nature keeps apart under 1 degree.
+    problem = Problem(_two_parts(18, 1.0, 0.1))
+    roots = _roots(problem)
+    kept = kept_apart(problem.machine, solvable.candidate_pairs(problem))
+    assert kept
+    monkeypatch.setattr(solvable, "solve", lambda *_a, **_k: pytest.fail("a search was run"))
+    got = unsolvable_by_pairs(problem, roots)
+    assert got and all(any(r >> i & 1 and r >> j & 1 for i, j in kept) for r in got)
+
+
+def test_with_single_outcomes_no_pair_is_kept_apart():
+    # The ideal model: a pair that neither merges nor reads apart is inseparable (a goal).
+    machine = build_machine(
+        [random_pf(8018), random_pf(9018)], ToleranceSensor(0.1), Uncertainty(0.0)
+    )
+    problem = Problem(machine)
+    assert kept_apart(machine, solvable.candidate_pairs(problem)) == set()

@@ -62,13 +62,13 @@ from feederkit.design.steps import (
 from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
 from feederkit.machine.build import build_machine
-from feederkit.machine.inseparable import inseparable_masks
+from feederkit.machine.inseparable import inseparable_masks, kept_apart
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness, distinguishable
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import FIRST_LIMIT, goal_relation, strong_plan_exists
 from feederkit.planning.budget import Deadline
-from feederkit.planning.lumping import kept_apart, try_lumping
+from feederkit.planning.lumping import try_lumping
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
@@ -254,7 +254,7 @@ def _one_part_problem(machine: PushAlignMachine, tolerance: float) -> Problem:
 
 def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
     """The cross pairs nature can keep apart for ever, reading alike
-    (:func:`~feederkit.planning.lumping.kept_apart`): when there is one, some first reading
+    (:func:`~feederkit.machine.inseparable.kept_apart`): when there is one, some first reading
     holds both states of it, and no strong plan separates the parts (a cheap, sound no).
     Monotone in the tolerance (a greatest fixpoint over read-alike pairs)."""
     m = problem.machine
@@ -265,7 +265,7 @@ def kept_cross_pairs(problem: Problem) -> set[tuple[int, int]]:
         for j in range(i + 1, m.n)
         if m.states[i].part != m.states[j].part and m.sensor.can_read_alike(sensed[i], sensed[j])
     ]
-    return kept_apart(problem, pairs)
+    return kept_apart(m, pairs)
 
 
 def outcomes_cover_parts(machine: PushAlignMachine) -> bool:

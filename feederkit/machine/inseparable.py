@@ -17,6 +17,14 @@ run of the one by a run of the other, reading alike at every step and never merg
 strong plan can tell them apart or merge them: the relation is sound. With single outcomes it
 is exactly the fixpoint above; symmetric poses of one part (whose outcome sets are rotated
 copies) and Lemma 8 twins stay inseparable. docs/planning.md ("Strong plans") says more.
+
+Nature can also keep two states *apart* without mirroring every run: their readings can
+agree, they are not a goal together, and for every action *some* outcome of the one and
+*some* different outcome of the other are again kept apart (:func:`kept_apart`, the
+greatest such relation inside a set of pairs). Nature then keeps both in every reading set a
+plan meets, so no strong plan orients a set holding such a pair: the cheap proof of
+unresolvable pairs (:mod:`feederkit.planning.lumping`) and of "no strong plan exists"
+(:mod:`feederkit.planning.solvable`).
 """
 
 from __future__ import annotations
@@ -333,4 +341,45 @@ def _bisimilar(
                 if u in alive and u not in queued:
                     queued.add(u)
                     todo.append(u)
+    return alive
+
+
+def kept_apart(
+    machine: PushAlignMachine,
+    pairs: Iterable[tuple[int, int]],
+    check: Check | None = None,
+) -> set[tuple[int, int]]:
+    """The pairs of ``pairs`` (``i < j``) nature can keep apart for ever: the greatest subset
+    such that on every overlap range of a pair (section 3.2.2) some outcome of the one and a
+    *different* outcome of the other again form a kept pair.
+
+    Sound for unresolvability when ``pairs`` are pairs that can read alike and are not a
+    goal: nature answers every action with such outcomes and every reading with one both can
+    give, so every set a plan meets holds a kept pair, which is not a goal; no leaf is a
+    goal. It can miss pairs whose plans fail only on a larger set (three states each pair of
+    which some action merges, but no action all three). With single outcomes a kept pair is
+    bisimilar, so none is kept outside the inseparable relation.
+
+    Rounds over the pairs until none is dropped (each pair's cases made once, by
+    :func:`pair_outcomes`); ``check`` is polled once per pair and stops it by raising.
+    """
+    check = _no_check if check is None else check
+    alive = set(pairs)
+    cases = {}
+    for p in alive:
+        check()
+        cases[p] = sorted(set(pair_outcomes(machine, *p)))
+
+    def keeps(a: int, b: int) -> bool:
+        xs, ys = members(a), members(b)
+        return any(x != y and ((x, y) if x < y else (y, x)) in alive for x in xs for y in ys)
+
+    changed = True
+    while changed:
+        changed = False
+        for p in sorted(alive):
+            check()
+            if not all(keeps(a, b) for a, b in cases[p]):
+                alive.discard(p)
+                changed = True
     return alive

@@ -10,8 +10,9 @@ exact symmetry (section 3.3: a result lists the poses no plan can tell apart):
 
 - a pair of states is *resolvable* when a strong plan takes the set of the two to a goal of
   the machine's inseparable pairs (``R``), i.e. separates them by readings or merges them
-  for every outcome; :func:`kept_apart` proves many pairs unresolvable cheaply (a pair
-  fixpoint like the bisimulation), :func:`~feederkit.planning.solvable.solve` decides the
+  for every outcome; :func:`~feederkit.machine.inseparable.kept_apart` proves many pairs
+  unresolvable cheaply (a pair fixpoint like the bisimulation),
+  :func:`~feederkit.planning.solvable.solve` decides the
   rest from their pair sets at once (one pass over the sets they reach, shared);
 - the *lumped* relation is ``R`` together with the unresolvable pairs ``U``; a set is a
   goal when every pair in it is lumped (the same pairwise test as before, over more pairs).
@@ -46,18 +47,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from feederkit.errors import InputError
-from feederkit.machine import Grouping, PushAlignMachine, members, pair_outcomes
+from feederkit.machine import Grouping, PushAlignMachine, members
+from feederkit.machine.inseparable import kept_apart
 from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import MAX_SETS, solve
+from feederkit.planning.solvable import MAX_SETS, candidate_pairs, solve
 from feederkit.planning.tree import PlanTree, Step
 
 Pair = tuple[int, int]
 
 PAIR_SETS = 20_000
-"""The most sets the exact pair check explores before it settles for :func:`kept_apart`."""
+"""The most sets the exact pair check explores before it settles for
+:func:`~feederkit.machine.inseparable.kept_apart`."""
 
 
 @dataclass(frozen=True)
@@ -68,7 +71,8 @@ class LumpedGoal:
     :class:`~feederkit.planning.problem.Problem` takes as its goal; ``pairs``: the lumped
     pairs ``(i, j)``, ``i < j``, sorted (not inseparable, yet no strong plan separates or
     merges them under the machine's declared uncertainty); ``exact``: they are all such
-    pairs (False: those :func:`kept_apart` proves, when the exact check was too large).
+    pairs (False: those :func:`~feederkit.machine.inseparable.kept_apart` proves, when the
+    exact check was too large).
     """
 
     insep: tuple[int, ...]
@@ -105,56 +109,6 @@ class LumpedGoal:
         return tuple(sorted(found))
 
 
-def candidate_pairs(problem: Problem) -> list[Pair]:
-    """The pairs a goal test can meet that are not inseparable.
-
-    With exact reading branching every set a plan reaches holds states that can all give one
-    reading, so only pairs that can read alike meet; the components rule can join states
-    that cannot (through a third), so there every pair is a candidate.
-    """
-    machine = problem.machine
-    sensor = machine.sensor
-    sensed = [s.sensed for s in machine.states]
-    exact = problem.grouping is Grouping.EXACT
-    return [
-        (i, j)
-        for i in range(machine.n)
-        for j in range(i + 1, machine.n)
-        if not problem.insep[i] >> j & 1
-        and (not exact or sensor.can_read_alike(sensed[i], sensed[j]))
-    ]
-
-
-def kept_apart(problem: Problem, pairs: Sequence[Pair]) -> set[Pair]:
-    """The pairs of ``pairs`` nature can keep apart for ever: the greatest subset such that
-    on every overlap range of a pair (section 3.2.2) some outcome of the one and a
-    *different* outcome of the other again form a kept pair.
-
-    Sound for unresolvability, and cheap (a fixpoint over pairs, like the bisimulation of
-    :mod:`feederkit.machine.inseparable`): nature answers every action with such outcomes and
-    every reading with one both can give (kept pairs can read alike), so every set a plan
-    meets holds a kept pair, which is not inseparable: no leaf is a goal. It can miss pairs
-    of :func:`unresolvable_pairs` whose plans fail only on a larger set (three states each
-    pair of which some action merges, but no action all three).
-    """
-    machine = problem.machine
-    alive = set(pairs)
-    cases = {p: sorted(set(pair_outcomes(machine, *p))) for p in alive}
-
-    def keeps(a: int, b: int) -> bool:
-        xs, ys = members(a), members(b)
-        return any(x != y and ((x, y) if x < y else (y, x)) in alive for x in xs for y in ys)
-
-    changed = True
-    while changed:
-        changed = False
-        for p in sorted(alive):
-            if not all(keeps(a, b) for a, b in cases[p]):
-                alive.discard(p)
-                changed = True
-    return alive
-
-
 def unresolvable_pairs(
     problem: Problem, deadline: Deadline | None = None, max_sets: int = PAIR_SETS
 ) -> tuple[Pair, ...] | None:
@@ -162,12 +116,13 @@ def unresolvable_pairs(
     margin floor), exactly; None when undecided (more than ``max_sets`` sets). Raises
     Timeout when ``deadline`` passes.
 
-    The pairs :func:`kept_apart` finds are unresolvable at once, and so is every set that
-    holds one (nature keeps that pair); :func:`~feederkit.planning.solvable.solve` decides
-    the rest from their pair sets together, those sets pruned.
+    The pairs :func:`~feederkit.machine.inseparable.kept_apart` finds are unresolvable at
+    once, and so is every set that holds one (nature keeps that pair);
+    :func:`~feederkit.planning.solvable.solve` decides the rest from their pair sets
+    together, those sets pruned.
     """
     pairs = candidate_pairs(problem)
-    kept = kept_apart(problem, pairs)
+    kept = kept_apart(problem.machine, pairs)
     rest = [p for p in pairs if p not in kept]
     found = set(kept)
     if rest:
@@ -254,7 +209,7 @@ def try_lumping(
         pairs = unresolvable_pairs(problem, deadline, pair_sets)
         exact = pairs is not None
         if pairs is None:
-            pairs = tuple(sorted(kept_apart(problem, candidate_pairs(problem))))
+            pairs = tuple(sorted(kept_apart(problem.machine, candidate_pairs(problem))))
         unlike = tuple(p for p in pairs if not may_lump(machine, *p, rule))
         pairs = tuple(p for p in pairs if may_lump(machine, *p, rule))
         if not pairs:
@@ -284,7 +239,8 @@ def lumped_goal(
 
     The lumped pairs are the :func:`unresolvable_pairs` that ``rule`` allows
     (:func:`may_lump`); when deciding them all takes more than ``pair_sets`` sets, the
-    allowed pairs :func:`kept_apart` finds (every one unresolvable, maybe not all;
+    allowed pairs :func:`~feederkit.machine.inseparable.kept_apart` finds (every one
+    unresolvable, maybe not all;
     ``LumpedGoal.exact`` False). None when lumping does not help or cannot be decided: the
     machine is ideal (a plan always exists there), the rule is ``none``, no pair is lumped
     (the set-level failure of the module docstring, or only pairs the rule leaves out), the
@@ -341,8 +297,6 @@ def unlike_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
 __all__ = [
     "LumpedGoal",
     "LumpingTry",
-    "candidate_pairs",
-    "kept_apart",
     "lumped",
     "lumped_goal",
     "lumped_words",

@@ -16,7 +16,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from feederkit.machine import members
+from feederkit.machine import Grouping, members
+from feederkit.machine.inseparable import kept_apart
 from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.problem import Problem
 
@@ -135,8 +136,42 @@ def unsolvable(
     return decide(problem, roots, deadline, max_sets)[0]
 
 
+def candidate_pairs(problem: Problem) -> list[tuple[int, int]]:
+    """The pairs a goal test can meet that are not inseparable.
+
+    With exact reading branching every set a plan reaches holds states that can all give one
+    reading, so only pairs that can read alike meet; the components rule can join states
+    that cannot (through a third), so there every pair is a candidate.
+    """
+    machine = problem.machine
+    sensor = machine.sensor
+    sensed = [s.sensed for s in machine.states]
+    exact = problem.grouping is Grouping.EXACT
+    return [
+        (i, j)
+        for i in range(machine.n)
+        for j in range(i + 1, machine.n)
+        if not problem.insep[i] >> j & 1
+        and (not exact or sensor.can_read_alike(sensed[i], sensed[j]))
+    ]
+
+
+def holding_kept_pairs(roots: list[int], kept: set[tuple[int, int]]) -> list[int]:
+    """The roots holding a pair of ``kept`` (pairs nature keeps apart,
+    :func:`~feederkit.machine.inseparable.kept_apart`): no strong plan orients them."""
+    if not kept:
+        return []
+    partner: dict[int, int] = {}
+    for i, j in kept:
+        partner[i] = partner.get(i, 0) | 1 << j
+    return [r for r in roots if any(partner.get(i, 0) & r for i in members(r))]
+
+
 def unsolvable_by_pairs(
-    problem: Problem, roots: list[int], deadline: Deadline | None = None, max_sets: int = MAX_SETS
+    problem: Problem,
+    roots: list[int],
+    deadline: Deadline | None = None,
+    max_sets: int = MAX_SETS,
 ) -> list[int] | None:
     """Roots holding a pair of states that no strong plan orients: a subset of a solvable
     set is solvable, so these roots are not (empty: every pair is; that proves nothing of the
@@ -150,7 +185,17 @@ def unsolvable_by_pairs(
     has no strong plan, the roots holding such a pair are the answer (some of the roots
     with none, not necessarily all). Both landings of a 20-part mix at 5 % under 1 degree:
     0.28 s instead of 3.2 s.
+
+    Before any search, the pairs nature can keep apart whatever the plan does
+    (:func:`~feederkit.machine.inseparable.kept_apart` over :func:`candidate_pairs`, one
+    fixpoint over all pairs): the roots holding one are the answer. The 50-part mix at 5 %
+    under 1 degree: the same 30 roots in 0.3 s, where the pairs' searches take 5.8 s.
     """
+    deadline = deadline or Deadline(None)
+    kept = kept_apart(problem.machine, candidate_pairs(problem), deadline.check)
+    held = holding_kept_pairs(roots, kept)
+    if held:
+        return held
     bad = _bad_pairs(problem, _pairs_within(problem, roots, NEIGHBOUR_PAIRS), deadline, max_sets)
     if bad is not None and not bad:
         bad = _bad_pairs(problem, _pairs_within(problem, roots, None), deadline, max_sets)
