@@ -105,7 +105,23 @@ def test_the_beam_keeps_the_actions_with_the_smallest_branches():
     kept = list(beam.actions_of(mask))
     assert len(kept) == min(2, len(every))
     assert [branch_key(a) for a in kept] == sorted(branch_key(a) for a in every)[: len(kept)]
+    # The very actions of the length view, ties in its order, made from the cells alone.
+    assert kept == sorted(every, key=branch_key)[:2]
     assert beam.cut == (len(every) > 2)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10**6), st.integers(6, 12), st.floats(0.005, 0.1))
+def test_the_beams_ranking_keeps_what_sorting_every_action_keeps(seed, n, rel):
+    machine = _random_part_machine(seed, n, rel)
+    problem, _branches, roots = _problem(machine)
+    for width in (1, 3, 8):
+        beam = BeamSearch(problem, width)
+        for mask in roots:
+            if problem.is_goal(mask):
+                continue
+            every = problem.choices.actions(mask)
+            assert list(beam.actions_of(mask)) == sorted(every, key=branch_key)[:width]
 
 
 def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):

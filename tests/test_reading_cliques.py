@@ -19,6 +19,7 @@ from feederkit.machine import Grouping, build_machine, members
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning import readings as readings_module
 from feederkit.planning.readings import Readings, _cells_are_runs
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import ToleranceSensor
@@ -72,6 +73,11 @@ def test_the_sweep_finds_the_maximal_sets_that_read_alike(readings, data):
     assert set(got) == _brute_force_maximal(readings, image)
     assert len(got) == len(set(got))
     assert [c.bit_count() for c in got] == sorted((c.bit_count() for c in got), reverse=True)
+    # The members in the order their runs end, by sorting them (large machines) instead
+    # of a scan of every state: the same sets in the same order.
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(readings_module, "CLIQUE_SCAN_STATES", 0)
+        assert readings._interval_cliques(image) == got
 
 
 def test_the_whole_machine_reads_as_its_reading_cells(readings):

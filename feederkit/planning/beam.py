@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
+from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Act, Problem
@@ -36,7 +37,12 @@ FIRST_WIDTH = 4
 def branch_key(act: Act) -> tuple[int, int]:
     """The beam's order of a set's actions: the smallest largest branch, then the fewest
     states over all branches (the most a reading can tell apart)."""
-    sizes = [c.bit_count() for c in act.children]
+    return _children_key(act.children)
+
+
+def _children_key(children: tuple[int, ...]) -> tuple[int, int]:
+    """:func:`branch_key` of an action with these branches."""
+    sizes = [c.bit_count() for c in children]
     return max(sizes), sum(sizes)
 
 
@@ -57,11 +63,23 @@ class BeamSearch(WorstCase):
         acts = self._beam.get(mask)
         if acts is None:
             choices = self.p.choices
-            exact = self.p.min_margin > 0.0  # margins are not monotone: every branch counts
-            every = choices.exact_actions(mask) if exact else choices.actions(mask)
-            if len(every) > self.width:
-                self.cut = True
-            acts = self._beam[mask] = tuple(sorted(every, key=branch_key)[: self.width])
+            if self.p.min_margin > 0.0:  # margins are not monotone: every branch counts
+                every = choices.exact_actions(mask)
+                self.cut |= len(every) > self.width
+                acts = tuple(sorted(every, key=branch_key)[: self.width])
+            else:
+                # Ranked from the cells and their branches; only the kept actions are made
+                # (a set has about a hundred on a near-round part, and the beam keeps four).
+                ranked = sorted(
+                    (*_children_key(children), k, cell, children)
+                    for k, (cell, children) in enumerate(choices.useful_cells(mask))
+                )
+                self.cut |= len(ranked) > self.width
+                acts = tuple(
+                    Act(OverlapRange(*cell), children)
+                    for *_key, cell, children in ranked[: self.width]
+                )
+            self._beam[mask] = acts
         return iter(acts)
 
 

@@ -258,31 +258,44 @@ class Choices:
             return
         state = self._lazy.get(mask)
         if state is None:
-            cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
-            state = self._lazy[mask] = [cells, 0, [], []]
-        cells, _, made, kept = state
+            state = self._lazy[mask] = [self.useful_cells(mask), []]
+        cells, made = state
         i = 0
         while True:
             if i < len(made):
                 yield made[i]
                 i += 1
-            elif state[1] < len(cells):
-                cell = cells[state[1]]
-                state[1] += 1
-                img = cell[2]
-                # Sorted by size: only an earlier image can lie inside this one. Only the
-                # first few (smallest) are tried: they dominate most, and the test is cheap.
-                if any(k & img == k for k in kept):
-                    continue
-                if len(kept) < _DOMINATORS:
-                    kept.append(img)
-                act = self.act(mask, cell)
-                if act is not None:
-                    made.append(act)
-            else:
+                continue
+            nxt = next(cells, None)
+            if nxt is None:
                 self._lazy.pop(mask, None)
                 self._actions.setdefault(mask, tuple(made))
                 return
+            cell, children = nxt
+            made.append(Act(OverlapRange(*cell), children))
+
+    def useful_cells(self, mask: int) -> Iterator[tuple[tuple[float, float, int], tuple[int, ...]]]:
+        """The cells of :meth:`lazy_actions` with their maximal branches, in its order and
+        with its tests (dominated images and branches holding the set left out), before any
+        action is made: a caller that ranks them makes only the actions it keeps."""
+        cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
+        kept: list[int] = []
+        readings = self.readings
+        for cell in cells:
+            img = cell[2]
+            # Sorted by size: only an earlier image can lie inside this one. Only the
+            # first few (smallest) are tried: they dominate most, and the test is cheap.
+            if any(k & img == k for k in kept):
+                continue
+            if len(kept) < _DOMINATORS:
+                kept.append(img)
+            if readings.sensorless:
+                yield cell, (img,)
+                continue
+            children = readings.children(img)
+            if any(c & mask == mask for c in children):
+                continue
+            yield cell, children
 
     def targets(self, mask: int, sa: OverlapRange) -> tuple[int, ...]:
         """Where each member of ``mask`` (ascending) can go under the range's representative:

@@ -22,6 +22,8 @@ Planner and statistics use this same model.
 
 from __future__ import annotations
 
+import bisect
+
 from feederkit.machine import Grouping, PushAlignMachine, ReadingBranch, members, search_space
 
 
@@ -37,6 +39,11 @@ def maximal_sets(masks) -> tuple[int, ...]:
         if not any(m & o == m for o in out):
             out.append(m)
     return tuple(out)
+
+
+CLIQUE_SCAN_STATES = 128
+"""Up to this many states an image's members are taken in the order their reading runs end
+by one scan of the machine's states; above it, by sorting the members."""
 
 
 class Readings:
@@ -69,8 +76,9 @@ class Readings:
         self._runs = False
         """Whether each state's reading cells are one run of consecutive cells: the
         branches of an image are then the cliques of intervals (:meth:`_interval_cliques`)."""
-        self._span_begin: list[int] = []
         self._span_end: list[int] = []
+        self._end_order: list[int] = []
+        self._open_at: list[int] = []
         if exact and not self.sensorless:
             cells = self._space.branches(full, Grouping.EXACT)
             self._cell_masks = [b.mask for b in cells]
@@ -81,8 +89,9 @@ class Readings:
                     span[i][1] = max(span[i][1], c + 1)
             self._cell_span = [(a, b) for a, b in span]
             self._runs = _cells_are_runs(self._cell_masks, self._cell_span)
-            self._span_begin = [a for a, _b in self._cell_span]
             self._span_end = [b for _a, b in self._cell_span]
+            self._end_order = sorted(range(machine.n), key=self._span_end.__getitem__)
+            self._open_at = _open_at_ends(self._cell_span)
         self._branches: dict[int, tuple[ReadingBranch, ...]] = {}
         self._maximal: dict[int, tuple[int, ...]] = {}
         self._all: dict[int, tuple[int, ...]] = {}
@@ -227,34 +236,29 @@ class Readings:
         """The maximal reading branches of an image when each state's reading cells are a
         run (``_cell_span``): the maximal cliques of those intervals, by one sweep.
 
-        Sweeping the cells in order, the states read together form the set of runs begun
-        and not yet ended; just before a run ends, after a run began since the last end,
-        that set is maximal (no run left out meets both the last begun and the ending one),
-        and every maximal set is met so (the interval graphs' maximal cliques, Gilmore and
-        Hoffman 1964). Largest first, then along the reading axis. The same sets as
-        :func:`maximal_sets` of ``_restricted_cells``, in O(m log m) for m states instead of
-        a look at every cell and every pair of sets.
+        Just before a member's run ends, the members read together are those begun before
+        that cell and not ended before it (``_open_at[e] & image``). Taken in the order the
+        runs end, such a set is maximal exactly when a member began since the previous end
+        (it is then not inside the previous set; no run left out meets both the last begun
+        and the ending one), and every maximal set is met so (the interval graphs' maximal
+        cliques, Gilmore and Hoffman 1964). Largest first, then along the reading axis. The
+        same sets as :func:`maximal_sets` of ``_restricted_cells``, without a look at every
+        cell and every pair of sets.
         """
-        idx = members(image)
-        if len(idx) == 1:
+        if image & (image - 1) == 0:
             return (image,)
-        begin, end = self._span_begin, self._span_end
-        begins = sorted(idx, key=begin.__getitem__)
+        if self.machine.n <= CLIQUE_SCAN_STATES:
+            ends = [e for e in self._end_order if image >> e & 1]
+        else:
+            ends = sorted(members(image), key=self._span_end.__getitem__)
+        open_at = self._open_at
         out = []
-        active = 0
-        grew = False
-        j = 0
-        last = len(begins)
-        for e in sorted(idx, key=end.__getitem__):
-            stop = end[e]
-            while j < last and begin[begins[j]] < stop:
-                active |= 1 << begins[j]
-                j += 1
-                grew = True
-            if grew:
-                out.append(active)
-                grew = False
-            active ^= 1 << e
+        last = 0
+        for e in ends:
+            c = image & open_at[e]
+            if c & last != c:
+                out.append(c)
+            last = c
         if len(out) > 1:
             out.sort(key=int.bit_count, reverse=True)
         return tuple(out)
@@ -342,6 +346,27 @@ class Readings:
 
 
 _UNSET = object()
+
+
+def _open_at_ends(span: list[tuple[int, int]]) -> list[int]:
+    """Per state, the states whose runs of cells hold the last cell of its own run
+    (``a <= end - 1 < b``): begun before its end and not ended before it. Prefix masks over
+    the states by begin and suffix masks by end, one bisection each."""
+    n = len(span)
+    by_begin = sorted(range(n), key=lambda i: span[i][0])
+    by_end = sorted(range(n), key=lambda i: span[i][1])
+    begins = [span[i][0] for i in by_begin]
+    ends = [span[i][1] for i in by_end]
+    begun = [0]  # begun[k]: the first k states by begin
+    for i in by_begin:
+        begun.append(begun[-1] | 1 << i)
+    left = [0] * (n + 1)  # left[k]: the states from the k-th by end on
+    for k in range(n - 1, -1, -1):
+        left[k] = left[k + 1] | 1 << by_end[k]
+    out = []
+    for _a, b in span:
+        out.append(begun[bisect.bisect_left(begins, b)] & left[bisect.bisect_left(ends, b)])
+    return out
 
 
 def _cells_are_runs(cell_masks: list[int], span: list[tuple[int, int]]) -> bool:
