@@ -122,6 +122,7 @@ def test_the_fallback_answers_with_it_when_nothing_else_finds_a_plan(monkeypatch
     # the plan in hand, and the depth-first search only looks for something shorter.
     monkeypatch.setattr(api, "longest_root", out_of_time)
     monkeypatch.setattr(api, "beam_plan", lambda *_args, **_kwargs: None)
+    monkeypatch.setattr(api, "sequential_plan", lambda *_args: None)
     made = []
     real = api.pairwise_plan
 

@@ -183,7 +183,7 @@ class WorstCase:
         no more operations, and a part's states only reach states of that part). 0 for
         parts that are not push functions (outcome sets, or goals other than symmetry)."""
         if self._chains is None:
-            self._chains = _part_chains(self.p)
+            self._chains = part_chains(self.p)
             self._chain_of = {i: c for c in self._chains for i in c[1]}
         chains = self._chains
         if mask.bit_count() < len(chains):
@@ -294,7 +294,7 @@ class WorstCase:
         return k
 
 
-def _part_chains(problem: Problem) -> list[tuple[int, dict[int, int], object]]:
+def part_chains(problem: Problem) -> list[tuple[int, dict[int, int], object]]:
     """Per part whose states form a push function with the goal its symmetry: the mask of
     its states, their local numbers and the part's backchaining table."""
     from feederkit.planning.sensorless import Backchain, push_circle  # sensorless imports us

@@ -44,6 +44,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
+from feederkit.planning.sequential import sequential_plan
 from feederkit.planning.solvable import decide, unsolvable, unsolvable_by_pairs
 from feederkit.planning.stats import (
     expected_operations,
@@ -533,7 +534,9 @@ def _fallback(
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
     within ``READ_SHARE`` of what is left, when it is shorter); else, on the ideal model, the
-    plan that tells the states apart one pair at a time (within ``PAIRWISE_SHARE``); the
+    parts' chains in turn (:func:`~feederkit.planning.sequential.sequential_plan`, when the
+    readings after them leave goals), else the plan that tells the states apart one pair at
+    a time (within ``PAIRWISE_SHARE``); the
     widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
     shorter; with a plan in hand, the hardest subsets' bound
     (:func:`~feederkit.planning.subsets.subset_lower_bound`); then a depth-first search (the
@@ -570,6 +573,13 @@ def _fallback(
             read = None
         if read is not None and tree_length(read) < tree_length(blind):
             blind = read
+    if blind is None:
+        try:  # several parts on the ideal model: each part's backchaining chain in turn
+            blind = sequential_plan(problem, root_branches, budget.ending(None))
+        except Timeout:
+            blind = None
+        if blind is not None and tree_length(blind) > FALLBACK_MAX_OPERATIONS:
+            blind = None
     held = _Held(budget)  # the plan in hand's verification comes out of the time left
     held.hold(blind)
     if blind is None and pairwise_applies(problem):
