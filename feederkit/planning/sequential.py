@@ -13,10 +13,10 @@ readings after its last operation are kept, and each must leave a goal: the part
 apart there, or their last classes are inseparable (both landings of a part whose readings
 carry nothing, where no plan tells up from down). Otherwise there is no such plan.
 
-This is a first plan where the exact search runs out: both landings of a random 1000-point
-outline at 3 % on the ideal model (32 states, readings that carry nothing) need 22
-operations each by backchaining, and the plan that tells the states apart one pair at a
-time (:mod:`feederkit.planning.pairwise`) takes 69.
+This is a first plan where the exact search runs out: on both landings of a random
+1000-point outline at 3 % on the ideal model the chains give 39 operations in 0.1 s, where
+the plan that tells the states apart one pair at a time (:mod:`feederkit.planning.pairwise`)
+takes 69 in 6 s.
 
 References
 ----------
