@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import random
 
+from feederkit.machine import OutcomeRange, PushAlignMachine
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
@@ -53,3 +54,33 @@ def one_line_error(capsys, args: list[str], code: int = 2) -> str:
     assert rc == code, err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     return err
+
+
+def rotation_mids(machine: PushAlignMachine) -> list[float]:
+    """One rotation per cell of all the machine's action-range boundaries (the cells' middles,
+    deg): what the brute-force models of the tests try, looked up here, not in the library."""
+    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
+    return [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+
+
+def outcome_mask(machine: PushAlignMachine, i: int, a: float) -> int:
+    """The states (a mask) state ``i`` can settle in after rotating by ``a`` degrees, read
+    from its action ranges by the tests' own lookup."""
+    for r in machine.action_maps[i]:
+        if 0 < (a - r.lo) % 360 < r.hi - r.lo:
+            return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
+    raise AssertionError("no range holds the rotation")
+
+
+def read_alike_sets(intervals: dict[int, tuple[float, float]]) -> list[int]:
+    """The sets of states (masks, ascending) that can give one reading, from each state's
+    open reading interval: between consecutive interval ends the states that can read there
+    are fixed, so one probe per gap finds every such set (the tests' own reading model)."""
+    ends = sorted({x for iv in intervals.values() for x in iv})
+    found = set()
+    for a, b in zip(ends, ends[1:], strict=False):
+        x = (a + b) / 2.0
+        m = sum(1 << i for i, (lo, hi) in intervals.items() if lo < x < hi)
+        if m:
+            found.add(m)
+    return sorted(found)

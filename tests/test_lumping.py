@@ -14,6 +14,7 @@ import random
 from pathlib import Path
 
 import pytest
+from shared import outcome_mask, read_alike_sets, rotation_mids
 
 import feederkit.planning.api as api
 from feederkit.machine import (
@@ -207,14 +208,10 @@ def brute(machine: PushAlignMachine, tol: float | None, goal_pairs: set[tuple[in
     """``solvable(mask)``: whether a strong plan takes ``mask`` to a set whose pairs are all
     in ``goal_pairs`` (own code, see the module docstring)."""
     n = machine.n
-    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
-    mids = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+    mids = rotation_mids(machine)
 
     def out(i, a):
-        for r in machine.action_maps[i]:
-            if 0 < (a - r.lo) % 360 < r.hi - r.lo:
-                return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
-        raise AssertionError("no range holds the rotation")
+        return outcome_mask(machine, i, a)
 
     def sensed(i):
         d = machine.states[i].sensed
@@ -223,15 +220,7 @@ def brute(machine: PushAlignMachine, tol: float | None, goal_pairs: set[tuple[in
     def children(mask):
         if tol is None:
             return [mask]
-        ivs = {i: (sensed(i)[0] - tol, sensed(i)[1] + tol) for i in members(mask)}
-        ends = sorted({x for iv in ivs.values() for x in iv})
-        found = set()
-        for a, b in zip(ends, ends[1:], strict=False):
-            x = (a + b) / 2
-            m = sum(1 << i for i, (lo, hi) in ivs.items() if lo < x < hi)
-            if m:
-                found.add(m)
-        return sorted(found)
+        return read_alike_sets({i: (sensed(i)[0] - tol, sensed(i)[1] + tol) for i in members(mask)})
 
     def goal(mask):
         idx = members(mask)

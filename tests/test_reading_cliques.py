@@ -13,6 +13,7 @@ import random
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared import read_alike_sets
 
 from feederkit.landing.model import landings_of_outline
 from feederkit.machine import Grouping, build_machine, members
@@ -49,18 +50,11 @@ def readings(request):
 
 
 def _brute_force_maximal(readings: Readings, image: int) -> set[int]:
-    """The maximal sets of the image's states that can give one reading: each state's
-    reading set is an open interval; between consecutive ends the states that can read
-    there are fixed, so one probe per gap finds every such set."""
+    """The maximal sets of the image's states that can give one reading, from the sensor's
+    reading intervals (:func:`shared.read_alike_sets`, one probe per gap between ends)."""
     sensor = readings.machine.sensor
     spans = {i: sensor.reading_interval(readings.machine.states[i].sensed) for i in members(image)}
-    ends = sorted({x for lo_hi in spans.values() for x in lo_hi})
-    sets = set()
-    for a, b in zip(ends, ends[1:], strict=False):
-        x = (a + b) / 2.0
-        s = sum(1 << i for i, (lo, hi) in spans.items() if lo < x < hi)
-        if s:
-            sets.add(s)
+    sets = set(read_alike_sets(spans))
     return {s for s in sets if not any(s != o and s & o == s for o in sets)}
 
 

@@ -17,10 +17,11 @@ import random
 from functools import cache
 
 import pytest
+from shared import outcome_mask, read_alike_sets, rotation_mids
 
 from feederkit.cli.app import main
 from feederkit.errors import CheckFailed, PlanningError
-from feederkit.machine import OutcomeRange, build_machine, inseparable
+from feederkit.machine import build_machine, inseparable
 from feederkit.mechanics import push_function
 from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.outline import make_outline
@@ -295,14 +296,10 @@ def exhaustive_length(machine, tol, lumped=()):
         idx = [i for i in range(n) if mask >> i & 1]
         return all(frozenset((a, b)) in lumps for k, a in enumerate(idx) for b in idx[k + 1 :])
 
-    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
-    mids = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+    mids = rotation_mids(machine)
 
     def out(i, a):
-        for r in machine.action_maps[i]:
-            if 0 < (a - r.lo) % 360 < r.hi - r.lo:
-                return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
-        raise AssertionError
+        return outcome_mask(machine, i, a)
 
     def intervals(mask):
         return {
@@ -314,15 +311,7 @@ def exhaustive_length(machine, tol, lumped=()):
     def children(mask):
         if tol is None:
             return [mask]
-        ivs = intervals(mask)
-        ends = sorted({x for iv in ivs.values() for x in iv})
-        out_ = set()
-        for a, b in zip(ends, ends[1:], strict=False):
-            x = (a + b) / 2
-            m = sum(1 << i for i, (lo, hi) in ivs.items() if lo < x < hi)
-            if m:
-                out_.add(m)
-        return sorted(out_)
+        return read_alike_sets(intervals(mask))
 
     memo = {}
 

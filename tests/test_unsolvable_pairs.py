@@ -14,9 +14,10 @@ from __future__ import annotations
 import math
 
 import pytest
+from shared import outcome_mask, rotation_mids
 from test_strong_plans import random_pf
 
-from feederkit.machine import OutcomeRange, build_machine
+from feederkit.machine import build_machine
 from feederkit.machine.inseparable import kept_apart
 from feederkit.planning import api, solvable
 from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
@@ -126,15 +127,11 @@ def _kept_apart_by_definition(machine, goal) -> set[tuple[int, int]]:
     rotation (one per cell of all the machine's action boundaries) have some outcome of each
     making a different pair again in it: repeated until nothing changes."""
     n = machine.n
-    bounds = sorted({r.lo % 360 for rs in machine.action_maps for r in rs})
-    mids = [(a + b) / 2 for a, b in zip(bounds, bounds[1:] + [bounds[0] + 360], strict=True)]
+    mids = rotation_mids(machine)
 
     def out(i, a):
-        for r in machine.action_maps[i]:
-            if 0 < (a - r.lo) % 360 < r.hi - r.lo:
-                t = r.targets if isinstance(r, OutcomeRange) else 1 << r.target
-                return [k for k in range(n) if t >> k & 1]
-        raise AssertionError
+        t = outcome_mask(machine, i, a)
+        return [k for k in range(n) if t >> k & 1]
 
     sensor = machine.sensor
     rel = {
