@@ -38,10 +38,10 @@ def test_tolerance_design_json(capsys):
     x = data["critical_tolerance_mm"]
     assert data["sensor_model"] == "tolerance" and x > 0
     assert data["cell_profile"] == "built-in defaults"
+    # Every landing is a member of the mix, as plan plans it (design.md, "Landings").
+    members = [f"{Path(m).stem}/{side}" for m in MIX for side in ("up", "down")]
     assert [(p["a"], p["b"]) for p in data["pairs"]] == [
-        ("quadrilateral", "rectangle-2x1"),
-        ("quadrilateral", "l-bracket"),
-        ("rectangle-2x1", "l-bracket"),
+        (a, b) for i, a in enumerate(members) for b in members[i + 1 :]
     ]
     assert x == min(p["critical_tolerance_mm"] for p in data["pairs"])
     rows = data["lengths"]
@@ -105,7 +105,8 @@ def test_a_lookalike_pair_exits_1_naming_lemma_8(capsys, tmp_path):
     capsys.readouterr()
     data, err = run_json(capsys, ["design", "sensor", src, str(twin), "--json"], code=1)
     assert data["critical_tolerance_mm"] is None and data["lengths"] == []
-    assert "Lemma 8" in data["pairs"][0]["reason"]
+    alike = {(p["a"], p["b"]) for p in data["pairs"] if "Lemma 8" in p.get("reason", "")}
+    assert alike == {("quadrilateral/up", "twin/up"), ("quadrilateral/down", "twin/down")}
     assert len(err.strip().splitlines()) == 1 and "Lemma 8" in err
 
 
@@ -129,7 +130,10 @@ def test_bad_options_are_one_line_exit_2(capsys, args, needle):
 
 
 def test_bad_mixes_and_profiles_are_one_line_exit_2(capsys, tmp_path):
-    assert "at least two parts" in one_line_error(capsys, ["design", "sensor", MIX[0]])
+    err = one_line_error(capsys, ["design", "sensor", MIX[0], "--landings", "up"])
+    assert "at least two parts" in err
+    err = one_line_error(capsys, ["design", "sensor", *MIX, "--landings", "x"])
+    assert "invalid landing" in err
     assert "SOURCE" in one_line_error(capsys, ["design", "sensor"])
     assert "not both" in one_line_error(capsys, ["design", "sensor", MIX[0], "--mix", "a,b"])
     assert "part names only" in one_line_error(capsys, ["design", "sensor", "--mix", "a:0.7,b"])
@@ -147,3 +151,40 @@ def test_a_shorter_table_says_where_it_stops(capsys):
     top = data["lengths"][-1]["tolerance_mm"][1]
     assert 0.1 <= top < data["critical_tolerance_mm"]
     assert f"tabulated up to {top:.6g} mm only" in data["answer"]
+
+
+def mirrored(src: str, out: Path) -> Path:
+    """The outline of ``src`` mirrored in the y axis: its face-down landing, named anew."""
+    data = json.loads(Path(src).read_text())
+    data["name"] = out.stem
+    data["vertices"] = [[-x, y] for x, y in data["vertices"]][::-1]
+    data["holes"] = [[[-x, y] for x, y in h][::-1] for h in data.get("holes", [])]
+    out.write_text(json.dumps(data))
+    return out
+
+
+def test_the_design_covers_every_landing_as_plan_does(capsys, tmp_path):
+    """A part and its mirror image read alike face up against face down: no sensor tells
+    them apart, as ``plan`` says; face up only (``--landings up``) one does."""
+    bracket = str(CATALOG / "l-bracket.json")
+    mirror = str(mirrored(bracket, tmp_path / "l-bracket-mirror.json"))
+    data, err = run_json(capsys, ["design", "sensor", bracket, mirror, "--json"], code=1)
+    alike = {(p["a"], p["b"]) for p in data["pairs"] if "Lemma 8" in p.get("reason", "")}
+    assert alike == {
+        ("l-bracket/up", "l-bracket-mirror/down"),
+        ("l-bracket/down", "l-bracket-mirror/up"),
+    }
+    assert "no tolerance makes this mix recognizable" in err
+    assert main(["plan", bracket, mirror, "--tolerance", "0.2", "--time-limit", "20"]) == 1
+    capsys.readouterr()
+    up, _ = run_json(capsys, ["design", "sensor", bracket, mirror, "--landings", "up", "--json"])
+    assert up["critical_tolerance_mm"] > 0
+
+
+def test_the_length_table_is_the_plans_length(capsys):
+    """The design's length at a tolerance is the length ``plan`` finds there."""
+    data, _ = run_json(capsys, ["design", "sensor", *MIX, "--json"])
+    for row in data["lengths"]:
+        lo, hi = row["tolerance_mm"]
+        plan, _ = run_json(capsys, ["plan", *MIX, "--tolerance", f"{(lo + hi) / 2:.6g}", "--json"])
+        assert plan["stats"]["length"] == row["length"], row

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from feederkit.cli.app import main
+from feederkit.landing.model import landings_of_outline
 from feederkit.mechanics.push import push_function
 from feederkit.plans.verify import verify_plan
 from feederkit.sources import load_part
@@ -39,7 +40,7 @@ def run_json(capsys, args, code=0):
     return json.loads(captured.out)
 
 
-def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys):
+def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys, tmp_path):
     # Exit 1: a result to act on (design.md), the pair of look-alikes.
     data = run_json(
         capsys,
@@ -47,17 +48,26 @@ def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys):
         code=1,
     )
     counts = data["counts"]
-    assert counts["parts"] == len(list(CATALOG.glob("*.json"))) + 1
+    # Every landing is a member, as plan plans a mix (design.md, "Landings").
+    assert data["members"] == "landings"
+    parts = [*CATALOG.glob("*.json"), tmp_path / "quad-twin.json"]
+    landings = sum(len(landings_of_outline(load_part(str(p)))) for p in parts)
+    assert counts["parts"] == landings > len(parts)
     push_sets = [set(c["members"]) for c in data["push_classes"]]
-    assert {"equilateral-triangle", "heptagon-fig17"} in push_sets
-    assert {"quadrilateral", "quad-twin"} in push_sets
+    assert {"equilateral-triangle/up", "heptagon-fig17/up", "heptagon-fig17/down"} in push_sets
+    assert {"quadrilateral/up", "quad-twin/up"} in push_sets
+    assert {"quadrilateral/down", "quad-twin/down"} in push_sets
     assert [set(c["members"]) for c in data["push_diameter_classes"]] == [
-        {"quadrilateral", "quad-twin"}
+        {"quadrilateral/up", "quad-twin/up"},
+        {"quadrilateral/down", "quad-twin/down"},
     ]
     pairs = data["unrecognizable_pairs"]
-    assert len(pairs) == counts["unrecognizable_pairs"] == 1
-    assert {pairs[0]["part_a"], pairs[0]["part_b"]} == {"quadrilateral", "quad-twin"}
-    assert "Lemma 8" in pairs[0]["reason"]
+    assert len(pairs) == counts["unrecognizable_pairs"] == 2
+    assert {frozenset((p["part_a"], p["part_b"])) for p in pairs} == {
+        frozenset(("quadrilateral/up", "quad-twin/up")),
+        frozenset(("quadrilateral/down", "quad-twin/down")),
+    }
+    assert all("Lemma 8" in p["reason"] for p in pairs)
     assert set(pairs[0]) == {"part_a", "part_b", "states_a", "states_b", "reason"}
 
 
@@ -198,4 +208,29 @@ def test_analyze_with_an_led_array(db, capsys):
     data = run_json(capsys, [*args, "--catalog", str(db)], code=1)
     assert data["sensor"] == {"model": "led", "pitch_mm": 0.05, "noise_mm": 0.005}
     pairs = {frozenset((p["part_a"], p["part_b"])) for p in data["unrecognizable_pairs"]}
-    assert frozenset(("quadrilateral", "quad-twin")) in pairs
+    assert frozenset(("quadrilateral/up", "quad-twin/up")) in pairs
+
+
+def test_analyze_finds_a_part_and_its_mirror_image(tmp_path, capsys):
+    """A left and a right bracket read alike face up against face down: ``plan`` cannot tell
+    them apart, and neither can the analysis (it once looked at the parts face up only)."""
+    path = tmp_path / "mirror.db"
+    data = json.loads((CATALOG / "l-bracket.json").read_text())
+    data["name"] = "l-bracket-mirror"
+    data["vertices"] = [[-x, y] for x, y in data["vertices"]][::-1]
+    data["holes"] = [[[-x, y] for x, y in h][::-1] for h in data.get("holes", [])]
+    mirror = tmp_path / "l-bracket-mirror.json"
+    mirror.write_text(json.dumps(data))
+    for src in (CATALOG / "l-bracket.json", mirror):
+        assert main(["catalog", "add", str(src), "--catalog", str(path)]) == 0
+    capsys.readouterr()
+    args = ["catalog", "analyze", "--tolerance", "0.2", "--json", "--catalog", str(path)]
+    out = run_json(capsys, args, code=1)
+    pairs = {frozenset((p["part_a"], p["part_b"])) for p in out["unrecognizable_pairs"]}
+    assert pairs == {
+        frozenset(("l-bracket/up", "l-bracket-mirror/down")),
+        frozenset(("l-bracket/down", "l-bracket-mirror/up")),
+    }
+    assert main(["plan", "l-bracket", "l-bracket-mirror", "--tolerance", "0.2",
+                 "--catalog", str(path), "--time-limit", "20"]) == 1  # fmt: skip
+    assert "cannot tell these landings apart" in capsys.readouterr().err

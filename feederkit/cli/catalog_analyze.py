@@ -11,8 +11,13 @@ from pathlib import Path
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.catalog import get_part as catalog_get_part
-from feederkit.catalog import list_parts, open_catalog, resolve_catalog_path
+from feederkit.catalog import (
+    get_revision,
+    list_parts,
+    open_catalog,
+    part_from_revision,
+    resolve_catalog_path,
+)
 from feederkit.cli.common import (
     CatalogOpt,
     JsonOpt,
@@ -29,9 +34,12 @@ from feederkit.cli.common import (
 )
 from feederkit.cli.plan_render import sensor_text
 from feederkit.errors import CheckFailed, InputError
+from feederkit.importers.orientable import orientability
+from feederkit.landing.model import Landing, landings_of_outline
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
 from feederkit.mix.pairs import PairWitness
+from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
 
 
@@ -46,12 +54,20 @@ def catalog_file(option: Path | None) -> Path:
     return path
 
 
-def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str]]:
-    """Push functions of every orientable part's latest revision; a warning per part left out."""
+def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]:
+    """Push functions of every landing of every orientable part's latest revision, a
+    warning per part (or mesh pose) left out, and whether the members are the landings.
+
+    design.md, "Landings": plans cover every landing unless told otherwise, so the analysis
+    is of the mix ``plan`` would plan: when some part has several landings, each landing is
+    a member named ``PART/LANDING`` (a part and its mirror image read alike face up against
+    face down, and one part's sides must be told apart too); else the parts themselves.
+    """
     conn = open_catalog(path)
     try:
         summaries = list_parts(conn)
-        pfs, skipped = [], []
+        per_part: list[tuple[Part, tuple[Landing, ...]]] = []
+        skipped = []
         with progress_bar() as progress:
             task = progress.add_task("reading parts", total=len(summaries))
             for s in summaries:
@@ -61,10 +77,21 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str]]:
                     continue
                 # Rows are validated when read (COM strictly inside a convex hull), so every
                 # stored orientable part has a push function.
-                pfs.append(push_function(catalog_get_part(conn, s.name, s.revision)))
+                rev = get_revision(conn, s.name, s.revision)
+                part = part_from_revision(rev)
+                per_part.append((part, rev.landings or landings_of_outline(part)))
     finally:
         conn.close()
-    return pfs, skipped
+    if not any(len(lands) > 1 for _, lands in per_part):
+        return [push_function(part) for part, _ in per_part], skipped, False
+    pfs = []
+    for _, lands in per_part:
+        for x in lands:
+            if x.name.startswith("pose-") and not orientability(x.part, None).orientable:
+                skipped.append(f"{x.label}: not orientable by pushing, left out")
+                continue
+            pfs.append(push_function(x.part))
+    return pfs, skipped, True
 
 
 def analyze_command(
@@ -79,28 +106,32 @@ def analyze_command(
     catalog's parts, and with a sensor every pair of parts no plan can tell apart, with its
     witness: the states that can never be told apart and why (decided exactly).
 
+    Every landing of every part is a member, as ``plan`` plans a mix (a flat part face up
+    and face down: a part and its mirror image read alike face up against face down).
+
     Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    pfs, skipped = load_catalog_parts(catalog_file(catalog))
+    pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
     with err_console.status("analyzing ..."):
         result = analyze_mix(pfs, sensor)
     if json_out:
         data = result.to_dict()
         data["skipped"] = skipped
+        data["members"] = "landings" if over_landings else "parts"
         print_json(data)
     else:
         for line in skipped:
             err_console.print(f"warning: {line}", highlight=False, markup=False)
-        _print_report(result, pfs)
+        _print_report(result, pfs, over_landings)
     if result.pairs:
         n = len(result.pairs)
         named = "; ".join(f"{w.part_a} & {w.part_b}" for w in result.pairs[:5])
         more = f" and {n - 5} more" if n > 5 else ""
         raise CheckFailed(
-            f"{plural(n, 'pair')} of parts no plan can tell apart with this sensor: {named}{more}; "
-            + _advice({w.kind for w in result.pairs})
+            f"{plural(n, 'pair')} of {'landings' if over_landings else 'parts'} no plan can tell "
+            f"apart with this sensor: {named}{more}; " + _advice({w.kind for w in result.pairs})
         )
 
 
@@ -117,10 +148,11 @@ def _advice(kinds: set[str]) -> str:
     return "keep them out of one mix or use a finer sensor"
 
 
-def _print_report(result: MixAnalysis, pfs: list[PushFunction]) -> None:
+def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: bool) -> None:
     c = result.counts()
     summary = Table(title="catalog analysis (section 8)", show_header=False)
-    summary.add_row("parts", str(c["parts"]))
+    # Over landings each member is a part face up or face down (or a mesh pose).
+    summary.add_row("landings" if over_landings else "parts", str(c["parts"]))
     summary.add_row("sensor", sensor_text(result.sensor))
     summary.add_row(
         "tolerances",

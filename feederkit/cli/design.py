@@ -3,13 +3,15 @@
 A thin layer over :mod:`feederkit.design`: read the cell profile (``--cell FILE`` or
 ``./feederkit.toml``) and the command line's overrides, with the declared uncertainty
 (``--rotation-error``, ``--shape-tolerance``, ``--com-tolerance``, as ``plan`` takes them),
-load the parts, decide the critical tolerances (or each LED pitch) for strong plans at that
-uncertainty, print the tables, the one-line answer, the profile and the uncertainty used,
-and exit 1 when no sensor in the range makes the mix recognizable (docs/design.md). While
-it runs, a progress bar on stderr (on a terminal only, so ``--json`` output stays clean)
-shows the pairs decided, then the length table; past ``--time-limit`` it stops with one
-line saying what was decided (exit 1), after printing the pairs' table when every pair was
-decided (a tolerance sensor's design without its length table).
+load the parts with their landings (each landing one member of the mix, as ``plan`` plans
+it; ``--landings`` picks them), decide the critical tolerances (or each LED pitch) for
+strong plans at that uncertainty, print the tables, the one-line answer, the profile and
+the uncertainty used, and exit 1 when no sensor in the range makes the mix recognizable
+(docs/design.md). While it runs, a progress bar on stderr (on a terminal only, so
+``--json`` output stays clean) shows the pairs decided, then the length table; past
+``--time-limit`` it stops with one line saying what was decided (exit 1), after printing
+the pairs' table when every pair was decided (a tolerance sensor's design without its
+length table).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from feederkit.cli.common import (
     CatalogOpt,
     ComToleranceOpt,
     JsonOpt,
+    LandingsOpt,
     ShapeToleranceOpt,
     console,
     default_memory_limit,
@@ -45,7 +48,9 @@ from feederkit.design.sensor import (
     design_tolerance,
 )
 from feederkit.errors import InputError
-from feederkit.loading import load_parts
+from feederkit.landing.plan import landing_names, load_landings
+from feederkit.mechanics import push_function
+from feederkit.mix.changeover import plans_over_landings
 
 design_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -145,12 +150,17 @@ def sensor_command(
             "time limit (default: half the machine's memory).",
         ),
     ] = None,
+    landings: LandingsOpt = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
     """The exact critical tolerance (or LED pitch) of a mix and its pairs (Theorem 9), and
     the optimal plan length as a step function of the tolerance, for strong plans at the
-    declared uncertainty (``--rotation-error``, default 1 degree; all 0: the ideal model)."""
+    declared uncertainty (``--rotation-error``, default 1 degree; all 0: the ideal model).
+
+    Every landing of every part is a member of the mix, as ``plan`` plans it (a flat part
+    face up and face down, a mesh in each resting pose; ``--landings up`` designs for the
+    parts face up only)."""
     names = list(sources or [])
     if mix is not None:
         if names:
@@ -160,9 +170,7 @@ def sensor_command(
         raise InputError("no parts: give SOURCE... or --mix A,B,...")
     profile = load_cell(cell)
     r = profile.robot.rotation_error_deg if rotation_error is None else rotation_error
-    if not 0.0 <= r < 180.0:
-        raise InputError(f"--rotation-error must be in [0, 180) degrees, got {r}")
-    uncertainty = uncertainty_option(r, shape_tolerance, com_tolerance)
+    uncertainty = uncertainty_option(r, shape_tolerance, com_tolerance)  # validates r
     led = pitches is not None or profile.sensor.model == "led"
     if not led and noise is not None:
         raise InputError("--noise goes with --pitches (or a profile with an LED array)")
@@ -179,8 +187,19 @@ def sensor_command(
     with flag_words():
         check_limits(time_limit, memory_limit)
 
-    loaded = load_parts(names, catalog=catalog)
-    pfs = list(loaded.push_functions)
+    with flag_words():
+        which = "all" if landings in (None, "all") else landing_names(landings)
+        found = load_landings(names, catalog=catalog, which=which)
+    loaded = found.parts
+    # design.md: plans cover every landing unless told otherwise, so the design is of the
+    # mix whose members are the landings, as ``plan`` and ``changeover compile`` plan it.
+    over_landings = plans_over_landings(found.landings, landings is not None, False)
+    if over_landings:
+        pfs = [push_function(x.part) for x in found.all]
+    else:
+        pfs = list(loaded.push_functions)
+    # The design's expected figures weigh its members alike (plan weighs each part's landings).
+    members = "landings" if over_landings else "parts"
     design: ToleranceDesign | PitchDesign
     with progress_bar() as bar, flag_words():
         tasks: dict[str, Any] = {}
@@ -229,9 +248,9 @@ def sensor_command(
         print_json(data)
     else:
         if isinstance(design, ToleranceDesign):
-            _print_tolerance(design)
+            _print_tolerance(design, members)
         else:
-            _print_pitches(design)
+            _print_pitches(design, members)
         model = "" if uncertainty.is_ideal else " (the figures are for strong plans)"
         console.print(
             f"cell profile: {profile.source}; uncertainty: "
@@ -274,13 +293,13 @@ def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
     return table
 
 
-def _print_tolerance(design: ToleranceDesign) -> None:
+def _print_tolerance(design: ToleranceDesign, members: str) -> None:
     console.print(_pairs_table(design))
     what = "optimal plan length" if design.uncertainty.is_ideal else "optimal strong plan length"
     table = Table(title=f"{what} by tolerance (each step holds on (lo, hi])")
     table.add_column("tolerance (mm)")
     table.add_column("length", justify="right")
-    table.add_column("expected (at hi; parts equally likely)", justify="right")
+    table.add_column(f"expected (at hi; {members} equally likely)", justify="right")
     for s in design.steps:
         hi = "..." if s.hi is None else f"{s.hi:.6g}"
         length = "no strong plan" if s.length is None else str(s.length)
@@ -290,12 +309,12 @@ def _print_tolerance(design: ToleranceDesign) -> None:
         console.print(table)
 
 
-def _print_pitches(design: PitchDesign) -> None:
+def _print_pitches(design: PitchDesign, members: str) -> None:
     table = Table(title=f"LED pitches, each on its own (noise {design.noise:g} mm)")
     table.add_column("pitch (mm)", justify="right")
     table.add_column("recognizable")
     table.add_column("length", justify="right")
-    table.add_column("expected (parts equally likely)", justify="right")
+    table.add_column(f"expected ({members} equally likely)", justify="right")
     table.add_column("pairs it cannot tell apart", overflow="fold")
     for row in design.rows:
         bad = ", ".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])

@@ -7,7 +7,7 @@ is the cheapest such bound (``WorstCase.pair_bound``); a handful of states that 
 hard to tell apart is often much harder than any pair, and still a small set whose exact
 length the AND/OR search proves in a fraction of the time the whole set would take.
 
-:func:`subset_bound` grows such a subset from the set's hardest pair, one state at a
+:meth:`SubsetBound.bound` grows such a subset from the set's hardest pair, one state at a
 time: the few states hardest to tell apart from those already in (by the pairs' lengths)
 are tried, and the one whose subset needs the most operations is kept.
 """
