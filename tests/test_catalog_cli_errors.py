@@ -158,10 +158,14 @@ def test_analyze_exits_1_when_pairs_cannot_be_told_apart(tmp_path, db, capsys):
         capsys, "catalog", "analyze", "--tolerance", "0.01", "--json", "--catalog", str(db)
     )
     assert code == 1, err
-    pairs = json.loads(out)["unrecognizable_pairs"]
-    assert {pairs[0]["part_a"], pairs[0]["part_b"]} == {"twin-a", "twin-b"}
+    # Each landing is a member (face up and face down, as plan plans the two parts).
+    pairs = {frozenset((p["part_a"], p["part_b"])) for p in json.loads(out)["unrecognizable_pairs"]}
+    assert pairs == {
+        frozenset(("twin-a/up", "twin-b/up")),
+        frozenset(("twin-a/down", "twin-b/down")),
+    }
     last = [line for line in err.splitlines() if line.strip()][-1]
     # A result to act on (exit 1) is not an error of the input: no "error:" prefix.
-    assert last.startswith("result: 1 pair of parts") and "twin-a & twin-b" in last, err
+    assert last.startswith("result: 2 pairs of landings") and "twin-a/up & twin-b/up" in last, err
     assert "error:" not in err
     assert run(capsys, "catalog", "analyze", "--json", "--catalog", str(db))[0] == 0

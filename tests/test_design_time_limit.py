@@ -378,7 +378,8 @@ def test_cli_timeout_is_one_line_exit_1(capsys, in_tmp):
     assert err.startswith(
         "result: the sensor design did not finish within the time limit of 0.001 s"
     )
-    assert " of 3 pairs" in err and err.rstrip().endswith("allow more time with --time-limit S")
+    # Three parts, two landings each: 15 pairs of landings (design.md, "Landings").
+    assert " of 15 pairs" in err and err.rstrip().endswith("allow more time with --time-limit S")
     assert not list(in_tmp.iterdir())
 
 

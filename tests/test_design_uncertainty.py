@@ -36,6 +36,7 @@ from feederkit.design.strong import (
     strong_mix_critical,
 )
 from feederkit.errors import InputError
+from feederkit.landing.plan import load_landings
 from feederkit.loading import load_parts
 from feederkit.machine import Grouping, members
 from feederkit.machine.build import build_machine
@@ -371,7 +372,8 @@ def test_the_json_says_which_uncertainty_was_applied(cli, capsys):
 def test_rotation_error_zero_on_the_command_line_is_the_ideal_table(cli, capsys):
     assert main(["design", "sensor", *MIX, "--rotation-error", "0", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    pfs = list(load_parts(MIX).push_functions)
+    # The command designs for every landing (design.md, "Landings").
+    pfs = [push_function(x.part) for x in load_landings(MIX).all]
     want = design_tolerance(pfs, uncertainty=IDEAL).to_dict()
     assert data["lengths"] == want["lengths"] and data["pairs"] == want["pairs"]
     assert data["uncertainty"]["applied"] is True and data["uncertainty"]["rotation_error_deg"] == 0
