@@ -4,7 +4,7 @@ Functions take a catalog as an open connection (:func:`open_catalog`) or a path;
 is one transaction. See docs/catalog.md.
 """
 
-from feederkit.catalog.bulk import DirectoryImport, import_directory, source_files
+from feederkit.catalog.bulk import BadFilesError, DirectoryImport, import_directory, source_files
 from feederkit.catalog.changeovers import (
     get_changeover,
     list_changeovers,
@@ -34,6 +34,7 @@ from feederkit.catalog.store import (
     CATALOG_ENV,
     DEFAULT_CATALOG,
     CatalogLike,
+    DuplicateNameError,
     add_file,
     add_outline,
     default_catalog_path,
@@ -59,10 +60,12 @@ __all__ = [
     "DEFAULT_WAIT",
     "SCHEMA_VERSION",
     "AddOutcome",
+    "BadFilesError",
     "CatalogLike",
     "Changeover",
     "ChangeoverInfo",
     "DirectoryImport",
+    "DuplicateNameError",
     "PartSummary",
     "Revision",
     "add_file",

@@ -3,7 +3,8 @@
 Every file is read and checked first; only then are all parts written, in one transaction.
 A bad file, a duplicate name or a killed process leaves the catalog as it was; every bad
 file is named with its path and reason. With ``skip_bad`` the good files are imported (one
-transaction) and the bad ones reported.
+transaction) and the bad ones, and parts whose name the catalog has from another source,
+reported.
 """
 
 from __future__ import annotations
@@ -16,7 +17,14 @@ from pathlib import Path
 
 from feederkit.catalog.model import AddOutcome, check_name
 from feederkit.catalog.schema import transaction
-from feederkit.catalog.store import CatalogLike, _conn, landings_for, options_key, write_revision
+from feederkit.catalog.store import (
+    CatalogLike,
+    DuplicateNameError,
+    _conn,
+    landings_for,
+    options_key,
+    write_revision,
+)
 from feederkit.errors import InputError
 from feederkit.importers import SUPPORTED_SUFFIXES, ImportedPart, ImportOptions, import_parts
 from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
@@ -33,6 +41,29 @@ class DirectoryImport:
     outcomes: tuple[AddOutcome, ...]
     ignored: tuple[str, ...]
     bad: tuple[str, ...] = ()
+
+
+SKIP_BAD_ADVICE = "--skip-bad imports the rest"
+"""What :class:`BadFilesError` advises by default (``catalog import`` has ``--skip-bad``)."""
+
+
+class BadFilesError(InputError):
+    """Some files of a directory import are bad and nothing was imported.
+
+    Keeps the parts of the message, so a command without ``--skip-bad`` (``demo``) can give
+    advice that works for it: :meth:`with_advice`.
+    """
+
+    def __init__(self, bad: tuple[str, ...], total: int, root: Path) -> None:
+        self.bad, self.total, self.root = bad, total, root
+        super().__init__(self.with_advice(SKIP_BAD_ADVICE))
+
+    def with_advice(self, advice: str) -> str:
+        """The one-line message with ``advice`` in parentheses, every bad file named."""
+        return (
+            f"{len(self.bad)} of {self.total} files in {self.root} are bad, nothing imported "
+            f"({advice}): {'; '.join(self.bad)}"
+        )
 
 
 OUTLINE_PEEK_BYTES = 1 << 20
@@ -82,6 +113,18 @@ def source_files(directory: Path) -> tuple[list[Path], list[Path]]:
     return found, ignored
 
 
+def _bad_line(path: Path, exc: InputError) -> str:
+    """One skipped file: ``path: reason``, a name clash with advice that works for a folder
+    import (it has no ``--name``)."""
+    if isinstance(exc, DuplicateNameError):
+        return (
+            f"{path}: duplicate name: part {exc.name!r} already exists from {exc.old_path} "
+            "(rename this part, or --revise makes this file its next revision)"
+        )
+    reason = str(exc)
+    return reason if str(path) in reason else f"{path}: {reason}"
+
+
 def import_directory(
     catalog: CatalogLike,
     directory: str | os.PathLike[str],
@@ -96,9 +139,11 @@ def import_directory(
     """Import every source file under ``directory`` in one transaction (all files or none).
 
     Part names come from the files (outline name or file stem); two files giving the same
-    name are refused. Every file is read; a bad one raises InputError naming every bad file
-    with its path and reason, and nothing is written; with ``skip_bad`` the good files are
-    written and the bad ones listed in :attr:`DirectoryImport.bad`.
+    name are refused, and so is a name the catalog has from another source (unless
+    ``revise``). Every file is read; a bad one raises :class:`BadFilesError` naming every bad
+    file with its path and reason, and nothing is written; with ``skip_bad`` the good files
+    are written and the bad ones, and the parts whose name is taken, are listed in
+    :attr:`DirectoryImport.bad`.
     """
     check_side_probability(side_probability)
     root = Path(directory)
@@ -116,8 +161,7 @@ def import_directory(
             names = [check_name(p.part.name) for p in parts]
             landings = [landings_for(p, options, path, side_probability) for p in parts]
         except InputError as exc:
-            reason = str(exc)
-            bad.append(reason if str(path) in reason else f"{path}: {reason}")
+            bad.append(_bad_line(path, exc))
             continue
         for name, p, lands in zip(names, parts, landings, strict=True):
             if name in seen:
@@ -128,28 +172,34 @@ def import_directory(
     if progress:
         progress("read", len(files), len(files), "")
     if bad and not skip_bad:
-        listed = "; ".join(bad)
-        raise InputError(
-            f"{len(bad)} of {len(files)} files in {root} are bad, nothing imported "
-            f"(--skip-bad imports the rest): {listed}"
-        )
+        raise BadFilesError(tuple(bad), len(files), root)
     outcomes = []
     with _conn(catalog, create=True) as conn, transaction(conn):
         for k, (path, sha, p, lands) in enumerate(batch):
             if progress:
                 progress("write", k, len(batch), p.part.name)
-            outcomes.append(
-                write_revision(
-                    conn,
-                    p,
-                    source_path=str(path.resolve()),
-                    sha256=sha,
-                    options_key=options_key(options, side_probability, p.source.kind),
-                    revise=revise,
-                    created_by=created_by,
-                    landings=lands,
+            # A part the catalog refuses (a name taken by another source) is, with
+            # skip_bad, skipped and named like a bad file; its savepoint undoes its writes.
+            conn.execute("SAVEPOINT import_part")
+            try:
+                outcomes.append(
+                    write_revision(
+                        conn,
+                        p,
+                        source_path=str(path.resolve()),
+                        sha256=sha,
+                        options_key=options_key(options, side_probability, p.source.kind),
+                        revise=revise,
+                        created_by=created_by,
+                        landings=lands,
+                    )
                 )
-            )
+            except InputError as exc:
+                if not skip_bad:
+                    raise
+                conn.execute("ROLLBACK TO import_part")
+                bad.append(_bad_line(path, exc))
+            conn.execute("RELEASE import_part")
         if progress:
             progress("write", len(batch), len(batch), "")
     return DirectoryImport(

@@ -125,10 +125,15 @@ def set_busy_notifier(notify: Callable[[str], None] | None) -> None:
 
 
 class CatalogConnection(sqlite3.Connection):
-    """A catalog connection that knows its file and how long to wait for a busy catalog."""
+    """A catalog connection that knows its file and how long to wait for a busy catalog.
+
+    ``empty_file``: the file is empty (0 bytes) and this is an empty catalog in memory
+    standing in for it, which commits no write (:func:`_empty_catalog`).
+    """
 
     path: Path = Path("?")
     wait: float = DEFAULT_WAIT
+    empty_file: bool = False
 
 
 def catalog_file_of(conn: sqlite3.Connection) -> Path:
@@ -246,12 +251,19 @@ def transaction(
 
     ``before_commit`` runs after the body, inside the transaction: when it raises, nothing is
     committed (used to write a changeover's files only together with its row). SQLite errors
-    (busy, read-only, full disk at ``COMMIT``, damaged file) become one-line InputErrors.
+    (busy, read-only, full disk at ``COMMIT``, damaged file) become one-line InputErrors. On
+    the stand-in for an empty file (:func:`_empty_catalog`) the body runs, so its own errors
+    ("no part named ...") are said, but nothing is committed: the write would be lost.
     """
     path = catalog_file_of(conn)
     _begin(conn, path)
     try:
         yield conn
+        if isinstance(conn, CatalogConnection) and conn.empty_file:
+            raise InputError(
+                f"{path}: an empty file, not a catalog yet; nothing was written (make it a "
+                "catalog with 'feederkit catalog init')"
+            )
         if before_commit is not None:
             before_commit()
         conn.execute("COMMIT")
@@ -284,6 +296,28 @@ def migrate(conn: sqlite3.Connection) -> int:
     return version
 
 
+def _text(raw: bytes) -> str:
+    """Text that is not UTF-8 is read with surrogate escapes, so each row's check can name it."""
+    return raw.decode("utf-8", "surrogateescape")
+
+
+def _empty_catalog(p: Path, wait: float) -> CatalogConnection:
+    """An empty catalog in memory for the empty (0-byte) file ``p``, opened without ``create``.
+
+    SQLite takes such a file for an empty database, and migrating it would write the schema:
+    a read (``catalog list``, ``plan NAME``, ...) would turn any empty file into a catalog.
+    Only ``init``, ``add`` and ``import`` make a catalog (docs/catalog.md); this connection
+    reads as a catalog without parts and commits no write (:func:`transaction`).
+    """
+    conn = sqlite3.connect(":memory:", isolation_level=None, factory=CatalogConnection)
+    conn.path, conn.wait = p, wait
+    conn.text_factory = _text
+    conn.execute("PRAGMA foreign_keys = ON")
+    migrate(conn)
+    conn.empty_file = True
+    return conn
+
+
 def connect(
     path: str | Path, *, create: bool = False, wait: float = DEFAULT_WAIT
 ) -> CatalogConnection:
@@ -291,7 +325,9 @@ def connect(
 
     ``wait`` is how many seconds a write waits for another process's transaction. Raises
     InputError, one line naming the file, when it is missing (without ``create``), cannot be
-    created or opened, is read-only where a write is needed, or is not a catalog.
+    created or opened, is read-only where a write is needed, or is not a catalog. An empty
+    (0-byte) file is made a catalog only with ``create``; without, it reads as an empty
+    catalog and is not written (:func:`_empty_catalog`).
     """
     p = Path(path)
     if not wait >= 0.0 or wait > 86400.0:
@@ -300,8 +336,11 @@ def connect(
         exists = p.exists()
         if exists and p.is_dir():
             raise InputError(f"{p}: is a directory, not a catalog file")
+        empty = exists and p.stat().st_size == 0 and os.access(p, os.R_OK)
     except OSError as exc:
         raise InputError(f"{p}: cannot open the catalog ({exc.strerror})") from None
+    if empty and not create:
+        return _empty_catalog(p, wait)
     if not exists:
         if not create:
             raise InputError(f"{p}: no catalog there (create one with 'feederkit catalog init')")
@@ -315,8 +354,7 @@ def connect(
     except sqlite3.Error as exc:
         raise catalog_error(exc, p) from None
     conn.path, conn.wait = p, wait
-    # Text that is not UTF-8 is read with surrogate escapes, so each row's check can name it.
-    conn.text_factory = lambda raw: raw.decode("utf-8", "surrogateescape")
+    conn.text_factory = _text
     try:
         conn.execute("PRAGMA foreign_keys = ON")
         conn.execute(f"PRAGMA busy_timeout = {int(wait * 1000)}")

@@ -216,6 +216,18 @@ def _write_landings(
         )
 
 
+class DuplicateNameError(InputError):
+    """A part name the catalog already has from another source file (``name``, ``old_path``),
+    kept apart so a folder import can skip and name the clash in its own words."""
+
+    def __init__(self, name: str, old_path: str) -> None:
+        self.name, self.old_path = name, old_path
+        super().__init__(
+            f"duplicate name: part {name!r} already exists from {old_path}; choose another "
+            "--name, or use --revise to make this file its next revision"
+        )
+
+
 def write_revision(
     conn: sqlite3.Connection,
     imported: ImportedPart,
@@ -253,10 +265,7 @@ def write_revision(
     else:
         rev, old_path, old_sha, old_options, old_id = _latest(conn, pid)
         if old_path != source_path and not revise:
-            raise InputError(
-                f"duplicate name: part {name!r} already exists from {old_path}; choose another "
-                "--name, or use --revise to make this file its next revision"
-            )
+            raise DuplicateNameError(name, old_path)
         poses_missing = (
             imported.source.kind == "mesh" and len(landings) > 1 and not _has_landings(conn, old_id)
         )

@@ -170,7 +170,7 @@ def cmd_init(
 ) -> None:
     """Create the catalog (or bring an existing one to the current schema)."""
     path = catalog_path(catalog)
-    existed = path.exists()
+    existed = _has_content(path)
     with opened(catalog, wait, create=True):
         pass
     if json_out:
@@ -182,6 +182,15 @@ def cmd_init(
             highlight=False,
             markup=False,
         )
+
+
+def _has_content(path: Path) -> bool:
+    """Whether ``path`` is a file with bytes in it: an empty file becomes a catalog only now,
+    so ``init`` says it was created."""
+    try:
+        return path.stat().st_size > 0
+    except OSError:
+        return False
 
 
 @takes_import_options
