@@ -400,8 +400,8 @@ def run_demo(
 ) -> DemoResult:
     """Run the demo on the part files in ``source_dir``, writing into ``output``.
 
-    ``percent``: the diameter sensor's tolerance in percent of the largest part's size, in
-    (0, 50); ``reports``: write each changeover's HTML report (its part plots are most of the
+    ``percent``: the diameter sensor's tolerance in percent of the largest part's size of
+    what is planned (each part alone, then each changeover's mix), in (0, 50); ``reports``: write each changeover's HTML report (its part plots are most of the
     demo's time); ``cell``: the cell profile whose timing gives each changeover's cycle time
     (the demo keeps its own sensor). Raises InputError for a missing folder, a bad
     percentage, or bad part files.

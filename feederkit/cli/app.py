@@ -5,7 +5,10 @@ on stderr), 2 bad input or usage, 130 interrupted (Ctrl-C), 70 a bug in feederki
 one clear ``error: ...`` line on stderr, never a traceback: feederkit's own errors carry their
 message; errors from the system (SQLite, files, numbers too large, input nested too deeply)
 are named with what to do. Anything else is a bug: one line says so and names the log file
-that holds the traceback.
+that holds the traceback. Ctrl-C is ``interrupted`` and 130 however it surfaces: as a
+KeyboardInterrupt, as an error raised while handling one, or as an error after one was
+swallowed (a library that catches BaseException around a lazy import, as trimesh does,
+fails later with an unrelated TypeError); :class:`_CtrlCWatch` notes that SIGINT came.
 """
 
 from __future__ import annotations
@@ -21,8 +24,10 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     import sqlite3
     import tempfile
     import traceback
+    from collections.abc import Callable
     from datetime import UTC, datetime
-    from typing import Annotated
+    from types import FrameType
+    from typing import Annotated, Any
 
     import typer
     from rich.markup import escape
@@ -200,62 +205,128 @@ def write_crash_log(exc: BaseException, argv: list[str] | None) -> str | None:
     return path
 
 
+class _CtrlCWatch:
+    """Notes whether SIGINT arrived while a command ran, and raises KeyboardInterrupt as before.
+
+    Installed only over a Python-level handler (the default one, or a caller's, which is
+    still called), so an ignored SIGINT stays ignored; only in the main thread, where
+    signal handlers can be set. A context manager: the previous handler comes back.
+    """
+
+    def __init__(self) -> None:
+        self.seen = False
+        self._previous: Callable[[int, FrameType | None], Any] | None = None
+
+    def _handler(self, signum: int, frame: FrameType | None) -> None:
+        self.seen = True
+        if self._previous is not None:
+            self._previous(signum, frame)  # the default handler raises KeyboardInterrupt
+
+    def __enter__(self) -> _CtrlCWatch:
+        previous = signal.getsignal(signal.SIGINT)
+        if callable(previous):
+            self._previous = previous  # before the handler: a SIGINT at once must reach it
+            try:
+                signal.signal(signal.SIGINT, self._handler)
+            except ValueError:  # not the main thread: no handler can be set
+                self._previous = None
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+            self._previous = None
+
+
+def _from_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` is, or was raised while handling, a KeyboardInterrupt (or click's
+    Abort for one), following ``__cause__`` and ``__context__``."""
+    seen: set[int] = set()
+    todo: list[BaseException | None] = [exc]
+    while todo:
+        e = todo.pop()
+        if e is None or id(e) in seen:
+            continue
+        seen.add(id(e))
+        if isinstance(e, KeyboardInterrupt | Abort):
+            return True
+        todo += [e.__cause__, e.__context__]
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app and turn every error into one line on stderr and an exit code.
 
     Usage errors (unknown options, missing arguments, bad values) are one line too, naming
-    the command's ``--help``, and exit with 2, as click does.
+    the command's ``--help``, and exit with 2, as click does. After Ctrl-C the end is
+    ``interrupted`` and 130, whatever error followed (the interrupt's doing, not a bug or bad
+    input) and even when a library swallowed the interrupt and the command went on.
     """
     set_busy_notifier(_notify_busy)
+    with _CtrlCWatch() as ctrl_c:
+        try:
+            code = _run_app(argv)
+            if ctrl_c.seen and code != EXIT_INTERRUPTED:  # a library swallowed the interrupt
+                _say("interrupted")
+                return EXIT_INTERRUPTED
+            return code
+        except Exception as exc:  # noqa: BLE001 - the boundary: every error becomes one line
+            if ctrl_c.seen or _from_interrupt(exc):
+                _say("interrupted")
+                return EXIT_INTERRUPTED
+            return _error_exit(exc, argv)
+        except KeyboardInterrupt:
+            _say("interrupted")
+            return EXIT_INTERRUPTED
+        finally:
+            set_busy_notifier(None)
+
+
+def _run_app(argv: list[str] | None) -> int:
+    """Run the command; its exit code (a SystemExit becomes one, Ctrl-C's saying so)."""
     try:
         code = _click_command().main(args=argv, prog_name="feederkit", standalone_mode=False)
-        if isinstance(code, int) and code == EXIT_INTERRUPTED:
-            _say("interrupted")
-        return code if isinstance(code, int) else 0
-    except FeederkitError as exc:
+    except SystemExit as exc:
+        code = exc.code
+        if code is None:
+            return 0
+        if not isinstance(code, int):
+            return 2
+    if isinstance(code, int) and code == EXIT_INTERRUPTED:  # typer's Exit(130) for Ctrl-C
+        _say("interrupted")
+    return code if isinstance(code, int) else 0
+
+
+def _error_exit(exc: Exception, argv: list[str] | None) -> int:
+    """Say ``exc`` in one line on stderr and return its exit code (not for Ctrl-C's errors)."""
+    if isinstance(exc, FeederkitError):
         if exc.exit_code == EXIT_RESULT:
             _say_result(_oneline(exc))
         else:
             _say(_oneline(exc))
         return exc.exit_code
-    except NoArgsIsHelpError as exc:  # ``feederkit`` or a group alone: its help
+    if isinstance(exc, NoArgsIsHelpError):  # ``feederkit`` or a group alone: its help
         if exc.ctx is not None:
             typer.echo(exc.ctx.get_help())
         return 0
-    except UsageError as exc:
+    if isinstance(exc, UsageError):
         where = exc.ctx.command_path if exc.ctx is not None else "feederkit"
         _say(f"{_oneline(exc.format_message())} (see {where} --help)")
         return 2
-    except ClickException as exc:
+    if isinstance(exc, ClickException):
         _say(_oneline(exc.format_message()))
         return exc.exit_code
-    except Abort:
-        _say("interrupted")
-        return EXIT_INTERRUPTED
-    except SystemExit as exc:
-        if exc.code is None:
-            return 0
-        if exc.code == EXIT_INTERRUPTED:  # typer turns Ctrl-C in a command into Exit(130)
-            _say("interrupted")
-        return exc.code if isinstance(exc.code, int) else 2
-    except KeyboardInterrupt:
-        _say("interrupted")
-        return EXIT_INTERRUPTED
-    except Exception as exc:  # noqa: BLE001 - the boundary: every error becomes one line
-        message = system_error_message(exc)
-        log = write_crash_log(exc, argv)
-        where = f"; details in {log}" if log else ""
-        if message is not None:
-            _say(f"{message}{where}")
-            return 2
-        _say(
-            f"this is a bug in feederkit ({type(exc).__name__}: {_oneline(exc)[:200]}); "
-            f"please report it with the log{where}"
-        )
-        return EXIT_BUG
-    finally:
-        set_busy_notifier(None)
-    return 0
+    message = system_error_message(exc)
+    log = write_crash_log(exc, argv)
+    where = f"; details in {log}" if log else ""
+    if message is not None:
+        _say(f"{message}{where}")
+        return 2
+    _say(
+        f"this is a bug in feederkit ({type(exc).__name__}: {_oneline(exc)[:200]}); "
+        f"please report it with the log{where}"
+    )
+    return EXIT_BUG
 
 
 def end_quietly_on_closed_pipe() -> None:

@@ -45,8 +45,8 @@ from feederkit.cli.common import (
     ObjectiveOpt,
     PlanOutputOpt,
     ProfileRotationErrorOpt,
+    ProfileSensorlessOpt,
     ReportOpt,
-    SensorlessOpt,
     ShapeToleranceOpt,
     TimeLimitOpt,
     ToleranceOpt,
@@ -236,7 +236,7 @@ def compile_command(
             "gives their shares of the production (default equal; normalised).",
         ),
     ],
-    sensorless: SensorlessOpt = False,
+    sensorless: ProfileSensorlessOpt = False,
     tolerance: ToleranceOpt = None,
     led_pitch: LedPitchOpt = None,
     noise: NoiseOpt = None,
@@ -476,9 +476,20 @@ def export_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None)
     console.print(f"wrote the plan to {output}", highlight=False, markup=False, soft_wrap=True)
 
 
+ReportOutputOpt = Annotated[
+    Path,
+    typer.Option(
+        "-o", "--output", metavar="REPORT.html", help="Write the HTML report here (atomic)."
+    ),
+]
+
+
 @changeover_app.command("report")
-def report_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None) -> None:
+def report_command(name: NameArg, output: ReportOutputOpt, catalog: CatalogOpt = None) -> None:
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
+    from feederkit.reports import check_report_path
+
+    check_report_path(output)  # a .txt or .pdf would hold HTML: refused before any work
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     html = changeover_report(co.plan, list(co.parts), co.witnesses())

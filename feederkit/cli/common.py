@@ -48,6 +48,7 @@ SensorlessOpt = Annotated[
     bool,
     typer.Option("--sensorless", help="No sensor (the default when no sensor option is given)."),
 ]
+"""``--sensorless`` of a command that reads no cell profile; see :data:`ProfileSensorlessOpt`."""
 ToleranceOpt = Annotated[
     float | None,
     typer.Option(
@@ -340,8 +341,13 @@ def plan_outputs(
 
 
 def check_output_folders(output: Path | None, report: Path | None) -> None:
-    """Refuse ``-o`` and ``--report`` paths whose folder does not exist before any work is done
-    (a plan that took a minute must not be lost to a typo in a folder name)."""
+    """Refuse ``-o`` and ``--report`` paths whose folder does not exist, and a ``--report``
+    not named .html, before any work is done (a plan that took a minute must not be lost to
+    a typo in a folder name, nor a page of HTML be written as ``report.txt``)."""
+    if report is not None:
+        from feederkit.reports import check_report_path  # the report library, only when asked
+
+        check_report_path(report)
     for path, what in ((output, "plan file"), (report, "report")):
         if path is None:
             continue
@@ -403,6 +409,16 @@ CellOpt = Annotated[
         "docs/cell.md).",
     ),
 ]
+ProfileSensorlessOpt = Annotated[
+    bool,
+    typer.Option(
+        "--sensorless",
+        help="No sensor, whatever the cell profile says (default: the profile's sensor; none "
+        "without a profile).",
+    ),
+]
+"""``--sensorless`` of a command that reads the cell profile (:func:`cell_settings`): without
+a sensor option its sensor is the profile's, not none."""
 ProfileRotationErrorOpt = Annotated[
     float | None,
     typer.Option(

@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from feederkit.catalog import BadFilesError
 from feederkit.cell import load_cell, resolve_settings
 from feederkit.cli.changeover import CellOpt, landings_text
 from feederkit.cli.common import (
@@ -41,9 +42,13 @@ from feederkit.demo import (
     default_catalog_dir,
     run_demo,
 )
+from feederkit.errors import InputError
 
 DEMO_FLAGS = (("sensor tolerance", "--tolerance-percent"),)
 """The demo's flag for the library's term."""
+
+DEMO_BAD_FILES_ADVICE = "the demo reads every file: fix the bad ones or move them out of the folder"
+"""What to do about bad part files: the demo has no ``--skip-bad``."""
 
 
 def margin_text(m: float | None) -> str:
@@ -212,7 +217,8 @@ def demo_command(
         typer.Option(
             "--tolerance-percent",
             metavar="PERCENT",
-            help="The diameter sensor's tolerance, in percent of the largest part's size.",
+            help="The diameter sensor's tolerance, in percent of the part's size (each part's "
+            "own plan) or of the largest part's (each changeover).",
         ),
     ] = 1.0,
     json_out: Annotated[bool, typer.Option("--json", help="A summary on stdout as JSON.")] = False,
@@ -231,7 +237,10 @@ def demo_command(
         def progress(what: str, done: int, total: int | None) -> None:
             bar.update(task, description=what, completed=done, total=total)
 
-        result = run_demo(source_dir, output, percent, progress, cell=settings)
+        try:
+            result = run_demo(source_dir, output, percent, progress, cell=settings)
+        except BadFilesError as exc:  # its advice is catalog import's --skip-bad
+            raise InputError(exc.with_advice(DEMO_BAD_FILES_ADVICE)) from None
     if json_out:
         print_result(err_console, result)
         print_json(result.to_dict())

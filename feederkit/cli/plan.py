@@ -35,8 +35,8 @@ from feederkit.cli.common import (
     ObjectiveOpt,
     PlanOutputOpt,
     ProfileRotationErrorOpt,
+    ProfileSensorlessOpt,
     ReportOpt,
-    SensorlessOpt,
     ShapeToleranceOpt,
     TimeLimitOpt,
     ToleranceOpt,
@@ -177,7 +177,7 @@ def plan_command(
             metavar="SOURCE", help="Outline or CAD files, or catalog names; several: a mix."
         ),
     ],
-    sensorless: SensorlessOpt = False,
+    sensorless: ProfileSensorlessOpt = False,
     tolerance: ToleranceOpt = None,
     led_pitch: LedPitchOpt = None,
     noise: NoiseOpt = None,

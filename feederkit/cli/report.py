@@ -1,7 +1,8 @@
 """``feederkit report PLAN -o REPORT.html``: the self-contained HTML changeover report.
 
 The plan is loaded and checked as ``run`` and ``simulate`` load it; a plan that fails
-verification is still drawn, under a red banner that says so (docs/reports.md). The report
+verification is still drawn, under a red banner that says so (docs/reports.md), and the
+command exits 1 as ``run`` and ``simulate`` do: a result the user must act on. The report
 is HTML only: ``-o`` must end in .html (print it to PDF from a browser).
 """
 
@@ -15,9 +16,10 @@ import typer
 
 from feederkit.cli.common import console, plural, progress_bar
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
-from feederkit.errors import InputError
+from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import read_json
 from feederkit.plans.model import Plan
+from feederkit.plans.verify import verify_declared
 from feederkit.reports import check_report_path, render_report, write_report
 
 
@@ -78,7 +80,10 @@ def report_command(
     ] = 0,
     max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
-    """Write one self-contained HTML page: the mix, the plan as a tree, statistics, part plots."""
+    """Write one self-contained HTML page: the mix, the plan as a tree, statistics, part plots.
+
+    A plan that fails verification is still drawn, under a red banner; exit 1 then.
+    """
     check_report_path(output)
     data = load_plan(plan, max_plan_mb)
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -103,6 +108,13 @@ def report_command(
             markup=False,
         )
     console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)
+    # The page's banner is for whoever opens it; the exit code is for the shell (design.md).
+    verdict = verify_declared(data)
+    if not verdict.ok:
+        raise CheckFailed(
+            f"the plan failed verification: {verdict.first_problem()} (the report {output} "
+            "shows it under a red banner; do not run this plan)"
+        )
 
 
 def register(app: typer.Typer) -> None:

@@ -125,23 +125,42 @@ def parse_pitches(text: str) -> tuple[float, ...]:
     return tuple(sorted(set(out)))
 
 
-def _positive(item: str) -> float:
+def _number(item: str) -> float:
+    """A finite number of mm; InputError otherwise."""
     try:
         v = float(item)
     except ValueError:
         raise InputError(f"--pitches: {item!r} is not a number of mm") from None
-    if not math.isfinite(v) or v <= 0.0:
+    if not math.isfinite(v):
+        raise InputError(f"--pitches: a pitch must be a finite number of mm, got {item}")
+    return v
+
+
+def _positive(item: str) -> float:
+    """A pitch: a positive finite number of mm; InputError otherwise."""
+    v = _number(item)
+    if v <= 0.0:
         raise InputError(f"--pitches: a pitch must be a positive number of mm, got {item}")
     return v
 
 
 def _range(item: str) -> list[float]:
+    """``START:STOP:STEP``, STOP included. START above STOP is said first: ``1:0:0.5`` is an
+    empty range, not a zero pitch."""
     parts = item.split(":")
     if len(parts) != 3:
         raise InputError(f"--pitches: a range is START:STOP:STEP, got {item!r}")
-    start, stop, step = (_positive(p) for p in parts)
+    start, stop, step = (_number(p) for p in parts)
     if stop < start:
-        raise InputError(f"--pitches: the range {item!r} ends before it starts")
+        raise InputError(
+            f"--pitches: the range {item!r} is empty, it ends before it starts: START "
+            f"{parts[0].strip()} is above STOP {parts[1].strip()} (write START:STOP:STEP)"
+        )
+    start = _positive(parts[0])  # then STOP >= START is positive too
+    if step <= 0.0:
+        raise InputError(
+            f"--pitches: the range {item!r} needs a positive STEP of mm, got {parts[2].strip()}"
+        )
     count = math.floor((stop - start) / step + 1e-9) + 1
     if count > 1000:
         raise InputError(f"--pitches: the range {item!r} has {count} pitches (at most 1000)")

@@ -1172,8 +1172,8 @@ def read_plan(
         raise InputError(f"{p}: a folder, not a plan file")
     if size > max_bytes:
         raise InputError(
-            f"{p}: the plan file is {size / 1e6:.1f} MB, more than the limit of "
-            f"{max_bytes / 1e6:.1f} MB"
+            f"{p}: the plan file is {size / 1e6:.3g} MB, more than the limit of "
+            f"{max_bytes / 1e6:.3g} MB"
         )
     try:
         text = p.read_text(encoding="utf-8")

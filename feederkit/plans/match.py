@@ -36,7 +36,7 @@ def match_part(plan: Plan | Mapping[str, Any], part: Part, source: str) -> int:
             return k
     if alike:
         return alike[0]
-    names = ", ".join(repr(p.name) for p in plan.parts)
+    names = ", ".join(dict.fromkeys(p.name for p in plan.parts))  # each part once
     if any(p.name == part.name for p in plan.parts):
         raise InputError(
             f"{source}: part {part.name!r} differs from the plan's part of that name "

@@ -238,10 +238,11 @@ class _Run:
         if isinstance(hit, float):
             p, s = x
             diam = self.model.diameters[p][s]
+            action = node.get("action_deg")
+            after = "the first alignment" if action is None else f"rotation {action:.6g}°"
             raise CheckFailed(
                 f"{self.model.label(p)}: physical state {s} (diameter {diam[0]:.6g} to "
-                f"{diam[1]:.6g} mm) can read {hit:.6g} mm, which no branch after rotation "
-                f"{node.get('action_deg')} holds"
+                f"{diam[1]:.6g} mm) can read {hit:.6g} mm, which no branch after {after} holds"
             )
         return hit
 

@@ -1,0 +1,293 @@
+"""Command-line defects found in review, each pinned through ``main`` (design.md, "Command
+line": exit 0 success, 1 a result to act on, 2 bad input, 130 Ctrl-C; one line on stderr).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import signal
+from pathlib import Path
+
+import pytest
+from shared import one_line_error
+
+from feederkit.cell import CellProfile, resolve_settings
+from feederkit.cli import run as run_cli
+from feederkit.cli.app import _click_command, main
+from feederkit.design.pitches import parse_pitches
+from feederkit.errors import InputError
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+L_BRACKET = str(CATALOG / "l-bracket.json")
+T_CLIP = str(CATALOG / "t-clip.json")
+
+
+@pytest.fixture(autouse=True)
+def no_stray_profile(tmp_path, monkeypatch):
+    """No ./feederkit.toml of the working tree, no catalog from the environment."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
+
+
+@pytest.fixture(scope="module")
+def good_plan(tmp_path_factory) -> Path:
+    """A verified plan of the l-bracket with an LED array (both landings, 3 operations)."""
+    path = tmp_path_factory.mktemp("plans") / "lb.plan.json"
+    args = ["plan", L_BRACKET, "--led-pitch", "0.5", "-o", str(path), "--time-limit", "30"]
+    assert main(args) == 0
+    return path
+
+
+def edited(good: Path, folder: Path, edit) -> Path:
+    """A copy of the plan file ``good`` in ``folder`` with ``edit`` applied to its JSON."""
+    data = json.loads(good.read_text())
+    edit(data)
+    path = folder / "edited.plan.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+def failing_plan(good: Path, folder: Path) -> Path:
+    """The plan with one shared node's rotation set to 10 degrees: it fails verification."""
+
+    def edit(data):
+        first = next(iter(data["nodes"]))
+        data["nodes"][first]["action_deg"] = 10.0
+
+    return edited(good, folder, edit)
+
+
+# 1. ``report`` on a plan that fails verification: the page is written, the exit is 1.
+
+
+def test_report_of_a_failing_plan_writes_the_page_and_exits_1(good_plan, tmp_path, capsys):
+    bad = failing_plan(good_plan, tmp_path)
+    page = tmp_path / "bad.html"
+    err = one_line_error(capsys, ["report", str(bad), "-o", str(page)], code=1)
+    assert err.startswith("result: the plan failed verification: ")
+    assert str(page) in err and "do not run" in err
+    assert 'data-ok="false"' in page.read_text(encoding="utf-8")  # the red banner is drawn
+    # run says the same plan failed: the two agree on the exit code
+    assert main(["run", str(bad)]) == 1
+    capsys.readouterr()
+
+
+def test_report_of_a_verified_plan_exits_0(good_plan, tmp_path, capsys):
+    page = tmp_path / "ok.html"
+    assert main(["report", str(good_plan), "-o", str(page)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err == "" and f"wrote {page}" in captured.out
+    assert 'id="verification"' not in page.read_text(encoding="utf-8")
+
+
+# 2. A report file must end in .html everywhere, refused before any work.
+
+
+def test_changeover_compile_refuses_a_report_not_named_html(tmp_path, capsys):
+    missing = tmp_path / "no-such.db"  # refused before the catalog is even looked at
+    args = ["changeover", "compile", "mx", "--mix", "l-bracket,t-clip", "--tolerance", "0.2"]
+    err = one_line_error(
+        capsys, [*args, "--report", str(tmp_path / "x.txt"), "--catalog", str(missing)]
+    )
+    assert "x.txt: the report is an HTML page: name it .html" in err
+    assert not (tmp_path / "x.txt").exists()
+
+
+def test_changeover_report_refuses_an_output_not_named_html(tmp_path, capsys):
+    missing = tmp_path / "no-such.db"
+    args = ["changeover", "report", "mx", "-o", str(tmp_path / "y.txt"), "--catalog", str(missing)]
+    err = one_line_error(capsys, args)
+    assert "y.txt: the report is an HTML page: name it .html" in err
+    assert not (tmp_path / "y.txt").exists()
+
+
+def test_plan_refuses_a_report_not_named_html_before_planning(tmp_path, capsys):
+    err = one_line_error(capsys, ["plan", L_BRACKET, "--report", str(tmp_path / "z.pdf")])
+    assert "z.pdf: the report is an HTML page" in err
+    assert not (tmp_path / "z.pdf").exists()
+
+
+def test_changeover_report_writes_html(tmp_path, capsys):
+    db = tmp_path / "c.db"
+    assert main(["catalog", "init", "--catalog", str(db)]) == 0
+    for source in (L_BRACKET, T_CLIP):
+        assert main(["catalog", "add", source, "--catalog", str(db)]) == 0
+    args = ["changeover", "compile", "mx", "--mix", "l-bracket,t-clip", "--tolerance", "0.2"]
+    assert main([*args, "--catalog", str(db), "--time-limit", "30"]) == 0
+    page = tmp_path / "mx.html"
+    assert main(["changeover", "report", "mx", "-o", str(page), "--catalog", str(db)]) == 0
+    assert page.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+    capsys.readouterr()
+
+
+# 3. Ctrl-C is "interrupted" and 130 however it surfaces, never "a bug in feederkit".
+
+
+def make_run_raise(monkeypatch, boom) -> list[str]:
+    """``feederkit run`` calling ``boom`` where it loads the plan; the args to run it."""
+    monkeypatch.setattr(run_cli, "load_plan", lambda *args, **kwargs: boom())
+    return ["run", "any.plan.json"]
+
+
+def interrupted(capsys, args: list[str]) -> None:
+    before = signal.getsignal(signal.SIGINT)
+    assert main(args) == 130
+    err = capsys.readouterr().err
+    assert err == "error: interrupted\n", err
+    assert signal.getsignal(signal.SIGINT) is before  # the handler main set is gone again
+
+
+def test_ctrl_c_in_a_command_is_interrupted(capsys, monkeypatch):
+    def boom():
+        raise KeyboardInterrupt
+
+    interrupted(capsys, make_run_raise(monkeypatch, boom))
+
+
+def test_an_error_while_handling_ctrl_c_is_interrupted_not_a_bug(capsys, monkeypatch):
+    def boom():
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise TypeError("cleanup failed") from None  # __context__ still holds it
+
+    interrupted(capsys, make_run_raise(monkeypatch, boom))
+
+
+def test_an_error_after_a_swallowed_ctrl_c_is_interrupted_not_a_bug(capsys, monkeypatch):
+    """trimesh imports its optional parts in ``try: ... except BaseException`` and keeps the
+    exception in an ``ExceptionWrapper``: a Ctrl-C there surfaces as an unrelated TypeError
+    (``'ExceptionWrapper' | None``), with no KeyboardInterrupt in its chain."""
+
+    def boom():
+        with contextlib.suppress(BaseException):  # what trimesh does
+            signal.raise_signal(signal.SIGINT)  # a real Ctrl-C, through the SIGINT handler
+        raise TypeError("unsupported operand type(s) for |: 'ExceptionWrapper' and 'NoneType'")
+
+    interrupted(capsys, make_run_raise(monkeypatch, boom))
+
+
+def test_a_command_that_goes_on_after_a_swallowed_ctrl_c_is_interrupted(
+    good_plan, capsys, monkeypatch
+):
+    real = run_cli.load_plan
+
+    def load(*args, **kwargs):
+        with contextlib.suppress(BaseException):  # swallowed by a library
+            signal.raise_signal(signal.SIGINT)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(run_cli, "load_plan", load)
+    assert main(["run", str(good_plan)]) == 130
+    assert capsys.readouterr().err.splitlines()[-1] == "error: interrupted"
+
+
+def test_a_bug_without_ctrl_c_is_still_a_bug(capsys, monkeypatch):
+    def boom():
+        raise TypeError("a real bug")
+
+    assert main(make_run_raise(monkeypatch, boom)) == 70
+    err = capsys.readouterr().err
+    assert "this is a bug in feederkit (TypeError: a real bug)" in err
+    Path(err.split("details in ")[1].split()[0]).unlink()
+
+
+# 4. ``run``'s wording. The lines come from the library (feederkit/plans/match.py, strong.py,
+# fileformat.py); the command line passes them through.
+
+
+def test_a_part_not_in_the_plan_names_the_plans_parts_plainly(good_plan, capsys):
+    err = one_line_error(capsys, ["run", str(good_plan), T_CLIP])
+    assert err.rstrip().endswith("is not one of the plan's parts (l-bracket)")
+
+
+def test_no_branch_after_the_first_alignment_is_said_so(good_plan, tmp_path, capsys):
+    def edit(data):  # no root branch holds any reading the part gives
+        for k, branch in enumerate(data["root"]["branches"]):
+            branch["reading"] = [10.0 + 2 * k, 11.0 + 2 * k]
+
+    plan = edited(good_plan, tmp_path, edit)
+    err = one_line_error(capsys, ["run", str(plan), "--all"], code=1)
+    assert "no branch after the first alignment holds" in err
+    assert "None" not in err
+
+
+def test_a_plan_over_a_tiny_size_limit_gives_both_sizes(good_plan, capsys):
+    err = one_line_error(capsys, ["run", str(good_plan), "--max-plan-mb", "0.001"])
+    assert "more than the limit of 0.001 MB" in err
+    assert "0.0 MB" not in err
+
+
+# 5. ``--pitches START:STOP:STEP`` with START above STOP is an empty range, not a zero pitch.
+
+
+def test_a_range_that_starts_above_its_stop_is_said_empty():
+    with pytest.raises(
+        InputError,
+        match=r"the range '1:0:0\.5' is empty, it ends before it starts: START 1 is above STOP 0",
+    ):
+        parse_pitches("1:0:0.5")
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("0:1:0.5", "a pitch must be a positive number of mm, got 0"),
+        ("0.5:1:0", "needs a positive STEP of mm, got 0"),
+        ("0.5:1:-0.1", "needs a positive STEP of mm, got -0.1"),
+        ("0.5:nan:0.1", "a finite number of mm, got nan"),
+    ],
+)
+def test_other_bad_ranges_say_what_is_wrong(text, said):
+    with pytest.raises(InputError, match=said):
+        parse_pitches(text)
+
+
+def test_ranges_still_include_their_stop():
+    assert parse_pitches("0.5:1:0.25,2") == (0.5, 0.75, 1.0, 2.0)
+    assert parse_pitches("0.5:0.5:0.1") == (0.5,)
+
+
+def test_design_sensor_says_the_range_is_empty(capsys):
+    err = one_line_error(capsys, ["design", "sensor", L_BRACKET, "--pitches", "1:0:0.5"])
+    assert "is empty, it ends before it starts: START 1 is above STOP 0" in err
+    assert "positive" not in err
+
+
+# 6. The overrides name the options that replaced a profile field (docs/cell.md); the profile
+# has no shape or COM tolerance, so those two are in the uncertainty line, not the overrides.
+
+
+def test_overrides_are_profile_fields_and_the_uncertainty_line_has_the_rest():
+    settings = resolve_settings(CellProfile(), tolerance=0.2, rotation_error=0.5)
+    assert settings.overrides == ("--tolerance", "--rotation-error")
+
+
+def test_plan_prints_the_shape_tolerance_it_was_given(capsys):
+    args = ["plan", L_BRACKET, "--tolerance", "0.2", "--rotation-error", "0.5"]
+    args += ["--shape-tolerance", "0.02", "--com-tolerance", "0.01", "--time-limit", "30"]
+    assert main(args) in (0, 1)  # 1: landings no plan tells apart, a result, not an error
+    out = " ".join(capsys.readouterr().out.split())  # the terminal wraps long lines
+    assert "cell profile: built-in defaults (overridden: --tolerance, --rotation-error)" in out
+    assert "shape tolerance 0.02 mm, COM tolerance 0.01 mm" in out
+
+
+# 8. ``--sensorless``'s help says what the default is where a cell profile gives the sensor.
+
+
+def option_help(*path: str, name: str = "sensorless") -> str:
+    command = _click_command()
+    for word in path:
+        command = command.commands[word]  # type: ignore[attr-defined]
+    (param,) = [p for p in command.params if p.name == name]
+    return param.help
+
+
+def test_sensorless_help_names_the_profile_where_one_is_read():
+    assert "the profile's sensor" in option_help("changeover", "compile")
+    assert "default when no sensor option" in option_help("catalog", "analyze")  # no profile
+
+
+def test_plan_sensorless_help_names_the_profile():
+    assert "the profile's sensor" in option_help("plan")
