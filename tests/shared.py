@@ -1,10 +1,12 @@
 """Helpers several test files use: a plan file's part entry, the one-line CLI error check, and
-the planners' random mix (also benchmarks/dump_plans.py's)."""
+the planners' random mix (also benchmarks/dump_plans.py's), a catalog's snapshot."""
 
 from __future__ import annotations
 
 import math
 import random
+import sqlite3
+from pathlib import Path
 
 from feederkit.machine import OutcomeRange, PushAlignMachine
 from feederkit.mechanics.push import PushFunction, push_function
@@ -84,3 +86,12 @@ def read_alike_sets(intervals: dict[int, tuple[float, float]]) -> list[int]:
         if m:
             found.add(m)
     return sorted(found)
+
+
+def catalog_snapshot(db: Path) -> list[str]:
+    """Everything in a catalog file, as SQL text: equal snapshots, nothing written."""
+    conn = sqlite3.connect(db)
+    try:
+        return list(conn.iterdump())
+    finally:
+        conn.close()

@@ -13,21 +13,13 @@ from pathlib import Path
 
 import fixtures_cad as fx
 import pytest
+from shared import catalog_snapshot as snapshot
 
 from feederkit import catalog as cat
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.outline import load_outline_json, make_outline, save_outline_json
 from feederkit.sources import load_part, load_part_with_warnings
-
-
-def snapshot(db: Path) -> list[str]:
-    """Everything in the catalog, as SQL text."""
-    conn = sqlite3.connect(db)
-    try:
-        return list(conn.iterdump())
-    finally:
-        conn.close()
 
 
 def square(name: str = "sq", side: float = 10.0):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import sqlite3
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +10,7 @@ from pathlib import Path
 import fixtures_cad as fx
 import pytest
 import trimesh
+from shared import catalog_snapshot as snapshot
 
 from feederkit.cli.app import main
 from feederkit.outline import make_outline, save_outline_json
@@ -35,14 +35,6 @@ def run_json(capsys, *args: str):
     code, out, err = run(capsys, *args, "--json")
     assert code == 0, err
     return json.loads(out)
-
-
-def snapshot(path: Path) -> list[str]:
-    conn = sqlite3.connect(path)
-    try:
-        return list(conn.iterdump())
-    finally:
-        conn.close()
 
 
 def square(path: Path, side: float = 10.0, name: str | None = None) -> Path:

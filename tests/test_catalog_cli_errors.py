@@ -8,6 +8,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
+from shared import catalog_snapshot as snapshot
 
 from feederkit.cli.app import main
 from feederkit.outline import make_outline, save_outline_json
@@ -33,14 +34,6 @@ def run(capsys, *args: str) -> tuple[int, str, str]:
     code = main(list(args))
     out, err = capsys.readouterr()
     return code, out, err
-
-
-def snapshot(path: Path) -> list[str]:
-    conn = sqlite3.connect(path)
-    try:
-        return list(conn.iterdump())
-    finally:
-        conn.close()
 
 
 def error_line(err: str) -> str:

@@ -13,6 +13,7 @@ import threading
 from pathlib import Path
 
 import pytest
+from shared import catalog_snapshot as snapshot
 
 from feederkit import catalog as cat
 from feederkit.catalog.schema import CatalogConnection
@@ -22,14 +23,6 @@ from feederkit.outline import make_outline
 
 def square(name: str = "l-bracket", side: float = 10.0):
     return make_outline(name, [(0, 0), (side, 0), (side, side), (0, side)])
-
-
-def snapshot(db: Path) -> list[str]:
-    conn = sqlite3.connect(db)
-    try:
-        return list(conn.iterdump())
-    finally:
-        conn.close()
 
 
 @pytest.fixture

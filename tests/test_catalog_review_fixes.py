@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import json
 import shutil
-import sqlite3
 from pathlib import Path
 
 import pytest
+from shared import catalog_snapshot as snapshot
 
 from feederkit.catalog import SCHEMA_VERSION, add_file, list_parts, open_catalog, schema_version
 from feederkit.cli.app import main
@@ -43,15 +43,6 @@ def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
     code = main(list(args))
     out, err = capsys.readouterr()
     return code, out, err
-
-
-def snapshot(db: Path) -> list[str]:
-    """Everything in the catalog, as SQL text."""
-    conn = sqlite3.connect(db)
-    try:
-        return list(conn.iterdump())
-    finally:
-        conn.close()
 
 
 def plate(path: Path) -> Path:
