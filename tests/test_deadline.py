@@ -280,13 +280,9 @@ def test_the_tree_of_a_proven_length_polls_its_deadline():
     machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
     refiner, children, k = _proven_refiner(machine, Deadline(1e-9))
     time.sleep(1e-4)
-    b, _pb, ms = next(c for c in children if not refiner.p.is_goal(c[0].mask))
-
-    def first(mask, masses, budget):
-        return refiner.choose_worst(mask, masses, budget, "first")
-
+    b, _pb, _ms = next(c for c in children if not refiner.p.is_goal(c[0].mask))
     try:
-        refiner.build(b.mask, ms, k, first)
+        refiner.follow(b.mask, k)
     except Timeout:
         return
     raise AssertionError("the build ran past its deadline without stopping")

@@ -455,10 +455,14 @@ def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
     def chooser(mask, masses, k):
         return refiner.choose_worst(mask, masses, k, tie)
 
-    # The first allowed action depends on the set and the budget only: share equal subtrees.
-    shared: dict | None = {} if tie == "first" else None
     refiner.new_tree()
-    subs = [(b, refiner.build(b.mask, ms, horizon, chooser, shared)) for b, _pb, ms in children]
+    if tie == "first":
+        # No choice left to make: follow the plans the margin probes found, with no new
+        # search where they recorded one (Refiner.follow), else the first allowed action.
+        shared: dict = {}
+        subs = [(b, refiner.follow(b.mask, horizon, None, shared)) for b, _pb, _ms in children]
+    else:
+        subs = [(b, refiner.build(b.mask, ms, horizon, chooser)) for b, _pb, ms in children]
     return root_step(subs, refiner.deadline)
 
 

@@ -128,6 +128,8 @@ class Refiner:
         self._monotone = problem.min_margin == 0.0 and not problem.sensorless
         """Margins and lengths are monotone under subsets: the maximal branches decide."""
         self._lo: dict[tuple[int, int], float] = {}
+        # The first action (its cell) of the plan behind each ``_lo`` (:meth:`follow`).
+        self._how: dict[tuple[int, int], Cell] = {}
         self._le: dict[tuple[int, int], float] = {}
         self._lt: dict[tuple[int, int], float] = {}
         self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[Value, Act | None]] = {}
@@ -247,9 +249,11 @@ class Refiner:
             self._lt[key] = -math.inf
             return False
         self.deadline.check()
-        found = self._keeping_plan(mask, k, x, strict)
-        if found is not None:
-            self._lo[key] = found if lo is None else max(lo, found)
+        kept = self._keeping_plan(mask, k, x, strict)
+        if kept is not None:
+            found, cell = kept
+            if lo is None or found > lo:
+                self._lo[key], self._how[key] = found, cell
             return True
         if strict:
             self._le[key] = x if le is None else min(le, x)
@@ -267,9 +271,10 @@ class Refiner:
             return e > k
         return w.lb.get(mask, 1) > k or mask in w.never or w.pair_bound(mask) > k
 
-    def _keeping_plan(self, mask: int, k: int, x: float, strict: bool) -> float | None:
+    def _keeping_plan(self, mask: int, k: int, x: float, strict: bool) -> tuple[float, Cell] | None:
         """The smallest margin of a plan for ``mask`` within ``k`` keeping ``x`` (as
-        :meth:`keeps` says), or None when there is none: the widest action first (its plan
+        :meth:`keeps` says) and its first action's cell, or None when there is none: the
+        widest action first (its plan
         then keeps the most), any plan at all (``x`` -inf) in the length search's order;
         on the maximal reading branches without a margin floor (module docstring)."""
         cells = self.p.choices.cells(mask, useful=False)  # widest first
@@ -305,7 +310,7 @@ class Refiner:
                 if not self.p.is_goal(c):
                     val = min(val, self._lo[(c, k - 1)])
             else:
-                return val
+                return val, cell
         return None
 
     def margin(self, mask: int, k: int) -> float:
@@ -525,21 +530,15 @@ class Refiner:
         masses: Masses,
         k: int,
         chooser: Callable[[int, Masses, int], Act],
-        shared: dict[tuple[int, int], Step] | None = None,
     ) -> Step | Leaf:
         """The subtree orienting ``mask`` in at most ``k`` operations, actions from ``chooser``.
 
-        ``shared`` (for a chooser that ignores the masses): one node per set and budget.
-        Either way equal subtrees are one object (a DAG in memory: a chooser that reads the
-        masses makes the same subtree on many paths), and each new node's branches are
-        committed to the deadline (:meth:`~feederkit.planning.budget.Deadline.commit`): its
-        verification walks each (node, state) pair of each distinct step once."""
+        Equal subtrees are one object (a DAG in memory: a chooser that reads the masses makes
+        the same subtree on many paths), and each new node's branches are committed to the
+        deadline (:meth:`~feederkit.planning.budget.Deadline.commit`): its verification walks
+        each (node, state) pair of each distinct step once."""
         if self.p.is_goal(mask):
             return Leaf(mask)
-        if shared is not None:
-            hit = shared.get((mask, k))
-            if hit is not None:
-                return hit
         self.deadline.check()
         act = chooser(mask, masses, k)
         table = self.p.readings.branch_table(act.action.image)
@@ -548,17 +547,76 @@ class Refiner:
             subs = [(b, Leaf(b.mask)) for b, _idx, _probs in table]
         else:
             subs = [
-                (b, self.build(b.mask, ms, k - 1, chooser, shared))
+                (b, self.build(b.mask, ms, k - 1, chooser))
                 for b, _pb, ms in child_masses(self.p, mask, masses, act)
             ]
+        return self._node(act, subs)
+
+    def follow(
+        self,
+        mask: int,
+        k: int,
+        witness: int | None = None,
+        shared: dict[tuple[int, int, int | None], Step | Leaf] | None = None,
+    ) -> Step | Leaf:
+        """The subtree for ``mask`` within ``k`` keeping the floor that follows the plans the
+        margin probes found (:meth:`keeps` keeps each one's first action), with no new search.
+
+        ``witness`` is a set containing ``mask`` with such a plan (None: ``mask`` itself, as
+        at a root branch the probes decided). With margins monotone under subsets (module
+        docstring), ``mask``'s overlap range around the witness's rotation is as wide or
+        wider, and each of its reading branches lies in one of the witness's maximal
+        branches, whose plans go on. Where no plan is recorded, the first allowed action
+        (:meth:`choose_worst` ``"first"``), whose maximal branches the probes then decided.
+        Equal subtrees are one object, each new node committed to the deadline as in
+        :meth:`build`.
+        """
+        if self.p.is_goal(mask):
+            return Leaf(mask)
+        if shared is None:
+            shared = {}
+        key = (mask, k, witness)
+        hit = shared.get(key)
+        if hit is not None:
+            return hit
+        self.deadline.check()
+        lender = mask if witness is None else witness
+        cell = self._how.get((lender, k))
+        act = None
+        if self._monotone and cell is not None and self._lo[(lender, k)] >= self.floor:
+            act = self._around(mask, cell)
+        if act is None:
+            act = self.choose_worst(mask, (), k, "first")
+            cell = (act.action.lo, act.action.hi, act.action.image)
+        maximal = self.p.readings.children(cell[2]) if self._monotone else ()
+        subs: list[tuple[ReadingBranch, Step | Leaf]] = []
+        for b, _idx, _probs in self.p.readings.branch_table(act.action.image):
+            inside = next((m for m in maximal if b.mask & ~m == 0), None)
+            subs.append((b, self.follow(b.mask, k - 1, inside, shared)))
+        node = shared[key] = self._node(act, subs)
+        return node
+
+    def _node(self, act: Act, subs: list[tuple[ReadingBranch, Step | Leaf]]) -> Step:
+        """The tree's node of ``act`` over ``subs``: one object per equal subtree, each new
+        one's (node, state) pairs committed to the deadline."""
         key = (act.action, tuple((b, c if isinstance(c, Leaf) else id(c)) for b, c in subs))
         node = self._nodes.get(key)
         if node is None:
             node = self._nodes[key] = Step(act.action, tuple(subs))
             self.deadline.commit(branch_pairs(subs))
-        if shared is not None:
-            shared[(mask, k)] = node
         return node
+
+    def _around(self, mask: int, cell: Cell) -> Act | None:
+        """The action of ``mask``'s overlap range that contains ``cell`` (an overlap range of
+        a superset: ``mask``'s range boundaries are among the superset's), with every branch
+        set; None when none does or it is narrower than the floor."""
+        x = (cell[0] + cell[1]) / 2.0
+        for lo, hi, img in self.p.choices.fixed_cells(mask):
+            if any(lo <= y <= hi for y in (x, x - 360.0, x + 360.0)):
+                if (hi - lo) / 2.0 < self.floor:
+                    return None
+                return self.p.choices.act(mask, (lo, hi, img), exact=True)
+        return None
 
 
 def tie_floor(margin: float) -> float:
