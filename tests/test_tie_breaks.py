@@ -386,3 +386,25 @@ def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
     assert any(searches) is False and len(searches) > 0
     assert check_plan(got) <= got.length
+
+
+@pytest.mark.parametrize(("count", "tolerance"), [(5, 2.0), (6, 3.0)])
+def test_ties_cut_after_the_margin_under_uncertainty_give_a_verified_strong_plan(
+    monkeypatch, count, tolerance
+):
+    # The same tree under a rotation error of 1 degree: make_plan verifies it for every
+    # outcome before it is returned (a plan that fails raises).
+    from feederkit.plans.make import make_plan
+
+    pfs = small_mix(count)
+    exact = make_plan(pfs, ToleranceSensor(tolerance), uncertainty=Uncertainty()).result
+
+    def cut(self, *args):
+        raise Timeout("time")
+
+    monkeypatch.setattr(Refiner, "expected", cut)
+    made = make_plan(pfs, ToleranceSensor(tolerance), uncertainty=Uncertainty())
+    got = made.result
+    assert got.tie_breaks == api.TIES_MARGIN and made.report.ok
+    assert got.length == exact.length
+    assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
