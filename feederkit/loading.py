@@ -16,7 +16,7 @@ from pathlib import Path
 
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
-from feederkit.mechanics.analysis import fragile_warning
+from feederkit.mechanics.analysis import fragile_warnings
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.sources import load_parts_with_warnings
 
@@ -88,12 +88,9 @@ def load_parts(
                 left_out.append(line)
                 continue
             warnings += [f"{where}: {w}" for w in loaded.warnings]
-            pf = push_function(loaded.part)
-            fragile = fragile_warning(pf)
-            if fragile is not None:
-                warnings.append(fragile)
-            pfs.append(pf)
+            pfs.append(push_function(loaded.part))
             origins.append(source)
+    warnings += fragile_warnings(pfs)  # one line for a large mix's fragile parts
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:

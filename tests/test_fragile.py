@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from feederkit.mechanics import push_function
-from feederkit.mechanics.analysis import fragile_states, fragile_warning
+from feederkit.mechanics.analysis import (
+    FRAGILE_LINES,
+    fragile_states,
+    fragile_warning,
+    fragile_warnings,
+)
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.sources import load_part
@@ -55,3 +61,25 @@ def test_plan_and_analyze_warn_about_fragile_states(capsys) -> None:  # noqa: AN
     rectangle = str(CATALOG / "rectangle-2x1.json")
     assert main(["plan", rectangle, "--tolerance", "0.01", "--json"]) == 0
     assert "fragile" not in capsys.readouterr().err
+
+
+def _bent_bar(name: str, degrees: float) -> object:
+    """A 40 x 10 bar whose bottom bends by ``degrees``: two fragile states (see above)."""
+    bend = 20.0 * math.tan(math.radians(degrees))
+    return push_function(
+        make_part(make_outline(name, [(0, 0), (20, -bend), (40, 0), (40, 10), (0, 10)]))
+    )
+
+
+def test_a_large_mix_gets_one_line_for_its_fragile_parts() -> None:
+    few = [_bent_bar(f"bar-{k}", 0.5 + 0.1 * k) for k in range(FRAGILE_LINES)]
+    lines = fragile_warnings(few)
+    assert lines == [fragile_warning(pf) for pf in few]
+    many = [*few, _bent_bar("bar-x", 0.45)]
+    octagon = push_function(load_part(str(CATALOG / "octagon.json")))
+    (line,) = fragile_warnings([*many, octagon])
+    assert line.startswith(f"{len(many)} parts have fragile states")
+    for pf in many:
+        ids = ", ".join(map(str, fragile_states(pf)))
+        assert f"{pf.part.name} ({ids})" in line
+    assert "octagon" not in line and "simulate" in line

@@ -8,6 +8,7 @@ docs/analysis.md).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from feederkit.mechanics.polygon_classes import PolygonClass, polygon_class
@@ -66,6 +67,34 @@ def fragile_warning(pf: PushFunction) -> str | None:
         f"{pf.part.name}: fragile states {named} (barrier below {limit:.3g} mm): the part may "
         "settle on a neighbour; check the plan with feederkit simulate"
     )
+
+
+FRAGILE_LINES = 3
+"""A mix with more parts than this that have fragile states gets one line for all of them."""
+
+
+def fragile_warnings(pfs: Sequence[PushFunction]) -> list[str]:
+    """The fragile states of a mix's parts in words: a line per part (:func:`fragile_warning`)
+    for up to ``FRAGILE_LINES`` such parts, else one line naming each part with its states,
+    so that a large mix's warnings stay readable.
+
+    >>> from feederkit.mechanics.push import push_function
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> bar = push_function(make_part(make_outline("bar", [(0, 0), (30, 0), (30, 10), (0, 10)])))
+    >>> fragile_warnings([bar])
+    []
+    """
+    fragile = [(pf, fragile_states(pf)) for pf in pfs]
+    fragile = [(pf, ids) for pf, ids in fragile if ids]
+    if len(fragile) <= FRAGILE_LINES:
+        return [line for pf, _ in fragile if (line := fragile_warning(pf)) is not None]
+    named = "; ".join(f"{pf.part.name} ({', '.join(map(str, ids))})" for pf, ids in fragile)
+    return [
+        f"{len(fragile)} parts have fragile states (barrier below "
+        f"{FRAGILE_BARRIER_REL:.1%} of the part's size): {named}: a part may settle on a "
+        "neighbour; check the plan with feederkit simulate"
+    ]
 
 
 @dataclass(frozen=True)
