@@ -10,7 +10,8 @@ work budget, docs/planning.md). Printed per stage: the goal relation (``goal_rel
 the length proof (``longest_root``), the margin stage (``stage``), the tree with its
 remaining tie-breaks (``_build``: the expected-operations choice, or, when that runs out,
 the tree that follows the margin probes' plans), the result's statistics (``_result``);
-then the whole call, ``tie_breaks`` and the peak resident memory of the process. Each case
+then the whole call, its length, ``tie_breaks``, smallest margin (degrees) and the peak
+resident memory of the process. Each case
 runs in its own process so that the peaks do not mix.
 """
 
@@ -51,14 +52,15 @@ machine = build_machine(pfs, ToleranceSensor(float(tol.rstrip("%")) / 100.0 * si
 t = time.process_time()
 r = api.plan(machine)
 print(json.dumps({"states": machine.n, "cpu": time.process_time() - t, "stages": spent,
-                  "length": r.length, "ties": r.tie_breaks,
+                  "length": r.length, "ties": r.tie_breaks, "margin": r.min_margin,
                   "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 """
 
 
 def main(argv: list[str]) -> int:
     cases = argv or list(DEFAULT_CASES)
-    print("case | states | " + " | ".join(STAGES) + " | plan CPU s | length | ties | peak MB")
+    tail = " | plan CPU s | length | ties | margin | peak MB"
+    print("case | states | " + " | ".join(STAGES) + tail)
     for case in cases:
         p = subprocess.run(
             [sys.executable, "-c", CHILD, case, str(HERE), json.dumps(STAGES)],
@@ -72,7 +74,7 @@ def main(argv: list[str]) -> int:
         cells = " | ".join(f"{r['stages'].get(s, 0.0):.2f}" for s in STAGES)
         print(
             f"{case} | {r['states']} | {cells} | {r['cpu']:.2f} | {r['length']} | "
-            f"{r['ties']} | {r['peak_mb']:.0f}",
+            f"{r['ties']} | {r['margin']:.6g} | {r['peak_mb']:.0f}",
             flush=True,
         )
     return 0
