@@ -401,10 +401,11 @@ def run_demo(
     """Run the demo on the part files in ``source_dir``, writing into ``output``.
 
     ``percent``: the diameter sensor's tolerance in percent of the largest part's size of
-    what is planned (each part alone, then each changeover's mix), in (0, 50); ``reports``: write each changeover's HTML report (its part plots are most of the
-    demo's time); ``cell``: the cell profile whose timing gives each changeover's cycle time
-    (the demo keeps its own sensor). Raises InputError for a missing folder, a bad
-    percentage, or bad part files.
+    what is planned (each part alone, then each changeover's mix), in (0, 50); ``reports``:
+    write each changeover's HTML report (its part plots are most of the demo's time);
+    ``cell``: the cell profile whose timing gives each changeover's cycle time (the demo
+    keeps its own sensor). Raises InputError for a missing folder, a bad percentage, or bad
+    part files.
     """
     src, out = Path(source_dir), Path(output)
     if not src.is_dir():
