@@ -38,6 +38,7 @@ from feederkit.importers.orientable import orientability
 from feederkit.landing.model import Landing, landings_of_outline
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
+from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
@@ -82,7 +83,7 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]
                 per_part.append((part, rev.landings or landings_of_outline(part)))
     finally:
         conn.close()
-    if not any(len(lands) > 1 for _, lands in per_part):
+    if not plans_over_landings([lands for _, lands in per_part], False, False):
         return [push_function(part) for part, _ in per_part], skipped, False
     pfs = []
     for _, lands in per_part:
