@@ -407,9 +407,9 @@ def _plan(
         root = _build(refiner, children, horizon, tie)
         ties = TIES_EXACT
     except Timeout:
-        # The lengths are proven; the tie-breaking stages ran out of time: the first
-        # action that keeps the proven length (and the margin decided or found so far) at
-        # each node, while time remains.
+        # The lengths are proven; the tie-breaking stages ran out of time: a tree that
+        # keeps the proven length and the margin decided or found so far, following the
+        # plans the margin probes found (Refiner.follow), while time remains.
         worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
         ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
         if not staged:
