@@ -81,9 +81,11 @@ TIE_SHARE = 5.0
 """The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
 may poll their budget this many times as often as the length proof did, plus
 ``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
-the same machine gives the same plan on any computer and under any load. A tie-breaking
-poll costs a third to a fifth of a proof's (benchmarks/bench_tie_budget.py), so this is
-about one to two times the proof's time."""
+the same machine gives the same plan on any computer and under any load. On the
+benchmark's mixes a tie-breaking poll costs a third to a fifth of a proof's
+(benchmarks/bench_tie_budget.py), so this is about one to two times the proof's time; on
+a 240-state mix at 3 % it costs more than a proof's, and the stages take about three times
+the proof's time (benchmarks/bench_plan_stages.py, docs/performance.md)."""
 
 TIE_GRACE_POLLS = 10_000
 """Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (one to
