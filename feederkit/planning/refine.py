@@ -332,9 +332,9 @@ class Refiner:
         some plan has, and between steps the probes leap: halfway from ``m`` to the least
         margin not yet refuted (at first the widest first action's), ``m`` rises to what the
         plans found there keep while every set keeps the midpoint, and the first that does
-        not refutes it (a mix of 240 states took 237 steps from below, 51-60 CPU seconds;
-        22 with the leaps). The probes share one memo, and a set that refuted a margin is
-        asked first next time.
+        not refutes it (a mix of 240 states took 237 steps from below, 51-53 CPU seconds;
+        22 with the leaps: docs/planning.md). The probes share one memo, and a set that
+        refuted a margin is asked first next time.
         """
         open_ = sorted((r for r in masks if not self.p.is_goal(r)), key=lambda r: -r.bit_count())
         if not open_:
