@@ -35,7 +35,8 @@ from feederkit.cli.common import (
 from feederkit.cli.plan_render import sensor_text
 from feederkit.errors import CheckFailed, InputError
 from feederkit.importers.orientable import orientability
-from feederkit.landing.model import Landing, landings_of_outline
+from feederkit.landing.model import Landing
+from feederkit.landing.plan import revision_landings
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
 from feederkit.mix.changeover import plans_over_landings
@@ -80,7 +81,7 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]
                 # stored orientable part has a push function.
                 rev = get_revision(conn, s.name, s.revision)
                 part = part_from_revision(rev)
-                per_part.append((part, rev.landings or landings_of_outline(part)))
+                per_part.append((part, revision_landings(rev, part)))
     finally:
         conn.close()
     if not plans_over_landings([lands for _, lands in per_part], False, False):

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from feederkit.catalog import default_catalog_path, get_revision, landings_for
+from feederkit.catalog import Revision, default_catalog_path, get_revision, landings_for
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.importers.reader import MESH_SUFFIXES, import_parts
@@ -35,6 +35,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import accepted_lumps, checked_landings, plan_landing_members
 from feederkit.mix.changeover import landing_members as landing_members  # re-exported
 from feederkit.mix.pairs import PairWitness
+from feederkit.part import Part
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.make import MadePlan
@@ -236,8 +237,13 @@ def _landings_of(
         return landings_for((same or imported)[0], opts, path)
     db = Path(catalog) if catalog is not None else default_catalog_path()
     revision = None if pf.part.revision is None else int(pf.part.revision)
-    stored = get_revision(db, pf.part.name, revision).landings
-    return stored or landings_of_outline(pf.part)
+    return revision_landings(get_revision(db, pf.part.name, revision), pf.part)
+
+
+def revision_landings(rev: Revision, part: Part) -> tuple[Landing, ...]:
+    """A catalog revision's landings: the stored ones, or those of ``part`` (the revision's
+    part) computed from its outline for a revision stored before landings."""
+    return rev.landings or landings_of_outline(part)
 
 
 def load_landings(
