@@ -93,11 +93,14 @@ def report_command(
     if simulate is not None and simulate < 1:
         raise InputError(f"--simulate must be a positive number of trials, got {simulate}")
     simulation = None if simulate is None else _simulate(data, simulate, seed)
+    # One verification: the page's banner shows it, the exit code says it (design.md).
+    verdict = verify_declared(data)
     html = render_report(
         data,
         seconds_per_op=seconds_per_op,
         simulation=simulation,
         cycle_time=None if seconds_per_op is not None else _cycle_time(plan),
+        verification=verdict,
     )
     write_report(output, html)
     if simulation is not None:
@@ -108,8 +111,6 @@ def report_command(
             markup=False,
         )
     console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)
-    # The page's banner is for whoever opens it; the exit code is for the shell (design.md).
-    verdict = verify_declared(data)
     if not verdict.ok:
         raise CheckFailed(
             f"the plan failed verification: {verdict.first_problem()} (the report {output} "

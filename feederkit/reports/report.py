@@ -134,6 +134,7 @@ def render_report(
     outlines: Mapping[str, Outline] | None = None,
     cycle_time: Mapping[str, Any] | None = None,
     design: Mapping[str, Any] | None = None,
+    verification: VerificationReport | None = None,
 ) -> str:
     """The HTML report of a plan (or a plan file's JSON object, checked; design.md).
 
@@ -143,7 +144,9 @@ def render_report(
     pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis;
     ``outlines`` (part name, or ``PART/LANDING`` for a member of a plan over landings, ->
     Outline) draws holes around the plan's hulls; ``design`` (the
-    JSON of ``feederkit design sensor``) adds the sensor design table and plot. Raises
+    JSON of ``feederkit design sensor``) adds the sensor design table and plot;
+    ``verification``, the plan's :func:`~feederkit.plans.verify.verify_declared` when the
+    caller has it (else it is made here), gives the banner. Raises
     InputError for a malformed plan or option.
     """
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -152,7 +155,7 @@ def render_report(
         stats = plan.get("stats")
         cycle_time = stats.get("cycle_time") if isinstance(stats, Mapping) else None
     plan = as_plan(plan)
-    report = verify_declared(plan)
+    report = verify_declared(plan) if verification is None else verification
     numbered = places(plan)
     trace = trace_plan(plan, numbered)
     draw = drawing_for(plan, member_rings(plan, outlines))
