@@ -12,6 +12,7 @@
 
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import (
+    CandidatePairs,
     PairWitness,
     candidate_pairs,
     distinguishable,
@@ -31,6 +32,7 @@ __all__ = [
     "ANGLE_TOL_DEG",
     "LENGTH_TOL_MM",
     "BehaviourClass",
+    "CandidatePairs",
     "PairWitness",
     "Signature",
     "candidate_pairs",

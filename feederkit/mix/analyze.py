@@ -102,7 +102,7 @@ def analyze_mix(
     else:
         todo = candidate_pairs(pfs, sensor)
         cand = len(todo)
-        pairs = tuple(unrecognizable_pairs(pfs, sensor, todo))
+        pairs = tuple(unrecognizable_pairs(pfs, sensor, todo, signatures=sigs))
     t3 = time.perf_counter()
     return MixAnalysis(
         names=tuple(pf.part.name for pf in pfs),

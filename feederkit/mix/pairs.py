@@ -16,7 +16,9 @@ inseparable pairs, with the reason in words. With noise the relation is not tran
 
 from __future__ import annotations
 
+import functools
 import itertools
+from array import array
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -52,7 +54,7 @@ REASON_TOLERANCE = (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class PairWitness:
     """Two parts that no plan can tell apart, and why.
 
@@ -60,7 +62,7 @@ class PairWitness:
     the k-th inseparable pair: if the part is in one of them no action sequence ever makes
     its readings differ from those of the other. ``kind`` names the reason in one word:
     ``same-push-diameter``, ``sensorless``, ``single-diameter``, ``same-diameters`` or
-    ``tolerance``.
+    ``tolerance``. Slotted: a catalog's analysis holds a million of them.
     """
 
     part_a: str
@@ -167,7 +169,13 @@ def _reason(
     db = [s.diameter for s in pf_b.states]
     if all(abs(da[i] - db[j]) <= LENGTH_TOL_MM for i, j in pairs):
         return "same-diameters", REASON_SAME_DIAMETERS
-    return "tolerance", REASON_TOLERANCE + f" ({sensor.describe()})"
+    return "tolerance", _tolerance_reason(sensor.describe())
+
+
+@functools.lru_cache(maxsize=64)
+def _tolerance_reason(described: str) -> str:
+    """One string per sensor for every witness that cites it (a catalog holds a million)."""
+    return REASON_TOLERANCE + f" ({described})"
 
 
 def distinguishable(
@@ -198,13 +206,20 @@ def distinguishable(
     return _witness(pf_a, pf_b, sensor, pairs, None, None, index_a, index_b)
 
 
-def _witness(pf_a, pf_b, sensor, pairs, sig_a, sig_b, index_a, index_b) -> PairWitness:
+def _witness(pf_a, pf_b, sensor, pairs, sig_a, sig_b, index_a, index_b, shared=None) -> PairWitness:
+    """The witness of an inseparable pair of parts; equal state tuples are one object in
+    ``shared`` (a catalog's witnesses repeat a few patterns, such as every state)."""
     kind, reason = _reason(pf_a, pf_b, sensor, pairs, sig_a, sig_b)
+    states_a = tuple(i for i, _ in pairs)
+    states_b = tuple(j for _, j in pairs)
+    if shared is not None:
+        states_a = shared.setdefault(states_a, states_a)
+        states_b = shared.setdefault(states_b, states_b)
     return PairWitness(
         part_a=pf_a.part.name,
         part_b=pf_b.part.name,
-        states_a=tuple(i for i, _ in pairs),
-        states_b=tuple(j for _, j in pairs),
+        states_a=states_a,
+        states_b=states_b,
         reason=reason,
         kind=kind,
         index_a=index_a,
@@ -258,7 +273,49 @@ def landing_profile(pf: PushFunction, bins: int = QUANTILE_BINS) -> list[float]:
     return out
 
 
-def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[int, int]]:
+class CandidatePairs(Sequence[tuple[int, int]]):
+    """Sorted pairs ``(i, j)``, ``i < j``, of part indices, held as two int32 arrays.
+
+    A 50,000-part catalog over both landings leaves 2.6 million candidate pairs: as Python
+    tuples they took about 240 MB, here 21 MB. Iterating yields plain tuples of ints.
+    """
+
+    __slots__ = ("_a", "_b")
+    _CHUNK = 1 << 16
+
+    def __init__(self, a: np.ndarray, b: np.ndarray) -> None:
+        order = np.lexsort((b, a))
+        self._a = np.ascontiguousarray(a[order], dtype=np.int32)
+        self._b = np.ascontiguousarray(b[order], dtype=np.int32)
+
+    def __len__(self) -> int:
+        return len(self._a)
+
+    def __getitem__(self, k):  # type: ignore[override]
+        if isinstance(k, slice):
+            return [(int(x), int(y)) for x, y in zip(self._a[k], self._b[k], strict=True)]
+        return (int(self._a[k]), int(self._b[k]))
+
+    def __iter__(self):
+        for s in range(0, len(self._a), self._CHUNK):
+            yield from zip(
+                self._a[s : s + self._CHUNK].tolist(),
+                self._b[s : s + self._CHUNK].tolist(),
+                strict=True,
+            )
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, CandidatePairs):
+            return bool(np.array_equal(self._a, other._a) and np.array_equal(self._b, other._b))
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"CandidatePairs({len(self)} pairs)"
+
+
+def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> CandidatePairs:
     """Pairs of parts that may be unrecognizable, found without an all-pairs pass.
 
     Two necessary conditions, both from the parts alone: every state of each part reads
@@ -271,7 +328,8 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[i
     """
     n = len(pfs)
     if not sensor.informative:
-        return [(i, j) for i in range(n) for j in range(i + 1, n)]
+        a, b = np.triu_indices(n, 1)
+        return CandidatePairs(a, b)
     reach = sensor.reading_reach()
     diams = [sorted(s.diameter for s in pf.states) for pf in pfs]
     eps = [DIAMETER_REL_EPS * pf.part.size for pf in pfs]
@@ -287,7 +345,7 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[i
     def alike(x: float, y: float) -> bool:
         return sensor.can_read_alike(x, y) or abs(x - y) <= cell - reach
 
-    out = []
+    out_a, out_b = array("i"), array("i")
     steps = list(itertools.product((-1, 0, 1), repeat=len(HASH_BINS)))
     for key, here in grid.items():
         there_all = []
@@ -309,27 +367,37 @@ def candidate_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> list[tuple[i
                 if not (alike(lo_i, dj[0]) and alike(hi_i, dj[-1])):
                     continue
                 if _covers(diams[i], dj, alike) and _covers(dj, diams[i], alike):
-                    out.append((i, j))
-    out.sort()
-    return out
+                    out_a.append(i)
+                    out_b.append(j)
+    return CandidatePairs(np.frombuffer(out_a, np.int32), np.frombuffer(out_b, np.int32))
 
 
 def unrecognizable_pairs(
     pfs: Sequence[PushFunction],
     sensor: Sensor,
     candidates: Sequence[tuple[int, int]] | None = None,
+    *,
+    signatures: Sequence[Signature] | None = None,
 ) -> list[PairWitness]:
     """Every pair of parts of a mix that no plan can tell apart, each with its witness.
 
     Exact (the greatest fixpoint of :func:`inseparable_cross_pairs`) on the pairs that
     :func:`candidate_pairs` leaves (or ``candidates``, if given, already computed by it);
-    the others cannot be unrecognizable. Sorted by part index.
+    the others cannot be unrecognizable. Sorted by part index. ``signatures``, when the
+    caller has them (one per part), name the witnesses' reasons without recomputing them.
+
+    A part's action ranges are made at its first pair and dropped after its last, so a
+    catalog's analysis holds those of the parts in between only.
     """
+    todo = candidate_pairs(pfs, sensor) if candidates is None else candidates
+    last: dict[int, int] = {}
+    for t, (i, j) in enumerate(todo):
+        last[i] = last[j] = t
     ranges: dict[int, list] = {}
     sigs: dict[int, Signature] = {}
+    shared: dict[tuple[int, ...], tuple[int, ...]] = {}
     out = []
-    todo = candidate_pairs(pfs, sensor) if candidates is None else candidates
-    for i, j in todo:
+    for t, (i, j) in enumerate(todo):
         for k in (i, j):
             if k not in ranges:
                 ranges[k] = _ranges(pfs[k])
@@ -339,12 +407,17 @@ def unrecognizable_pairs(
         if pairs:
             for k in (i, j):
                 if k not in sigs:
-                    sigs[k] = signature(pfs[k])
-            out.append(_witness(pfs[i], pfs[j], sensor, pairs, sigs[i], sigs[j], i, j))
+                    sigs[k] = signature(pfs[k]) if signatures is None else signatures[k]
+            out.append(_witness(pfs[i], pfs[j], sensor, pairs, sigs[i], sigs[j], i, j, shared))
+        for k in (i, j):
+            if last[k] == t:
+                ranges.pop(k, None)
+                sigs.pop(k, None)
     return out
 
 
 __all__ = [
+    "CandidatePairs",
     "PairWitness",
     "candidate_pairs",
     "distinguishable",
