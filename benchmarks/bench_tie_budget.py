@@ -8,7 +8,8 @@ The ``worst`` objective's tie-breaking stages get a budget of polls (a
 shortest"), a multiple of the length proof's polls. Per case, with the budget lifted: the
 length proof's polls and CPU seconds, the tie-breaking stages' polls and CPU seconds, the
 share they would need (``(tie polls - TIE_GRACE_POLLS) / proof polls``) and whether the
-default budget cuts them short. The last lines give each phase's polls per CPU second over
+default budget (``TIE_SHARE`` for both stages, ``api.EXPECTED_SHARE`` for the second) cuts
+them short. The last lines give each phase's polls per CPU second over
 every case that polls at least a thousand times, the ratio that turns the poll budget into
 seconds.
 """
@@ -30,28 +31,32 @@ from feederkit.planning.budget import Deadline, WorkBudget  # noqa: E402
 
 
 class _Recording(WorkBudget):
-    """The tie-breaking budget, remembering the length proof's polls and the CPU clock."""
+    """The tie-breaking budgets of one plan (the stages', then the expected stage's share),
+    remembering the length proof's polls and the CPU clock."""
 
-    last: _Recording | None = None
+    made: list[_Recording] = []
 
     def __init__(self, outer: Deadline, polls: float) -> None:
         super().__init__(outer, polls)
         self.proof_polls = outer.polls
         self.cpu_start = time.process_time()
-        _Recording.last = self
+        _Recording.made.append(self)
 
 
 def main(argv: list[str]) -> int:
-    share, grace = api.TIE_SHARE, api.TIE_GRACE_POLLS
+    share, grace, eshare = api.TIE_SHARE, api.TIE_GRACE_POLLS, api.EXPECTED_SHARE
     api.WorkBudget = _Recording
-    api.TIE_SHARE = 1e9  # lifted: every case's stages run to the end
+    api.TIE_SHARE = api.EXPECTED_SHARE = 1e9  # lifted: every case's stages run to the end
     proof_rate, tie_rate = [0, 0.0], [0, 0.0]
-    print(f"default budget: {share:g} x proof polls + {grace} polls")
+    print(
+        f"default budget: {share:g} x proof polls + {grace} polls, of which the expected "
+        f"stage at most {eshare:g} x proof polls + {grace}"
+    )
     print(f"{'proof polls':>11} {'CPU s':>6} {'tie polls':>9} {'CPU s':>6} {'share':>7}  case")
     for name, machine, options in dp.cases("--quick" in argv):
         if options.objective.value != "worst":
             continue
-        _Recording.last = None
+        _Recording.made = []
         start = time.process_time()
         try:
             api.plan(bp.fresh(machine), options)
@@ -59,14 +64,16 @@ def main(argv: list[str]) -> int:
             print(f"{'':>11} {'':>6} {'':>9} {'':>6} {'':>7}  {name}: no plan")
             continue
         end = time.process_time()
-        budget = _Recording.last
-        if budget is None:
+        if not _Recording.made:
             print(f"{'':>11} {'':>6} {'':>9} {'':>6} {'':>7}  {name}: no tie-breaking stage")
             continue
-        proof, ties = budget.proof_polls, budget.polls
+        budget = _Recording.made[0]
+        proof, ties = budget.proof_polls, sum(b.polls for b in _Recording.made)
         proof_s, ties_s = budget.cpu_start - start, end - budget.cpu_start
         need = (ties - grace) / max(proof, 1)
-        cut = " (cut short by default)" if ties > share * proof + grace else ""
+        expected = sum(b.polls for b in _Recording.made[1:])
+        over = ties > share * proof + grace or expected > eshare * proof + grace
+        cut = " (cut short by default)" if over else ""
         print(f"{proof:11d} {proof_s:6.2f} {ties:9d} {ties_s:6.2f} {need:7.2f}  {name}{cut}")
         if proof >= 1000 or ties >= 1000:
             proof_rate[0] += proof

@@ -27,6 +27,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses
 from feederkit.planning.reindex import by_diameter
+from feederkit.planning.tree import Leaf
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -79,6 +80,10 @@ def test_the_largest_margin_is_the_max_min_over_every_branch(name, machine):
     for r in every:
         assert refiner.margin(r, k) == want[r], name
     assert refiner.largest_floor(every, k) == min(want.values())
+    # Told that every root has a plan (the length proof's), the stage leaps from 0 at once,
+    # on a fresh memo, and finds the same margin.
+    fresh = Refiner(refiner.p, refiner.w)
+    assert fresh.largest_floor(every, k, planned=True) == min(want.values())
 
 
 @pytest.mark.parametrize(("name", "machine"), MACHINES, ids=[n for n, _ in MACHINES])
@@ -165,8 +170,8 @@ def _tie_polls(monkeypatch) -> tuple[int, int]:
     with monkeypatch.context() as m:
         m.setattr(api, "WorkBudget", Recording)
         api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
-    (budget,) = seen
-    return budget.proof, budget.polls
+    margin, expected = seen  # the stages' budget, then the expected stage's share of it
+    return margin.proof, margin.polls + expected.polls
 
 
 def test_a_plan_cut_short_in_its_tie_breaks_is_the_same_on_a_slow_computer(monkeypatch):
@@ -367,18 +372,18 @@ def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     def cut(self, *args):
         raise Timeout("time")
 
-    build = api._build
+    follow = Refiner.follow
 
-    def watched(refiner, children, horizon, tie):
-        following[0] = tie == "first"
+    def watched(self, *args):
+        was, following[0] = following[0], True
         try:
-            return build(refiner, children, horizon, tie)
+            return follow(self, *args)
         finally:
-            following[0] = False
+            following[0] = was
 
     monkeypatch.setattr(Refiner, "_keeping_plan", counted)
     monkeypatch.setattr(Refiner, "expected", cut)
-    monkeypatch.setattr(api, "_build", watched)
+    monkeypatch.setattr(Refiner, "follow", watched)
     fresh = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
     got = api.plan(fresh)
     assert got.tie_breaks == api.TIES_MARGIN and got.optimal
@@ -408,3 +413,88 @@ def test_ties_cut_after_the_margin_under_uncertainty_give_a_verified_strong_plan
     assert got.tie_breaks == api.TIES_MARGIN and made.report.ok
     assert got.length == exact.length
     assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
+
+
+def test_the_expected_stage_gets_its_own_share_of_the_tie_budget(monkeypatch):
+    # The margin stage comes first; the expected-operations stage may poll at most
+    # EXPECTED_SHARE times the proof's polls plus the grace, of what the margin stage left.
+    seen: list[tuple[int, float]] = []
+
+    class Recording(WorkBudget):
+        def __init__(self, outer: Deadline, polls: float) -> None:
+            super().__init__(outer, polls)
+            seen.append((outer.polls, polls))
+
+    monkeypatch.setattr(api, "WorkBudget", Recording)
+    monkeypatch.setattr(api, "TIE_GRACE_POLLS", 5)
+    monkeypatch.setattr(api, "TIE_SHARE", 1e6)
+    monkeypatch.setattr(api, "EXPECTED_SHARE", 0.5)
+    got = api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
+    (proof, whole), (_, share) = seen
+    assert whole == 1e6 * proof + 5
+    assert share == 0.5 * proof + 5
+    assert got.tie_breaks == api.TIES_MARGIN  # 5 polls do not finish it
+    assert check_plan(got) <= got.length
+
+
+def test_root_branches_chosen_before_the_expected_stage_ran_out_keep_their_subtrees(
+    monkeypatch,
+):
+    # The expected stage builds the tree one root branch after the other; when it runs out,
+    # the branches already built keep their subtrees and the rest follow the margin probes.
+    machine = build_machine(small_mix(6), ToleranceSensor(3.0), IDEAL)
+    exact = api.plan(machine)
+    first = next(i for i, (_b, c) in enumerate(exact.root.branches) if not isinstance(c, Leaf))
+    followed = _cut_after(monkeypatch, 0)
+    partial = _cut_after(monkeypatch, first + 1)
+    for got in (followed, partial):
+        assert got.tie_breaks == api.TIES_MARGIN and got.optimal
+        assert got.length == exact.length
+        assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
+        assert check_plan(got) <= got.length
+    assert partial.root.branches[: first + 1] == exact.root.branches[: first + 1]
+    assert followed.root.branches[first] != exact.root.branches[first]
+    assert exact.expected_length <= partial.expected_length + 1e-9
+    assert partial.expected_length < followed.expected_length - 1e-9
+
+
+def _cut_after(monkeypatch, roots: int):
+    """The plan of the 6-part mix at 3 mm whose expected stage builds the subtrees of
+    ``roots`` root branches, then runs out."""
+    build = Refiner.build
+    left = [roots]
+    depth = [0]
+
+    def counted(self, *args):
+        if depth[0] == 0:
+            if left[0] <= 0:
+                raise Timeout("time")
+            left[0] -= 1
+        depth[0] += 1
+        try:
+            return build(self, *args)
+        finally:
+            depth[0] -= 1
+
+    with monkeypatch.context() as m:
+        m.setattr(Refiner, "build", counted)
+        return api.plan(build_machine(small_mix(6), ToleranceSensor(3.0), IDEAL))
+
+
+def test_the_expected_objective_cut_short_is_not_optimal(monkeypatch):
+    # Only the worst objective keeps the root branches its last stage built: a plan of the
+    # expected objective cut short is the shortest tree, and not claimed optimal.
+    machine = build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL)
+    best = api.plan(machine, PlanningOptions(objective="expected"))
+    assert best.optimal
+
+    def cut(self, *args):
+        raise Timeout("time")
+
+    monkeypatch.setattr(Refiner, "expected", cut)
+    got = api.plan(
+        build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL),
+        PlanningOptions(objective="expected"),
+    )
+    assert not got.optimal and got.tie_breaks == api.TIES_NONE
+    assert check_plan(got) <= got.length

@@ -19,6 +19,7 @@ from __future__ import annotations
 import gc
 import math
 import time
+from collections.abc import Callable
 from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
@@ -53,7 +54,7 @@ from feederkit.planning.stats import (
     tree_min_margin,
 )
 from feederkit.planning.subsets import subset_lower_bound
-from feederkit.planning.tree import Leaf, PlanResult, Step, build_dag, root_step
+from feederkit.planning.tree import Leaf, PlanResult, Step, branch_pairs, build_dag, root_step
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -77,15 +78,20 @@ FIRST_TREE_SHARE = 0.85
 """Where (as a share of the time limit) the tree of a proven length with no tie-breaking
 must be built; after that the fallback answers."""
 
-TIE_SHARE = 5.0
+TIE_SHARE = 3.0
 """The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
 may poll their budget this many times as often as the length proof did, plus
 ``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
-the same machine gives the same plan on any computer and under any load. On the
-benchmark's mixes a tie-breaking poll costs a third to a fifth of a proof's
-(benchmarks/bench_tie_budget.py), so this is about one to two times the proof's time; on
-a 240-state mix at 3 % it costs more than a proof's, and the stages take about three times
-the proof's time (benchmarks/bench_plan_stages.py, docs/performance.md)."""
+the same machine gives the same plan on any computer and under any load. A tie-breaking
+poll costs about a third of a proof's (``python benchmarks/bench_tie_budget.py``: 10,596
+against 3,467 per CPU second over its cases; on the 240-state mix at 3 %, half), so this is
+about one to one and a half times the proof's time."""
+
+EXPECTED_SHARE = 1.0
+"""Of that budget the expected-operations stage, the last and least of the tie-breaks, may
+poll at most this many times as often as the length proof did, plus ``TIE_GRACE_POLLS``:
+the margin stage (the larger margin, what a real feeder's rotation error needs) gets the
+rest first."""
 
 TIE_GRACE_POLLS = 10_000
 """Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (one to
@@ -406,8 +412,19 @@ def _plan(
     try:
         tie, horizon = stage(objective, refiner, every, budget_ops)
         staged = True
-        root = _build(refiner, children, horizon, tie)
-        ties = TIES_EXACT
+        then = None
+        if objective == "worst":
+            # The last tie-break gets its own share; out of it, the root branches built so
+            # far keep their subtrees and the rest follow the margin probes (_build).
+            cap = EXPECTED_SHARE * exact_deadline.polls + TIE_GRACE_POLLS
+            left = ties_deadline.allowance - ties_deadline.polls
+            worst.deadline = refiner.deadline = WorkBudget(exact_deadline, min(left, cap))
+
+            def then() -> Deadline:
+                return budget.until(FIRST_TREE_SHARE)
+
+        root, exact = _build(refiner, children, horizon, tie, then)
+        ties = TIES_EXACT if exact else TIES_MARGIN
     except Timeout:
         # The lengths are proven; the tie-breaking stages ran out of time: a tree that
         # keeps the proven length and the margin decided or found so far, following the
@@ -417,7 +434,7 @@ def _plan(
         if not staged:
             refiner.floor = tie_floor(refiner.floor_found) if objective == "worst" else -math.inf
         try:
-            root = _build(refiner, children, budget_ops, "first")
+            root, _ = _build(refiner, children, budget_ops, "first")
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         complete = objective == "worst"
@@ -451,21 +468,45 @@ def _on_course(problem: Problem, worst: WorstCase, roots: list[int]) -> bool:
     return done >= EXACT_CHECK_SHARE * len(roots)
 
 
-def _build(refiner: Refiner, children, horizon: int, tie: str) -> Step:
-    """The plan: the first alignment, then a subtree per root branch."""
+def _build(
+    refiner: Refiner,
+    children,
+    horizon: int,
+    tie: str,
+    then: Callable[[], Deadline] | None = None,
+) -> tuple[Step, bool]:
+    """The plan: the first alignment, then a subtree per root branch; and whether every
+    subtree was chosen by ``tie``.
+
+    ``then``, for the ``worst`` objective's expected-operations stage: when that stage runs
+    out of its budget, the root branches built so far keep their subtrees, and the others
+    follow the margin probes' plans (``"first"``) under the budget ``then()`` gives, which
+    the kept subtrees' (node, state) pairs are committed to. Without ``then``, Timeout.
+    """
 
     def chooser(mask, masses, k):
         return refiner.choose_worst(mask, masses, k, tie)
 
     refiner.new_tree()
-    if tie == "first":
+    shared: dict = {}
+    subs: list = []
+    exact = True
+    for b, _pb, ms in children:
+        if tie != "first":
+            try:
+                subs.append((b, refiner.build(b.mask, ms, horizon, chooser)))
+                continue
+            except Timeout:
+                if then is None:
+                    raise
+                deadline = then()
+                deadline.commit(sum(branch_pairs(s.branches) for s in refiner.nodes()), False)
+                refiner.w.deadline = refiner.deadline = deadline
+                tie, exact = "first", False
         # No choice left to make: follow the plans the margin probes found, with no new
         # search where they recorded one (Refiner.follow), else the first allowed action.
-        shared: dict = {}
-        subs = [(b, refiner.follow(b.mask, horizon, None, shared)) for b, _pb, _ms in children]
-    else:
-        subs = [(b, refiner.build(b.mask, ms, horizon, chooser)) for b, _pb, ms in children]
-    return root_step(subs, refiner.deadline)
+        subs.append((b, refiner.follow(b.mask, horizon, None, shared)))
+    return root_step(subs, refiner.deadline), exact
 
 
 def _check_margin(
