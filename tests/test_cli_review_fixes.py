@@ -30,6 +30,18 @@ def no_stray_profile(tmp_path, monkeypatch):
     monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
 
 
+@pytest.fixture(autouse=True)
+def python_sigint():
+    """Ctrl-C reaches Python's handler, as in a terminal: a process started in the
+    background by a shell without job control inherits SIGINT ignored, and main() then
+    rightly leaves it ignored, so the Ctrl-C tests below would test nothing."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
 @pytest.fixture(scope="module")
 def good_plan(tmp_path_factory) -> Path:
     """A verified plan of the l-bracket with an LED array (both landings, 3 operations)."""
@@ -291,3 +303,19 @@ def test_sensorless_help_names_the_profile_where_one_is_read():
 
 def test_plan_sensorless_help_names_the_profile():
     assert "the profile's sensor" in option_help("plan")
+
+
+def test_an_ignored_ctrl_c_stays_ignored(capsys, monkeypatch):
+    # nohup, or a background job of a shell without job control: SIGINT is ignored, and a
+    # command must not start taking it (nor leave a handler of its own behind).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    seen = []
+
+    def boom():
+        seen.append(signal.getsignal(signal.SIGINT))
+        raise TypeError("a real bug")
+
+    assert main(make_run_raise(monkeypatch, boom)) == 70
+    assert seen == [signal.SIG_IGN]
+    assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    capsys.readouterr()
