@@ -461,9 +461,15 @@ def test_root_branches_chosen_before_the_expected_stage_ran_out_keep_their_subtr
 def _cut_after(monkeypatch, roots: int):
     """The plan of the 6-part mix at 3 mm whose expected stage builds the subtrees of
     ``roots`` root branches, then runs out."""
+    with monkeypatch.context() as m:
+        _run_out_after(m, roots)
+        return api.plan(build_machine(small_mix(6), ToleranceSensor(3.0), IDEAL))
+
+
+def _run_out_after(patch, roots: int) -> None:
+    """Make the expected stage's tree builder run out after ``roots`` root branches."""
     build = Refiner.build
-    left = [roots]
-    depth = [0]
+    left, depth = [roots], [0]
 
     def counted(self, *args):
         if depth[0] == 0:
@@ -476,9 +482,7 @@ def _cut_after(monkeypatch, roots: int):
         finally:
             depth[0] -= 1
 
-    with monkeypatch.context() as m:
-        m.setattr(Refiner, "build", counted)
-        return api.plan(build_machine(small_mix(6), ToleranceSensor(3.0), IDEAL))
+    patch.setattr(Refiner, "build", counted)
 
 
 def test_the_expected_objective_cut_short_is_not_optimal(monkeypatch):
@@ -498,3 +502,18 @@ def test_the_expected_objective_cut_short_is_not_optimal(monkeypatch):
     )
     assert not got.optimal and got.tie_breaks == api.TIES_NONE
     assert check_plan(got) <= got.length
+
+
+def test_root_branches_kept_under_uncertainty_give_a_verified_strong_plan(monkeypatch):
+    # The same partial tree under a rotation error of 1 degree: make_plan verifies it for
+    # every outcome before it is returned (a plan that fails raises).
+    from feederkit.plans.make import make_plan
+
+    pfs = small_mix(6)
+    exact = make_plan(pfs, ToleranceSensor(3.0), uncertainty=Uncertainty()).result
+    _run_out_after(monkeypatch, 2)
+    made = make_plan(pfs, ToleranceSensor(3.0), uncertainty=Uncertainty())
+    got = made.result
+    assert got.tie_breaks == api.TIES_MARGIN and made.report.ok
+    assert got.length == exact.length
+    assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
