@@ -83,8 +83,8 @@ TIE_SHARE = 3.0
 may poll their budget this many times as often as the length proof did, plus
 ``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
 the same machine gives the same plan on any computer and under any load. A tie-breaking
-poll costs about a third of a proof's (``python benchmarks/bench_tie_budget.py``: 10,596
-against 3,467 per CPU second over its cases; on the 240-state mix at 3 %, half), so this is
+poll costs about a third of a proof's (``python benchmarks/bench_tie_budget.py --quick``: 9,177
+against 2,990 per CPU second over its cases; on the 240-state mix at 3 %, half), so this is
 about one to one and a half times the proof's time."""
 
 EXPECTED_SHARE = 1.0
@@ -423,8 +423,8 @@ def _plan(
             def then() -> Deadline:
                 return budget.until(FIRST_TREE_SHARE)
 
-        root, exact = _build(refiner, children, horizon, tie, then)
-        ties = TIES_EXACT if exact else TIES_MARGIN
+        root, all_chosen = _build(refiner, children, horizon, tie, then)
+        ties = TIES_EXACT if all_chosen else TIES_MARGIN
     except Timeout:
         # The lengths are proven; the tie-breaking stages ran out of time: a tree that
         # keeps the proven length and the margin decided or found so far, following the
