@@ -329,6 +329,9 @@ def test_a_command_says_when_the_choice_among_shortest_plans_was_cut(monkeypatch
     assert quick.result.tie_breaks == api.TIES_NONE
     (line,) = [w for w in quick.warnings if "choice among shortest plans" in w]
     assert "not proven the largest" in line and "\n" not in line
+    # The tie-breaking budget cut it, not the clock: more time would not help.
+    assert quick.result.ties_cut_by == "work"
+    assert "more time does not change it" in line and "--time-limit" not in line
     monkeypatch.undo()
 
     def out_of_time(self, *args, **kwargs):
@@ -337,7 +340,11 @@ def test_a_command_says_when_the_choice_among_shortest_plans_was_cut(monkeypatch
     monkeypatch.setattr(Refiner, "expected", out_of_time)
     partial = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
     assert partial.result.tie_breaks == api.TIES_MARGIN
-    assert any("not the fewest expected operations" in w for w in partial.warnings)
+    assert partial.result.ties_cut_by == "time"
+    (line,) = [w for w in partial.warnings if "choice among shortest plans" in w]
+    assert "not the fewest expected operations" in line
+    assert "allow more time with --time-limit S" in line
+    assert exact.result.ties_cut_by is None
 
 
 def test_the_backchaining_plan_is_no_tie_break_cut_short():
@@ -434,6 +441,7 @@ def test_the_expected_stage_gets_its_own_share_of_the_tie_budget(monkeypatch):
     assert whole == 1e6 * proof + 5
     assert share == 0.5 * proof + 5
     assert got.tie_breaks == api.TIES_MARGIN  # 5 polls do not finish it
+    assert got.ties_cut_by == "work"
     assert check_plan(got) <= got.length
 
 

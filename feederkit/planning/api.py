@@ -245,7 +245,7 @@ def _plan_machine(
     share_bisimilar(machine, sorted_machine, old)
     lumping = None
     try:
-        root, optimal, length, lower, ties = _plan(sorted_machine, options, budget)
+        root, optimal, length, lower, ties, cut = _plan(sorted_machine, options, budget)
     except NoStrongPlan as exc:
         if options.lumping is Lumping.NONE:
             raise
@@ -256,14 +256,16 @@ def _plan_machine(
         if lumping is None:
             hint = unlike_words(sorted_machine, tried.unlike)
             raise NoStrongPlan(exc.reason, hint) from None
-        root, optimal, length, lower, ties = _plan(sorted_machine, options, budget, lumping.insep)
+        root, optimal, length, lower, ties, cut = _plan(
+            sorted_machine, options, budget, lumping.insep
+        )
     share_bisimilar(machine, sorted_machine, old)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
     result = _result(
         machine, root, optimal, length, lower, options.objective.value, options.grouping.value
     )
-    result = replace(result, tie_breaks=ties)
+    result = replace(result, tie_breaks=ties, ties_cut_by=cut)
     if lumping is None:
         return result
     return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
@@ -301,8 +303,10 @@ def _plan(
     replaces the goal relation (the lumped one, :func:`~feederkit.planning.lumping.lumped_goal`).
 
     Returns the plan tree, whether it is proven optimal, its proven length (None when the
-    tree's own length is the answer), a proven lower bound and which tie-breaks are exact
-    (``TIES_EXACT``, ``TIES_MARGIN`` or ``TIES_NONE``).
+    tree's own length is the answer), a proven lower bound, which tie-breaks are exact
+    (``TIES_EXACT``, ``TIES_MARGIN`` or ``TIES_NONE``) and, when a tie-breaking stage was
+    cut short, why (a :class:`~feederkit.planning.budget.Timeout`'s reason: ``"work"``
+    for the tie-breaking budget, ``"time"`` or ``"memory"`` for the run's limits).
     """
     objective = options.objective.value
     min_margin = options.min_margin_deg
@@ -399,7 +403,7 @@ def _plan(
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         if chain is not None and tree_length(chain) == length:
-            return chain, True, length, length, TIES_CHAIN
+            return chain, True, length, length, TIES_CHAIN, None
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline
     if objective == "worst":
@@ -423,25 +427,26 @@ def _plan(
             def then() -> Deadline:
                 return budget.until(FIRST_TREE_SHARE)
 
-        root, all_chosen = _build(refiner, children, horizon, tie, then)
-        ties = TIES_EXACT if all_chosen else TIES_MARGIN
-    except Timeout:
+        root, cut = _build(refiner, children, horizon, tie, then)
+        ties = TIES_EXACT if cut is None else TIES_MARGIN
+    except Timeout as exc:
         # The lengths are proven; the tie-breaking stages ran out of time: a tree that
         # keeps the proven length and the margin decided or found so far, following the
         # plans the margin probes found (Refiner.follow), while time remains.
         worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
         ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
+        cut = exc.reason
         if not staged:
             refiner.floor = tie_floor(refiner.floor_found) if objective == "worst" else -math.inf
         try:
-            root, _ = _build(refiner, children, budget_ops, "first")
+            root, _cut = _build(refiner, children, budget_ops, "first")
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         complete = objective == "worst"
     else:
         complete = True
     shortest = objective in ("worst", "worst-time")
-    return root, complete, length if shortest else None, length, ties
+    return root, complete, length if shortest else None, length, ties, cut
 
 
 def _exact_budget(budget: Deadline) -> Deadline:
@@ -474,9 +479,9 @@ def _build(
     horizon: int,
     tie: str,
     then: Callable[[], Deadline] | None = None,
-) -> tuple[Step, bool]:
-    """The plan: the first alignment, then a subtree per root branch; and whether every
-    subtree was chosen by ``tie``.
+) -> tuple[Step, str | None]:
+    """The plan: the first alignment, then a subtree per root branch; and None when every
+    subtree was chosen by ``tie``, else why it stopped (the Timeout's reason).
 
     ``then``, for the ``worst`` objective's expected-operations stage: when that stage runs
     out of its budget, the root branches built so far keep their subtrees, and the others
@@ -490,23 +495,23 @@ def _build(
     refiner.new_tree()
     shared: dict = {}
     subs: list = []
-    exact = True
+    cut = None
     for b, _pb, ms in children:
         if tie != "first":
             try:
                 subs.append((b, refiner.build(b.mask, ms, horizon, chooser)))
                 continue
-            except Timeout:
+            except Timeout as exc:
                 if then is None:
                     raise
                 deadline = then()
                 deadline.commit(sum(branch_pairs(s.branches) for s in refiner.nodes()), False)
                 refiner.w.deadline = refiner.deadline = deadline
-                tie, exact = "first", False
+                tie, cut = "first", exc.reason
         # No choice left to make: follow the plans the margin probes found, with no new
         # search where they recorded one (Refiner.follow), else the first allowed action.
         subs.append((b, refiner.follow(b.mask, horizon, None, shared)))
-    return root_step(subs, refiner.deadline), exact
+    return root_step(subs, refiner.deadline), cut
 
 
 def _check_margin(
@@ -767,13 +772,13 @@ def _fallback(
             last = exc.reason
     if root is None:
         if blind is not None:
-            return blind, False, None, lower, TIES_NONE
+            return blind, False, None, lower, TIES_NONE, None
         reason = last if last == "memory" else stop
         raise PlanningError(
             f"no plan found within {_out_of_budget(options, reason)} "
             f"(a plan needs at least {plural(lower, 'operation')})"
         )
-    return root, False, None, lower, TIES_NONE
+    return root, False, None, lower, TIES_NONE, None
 
 
 def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:

@@ -39,7 +39,8 @@ def rss_mb() -> float:
 
 
 class Timeout(Exception):
-    """A search ran out of its budget; ``reason`` is ``"time"`` or ``"memory"``."""
+    """A search ran out of its budget; ``reason`` is ``"time"``, ``"memory"`` or ``"work"``
+    (a :class:`WorkBudget`'s polls)."""
 
     def __init__(self, reason: str = "time") -> None:
         super().__init__(reason)
@@ -252,7 +253,7 @@ class WorkBudget(Deadline):
     >>> budget.check()
     Traceback (most recent call last):
     ...
-    feederkit.planning.budget.Timeout: time
+    feederkit.planning.budget.Timeout: work
     """
 
     def __init__(self, outer: Deadline, polls: float) -> None:
@@ -271,10 +272,11 @@ class WorkBudget(Deadline):
         return True
 
     def check(self) -> None:
-        """Raise Timeout past the allowance of polls or one of ``outer``'s limits."""
+        """Raise Timeout past the allowance of polls (``"work"``) or one of ``outer``'s
+        limits."""
         super().check()
         if self.polls > self.allowance:
-            raise Timeout("time")
+            raise Timeout("work")
 
 
 UNLIMITED = Deadline()

@@ -143,7 +143,9 @@ class PlanResult:
     the shortest"): ``"exact"`` every stage, ``"margin"`` the largest smallest margin but
     not the fewest expected operations, ``"none"`` the margin found when the tie-breaking
     budget ran out, ``"backchain"`` the backchaining plan where readings carry nothing (no
-    tie-break searched).
+    tie-break searched). ``ties_cut_by``: what cut the choice short, ``"work"`` (the
+    tie-breaking stages' budget, a multiple of the length proof's work: the same on any
+    computer), ``"time"`` or ``"memory"`` (the run's limits); None when nothing did.
     """
 
     machine: PushAlignMachine
@@ -158,6 +160,7 @@ class PlanResult:
     certificate: Certificate | None = None
     lumped_pairs: tuple[tuple[int, int], ...] = ()
     tie_breaks: str = "exact"
+    ties_cut_by: str | None = None
 
     @property
     def uncertainty(self) -> Uncertainty:

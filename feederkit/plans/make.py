@@ -279,19 +279,29 @@ def _ties_cut_words(result: PlanResult, options: PlanningOptions) -> str | None:
     if not result.optimal or options.objective.value != "worst":
         return None
     words = f"a plan of {plural(result.length, 'operation')}"
+    more = _MORE.get(result.ties_cut_by or "", _MORE["time"])
     if result.tie_breaks == "margin":
         return (
             f"the choice among shortest plans stopped at {words} with the largest margin, "
-            "not the fewest expected operations (allow more time with --time-limit S)"
+            f"not the fewest expected operations ({more})"
         )
     if result.tie_breaks == "none" and math.isfinite(result.min_margin):
         return (
             f"the choice among shortest plans stopped at {words} whose smallest margin, "
             f"±{result.min_margin:.4g}° of slack beyond the declared uncertainty, is not "
-            "proven the largest; another may keep more slack (allow more time with "
-            "--time-limit S)"
+            f"proven the largest; another may keep more slack ({more})"
         )
     return None
+
+
+_MORE = {
+    "time": "allow more time with --time-limit S",
+    "memory": "allow more memory with --memory-limit MB",
+    "work": "the tie-breaking budget, a multiple of the length proof's work, ran out; "
+    "more time does not change it",
+}
+"""What a user can do when the choice among shortest plans was cut short, by its cause
+(``PlanResult.ties_cut_by``)."""
 
 
 def _lump_shapes(
