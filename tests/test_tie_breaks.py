@@ -4,8 +4,9 @@ The largest smallest margin is decided by feasibility probes ("a plan within k k
 every margin >= m", ``Refiner.keeps``) on the maximal reading branches; here it is checked
 against the plain max-min recursion over every action and every branch set. The stages
 run under a budget of work bounded by the length proof's (``api.TIE_SHARE``,
-``api.TIE_GRACE_POLLS``), so a machine gives the same plan however fast the computer; out
-of it the plan keeps the proven length and says which tie-breaks are exact.
+``api.TIE_GRACE_POLLS``; the expected stage ``api.EXPECTED_SHARE`` of it), so a machine
+gives the same plan however fast the computer; out of it the plan keeps the proven length,
+the root branches the expected stage built, and says which tie-breaks are exact and why not.
 """
 
 from __future__ import annotations
