@@ -248,6 +248,23 @@ def test_cells_from_the_cell_table_are_the_boundary_cells(rotation_error, monkey
     assert got == [(slow.cells(x, False), slow.cells(x, True)) for x in masks]
 
 
+@pytest.mark.parametrize("rotation_error", [0.0, 1.0])
+def test_the_cell_at_a_rotation_is_the_fixed_cell_holding_it(rotation_error):
+    # Choices.cell_at finds a set's cell around a rotation from the members' boundaries
+    # alone (Refiner.follow's subsets); it must be the very cell of the set's cell table.
+    unc = IDEAL if rotation_error == 0.0 else Uncertainty(rotation_error_deg=rotation_error)
+    m = build_machine(small_mix(8), ToleranceSensor(1.0), unc)
+    choices = Problem(m).choices
+    rng = random.Random(6)
+    for _ in range(600):
+        mask = rng.getrandbits(m.n) or 1
+        lo, hi, img = rng.choice(choices.fixed_cells(mask))
+        x = lo + rng.uniform(0.01, 0.99) * (hi - lo)
+        assert choices.cell_at(mask, x % 360.0) == (lo, hi, img)
+    # On a member's boundary there is no cell to hold it.
+    assert choices.cell_at((1 << m.n) - 1, m.starts[0][0]) is None
+
+
 def test_open_probabilities_from_neighbours_are_the_whole_images():
     # Readings.open_probability works per (previous, state, next) triple; the sensor's
     # closed form over the whole image must give the same floats.

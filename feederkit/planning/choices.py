@@ -130,6 +130,47 @@ class Choices:
         self._fixed[mask] = out
         return out
 
+    def cell_at(self, mask: int, x: float) -> tuple[float, float, int] | None:
+        """The cell of :meth:`fixed_cells` holding the rotation ``x`` (in [0, 360)) strictly
+        inside, from the members' boundaries alone (no cell table of the set); None when
+        ``x`` lies on a boundary or in no cell wider than ``ANGLE_EPS``.
+
+        A set's cell around a rotation is bounded by the nearest boundary of any member on
+        each side, and its image is the members' outcomes there (constant inside a cell).
+        For a subset of a set whose cell holds ``x`` this costs a bisection per member
+        instead of the subset's whole cell table (``Refiner.follow``).
+        """
+        starts = self.machine.starts
+        idx = members(mask)
+        lo = hi = None
+        wrap_lo, wrap_hi = -1.0, 720.0
+        for i in idx:
+            s = starts[i]
+            k = bisect.bisect_right(s, x)
+            if k > 0:
+                if s[k - 1] == x:
+                    return None
+                if lo is None or s[k - 1] > lo:
+                    lo = s[k - 1]
+            nxt = s[k] if k < len(s) else s[0] + 360.0
+            if hi is None or nxt < hi:
+                hi = nxt
+            wrap_lo, wrap_hi = max(wrap_lo, s[-1]), min(wrap_hi, s[0] + 360.0)
+        if lo is None:  # before every boundary: the cell that wraps past 360
+            lo, hi = wrap_lo, wrap_hi
+        if hi is None or hi - lo <= ANGLE_EPS:
+            return None
+        row = self._space.targets_at(mask, x)
+        if row is not None:
+            img = 0
+            for j in row:
+                img |= 1 << j
+        else:
+            img = 0
+            for i in idx:
+                img |= self.machine.outcomes(i, x)
+        return (lo, hi, img)
+
     def cells(self, mask: int, useful: bool = True) -> list[tuple[float, float, int]]:
         """The set's overlap ranges as ``(lo, hi, image)``, widest first (cached).
 

@@ -655,6 +655,11 @@ class Refiner:
         a superset: ``mask``'s range boundaries are among the superset's), with every branch
         set; None when none does or it is narrower than the floor."""
         x = (cell[0] + cell[1]) / 2.0
+        found = self.p.choices.cell_at(mask, norm360(x))  # no cell table of the set
+        if found is not None:
+            if (found[1] - found[0]) / 2.0 < self.floor:
+                return None
+            return self.p.choices.act(mask, found, exact=True)
         for lo, hi, img in self.p.choices.fixed_cells(mask):
             if any(lo <= y <= hi for y in (x, x - 360.0, x + 360.0)):
                 if (hi - lo) / 2.0 < self.floor:
