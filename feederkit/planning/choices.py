@@ -160,15 +160,9 @@ class Choices:
             lo, hi = wrap_lo, wrap_hi
         if hi is None or hi - lo <= ANGLE_EPS:
             return None
-        row = self._space.targets_at(mask, x)
-        if row is not None:
-            img = 0
-            for j in row:
-                img |= 1 << j
-        else:
-            img = 0
-            for i in idx:
-                img |= self.machine.outcomes(i, x)
+        img = 0
+        for t in self._outcomes_at(mask, x):
+            img |= t
         return (lo, hi, img)
 
     def cells(self, mask: int, useful: bool = True) -> list[tuple[float, float, int]]:
@@ -344,14 +338,16 @@ class Choices:
         key = (mask, sa.lo)
         t = self._targets.get(key)
         if t is None:
-            rep = sa.representative
-            row = self._space.targets_at(mask, rep)
-            if row is not None:
-                t = tuple(1 << j for j in row)
-            else:
-                t = tuple(self.machine.outcomes(i, rep) for i in members(mask))
-            self._targets[key] = t
+            t = self._targets[key] = self._outcomes_at(mask, sa.representative)
         return t
+
+    def _outcomes_at(self, mask: int, x: float) -> tuple[int, ...]:
+        """Each member's outcome set (a mask) under the rotation ``x``: from the search
+        space's table when it has one, else from the machine."""
+        row = self._space.targets_at(mask, x)
+        if row is not None:
+            return tuple(1 << j for j in row)
+        return tuple(self.machine.outcomes(i, x) for i in members(mask))
 
 
 def spread(masses, outcomes) -> dict[int, float]:
