@@ -12,12 +12,19 @@ from __future__ import annotations
 import json
 import math
 import random
+from pathlib import Path
 
 import pytest
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import MachineState, OutcomeRange, PushAlignMachine, build_machine
+from feederkit.machine import (
+    MachineState,
+    OutcomeRange,
+    PushAlignMachine,
+    build_machine,
+    search_space,
+)
 from feederkit.mechanics import push_function
 from feederkit.mechanics.symmetry import (
     NEAR_SYMMETRIC_REL,
@@ -25,11 +32,12 @@ from feederkit.mechanics.symmetry import (
     pose_difference,
     poses_difference,
 )
-from feederkit.outline import make_outline
+from feederkit.outline import load_outline_json, make_outline
 from feederkit.part import make_part
 from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
 from feederkit.planning.lumping import may_lump, try_lumping
 from feederkit.planning.options import Lumping, PlanningOptions
+from feederkit.planning.tree import Leaf
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import verify_strong
 from feederkit.sensors import NoSensor, ToleranceSensor
@@ -348,3 +356,136 @@ def test_the_command_line_plans_the_near_symmetric_part(tmp_path, capsys):
     assert main(["plan", str(near), "--sensorless", "--landings", "up"]) == 0
     err = capsys.readouterr().err
     assert "results list states together" in err and "not near-symmetric" not in err
+
+
+# --- bisimilar poses that only behave alike --------------------------------------------------
+
+CATALOG = Path(__file__).resolve().parent.parent / "catalog"
+
+
+def _leaves(node) -> list[int]:
+    """The masks of a plan tree's leaves (each shared subtree walked once)."""
+    out, seen, todo = [], set(), [node]
+    while todo:
+        n = todo.pop()
+        if id(n) in seen:
+            continue
+        seen.add(id(n))
+        if isinstance(n, Leaf):
+            out.append(n.mask)
+        else:
+            todo.extend(sub for _b, sub in n.branches)
+    return out
+
+
+def _ideal_classes(pf, sensor) -> dict[int, int]:
+    """Each ideal stable state's indistinguishable set on the ideal model (a mask over the
+    ideal machine's states, itself included): what the paper lets a result list."""
+    ideal = build_machine([pf], sensor, IDEAL)
+    masks = search_space(ideal).bisimilar
+    return {s.state: masks[i] | 1 << i for i, s in enumerate(ideal.states)}
+
+
+def _unlike_pairs_in_leaves(machine, pfs, leaves) -> list[tuple[int, int, float]]:
+    """Pairs of one part's states some leaf lists together whose poses differ by more than
+    ``NEAR_SYMMETRIC_REL`` of the part's size, by the exact pose difference (not the
+    machine's record), and that the ideal model does not list together either (each ideal
+    member of one indistinguishable from one of the other's)."""
+    classes = {p: _ideal_classes(pf, machine.sensor) for p, pf in enumerate(pfs)}
+    bad = []
+    for mask in leaves:
+        idx = [i for i in range(machine.n) if mask >> i & 1]
+        for a, i in enumerate(idx):
+            for j in idx[a + 1 :]:
+                si, sj = machine.states[i], machine.states[j]
+                if si.part != sj.part:
+                    continue
+                pf = pfs[si.part]
+                d = poses_difference(pf, si.ideal_states, sj.ideal_states)
+                if d <= NEAR_SYMMETRIC_REL * pf.part.size + 1e-9:
+                    continue
+                cls = classes[si.part]
+                twins = all(
+                    any(cls[a] >> b & 1 for b in sj.ideal_states) for a in si.ideal_states
+                ) and all(any(cls[b] >> a & 1 for a in si.ideal_states) for b in sj.ideal_states)
+                if not twins:
+                    bad.append((i, j, d))
+    return bad
+
+
+def test_a_large_rotation_error_makes_unlike_poses_bisimilar_but_not_the_goal():
+    """At 75 degrees every action can send each pose of an L anywhere: all four are
+    bisimilar, and a leaf listing them would not orient the part."""
+    pf = push_function(make_part(load_outline_json(CATALOG / "l-bracket.json")))
+    m = build_machine([pf], NoSensor(), Uncertainty(75.0))
+    space = search_space(m)
+    assert all(b == m.all_states & ~(1 << i) for i, b in enumerate(space.bisimilar))
+    assert not any(space.inseparable)
+    with pytest.raises(NoStrongPlan) as exc:
+        plan(m)
+    assert "lumping 'any'" in exc.value.hint
+    assert not strong_plan_exists(m)
+    options = PlanningOptions(lumping="any")
+    made = make_plan([pf], NoSensor(), options, uncertainty=Uncertainty(75.0), certify=False)
+    assert any("not near-symmetric" in w for w in made.warnings)
+
+
+@pytest.mark.parametrize(
+    "name", ["l-bracket", "rectangle-2x1", "t-clip", "chamfered-plate", "heptagon-fig17"]
+)
+@pytest.mark.parametrize("error", [1.0, 40.0, 75.0])
+@pytest.mark.parametrize("sensor", [NoSensor(), ToleranceSensor(0.2)], ids=["none", "tol"])
+def test_no_plan_lists_unlike_poses_of_one_part_together(name, error, sensor):
+    """Under the default rule every leaf's poses of one part look alike, whatever the
+    rotation error: the plan orients the part up to its (near) symmetry, or none exists."""
+    pf = push_function(make_part(load_outline_json(CATALOG / f"{name}.json")))
+    m = build_machine([pf], sensor, Uncertainty(error))
+    try:
+        result = plan(m, PlanningOptions(time_limit_s=30.0))
+    except NoStrongPlan:
+        return
+    assert _unlike_pairs_in_leaves(result.machine, [pf], _leaves(result.root)) == []
+
+
+def test_a_large_shape_tolerance_does_not_list_unlike_poses_together():
+    """2 mm on the 60 mm L with a 0.2 mm sensor: no strong plan, not a one-operation plan
+    listing three poses."""
+    pf = push_function(make_part(load_outline_json(CATALOG / "l-bracket.json")))
+    m = build_machine([pf], ToleranceSensor(0.2), Uncertainty(1.0, shape_tolerance_mm=2.0))
+    try:
+        result = plan(m, PlanningOptions(time_limit_s=30.0))
+    except NoStrongPlan:
+        return
+    assert _unlike_pairs_in_leaves(result.machine, [pf], _leaves(result.root)) == []
+
+
+@pytest.mark.parametrize("error", [0.0, 1.0, 75.0])
+def test_the_papers_heptagon_lists_its_three_poses_under_any_rotation_error(error):
+    """Fig. 17's heptagon without a sensor: three poses that no push tells apart even on the
+    ideal model (one push function); the result lists them (the paper's answer) at any
+    rotation error. With a sensor their diameters tell them apart at once."""
+    pf = push_function(make_part(load_outline_json(CATALOG / "heptagon-fig17.json")))
+    model = IDEAL if error == 0.0 else Uncertainty(error)
+    blind = plan(build_machine([pf], NoSensor(), model))
+    assert blind.length == 1 and _leaves(blind.root) == [0b111]
+    read = plan(build_machine([pf], ToleranceSensor(0.0091), model))
+    assert read.length == 1 and sorted(_leaves(read.root)) == [0b1, 0b10, 0b100]
+
+
+def test_a_symmetric_part_still_lists_its_symmetric_poses_at_a_large_rotation_error():
+    """The 2 x 1 rectangle at 75 degrees: the reading tells a long side from a short one,
+    and each leaf lists a side's two symmetric poses."""
+    pf = push_function(make_part(load_outline_json(CATALOG / "rectangle-2x1.json")))
+    result = plan(build_machine([pf], ToleranceSensor(0.2), Uncertainty(75.0)))
+    leaves = _leaves(result.root)
+    assert sorted(mask.bit_count() for mask in leaves) == [2, 2]
+    with pytest.raises(NoStrongPlan):  # without the reading nothing tells the sides apart
+        plan(build_machine([pf], NoSensor(), Uncertainty(75.0)))
+
+
+def test_the_command_line_refuses_a_rotation_error_that_makes_every_pose_alike(capsys):
+    """Not a one-operation "plan" listing every pose of the L: no strong plan, exit 1."""
+    src = str(CATALOG / "l-bracket.json")
+    assert main(["plan", src, "--landings", "up", "--rotation-error", "75"]) == 1
+    err = capsys.readouterr().err
+    assert "result: no strong plan exists" in err and "largest rotation error" in err

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from feederkit.angles import ActionRange
+from feederkit.machine.inseparable import inseparable_masks
 from feederkit.machine.model import MachineState, OutcomeRange, PushAlignMachine
 from feederkit.mechanics.actions import action_ranges
 from feederkit.mechanics.push import PushFunction, resting_widths
@@ -135,7 +136,8 @@ def uncertain_machine(
     equally among the physical states it may settle in (``destinations``). ``look_alike``
     names the part's other physical states whose poses are near-congruent
     (:func:`~feederkit.mechanics.symmetry.look_alike`: within ``NEAR_SYMMETRIC_REL`` of the
-    part's size), the pairs the planners' default lumping may list together.
+    part's size) or that no plan tells apart even on the ideal model (:func:`ideal_twins`):
+    the pairs of one part a leaf may list together.
     """
     offsets = []
     total = 0
@@ -155,6 +157,10 @@ def uncertain_machine(
             for t in dest:
                 weight[t] += widths[i] / 360.0 / share / len(dest)
         alike = look_alike(pf, [s.members for s in mech.states])
+        # Only pairs that do not look alike can be twins worth finding (the ideal fixpoint
+        # costs more than the build on a part of hundreds of near-round facets).
+        unlike = any(len(alike[s.id]) < mech.n - 1 for s in mech.states)
+        twins = ideal_twins(pf, mech, sensor) if unlike else [set()] * mech.n
         for s in mech.states:
             lo, hi = ends[k]
             k += 1
@@ -166,7 +172,9 @@ def uncertain_machine(
                     weight[s.id],
                     (lo, hi),
                     s.members,
-                    look_alike=tuple(mech.states[t].members[0] for t in alike[s.id]),
+                    look_alike=tuple(
+                        mech.states[t].members[0] for t in sorted({*alike[s.id], *twins[s.id]})
+                    ),
                 )
             )
             ranges = []
@@ -183,3 +191,32 @@ def uncertain_machine(
         sensor=sensor,
         uncertainty=mechanics[0].uncertainty,
     )
+
+
+def ideal_twins(pf: PushFunction, mech: UncertainMechanics, sensor: Sensor) -> list[set[int]]:
+    """Per physical state of ``mech``, the part's other physical states that no plan tells
+    apart from it even on the ideal model with ``sensor``: every ideal member of either is
+    inseparable (:func:`~feederkit.machine.inseparable.inseparable_masks`) from one of the
+    other's. These are the paper's indistinguishable sets of one part, symmetric poses and
+    poses that behave identically (the heptagon of Fig. 17, whose three poses share one push
+    function and diameter), which a result may list together under any uncertainty.
+    """
+    ideal = build_machine([pf], sensor, IDEAL)
+    insep = inseparable_masks(ideal)
+    index = {s.state: i for i, s in enumerate(ideal.states)}
+
+    def together(a: int, b: int) -> bool:
+        return a == b or bool(insep[index[a]] >> index[b] & 1)
+
+    out: list[set[int]] = []
+    for s in mech.states:
+        out.append(
+            {
+                t.id
+                for t in mech.states
+                if t.id != s.id
+                and all(any(together(a, b) for b in t.members) for a in s.members)
+                and all(any(together(a, b) for a in s.members) for b in t.members)
+            }
+        )
+    return out

@@ -40,10 +40,12 @@ class MachineState:
     (:attr:`feederkit.machine.space.SearchSpace.inseparable`). It travels with the state, so
     renumbering the states keeps it. ``look_alike`` names (by ``state``) the other states of
     the same part whose poses look like this one's to the next station (near-congruent
-    outlines, docs/planning.md "Near-symmetric states under uncertainty"): the only pairs of
-    one part a plan may list together when no strong plan resolves them. The machine build
-    records it under uncertainty; None (a machine built by hand, or the ideal model, where
-    nothing is lumped) records nothing, and then any pair may be lumped.
+    outlines, docs/planning.md "Near-symmetric states under uncertainty") or that no plan
+    tells apart even on the ideal model (``machine.build.ideal_twins``): the only pairs of
+    one part a leaf may list together, in the goal (``SearchSpace.alike``) and when no
+    strong plan resolves them. The machine build records it under uncertainty; None (a
+    machine built by hand, or the ideal model, where nothing is lumped) records nothing,
+    and then any pair may be listed.
     """
 
     part: int

@@ -231,15 +231,45 @@ class SearchSpace:
         return mask_of(i for i, s in enumerate(self.machine.states) if s.reject)
 
     @cached_property
+    def alike(self) -> tuple[int, ...]:
+        """For each state, the states a leaf may list with it: every state of another
+        member, and the states of its own member whose poses look alike
+        (``MachineState.look_alike``, recorded both ways; any state of the member when
+        either records nothing: a machine built by hand, or the ideal model)."""
+        states = self.machine.states
+        of_part: dict[int, int] = {}
+        for i, s in enumerate(states):
+            of_part[s.part] = of_part.get(s.part, 0) | 1 << i
+        full = self.machine.all_states
+        out = []
+        for i, a in enumerate(states):
+            own = of_part[a.part]
+            if a.look_alike is None:
+                out.append(full)
+                continue
+            keep = full & ~own | 1 << i
+            for j in members(own):
+                b = states[j]
+                if b.look_alike is None or (b.state in a.look_alike and a.state in b.look_alike):
+                    keep |= 1 << j
+            out.append(keep)
+        return tuple(out)
+
+    @cached_property
     def inseparable(self) -> tuple[int, ...]:
         """For each state, the mask of states a plan need not tell it from: the goal relation.
 
-        The :attr:`bisimilar` states and, for a state of a rejected member, every other
-        state of a rejected member: a set of only rejected states ends in a reject leaf as
-        soon as the plan knows it (design.md "Landings"), whichever of them the part is in.
-        Without rejected members it is :attr:`bisimilar` itself.
+        The :attr:`bisimilar` states that look alike (:attr:`alike`) and, for a state of a
+        rejected member, every other state of a rejected member: a set of only rejected
+        states ends in a reject leaf as soon as the plan knows it (design.md "Landings"),
+        whichever of them the part is in. Two poses of one part that merely *behave* alike
+        under the declared uncertainty (a large rotation error lets every action send each
+        to every state) are bisimilar, yet a leaf listing them does not orient the part:
+        they stay apart here, and ``PlanningOptions.lumping`` decides whether a plan may list
+        them (docs/planning.md, "Near-symmetric states under uncertainty"). Without rejected
+        members and unlike poses it is :attr:`bisimilar` itself.
         """
-        base = self.bisimilar
+        base = tuple(b & a for b, a in zip(self.bisimilar, self.alike, strict=True))
         rej = self.rejected
         if not rej:
             return base
