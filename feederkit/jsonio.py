@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import stat
 import tempfile
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -153,16 +154,37 @@ def _cannot(path: object, what: str, exc: OSError) -> InputError:
     return InputError(f"{path}: cannot write the {what} ({_reason(exc)})")
 
 
-def _stage(f: OutputFile, mode: int) -> str:
-    """Write ``f`` in full to a temporary file beside its target; return the temporary's path."""
-    target = Path(f.path)
-    if target.is_dir():
-        raise InputError(f"{target}: cannot write the {f.what} (a folder is there)")
+def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
+    """Where a file written to ``path`` lands: through symbolic links to the file they name
+    (a plan written to ``current.plan.json``, a link to a versioned file, updates that file,
+    as a plain ``open`` would; renaming over the link would replace the link instead), and
+    bad input when that is a folder, or exists and is not a regular file (a pipe, socket or
+    device, which a rename would replace)."""
+    given = Path(path)
+    target = Path(os.path.realpath(given)) if given.is_symlink() else given
+    try:
+        st = os.stat(target)
+    except OSError:
+        return target  # not there yet (or not reachable: staging says why)
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{given}: cannot write the {what} (a folder is there)")
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(
+            f"{given}: cannot write the {what} (not a regular file: a pipe, socket or device "
+            "is there)"
+        )
+    return target
+
+
+def _stage(f: OutputFile, mode: int) -> tuple[Path, str]:
+    """Write ``f`` in full to a temporary file beside its :func:`destination`; return that
+    destination and the temporary's path."""
+    target = destination(f.path, f.what)
     directory = target.parent if str(target.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
     except OSError as exc:
-        raise _cannot(target, f.what, exc) from None
+        raise _cannot(f.path, f.what, exc) from None
     data = f.data.encode("utf-8") if isinstance(f.data, str) else f.data
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -173,9 +195,9 @@ def _stage(f: OutputFile, mode: int) -> str:
     except BaseException as exc:
         os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise _cannot(target, f.what, exc) from None
+            raise _cannot(f.path, f.what, exc) from None
         raise
-    return tmp
+    return target, tmp
 
 
 class StagedFiles:
@@ -191,25 +213,25 @@ class StagedFiles:
 
     def __init__(self, files: Iterable[OutputFile], mode: int | None = None) -> None:
         mode = 0o666 & ~_umask() if mode is None else mode
-        self._staged: list[tuple[OutputFile, str]] = []
+        self._staged: list[tuple[OutputFile, Path, str]] = []
         self.committed = False
         try:
             for f in files:
-                self._staged.append((f, _stage(f, mode)))
+                self._staged.append((f, *_stage(f, mode)))
         except BaseException:
             self.discard()
             raise
 
     @property
     def paths(self) -> list[Path]:
-        """The target paths, in order."""
-        return [Path(f.path) for f, _ in self._staged]
+        """The target paths as given, in order."""
+        return [Path(f.path) for f, _, _ in self._staged]
 
     def commit(self) -> None:
-        """Rename every temporary onto its target, in order."""
-        for f, tmp in self._staged:
+        """Rename every temporary onto its destination (a link's file), in order."""
+        for f, target, tmp in self._staged:
             try:
-                os.replace(tmp, f.path)
+                os.replace(tmp, target)
             except OSError as exc:
                 self.discard()
                 raise _cannot(f.path, f.what, exc) from None
@@ -217,16 +239,16 @@ class StagedFiles:
 
     def discard(self) -> None:
         """Remove the temporaries not yet renamed."""
-        for _, tmp in self._staged:
+        for _, _, tmp in self._staged:
             if os.path.exists(tmp):
                 os.unlink(tmp)
 
     def undo(self) -> None:
         """Remove the files a commit put in place (best effort: their old contents are gone)."""
         if self.committed:
-            for f, _ in self._staged:
-                if Path(f.path).is_file():
-                    Path(f.path).unlink()
+            for _, target, _ in self._staged:
+                if target.is_file():
+                    target.unlink()
             self.committed = False
 
     def __enter__(self) -> StagedFiles:

@@ -129,3 +129,40 @@ def test_a_failed_write_in_the_middle_leaves_no_temporaries(tmp_path: Path, monk
             ]
         )
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_symbolic_link_is_written_through_to_its_file(tmp_path: Path) -> None:
+    """A plan written to ``current.json``, a link to a versioned file, updates that file and
+    leaves the link a link (a rename onto the link would replace it and leave the file
+    stale)."""
+    (tmp_path / "v1").mkdir()
+    real = tmp_path / "v1" / "plan.json"
+    real.write_text('{"old": true}')
+    link = tmp_path / "current.json"
+    link.symlink_to(real)
+    write_text_atomic(link, '{"new": true}')
+    assert link.is_symlink() and os.readlink(link) == str(real)
+    assert read_json(real) == {"new": True}
+    hidden = [p.name for d in (tmp_path, tmp_path / "v1") for p in d.iterdir() if p.name[0] == "."]
+    assert hidden == []
+    dangling = tmp_path / "next.json"  # a link to a file not made yet: it is made
+    dangling.symlink_to(tmp_path / "v1" / "next-plan.json")
+    write_text_atomic(dangling, "{}")
+    assert dangling.is_symlink() and read_json(tmp_path / "v1" / "next-plan.json") == {}
+
+
+def test_a_pipe_or_a_link_to_a_folder_is_not_replaced(tmp_path: Path) -> None:
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="not a regular file") as exc:
+        write_files([OutputFile(fifo, "{}", "plan file")])
+    assert str(exc.value).startswith(f"{fifo}: cannot write the plan file") and "\n" not in str(
+        exc.value
+    )
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    folder_link = tmp_path / "out.json"
+    folder_link.symlink_to(tmp_path)
+    with pytest.raises(InputError, match="a folder is there"):
+        write_text_atomic(folder_link, "{}")
+    assert folder_link.is_symlink()
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
