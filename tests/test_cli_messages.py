@@ -190,3 +190,14 @@ def test_an_outline_with_two_points_names_the_file(tmp_path, capsys) -> None:
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1
     assert "two-points.json" in err and "three distinct points" in err, err
+
+
+@pytest.mark.parametrize("name", [":thumbs_up:.json", "x:100:y", "part:smile:2.dxf"])
+def test_names_with_colons_are_echoed_as_typed(name, tmp_path, capsys, monkeypatch) -> None:
+    """No emoji codes in messages: a part number like ``x:100:y`` stays as the user typed it."""
+    from feederkit.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["part", "analyze", name]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {name}: no such file") and len(err.splitlines()) == 1

@@ -41,8 +41,9 @@ from feederkit.sensors import Sensor, make_sensor
 from feederkit.uncertainty import Uncertainty
 from feederkit.words import plural
 
-console = Console()
-err_console = Console(stderr=True)
+# No emoji codes: a file name or value such as ``x:100:y`` is printed as typed.
+console = Console(emoji=False)
+err_console = Console(stderr=True, emoji=False)
 
 SensorlessOpt = Annotated[
     bool,
