@@ -1,15 +1,39 @@
-"""Words for counts in messages: one rule, so no line anywhere reads "1 operations".
+"""Words for counts and limits in messages: one rule each, so no line anywhere reads
+"1 operations", and no stated maximum is one the user cannot use.
 
 >>> plural(1, "operation")
 '1 operation'
 >>> plural(3, "vertex", "vertices")
 '3 vertices'
+>>> at_most(6.0274084767)
+'6.02740'
 """
 
 from __future__ import annotations
+
+import math
+from decimal import ROUND_FLOOR, Decimal
 
 
 def plural(n: int, word: str, many: str | None = None) -> str:
     """``n`` and the noun in the number it takes: ``1 part``, ``2 parts``, ``0 parts``;
     ``many`` is the plural when it is not ``word + "s"`` (``1 vertex``, ``3 vertices``)."""
     return f"{n} {word if n == 1 else (many or word + 's')}"
+
+
+def at_most(x: float, digits: int = 6) -> str:
+    """``x`` to ``digits`` significant digits, rounded down (toward minus infinity): a
+    largest value that works, printed so that the printed value works too (``{x:.6g}``
+    rounds 6.0274085 up to 6.02741, past the limit). Significant trailing zeros are kept,
+    so the text reads as the bound it is.
+
+    >>> at_most(2.5)
+    '2.50000'
+    >>> at_most(0.000123456789)
+    '0.000123456'
+    """
+    if x == 0.0 or not math.isfinite(x):
+        return f"{x:.{digits}g}"
+    exact = Decimal(x)  # the float's exact binary value
+    quantum = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    return format(exact.quantize(quantum, rounding=ROUND_FLOOR), "g")

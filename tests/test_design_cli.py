@@ -188,3 +188,17 @@ def test_the_length_table_is_the_plans_length(capsys):
         lo, hi = row["tolerance_mm"]
         plan, _ = run_json(capsys, ["plan", *MIX, "--tolerance", f"{(lo + hi) / 2:.6g}", "--json"])
         assert plan["stats"]["length"] == row["length"], row
+
+
+def test_the_printed_critical_tolerance_is_one_the_plan_accepts(capsys) -> None:
+    """The line's tolerance is rounded down, so copying it into ``plan --tolerance`` works
+    (6.0274085 printed as 6.02741 was past the limit: the plan then could not tell two
+    landings apart)."""
+    parts = [str(CATALOG / f"{n}.json") for n in ("l-bracket", "t-clip", "d-washer")]
+    assert main(["design", "sensor", "--mix", ",".join(parts), "--json"]) == 0
+    exact = json.loads(capsys.readouterr().out)["critical_tolerance_mm"]
+    assert main(["design", "sensor", "--mix", ",".join(parts)]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    printed = out.split("recognizable with a tolerance up to ")[1].split(" mm")[0]
+    assert float(printed) <= exact and float(printed) == pytest.approx(exact, rel=1e-5)
+    assert main(["plan", *parts, "--tolerance", printed]) == 0

@@ -51,6 +51,7 @@ from feederkit.errors import InputError
 from feederkit.landing.plan import landing_names, load_landings
 from feederkit.mechanics import push_function
 from feederkit.mix.changeover import plans_over_landings
+from feederkit.words import at_most
 
 design_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -269,7 +270,8 @@ def sensor_command(
 
 
 def _mm(x: float | None) -> str:
-    return "none" if x is None else f"{x:.6g}"
+    """A critical tolerance (a largest value that works), rounded down (``at_most``)."""
+    return "none" if x is None else at_most(x)
 
 
 def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
@@ -301,7 +303,7 @@ def _print_tolerance(design: ToleranceDesign, members: str) -> None:
     table.add_column("length", justify="right")
     table.add_column(f"expected (at hi; {members} equally likely)", justify="right")
     for s in design.steps:
-        hi = "..." if s.hi is None else f"{s.hi:.6g}"
+        hi = "..." if s.hi is None else at_most(s.hi)  # the step holds up to hi
         length = "no strong plan" if s.length is None else str(s.length)
         expected = "-" if s.expected is None else f"{s.expected:.4f}"
         table.add_row(f"({s.lo:.6g}, {hi}]", length, expected)

@@ -28,6 +28,7 @@ from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
 from feederkit.planning.budget import Timeout
 from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.words import at_most
 
 MODEL_NOTE = "ideal model: plans assume no rotation error"
 """The model note of the ideal model (all three bounds zero)."""
@@ -131,10 +132,10 @@ class ToleranceDesign:
         pairs_x = self.critical.critical_tolerance
         if self.stopped is not None and pairs_x is not None:
             if x is not None:  # the ideal model: the pairs' tolerance is the mix's
-                text = f"this mix is recognizable with a tolerance up to {x:.6g} mm"
+                text = f"this mix is recognizable with a tolerance up to {at_most(x)} mm"
             else:
                 text = (
-                    f"every pair of this mix is told apart up to {pairs_x:.6g} mm, so no "
+                    f"every pair of this mix is told apart up to {at_most(pairs_x)} mm, so no "
                     "larger tolerance recognizes it; whether one strong plan does up to it "
                     "was not decided"
                 )
@@ -150,7 +151,7 @@ class ToleranceDesign:
                 + self._model_words()
             )
         step = self.step_at(x)
-        text = f"this mix is recognizable with a tolerance up to {x:.6g} mm"
+        text = f"this mix is recognizable with a tolerance up to {at_most(x)} mm"
         if step is not None and step.length is not None and step.expected is not None:
             text += (
                 f"; with it the plan takes {step.length} operations (expected {step.expected:.4g})"
