@@ -168,3 +168,19 @@ def test_a_plan_file_over_the_size_limit_is_refused(tri, capsys):
     _, plan = tri
     err = one_line_error(capsys, ["run", str(plan), "--max-plan-mb", "0.0001"])
     assert "more than the limit" in err and "--max-plan-mb" in err
+
+
+def test_a_source_names_every_landing_of_its_part(tmp_path, capsys):
+    """``run PLAN SOURCE --all`` on a plan over both landings checks both, not only the
+    landing whose outline the file draws (docs/plans.md: every member is run)."""
+    from pathlib import Path
+
+    src = str(Path(__file__).resolve().parents[1] / "catalog" / "l-bracket.json")
+    plan = tmp_path / "lb.plan.json"
+    assert main(["plan", src, "--tolerance", "0.2", "-o", str(plan)]) == 0
+    capsys.readouterr()
+    assert main(["run", str(plan), src, "--all", "--json"]) == 0
+    parts = json.loads(capsys.readouterr().out)["parts"]
+    assert sorted(p["landing"] for p in parts) == ["down", "up"]
+    assert main(["run", str(plan), "--all", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["parts"] == parts

@@ -28,8 +28,9 @@ from feederkit.cli.plan_render import (
     verification_table,
 )
 from feederkit.errors import CheckFailed, InputError
+from feederkit.landing.plan import load_landings
 from feederkit.plans.execute import execute
-from feederkit.plans.match import match_part
+from feederkit.plans.match import match_part, same_geometry
 from feederkit.plans.model import Plan
 from feederkit.plans.verify import verify_declared
 from feederkit.sources import load_part
@@ -70,9 +71,9 @@ def run_command(
     plan = load_plan(plan_path, max_plan_mb)
     indices: list[int] = []
     for source in sources or []:
-        k = match_part(plan, load_part(source, catalog=catalog), source)
-        if k not in indices:
-            indices.append(k)
+        for k in _members_of(plan, source, catalog):
+            if k not in indices:
+                indices.append(k)
     if not sources:
         indices = list(range(len(plan.parts)))
     warnings = [w for w in (plan.low_margin_warning(),) if w]
@@ -128,6 +129,28 @@ def run_command(
         raise CheckFailed(failed[0].message)
     if not report.ok:
         raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
+
+
+def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
+    """The plan's members a SOURCE names: its part (same hull and COM, ``match_part``) and,
+    in a plan over landings, every landing of that part the plan holds, each checked
+    against the source's own landing (docs/plans.md: every member is run)."""
+    k = match_part(plan, load_part(source, catalog=catalog), source)
+    if not plan.over_landings:
+        return [k]
+    name = plan.parts[k].name
+    out = [k]
+    for x in load_landings([source], catalog=catalog).all:
+        for j, member in enumerate(plan.parts):
+            if j in out or member.name != name or member.landing != x.name:
+                continue
+            if not same_geometry(x.part, member):
+                raise InputError(
+                    f"{source}: its {x.name} landing differs from the plan's (its hull or COM "
+                    "is not the one the plan was made for)"
+                )
+            out.append(j)
+    return sorted(out)
 
 
 def _every_path(n: int) -> str:
