@@ -215,9 +215,12 @@ def outline_to_dict(outline: Outline) -> dict[str, object]:
     return out
 
 
-def load_outline_json(path: str | os.PathLike[str]) -> Outline:
-    """Load an outline file; unreadable or malformed files are bad input."""
+def load_outline_json(path: str | os.PathLike[str], units: str | None = None) -> Outline:
+    """Load an outline file; unreadable or malformed files are bad input. ``units``, when
+    given, overrides the file's ``units`` (as ``--units`` does for every drawing)."""
     data = read_json(path, "file")
+    if units is not None and isinstance(data, dict):
+        data = {**data, "units": units}
     try:
         return outline_from_dict(data, default_name=Path(path).stem)
     except InputError as exc:  # name the file the user gave, not only the outline's name

@@ -26,6 +26,7 @@ from feederkit.importers import (
     import_parts,
     orientability,
 )
+from feederkit.outline import unit_scale
 from feederkit.part import Part, make_part
 
 Point = tuple[float, float]
@@ -94,6 +95,11 @@ def load_parts_with_warnings(
         raise InputError(f"{source}: not a file")
     if not could_be_part_name(source):
         raise InputError(f"{source}: no such file")
+    if opts.units is not None:
+        unit_scale(opts.units)  # an unknown unit is bad input first
+        raise InputError(
+            f"{source}: --units applies to drawing files; a catalog part is stored in mm"
+        )
     return (_from_catalog(source, opts.com, catalog),)
 
 

@@ -214,3 +214,25 @@ def test_plot_and_lookalike_print_the_importers_warnings(capsys, tmp_path: Path)
     assert "the drawing has no units" not in capsys.readouterr().err  # --units given
     assert main(["lookalike", src, "--keep", "push", "-o", str(tmp_path / "l.json")]) == 0
     assert "the drawing has no units" in capsys.readouterr().err
+
+
+def test_units_apply_to_outline_files_and_are_refused_for_catalog_parts(tmp_path, capsys):
+    """``--units`` overrides an outline file's units as it does a drawing's; an unknown
+    unit, or one given for a catalog part (stored in mm), is one line and exit 2."""
+    src = tmp_path / "tri.json"
+    src.write_text(json.dumps({"name": "tri", "vertices": [[0, 0], [10, 0], [0, 5]]}))
+    assert main(["part", "analyze", str(src), "--json"]) == 0
+    mm = json.loads(capsys.readouterr().out)[0]
+    assert main(["part", "analyze", str(src), "--units", "cm", "--json"]) == 0
+    cm = json.loads(capsys.readouterr().out)[0]
+    assert cm["com"] == pytest.approx([10 * x for x in mm["com"]])
+    assert main(["part", "analyze", str(src), "--units", "furlong"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown unit 'furlong'" in err and len(err.strip().splitlines()) == 1
+    db = str(tmp_path / "cat.db")
+    assert main(["catalog", "init", "--catalog", db]) == 0
+    assert main(["catalog", "add", str(src), "--catalog", db]) == 0
+    capsys.readouterr()
+    assert main(["part", "analyze", "tri", "--catalog", db, "--units", "cm"]) == 2
+    err = capsys.readouterr().err
+    assert "--units applies to drawing files" in err and len(err.strip().splitlines()) == 1

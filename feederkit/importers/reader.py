@@ -84,7 +84,7 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     others: list[str] = []
     warnings: list[str] = []
     if suffix in OUTLINE_SUFFIXES:
-        outline = load_outline_json(p)
+        outline = load_outline_json(p, options.units)
         budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
         budget.loops(1 + len(outline.holes))
         if name:
