@@ -210,7 +210,16 @@ def test_open_outline(tmp_path):
         msp.add_line((10, 0), (10, 10))
         msp.add_line((10, 10), (0, 10))
 
-    bad(fx.write_entities(tmp_path / "open.dxf", build), "no closed outline.*open ends")
+    bad(fx.write_entities(tmp_path / "open.dxf", build), r"no closed outline.*\(2 open ends\)")
+
+
+def test_an_open_polyline_has_two_open_ends(tmp_path):
+    """Its two ends, counted as ends (not as the open pieces left over)."""
+
+    def build(msp):
+        msp.add_lwpolyline([(0, 0), (10, 0), (10, 5), (0, 5)], close=False)
+
+    bad(fx.write_entities(tmp_path / "open.dxf", build), r"\(2 open ends\)$")
 
 
 def test_zero_area_outline(tmp_path):

@@ -20,6 +20,7 @@ from shapely.geometry import LineString, Polygon
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import Budget
+from feederkit.words import plural
 
 Point = tuple[float, float]
 
@@ -368,7 +369,8 @@ def drawing_from_lines(
         budget.check_time()
     loops, dangles = closed_loops(healed, budget)
     if not loops:
-        detail = f" ({len(dangles)} open ends)" if dangles else ""
+        ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
+        detail = f" ({plural(ends, 'open end')})" if ends else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
     drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
