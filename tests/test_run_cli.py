@@ -184,3 +184,16 @@ def test_a_source_names_every_landing_of_its_part(tmp_path, capsys):
     assert sorted(p["landing"] for p in parts) == ["down", "up"]
     assert main(["run", str(plan), "--all", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["parts"] == parts
+
+
+def test_a_clockwise_hull_in_a_plan_file_is_bad_input(tri, tmp_path, capsys):
+    """design.md fixes the hull counter-clockwise; a hand-edited file reversed it and still
+    passed ``run --all``."""
+    _src, plan = tri
+    data = json.loads(plan.read_text())
+    data["parts"][0]["hull"] = data["parts"][0]["hull"][::-1]
+    bad = tmp_path / "reversed.plan.json"
+    bad.write_text(json.dumps(data))
+    assert main(["run", str(bad), "--all"]) == 2
+    err = capsys.readouterr().err
+    assert "hull is not counter-clockwise" in err and len(err.strip().splitlines()) == 1

@@ -780,6 +780,11 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     hull = tuple(c.pair(v, f"{where} hull vertex") for v in c.lst(c.key(d, "hull", where), where))
     if len(hull) < 3:
         raise c.fail(f"{where} hull has fewer than three vertices")
+    twice_area = sum(
+        a[0] * b[1] - b[0] * a[1] for a, b in zip(hull, hull[1:] + hull[:1], strict=True)
+    )
+    if not twice_area > 0.0:  # design.md: counter-clockwise, so edges and normals agree
+        raise c.fail(f"{where} hull is not counter-clockwise (its signed area is not positive)")
     raw_states = c.lst(c.key(d, "stable_states", where), f"{where} stable_states")
     if not raw_states:
         raise c.fail(f"{where} has no stable states")
