@@ -88,40 +88,15 @@ CASES: dict[str, tuple[str, str, bool]] = {
 }
 
 CHILD = r"""
-import json, math, random, resource, sys, time
+import json, resource, sys, time
 sys.path.insert(0, sys.argv[4])
-from bench_planners import mix
+from bench_planners import circle_cut, mix, near_round, random_outline
 from feederkit.errors import PlanningError
 from feederkit.machine import build_machine
-from feederkit.mechanics import push_function
-from feederkit.outline import make_outline
-from feederkit.part import make_part
 from feederkit.planning.api import plan
 from feederkit.planning.options import PlanningOptions
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
-
-def near_round(n, noise, seed=0, r=10.0):
-    rng = random.Random(seed)
-    pts = []
-    for k in range(n):
-        a, f = 2 * math.pi * k / n, 1 + rng.uniform(-noise, noise)
-        pts.append((r * f * math.cos(a), r * f * math.sin(a)))
-    return push_function(make_part(make_outline(f"round-{n}", pts)))
-
-def random_outline(n, seed):
-    # The hull of n points at random angles and radii 21-30 mm: 10-32 stable states.
-    rng = random.Random(seed)
-    pts = []
-    for t in sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n)):
-        f = 30.0 * rng.uniform(0.7, 1.0)
-        pts.append((f * math.cos(t), f * math.sin(t)))
-    return push_function(make_part(make_outline(f"rand-{n}-{seed}", pts)))
-
-def circle_cut(n=360, cut=0.9, r=10.0):
-    pts = [(r * math.cos(2 * math.pi * k / n), max(r * math.sin(2 * math.pi * k / n), -cut * r))
-           for k in range(n)]
-    return push_function(make_part(make_outline("cut", pts)))
 
 expr, tol, unc = sys.argv[1].split("|")
 limit = float(sys.argv[2])
@@ -147,13 +122,15 @@ print(json.dumps(out))
 
 def run_case(spec: str, limit: float, memory: str, here: str) -> dict:
     """One case in a fresh process: its JSON line, or ``{"missed": why}``."""
-    hard = 3 * limit + 30
+    return run_child(CHILD, [spec, str(limit), memory, here], 3 * limit + 30)
+
+
+def run_child(code: str, args: list[str], hard: float) -> dict:
+    """``code`` run by a fresh Python with ``args``, killed after ``hard`` seconds: the JSON
+    of its last line on stdout, or ``{"missed": why}``."""
     try:
         p = subprocess.run(
-            [sys.executable, "-c", CHILD, spec, str(limit), memory, here],
-            capture_output=True,
-            text=True,
-            timeout=hard,
+            [sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=hard
         )
     except subprocess.TimeoutExpired:
         return {"missed": f"killed after {hard:.0f} s"}

@@ -106,6 +106,36 @@ def random_convex(n: int, seed: int, name: str):
     return push_function(make_part(make_outline(name, pts)))
 
 
+def random_outline(n: int, seed: int):
+    """The hull of ``n`` points at random angles and radii 21-30 mm (10-32 stable states)."""
+    rng = random.Random(seed)
+    pts = []
+    for t in sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(n)):
+        f = 30.0 * rng.uniform(0.7, 1.0)
+        pts.append((f * math.cos(t), f * math.sin(t)))
+    return push_function(make_part(make_outline(f"rand-{n}-{seed}", pts)))
+
+
+def near_round(n: int, noise: float, seed: int = 0, r: float = 10.0):
+    """A regular ``n``-gon of radius ``r`` mm with relative radial noise ``noise``."""
+    rng = random.Random(seed)
+    pts = []
+    for k in range(n):
+        a, f = 2 * math.pi * k / n, 1 + rng.uniform(-noise, noise)
+        pts.append((r * f * math.cos(a), r * f * math.sin(a)))
+    return push_function(make_part(make_outline(f"round-{n}", pts)))
+
+
+def circle_cut(n: int = 360, cut: float = 0.9, r: float = 10.0):
+    """A circle of ``n`` facets, radius ``r`` mm, with a flat cut at ``cut * r`` below its
+    centre."""
+    pts = [
+        (r * math.cos(2 * math.pi * k / n), max(r * math.sin(2 * math.pi * k / n), -cut * r))
+        for k in range(n)
+    ]
+    return push_function(make_part(make_outline("cut", pts)))
+
+
 def mix(count: int):
     return [
         random_convex(random.Random(s).randint(6, 10), 100 + s, f"mix-{s}") for s in range(count)
@@ -214,6 +244,14 @@ def cases(quick: bool):
         pf = random_convex(64, seed, f"random-64-{seed}")
         m = build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL)
         yield f"random convex 64-gon #{seed}, 3% [{m.n} states]", m, 0.2, seed < 3
+    # Issue 12's own sensor cases: a random part and a 10-part mix at 3 %.
+    pf = random_outline(50, 2)
+    m = build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL)
+    yield f"random 50-point outline, 3% [{m.n} states]", m, 0.2, True
+    parts = mix(10)
+    size = max(pf.part.size for pf in parts)
+    m = build_machine(parts, ToleranceSensor(0.03 * size), IDEAL)
+    yield f"10-part mix of 6-10-gons, 3% of {size:.0f} mm [{m.n} states]", m, 0.5, True
     for count, rel, target in ((20, 0.02, 0.5), (50, 0.01, 5.0)):
         parts = mix(count)
         size = max(pf.part.size for pf in parts)
