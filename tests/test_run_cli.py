@@ -197,3 +197,17 @@ def test_a_clockwise_hull_in_a_plan_file_is_bad_input(tri, tmp_path, capsys):
     assert main(["run", str(bad), "--all"]) == 2
     err = capsys.readouterr().err
     assert "hull is not counter-clockwise" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_plan_of_the_down_landing_runs_with_its_source(tmp_path, capsys):
+    """The source's outline is the up landing; the plan holds only the down one (mirrored):
+    it is still the plan's part."""
+    from pathlib import Path
+
+    src = str(Path(__file__).resolve().parents[1] / "catalog" / "l-bracket.json")
+    plan = tmp_path / "down.plan.json"
+    assert main(["plan", src, "--tolerance", "0.2", "--landings", "down", "-o", str(plan)]) == 0
+    capsys.readouterr()
+    assert main(["run", str(plan), src, "--all", "--json"]) == 0
+    parts = json.loads(capsys.readouterr().out)["parts"]
+    assert [p["landing"] for p in parts] == ["down"]

@@ -132,17 +132,19 @@ def run_command(
 
 
 def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
-    """The plan's members a SOURCE names: its part (same hull and COM, ``match_part``) and,
+    """The plan's members a SOURCE names: its part (same hull and COM, ``match_part``) or,
     in a plan over landings, every landing of that part the plan holds, each checked
     against the source's own landing (docs/plans.md: every member is run)."""
-    k = match_part(plan, load_part(source, catalog=catalog), source)
-    if not plan.over_landings:
-        return [k]
-    name = plan.parts[k].name
-    out = [k]
-    for x in load_landings([source], catalog=catalog).all:
+    part = load_part(source, catalog=catalog)
+    held = tuple(dict.fromkeys(m.landing for m in plan.parts if m.name == part.name and m.landing))
+    if not plan.over_landings or not held:
+        return [match_part(plan, part, source)]
+    out = []
+    # Only the landings the plan holds: another may be one pushing cannot orient (a mesh
+    # pose on a round face), which loading it would refuse.
+    for x in load_landings([source], catalog=catalog, which=held).all:
         for j, member in enumerate(plan.parts):
-            if j in out or member.name != name or member.landing != x.name:
+            if member.name != part.name or member.landing != x.name:
                 continue
             if not same_geometry(x.part, member):
                 raise InputError(
@@ -150,7 +152,7 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
                     "is not the one the plan was made for)"
                 )
             out.append(j)
-    return sorted(out)
+    return sorted(out) or [match_part(plan, part, source)]
 
 
 def _every_path(n: int) -> str:

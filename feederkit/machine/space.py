@@ -233,9 +233,10 @@ class SearchSpace:
     @cached_property
     def alike(self) -> tuple[int, ...]:
         """For each state, the states a leaf may list with it: every state of another
-        member, and the states of its own member whose poses look alike
-        (``MachineState.look_alike``, recorded both ways; any state of the member when
-        either records nothing: a machine built by hand, or the ideal model)."""
+        member, and the states of its own member recorded as alike both ways
+        (``MachineState.look_alike``: near-congruent poses, or ideal twins); any state of
+        the member when either records nothing (a machine built by hand, or the ideal
+        model)."""
         states = self.machine.states
         of_part: dict[int, int] = {}
         for i, s in enumerate(states):
@@ -266,8 +267,8 @@ class SearchSpace:
         under the declared uncertainty (a large rotation error lets every action send each
         to every state) are bisimilar, yet a leaf listing them does not orient the part:
         they stay apart here, and ``PlanningOptions.lumping`` decides whether a plan may list
-        them (docs/planning.md, "Near-symmetric states under uncertainty"). Without rejected
-        members and unlike poses it is :attr:`bisimilar` itself.
+        them (docs/planning.md, "Poses that only behave alike are not the goal"). Without
+        rejected members and such pairs it is :attr:`bisimilar` itself.
         """
         base = tuple(b & a for b, a in zip(self.bisimilar, self.alike, strict=True))
         rej = self.rejected
