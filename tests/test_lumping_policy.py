@@ -489,3 +489,20 @@ def test_the_command_line_refuses_a_rotation_error_that_makes_every_pose_alike(c
     assert main(["plan", src, "--landings", "up", "--rotation-error", "75"]) == 1
     err = capsys.readouterr().err
     assert "result: no strong plan exists" in err and "largest rotation error" in err
+
+
+def test_the_alike_record_does_not_depend_on_the_sensor():
+    """The sensor design builds its machine once and swaps sensors: the record (and so the
+    goal) must be the one a machine built with each sensor has. A finer sensor then never
+    loses the plan a coarser one has (the heptagon at a 0.02 mm shape tolerance)."""
+    from dataclasses import replace
+
+    pf = push_function(make_part(load_outline_json(CATALOG / "heptagon-fig17.json")))
+    model = Uncertainty(1.0, shape_tolerance_mm=0.02)
+    blind = build_machine([pf], NoSensor(), model)
+    for tol in (0.01, 0.06):
+        built = build_machine([pf], ToleranceSensor(tol), model)
+        assert [s.look_alike for s in built.states] == [s.look_alike for s in blind.states]
+        swapped = replace(blind, sensor=ToleranceSensor(tol))
+        assert search_space(swapped).inseparable == search_space(built).inseparable
+        assert plan(built).length == 1

@@ -160,7 +160,7 @@ def uncertain_machine(
         # Only pairs that do not look alike can be twins worth finding (the ideal fixpoint
         # costs more than the build on a part of hundreds of near-round facets).
         unlike = any(len(alike[s.id]) < mech.n - 1 for s in mech.states)
-        twins = ideal_twins(pf, mech, sensor) if unlike else [set()] * mech.n
+        twins = ideal_twins(pf, mech) if unlike else [set()] * mech.n
         for s in mech.states:
             lo, hi = ends[k]
             k += 1
@@ -193,15 +193,24 @@ def uncertain_machine(
     )
 
 
-def ideal_twins(pf: PushFunction, mech: UncertainMechanics, sensor: Sensor) -> list[set[int]]:
-    """Per physical state of ``mech``, the part's other physical states that no plan tells
-    apart from it even on the ideal model with ``sensor``: every ideal member of either is
-    inseparable (:func:`~feederkit.machine.inseparable.inseparable_masks`) from one of the
-    other's. These are the paper's indistinguishable sets of one part, symmetric poses and
-    poses that behave identically (the heptagon of Fig. 17, whose three poses share one push
-    function and diameter), which a result may list together under any uncertainty.
+TWIN_MAX_STATES = 64
+"""Parts with more ideal stable states get no :func:`ideal_twins` (the pair fixpoint costs
+0.7 s at 114 states and 14 s at 429; such near-round parts' alike poses are near-congruent)."""
+
+
+def ideal_twins(pf: PushFunction, mech: UncertainMechanics) -> list[set[int]]:
+    """Per physical state of ``mech``, the part's other physical states that pushing alone
+    cannot tell apart even on the ideal model: every ideal member of either is inseparable
+    without a sensor (:func:`~feederkit.machine.inseparable.inseparable_masks`) from one of
+    the other's. These are the paper's indistinguishable sets of a push function, symmetric
+    poses and poses that behave identically (the three poses of Fig. 17's heptagon, which
+    every rotation permutes), which a result may list together under any uncertainty. No
+    sensor, so the record is the same whatever sensor the machine is later given (the
+    sensor design swaps it). None beyond ``TWIN_MAX_STATES`` stable states.
     """
-    ideal = build_machine([pf], sensor, IDEAL)
+    if pf.n > TWIN_MAX_STATES:
+        return [set() for _ in mech.states]
+    ideal = build_machine([pf], NoSensor(), IDEAL)
     insep = inseparable_masks(ideal)
     index = {s.state: i for i, s in enumerate(ideal.states)}
 
