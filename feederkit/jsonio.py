@@ -208,12 +208,15 @@ class StagedFiles:
     does not fail halfway for lack of space. Leaving a ``with`` block without a commit
     discards the temporaries. ``mode`` sets the permissions; by default those of a newly
     created file (0666 less the umask), as a plain ``open(path, "w")`` gives, so a
-    controller's account can read a plan file.
+    controller's account can read a plan file. A file a commit replaces is kept (a hard
+    link beside it) until the block ends, so :meth:`undo` can put it back.
     """
 
     def __init__(self, files: Iterable[OutputFile], mode: int | None = None) -> None:
         mode = 0o666 & ~_umask() if mode is None else mode
         self._staged: list[tuple[OutputFile, Path, str]] = []
+        self._kept: dict[Path, str] = {}
+        self._done: list[Path] = []
         self.committed = False
         try:
             for f in files:
@@ -230,33 +233,56 @@ class StagedFiles:
     def commit(self) -> None:
         """Rename every temporary onto its destination (a link's file), in order."""
         for f, target, tmp in self._staged:
+            self._keep(target, tmp)
             try:
                 os.replace(tmp, target)
             except OSError as exc:
+                self.committed = True
+                self.undo()  # the files already replaced come back: all or none
                 self.discard()
                 raise _cannot(f.path, f.what, exc) from None
+            self._done.append(target)
         self.committed = True
 
+    def _keep(self, target: Path, tmp: str) -> None:
+        """A hard link to the file at ``target``, if any, beside its temporary (best effort:
+        without one, :meth:`undo` removes the new file instead)."""
+        if target.is_file():
+            kept = tmp + ".old"
+            try:
+                os.link(target, kept)
+            except OSError:
+                return
+            self._kept[target] = kept
+
     def discard(self) -> None:
-        """Remove the temporaries not yet renamed."""
+        """Remove the temporaries not yet renamed, and the kept old files."""
         for _, _, tmp in self._staged:
             if os.path.exists(tmp):
                 os.unlink(tmp)
+        for kept in self._kept.values():
+            if os.path.exists(kept):
+                os.unlink(kept)
+        self._kept.clear()
 
     def undo(self) -> None:
-        """Remove the files a commit put in place (best effort: their old contents are gone)."""
+        """Put back what a commit replaced: the old file where there was one, else remove
+        the new one (through a link: the file it names, the link left as it was)."""
         if self.committed:
-            for _, target, _ in self._staged:
-                if target.is_file():
+            for target in self._done:
+                kept = self._kept.pop(target, None)
+                if kept is not None:
+                    os.replace(kept, target)
+                elif target.is_file():
                     target.unlink()
+            self._done.clear()
             self.committed = False
 
     def __enter__(self) -> StagedFiles:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        if not self.committed:
-            self.discard()
+        self.discard()
 
 
 def write_files(files: Iterable[OutputFile], mode: int | None = None) -> None:

@@ -166,3 +166,48 @@ def test_a_pipe_or_a_link_to_a_folder_is_not_replaced(tmp_path: Path) -> None:
         write_text_atomic(folder_link, "{}")
     assert folder_link.is_symlink()
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+def test_undo_puts_back_what_the_commit_replaced(tmp_path: Path) -> None:
+    """A changeover whose catalog save fails after its files are in place undoes them: the
+    old plan comes back (through a link, into the file it names; the link stays a link),
+    and a file that was not there before is removed."""
+    from feederkit.jsonio import StagedFiles
+
+    (tmp_path / "v3").mkdir()
+    real = tmp_path / "v3" / "plan.json"
+    real.write_text('{"old": 1}')
+    link = tmp_path / "current.json"
+    link.symlink_to(real)
+    new = tmp_path / "report.json"
+    with StagedFiles([OutputFile(link, "{}", "plan file"), OutputFile(new, "{}")]) as staged:
+        staged.commit()
+        assert read_json(real) == {} and new.is_file()
+        staged.undo()
+    assert read_json(real) == {"old": 1} and link.is_symlink() and not new.exists()
+    assert sorted(p.name for d in (tmp_path, tmp_path / "v3") for p in d.iterdir()) == [
+        "current.json",
+        "plan.json",
+        "v3",
+    ]
+
+
+def test_a_failed_rename_puts_back_the_files_already_replaced(tmp_path: Path, monkeypatch):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text("old a")
+    b.write_text("old b")
+    real_replace = os.replace
+    calls = []
+
+    def replace(src, dst):
+        calls.append(dst)
+        if len(calls) == 2:  # the second file's rename fails
+            raise OSError(5, "Input/output error")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(InputError, match="b.json: cannot write"):
+        write_files([OutputFile(a, "new a"), OutputFile(b, "new b")])
+    monkeypatch.setattr(os, "replace", real_replace)
+    assert a.read_text() == "old a" and b.read_text() == "old b"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "b.json"]
