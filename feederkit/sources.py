@@ -95,12 +95,13 @@ def load_parts_with_warnings(
         raise InputError(f"{source}: not a file")
     if not could_be_part_name(source):
         raise InputError(f"{source}: no such file")
+    found = _from_catalog(source, opts.com, catalog)  # a mistyped name says so first
     if opts.units is not None:
-        unit_scale(opts.units)  # an unknown unit is bad input first
+        unit_scale(opts.units)  # then an unknown unit
         raise InputError(
             f"{source}: --units applies to drawing files; a catalog part is stored in mm"
         )
-    return (_from_catalog(source, opts.com, catalog),)
+    return (found,)
 
 
 def load_part_with_warnings(

@@ -24,16 +24,18 @@ def plural(n: int, word: str, many: str | None = None) -> str:
 def at_most(x: float, digits: int = 6) -> str:
     """``x`` to ``digits`` significant digits, rounded down (toward minus infinity): a
     largest value that works, printed so that the printed value works too (``{x:.6g}``
-    rounds 6.0274085 up to 6.02741, past the limit). Significant trailing zeros are kept,
-    so the text reads as the bound it is.
+    rounds 6.0274085 up to 6.02741, past the limit). The shortest text when it reads back
+    as at most ``x`` (0.3 is the float 0.3), else the digits rounded down, significant
+    trailing zeros kept.
 
-    >>> at_most(2.5)
-    '2.50000'
+    >>> at_most(0.3)
+    '0.3'
     >>> at_most(0.000123456789)
     '0.000123456'
     """
-    if x == 0.0 or not math.isfinite(x):
-        return f"{x:.{digits}g}"
+    short = f"{x:.{digits}g}"
+    if x == 0.0 or not math.isfinite(x) or float(short) <= x:
+        return short
     exact = Decimal(x)  # the float's exact binary value
     quantum = Decimal(1).scaleb(exact.adjusted() - digits + 1)
     return format(exact.quantize(quantum, rounding=ROUND_FLOOR), "g")

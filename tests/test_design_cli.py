@@ -202,3 +202,20 @@ def test_the_printed_critical_tolerance_is_one_the_plan_accepts(capsys) -> None:
     printed = out.split("recognizable with a tolerance up to ")[1].split(" mm")[0]
     assert float(printed) <= exact and float(printed) == pytest.approx(exact, rel=1e-5)
     assert main(["plan", *parts, "--tolerance", printed]) == 0
+
+
+def test_the_length_table_prints_each_breakpoint_once(capsys) -> None:
+    """A step's lower end is the step before's upper end, printed alike (both rounded
+    down), so the rows do not seem to leave a gap."""
+    parts = [str(CATALOG / f"{n}.json") for n in ("rectangle-2x1", "equilateral-triangle")]
+    assert main(["design", "sensor", "--mix", ",".join(parts), "--landings", "up"]) == 0
+    out = capsys.readouterr().out
+    rows = [
+        line.split("(")[1].split("]")[0]
+        for line in out.splitlines()
+        if "] " in line and "(" in line and "," in line.split("]")[0]
+    ]
+    ends = [tuple(part.strip() for part in row.split(",")) for row in rows]
+    assert len(ends) >= 2
+    for (_lo, hi), (lo, _hi) in zip(ends, ends[1:], strict=False):
+        assert lo == hi

@@ -236,3 +236,5 @@ def test_units_apply_to_outline_files_and_are_refused_for_catalog_parts(tmp_path
     assert main(["part", "analyze", "tri", "--catalog", db, "--units", "cm"]) == 2
     err = capsys.readouterr().err
     assert "--units applies to drawing files" in err and len(err.strip().splitlines()) == 1
+    assert main(["part", "analyze", "tir", "--catalog", db, "--units", "cm"]) == 2
+    assert "no such file or catalog part" in capsys.readouterr().err  # the typo first

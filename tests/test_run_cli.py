@@ -184,6 +184,10 @@ def test_a_source_names_every_landing_of_its_part(tmp_path, capsys):
     assert sorted(p["landing"] for p in parts) == ["down", "up"]
     assert main(["run", str(plan), "--all", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["parts"] == parts
+    copy = tmp_path / "bracket-copy.json"  # the same outline under another name
+    copy.write_text(Path(src).read_text().replace('"l-bracket"', '"bracket-copy"'))
+    assert main(["run", str(plan), str(copy), "--all", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["parts"] == parts
 
 
 def test_a_clockwise_hull_in_a_plan_file_is_bad_input(tri, tmp_path, capsys):

@@ -306,7 +306,7 @@ def _print_tolerance(design: ToleranceDesign, members: str) -> None:
         hi = "..." if s.hi is None else at_most(s.hi)  # the step holds up to hi
         length = "no strong plan" if s.length is None else str(s.length)
         expected = "-" if s.expected is None else f"{s.expected:.4f}"
-        table.add_row(f"({s.lo:.6g}, {hi}]", length, expected)
+        table.add_row(f"({at_most(s.lo)}, {hi}]", length, expected)  # both ends alike
     if design.steps:
         console.print(table)
 

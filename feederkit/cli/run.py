@@ -136,15 +136,21 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
     in a plan over landings, every landing of that part the plan holds, each checked
     against the source's own landing (docs/plans.md: every member is run)."""
     part = load_part(source, catalog=catalog)
-    held = tuple(dict.fromkeys(m.landing for m in plan.parts if m.name == part.name and m.landing))
-    if not plan.over_landings or not held:
+    if not plan.over_landings:
         return [match_part(plan, part, source)]
+    try:  # the plan's name for the part: a renamed file of the same geometry is the part
+        name = plan.parts[match_part(plan, part, source)].name
+    except InputError:
+        if not any(m.name == part.name for m in plan.parts):
+            raise
+        name = part.name  # a plan of other landings only (down): checked landing by landing
+    held = tuple(dict.fromkeys(m.landing for m in plan.parts if m.name == name and m.landing))
     out = []
     # Only the landings the plan holds: another may be one pushing cannot orient (a mesh
     # pose on a round face), which loading it would refuse.
     for x in load_landings([source], catalog=catalog, which=held).all:
         for j, member in enumerate(plan.parts):
-            if member.name != part.name or member.landing != x.name:
+            if member.name != name or member.landing != x.name:
                 continue
             if not same_geometry(x.part, member):
                 raise InputError(
