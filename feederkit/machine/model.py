@@ -62,6 +62,14 @@ class MachineState:
         """What the sensor sees: the exact diameter, or the diameter interval."""
         return self.diameter if self.diameter_range is None else self.diameter_range
 
+    def alike(self, other: MachineState) -> bool:
+        """Whether a leaf may list this state with ``other``: a state of another part, or
+        of this part when each names the other in ``look_alike`` (any when either records
+        nothing)."""
+        if self.part != other.part or self.look_alike is None or other.look_alike is None:
+            return True
+        return other.state in self.look_alike and self.state in other.look_alike
+
     @property
     def ideal_states(self) -> tuple[int, ...]:
         """The ideal stable states this state stands for (``(state,)`` in the ideal model)."""

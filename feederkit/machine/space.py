@@ -233,10 +233,9 @@ class SearchSpace:
     @cached_property
     def alike(self) -> tuple[int, ...]:
         """For each state, the states a leaf may list with it: every state of another
-        member, and the states of its own member recorded as alike both ways
-        (``MachineState.look_alike``: near-congruent poses, or ideal twins); any state of
-        the member when either records nothing (a machine built by hand, or the ideal
-        model)."""
+        member, and those of its own member recorded as alike (``MachineState.alike``:
+        near-congruent poses, or ideal twins; any when nothing is recorded, a machine built
+        by hand or the ideal model)."""
         states = self.machine.states
         of_part: dict[int, int] = {}
         for i, s in enumerate(states):
@@ -250,8 +249,7 @@ class SearchSpace:
                 continue
             keep = full & ~own | 1 << i
             for j in members(own):
-                b = states[j]
-                if b.look_alike is None or (b.state in a.look_alike and a.state in b.look_alike):
+                if a.alike(states[j]):
                     keep |= 1 << j
             out.append(keep)
         return tuple(out)

@@ -161,19 +161,15 @@ def may_lump(machine: PushAlignMachine, i: int, j: int, rule: Lumping | str) -> 
     """Whether ``rule`` lets a plan list states ``i`` and ``j`` together (:class:`Lumping`).
 
     ``near-symmetric``: states of different parts, or of one part when each names the other
-    in ``look_alike`` (a state that records nothing, built by hand, allows any).
+    in ``look_alike`` (``MachineState.alike``: a state that records nothing, built by hand,
+    allows any).
     """
     rule = _rule(rule)
     if rule is Lumping.NONE:
         return False
     if rule is Lumping.ANY:
         return True
-    a, b = machine.states[i], machine.states[j]
-    if a.part != b.part:
-        return True
-    if a.look_alike is None or b.look_alike is None:
-        return True
-    return b.state in a.look_alike and a.state in b.look_alike
+    return machine.states[i].alike(machine.states[j])
 
 
 @dataclass(frozen=True)
