@@ -281,7 +281,6 @@ class Choices:
 
         Smallest image first (a proxy for the smallest branches), then the widest; the
         search usually succeeds, or fails at a memoised depth, long before the last one.
-        A range whose image an earlier (wider) range has is left out: the same subproblem.
         An action whose image contains one of the first ``_DOMINATORS`` images is left
         out (dominated): the branches of a subset lie inside the branches of the set (each
         reading cell, or component, restricted), and a subset needs no more operations.
@@ -316,15 +315,9 @@ class Choices:
         action is made: a caller that ranks them makes only the actions it keeps."""
         cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
         kept: list[int] = []
-        seen: set[int] = set()
         readings = self.readings
         for cell in cells:
             img = cell[2]
-            # An image met before (its widest range came first) is the same subproblem; a
-            # near-round part's set has hundreds of ranges and far fewer images.
-            if img in seen:
-                continue
-            seen.add(img)
             # Sorted by size: only an earlier image can lie inside this one. Only the
             # first few (smallest) are tried: they dominate most, and the test is cheap.
             dominated = False
