@@ -329,9 +329,9 @@ def test_a_plan_too_large_to_verify_in_time_gives_way_to_a_smaller_one(monkeypat
     calls: list[str] = []
     real = api._build
 
-    def build(refiner, children, horizon, tie, *then):
+    def build(refiner, children, roots, horizon, tie, *then):
         calls.append(tie)
-        return real(refiner, children, horizon, tie, *then)
+        return real(refiner, children, roots, horizon, tie, *then)
 
     monkeypatch.setattr(api, "_build", build)
     budget = Deadline(30.0, per_pair_s=0.1)

@@ -24,6 +24,7 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import plan
+from feederkit.planning.choices import children_key
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
@@ -208,6 +209,12 @@ def test_the_length_view_leaves_out_dominated_actions():
             first = cells[0][2]
             assert not any(a != first and a & first == first for a in images)
             pruned += sum(c[2] != first and c[2] & first == first for c in cells)
+        # Tried in the search order: the smallest largest reading branch first, then the
+        # fewest states over the branches; each action's branches the maximal ones.
+        acts = list(choices.lazy_actions(mask))
+        keys = [children_key(a.children) for a in acts]
+        assert keys == sorted(keys)
+        assert all(a.children == problem.readings.children(a.action.image) for a in acts)
     assert pruned > 0
 
 

@@ -418,6 +418,48 @@ def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     assert check_plan(got) <= got.length
 
 
+@pytest.mark.parametrize(("count", "tolerance"), [(5, 2.0), (8, 1.0), (6, 3.0)])
+def test_ties_cut_before_any_margin_follow_the_length_proofs_plans_without_a_search(
+    monkeypatch, count, tolerance
+):
+    # When the margin stage runs out before its first probe, no probe recorded a plan: the
+    # tree follows the length proof's (WorstCase.choice), a root branch the proof did not
+    # prove (it is not maximal) that of a maximal one holding it, with no new search (on a
+    # 98-state mix "the first allowed action" of every root branch took 105 CPU seconds,
+    # the proof 9). It keeps the proven length and executes from every start.
+    machine = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
+    exact = api.plan(machine)
+    following = [False]
+    searched = []
+
+    def cut(self, *args):
+        raise Timeout("work")
+
+    follow = Refiner.follow
+
+    def watched(self, *args):
+        was, following[0] = following[0], True
+        try:
+            return follow(self, *args)
+        finally:
+            following[0] = was
+
+    choose = Refiner.choose_worst
+
+    def counted(self, *args):
+        searched.append(following[0])
+        return choose(self, *args)
+
+    monkeypatch.setattr(Refiner, "keeps", cut)
+    monkeypatch.setattr(Refiner, "follow", watched)
+    monkeypatch.setattr(Refiner, "choose_worst", counted)
+    got = api.plan(build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL))
+    assert got.tie_breaks == api.TIES_NONE and got.optimal
+    assert got.length == exact.length
+    assert searched == []
+    assert check_plan(got) <= got.length
+
+
 @pytest.mark.parametrize(("count", "tolerance"), [(5, 2.0), (6, 3.0)])
 def test_ties_cut_after_the_margin_under_uncertainty_give_a_verified_strong_plan(
     monkeypatch, count, tolerance

@@ -427,7 +427,7 @@ def _plan(
             def then() -> Deadline:
                 return budget.until(FIRST_TREE_SHARE)
 
-        root, cut = _build(refiner, children, horizon, tie, then)
+        root, cut = _build(refiner, children, roots, horizon, tie, then)
         ties = TIES_EXACT if cut is None else TIES_MARGIN
     except Timeout as exc:
         # The lengths are proven; the tie-breaking stages ran out of time: a tree that
@@ -439,7 +439,7 @@ def _plan(
         if not staged:
             refiner.floor = tie_floor(refiner.floor_found) if objective == "worst" else -math.inf
         try:
-            root, _cut = _build(refiner, children, budget_ops, "first")
+            root, _cut = _build(refiner, children, roots, budget_ops, "first")
         except Timeout as exc:
             return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
         complete = objective == "worst"
@@ -476,6 +476,7 @@ def _on_course(problem: Problem, worst: WorstCase, roots: list[int]) -> bool:
 def _build(
     refiner: Refiner,
     children,
+    roots: list[int],
     horizon: int,
     tie: str,
     then: Callable[[], Deadline] | None = None,
@@ -487,6 +488,8 @@ def _build(
     out of its budget, the root branches built so far keep their subtrees, and the others
     follow the margin probes' plans (``"first"``) under the budget ``then()`` gives, which
     the kept subtrees' (node, state) pairs are committed to. Without ``then``, Timeout.
+    A root branch with no plan of its own (neither a probe's nor the length proof's, which
+    proves the maximal ones, ``roots``) follows the plan of a maximal one holding it.
     """
 
     def chooser(mask, masses, k):
@@ -510,7 +513,10 @@ def _build(
                 tie, cut = "first", exc.reason
         # No choice left to make: follow the plans the margin probes found, with no new
         # search where they recorded one (Refiner.follow), else the first allowed action.
-        subs.append((b, refiner.follow(b.mask, horizon, None, shared)))
+        witness = None
+        if not refiner.planned(b.mask, horizon):
+            witness = next((r for r in roots if b.mask & ~r == 0), None)
+        subs.append((b, refiner.follow(b.mask, horizon, witness, shared)))
     return root_step(subs, refiner.deadline), cut
 
 

@@ -30,6 +30,7 @@ from collections.abc import Iterator
 from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.choices import children_key
 from feederkit.planning.problem import Act, Problem
 
 FIRST_WIDTH = 4
@@ -39,13 +40,7 @@ FIRST_WIDTH = 4
 def branch_key(act: Act) -> tuple[int, int]:
     """The beam's order of a set's actions: the smallest largest branch, then the fewest
     states over all branches (the most a reading can tell apart)."""
-    return _children_key(act.children)
-
-
-def _children_key(children: tuple[int, ...]) -> tuple[int, int]:
-    """:func:`branch_key` of an action with these branches."""
-    sizes = [c.bit_count() for c in children]
-    return max(sizes), sum(sizes)
+    return children_key(act.children)
 
 
 class BeamSearch(WorstCase):
@@ -72,14 +67,10 @@ class BeamSearch(WorstCase):
             else:
                 # Ranked from the cells and their branches; only the kept actions are made
                 # (a set has about a hundred on a near-round part, and the beam keeps four).
-                ranked = sorted(
-                    (*_children_key(children), k, cell, children)
-                    for k, (cell, children) in enumerate(choices.useful_cells(mask))
-                )
+                ranked = choices.useful_cells(mask)  # in branch_key order
                 self.cut |= len(ranked) > self.width
                 acts = tuple(
-                    Act(OverlapRange(*cell), children)
-                    for *_key, cell, children in ranked[: self.width]
+                    Act(OverlapRange(*cell), children) for cell, children in ranked[: self.width]
                 )
             self._beam[mask] = acts
         return iter(acts)

@@ -279,13 +279,8 @@ class Choices:
     def lazy_actions(self, mask: int) -> Iterator[Act]:
         """The length view's actions, made only as far as a search consumes them.
 
-        Smallest image first (a proxy for the smallest branches), then the widest; the
+        In :meth:`useful_cells`'s order (the smallest largest reading branch first): the
         search usually succeeds, or fails at a memoised depth, long before the last one.
-        An action whose image contains one of the first ``_DOMINATORS`` images is left
-        out (dominated): the branches of a subset lie inside the branches of the set (each
-        reading cell, or component, restricted), and a subset needs no more operations.
-        Testing against every earlier image costs more than it saves on sets with hundreds
-        of ranges.
         """
         done = self._actions.get(mask)
         if done is not None:
@@ -293,7 +288,7 @@ class Choices:
             return
         state = self._lazy.get(mask)
         if state is None:
-            state = self._lazy[mask] = [self.useful_cells(mask), []]
+            state = self._lazy[mask] = [iter(self.useful_cells(mask)), []]
         cells, made = state
         i = 0
         while True:
@@ -309,17 +304,25 @@ class Choices:
             cell, children = nxt
             made.append(Act(OverlapRange(*cell), children))
 
-    def useful_cells(self, mask: int) -> Iterator[tuple[tuple[float, float, int], tuple[int, ...]]]:
-        """The cells of :meth:`lazy_actions` with their maximal branches, in its order and
-        with its tests (dominated images and branches holding the set left out), before any
-        action is made: a caller that ranks them makes only the actions it keeps."""
+    def useful_cells(self, mask: int) -> list[tuple[tuple[float, float, int], tuple[int, ...]]]:
+        """The cells of :meth:`lazy_actions` with their maximal branches, before any action
+        is made: a caller that ranks them makes only the actions it keeps.
+
+        Ordered by :func:`children_key` (the smallest largest branch, then the fewest
+        states over all branches: the likeliest to succeed), then the smallest image, then
+        the widest. A cell whose image contains one of the first ``_DOMINATORS`` images
+        (smallest first) is left out (dominated): the branches of a subset lie inside the
+        branches of the set (each reading cell, or component, restricted), and a subset
+        needs no more operations; testing against every earlier image costs more than it
+        saves on sets with hundreds of ranges. So are cells with a branch holding the set.
+        """
         cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
         kept: list[int] = []
+        out: list[tuple[tuple[int, int], int, tuple[float, float, int], tuple[int, ...]]] = []
         readings = self.readings
-        for cell in cells:
+        for n, cell in enumerate(cells):
             img = cell[2]
-            # Sorted by size: only an earlier image can lie inside this one. Only the
-            # first few (smallest) are tried: they dominate most, and the test is cheap.
+            # Sorted by size: only an earlier image can lie inside this one.
             dominated = False
             for k in kept:
                 if k & img == k:
@@ -329,13 +332,12 @@ class Choices:
                 continue
             if len(kept) < _DOMINATORS:
                 kept.append(img)
-            if readings.sensorless:
-                yield cell, (img,)
+            children = (img,) if readings.sensorless else readings.children(img)
+            if not readings.sensorless and any(c & mask == mask for c in children):
                 continue
-            children = readings.children(img)
-            if any(c & mask == mask for c in children):
-                continue
-            yield cell, children
+            out.append((children_key(children), n, cell, children))
+        out.sort()
+        return [(cell, children) for _key, _n, cell, children in out]
 
     def targets(self, mask: int, sa: OverlapRange) -> tuple[int, ...]:
         """Where each member of ``mask`` (ascending) can go under the range's representative:
@@ -353,6 +355,17 @@ class Choices:
         if row is not None:
             return tuple(1 << j for j in row)
         return tuple(self.machine.outcomes(i, x) for i in members(mask))
+
+
+def children_key(children: tuple[int, ...]) -> tuple[int, int]:
+    """The search order of an action with these reading branches: the smallest largest
+    branch, then the fewest states over all branches (the most a reading tells apart).
+
+    >>> children_key((0b0111, 0b1000)), children_key((0b0011, 0b0110))
+    ((3, 4), (2, 4))
+    """
+    sizes = [c.bit_count() for c in children]
+    return max(sizes), sum(sizes)
 
 
 def spread(masses, outcomes) -> dict[int, float]:

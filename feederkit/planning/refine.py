@@ -47,7 +47,7 @@ from collections.abc import Callable
 from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
-from feederkit.planning.choices import spread
+from feederkit.planning.choices import children_key, spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step, branch_pairs
@@ -283,9 +283,9 @@ class Refiner:
         (module docstring)."""
         cells = self.p.choices.cells(mask, useful=False)  # widest first
         if x == -math.inf:
-            # Any plan: the length search's order (smallest image first) finds one soonest;
-            # the margins it keeps are then raised (largest_floor).
-            cells = sorted(cells, key=_small_first)
+            # Any plan: the length search's order finds one soonest; the margins it keeps
+            # are then raised (largest_floor).
+            cells = self._search_order(cells)
         for cell in cells:
             m = (cell[1] - cell[0]) / 2.0
             if m < x or (strict and m == x):
@@ -316,6 +316,18 @@ class Refiner:
             else:
                 return val, cell
         return None
+
+    def _search_order(self, cells: list[Cell]) -> list[Cell]:
+        """``cells`` in the length search's order (``Choices.useful_cells``): the smallest
+        largest reading branch first, then the fewest states over the branches, then the
+        smallest image, then the widest."""
+
+        def key(cell: Cell) -> tuple[int, int, int, float]:
+            img = cell[2]
+            children = (img,) if self.p.sensorless else self.p.readings.children(img)
+            return (*children_key(children), img.bit_count(), cell[0] - cell[1])
+
+        return sorted(cells, key=key)
 
     def margin(self, mask: int, k: int) -> float:
         """The largest smallest margin of plans for ``mask`` within ``k`` operations (inf
@@ -610,8 +622,9 @@ class Refiner:
         at a root branch the probes decided). With margins monotone under subsets (module
         docstring), ``mask``'s overlap range around the witness's rotation is as wide or
         wider, and each of its reading branches lies in one of the witness's maximal
-        branches, whose plans go on. Where no plan is recorded, the first allowed action
-        (:meth:`choose_worst` ``"first"``), whose maximal branches the probes then decided.
+        branches, whose plans go on. Where the probes recorded none, the length proof's
+        plan (``WorstCase.choice``: proven on the maximal branches too) when it keeps the
+        floor; else the first allowed action (:meth:`choose_worst` ``"first"``, a search).
         Equal subtrees are one object, each new node committed to the deadline as in
         :meth:`build`.
         """
@@ -629,6 +642,13 @@ class Refiner:
         act = None
         if self._monotone and cell is not None and self._lo[(lender, k)] >= self.floor:
             act = self._around(mask, cell)
+        if act is None and self._monotone:
+            # No probe's plan: the length proof's, when it keeps the floor (no search).
+            proved = self.w.choice.get(lender)
+            if proved is not None and proved[0] <= k:
+                sa = proved[1].action
+                cell = (sa.lo, sa.hi, sa.image)
+                act = self._around(mask, cell)
         if act is None:
             act = self.choose_worst(mask, (), k, "first")
             cell = (act.action.lo, act.action.hi, act.action.image)
@@ -639,6 +659,14 @@ class Refiner:
             subs.append((b, self.follow(b.mask, k - 1, inside, shared)))
         node = shared[key] = self._node(act, subs)
         return node
+
+    def planned(self, mask: int, k: int) -> bool:
+        """Whether :meth:`follow` has a plan of ``mask``'s own within ``k`` to follow: a
+        margin probe's or the length proof's."""
+        if (mask, k) in self._how:
+            return True
+        proved = self.w.choice.get(mask)
+        return proved is not None and proved[0] <= k
 
     def _node(self, act: Act, subs: list[tuple[ReadingBranch, Step | Leaf]]) -> Step:
         """The tree's node of ``act`` over ``subs``: one object per equal subtree, each new
@@ -673,12 +701,6 @@ def tie_floor(margin: float) -> float:
     within ``WIDTH_QUANTUM_DEG`` of it count as keeping it (:func:`~feederkit.angles.width_key`),
     so a mirror-image range a rounding below it stays a choice on every machine."""
     return margin - WIDTH_QUANTUM_DEG if math.isfinite(margin) else margin
-
-
-def _small_first(cell: Cell) -> tuple[int, float]:
-    """The length search's order of a set's cells (``Choices.lazy_actions``): the smallest
-    image first, then the widest."""
-    return (cell[2].bit_count(), cell[0] - cell[1])
 
 
 def _prefer(a: Act, b: Act | None) -> bool:
