@@ -1,0 +1,111 @@
+"""The hardest pair's lower bound of the AND/OR search (``WorstCase.pair_bound``).
+
+A plan of a set orients each of its pairs, so the largest length over the set's pairs
+bounds the set's length from below. Here each pair's length and each set's length come from
+the tests' own exhaustive search (every cell's middle, the read-alike sets of the states'
+reading intervals); the bound must never exceed a set's length, must equal its hardest pair's
+length, is searched only for the pairs a set asks about, and only once a length search has
+deepened to ``PAIR_BOUND_DEPTH``.
+"""
+
+from __future__ import annotations
+
+import functools
+import random
+
+import pytest
+from shared import outcome_mask, read_alike_sets, rotation_mids, small_mix
+
+import feederkit.planning.andor as andor
+from feederkit.machine import build_machine, is_goal, search_space
+from feederkit.planning.andor import WorstCase
+from feederkit.planning.methods import longest_root
+from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
+from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
+
+
+def _brute(machine, tol: float):
+    """The minimum worst-case length of a set (the tests' own search, memoised): None when
+    no plan of at most 6 operations orients it."""
+    insep = search_space(machine).inseparable  # the goal relation, tested on its own
+    mids = rotation_mids(machine)
+    n = machine.n
+    d = [s.sensed for s in machine.states]
+
+    def children(mask: int) -> list[int]:
+        # Ideal model: an exact diameter, read strictly within ``tol`` of it.
+        iv = {i: (d[i] - tol, d[i] + tol) for i in range(n) if mask >> i & 1}
+        return read_alike_sets(iv)
+
+    @functools.cache
+    def within(mask: int, k: int) -> bool:
+        if is_goal(insep, mask):
+            return True
+        if k == 0:
+            return False
+        for a in mids:
+            img = 0
+            for i in range(n):
+                if mask >> i & 1:
+                    img |= outcome_mask(machine, i, a)
+            if all(within(c, k - 1) for c in children(img)):
+                return True
+        return False
+
+    def length(mask: int) -> int | None:
+        return next((k for k in range(7) if within(mask, k)), None)
+
+    return length, children
+
+
+@pytest.mark.parametrize(("count", "seed", "tol"), [(3, 200, 4.0), (4, 200, 4.0), (2, 200, 8.0)])
+def test_the_pair_bound_is_the_hardest_pairs_length_and_never_above_the_sets(count, seed, tol):
+    machine = build_machine(small_mix(count, seed), ToleranceSensor(tol), IDEAL)
+    length, children = _brute(machine, tol)
+    w = WorstCase(Problem(machine))
+    rng = random.Random(count)
+    masks = [rng.getrandbits(machine.n) or 1 for _ in range(40)]
+    assert all(w.pair_bound(m) == 0 for m in masks)  # not before a deep search
+    w._deep = True  # as after a length search of PAIR_BOUND_DEPTH
+    asked = set()
+    seen = []
+    for mask in masks[:25]:
+        sub = mask & rng.getrandbits(machine.n)
+        for m in (mask, sub):
+            if m & (m - 1) == 0:
+                continue
+            idx = [i for i in range(machine.n) if m >> i & 1]
+            asked |= {(i, j) for k, i in enumerate(idx) for j in idx[k + 1 :]}
+            pairs = [
+                max(length(c) for c in children((1 << i) | (1 << j)))
+                for k, i in enumerate(idx)
+                for j in idx[k + 1 :]
+            ]
+            got = w.pair_bound(m)
+            seen.append(got)
+            assert got == max(pairs)
+            whole = length(m)
+            assert whole is None or got <= whole
+    assert max(seen) >= 2  # some pair needs more than one operation
+    table = w._pairs.table
+    searched = {
+        (i, j) for i in range(machine.n) for j in range(i + 1, machine.n) if table[i][j] >= 0
+    }
+    assert searched == asked  # a pair's length is searched only when a set asks
+
+
+def test_a_shallow_length_search_never_searches_pairs(monkeypatch):
+    machine = build_machine(small_mix(6), ToleranceSensor(1.0), IDEAL)  # length 3
+    problem = Problem(machine)
+    w = WorstCase(problem)
+    roots = sorted(maximal_sets({b.mask for b in problem.readings.branches(problem.full)}))
+    longest = longest_root(problem, w, roots, "auto")
+    assert longest < andor.PAIR_BOUND_DEPTH
+    assert w._pairs is None and w.pair_bound(problem.full) == 0
+    # Deepening to the budget turns the bound on: the same lengths, pairs searched.
+    monkeypatch.setattr(andor, "PAIR_BOUND_DEPTH", 1)
+    deep = WorstCase(Problem(machine))
+    assert longest_root(problem, deep, roots, "auto") == longest
+    assert deep._pairs and any(x >= 0 for row in deep._pairs.table for x in row)
