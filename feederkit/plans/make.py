@@ -230,16 +230,17 @@ comes after the certificate: writing the file, reading it back and drawing it (2
 def _planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
     """The planner's budget: the options' time limit from ``started`` less, when certifying,
     ``POST_SHARE`` of it or ``POST_MIN_S`` (at most ``POST_MAX_SHARE`` of it), whichever is
-    more (at least a tenth of the limit is left to plan), and their memory limit."""
+    more (at least a tenth of the limit is left to plan), and their memory limit; the
+    deadline comes ``POST_S_PER_PAIR`` earlier per pair of the plan made, whose
+    verification follows whether certified or not."""
     limit = options.time_limit_s
     if limit is None:
         return Deadline(None, options.memory_limit_mb)
     left = _left(options, started) or 0.0
     keep = max(POST_SHARE * limit, min(POST_MIN_S, POST_MAX_SHARE * limit)) if certify else 0.0
+    # A design's plan of 11,559 nodes took 7.6 s to verify past a 5 s limit uncommitted.
     return Deadline(
-        max(left - keep, 0.1 * limit),
-        options.memory_limit_mb,
-        per_pair_s=POST_S_PER_PAIR if certify else 0.0,
+        max(left - keep, 0.1 * limit), options.memory_limit_mb, per_pair_s=POST_S_PER_PAIR
     )
 
 
