@@ -4,8 +4,8 @@ A plan of a set orients each of its pairs, so the largest length over the set's 
 bounds the set's length from below. Here each pair's length and each set's length come from
 the tests' own exhaustive search (every cell's middle, the read-alike sets of the states'
 reading intervals); the bound must never exceed a set's length, must equal its hardest pair's
-length, is searched only for the pairs a set asks about, and only once a length search has
-deepened to ``PAIR_BOUND_DEPTH``.
+length, is searched only for the pairs a set asks about, and for sets other than those whose
+length is searched only once the search is deep (``PAIR_BOUND_DEPTH``).
 """
 
 from __future__ import annotations
@@ -96,16 +96,21 @@ def test_the_pair_bound_is_the_hardest_pairs_length_and_never_above_the_sets(cou
     assert searched == asked  # a pair's length is searched only when a set asks
 
 
-def test_a_shallow_length_search_never_searches_pairs(monkeypatch):
+def test_a_shallow_length_search_searches_only_its_roots_pairs(monkeypatch):
     machine = build_machine(small_mix(6), ToleranceSensor(1.0), IDEAL)  # length 3
     problem = Problem(machine)
     w = WorstCase(problem)
     roots = sorted(maximal_sets({b.mask for b in problem.readings.branches(problem.full)}))
     longest = longest_root(problem, w, roots, "auto")
-    assert longest < andor.PAIR_BOUND_DEPTH
-    assert w._pairs is None and w.pair_bound(problem.full) == 0
-    # Deepening to the budget turns the bound on: the same lengths, pairs searched.
+    assert longest < andor.PAIR_BOUND_DEPTH and not w._deep
+    n = machine.n
+    table = w._pairs.table
+    searched = {(i, j) for i in range(n) for j in range(i + 1, n) if table[i][j] >= 0}
+    inside = {(i, j) for i, j in searched if any(r >> i & 1 and r >> j & 1 for r in roots)}
+    assert searched and searched == inside  # each root's own bound, no other set's
+    assert w.pair_bound(problem.full) == 0  # not a root: no bound in a shallow search
+    # A deeper budget turns the bound on for every set: the same lengths.
     monkeypatch.setattr(andor, "PAIR_BOUND_DEPTH", 1)
     deep = WorstCase(Problem(machine))
     assert longest_root(problem, deep, roots, "auto") == longest
-    assert deep._pairs and any(x >= 0 for row in deep._pairs.table for x in row)
+    assert deep._deep and deep.pair_bound(problem.full) >= 1

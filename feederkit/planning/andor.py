@@ -32,10 +32,13 @@ from feederkit.planning.problem import Act, Problem
 __all__ = ["Deadline", "Timeout", "WorstCase"]
 
 PAIR_BOUND_DEPTH = 4
-"""The pair lower bound is used once a length search deepens to this budget: a shallower
-proof ends before the pairs' own searches pay (a 98-state mix of length 4: 0.05 s without
-them, 0.12 s with), a deeper one gains (a 98-state mix of length 6: 11,066 sets instead of
-26,671, 3.3 s instead of 7.4)."""
+"""The pair lower bound is used once a set whose length is searched (a root) has a hardest
+pair of this many operations, or its search deepens to this budget: a shallower proof ends
+before the pairs' own searches pay (a 98-state mix of length 4: 0.05 s without them, 0.12 s
+with), a deeper one gains (a 98-state mix of length 6: 11,066 sets instead of 26,671, 3.3 s
+instead of 7.4)."""
+PAIR_BOUND_SETS = 2000
+"""... or once the searches have opened this many sets (a proof that is long in work)."""
 PAIR_BOUND_STATES = 1024
 """The pair lower bound is used on machines with at most this many states (a pair's length
 is searched when a set holding it first asks; the table has n^2 entries)."""
@@ -66,7 +69,8 @@ class WorstCase:
         # None: not yet known whether the pair bound applies (``pair_bound``); False: never.
         self._pairs: _PairLengths | None | bool = None if pair_bound else False
         self._pair_memo: dict[int, int] = {}
-        self._deep = False  # a length search reached PAIR_BOUND_DEPTH: pair bounds pay
+        self._deep = False  # pair bounds pay: PAIR_BOUND_DEPTH or PAIR_BOUND_SETS reached
+        self._opened = 0  # sets the searches have opened (frames pushed)
 
     def _known(self, mask: int, k: int) -> bool | None:
         """What the memo already says about ``within(mask, k)`` (None: search)."""
@@ -92,13 +96,15 @@ class WorstCase:
             return False
         return None
 
-    def pair_bound(self, mask: int) -> int:
+    def pair_bound(self, mask: int, force: bool = False) -> int:
         """A lower bound on the length of ``mask``: its hardest pair's length (a subset
         needs no more operations). Only on the ideal model with readings, no margin floor
-        and at most ``PAIR_BOUND_STATES`` states, once a length search has deepened to
-        ``PAIR_BOUND_DEPTH`` (each pair's length by the same search on its reading
-        branches, when a set holding it first asks); 0 otherwise."""
-        if not self._deep:
+        and at most ``PAIR_BOUND_STATES`` states, once the search is deep (a set whose
+        length is searched has a pair bound or a budget of ``PAIR_BOUND_DEPTH``, or the
+        searches have opened ``PAIR_BOUND_SETS`` sets) or when ``force``d (each pair's
+        length by the same search on its reading branches, when a set holding it first
+        asks); 0 otherwise."""
+        if not (self._deep or force):
             return 0
         pairs = self._pairs
         if pairs is None:
@@ -255,6 +261,9 @@ class WorstCase:
                     if known is None:
                         f[3], f[4] = act, ci
                         self.deadline.check()
+                        self._opened += 1
+                        if self._opened >= PAIR_BOUND_SETS:
+                            self._deep = True
                         stack.append([c, fk - 1, self.actions_of(c), None, 0])
                         pushed = True
                         break
@@ -307,11 +316,12 @@ class WorstCase:
             if limit is not None and e > limit:
                 raise ValueError(f"no plan within {limit} operations")
             return e
-        k = max(self.lb.get(mask, 1), self.pair_bound(mask))
+        # The set's own hardest pair (a root's, from longest_root) says whether the
+        # search will be deep enough for every set's pair bound to pay.
+        k = max(self.lb.get(mask, 1), self.pair_bound(mask, force=True))
         while True:
-            if k >= PAIR_BOUND_DEPTH and not self._deep:
+            if k >= PAIR_BOUND_DEPTH:
                 self._deep = True
-                k = max(k, self.pair_bound(mask))
             if self.within(mask, k):
                 break
             k += 1
