@@ -375,6 +375,28 @@ def test_the_backchaining_plan_is_no_tie_break_cut_short():
     assert not any("choice among shortest plans" in w for w in made.warnings)
 
 
+def _calls_while_following(monkeypatch, name: str) -> list[bool]:
+    """Per call of ``Refiner.<name>``, whether it came from inside ``Refiner.follow``."""
+    calls: list[bool] = []
+    following = [False]
+    follow, method = Refiner.follow, getattr(Refiner, name)
+
+    def watched(self, *args):
+        was, following[0] = following[0], True
+        try:
+            return follow(self, *args)
+        finally:
+            following[0] = was
+
+    def counted(self, *args):
+        calls.append(following[0])
+        return method(self, *args)
+
+    monkeypatch.setattr(Refiner, "follow", watched)
+    monkeypatch.setattr(Refiner, name, counted)
+    return calls
+
+
 @pytest.mark.parametrize(("count", "tolerance"), [(5, 2.0), (8, 1.0), (6, 3.0)])
 def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     monkeypatch, count, tolerance
@@ -386,29 +408,12 @@ def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     # proven length, and it executes from every start (check_plan).
     machine = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
     exact = api.plan(machine)
-    searches = []
-    following = [False]
-    keeping = Refiner._keeping_plan
-
-    def counted(self, *args):
-        searches.append(following[0])
-        return keeping(self, *args)
 
     def cut(self, *args):
         raise Timeout("time")
 
-    follow = Refiner.follow
-
-    def watched(self, *args):
-        was, following[0] = following[0], True
-        try:
-            return follow(self, *args)
-        finally:
-            following[0] = was
-
-    monkeypatch.setattr(Refiner, "_keeping_plan", counted)
+    searches = _calls_while_following(monkeypatch, "_keeping_plan")
     monkeypatch.setattr(Refiner, "expected", cut)
-    monkeypatch.setattr(Refiner, "follow", watched)
     fresh = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
     got = api.plan(fresh)
     assert got.tie_breaks == api.TIES_MARGIN and got.optimal
@@ -429,30 +434,12 @@ def test_ties_cut_before_any_margin_follow_the_length_proofs_plans_without_a_sea
     # the proof 9). It keeps the proven length and executes from every start.
     machine = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
     exact = api.plan(machine)
-    following = [False]
-    searched = []
 
     def cut(self, *args):
         raise Timeout("work")
 
-    follow = Refiner.follow
-
-    def watched(self, *args):
-        was, following[0] = following[0], True
-        try:
-            return follow(self, *args)
-        finally:
-            following[0] = was
-
-    choose = Refiner.choose_worst
-
-    def counted(self, *args):
-        searched.append(following[0])
-        return choose(self, *args)
-
+    searched = _calls_while_following(monkeypatch, "choose_worst")
     monkeypatch.setattr(Refiner, "keeps", cut)
-    monkeypatch.setattr(Refiner, "follow", watched)
-    monkeypatch.setattr(Refiner, "choose_worst", counted)
     got = api.plan(build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL))
     assert got.tie_breaks == api.TIES_NONE and got.optimal
     assert got.length == exact.length
