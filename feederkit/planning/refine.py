@@ -267,8 +267,9 @@ class Refiner:
 
     def _short(self, mask: int, k: int) -> bool:
         """Whether the length search has already proven that ``mask`` needs more than ``k``
-        operations (its exact lengths, lower bounds and hardest pairs, no search): then no
-        plan within ``k`` keeps any margin."""
+        operations (its exact lengths, lower bounds and hardest pairs: no search of the set
+        itself, at most of a pair not asked before): then no plan within ``k`` keeps any
+        margin."""
         w = self.w
         e = w.exact.get(mask)
         if e is not None:
