@@ -38,7 +38,8 @@ before the pairs' own searches pay (a 98-state mix of length 4: 0.05 s without t
 with), a deeper one gains (a 98-state mix of length 6: 11,066 sets instead of 26,671, 3.3 s
 instead of 7.4)."""
 PAIR_BOUND_SETS = 2000
-"""... or once the searches have opened this many sets (a proof that is long in work)."""
+"""The pair lower bound is also used once the searches have opened this many sets: a
+proof long in work, however shallow its budget."""
 PAIR_BOUND_STATES = 1024
 """The pair lower bound is used on machines with at most this many states (a pair's length
 is searched when a set holding it first asks; the table has n^2 entries)."""
