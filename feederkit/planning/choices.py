@@ -308,17 +308,17 @@ class Choices:
         """The cells of :meth:`lazy_actions` with their maximal branches, before any action
         is made: a caller that ranks them makes only the actions it keeps.
 
-        Ordered by :func:`children_key` (the smallest largest branch, then the fewest
-        states over all branches: the likeliest to succeed), then the smallest image, then
-        the widest. A cell whose image contains one of the first ``_DOMINATORS`` images
-        (smallest first) is left out (dominated): the branches of a subset lie inside the
+        Ordered by :func:`search_key` (the smallest largest branch, then the fewest states
+        over all branches: the likeliest to succeed; then the smallest image, the widest).
+        A cell whose image contains one of the first ``_DOMINATORS`` images (smallest
+        first) is left out (dominated): the branches of a subset lie inside the
         branches of the set (each reading cell, or component, restricted), and a subset
         needs no more operations; testing against every earlier image costs more than it
         saves on sets with hundreds of ranges. So are cells with a branch holding the set.
         """
         cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
         kept: list[int] = []
-        out: list[tuple[tuple[int, int], int, tuple[float, float, int], tuple[int, ...]]] = []
+        out: list[tuple[tuple, int, tuple[float, float, int], tuple[int, ...]]] = []
         readings = self.readings
         for n, cell in enumerate(cells):
             img = cell[2]
@@ -333,9 +333,9 @@ class Choices:
             if len(kept) < _DOMINATORS:
                 kept.append(img)
             children = (img,) if readings.sensorless else readings.children(img)
-            if not readings.sensorless and any(c & mask == mask for c in children):
+            if any(c & mask == mask for c in children):
                 continue
-            out.append((children_key(children), n, cell, children))
+            out.append((search_key(cell, children), n, cell, children))
         out.sort()
         return [(cell, children) for _key, _n, cell, children in out]
 
@@ -366,6 +366,15 @@ def children_key(children: tuple[int, ...]) -> tuple[int, int]:
     """
     sizes = [c.bit_count() for c in children]
     return max(sizes), sum(sizes)
+
+
+def search_key(
+    cell: tuple[float, float, int], children: tuple[int, ...]
+) -> tuple[int, int, int, float]:
+    """The length search's order of a set's cells (``Choices.useful_cells``):
+    :func:`children_key` of the cell's reading branches, then the smallest image, then the
+    widest."""
+    return (*children_key(children), cell[2].bit_count(), cell[0] - cell[1])
 
 
 def spread(masses, outcomes) -> dict[int, float]:

@@ -47,7 +47,7 @@ from collections.abc import Callable
 from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
-from feederkit.planning.choices import children_key, spread
+from feederkit.planning.choices import search_key, spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step, branch_pairs
@@ -319,14 +319,12 @@ class Refiner:
         return None
 
     def _search_order(self, cells: list[Cell]) -> list[Cell]:
-        """``cells`` in the length search's order (``Choices.useful_cells``): the smallest
-        largest reading branch first, then the fewest states over the branches, then the
-        smallest image, then the widest."""
+        """``cells`` in the length search's order
+        (:func:`~feederkit.planning.choices.search_key`)."""
 
         def key(cell: Cell) -> tuple[int, int, int, float]:
             img = cell[2]
-            children = (img,) if self.p.sensorless else self.p.readings.children(img)
-            return (*children_key(children), img.bit_count(), cell[0] - cell[1])
+            return search_key(cell, (img,) if self.p.sensorless else self.p.readings.children(img))
 
         return sorted(cells, key=key)
 
@@ -663,8 +661,8 @@ class Refiner:
 
     def planned(self, mask: int, k: int) -> bool:
         """Whether :meth:`follow` has a plan of ``mask``'s own within ``k`` to follow: a
-        margin probe's or the length proof's."""
-        if (mask, k) in self._how:
+        margin probe's keeping the floor or the length proof's."""
+        if (mask, k) in self._how and self._lo[(mask, k)] >= self.floor:
             return True
         proved = self.w.choice.get(mask)
         return proved is not None and proved[0] <= k
