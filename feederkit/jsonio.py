@@ -176,15 +176,31 @@ def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
     return target
 
 
+def _temporary(path: object, target: Path, what: str) -> tuple[int, str]:
+    """A new temporary file beside ``target`` (its descriptor and path); bad input naming
+    ``path`` when the folder takes no new file (missing, read-only, no permission)."""
+    directory = target.parent if str(target.parent) else Path(".")
+    try:
+        return tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise _cannot(path, what, exc) from None
+
+
+def check_writable(path: str | os.PathLike[str], what: str = "file") -> None:
+    """Refuse now a ``path`` that writing it later would refuse, with the same message: a
+    folder, pipe, socket or device there (:func:`destination`), or a folder that takes no
+    new file. A command checks its outputs before long work with this; the temporary file
+    it makes to find out is removed at once."""
+    fd, tmp = _temporary(path, destination(path, what), what)
+    os.close(fd)
+    os.unlink(tmp)
+
+
 def _stage(f: OutputFile, mode: int) -> tuple[Path, str]:
     """Write ``f`` in full to a temporary file beside its :func:`destination`; return that
     destination and the temporary's path."""
     target = destination(f.path, f.what)
-    directory = target.parent if str(target.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise _cannot(f.path, f.what, exc) from None
+    fd, tmp = _temporary(f.path, target, f.what)
     data = f.data.encode("utf-8") if isinstance(f.data, str) else f.data
     try:
         with os.fdopen(fd, "wb") as fh:

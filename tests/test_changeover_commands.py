@@ -160,8 +160,9 @@ def test_a_newer_part_revision_is_warned_about(db, tmp_path, capsys):
     listed = json.loads(ok(capsys, ["changeover", "list", "--json", "--catalog", str(db)]).out)
     assert listed[0]["warnings"] == shown["warnings"]
     out = tmp_path / "e.json"
-    cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(out), "--catalog", str(db)])
-    assert "latest is 2" in cap.err
+    # A stale export is a result to act on (exit 1), the file still written.
+    cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(out), "--catalog", str(db)], 1)
+    assert "latest is 2" in cap.err and out.is_file()
     # Compiling against the old revision on purpose says so, too.
     pinned = ["changeover", "compile", "old", "--mix", "octagon@1,rectangle-2x1"]
     cap = ok(capsys, [*pinned, "--tolerance", "0.01", "--json", "--catalog", str(db)])

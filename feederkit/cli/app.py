@@ -16,6 +16,7 @@ from __future__ import annotations
 import sys
 
 try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one line, too.
+    import contextlib
     import errno
     import functools
     import importlib
@@ -24,10 +25,10 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     import sqlite3
     import tempfile
     import traceback
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator, Sequence
     from datetime import UTC, datetime
     from types import FrameType
-    from typing import Annotated, Any
+    from typing import Annotated, Any, TextIO
 
     import typer
     from rich.markup import escape
@@ -41,7 +42,7 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     import feederkit
     from feederkit.catalog import set_busy_notifier
     from feederkit.cli import helpstyle
-    from feederkit.cli.common import err_console
+    from feederkit.cli.common import JSON_ANSWER, err_console, json_failure, print_json
     from feederkit.errors import FeederkitError
 except KeyboardInterrupt:
     sys.stderr.write("error: interrupted\n")
@@ -125,6 +126,34 @@ def _click_command() -> typer.core.TyperGroup:
     return typer.main.get_command(app)  # type: ignore[return-value]
 
 
+def _command_words(args: Sequence[str]) -> tuple[list[str], Any]:
+    """The command words ``args`` start with (``["part", "analyze"]``, options between them
+    skipped) and the command they name (the app itself for none)."""
+    command: Any = _click_command()
+    words: list[str] = []
+    for arg in args:
+        sub = getattr(command, "commands", {}).get(arg)
+        if sub is None:
+            if arg.startswith("-"):
+                continue
+            break
+        command, words = sub, [*words, arg]
+    return words, command
+
+
+def _command_path(args: Sequence[str]) -> str:
+    """``feederkit part analyze``: the command ``args`` name, for a usage error that click
+    raises without its context (an option missing one of its values, ``--com 1``)."""
+    return " ".join(["feederkit", *_command_words(args)[0]])
+
+
+def _group_alone(args: Sequence[str]) -> list[str] | None:
+    """The words of a group given without a command and nothing else (``[]`` for
+    ``feederkit`` alone, ``["part"]``), else None."""
+    words, command = _command_words(args)
+    return words if len(words) == len(args) and hasattr(command, "commands") else None
+
+
 def _say(message: str) -> None:
     """One line on stderr, ``error: ...`` (markup in the message is shown as typed)."""
     err_console.print(
@@ -163,6 +192,49 @@ _OS_ADVICE = {
 }
 
 
+class StdoutError(OSError):
+    """Writing the standard output failed (``> /dev/full``, a full disk): an OSError from a
+    write names no file, so without this the message could only say "a file"."""
+
+
+class _GuardedStdout:
+    """``sys.stdout`` while a command runs: the same stream, whose write errors are
+    :class:`StdoutError`. Everything else is the stream's own (rich and click ask it for
+    ``isatty``, ``encoding``, ...)."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except OSError as exc:
+            raise StdoutError(exc.errno, exc.strerror) from exc
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except OSError as exc:
+            raise StdoutError(exc.errno, exc.strerror) from exc
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _guarded_stdout() -> Iterator[None]:
+    """Install :class:`_GuardedStdout` for the block; the stream comes back after (unless a
+    library replaced it meanwhile, as click does after a broken pipe)."""
+    stream = sys.stdout
+    guard = _GuardedStdout(stream)
+    sys.stdout = guard  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        if sys.stdout is guard:
+            sys.stdout = stream
+
+
 def system_error_message(exc: BaseException) -> str | None:
     """The one line for an error from the system or the input, or None when it is not one.
 
@@ -176,6 +248,9 @@ def system_error_message(exc: BaseException) -> str | None:
             f"catalog error ({_oneline(exc)}, {code}); check the catalog file given by "
             "--catalog or $FEEDERKIT_CATALOG"
         )
+    if isinstance(exc, StdoutError):
+        what = _OS_ADVICE.get(exc.errno or -1) or _oneline(exc.strerror or exc)
+        return f"cannot write the standard output: {what}"
     if isinstance(exc, OSError):
         what = _OS_ADVICE.get(exc.errno or -1) or _oneline(exc.strerror or exc)
         name = exc.filename if exc.filename is not None else "a file"
@@ -263,7 +338,8 @@ def main(argv: list[str] | None = None) -> int:
     input) and even when a library swallowed the interrupt and the command went on.
     """
     set_busy_notifier(_notify_busy)
-    with _CtrlCWatch() as ctrl_c:
+    JSON_ANSWER.reset()
+    with _CtrlCWatch() as ctrl_c, _guarded_stdout():
         try:
             code = _run_app(argv)
             if ctrl_c.seen and code != EXIT_INTERRUPTED:  # a library swallowed the interrupt
@@ -283,7 +359,19 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run_app(argv: list[str] | None) -> int:
-    """Run the command; its exit code (a SystemExit becomes one, Ctrl-C's saying so)."""
+    """Run the command; its exit code (a SystemExit becomes one, Ctrl-C's saying so).
+
+    ``feederkit`` or a group without a command is a usage error: its help on stderr, exit 2
+    (``--help`` asks for the help: stdout, exit 0).
+    """
+    args = sys.argv[1:] if argv is None else argv
+    group = _group_alone(args)
+    if group is not None:
+        with contextlib.redirect_stdout(sys.stderr):
+            _click_command().main(
+                args=[*group, "--help"], prog_name="feederkit", standalone_mode=False
+            )
+        return 2
     try:
         code = _click_command().main(args=argv, prog_name="feederkit", standalone_mode=False)
     except SystemExit as exc:
@@ -302,15 +390,15 @@ def _error_exit(exc: Exception, argv: list[str] | None) -> int:
     if isinstance(exc, FeederkitError):
         if exc.exit_code == EXIT_RESULT:
             _say_result(_oneline(exc))
+            _print_json_failure(_oneline(exc), exc.exit_code)
         else:
             _say(_oneline(exc))
         return exc.exit_code
-    if isinstance(exc, NoArgsIsHelpError):  # ``feederkit`` or a group alone: its help
-        if exc.ctx is not None:
-            typer.echo(exc.ctx.get_help())
-        return 0
+    if isinstance(exc, NoArgsIsHelpError):  # click printed the help when it raised this
+        return 2
     if isinstance(exc, UsageError):
-        where = exc.ctx.command_path if exc.ctx is not None else "feederkit"
+        args = sys.argv[1:] if argv is None else argv
+        where = exc.ctx.command_path if exc.ctx is not None else _command_path(args)
         _say(f"{_oneline(exc.format_message())} (see {where} --help)")
         return 2
     if isinstance(exc, ClickException):
@@ -327,6 +415,17 @@ def _error_exit(exc: Exception, argv: list[str] | None) -> int:
         f"please report it with the log{where}"
     )
     return EXIT_BUG
+
+
+def _print_json_failure(message: str, code: int) -> None:
+    """With ``--json``, a result without an answer still prints one JSON object on stdout
+    (:func:`feederkit.cli.common.json_failure`); a stdout that cannot take it changes
+    nothing (the ``result:`` line on stderr has said it)."""
+    data = json_failure(message, code)
+    if data is None:
+        return
+    with contextlib.suppress(OSError):
+        print_json(data)
 
 
 def end_quietly_on_closed_pipe() -> None:

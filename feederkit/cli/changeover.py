@@ -54,10 +54,13 @@ from feederkit.cli.common import (
     cell_planning_options,
     cell_settings,
     check_output_folders,
+    check_outputs,
     console,
     cycle_line,
     flag_words,
+    json_found,
     plan_outputs,
+    plural,
     print_json,
     print_warnings,
     print_written,
@@ -281,6 +284,7 @@ def compile_command(
         settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    json_found(name=name, mix=members, cell=settings.to_dict())
     path = resolve_catalog_path(catalog)
     if not replace and changeover_exists(path, name):
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
@@ -469,11 +473,28 @@ OutputOpt = Annotated[
 
 @changeover_app.command("export")
 def export_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None) -> None:
-    """Write a stored changeover's plan file, for feederkit run or a controller."""
+    """Write a stored changeover's plan file, for feederkit run or a controller.
+
+    Exit 1 when a part has a newer revision than the changeover names: the file is still
+    written (the plan is valid for the revisions it names), but a script must notice that
+    the changeover needs compiling again.
+    """
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     write_files([OutputFile(output, plan_json(co.plan), "plan file")])
     console.print(f"wrote the plan to {output}", highlight=False, markup=False, soft_wrap=True)
+    if co.warnings:
+        raise CheckFailed(_stale_result(name, len(co.warnings)))
+
+
+def _stale_result(name: str, stale: int) -> str:
+    """The ``result:`` line of an export of a changeover whose parts have newer revisions
+    (``stale`` of them, each named in a warning line)."""
+    return (
+        f"changeover {name!r} is out of date (newer catalog revisions of "
+        f"{plural(stale, 'part')}, warned above); the plan file is written for the revisions "
+        "it names: compile the changeover again to plan for the latest"
+    )
 
 
 ReportOutputOpt = Annotated[
@@ -490,6 +511,7 @@ def report_command(name: NameArg, output: ReportOutputOpt, catalog: CatalogOpt =
     from feederkit.reports import check_report_path
 
     check_report_path(output)  # a .txt or .pdf would hold HTML: refused before any work
+    check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     html = changeover_report(co.plan, list(co.parts), co.witnesses())

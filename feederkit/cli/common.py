@@ -32,7 +32,7 @@ from rich.table import Table
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
-from feederkit.jsonio import OutputFile
+from feederkit.jsonio import OutputFile, check_writable
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
@@ -44,6 +44,52 @@ from feederkit.words import plural
 # No emoji codes: a file name or value such as ``x:100:y`` is printed as typed.
 console = Console(emoji=False)
 err_console = Console(stderr=True, emoji=False)
+
+
+class JsonAnswer:
+    """``--json`` in this run: whether it was asked for, whether an answer was printed, and
+    what the command found so far. A result without an answer (exit 1 before anything was
+    printed: no plan, a failed check) still gives scripts one JSON object on stdout
+    (:func:`json_failure`, printed by the app's error boundary; docs/cli.md)."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the previous run (``main`` is called many times in one process by tests)."""
+        self.requested = False
+        self.printed = False
+        self.found: dict[str, Any] = {}
+
+
+JSON_ANSWER = JsonAnswer()
+
+
+def _note_json(value: bool) -> bool:
+    """The ``--json`` option's callback: note that machine-readable output was asked for."""
+    if value:
+        JSON_ANSWER.requested = True
+    return value
+
+
+def json_option(help_text: str = "Machine-readable output on stdout.") -> Any:
+    """The ``--json`` option of every command (noted in :data:`JSON_ANSWER`)."""
+    return typer.Option("--json", help=help_text, callback=_note_json)
+
+
+def json_found(**fields: Any) -> None:
+    """Note what the command found (its sources, sensor, ...) for :func:`json_failure`."""
+    JSON_ANSWER.found.update(fields)
+
+
+def json_failure(message: str, code: int) -> dict[str, Any] | None:
+    """The JSON object a result without an answer prints with ``--json``: ``error`` (the
+    ``result:`` line's message), ``exit_code`` and what the command found; None when
+    ``--json`` was not asked for or the command already printed its answer."""
+    if not JSON_ANSWER.requested or JSON_ANSWER.printed:
+        return None
+    return {"error": message, "exit_code": code, **JSON_ANSWER.found}
+
 
 SensorlessOpt = Annotated[
     bool,
@@ -138,7 +184,7 @@ ReportOpt = Annotated[
     Path | None,
     typer.Option("--report", metavar="REPORT.html", help="Also write the HTML report here."),
 ]
-JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable output on stdout.")]
+JsonOpt = Annotated[bool, json_option()]
 LandingsOpt = Annotated[
     str | None,
     typer.Option(
@@ -341,21 +387,31 @@ def plan_outputs(
     return files
 
 
-def check_output_folders(output: Path | None, report: Path | None) -> None:
-    """Refuse ``-o`` and ``--report`` paths whose folder does not exist, and a ``--report``
-    not named .html, before any work is done (a plan that took a minute must not be lost to
-    a typo in a folder name, nor a page of HTML be written as ``report.txt``)."""
-    if report is not None:
-        from feederkit.reports import check_report_path  # the report library, only when asked
-
-        check_report_path(report)
-    for path, what in ((output, "plan file"), (report, "report")):
+def check_outputs(*outputs: tuple[Path | None, str]) -> None:
+    """Refuse, before any work is done, each output ``(path, what it is)`` that could not be
+    written (None: not asked for): its folder missing, a folder or a pipe at the path, a
+    folder that takes no new file (read-only, no permission). The message is the one the
+    write itself would give (:func:`feederkit.jsonio.check_writable`), exit 2: a result that
+    took a minute must not be lost to a typo in a file name."""
+    for path, what in outputs:
         if path is None:
             continue
         folder = path.parent
         if not folder.is_dir():
             why = "is not a folder" if folder.exists() else "does not exist"
             raise InputError(f"{path}: cannot write the {what}: the folder {folder} {why}")
+        check_writable(path, what)
+
+
+def check_output_folders(output: Path | None, report: Path | None) -> None:
+    """Refuse ``-o`` and ``--report`` paths that could not be written (:func:`check_outputs`)
+    and a ``--report`` not named .html, before any work is done (nor may a page of HTML be
+    written as ``report.txt``)."""
+    if report is not None:
+        from feederkit.reports import check_report_path  # the report library, only when asked
+
+        check_report_path(report)
+    check_outputs((output, "plan file"), (report, "report"))
 
 
 def print_written(output: Path | None, report: Path | None) -> None:
@@ -368,7 +424,9 @@ def print_written(output: Path | None, report: Path | None) -> None:
 
 
 def print_json(data: Any) -> None:
-    """Machine-readable output on stdout (``--json``)."""
+    """Machine-readable output on stdout (``--json``): one answer per run (noted, so that
+    a result after it prints no second object)."""
+    JSON_ANSWER.printed = True
     sys.stdout.write(json.dumps(data, indent=2, allow_nan=False) + "\n")
     sys.stdout.flush()
 

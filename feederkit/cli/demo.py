@@ -28,6 +28,7 @@ from feederkit.cli.common import (
     cycle_line,
     err_console,
     flag_words,
+    json_option,
     plural,
     print_json,
     progress_bar,
@@ -221,7 +222,7 @@ def demo_command(
             "own plan) or of the largest part's (each changeover).",
         ),
     ] = 1.0,
-    json_out: Annotated[bool, typer.Option("--json", help="A summary on stdout as JSON.")] = False,
+    json_out: Annotated[bool, json_option("A summary on stdout as JSON.")] = False,
     cell: CellOpt = None,
 ) -> None:
     """The main job on the bundled catalog: import, analyse, plan, compile changeovers, report.

@@ -29,10 +29,12 @@ from feederkit.cli.common import (
     JsonOpt,
     LandingsOpt,
     ShapeToleranceOpt,
+    check_outputs,
     console,
     default_memory_limit,
     fail,
     flag_words,
+    json_found,
     print_json,
     print_warnings,
     progress_bar,
@@ -183,6 +185,7 @@ def sensor_command(
             raise InputError(f"--noise must be zero or a positive number of mm, got {e}")
     if plot is not None and plot.suffix.lower() not in (".png", ".svg"):
         raise InputError(f"{plot}: the plot is written as .png or .svg")
+    check_outputs((plot, "plot"))
     if memory_limit is None:
         memory_limit = default_memory_limit()
     with flag_words():
@@ -199,6 +202,11 @@ def sensor_command(
         pfs = [push_function(x.part) for x in found.all]
     else:
         pfs = list(loaded.push_functions)
+    json_found(
+        parts=[pf.part.name for pf in pfs],
+        cell_profile=profile.source,
+        uncertainty=uncertainty.to_dict(),
+    )
     # The design's expected figures weigh its members alike (plan weighs each part's landings).
     members = "landings" if over_landings else "parts"
     design: ToleranceDesign | PitchDesign

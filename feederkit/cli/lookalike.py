@@ -15,7 +15,14 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from feederkit.cli.common import CatalogOpt, JsonOpt, console, err_console, print_json
+from feederkit.cli.common import (
+    CatalogOpt,
+    JsonOpt,
+    check_outputs,
+    console,
+    err_console,
+    print_json,
+)
 from feederkit.cli.importopts import print_import_warnings, takes_import_options
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
@@ -59,6 +66,7 @@ def lookalike_command(
         raise InputError(f"--keep must be push or push-diameter, got {keep!r}")
     if output is not None and output.suffix.lower() != ".json":
         raise InputError(f"{output}: the look-alike is written as an outline file (.json)")
+    check_outputs((output, "file"))
     loaded = load_part_with_warnings(source, catalog=catalog, options=import_opts)
     print_import_warnings(source, loaded.warnings)
     part = loaded.part

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from feederkit.cli.common import CatalogOpt, console
+from feederkit.cli.common import CatalogOpt, check_outputs, console
 from feederkit.cli.importopts import print_import_warnings, takes_import_options
 from feederkit.importers import ImportOptions
 from feederkit.reports import plot_format, write_part_plot
@@ -41,6 +41,7 @@ def plot_command(
     """Draw the outline with hull, COM and numbered stable edges, and below it the radius,
     push and push-diameter functions with stable orientations and resting ranges marked."""
     plot_format(output)
+    check_outputs((output, "file"))
     loaded = load_part_with_warnings(source, com=com, catalog=catalog, options=import_opts)
     print_import_warnings(source, loaded.warnings)
     part = loaded.part

@@ -46,6 +46,8 @@ from feederkit.cli.common import (
     console,
     cycle_line,
     flag_words,
+    json_found,
+    json_option,
     plan_outputs,
     print_json,
     print_warnings,
@@ -188,9 +190,7 @@ def plan_command(
     grouping: GroupingOpt = "exact",
     lumping: LumpingOpt = "near-symmetric",
     output: PlanOutputOpt = None,
-    json_out: Annotated[
-        bool, typer.Option("--json", help="Print the plan file's JSON on stdout.")
-    ] = False,
+    json_out: Annotated[bool, json_option("Print the plan file's JSON on stdout.")] = False,
     report: ReportOpt = None,
     catalog: CatalogOpt = None,
     rotation_error: ProfileRotationErrorOpt = None,
@@ -219,6 +219,7 @@ def plan_command(
         settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    json_found(sources=list(sources), sensor=sensor.to_dict(), uncertainty=uncertainty.to_dict())
     with flag_words(terms):
         which = "all" if landings in (None, "all") else landing_names(landings)
         found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
@@ -230,6 +231,7 @@ def plan_command(
     if not plans_over_landings(found.landings, landings is not None, accept is not None):
         print_warnings(loaded.warnings)
         pfs = list(loaded.push_functions)
+        json_found(members=[pf.part.name for pf in pfs])
         with searching("planning and verifying", options.time_limit_s), flag_words():
             made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
     else:
@@ -238,6 +240,7 @@ def plan_command(
         taken = _accepted_names(accept, names)  # bad input: one line, before any warning
         print_warnings(loaded.warnings)
         pfs = [push_function(x.part) for x in every]
+        json_found(members=[x.label for x in every])
         with searching("planning and verifying", options.time_limit_s), flag_words(terms):
             planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
         made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]

@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
-from feederkit.cli.common import console, plural, progress_bar
+from feederkit.cli.common import check_outputs, console, plural, progress_bar
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import read_json
@@ -85,6 +85,7 @@ def report_command(
     A plan that fails verification is still drawn, under a red banner; exit 1 then.
     """
     check_report_path(output)
+    check_outputs((output, "report"))
     data = load_plan(plan, max_plan_mb)
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
         raise InputError(

@@ -19,7 +19,15 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from feederkit.cli.common import add_name_column, console, err_console, plural, print_json
+from feederkit.cli.common import (
+    add_name_column,
+    console,
+    err_console,
+    json_found,
+    json_option,
+    plural,
+    print_json,
+)
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
 from feederkit.sim.api import (
@@ -188,7 +196,7 @@ def simulate_command(
             metavar="RATE",
         ),
     ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+    json_out: Annotated[bool, json_option("Print the summary as JSON.")] = False,
     max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
     """Execute a plan in a MuJoCo conveyor, fence and robot and compare it with its claims."""
@@ -196,6 +204,11 @@ def simulate_command(
     if require_success is not None and not 0.0 <= require_success <= 1.0:
         raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
     data = load_plan(plan, max_plan_mb)  # the one loader and validator
+    json_found(
+        plan=str(plan),
+        uncertainty=data.uncertainty.to_dict(),
+        uncertainty_declared=data.uncertainty_declared,
+    )
     warning = data.low_margin_warning()
     if warning:
         err_console.print(f"warning: {warning}", style="yellow", highlight=False, markup=False)
