@@ -3,12 +3,13 @@ the planners' random mix (also benchmarks/dump_plans.py's), a catalog's snapshot
 
 from __future__ import annotations
 
+import functools
 import math
 import random
 import sqlite3
 from pathlib import Path
 
-from feederkit.machine import OutcomeRange, PushAlignMachine
+from feederkit.machine import OutcomeRange, PushAlignMachine, is_goal, search_space
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
@@ -86,6 +87,41 @@ def read_alike_sets(intervals: dict[int, tuple[float, float]]) -> list[int]:
         if m:
             found.add(m)
     return sorted(found)
+
+
+def brute_lengths(machine: PushAlignMachine, tol: float):
+    """The minimum worst-case length of a set under a tolerance sensor of ``tol`` on the
+    ideal model (the tests' own search, memoised; None when no plan of at most 6
+    operations orients it), and a set's reading branches."""
+    insep = search_space(machine).inseparable  # the goal relation, tested on its own
+    mids = rotation_mids(machine)
+    n = machine.n
+    d = [s.sensed for s in machine.states]
+
+    def children(mask: int) -> list[int]:
+        # Ideal model: an exact diameter, read strictly within ``tol`` of it.
+        iv = {i: (d[i] - tol, d[i] + tol) for i in range(n) if mask >> i & 1}
+        return read_alike_sets(iv)
+
+    @functools.cache
+    def within(mask: int, k: int) -> bool:
+        if is_goal(insep, mask):
+            return True
+        if k == 0:
+            return False
+        for a in mids:
+            img = 0
+            for i in range(n):
+                if mask >> i & 1:
+                    img |= outcome_mask(machine, i, a)
+            if all(within(c, k - 1) for c in children(img)):
+                return True
+        return False
+
+    def length(mask: int) -> int | None:
+        return next((k for k in range(7) if within(mask, k)), None)
+
+    return length, children
 
 
 def catalog_snapshot(db: Path) -> list[str]:

@@ -84,8 +84,8 @@ def test_a_memory_limit_in_the_table_names_the_memory(catalog_mix, monkeypatch):
 
 
 def test_a_limit_passed_while_deciding_pairs_gives_no_partial_design():
-    pfs = ellipse_mix(6)  # 15 pairs, seconds of exact solves at 1 degree
-    with pytest.raises(DesignTimeout, match=r" of 15 pairs\); no partial design is given$"):
+    pfs = ellipse_mix(12)  # 66 pairs: about a second of exact solves at 1 degree
+    with pytest.raises(DesignTimeout, match=r" of 66 pairs\); no partial design is given$"):
         design_tolerance(pfs, uncertainty=ONE_DEGREE, time_limit_s=0.3, partial=True)
 
 

@@ -10,14 +10,13 @@ length is searched only once the search is deep (``PAIR_BOUND_DEPTH``).
 
 from __future__ import annotations
 
-import functools
 import random
 
 import pytest
-from shared import outcome_mask, read_alike_sets, rotation_mids, small_mix
+from shared import brute_lengths, small_mix
 
 import feederkit.planning.andor as andor
-from feederkit.machine import build_machine, is_goal, search_space
+from feederkit.machine import build_machine
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.methods import longest_root
 from feederkit.planning.problem import Problem
@@ -26,44 +25,10 @@ from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
 
 
-def _brute(machine, tol: float):
-    """The minimum worst-case length of a set (the tests' own search, memoised): None when
-    no plan of at most 6 operations orients it."""
-    insep = search_space(machine).inseparable  # the goal relation, tested on its own
-    mids = rotation_mids(machine)
-    n = machine.n
-    d = [s.sensed for s in machine.states]
-
-    def children(mask: int) -> list[int]:
-        # Ideal model: an exact diameter, read strictly within ``tol`` of it.
-        iv = {i: (d[i] - tol, d[i] + tol) for i in range(n) if mask >> i & 1}
-        return read_alike_sets(iv)
-
-    @functools.cache
-    def within(mask: int, k: int) -> bool:
-        if is_goal(insep, mask):
-            return True
-        if k == 0:
-            return False
-        for a in mids:
-            img = 0
-            for i in range(n):
-                if mask >> i & 1:
-                    img |= outcome_mask(machine, i, a)
-            if all(within(c, k - 1) for c in children(img)):
-                return True
-        return False
-
-    def length(mask: int) -> int | None:
-        return next((k for k in range(7) if within(mask, k)), None)
-
-    return length, children
-
-
 @pytest.mark.parametrize(("count", "seed", "tol"), [(3, 200, 4.0), (4, 200, 4.0), (2, 200, 8.0)])
 def test_the_pair_bound_is_the_hardest_pairs_length_and_never_above_the_sets(count, seed, tol):
     machine = build_machine(small_mix(count, seed), ToleranceSensor(tol), IDEAL)
-    length, children = _brute(machine, tol)
+    length, children = brute_lengths(machine, tol)
     w = WorstCase(Problem(machine))
     rng = random.Random(count)
     masks = [rng.getrandbits(machine.n) or 1 for _ in range(40)]

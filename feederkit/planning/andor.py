@@ -4,7 +4,9 @@ A node is a set of states; an OR choice is a representative action; its AND chil
 sets the reading can leave. ``length(mask)`` is the smallest number of further push-align
 operations that orient every state of ``mask`` (0 for a goal). The search is depth-first
 iterative deepening with memoised proven bounds per set (a set that failed with ``k`` steps
-is never retried with ``k``), so repeated sets and repeated depths cost nothing.
+is never retried with ``k``), so repeated sets and repeated depths cost nothing; lengths being
+monotone under subsets (no margin floor), a set holding a set refuted with ``k`` steps is
+refuted with ``k`` unopened (:mod:`~feederkit.planning.refuted`).
 
 Where readings carry no information (every set reachable from a set reads alike:
 :meth:`~feederkit.planning.readings.Readings.carries_no_information`) the AND/OR tree is a
@@ -28,6 +30,7 @@ from feederkit.angles import ActionRange
 from feederkit.machine import PushAlignMachine, members
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Act, Problem
+from feederkit.planning.refuted import RefutedSets
 
 __all__ = ["Deadline", "Timeout", "WorstCase"]
 
@@ -52,7 +55,13 @@ class WorstCase:
     first proved the smallest bound (with that bound), so some plan can always be rebuilt.
     ``pair_bound=False``: no hardest-pair bound (:meth:`pair_bound` answers 0), for searches
     that are themselves about pairs.
+
+    Without a margin floor lengths are monotone under subsets, so a set holding a set the
+    search refuted at a depth is refuted there too (:mod:`~feederkit.planning.refuted`);
+    ``SUBSET_REFUTES`` False turns that off for searches whose failures are not proofs.
     """
+
+    SUBSET_REFUTES = True
 
     def __init__(
         self, problem: Problem, deadline: Deadline | None = None, pair_bound: bool = True
@@ -72,6 +81,10 @@ class WorstCase:
         self._pair_memo: dict[int, int] = {}
         self._deep = False  # pair bounds pay: PAIR_BOUND_DEPTH or PAIR_BOUND_SETS reached
         self._opened = 0  # sets the searches have opened (frames pushed)
+        machine = getattr(problem, "machine", None)
+        monotone = self.SUBSET_REFUTES and getattr(problem, "min_margin", None) == 0.0
+        ok = monotone and isinstance(machine, PushAlignMachine)
+        self._refuted = RefutedSets(machine.n) if ok else None
 
     def _known(self, mask: int, k: int) -> bool | None:
         """What the memo already says about ``within(mask, k)`` (None: search)."""
@@ -234,6 +247,8 @@ class WorstCase:
         a half to a sixth of the sets the largest first visits).
         """
         known = self._known(mask, k)
+        if known is None and self.holds_refuted(mask, k):
+            known = False
         if known is not None:
             return known
         self.deadline.check()
@@ -259,6 +274,8 @@ class WorstCase:
                 while ci < len(children):
                     c = children[ci]
                     known = self._known(c, fk - 1)
+                    if known is None and self.holds_refuted(c, fk - 1):
+                        known = False
                     if known is None:
                         f[3], f[4] = act, ci
                         self.deadline.check()
@@ -286,6 +303,8 @@ class WorstCase:
                 result = True
             else:
                 self.lb[fmask] = fk + 1
+                if self._refuted is not None:
+                    self._refuted.add(fmask, fk + 1)
                 result = False
             if stack:
                 parent = stack[-1]
@@ -294,6 +313,17 @@ class WorstCase:
                 else:
                     parent[3] = None  # the parent's action failed: its next action
         return result
+
+    def holds_refuted(self, mask: int, k: int) -> bool:
+        """Whether ``mask`` holds a set the search refuted within ``k`` (it is then
+        refuted too, and its lower bound kept), asked before the search opens it."""
+        if self._refuted is None:
+            return False
+        lb = self._refuted.bound(mask, k + 1)
+        if lb is None:
+            return False
+        self.lb[mask] = max(self.lb.get(mask, 1), int(lb))
+        return True
 
     def actions_of(self, mask: int) -> Iterator[Act]:
         """The actions :meth:`within` tries for a set, in order: every one the length search

@@ -48,6 +48,8 @@ class BeamSearch(WorstCase):
     set (:func:`branch_key`). ``within`` answers for that restricted space: True is a plan,
     False only that this beam has none."""
 
+    SUBSET_REFUTES = False  # a beam's failure is no proof: it does not refute supersets
+
     def __init__(self, problem: Problem, width: int, deadline: Deadline | None = None) -> None:
         super().__init__(problem, deadline)
         self.width = width

@@ -267,14 +267,16 @@ class Refiner:
 
     def _short(self, mask: int, k: int) -> bool:
         """Whether the length search has already proven that ``mask`` needs more than ``k``
-        operations (its exact lengths, lower bounds and hardest pairs: no search of the set
-        itself, at most of a pair not asked before): then no plan within ``k`` keeps any
-        margin."""
+        operations (its exact lengths, lower bounds, hardest pairs and the sets it refuted
+        that ``mask`` holds: no search of the set itself, at most of a pair not asked
+        before): then no plan within ``k`` keeps any margin."""
         w = self.w
         e = w.exact.get(mask)
         if e is not None:
             return e > k
-        return w.lb.get(mask, 1) > k or mask in w.never or w.pair_bound(mask) > k
+        if w.lb.get(mask, 1) > k or mask in w.never or w.pair_bound(mask) > k:
+            return True
+        return w.holds_refuted(mask, k)
 
     def _keeping_plan(self, mask: int, k: int, x: float, strict: bool) -> tuple[float, Cell] | None:
         """The smallest margin of a plan for ``mask`` within ``k`` keeping ``x`` (as
