@@ -10,6 +10,7 @@ floor, under which lengths are not monotone, keep no index.
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
@@ -98,3 +99,32 @@ def test_the_index_stops_growing_at_its_cap(monkeypatch):
     for i in range(400):
         index.add(1 << (i % 10), 2)
     assert len(index) == 300 and index.bound(0b1, 2) == 2.0
+
+
+def test_margin_probes_refute_a_set_holding_a_refuted_set_without_a_search(monkeypatch):
+    from test_tie_breaks import _max_min, _proven
+
+    machine = build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL)
+    refiner, every, k = _proven(machine)
+    memo: dict = {}
+    for r in every:  # probes above each root's largest margin: each is refuted
+        best = _max_min(refiner.p, r, k, memo)
+        if math.isfinite(best):
+            assert not refiner.keeps(r, k, best + 1.0)
+    refuted = [(m, j, x) for (m, j), x in refiner._lt.items() if math.isfinite(x)]
+    assert refuted
+    n = machine.n
+    searched: list[int] = []
+    real = refiner._keeping_plan
+    monkeypatch.setattr(refiner, "_keeping_plan", lambda m, *a: searched.append(m) or real(m, *a))
+    held = 0
+    for mask, j, x in refuted:
+        for i in range(n):
+            bigger = mask | 1 << i
+            if bigger == mask or (bigger, j) in refiner._lt or refiner._short(bigger, j):
+                continue
+            searched.clear()
+            assert not refiner.keeps(bigger, j, x)
+            assert _max_min(refiner.p, bigger, j, memo) < x  # the exhaustive answer
+            held += bigger not in searched
+    assert held > 0

@@ -50,6 +50,7 @@ from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.choices import search_key, spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
+from feederkit.planning.refuted import RefutedSets
 from feederkit.planning.tree import Leaf, Step, branch_pairs
 
 EXPECTED_HORIZON = 2
@@ -136,6 +137,10 @@ class Refiner:
         self._how: dict[tuple[int, int], Cell] = {}
         self._le: dict[tuple[int, int], float] = {}
         self._lt: dict[tuple[int, int], float] = {}
+        # The sets of each budget no plan keeps a margin for, valued minus that margin
+        # (``_lt``: at least it; ``_le``: above it), for the sets that hold them.
+        self._lt_sets: dict[int, RefutedSets] = {}
+        self._le_sets: dict[int, RefutedSets] = {}
         self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[Value, Act | None]] = {}
         self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
         self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
@@ -253,6 +258,8 @@ class Refiner:
             self._lt[key] = -math.inf
             return False
         self.deadline.check()
+        if self._holds_refuted(mask, k, x, strict):
+            return False
         kept = self._keeping_plan(mask, k, x, strict)
         if kept is not None:
             found, cell = kept
@@ -263,6 +270,30 @@ class Refiner:
             self._le[key] = x if le is None else min(le, x)
         else:
             self._lt[key] = x if lt is None else min(lt, x)
+        if self._monotone:
+            sets = self._le_sets if strict else self._lt_sets
+            if k not in sets:
+                sets[k] = RefutedSets(self.p.machine.n)
+            sets[k].add(mask, -x)
+        return False
+
+    def _holds_refuted(self, mask: int, k: int, x: float, strict: bool) -> bool:
+        """Whether ``mask`` holds a set that no plan within ``k`` keeps ``x`` for (above
+        ``x`` when ``strict``): margins are monotone under subsets, so neither does one for
+        ``mask`` (:mod:`~feederkit.planning.refuted`); the refutation is memoised."""
+        if not self._monotone:
+            return False
+        key = (mask, k)
+        at_least = self._lt_sets.get(k)
+        v = None if at_least is None else at_least.bound(mask, -x)
+        if v is not None:  # no plan keeps -v <= x: nor x
+            self._lt[key] = min(self._lt.get(key, math.inf), -v)
+            return True
+        above = self._le_sets.get(k) if strict else None
+        v = None if above is None else above.bound(mask, -x)
+        if v is not None:  # no plan keeps more than -v <= x
+            self._le[key] = min(self._le.get(key, math.inf), -v)
+            return True
         return False
 
     def _short(self, mask: int, k: int) -> bool:
