@@ -9,7 +9,10 @@ held a smaller set refuted at the same depth. :class:`RefutedSets` answers "does
 hold a set known to need more than ``k`` operations?" with one vectorised test over every
 refuted set kept, before the search opens ``mask`` (which costs its overlap ranges and their
 reading branches). The hardest pair (``WorstCase.pair_bound``) is the two-state case of the
-same fact.
+same fact. Margins are monotone the same way (docs/planning.md, "Which plan among the
+shortest"): a set holding a set that no plan within ``k`` keeps a margin of ``x`` for keeps
+none either, so the margin probes (``Refiner.keeps``) keep an index per budget, each set
+valued ``-x``.
 """
 
 from __future__ import annotations
@@ -24,7 +27,8 @@ and a search opens a set for about a millisecond, so more would cost more than i
 
 
 class RefutedSets:
-    """Sets with proven lower bounds on their lengths, as rows of 64-bit words.
+    """Sets with proven lower bounds (on their lengths; or minus a margin no plan keeps), as
+    rows of 64-bit words.
 
     >>> r = RefutedSets(70)
     >>> r.add(0b0110, 3)
