@@ -1,5 +1,6 @@
-"""Helpers several test files use: a plan file's part entry, the one-line CLI error check, and
-the planners' random mix (also benchmarks/dump_plans.py's), a catalog's snapshot."""
+"""Helpers several test files use: a plan file's part entry, the one-line CLI error check, the
+command-line tests' clean working folder, the planners' random mix (also
+benchmarks/dump_plans.py's) and exhaustive lengths, a catalog's snapshot."""
 
 from __future__ import annotations
 
@@ -9,10 +10,20 @@ import random
 import sqlite3
 from pathlib import Path
 
+import pytest
+
 from feederkit.machine import OutcomeRange, PushAlignMachine, is_goal, search_space
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
+
+
+@pytest.fixture(autouse=True)
+def no_stray_profile(tmp_path, monkeypatch):
+    """No ./feederkit.toml of the working tree, no catalog from the environment (autouse in
+    the command-line test files that import it)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
 
 
 def small_mix(count: int, seed: int = 100) -> list[PushFunction]:

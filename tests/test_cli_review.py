@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from shared import one_line_error
+from shared import no_stray_profile, one_line_error  # noqa: F401 (autouse)
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError
@@ -25,13 +25,6 @@ CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 L_BRACKET = str(CATALOG / "l-bracket.json")
 T_CLIP = str(CATALOG / "t-clip.json")
 OCTAGON = str(CATALOG / "octagon.json")
-
-
-@pytest.fixture(autouse=True)
-def no_stray_profile(tmp_path, monkeypatch):
-    """No ./feederkit.toml of the working tree, no catalog from the environment."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
 
 
 def run(capsys, args: list[str]) -> tuple[int, str, str]:

@@ -10,7 +10,7 @@ import signal
 from pathlib import Path
 
 import pytest
-from shared import one_line_error
+from shared import no_stray_profile, one_line_error  # noqa: F401 (autouse)
 
 from feederkit.cell import CellProfile, resolve_settings
 from feederkit.cli import run as run_cli
@@ -21,13 +21,6 @@ from feederkit.errors import InputError
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 L_BRACKET = str(CATALOG / "l-bracket.json")
 T_CLIP = str(CATALOG / "t-clip.json")
-
-
-@pytest.fixture(autouse=True)
-def no_stray_profile(tmp_path, monkeypatch):
-    """No ./feederkit.toml of the working tree, no catalog from the environment."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.delenv("FEEDERKIT_CATALOG", raising=False)
 
 
 @pytest.fixture(autouse=True)
