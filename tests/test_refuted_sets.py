@@ -49,6 +49,32 @@ def test_the_index_answers_as_a_plain_scan(n, seed):
         assert index.bound(query, need) == plain
 
 
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.sampled_from([5, 64, 65, 150]),
+    seed=st.integers(0, 10**6),
+)
+def test_the_index_asked_again_as_it_grows_answers_as_a_plain_scan(n, seed):
+    # The searches ask the same sets again, at other bounds, between additions: the index
+    # remembers what it found a set holds nothing of and scans only the rows added since.
+    rng = random.Random(seed)
+    index = RefutedSets(n)
+    kept: list[tuple[int, int]] = []
+    asked = [rng.getrandbits(n) | rng.getrandbits(n) for _ in range(12)]
+    for _ in range(400):
+        if rng.random() < 0.35:
+            mask = rng.getrandbits(n) & rng.getrandbits(n) & rng.getrandbits(n)
+            if rng.random() < 0.3:
+                mask &= rng.choice(asked)  # a set some asked set holds
+            lb = rng.randint(1, 6)
+            index.add(mask, lb)
+            kept.append((mask, lb))
+        else:
+            query, need = rng.choice(asked), rng.randint(1, 7)
+            plain = max((lb for m, lb in kept if m & query == m and lb >= need), default=None)
+            assert index.bound(query, need) == plain
+
+
 @pytest.mark.parametrize(("count", "seed", "tol"), [(3, 200, 4.0), (4, 200, 4.0), (4, 7, 2.0)])
 def test_lengths_with_refutations_kept_across_queries_are_the_exhaustive_searchs(count, seed, tol):
     machine = build_machine(small_mix(count, seed), ToleranceSensor(tol), IDEAL)

@@ -28,7 +28,12 @@ and a search opens a set for about a millisecond, so more would cost more than i
 
 class RefutedSets:
     """Sets with proven lower bounds (on their lengths; or minus a margin no plan keeps), as
-    rows of 64-bit words.
+    columns of 64-bit words.
+
+    A search asks about the same set again and again (a margin probe per margin, a length
+    per budget) while the index grows by appending, so each set asked remembers the bound
+    and the rows it was found to hold nothing for: the next query at that bound or above
+    scans only the rows added since.
 
     >>> r = RefutedSets(70)
     >>> r.add(0b0110, 3)
@@ -37,13 +42,19 @@ class RefutedSets:
     >>> r.add(1 << 69 | 1, 4)
     >>> r.bound((1 << 69) | 0b111, 4)
     4.0
+    >>> r.add(0b1000, 5)
+    >>> r.bound(0b1010, 2)
+    5.0
     """
 
     def __init__(self, n: int) -> None:
         self._words = max(1, -(-n // 64))
-        self._rows = np.zeros((_START, self._words), dtype=np.uint64)
+        self._cols = np.zeros((self._words, _START), dtype=np.uint64)
         self._lb = np.zeros(_START, dtype=np.float64)
         self._count = 0
+        # mask -> (need, rows): no set among the first ``rows`` inside ``mask`` has a bound
+        # of at least ``need``.
+        self._clear: dict[int, tuple[float, int]] = {}
 
     def __len__(self) -> int:
         return self._count
@@ -58,9 +69,9 @@ class RefutedSets:
         if self._count >= MAX_ROWS:
             return
         if self._count == len(self._lb):
-            self._rows = np.concatenate([self._rows, np.zeros_like(self._rows)])
+            self._cols = np.concatenate([self._cols, np.zeros_like(self._cols)], axis=1)
             self._lb = np.concatenate([self._lb, np.zeros_like(self._lb)])
-        self._rows[self._count] = self._split(mask)
+        self._cols[:, self._count] = self._split(mask)
         self._lb[self._count] = lb
         self._count += 1
 
@@ -68,15 +79,25 @@ class RefutedSets:
         """The largest bound of at least ``need`` among the kept sets inside ``mask`` (None:
         none)."""
         n = self._count
-        if n == 0:
-            return None
-        lbs = self._lb[:n]
-        hard = lbs >= need
-        if not hard.any():
-            return None
-        rows = self._rows[:n]
-        words = self._split(mask)
-        inside = ((rows & words) == rows).all(axis=1) & hard
-        if not inside.any():
-            return None
-        return float(lbs[inside].max())
+        start, floor = 0, need
+        clear = self._clear.get(mask)
+        if clear is not None and need >= clear[0]:
+            if clear[1] == n:
+                return None
+            # The rows before hold nothing of at least clear[0] <= need: scan the new ones
+            # at clear[0], so that what is remembered stays as strong.
+            start, floor = clear[1], clear[0]
+        lbs = self._lb[start:n]
+        hard = lbs >= floor
+        if hard.any():
+            outside = np.zeros(n - start, dtype=np.uint64)
+            for col, word in zip(self._cols, self._split(mask), strict=True):
+                outside |= col[start:n] & ~word
+            inside = (outside == 0) & hard
+            if inside.any():
+                found = lbs[inside].max()
+                if found >= need:
+                    return float(found)
+                floor = need  # held below ``need`` only: remember the weaker fact
+        self._clear[mask] = (floor, n)
+        return None
