@@ -173,6 +173,64 @@ def strong_plan_exists(
     return lumping.goal is not None or not lumping.decided
 
 
+def shortest_length(
+    machine: PushAlignMachine,
+    options: PlanningOptions | None = None,
+    *,
+    budget: Deadline | None = None,
+) -> int | None:
+    """The minimum worst-case number of push-align operations of a plan for ``machine``
+    on the ideal model (the first alignment counted, as a plan's ``length``), under
+    ``options``' grouping, method and margin floor: the length search alone (section 6.1),
+    with no tie-breaking and no tree, so it is what :func:`plan` proves first.
+
+    None when ``budget`` (by default the options' limits from now) passes before it is
+    proven, or when no plan keeps the margin floor. InputError under uncertainty: there a
+    strong plan need not exist, and :func:`plan` decides it.
+
+    >>> from feederkit.machine import ActionRange, MachineState, PushAlignMachine
+    >>> from feederkit.sensors import NoSensor
+    >>> m = PushAlignMachine(("toy",), (MachineState(0, 0, 1.0, 0.5), MachineState(0, 1, 2.0, 0.5)),
+    ...     ((ActionRange(0.0, 180.0, 0), ActionRange(180.0, 360.0, 1)),
+    ...      (ActionRange(0.0, 180.0, 0), ActionRange(180.0, 360.0, 0))), NoSensor())
+    >>> shortest_length(m)
+    2
+    """
+    options = PlanningOptions() if options is None else options
+    if not machine.deterministic:
+        raise InputError("the shortest length alone is for the ideal model: plan it instead")
+    if machine.n == 0:
+        raise InputError("the machine has no states")
+    if budget is None:
+        budget = Deadline(options.time_limit_s, options.memory_limit_mb)
+    min_margin = options.min_margin_deg
+    with collector_paused():
+        sorted_machine, _old = by_diameter(machine)
+        try:
+            insep = goal_relation(sorted_machine, budget)
+            problem = Problem(sorted_machine, options.grouping, min_margin, insep)
+            _check_method(problem, options.method.value)
+            every = sorted({b.mask for b in problem.readings.branches(problem.full)})
+            roots = sorted(maximal_sets(every)) if min_margin == 0.0 else every
+            if min_margin > 0.0 and largest_margin(problem, roots, budget) < min_margin:
+                return None
+            worst = make_oracle(problem, options.method.value, budget)
+            return 1 + longest_root(problem, worst, roots, options.method.value)
+        except Timeout:
+            return None
+
+
+def _check_method(problem: Problem, method: str) -> None:
+    """InputError when ``method`` cannot plan ``problem``."""
+    if method in ("bfs", "backchain") and not problem.sensorless:
+        raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
+    if method == "backchain" and not problem.machine.deterministic:
+        raise InputError(
+            "backchaining needs the ideal model (exact push functions): use rotation error 0, "
+            "or the bfs or andor method under uncertainty"
+        )
+
+
 FIRST_LIMIT = 8
 """Under uncertainty with readings, the AND/OR search first tries plans of at most this many
 operations before deciding whether a strong plan exists at all (:func:`_decide`)."""
@@ -326,13 +384,7 @@ def _plan(
         objective = "worst"
     elif objective in ("expected", "time"):
         problem = Problem(machine, grouping, min_margin, problem.insep, distinct_maps=True)
-    if method in ("bfs", "backchain") and not problem.sensorless:
-        raise InputError(f"method {method!r} is for sensorless machines (readings all alike)")
-    if method == "backchain" and not machine.deterministic:
-        raise InputError(
-            "backchaining needs the ideal model (exact push functions): use rotation error 0, "
-            "or the bfs or andor method under uncertainty"
-        )
+    _check_method(problem, method)
     root_branches = problem.readings.branches(problem.full)
     # Without a margin floor a reading set inside another is oriented by its rotations in no
     # more operations, so the length depends on the maximal ones only. Margins are not

@@ -32,7 +32,7 @@ from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
-from feederkit.planning.api import NoStrongPlan, strong_plan_exists
+from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
@@ -351,18 +351,16 @@ def _output_s(data: dict[str, Any]) -> float:
 def _ideal_length(
     ideal: PushAlignMachine, options: PlanningOptions, started: float, output_s: float = 0.0
 ) -> int | None:
-    """The optimal length on the ideal model (the certificate's ``ideal_length``), within
-    what is left of the time limit less ``OUTPUT_SHARE`` of it and ``output_s`` seconds; None
-    when no time is left, or when the ideal model cannot meet the options (e.g. a margin
+    """The optimal length on the ideal model (the certificate's ``ideal_length``: the length
+    search alone, ``shortest_length``), within what is left of the time limit less
+    ``OUTPUT_SHARE`` of it and ``output_s`` seconds; None when no time is left or the length
+    is not proven in it, or when the ideal model cannot meet the options (e.g. a margin
     floor it cannot keep)."""
     left = _left(options, started, OUTPUT_SHARE, output_s)
     if left is not None and left <= 0.0:
         return None
     opts = options if left is None else replace(options, time_limit_s=left)
-    try:
-        return plan_machine(ideal, opts).length
-    except PlanningError:
-        return None
+    return shortest_length(ideal, opts)
 
 
 def _weighted_members(
