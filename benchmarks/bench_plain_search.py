@@ -2,6 +2,7 @@
 
     python benchmarks/bench_plain_search.py            # T = 60 s (plan's default limit)
     python benchmarks/bench_plain_search.py 10 mix     # T = 10 s, cases whose name has "mix"
+    python benchmarks/bench_plain_search.py 60 "20-part mix, 5%" --plain-limit 1800
 
 Issue 12 asks for sensor-based planning well ahead of the plain search, and for every case
 of its own to keep its ratio against the plain search. ``bench_planners.py`` does so on its
@@ -15,11 +16,11 @@ Each case runs in a fresh process (machine built first, not timed): ``plan`` wit
 ``PlanningOptions(time_limit_s=T)``, its CPU seconds, length and whether it is proven
 optimal; then ``bench_planners.baseline_length`` (iterative deepening over sets, every
 overlap range, exact reading branching, a memo and nothing else) on a fresh copy of the
-machine, which gives up after ``BASELINE_LIMIT_S`` of wall time, and its CPU seconds and
-length. The ratio is the plain search's CPU over the plan's, ``>`` when the plain search
-gave up. Both processes are capped at ``MEMORY_MB`` of address space: a search that runs
-out says so. Exit code 1 when two finished searches disagree on a length the planner
-proved optimal (a wrong answer on one side), or a case crashes.
+machine, which gives up after ``BASELINE_LIMIT_S`` of wall time (``--plain-limit S``: after
+``S``), and its CPU seconds and length. The ratio is the plain search's CPU over the plan's,
+``>`` when the plain search gave up. Both processes are capped at ``MEMORY_MB`` of address
+space: a search that runs out says so. Exit code 1 when two finished searches disagree on a
+length the planner proved optimal (a wrong answer on one side), or a case crashes.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ except MemoryError:
 out["cpu"] = time.process_time() - c0
 c0 = time.process_time()
 try:
-    out["base_length"] = baseline_length(fresh(machine))
+    out["base_length"] = baseline_length(fresh(machine), float(sys.argv[5]))
 except GaveUp:
     out["base_gave_up"] = True
 except MemoryError:
@@ -88,13 +89,13 @@ def ideal_cases() -> dict[str, str]:
     return out
 
 
-def run_case(spec: str, limit: float, here: str) -> dict:
+def run_case(spec: str, limit: float, here: str, plain_s: float = BASELINE_LIMIT_S) -> dict:
     """One case in a fresh process: its JSON line, or ``{"missed": why}``."""
-    hard = 3 * limit + BASELINE_LIMIT_S + 60
-    return run_child(CHILD, [spec, str(limit), here, str(MEMORY_MB)], hard)
+    hard = 3 * limit + plain_s + 60
+    return run_child(CHILD, [spec, str(limit), here, str(MEMORY_MB), str(plain_s)], hard)
 
 
-def cells(name: str, r: dict) -> list[str]:
+def cells(name: str, r: dict, plain_s: float = BASELINE_LIMIT_S) -> list[str]:
     """The markdown cells of one case: name, states, plan CPU, length, optimal, plain CPU,
     its length, ratio."""
     if "missed" in r:
@@ -103,7 +104,7 @@ def cells(name: str, r: dict) -> list[str]:
     length = str(r["length"]) if planned else "none"
     proven = ("yes" if r["optimal"] else f"no (bound {r['lower']})") if planned else r["error"][:40]
     if r.get("base_gave_up"):
-        why = "out of memory" if r.get("base_memory") else f"gave up at {BASELINE_LIMIT_S:.0f} s"
+        why = "out of memory" if r.get("base_memory") else f"gave up at {plain_s:.0f} s"
         base, blen = f"> {r['base_cpu']:.1f}", why
         ratio = f"> {r['base_cpu'] / max(r['cpu'], 1e-9):.0f}x" if planned else "-"
     else:
@@ -117,18 +118,22 @@ HEAD = ("case", "states", "plan cpu s", "length", "optimal", "plain cpu s", "pla
 
 
 def main(argv: list[str]) -> int:
-    limit = 60.0
+    limit, plain_s = 60.0, BASELINE_LIMIT_S
+    if "--plain-limit" in argv:
+        at = argv.index("--plain-limit")
+        plain_s = float(argv[at + 1])
+        argv = argv[:at] + argv[at + 2 :]
     if argv and argv[0].replace(".", "", 1).isdigit():
         limit, argv = float(argv[0]), argv[1:]
     here = str(Path(__file__).resolve().parent)
-    print(f"plan time limit {limit:g} s; the plain search gives up after {BASELINE_LIMIT_S:g} s")
+    print(f"plan time limit {limit:g} s; the plain search gives up after {plain_s:g} s")
     rows, bad = [], 0
     began = time.perf_counter()
     for name, spec in ideal_cases().items():
         if argv and not any(w in name for w in argv):
             continue
-        r = run_case(spec, limit, here)
-        row = cells(name, r)
+        r = run_case(spec, limit, here, plain_s)
+        row = cells(name, r, plain_s)
         rows.append(row)
         wrong = "base_length" in r and r.get("optimal") and r["base_length"] != r["length"]
         bad += "missed" in r or bool(wrong)
