@@ -20,6 +20,7 @@ from test_deadline import near_round, small_mix
 from test_planners import check_plan, random_convex
 
 import feederkit.planning.api as api
+import feederkit.planning.refine as refine
 from feederkit.machine import build_machine, members, search_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.methods import longest_root, make_oracle
@@ -490,6 +491,34 @@ def test_the_expected_stage_gets_its_own_share_of_the_tie_budget(monkeypatch):
     assert got.tie_breaks == api.TIES_MARGIN  # 5 polls do not finish it
     assert got.ties_cut_by == "work"
     assert check_plan(got) <= got.length
+
+
+def test_the_expected_stages_budget_counts_the_bounds_it_computes(monkeypatch):
+    # Its work is the bounds (a pass over a set's members per range), many per set: polled
+    # once per set only, a budget of polls let it compute any number of them.
+    budgets: list[WorkBudget] = []
+
+    class Recording(WorkBudget):
+        def __init__(self, outer: Deadline, polls: float) -> None:
+            super().__init__(outer, polls)
+            budgets.append(self)
+
+    bounds = []
+    real = Refiner._open_mass
+
+    def counted(self, *args):
+        bounds.append(self.deadline)
+        return real(self, *args)
+
+    monkeypatch.setattr(api, "WorkBudget", Recording)
+    monkeypatch.setattr(Refiner, "_open_mass", counted)
+    monkeypatch.setattr(refine, "BOUNDS_PER_POLL", 1)
+    got = api.plan(build_machine(small_mix(8), ToleranceSensor(2.0), IDEAL))
+    assert got.tie_breaks == api.TIES_EXACT
+    expected_stage = budgets[-1]
+    made = sum(1 for d in bounds if d is expected_stage)
+    assert made > 100
+    assert expected_stage.polls >= made  # a poll per bound, and one per set besides
 
 
 def test_root_branches_chosen_before_the_expected_stage_ran_out_keep_their_subtrees(

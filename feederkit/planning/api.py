@@ -82,10 +82,14 @@ TIE_SHARE = 3.0
 """The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
 may poll their budget this many times as often as the length proof did, plus
 ``TIE_GRACE_POLLS``: a budget of work (:class:`~feederkit.planning.budget.WorkBudget`), so
-the same machine gives the same plan on any computer and under any load. A tie-breaking
-poll costs about a third of a proof's (``python benchmarks/bench_tie_budget.py --quick``: 9,177
-against 2,990 per CPU second over its cases; on the 240-state mix at 3 %, half), so this is
-about one to one and a half times the proof's time."""
+the same machine gives the same plan on any computer and under any load. A margin probe's
+poll costs about what a proof's does (it asks the length search too: on the 20-part mix at
+5 % under 1 degree 2,300 against 2,000 per CPU second), an expected-operations poll (a set,
+or ``refine.BOUNDS_PER_POLL`` bounds) a quarter (``python benchmarks/bench_tie_budget.py``:
+14,436 against 3,456 per CPU second over its cases, mostly that stage's), so the margin
+stage takes at most about three times the proof's time and the expected stage at most
+about a quarter of it, plus the grace. The margin stage needs 1.0-2.2 times the proof's
+polls on the mixes of docs/performance.md's "Margin probes in the length search's order"."""
 
 EXPECTED_SHARE = 1.0
 """Of that budget the expected-operations stage, the last and least of the tie-breaks, may
@@ -94,8 +98,9 @@ the margin stage (the larger margin, what a real feeder's rotation error needs) 
 rest first."""
 
 TIE_GRACE_POLLS = 10_000
-"""Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (one to
-two seconds on the benchmark machine)."""
+"""Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (a second
+of expected-operations polls on the benchmark machine, up to four of margin probes): the
+small cases, whose proof polls a few hundred times, break their ties exactly."""
 
 TIES_EXACT = "exact"
 """``tie_breaks``: every tie-break of the objective was decided exactly."""

@@ -56,6 +56,11 @@ from feederkit.planning.tree import Leaf, Step, branch_pairs
 EXPECTED_HORIZON = 2
 """``objective="expected"`` searches plans of at most this many times the minimum length."""
 
+BOUNDS_PER_POLL = 8
+"""The expected-operations stage polls its budget once per this many bounds it computes (as
+well as once per set): a poll then costs about what a length proof's or a margin probe's
+does (``python benchmarks/bench_tie_budget.py``)."""
+
 _TIE = 1e-9
 
 LEAP_MIN_DEG = 1e-6
@@ -145,6 +150,7 @@ class Refiner:
         self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
         self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
         self._one: dict[tuple[int, float], tuple[Value, Act | None]] = {}
+        self._bounds = 0  # expected-operations bounds computed (BOUNDS_PER_POLL)
         self._nodes: dict[tuple[object, ...], Step] = {}
         """The distinct steps :meth:`build` made, by action and branches (children that are
         steps by identity: they are distinct already)."""
@@ -452,7 +458,12 @@ class Refiner:
         options = []
         for cell in self.cells(mask, True):
             if (cell[1] - cell[0]) / 2.0 >= self.floor:
-                # Every branch not yet oriented needs at least one more operation.
+                # Every branch not yet oriented needs at least one more operation. The bounds
+                # are the stage's work (a pass over the members each): every
+                # BOUNDS_PER_POLL of them poll, so its budget of polls bounds it.
+                self._bounds += 1
+                if self._bounds % BOUNDS_PER_POLL == 0:
+                    self.deadline.check()
                 sa = OverlapRange(*cell)
                 step = 1.0 if self.costs is None else self._step(Act(sa, ()))[0]
                 bound = step + least * self._open_mass(mask, masses, sa)
