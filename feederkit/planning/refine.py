@@ -323,8 +323,9 @@ class Refiner:
         Only the ranges wide enough to keep ``x`` can start such a plan, and among them the
         length search's order finds one soonest: a probe that succeeds stops at the first
         plan, one that fails tries them all in any order. Widest first instead, a probe of the
-        20-part mix at 5 % polled 40,000-60,000 times at any margin; in this order 4,000-8,000
-        (docs/planning.md). A plan keeping ``x`` within ``k`` is one within ``k`` at all,
+        20-part mix at 5 % polled 39,000-61,000 times at any margin; in this order, the
+        length search asked as below, 2,100-3,700 (docs/performance.md, "Margin probes in
+        the length search's order"). A plan keeping ``x`` within ``k`` is one within ``k`` at all,
         so the length search (its memo, pair bounds and refuted sets) is asked of each
         range's branches first.
         """
