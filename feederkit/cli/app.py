@@ -339,9 +339,10 @@ def main(argv: list[str] | None = None) -> int:
     """
     set_busy_notifier(_notify_busy)
     JSON_ANSWER.reset()
+    args = sys.argv[1:] if argv is None else list(argv)
     with _CtrlCWatch() as ctrl_c, _guarded_stdout():
         try:
-            code = _run_app(argv)
+            code = _run_app(args)
             if ctrl_c.seen and code != EXIT_INTERRUPTED:  # a library swallowed the interrupt
                 _say("interrupted")
                 return EXIT_INTERRUPTED
@@ -350,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
             if ctrl_c.seen or _from_interrupt(exc):
                 _say("interrupted")
                 return EXIT_INTERRUPTED
-            return _error_exit(exc, argv)
+            return _error_exit(exc, args)
         except KeyboardInterrupt:
             _say("interrupted")
             return EXIT_INTERRUPTED
@@ -358,13 +359,12 @@ def main(argv: list[str] | None = None) -> int:
             set_busy_notifier(None)
 
 
-def _run_app(argv: list[str] | None) -> int:
+def _run_app(args: list[str]) -> int:
     """Run the command; its exit code (a SystemExit becomes one, Ctrl-C's saying so).
 
     ``feederkit`` or a group without a command is a usage error: its help on stderr, exit 2
     (``--help`` asks for the help: stdout, exit 0).
     """
-    args = sys.argv[1:] if argv is None else argv
     group = _group_alone(args)
     if group is not None:
         with contextlib.redirect_stdout(sys.stderr):
@@ -373,7 +373,7 @@ def _run_app(argv: list[str] | None) -> int:
             )
         return 2
     try:
-        code = _click_command().main(args=argv, prog_name="feederkit", standalone_mode=False)
+        code = _click_command().main(args=args, prog_name="feederkit", standalone_mode=False)
     except SystemExit as exc:
         code = exc.code
         if code is None:
@@ -385,7 +385,7 @@ def _run_app(argv: list[str] | None) -> int:
     return code if isinstance(code, int) else 0
 
 
-def _error_exit(exc: Exception, argv: list[str] | None) -> int:
+def _error_exit(exc: Exception, args: list[str]) -> int:
     """Say ``exc`` in one line on stderr and return its exit code (not for Ctrl-C's errors)."""
     if isinstance(exc, FeederkitError):
         if exc.exit_code == EXIT_RESULT:
@@ -397,7 +397,6 @@ def _error_exit(exc: Exception, argv: list[str] | None) -> int:
     if isinstance(exc, NoArgsIsHelpError):  # click printed the help when it raised this
         return 2
     if isinstance(exc, UsageError):
-        args = sys.argv[1:] if argv is None else argv
         where = exc.ctx.command_path if exc.ctx is not None else _command_path(args)
         _say(f"{_oneline(exc.format_message())} (see {where} --help)")
         return 2
@@ -405,7 +404,7 @@ def _error_exit(exc: Exception, argv: list[str] | None) -> int:
         _say(_oneline(exc.format_message()))
         return exc.exit_code
     message = system_error_message(exc)
-    log = write_crash_log(exc, argv)
+    log = write_crash_log(exc, args)
     where = f"; details in {log}" if log else ""
     if message is not None:
         _say(f"{message}{where}")
