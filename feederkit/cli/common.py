@@ -348,13 +348,24 @@ def searching(what: str, time_limit: float | None) -> Iterator[None]:
 
 
 def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | None:
-    """One line when the search stopped at the time limit: the plan and the proven lower bound."""
+    """One line when the search stopped at the time limit: the plan and the proven lower bound
+    (a worst-case number of operations whatever the objective: under ``expected`` or ``time``
+    the plan's length may meet it and the plan still not be proven best)."""
     if stats.get("optimal", True) or time_limit is None:
         return None
+    objective = stats.get("objective") or "worst"
+    ops = plural(stats["length"], "operation")
+    bound = stats["lower_bound"]
+    if objective == "worst":
+        what = f"this plan has {ops} and is not proven shortest; a plan needs at least {bound}"
+    else:
+        what = (
+            f"this plan ({ops}) is not proven best for the {objective} objective; every plan "
+            f"needs at least {plural(bound, 'operation')} in the worst case"
+        )
     return (
-        f"the time limit of {time_limit:g} s was reached: this plan has "
-        f"{plural(stats['length'], 'operation')} and is not proven shortest; a plan needs at "
-        f"least {stats['lower_bound']} (allow more time with --time-limit S)"
+        f"the time limit of {time_limit:g} s was reached: {what} "
+        "(allow more time with --time-limit S)"
     )
 
 

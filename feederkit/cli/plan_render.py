@@ -201,7 +201,8 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
         t.add_row("certified shape tolerance (largest)", f"{cert.max_shape_tolerance_mm:.4g} mm")
         ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
         t.add_row("length: robust / ideal model", f"{s.length} / {ideal}")
-    optimal = "yes" if s.optimal else f"not proven (lower bound {s.lower_bound})"
+    bound = "lower bound" if (s.objective or "worst") == "worst" else "worst-case length at least"
+    optimal = "yes" if s.optimal else f"not proven ({bound} {s.lower_bound})"
     t.add_row(f"optimal ({s.objective or 'worst'} objective)", optimal)
     if s.grouping:
         t.add_row("reading branching", str(s.grouping))

@@ -316,6 +316,13 @@ def _plan_machine(
         # that the rule allows (by default: poses that look alike).
         tried = try_lumping(sorted_machine, options.grouping, budget, rule=options.lumping)
         lumping = tried.goal
+        if lumping is None and tried.cut_by in ("time", "memory"):
+            # Unproven: listing near-symmetric states together may still give a plan.
+            raise PlanningError(
+                f"no plan found within {_out_of_budget(options, tried.cut_by)}: no strong "
+                "plan tells every pair of states apart, and it ran out while deciding which "
+                "near-symmetric states a plan may list together"
+            ) from None
         if lumping is None:
             hint = unlike_words(sorted_machine, tried.unlike)
             raise NoStrongPlan(exc.reason, hint) from None
@@ -375,6 +382,9 @@ def _plan(
     min_margin = options.min_margin_deg
     grouping = options.grouping
     method = options.method.value
+    # The goal tells every pair apart, yet lumping may follow (when no strong plan reaches
+    # it): a bound proven here need not hold for the plan the lumped goal gets.
+    apart = goal is None and not machine.deterministic and options.lumping is not Lumping.NONE
     try:
         insep = goal_relation(machine, budget) if goal is None else goal
     except Timeout as exc:
@@ -415,7 +425,9 @@ def _plan(
         try:
             _check_margin(problem, roots, min_margin, exact_deadline)
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
+            return _fallback(
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+            )
     if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
         worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
     checkpoint = exact_deadline if isinstance(exact_deadline, Checkpoint) else None
@@ -446,7 +458,7 @@ def _plan(
             # the search, which holds the checkpoint: a cycle only the collector would free.
             checkpoint.on_course = None
     if stopped is not None:
-        return _fallback(problem, worst, roots, root_branches, budget, options, stopped)
+        return _fallback(problem, worst, roots, root_branches, budget, options, stopped, apart)
     if checkpoint is not None:
         checkpoint.go_on()  # every root's length is proven: the rest of the share is ours
     length = 1 + longest
@@ -458,7 +470,9 @@ def _plan(
         try:  # under a copy: a chain too large to verify leaves its commits behind
             chain = _sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
+            return _fallback(
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+            )
         if chain is not None and tree_length(chain) == length:
             return chain, True, length, length, TIES_CHAIN, None
     children = _root_children(problem, root_branches, start_mass)
@@ -498,7 +512,9 @@ def _plan(
         try:
             root, _cut = _build(refiner, children, roots, budget_ops, "first")
         except Timeout as exc:
-            return _fallback(problem, worst, roots, root_branches, budget, options, exc.reason)
+            return _fallback(
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+            )
         complete = objective == "worst"
     else:
         complete = True
@@ -642,9 +658,11 @@ def _fallback(
     budget: Deadline,
     options: PlanningOptions,
     stop: str,
+    apart: bool = False,
 ):
     """Some plan when the exact search ran out of its budget (``stop``: the Timeout's reason),
-    with the lower bound proven.
+    with the lower bound proven; ``apart``: the goal tells every pair of states apart and a
+    lumped one may follow, so with no plan found the bound is stated for this goal only.
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
@@ -837,9 +855,10 @@ def _fallback(
         if blind is not None:
             return blind, False, None, lower, TIES_NONE, None
         reason = last if last == "memory" else stop
+        which = "one that tells every pair of states apart" if apart else "a plan"
         raise PlanningError(
             f"no plan found within {_out_of_budget(options, reason)} "
-            f"(a plan needs at least {plural(lower, 'operation')})"
+            f"({which} needs at least {plural(lower, 'operation')})"
         )
     return root, False, None, lower, TIES_NONE, None
 

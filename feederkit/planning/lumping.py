@@ -179,12 +179,14 @@ class LumpingTry:
     ``goal``: the lumped goal, when it gives every root reading set a strong plan (else
     None); ``unlike``: the unresolvable pairs the rule left out (poses that do not look
     alike), sorted; ``decided``: False when the search ran out of time or sets (``goal`` is
-    then None, and no strong plan may yet exist).
+    then None, and no strong plan may yet exist); ``cut_by``: then what it ran out of (the
+    Timeout's reason, ``"time"`` or ``"memory"``, or ``"sets"``), else None.
     """
 
     goal: LumpedGoal | None
     unlike: tuple[Pair, ...] = ()
     decided: bool = True
+    cut_by: str | None = None
 
 
 def try_lumping(
@@ -214,10 +216,10 @@ def try_lumping(
         wide = Problem(machine, grouping, 0.0, goal)
         roots = sorted(maximal_sets(b.mask for b in wide.readings.branches(wide.full)))
         value = solve(wide, roots, deadline, max_sets)
-    except Timeout:
-        return LumpingTry(None, decided=False)
+    except Timeout as exc:
+        return LumpingTry(None, decided=False, cut_by=exc.reason)
     if value is None:
-        return LumpingTry(None, unlike, decided=False)
+        return LumpingTry(None, unlike, decided=False, cut_by="sets")
     if any(value[r] == math.inf for r in roots):
         return LumpingTry(None, unlike)
     return LumpingTry(LumpedGoal(goal, pairs, exact), unlike)
