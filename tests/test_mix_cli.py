@@ -69,6 +69,12 @@ def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys, tmp_path):
     }
     assert all("Lemma 8" in p["reason"] for p in pairs)
     assert set(pairs[0]) == {"part_a", "part_b", "states_a", "states_b", "reason"}
+    # The analysis is the ideal model's, and says so (design.md: never assume it silently).
+    assert data["uncertainty"] == {
+        "rotation_error_deg": 0.0,
+        "shape_tolerance_mm": 0.0,
+        "com_tolerance_mm": 0.0,
+    }
 
 
 def test_analyze_sensorless_lists_no_pairs_and_people_get_tables(db, capsys):
@@ -78,6 +84,7 @@ def test_analyze_sensorless_lists_no_pairs_and_people_get_tables(db, capsys):
     assert main(["catalog", "analyze", "--tolerance", "0.01", "--catalog", str(db)]) == 1
     out = capsys.readouterr().out
     assert "same push-diameter function" in out and "quad-twin" in out
+    assert "declared uncertainty" in out and "the ideal model" in out
 
 
 def test_analyze_bad_input_exits_2(tmp_path, capsys):

@@ -111,6 +111,10 @@ def analyze_command(
     Every landing of every part is a member, as ``plan`` plans a mix (a flat part face up
     and face down: a part and its mirror image read alike face up against face down).
 
+    The analysis is the ideal model's (exact rotations and diameters, as section 8 decides
+    it), and says so: under a rotation error a strong plan may tell fewer pairs apart, which
+    ``plan`` and ``changeover compile`` decide for a mix.
+
     Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
@@ -156,6 +160,12 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
     # Over landings each member is a part face up or face down (or a mesh pose).
     summary.add_row("landings" if over_landings else "parts", str(c["parts"]))
     summary.add_row("sensor", sensor_text(result.sensor))
+    summary.add_row(
+        "declared uncertainty",
+        "none: the ideal model (exact rotations and diameters, section 8); under a rotation "
+        "error plans may tell fewer pairs apart (feederkit plan and changeover compile decide "
+        "those)",
+    )
     summary.add_row(
         "tolerances",
         f"{result.angle_tol_deg:g} deg per resting-range side, "
@@ -203,7 +213,9 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
     if result.pairs:
         console.print(_pairs_table(result.pairs, pfs))
     elif result.pairs is not None and not isinstance(result.sensor, NoSensor):
-        console.print("every pair of parts can be told apart by some plan (Theorem 11)")
+        console.print(
+            "every pair of parts can be told apart by some plan on the ideal model (Theorem 11)"
+        )
 
 
 def _pairs_table(pairs: tuple[PairWitness, ...], pfs: list[PushFunction]) -> Table:

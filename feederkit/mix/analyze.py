@@ -16,6 +16,7 @@ from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
 from feederkit.sensors import Sensor
+from feederkit.uncertainty import IDEAL
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,8 @@ class MixAnalysis:
 
         return {
             "sensor": self.sensor.to_dict(),
+            # The exact analysis of section 8 is the ideal model's: say so (design.md).
+            "uncertainty": IDEAL.to_dict(),
             "tolerances": {"angle_deg": self.angle_tol_deg, "diameter_mm": self.length_tol_mm},
             "counts": self.counts(),
             "push_classes": [cls(c) for c in self.shared_push],

@@ -50,7 +50,7 @@ REASON_SAME_DIAMETERS = (
     "(the push-diameter functions agree on them)"
 )
 REASON_TOLERANCE = (
-    "diameters within the sensor tolerance: every action keeps these states reading alike"
+    "diameters the sensor can read alike: every action keeps these states reading alike"
 )
 
 
