@@ -194,11 +194,13 @@ def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
             values[section][key] = float(value)
     sensor = values["sensor"]
     model = sensor.get("model", "none")
+    # The keys given, valid or not: a bad value is named above, not missing as well.
+    given = data.get("sensor") if isinstance(data.get("sensor"), dict) else {}
     needs = {"tolerance": "tolerance_mm", "led": "pitch_mm"}
-    if model in needs and needs[model] not in sensor and not bad_model:
+    if model in needs and needs[model] not in given and not bad_model:
         problems.append(f"sensor.{needs[model]} is required with model = {model!r}")
     for key, owner in (("tolerance_mm", "tolerance"), ("pitch_mm", "led"), ("noise_mm", "led")):
-        if key in sensor and model != owner and not bad_model:
+        if key in given and model != owner and not bad_model:
             problems.append(f"sensor.{key} goes with model = {owner!r}, but the model is {model!r}")
     if problems:
         raise CellProfileError(source, problems)

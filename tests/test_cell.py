@@ -120,6 +120,15 @@ def test_every_bad_field_gets_its_own_line():
     assert len(info.value.problems) == 3
 
 
+def test_a_bad_required_value_is_named_once_not_also_missing():
+    with pytest.raises(CellProfileError) as info:
+        parse_cell({"sensor": {"model": "tolerance", "tolerance_mm": -1}}, "x")
+    assert info.value.problems == ("sensor.tolerance_mm must be a positive number of mm, got -1",)
+    with pytest.raises(CellProfileError) as info:
+        parse_cell({"sensor": {"model": "led"}}, "x")
+    assert info.value.problems == ("sensor.pitch_mm is required with model = 'led'",)
+
+
 def test_broken_and_missing_files_are_one_line(tmp_path):
     with pytest.raises(InputError, match="not a valid TOML file"):
         read_cell(write(tmp_path, "[sensor\nmodel = 1\n"))
