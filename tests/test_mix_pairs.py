@@ -115,7 +115,7 @@ def test_noise_makes_unrecognizability_non_transitive():
     ab, bc, ac = (distinguishable(x, y, sensor) for x, y in ((a, b), (b, c), (a, c)))
     assert ab is not None and bc is not None
     assert ac is None
-    assert ab.kind == "tolerance" and "tolerance" in ab.reason
+    assert ab.kind == "tolerance" and "read alike" in ab.reason and "±" in ab.reason
     pairs = unrecognizable_pairs([a, b, c], sensor)
     assert [(w.part_a, w.part_b) for w in pairs] == [("A", "B"), ("B", "C")]
 
