@@ -15,6 +15,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from feederkit.cli.app import main
 from feederkit.errors import InputError
 from feederkit.hull import clean_hull, contact_hull, convex_hull
 from feederkit.importers import ImportOptions, import_parts, read_source
@@ -227,6 +228,63 @@ def test_zero_area_outline(tmp_path):
         tmp_path / "flat.dxf", lambda m: m.add_lwpolyline([(0, 0), (10, 0), (20, 0)], close=True)
     )
     bad(path, "zero area")
+
+
+def test_a_self_intersecting_polyline_is_refused_not_split(tmp_path):
+    """A bow-tie is refused as the outline file is, naming the entity, not cut in two parts."""
+    path = fx.write_entities(
+        tmp_path / "bow.dxf",
+        lambda m: m.add_lwpolyline([(0, 0), (10, 10), (10, 0), (0, 10)], close=True),
+    )
+    message = bad(path, "the outline is self-intersecting")
+    assert "LWPOLYLINE" in message and "layer '0'" in message and "[5 5]" in message
+    assert main(["part", "analyze", str(path)]) == 2
+
+
+def _rectangle_lines(msp) -> None:
+    for a, b in (((0, 0), (40, 0)), ((40, 0), (40, 30)), ((40, 30), (0, 30)), ((0, 30), (0, 0))):
+        msp.add_line(a, b)
+
+
+CROSSING = {
+    "circle across a polyline": lambda m: (
+        m.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True),
+        m.add_circle((40, 15), 5),
+    ),
+    "circle across lines, beside a hole": lambda m: (
+        _rectangle_lines(m),
+        m.add_circle((40, 15), 5),
+        m.add_circle((20, 15), 5),
+    ),
+    "overlapping outlines": lambda m: (
+        m.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True),
+        m.add_lwpolyline([(20, 10), (60, 10), (60, 50), (20, 50)], close=True),
+    ),
+}
+
+
+@pytest.mark.parametrize("case", CROSSING)
+def test_a_closed_loop_across_the_outline_is_refused(tmp_path, case):
+    """A hole crossing the outline is refused as in an outline file, not welded onto the part."""
+    message = bad(fx.write_entities(tmp_path / "cross.dxf", CROSSING[case]), "crosses the outline")
+    assert "on layer '0'" in message
+    if case.startswith("circle"):
+        assert "CIRCLE" in message
+
+
+def test_loops_that_touch_or_nest_still_import(tmp_path):
+    """A tab drawn against the outline, a hole inside, a separate part: no crossing."""
+
+    def build(msp):
+        msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True)
+        msp.add_lwpolyline([(40, 10), (50, 10), (50, 20), (40, 20)])  # a tab on the side
+        msp.add_circle((20, 15), 5)
+        msp.add_lwpolyline([(60, 0), (70, 0), (70, 10), (60, 10)], close=True)
+
+    ip = one(fx.write_entities(tmp_path / "tab.dxf", build))
+    assert area(ip) == pytest.approx(1200.0 + 100.0 - math.pi * 25.0, rel=1e-3)
+    assert len(ip.part.outline.holes) == 1
+    assert any("2 separate parts" in w for w in ip.warnings)
 
 
 def test_unknown_unit_code(tmp_path):

@@ -400,8 +400,9 @@ def dxf_lines(
     scale: float,
     label: str,
     budget: Budget,
-) -> tuple[list[np.ndarray], Counter[str], list[str], float]:
-    """Outline polylines of the chosen space (mm), skipped types, warnings, flatten tolerance.
+) -> tuple[list[np.ndarray], list[str], Counter[str], list[str], float]:
+    """Outline polylines of the chosen space (mm), the entity (and layer) of each, skipped
+    types, warnings, flatten tolerance.
 
     With ``options.layers``, only entities on those layers (case-insensitive; block contents
     on layer "0" count on their reference's layer) are read. Every coordinate is checked as
@@ -416,6 +417,7 @@ def dxf_lines(
     layouts = space_layouts(doc, options.space)
     _count_expanded(doc, layouts, budget)
     paths: list[tuple[DXFGraphic, dxfpath.Path]] = []
+    owners: list[str] = []
     lo = np.full(2, np.inf)
     hi = np.full(2, -np.inf)
     for layout in layouts:
@@ -449,6 +451,7 @@ def dxf_lines(
             xy = cv[:, :2]
             lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
             paths.append((entity, path))
+            owners.append(f"{_label(entity)} on layer {layer!r}")
     notes: list[str] = []
     if wanted and not paths and seen:
         names = ", ".join(sorted(seen))
@@ -456,7 +459,7 @@ def dxf_lines(
             f"{label}: no geometry on layer {', '.join(sorted(layers))} (layers: {names})"
         )
     if not paths:
-        return [], skipped, notes, options.flatten_tolerance
+        return [], [], skipped, notes, options.flatten_tolerance
     size_mm = float((hi - lo).max()) * scale
     flatten_mm = options.flatten_tolerance
     if REL_FLATTEN * size_mm > flatten_mm:
@@ -474,7 +477,8 @@ def dxf_lines(
         entity = paths[exc.piece][0]
         raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates") from None
     lines = [pts * scale for pieces in flat for pts in pieces]
-    return lines, skipped, notes, flatten_mm
+    names = [owner for owner, pieces in zip(owners, flat, strict=True) for _ in pieces]
+    return lines, names, skipped, notes, flatten_mm
 
 
 def _describe(region: Region) -> str:
@@ -541,7 +545,7 @@ def _read_doc(
     doc: DxfDocument, path: Path, options: ImportOptions, name: str, budget: Budget
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
     unit_name, scale, warnings_ = drawing_units(doc, options.units, str(path))
-    lines, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
+    lines, names, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
     warnings_ += notes
     if not lines:
         what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
@@ -549,7 +553,7 @@ def _read_doc(
             f"{path}: no outline geometry (lines, arcs, curves) in the "
             f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget)
+    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget, names)
     warnings_ += list(drawing.warnings)
     if drawing.frames:
         warnings_.append(f"skipped {drawing.frames} drawing frame(s) around the part")

@@ -3,7 +3,9 @@
 Pure functions on polylines in millimetres (numpy arrays of shape (n, 2)). Loops are built
 with ``shapely.polygonize`` per connected group of lines, so lines that cross a part (centre
 lines, bend lines) do not split it; a loop inside a part is a hole, a loop inside a hole is
-a separate part.
+a separate part. A closed entity (polyline, circle) that crosses itself or another loop is
+refused rather than merged: polygonizing would split a bow-tie into two parts and weld a
+crossing circle onto the outline.
 """
 
 from __future__ import annotations
@@ -348,14 +350,90 @@ def heal_gaps(
     return list(lines) + bridges, [note]
 
 
+def _is_closed(line: np.ndarray, gap: float) -> bool:
+    """Whether a polyline is a closed ring (its ends within ``gap``) with room for an area."""
+    return len(line) >= 4 and float(np.hypot(*(line[0] - line[-1]))) <= gap
+
+
+def self_crossing(line: np.ndarray) -> str | None:
+    """Where a closed polyline crosses or touches itself (GEOS's reason), else None.
+
+    A ring that encloses no area (a line drawn there and back) is no outline and is left to
+    the loop search, which ignores it.
+    """
+    ring = shapely.linearrings(np.asarray(line, dtype=float))
+    if shapely.is_simple(ring):
+        return None
+    if float(shapely.area(shapely.polygonize([shapely.node(ring)]))) <= 0.0:
+        return None
+    return shapely.is_valid_reason(Polygon(ring.coords))
+
+
+def _overlap(a: Polygon, b: Polygon, tiny: float) -> bool:
+    """Whether two filled loops cross: they share area and neither holds the other."""
+    common = float(a.intersection(b).area)
+    return common > tiny and a.area - common > tiny and b.area - common > tiny
+
+
+def crossing_loop(
+    lines: Sequence[np.ndarray],
+    closed: Sequence[int],
+    shells: Sequence[Polygon],
+    gap: float,
+    budget: Budget | None = None,
+) -> int | None:
+    """The closed line (index into ``lines``) that crosses another loop, else None.
+
+    Polygonizing merges crossing loops into one part, so a circle drawn across the outline
+    (or two overlapping closed outlines) would silently change the part. A candidate is a
+    closed line lying partly on a loop's boundary and partly inside it; it crosses when
+    the other lines, without it, close a loop that it overlaps. Smallest candidates first,
+    so a circle across the outline is named rather than the outline.
+    """
+    if not shells:
+        return None
+    tree = shapely.STRtree(shells)
+    candidates: list[tuple[float, int, Polygon]] = []
+    for k in closed:
+        ring = np.asarray(lines[k], dtype=float)
+        poly = Polygon(ring)
+        if not poly.is_valid or poly.area <= 0.0:
+            continue
+        points = shapely.points(ring[:-1])
+        for j in tree.query(poly, predicate="intersects"):
+            shell = shells[int(j)]
+            if abs(shell.area - poly.area) <= 1e-9 * shell.area:
+                continue  # the outline itself
+            dist = shapely.distance(points, shell.exterior)
+            inside = shapely.contains_xy(shell, ring[:-1, 0], ring[:-1, 1])
+            if (dist <= gap).any() and (inside & (dist > gap)).any():
+                candidates.append((poly.area, k, poly))
+                break
+    for _, k, poly in sorted(candidates, key=lambda c: c[:2]):
+        if budget is not None:
+            budget.check_time()
+        others = [ln for i, ln in enumerate(lines) if i != k]
+        loops, _ = closed_loops(others)
+        tiny = 1e-9 * poly.area
+        if any(_overlap(poly, lp.polygon, tiny) for lp in loops):
+            return k
+    return None
+
+
 def drawing_from_lines(
-    lines: Sequence[np.ndarray], gap: float, label: str, budget: Budget | None = None
+    lines: Sequence[np.ndarray],
+    gap: float,
+    label: str,
+    budget: Budget | None = None,
+    names: Sequence[str] | None = None,
 ) -> Drawing:
     """Parts of a drawing from its flattened lines (mm); InputError without a closed loop.
 
     Line ends closer than ``gap`` (the flatten tolerance) are joined; open ends up to
     :data:`HEAL_GAP_REL` of the drawing's size apart are bridged, with a warning, before the
-    loops and holes are chosen.
+    loops and holes are chosen. A closed line that crosses itself, or crosses another loop
+    (a hole across the outline), is refused, as an outline file with those faults is;
+    ``names[k]`` names line ``k`` in that error (an entity and its layer).
     """
     if not lines:
         raise InputError(f"{label}: the drawing has no lines, arcs or curves")
@@ -364,6 +442,15 @@ def drawing_from_lines(
     if float(extent.max()) == 0.0 or float(extent.min()) <= 1e-12 * float(extent.max()):
         raise InputError(f"{label}: the outline has zero area (all geometry lies on a line)")
     snapped = snap_endpoints(lines, gap)
+
+    def name(k: int) -> str:
+        return names[k] if names is not None and k < len(names) else f"closed line {k + 1}"
+
+    closed = [k for k, ln in enumerate(snapped) if _is_closed(ln, gap)]
+    for k in closed:
+        reason = self_crossing(snapped[k])
+        if reason is not None:
+            raise InputError(f"{label}: the outline is self-intersecting ({name(k)}: {reason})")
     healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
     if budget is not None:
         budget.check_time()
@@ -372,6 +459,12 @@ def drawing_from_lines(
         ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
         detail = f" ({plural(ends, 'open end')})" if ends else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
+    crossing = crossing_loop(healed, closed, [lp.polygon for lp in loops], gap, budget)
+    if crossing is not None:
+        raise InputError(
+            f"{label}: a hole crosses the outline ({name(crossing)} crosses another loop; "
+            "leave construction geometry out with --layer)"
+        )
     drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
