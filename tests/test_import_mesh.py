@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import fixtures_cad as fx
@@ -160,6 +161,38 @@ def test_bad_mesh_files(tmp_path, content, match):
     with pytest.raises(InputError, match=match) as info:
         one(path)
     assert "\n" not in str(info.value)
+
+
+@pytest.fixture
+def no_charset_module(monkeypatch: pytest.MonkeyPatch) -> None:
+    """trimesh's optional text-encoding guesser is not installed (as in a plain install)."""
+    monkeypatch.setitem(sys.modules, "charset_normalizer", None)
+
+
+@pytest.mark.parametrize(
+    ("suffix", "said"),
+    [(".stl", "not an STL file (neither binary nor ASCII STL)"), (".obj", "not an OBJ file")],
+)
+def test_random_bytes_are_named_as_the_file_not_a_module(tmp_path, no_charset_module, suffix, said):
+    """Bytes that are no mesh make trimesh reach for an encoding guesser: the file is named."""
+    path = tmp_path / f"garbage{suffix}"
+    path.write_bytes(bytes(range(256)) * 2)
+    with pytest.raises(InputError) as info:
+        one(path)
+    message = str(info.value)
+    assert message == f"{path}: {said}" or message.startswith(f"{path}: {said} (")
+    assert "module" not in message and "charset" not in message
+
+
+def test_a_text_stl_that_is_not_utf8_names_the_package_it_needs(tmp_path, no_charset_module):
+    """A text STL in Latin-1 is readable with the guesser: the missing package is named."""
+    path = tmp_path / "latin.stl"
+    path.write_bytes(
+        b"solid caf\xe9\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"
+        b"   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid\n"
+    )
+    with pytest.raises(InputError, match="needs the Python package 'charset_normalizer'"):
+        one(path)
 
 
 def test_flat_mesh_refused(tmp_path):

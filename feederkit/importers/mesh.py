@@ -82,6 +82,55 @@ def _precount_faces(path: Path, budget: Budget) -> None:
             budget.need("faces", total, noun)
 
 
+NOT_THE_FORMAT = {
+    "stl": "not an STL file (neither binary nor ASCII STL)",
+    "obj": "not an OBJ file (not text with vertex lines)",
+    "ply": "not a PLY file (no 'ply' header)",
+}
+"""What a file that is not of its extension's format is called, by extension."""
+
+SNIFF_BYTES = 65_536
+"""Bytes read from a file's start to tell whether it looks like its mesh format."""
+
+
+def looks_like_format(head: bytes, kind: str) -> bool:
+    """Whether a file's first bytes look like a text STL, an OBJ or a PLY file.
+
+    Used only once trimesh failed, to tell a broken file from a readable one.
+    """
+    text = head.lstrip()
+    if kind == "stl":
+        return text[:5].lower() == b"solid" and b"facet" in text.lower()
+    if kind == "ply":
+        return text[:3] == b"ply"
+    if kind == "obj":
+        return any(ln.lstrip().startswith((b"v ", b"v\t")) for ln in text.splitlines())
+    return False
+
+
+def _needs_module(path: Path, exc: ImportError) -> InputError:
+    """The error for a file whose reading made trimesh import a module that is missing.
+
+    trimesh imports optional modules while it reads: ``charset_normalizer`` to guess the
+    encoding of text that is not UTF-8, which is how random bytes in an ``.stl`` end. A file
+    that does not look like its format is named as such (the module is trimesh's business);
+    one that does is readable with the module, which is then named so it can be installed.
+    """
+    kind = path.suffix.lower().lstrip(".")
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(SNIFF_BYTES)
+    except OSError as err:
+        return InputError(f"{path}: cannot read the file ({err.strerror})")
+    if not looks_like_format(head, kind):
+        return InputError(f"{path}: {NOT_THE_FORMAT.get(kind, 'not a readable mesh')}")
+    module = exc.name or "an optional module"
+    return InputError(
+        f"{path}: reading this {kind.upper()} file needs the Python package {module!r}, "
+        "which is not installed (its text is not UTF-8)"
+    )
+
+
 def load_mesh(
     path: Path, units: str | None, budget: Budget | None = None
 ) -> tuple[trimesh.Trimesh, str, list[str]]:
@@ -101,6 +150,8 @@ def load_mesh(
             mesh = trimesh.load_mesh(path, file_type=path.suffix.lower().lstrip("."), process=True)
     except InputError:
         raise
+    except ImportError as exc:  # an optional module trimesh wanted for this file's content
+        raise _needs_module(path, exc) from None
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types on broken files
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputError(f"{path}: not a readable mesh ({reason})") from None
