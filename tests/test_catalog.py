@@ -69,11 +69,13 @@ def test_missing_foreign_and_future_catalogs(tmp_path):
 
 def test_migration_from_an_empty_file(tmp_path):
     db = tmp_path / "empty.db"
-    sqlite3.connect(db).close()  # an empty SQLite file is version 0
-    assert cat.list_parts(db) == []
-    conn = cat.open_catalog(db)
+    sqlite3.connect(db).close()  # an empty SQLite file is version 0: no catalog until made one
+    with pytest.raises(InputError, match="no catalog there"):
+        cat.list_parts(db)
+    conn = cat.open_catalog(db, create=True)
     assert cat.schema_version(conn) == cat.SCHEMA_VERSION
     conn.close()
+    assert cat.list_parts(db) == []
 
 
 def test_revisions_by_sha256(tmp_path):

@@ -5,29 +5,30 @@ from __future__ import annotations
 
 import json
 import shutil
+import sqlite3
 from pathlib import Path
 
 import pytest
 from shared import catalog_snapshot as snapshot
 
-from feederkit.catalog import SCHEMA_VERSION, add_file, list_parts, open_catalog, schema_version
+from feederkit.catalog import SCHEMA_VERSION, list_parts, open_catalog, schema_version
 from feederkit.cli.app import main
 from feederkit.errors import InputError
 
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 
 READS = (
-    (("catalog", "list"), 0, "0 parts"),
-    (("catalog", "show", "octagon"), 2, "no part named 'octagon'"),
-    (("catalog", "export", "octagon", "-o", "out.json"), 2, "no part named 'octagon'"),
-    (("catalog", "analyze"), 0, ""),
-    (("catalog", "remove", "octagon"), 2, "no part named 'octagon'"),
-    (("changeover", "list"), 0, "no changeovers"),
-    (("changeover", "show", "line-1"), 2, "no changeover named 'line-1'"),
-    (("changeover", "remove", "line-1"), 2, "no changeover named 'line-1'"),
-    (("plan", "SOMENAME"), 2, "no part named 'SOMENAME'"),
+    ("catalog", "list"),
+    ("catalog", "show", "octagon"),
+    ("catalog", "export", "octagon", "-o", "out.json"),
+    ("catalog", "analyze"),
+    ("catalog", "remove", "octagon"),
+    ("changeover", "list"),
+    ("changeover", "show", "line-1"),
+    ("changeover", "remove", "line-1"),
+    ("plan", "SOMENAME"),
 )
-"""Commands that must read an empty file as an empty catalog: exit code, words said."""
+"""Commands that must take an empty file for no catalog, as a missing one, and leave it empty."""
 
 
 @pytest.fixture
@@ -53,37 +54,70 @@ def plate(path: Path) -> Path:
     return path
 
 
-# 1. An existing empty file is read as an empty catalog, never turned into one by a read.
+# 1. An existing empty file is no catalog, as a missing one, and a read never writes to it.
+
+NO_CATALOG = "no catalog there"
 
 
-@pytest.mark.parametrize(
-    ("command", "code", "said"), READS, ids=[" ".join(c[:2]) for c, _, _ in READS]
-)
-def test_a_read_leaves_an_empty_file_empty(here, capsys, command, code, said) -> None:
+@pytest.mark.parametrize("command", READS, ids=[" ".join(c[:2]) for c in READS])
+def test_a_read_takes_an_empty_file_for_no_catalog(here, capsys, command) -> None:
     db = here / "zero.db"
     db.write_bytes(b"")
     got, out, err = run(capsys, *command, "--catalog", str(db))
-    assert got == code and said in out + err
-    assert len(err.strip().splitlines()) <= 1 and "Traceback" not in err
+    assert got == 2 and NO_CATALOG in err and "catalog init" in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert db.stat().st_size == 0
     assert sorted(p.name for p in here.iterdir()) == ["zero.db"]  # no -wal, -shm or out.json
 
 
-def test_open_catalog_reads_an_empty_file_and_commits_no_write(here) -> None:
+def test_open_catalog_refuses_an_empty_file_unless_it_creates(here) -> None:
     db = here / "zero.db"
     db.write_bytes(b"")
-    plate(here / "plate.json")
-    conn = open_catalog(db)
+    with pytest.raises(InputError, match=f"{NO_CATALOG} \\(an empty file; create one with"):
+        open_catalog(db)
+    with pytest.raises(InputError, match=NO_CATALOG):
+        list_parts(db)
+    assert db.stat().st_size == 0
+    conn = open_catalog(db, create=True)
     try:
         assert list_parts(conn) == [] and schema_version(conn) == SCHEMA_VERSION
-        with pytest.raises(InputError, match="an empty file, not a catalog yet; nothing was"):
-            add_file(conn, here / "plate.json")  # it would be lost with the connection
-        assert list_parts(conn) == []
     finally:
         conn.close()
-    assert db.stat().st_size == 0
-    open_catalog(db, create=True).close()
     assert db.stat().st_size > 0
+
+
+def test_a_read_takes_an_sqlite_file_without_tables_for_no_catalog(here, capsys) -> None:
+    """An SQLite database with nothing in it is not a catalog either: a read leaves it so."""
+    db = here / "blank.db"
+    conn = sqlite3.connect(db)
+    conn.execute("CREATE TABLE t (x)")
+    conn.execute("DROP TABLE t")
+    conn.commit()
+    conn.close()
+    before = db.read_bytes()
+    code, _, err = run(capsys, "catalog", "list", "--catalog", str(db))
+    assert code == 2 and NO_CATALOG in err and "without tables" in err
+    assert db.read_bytes() == before
+    code, out, _ = run(capsys, "catalog", "init", "--catalog", str(db))
+    assert code == 0 and "ready" in out
+    assert run(capsys, "catalog", "list", "--catalog", str(db))[0] == 0
+
+
+def test_other_files_stay_refused_by_reads_and_init(here, capsys) -> None:
+    """A file that is not SQLite, or another program's database, is never taken over."""
+    text = here / "notes.db"
+    text.write_text("not a database at all, just some words in a file " * 20)
+    foreign = here / "other.db"
+    conn = sqlite3.connect(foreign)
+    conn.execute("CREATE TABLE t (x)")
+    conn.commit()
+    conn.close()
+    for db, said in ((text, "not a feederkit catalog"), (foreign, "not a feederkit catalog")):
+        before = db.read_bytes()
+        for command in (("catalog", "list"), ("catalog", "init")):
+            code, _, err = run(capsys, *command, "--catalog", str(db))
+            assert code == 2 and said in err, (db, command, err)
+        assert db.read_bytes() == before
 
 
 @pytest.mark.parametrize("command", (("catalog", "init"), ("catalog", "add", "plate.json")))

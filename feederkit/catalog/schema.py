@@ -125,15 +125,10 @@ def set_busy_notifier(notify: Callable[[str], None] | None) -> None:
 
 
 class CatalogConnection(sqlite3.Connection):
-    """A catalog connection that knows its file and how long to wait for a busy catalog.
-
-    ``empty_file``: the file is empty (0 bytes) and this is an empty catalog in memory
-    standing in for it, which commits no write (:func:`_empty_catalog`).
-    """
+    """A catalog connection that knows its file and how long to wait for a busy catalog."""
 
     path: Path = Path("?")
     wait: float = DEFAULT_WAIT
-    empty_file: bool = False
 
 
 def catalog_file_of(conn: sqlite3.Connection) -> Path:
@@ -251,19 +246,12 @@ def transaction(
 
     ``before_commit`` runs after the body, inside the transaction: when it raises, nothing is
     committed (used to write a changeover's files only together with its row). SQLite errors
-    (busy, read-only, full disk at ``COMMIT``, damaged file) become one-line InputErrors. On
-    the stand-in for an empty file (:func:`_empty_catalog`) the body runs, so its own errors
-    ("no part named ...") are said, but nothing is committed: the write would be lost.
+    (busy, read-only, full disk at ``COMMIT``, damaged file) become one-line InputErrors.
     """
     path = catalog_file_of(conn)
     _begin(conn, path)
     try:
         yield conn
-        if isinstance(conn, CatalogConnection) and conn.empty_file:
-            raise InputError(
-                f"{path}: an empty file, not a catalog yet; nothing was written (make it a "
-                "catalog with 'feederkit catalog init')"
-            )
         if before_commit is not None:
             before_commit()
         conn.execute("COMMIT")
@@ -301,21 +289,10 @@ def _text(raw: bytes) -> str:
     return raw.decode("utf-8", "surrogateescape")
 
 
-def _empty_catalog(p: Path, wait: float) -> CatalogConnection:
-    """An empty catalog in memory for the empty (0-byte) file ``p``, opened without ``create``.
-
-    SQLite takes such a file for an empty database, and migrating it would write the schema:
-    a read (``catalog list``, ``plan NAME``, ...) would turn any empty file into a catalog.
-    Only ``init``, ``add`` and ``import`` make a catalog (docs/catalog.md); this connection
-    reads as a catalog without parts and commits no write (:func:`transaction`).
-    """
-    conn = sqlite3.connect(":memory:", isolation_level=None, factory=CatalogConnection)
-    conn.path, conn.wait = p, wait
-    conn.text_factory = _text
-    conn.execute("PRAGMA foreign_keys = ON")
-    migrate(conn)
-    conn.empty_file = True
-    return conn
+def no_catalog(p: Path, what: str = "") -> InputError:
+    """The error for a catalog that is not there: a missing file, or ``what`` is there instead."""
+    where = f"{what}; " if what else ""
+    return InputError(f"{p}: no catalog there ({where}create one with 'feederkit catalog init')")
 
 
 def connect(
@@ -326,8 +303,9 @@ def connect(
     ``wait`` is how many seconds a write waits for another process's transaction. Raises
     InputError, one line naming the file, when it is missing (without ``create``), cannot be
     created or opened, is read-only where a write is needed, or is not a catalog. An empty
-    (0-byte) file is made a catalog only with ``create``; without, it reads as an empty
-    catalog and is not written (:func:`_empty_catalog`).
+    (0-byte) file or an SQLite file without tables is made a catalog only with ``create``;
+    without, it is no catalog, as a missing file is, and is left as it was: SQLite would take
+    it for an empty database and migrating it would write the schema on a mere read.
     """
     p = Path(path)
     if not wait >= 0.0 or wait > 86400.0:
@@ -340,10 +318,10 @@ def connect(
     except OSError as exc:
         raise InputError(f"{p}: cannot open the catalog ({exc.strerror})") from None
     if empty and not create:
-        return _empty_catalog(p, wait)
+        raise no_catalog(p, "an empty file")
     if not exists:
         if not create:
-            raise InputError(f"{p}: no catalog there (create one with 'feederkit catalog init')")
+            raise no_catalog(p)
         folder = p.parent if str(p.parent) else Path(".")
         if not folder.is_dir():
             raise InputError(f"{p}: cannot create the catalog: the folder {folder} does not exist")
@@ -358,14 +336,16 @@ def connect(
     try:
         conn.execute("PRAGMA foreign_keys = ON")
         conn.execute(f"PRAGMA busy_timeout = {int(wait * 1000)}")
+        if schema_version(conn) == 0:  # checked before WAL mode, which writes the header
+            tables = conn.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]
+            if tables:
+                raise InputError(f"{p}: an SQLite file but not a feederkit catalog")
+            if not create:
+                raise no_catalog(p, "an SQLite file without tables")
         mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
         if str(mode).lower() != "wal":
             raise InputError(f"{p}: the catalog cannot use WAL journaling (got {mode})")
         conn.execute("PRAGMA synchronous = FULL")
-        if schema_version(conn) == 0:
-            tables = conn.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]
-            if tables:
-                raise InputError(f"{p}: an SQLite file but not a feederkit catalog")
         migrate(conn)
     except sqlite3.DatabaseError as exc:
         conn.close()
