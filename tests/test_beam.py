@@ -16,7 +16,7 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning import api
 from feederkit.planning.api import _choice_plan, _result, goal_relation, plan
-from feederkit.planning.beam import BeamSearch, _depth, beam_plan, branch_key
+from feederkit.planning.beam import BeamSearch, _depth, _lengths, beam_plan, branch_key
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
@@ -96,6 +96,36 @@ def _random_part_machine(seed: int = 3, n: int = 10, rel: float = 0.08):
     return build_machine([pf], ToleranceSensor(rel * pf.part.size), uncertainty=IDEAL)
 
 
+def test_a_cheap_failure_probes_the_beam_twice_as_wide_at_the_same_target(monkeypatch):
+    """Width 4 has no plan within 3 for this part, width 8 has one: with the bound at 3 the
+    first plan is found there, not at a deeper target of the narrow beam; without polls for
+    the probe the target grows as before."""
+    from feederkit.planning import beam as beam_module
+
+    machine = _random_part_machine(seed=8, n=14, rel=0.2)
+    problem, branches, roots = _problem(machine)
+    assert _lengths(BeamSearch(problem, 4, Deadline()), roots, 3) is None
+    assert max(_lengths(BeamSearch(problem, 8, Deadline()), roots, 3)) == 3
+    calls = []
+    real = beam_module._lengths
+
+    def spy(beam, roots_, target):
+        out = real(beam, roots_, target)
+        calls.append((beam.width, target, None if out is None else max(out)))
+        return out
+
+    monkeypatch.setattr(beam_module, "_lengths", spy)
+    found = beam_plan(problem, roots, None, Deadline(), 2 * machine.n + 1, 3)
+    assert calls == [(4, 3, None), (8, 3, 3)] and found[1] == 3
+    root = _choice_plan(problem, found[0].choice, roots, branches, Deadline())
+    assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == 4
+    calls.clear()
+    monkeypatch.setattr(beam_module, "PROBE_POLLS", 0)
+    beam_plan(problem, roots, None, Deadline(), 2 * machine.n + 1, 3)
+    # The probe stops at its first poll (not recorded: it raised): the narrow beam goes on.
+    assert calls[:2] == [(4, 3, None), (4, 4, 4)]
+
+
 def test_the_beam_keeps_the_actions_with_the_smallest_branches():
     problem, _branches, roots = _problem(_random_part_machine())
     mask = max(roots, key=int.bit_count)
@@ -125,9 +155,10 @@ def test_the_beams_ranking_keeps_what_sorting_every_action_keeps(seed, n, rel):
 
 
 def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):
-    # Before the first plan the targets are the bound, then 1, 2, 4, ... more than the last;
-    # after it each target is one less than the best plan so far; a plan found within a
-    # target is never longer than it, and its tree is as long as the lengths say.
+    # Before the first plan the targets are the bound, then 1, 2, 4, ... more than the last,
+    # each cheap failure of the first width followed by one probe twice as wide at the same
+    # target; after it each target is one less than the best plan so far; a plan found
+    # within a target is never longer than it, and its tree is as long as the lengths say.
     from feederkit.planning import beam as beam_module
 
     machine = _random_part_machine(seed=1, n=10, rel=0.2)  # a plan of 6 in the first beam
@@ -137,16 +168,17 @@ def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):
 
     def spy(beam, roots_, target):
         out = real(beam, roots_, target)
-        calls.append((target, out, dict(beam.choice)))
+        calls.append((target, out, beam.width))
         return out
 
     monkeypatch.setattr(beam_module, "_lengths", spy)
     found = beam_plan(problem, roots, None, Deadline(), 2 * machine.n + 1)
     assert found is not None
-    firsts = [t for t, out, _c in calls[: next(i for i, c in enumerate(calls) if c[1]) + 1]]
-    assert firsts == [1, 2, 4, 8]
+    firsts = [(w, t) for t, _out, w in calls[: next(i for i, c in enumerate(calls) if c[1]) + 1]]
+    w = beam_module.FIRST_WIDTH
+    assert firsts == [(w, 1), (2 * w, 1), (w, 2), (2 * w, 2), (w, 4), (2 * w, 4), (w, 8)]
     best = None
-    for target, out, _choice in calls:
+    for target, out, _width in calls:
         if best is not None:
             assert target <= best - 1
         if out is not None:
