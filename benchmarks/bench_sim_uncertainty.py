@@ -25,7 +25,6 @@ creep (elliptic cones with a higher ``impratio``, ``noslip_iterations``).
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import tempfile
 import time
@@ -41,20 +40,12 @@ from feederkit.mechanics.push import PushFunction  # noqa: E402
 from feederkit.plans.make import make_plan  # noqa: E402
 from feederkit.sensors import ToleranceSensor  # noqa: E402
 from feederkit.sim import PushAligner, SceneConfig, simulate_plan  # noqa: E402
+from feederkit.sim.summary import wilson  # noqa: E402
 from feederkit.uncertainty import Uncertainty  # noqa: E402
 
 TARGET = 0.995
 UNCERTAINTY = Uncertainty(1.0, 0.0, 0.0)
 SENSOR_PERCENT = 1.0
-
-
-def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
-    """The 95 % Wilson score interval of ``k`` successes in ``n`` trials."""
-    p = k / n
-    den = 1.0 + z * z / n
-    mid = (p + z * z / (2 * n)) / den
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return max(0.0, mid - half), min(1.0, mid + half)
 
 
 def sensor_for(pfs: list[PushFunction]) -> ToleranceSensor:

@@ -276,7 +276,7 @@ def test_statistics_cycle_time_and_simulation():
     assert f"{expected:.3f} operations" in text
     assert "\u00b118.43\u00b0" in text
     assert f"{4.5 * expected:.3g} s expected, 9 s worst case at 4.5 s per operation" in text
-    assert "19 of 20 trials oriented correctly (95%)" in text
+    assert "successes (oriented correctly): 19 of 20 (95%)" in text
     assert "yes: no shorter plan exists (lower bound 2)" in text
     assert "within \u00b10.01 mm" in text
     without = "".join(parse(render_report(triangle_plan())).text)
@@ -474,8 +474,8 @@ def test_the_simulation_row_is_in_words():
         "min_margin_deg": 18.43,
     }
     text = "".join(parse(render_report(triangle_plan(), simulation=sim)).text)
-    assert "8 of 10 trials oriented correctly (80%)" in text
-    assert "2 ended in a wrong pose, 0 never settled" in text
+    assert "successes (oriented correctly): 8 of 10 (80%)" in text
+    assert "failures 2, never settled 0" in text
     assert "18 of 19 settled pushes ended where the push function says" in text
     assert "success_rate" not in text and "min_margin_deg" not in text
 

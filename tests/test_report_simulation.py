@@ -25,10 +25,57 @@ def test_report_shows_the_simulated_success_rate(plan_file: Path, tmp_path: Path
     html = tmp_path / "report.html"
     assert main(["report", str(plan_file), "-o", str(html), "--simulate", "4", "--seed", "3"]) == 0
     text = html.read_text(encoding="utf-8")
-    assert "of 4 trials oriented correctly" in text
+    assert "successes (oriented correctly): 4 of 4 (100.0 %; 95 % Wilson interval" in text
+    assert "seed 3" in text and "sampled: rotation error ±1 deg per rotation" in text
 
 
 def test_report_refuses_a_non_positive_trial_count(plan_file: Path, tmp_path: Path) -> None:
     html = tmp_path / "report.html"
     assert main(["report", str(plan_file), "-o", str(html), "--simulate", "0"]) == 2
     assert not html.exists()
+
+
+def _trial(i: int, outcome: str, cause: str | None = None, rejected: bool = False):
+    from feederkit.sim.summary import TrialResult
+
+    return TrialResult(
+        i, "bracket", 0.0, outcome, 2, "why", 0, (), cause=cause, predicted=False, rejected=rejected
+    )
+
+
+def test_the_simulation_row_uses_the_simulators_summary() -> None:
+    """The report says what ``simulate`` says: failures by cause (never all "a wrong pose"),
+    the sampled uncertainty, the seed, the Wilson interval, the rightly rejected apart."""
+    from feederkit.reports.sections import simulation_text
+    from feederkit.sim.summary import SimSettings, SimulationSummary
+    from feederkit.uncertainty import Uncertainty
+
+    failures = (
+        _trial(5, "failure", "reading in no branch"),
+        _trial(6, "failure", "reading in no branch"),
+        _trial(7, "failure", "wrong result"),
+    )
+    summary = SimulationSummary(
+        settings=SimSettings(40, 7, 1.0, 0.1, 0.5, 0.2, 0.002, sampled=Uncertainty(1.0, 0.0, 0.0)),
+        parts=("bracket (up)", "bracket (down)"),
+        part_trials=(20, 20),
+        part_successes=(18, 19),
+        scales=(1.0, 1.0),
+        min_margin_deg=3.0,
+        successes=37,
+        failures=failures,
+        unsettled=(),
+        pushes=80,
+        settled_pushes=80,
+        push_agreements=80,
+        push_misses=(),
+        wall_time_s=0.0,
+        sim_time_s=0.0,
+        rejects=19,
+    )
+    text = simulation_text(summary.to_dict())
+    assert "wrong pose" not in text
+    assert "reading in no branch: 2" in text and "wrong result: 1" in text
+    assert "95 % Wilson interval" in text and summary.success_words() in text
+    assert "18 oriented correctly and 19 rightly rejected" in text
+    assert "sampled: rotation error ±1 deg per rotation" in text and "seed 7" in text

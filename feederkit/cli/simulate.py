@@ -34,10 +34,15 @@ from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
     DEFAULT_FRICTION_BELT_RANGE,
     DEFAULT_FRICTION_FENCE_RANGE,
+    check_rotation_noise,
     simulate_plan,
 )
 from feederkit.sim.engine import require_mujoco
 from feederkit.sim.summary import SimulationSummary
+
+REJECTED = "rightly rejected"
+"""Successes that ended in a reject leaf naming the member (design.md, "Landings")."""
+REJECTED_WHY = "a reject leaf naming the landing"
 
 SHOWN_ROWS = 20
 """Failures and misses listed in the terminal (all of them are in ``--json``)."""
@@ -45,30 +50,21 @@ SHOWN_ROWS = 20
 
 def _print_summary(s: SimulationSummary, declared: str) -> None:
     st = s.settings
-    fb, ff = st.friction_belt_range, st.friction_fence_range
-    sampled = (
-        "nothing sampled (--ideal)"
-        if st.ideal
-        else f"sampled: rotation error ±{st.rotation_noise_deg:g} deg per rotation, vertices "
-        f"within {st.sampled.shape_tolerance_mm:g} mm, COM within "
-        f"{st.sampled.com_tolerance_mm:g} mm, friction belt {fb.text() if fb else '-'} / fence "
-        f"{ff.text() if ff else '-'}"
-    )
     console.print(
         f"[bold]simulated[/] {escape(', '.join(s.parts))}: {plural(st.trials, 'trial')}, "
         f"seed {st.seed}, "
         f"belt {st.belt_speed:g} m/s; declared uncertainty: {escape(declared)}; "
-        f"{escape(sampled)}; contact: {escape(st.contact)}",
+        f"{escape(st.sampled_words())}; contact: {escape(st.contact)}",
         highlight=False,
         soft_wrap=True,
     )
     table = Table(show_header=False, box=None, pad_edge=False)
-    table.add_row("successes", f"{s.successes} of {s.trials} ({100 * s.success_rate:.1f}%)")
+    table.add_row("successes", escape(s.success_words()))
     if len(s.parts) > 1:
         for name, t, k in zip(s.parts, s.part_trials, s.part_successes, strict=True):
             table.add_row(f"  {escape(name)}", f"{k} of {t}")
     if s.rejects:
-        table.add_row("  of them rejected", f"{s.rejects} (a reject leaf naming the landing)")
+        table.add_row(f"  of them {REJECTED}", f"{s.rejects} ({REJECTED_WHY})")
     table.add_row("failures", str(len(s.failures)))
     if s.wrong_accepts:
         table.add_row("  wrong accepts", f"{s.wrong_accepts} (accepted, landing or state wrong)")
@@ -83,19 +79,16 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     )
     margin = "none (no rotations)" if s.min_margin_deg is None else f"{s.min_margin_deg:.3g} deg"
     table.add_row("plan's smallest margin", margin)
+    if s.certified is not None:
+        table.add_row("plan certifies", escape(s.certified.words()))
     table.add_row(
         "wall time", f"{s.wall_time_s:.2f} s ({plural(s.pushes, 'push-align operation')})"
     )
     console.print(table)
-    if (
-        s.min_margin_deg is not None
-        and st.sampled.is_ideal
-        and st.rotation_noise_deg > s.min_margin_deg
-    ):
-        console.print(
-            "[yellow]note:[/] the rotation noise exceeds the plan's smallest margin; "
-            "failures are expected",
-        )
+    if s.beyond_certified:
+        console.print(f"[yellow]note:[/] {escape(s.beyond_certified)}", highlight=False)
+    if s.width_warning:
+        console.print(f"[yellow]warning:[/] {escape(s.width_warning)}", highlight=False)
     rows = s.went_wrong
     if rows:
         t = Table(title="trials that went wrong (model errors first)", title_justify="left")
@@ -164,7 +157,7 @@ def simulate_command(
         typer.Option(
             "--rotation-noise",
             help="Draw rotation errors in [-DEG, +DEG] instead of the plan's declared error "
-            "(a stress test beyond what the plan claims).",
+            "(a stress test beyond what the plan claims; not with --ideal).",
             metavar="DEG",
             show_default=False,
         ),
@@ -203,6 +196,7 @@ def simulate_command(
     require_mujoco()  # InputError (exit 2): install feederkit[sim]
     if require_success is not None and not 0.0 <= require_success <= 1.0:
         raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
+    check_rotation_noise(rotation_noise, ideal=ideal)  # before the plan: one line, exit 2
     data = load_plan(plan, max_plan_mb)  # the one loader and validator
     json_found(
         plan=str(plan),
@@ -246,6 +240,10 @@ def simulate_command(
                 "uncertainty_declared": data.uncertainty_declared,
             }
         )
+        if summary.width_warning:  # the human output says it beside the failures
+            err_console.print(
+                f"warning: {summary.width_warning}", style="yellow", highlight=False, markup=False
+            )
     else:
         _print_summary(summary, data.uncertainty_words())
     if require_success is not None and summary.success_rate < require_success:

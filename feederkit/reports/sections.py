@@ -146,24 +146,49 @@ def _count(value: object) -> int | None:
     return None
 
 
+def _int(value: object) -> int | None:
+    return value if isinstance(value, int) and not isinstance(value, bool) else None
+
+
 def simulation_text(simulation: Mapping[str, Any]) -> str:
-    """The simulator's result in words: successes of trials, then what went wrong, per part
-    and how often a simulated push ended where the push function says (docs/simulation.md)."""
-    trials, successes = simulation.get("trials"), simulation.get("successes")
-    if (
-        not isinstance(trials, int)
-        or not isinstance(successes, int)
-        or isinstance(trials, bool)
-        or isinstance(successes, bool)
-    ):
+    """The simulator's result in words, from the summary ``feederkit simulate --json`` prints
+    (``SimulationSummary.to_dict``, docs/simulation.md), in the command line's words: the
+    successes with their 95 % Wilson interval (the rightly rejected counted apart), what
+    was sampled and the seed, the failures by cause, the model errors, per part, the push
+    agreement, and the notes on what the plan certifies and the simulator's width accuracy."""
+    trials, successes = _int(simulation.get("trials")), _int(simulation.get("successes"))
+    if trials is None or successes is None:
         raise InputError("simulation results need integer 'trials' and 'successes'")
     rate = f" ({num(100.0 * successes / trials, 1)}%)" if trials > 0 else ""
-    words = [f"{successes} of {trials} trials oriented correctly{rate}"]
+    shown = simulation.get("success_words")
+    success = shown if isinstance(shown, str) else f"{successes} of {trials}{rate}"
+    rejects = _int(simulation.get("rejects")) or 0
+    if rejects:
+        words = [
+            f"successes: {success}, {successes - rejects} oriented correctly and {rejects} "
+            "rightly rejected (a reject leaf naming the landing)"
+        ]
+    else:
+        words = [f"successes (oriented correctly): {success}"]
+    settings = simulation.get("settings")
+    if isinstance(settings, Mapping):
+        sampled, seed = settings.get("sampled"), _int(settings.get("seed"))
+        if isinstance(sampled, str):
+            words.append(sampled)
+        if seed is not None:
+            words.append(f"seed {seed}")
     failed, unsettled = _count(simulation.get("failures")), _count(simulation.get("unsettled"))
     if failed is not None or unsettled is not None:
-        words.append(f"{failed or 0} ended in a wrong pose, {unsettled or 0} never settled")
-    model_errors = simulation.get("model_errors")
-    if isinstance(model_errors, int) and not isinstance(model_errors, bool):
+        went = f"failures {failed or 0}, never settled {unsettled or 0}"
+        by_cause = simulation.get("by_cause")
+        if isinstance(by_cause, Mapping) and by_cause:
+            went += " (" + ", ".join(f"{c}: {n}" for c, n in by_cause.items()) + ")"
+        wrong = _int(simulation.get("wrong_accepts"))
+        if wrong:
+            went += f", of them {wrong} wrong accepts (accepted, landing or state wrong)"
+        words.append(went)
+    model_errors = _int(simulation.get("model_errors"))
+    if model_errors is not None:
         words.append(f"{model_errors} went where the plan's model did not predict (model errors)")
     per_part = simulation.get("per_part")
     if isinstance(per_part, list) and len(per_part) > 1:
@@ -177,6 +202,10 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     agree, settled = simulation.get("push_agreements"), simulation.get("settled_pushes")
     if isinstance(agree, int) and isinstance(settled, int) and settled > 0:
         words.append(f"{agree} of {settled} settled pushes ended where the push function says")
+    for key, label in (("beyond_certified", "note"), ("width_accuracy_warning", "warning")):
+        text = simulation.get(key)
+        if isinstance(text, str) and text:
+            words.append(f"{label}: {text}")
     return "; ".join(words)
 
 

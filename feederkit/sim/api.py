@@ -38,7 +38,15 @@ from feederkit.sim.sampling import (
     perturbed_part,
 )
 from feederkit.sim.scene import SceneConfig
-from feederkit.sim.summary import PushMiss, SimSettings, SimulationSummary, TrialResult
+from feederkit.sim.summary import (
+    PushMiss,
+    SimSettings,
+    SimulationSummary,
+    TrialResult,
+    certified_bounds,
+    sensor_width_slack,
+    width_accuracy_warning,
+)
 from feederkit.sim.trial import TrialModel, divergent_distance, run_trial
 from feederkit.uncertainty import IDEAL
 
@@ -151,6 +159,22 @@ def _member_shares(plan: Plan) -> np.ndarray | None:
     return np.asarray(shares, dtype=float) / total
 
 
+def check_rotation_noise(rotation_noise_deg: float | None, *, ideal: bool = False) -> None:
+    """Refuse a rotation noise outside [0, 180] degrees, or any with ``ideal``: ``--ideal``
+    samples nothing and rotates exactly (docs/simulation.md), so a noise would be ignored."""
+    if rotation_noise_deg is None:
+        return
+    if not (math.isfinite(rotation_noise_deg) and 0.0 <= rotation_noise_deg <= 180.0):
+        raise InputError(
+            f"--rotation-noise must be in [0, 180] degrees, got {rotation_noise_deg:g}"
+        )
+    if ideal:
+        raise InputError(
+            "--ideal rotates exactly (it samples nothing), so --rotation-noise cannot go with "
+            "it: drop one of them"
+        )
+
+
 def simulate_plan(
     plan: Plan | Mapping[str, Any],
     trials: int,
@@ -175,7 +199,8 @@ def simulate_plan(
     tolerances, the friction coefficients from their ranges (``friction_*``: a number,
     ``LO:HI`` or a pair; default ``DEFAULT_FRICTION_*_RANGE``), and per rotation an error
     uniform in ``[-r, +r]``, ``r`` the declared rotation error (``rotation_noise_deg``
-    overrides it, to stress a plan beyond its claim). Trial ``i`` draws from generators
+    overrides it, to stress a plan beyond its claim; with ``ideal``, which rotates exactly,
+    it is bad input). Trial ``i`` draws from generators
     seeded with ``(seed, i)``, so a trial's outcome does not depend on the others. Every
     operation is judged by the plan's model.
 
@@ -186,12 +211,7 @@ def simulate_plan(
         raise InputError(f"--trials must be a positive integer, got {trials!r}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"--seed must be a non-negative integer, got {seed!r}")
-    if rotation_noise_deg is not None and not (
-        math.isfinite(rotation_noise_deg) and 0.0 <= rotation_noise_deg <= 180.0
-    ):
-        raise InputError(
-            f"--rotation-noise must be in [0, 180] degrees, got {rotation_noise_deg:g}"
-        )
+    check_rotation_noise(rotation_noise_deg, ideal=ideal)
     fb = _range(friction_belt, DEFAULT_FRICTION_BELT_RANGE, "--friction-belt")
     ff = _range(friction_fence, DEFAULT_FRICTION_FENCE_RANGE, "--friction-fence")
     if fb.lo <= 0.0:
@@ -315,6 +335,12 @@ def simulate_plan(
         ),
         scales=tuple(a.scale for a in aligners),
         min_margin_deg=sim_plan.stats.min_margin_deg,
+        certified=certified_bounds(
+            sim_plan.uncertainty, sim_plan.stats.min_margin_deg, sim_plan.stats.certificate
+        ),
+        width_warning=width_accuracy_warning(
+            sensor_width_slack(sim_plan.sensor), min(a.scale for a in aligners)
+        ),
         successes=sum(r.outcome == "success" for r in results),
         rejects=sum(r.outcome == "success" and r.rejected for r in results),
         failures=wrong("failure"),

@@ -1,16 +1,200 @@
-"""Values the simulator reports: pushes, trials and the summary of a run (with ``to_dict``)."""
+"""Values the simulator reports: pushes, trials and the summary of a run (with ``to_dict``).
+
+Also the pure judgements the summary carries (docs/simulation.md): the success rate's 95 %
+Wilson interval, what the plan certifies against what was sampled, and whether the plan's
+sensor is finer than the simulator's widths are accurate.
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 
+from feederkit.plans.model import Certificate
+from feederkit.sensors import LedSensor, Sensor, ToleranceSensor
 from feederkit.sim.sampling import FrictionRange, TrialDraw
 from feederkit.uncertainty import IDEAL, Uncertainty
+
+Z_95 = 1.959964
+"""The normal quantile of a two-sided 95 % interval."""
+
+INTERVAL_METHOD = "wilson"
+"""How the success rate's interval is computed: the Wilson score interval."""
+
+WIDTH_ACCURACY_MM = 0.3
+"""How close a simulated width comes to the push function's diameter, in mm at the simulated
+size: docs/simulation.md, "Agreement with the push function": on 40 mm parts over belt speeds
+0.03-0.3 m/s and the friction ranges the part rests with "its width within about 0.3 mm of
+the diameter" (``benchmarks/bench_sim.py``). A sensor finer than this reads the simulator's
+width error, not the plan's."""
 
 
 def _r(x: float | None, nd: int = 4) -> float | None:
     return None if x is None else round(float(x), nd)
+
+
+def wilson(k: int, n: int, z: float = Z_95) -> tuple[float, float]:
+    """The Wilson score interval (95 % by default) of ``k`` successes in ``n`` trials.
+
+    Unlike the normal approximation it stays inside [0, 1] and is not empty at 0 or ``n``
+    successes (Wilson 1927), which is where a plan's physics check usually lands.
+
+    >>> [round(x, 4) for x in wilson(40, 40)]
+    [0.9124, 1.0]
+    """
+    if n <= 0 or not 0 <= k <= n:
+        raise ValueError(f"need 0 <= k <= n and n > 0, got k={k}, n={n}")
+    p = k / n
+    den = 1.0 + z * z / n
+    mid = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return max(0.0, mid - half), min(1.0, mid + half)
+
+
+def _percent(x: float, round_up: bool) -> str:
+    """``x`` (a fraction) in percent to 0.1, rounded outward so an interval never shrinks."""
+    tenths = math.ceil(1000.0 * x - 1e-9) if round_up else math.floor(1000.0 * x + 1e-9)
+    return f"{tenths / 10:.1f}".removesuffix(".0")
+
+
+def success_words(successes: int, trials: int) -> str:
+    """``40 of 40 (100.0 %; 95 % Wilson interval 91.2-100 %)``: the rate and its interval,
+    the interval's ends rounded outward.
+
+    >>> success_words(19, 20)
+    '19 of 20 (95.0 %; 95 % Wilson interval 76.3-99.2 %)'
+    """
+    lo, hi = wilson(successes, trials)
+    return (
+        f"{successes} of {trials} ({100.0 * successes / trials:.1f} %; 95 % Wilson interval "
+        f"{_percent(lo, False)}-{_percent(hi, True)} %)"
+    )
+
+
+@dataclass(frozen=True)
+class Certified:
+    """What a plan holds: the largest rotation error (deg) and shape tolerance (mm) under which
+    it still reaches its results.
+
+    From the plan's certificate when it carries one (design.md, plan file
+    ``stats.certificate``); otherwise the declared rotation error plus the smallest margin
+    (a margin is slack beyond the declared error: docs/plans.md) and the declared shape
+    tolerance. ``rotation_error_deg`` is None for a plan without rotations (no rotation
+    error reaches it).
+    """
+
+    rotation_error_deg: float | None
+    shape_tolerance_mm: float
+    from_certificate: bool
+
+    def words(self) -> str:
+        """The bounds in one line, saying where they come from."""
+        rot = (
+            "any rotation error (no rotation)"
+            if self.rotation_error_deg is None
+            else f"rotation error up to ±{self.rotation_error_deg:.4g} deg"
+        )
+        source = (
+            "its certificate"
+            if self.from_certificate
+            else "no certificate: the declared uncertainty plus the smallest margin"
+        )
+        return f"{rot}, shape tolerance up to {self.shape_tolerance_mm:.4g} mm ({source})"
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready form."""
+        return {
+            "rotation_error_deg": _r(self.rotation_error_deg, 6),
+            "shape_tolerance_mm": _r(self.shape_tolerance_mm, 6),
+            "source": "certificate" if self.from_certificate else "declared plus smallest margin",
+        }
+
+
+def certified_bounds(
+    declared: Uncertainty, min_margin_deg: float | None, certificate: Certificate | None
+) -> Certified:
+    """What the plan holds (see :class:`Certified`): its certificate when it has one, else its
+    declared uncertainty plus its smallest margin (the ideal model's smallest margin alone)."""
+    if certificate is not None:
+        return Certified(
+            certificate.max_rotation_error_deg, certificate.max_shape_tolerance_mm, True
+        )
+    rot = None if min_margin_deg is None else declared.rotation_error_deg + min_margin_deg
+    return Certified(rot, declared.shape_tolerance_mm, False)
+
+
+def beyond_certified_note(
+    rotation_error_deg: float, shape_tolerance_mm: float, certified: Certified
+) -> str | None:
+    """One line when the sampled rotation error or shape tolerance exceeds what the plan
+    certifies (then failures are the stress test's, not the plan's); None otherwise.
+
+    >>> print(beyond_certified_note(8.0, 0.0, Certified(3.15, 0.0, True)))
+    sampled rotation error ±8 deg is beyond what the plan certifies (±3.15 deg): failures are ...
+    """
+    over = []
+    rot = certified.rotation_error_deg
+    if rot is not None and rotation_error_deg > rot:
+        over.append(
+            (f"rotation error ±{rotation_error_deg:.4g} deg", f"±{rot:.4g} deg"),
+        )
+    if shape_tolerance_mm > certified.shape_tolerance_mm:
+        over.append(
+            (
+                f"shape tolerance {shape_tolerance_mm:.4g} mm",
+                f"{certified.shape_tolerance_mm:.4g} mm",
+            )
+        )
+    if not over:
+        return None
+    sampled = " and ".join(a for a, _ in over)
+    held = ", ".join(b for _, b in over)
+    verb = "are" if len(over) > 1 else "is"
+    return (
+        f"sampled {sampled} {verb} beyond what the plan certifies ({held}): failures are expected"
+    )
+
+
+def sensor_width_slack(sensor: Sensor) -> tuple[float, str] | None:
+    """The width error (mm) the plan's sensor absorbs, and the sensor in words; None for a
+    sensorless plan (nothing is read).
+
+    A tolerance sensor's reading may lie anywhere within its tolerance of the diameter; an LED
+    array's width within its alignment noise (a width past a beam's height blocks it).
+    """
+    if isinstance(sensor, ToleranceSensor):
+        return sensor.tolerance, f"the sensor tolerance ±{sensor.tolerance:.4g} mm"
+    if isinstance(sensor, LedSensor):
+        return sensor.noise, (
+            f"the LED array's alignment noise ±{sensor.noise:.4g} mm (pitch {sensor.pitch:.4g} mm)"
+        )
+    return None
+
+
+def width_accuracy_warning(slack: tuple[float, str] | None, scale: float = 1.0) -> str | None:
+    """One line when the plan's sensor absorbs less width error than the simulator's widths
+    are accurate to (:data:`WIDTH_ACCURACY_MM` at the simulated size, divided by ``scale``, the
+    factor a part's lengths were multiplied by in the physics); None otherwise.
+
+    >>> width_accuracy_warning((0.3, "tolerance ±0.3 mm")) is None
+    True
+    """
+    if slack is None:
+        return None
+    mm, words = slack
+    accuracy = WIDTH_ACCURACY_MM / scale
+    if mm >= accuracy:
+        return None
+    scaled = (
+        ""
+        if scale == 1.0
+        else f"; {accuracy:.3g} mm at the plan's size, simulated {scale:.3g} times larger"
+    )
+    return (
+        f"{words} is finer than the simulator's width accuracy (about "
+        f"{WIDTH_ACCURACY_MM:g} mm, docs/simulation.md{scaled}): 'reading in no branch' "
+        "failures then measure the simulator's width error, not the plan"
+    )
 
 
 @dataclass(frozen=True)
@@ -154,8 +338,9 @@ class SimSettings:
 
     ``sampled`` is the uncertainty drawn from (the plan's declared one, IDEAL under
     ``--ideal``); ``rotation_noise_deg`` the rotation error actually drawn (the declared one
-    unless overridden); ``friction_belt`` and ``friction_fence`` the nominal coefficients and
-    ``*_range`` the ranges drawn from.
+    unless ``--rotation-noise`` overrides it, up to 180 deg, beyond what an ``Uncertainty``
+    holds); :attr:`sampled_dict` puts the two together. ``friction_belt`` and
+    ``friction_fence`` are the nominal coefficients and ``*_range`` the ranges drawn from.
     """
 
     trials: int
@@ -171,6 +356,24 @@ class SimSettings:
     friction_fence_range: FrictionRange | None = None
     contact: str = field(default="")
 
+    @property
+    def sampled_dict(self) -> dict[str, float]:
+        """The uncertainty actually sampled, under design.md's names: the shape and COM
+        tolerance drawn and the rotation error drawn (``rotation_noise_deg``)."""
+        return {**self.sampled.to_dict(), "rotation_error_deg": self.rotation_noise_deg}
+
+    def sampled_words(self) -> str:
+        """What was sampled, in words (the command line and the report say it alike)."""
+        if self.ideal:
+            return "nothing sampled (--ideal)"
+        fb, ff = self.friction_belt_range, self.friction_fence_range
+        return (
+            f"sampled: rotation error ±{self.rotation_noise_deg:g} deg per rotation, vertices "
+            f"within {self.sampled.shape_tolerance_mm:g} mm, COM within "
+            f"{self.sampled.com_tolerance_mm:g} mm, friction belt {fb.text() if fb else '-'} / "
+            f"fence {ff.text() if ff else '-'}"
+        )
+
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
         fb = self.friction_belt_range or FrictionRange(self.friction_belt, self.friction_belt)
@@ -179,7 +382,8 @@ class SimSettings:
             "trials": self.trials,
             "seed": self.seed,
             "ideal": self.ideal,
-            "sampled_uncertainty": self.sampled.to_dict(),
+            "sampled_uncertainty": self.sampled_dict,
+            "sampled": self.sampled_words(),
             "rotation_noise_deg": self.rotation_noise_deg,
             "belt_speed_m_s": self.belt_speed,
             "friction_belt": self.friction_belt,
@@ -221,6 +425,30 @@ class SimulationSummary:
     sim_time_s: float
     rejects: int = 0
     """Successes that ended in a reject leaf naming the member's landing (correct rejects)."""
+    certified: Certified | None = None
+    """What the plan holds (:func:`certified_bounds`); None when not known."""
+    width_warning: str | None = None
+    """The plan's sensor is finer than the simulated widths (:func:`width_accuracy_warning`)."""
+
+    @property
+    def success_interval(self) -> tuple[float, float]:
+        """The 95 % Wilson score interval of the success rate."""
+        return wilson(self.successes, self.trials)
+
+    def success_words(self) -> str:
+        """Successes of trials, the rate and its 95 % Wilson interval, in words."""
+        return success_words(self.successes, self.trials)
+
+    @property
+    def beyond_certified(self) -> str | None:
+        """A note when the sampled rotation error or shape tolerance exceeds what the plan
+        certifies (None otherwise, or when that is not known)."""
+        if self.certified is None:
+            return None
+        st = self.settings
+        return beyond_certified_note(
+            st.rotation_noise_deg, st.sampled.shape_tolerance_mm, self.certified
+        )
 
     @property
     def wrong_accepts(self) -> int:
@@ -269,6 +497,9 @@ class SimulationSummary:
             "trials": self.trials,
             "successes": self.successes,
             "success_rate": _r(self.success_rate, 6),
+            "success_interval_95": [_r(x, 6) for x in self.success_interval],
+            "interval_method": INTERVAL_METHOD,
+            "success_words": self.success_words(),
             "rejects": self.rejects,
             "wrong_accepts": self.wrong_accepts,
             "model_errors": self.model_errors,
@@ -288,6 +519,9 @@ class SimulationSummary:
             ],
             "scale": [_r(s, 6) for s in self.scales],
             "min_margin_deg": _r(self.min_margin_deg),
+            "certified": None if self.certified is None else self.certified.to_dict(),
+            "beyond_certified": self.beyond_certified,
+            "width_accuracy_warning": self.width_warning,
             "settings": self.settings.to_dict(),
             "wall_time_s": _r(self.wall_time_s, 3),
             "sim_time_s": _r(self.sim_time_s, 3),
