@@ -30,6 +30,7 @@ from feederkit.sim.summary import (
     SimulationSummary,
     beyond_certified_note,
     certified_bounds,
+    push_words,
     sensor_width_slack,
     success_words,
     width_accuracy_warning,
@@ -259,3 +260,27 @@ def test_simulate_warns_when_the_sensor_is_finer_than_the_simulated_widths(
     coarse = _plan(tmp_path, "t-clip", 0.5)
     assert main(["simulate", str(coarse), "--trials", "2", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["width_accuracy_warning"] is None
+
+
+def test_push_words_add_the_physical_state_only_when_it_counts_more() -> None:
+    assert push_words(5, 5, 5) == "5 of 5 settled pushes (100.0%) end where the push function says"
+    assert push_words(3, 7, None) == push_words(3, 7, 3)
+    assert push_words(3, 7, 7).endswith(
+        "; 7 of 7 (100.0%) in the same physical state (the plan's model merges states a "
+        "vibration knocks over)"
+    )
+
+
+@needs_mujoco
+def test_a_merged_states_facets_count_as_the_same_physical_state(tmp_path: Path, capsys) -> None:
+    """The d-washer's arc is many facet states the plan's model merges into one physical
+    state: a push that ends on another facet of it is no miss to the plan."""
+    path = _plan(tmp_path, "d-washer", 0.3)
+    assert main(["simulate", str(path), "--trials", "6", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["push_agreements"] < d["physical_agreements"] <= d["settled_pushes"]
+    assert d["push_words"] == push_words(
+        d["push_agreements"], d["settled_pushes"], d["physical_agreements"]
+    )
+    assert main(["simulate", str(path), "--trials", "6"]) == 0
+    assert "in the same physical state" in _words(capsys.readouterr().out)

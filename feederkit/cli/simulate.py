@@ -72,11 +72,7 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     table.add_row("model errors (not predicted)", str(s.model_errors))
     for cause, n in s.by_cause().items():
         table.add_row(f"  {escape(cause)}", str(n))
-    table.add_row(
-        "push agreement",
-        f"{s.push_agreements} of {s.settled_pushes} settled pushes "
-        f"({100 * s.push_agreement:.1f}%) end where the push function says",
-    )
+    table.add_row("push agreement", s.push_words())
     margin = "none (no rotations)" if s.min_margin_deg is None else f"{s.min_margin_deg:.3g} deg"
     table.add_row("plan's smallest margin", margin)
     if s.certified is not None:

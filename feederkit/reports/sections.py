@@ -200,7 +200,10 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
             )
         )
     agree, settled = simulation.get("push_agreements"), simulation.get("settled_pushes")
-    if isinstance(agree, int) and isinstance(settled, int) and settled > 0:
+    pushes = simulation.get("push_words")
+    if isinstance(pushes, str) and pushes:
+        words.append(pushes)
+    elif isinstance(agree, int) and isinstance(settled, int) and settled > 0:
         words.append(f"{agree} of {settled} settled pushes ended where the push function says")
     for key, label in (("beyond_certified", "note"), ("width_accuracy_warning", "warning")):
         text = simulation.get(key)

@@ -348,6 +348,11 @@ def simulate_plan(
         pushes=len(pushes),
         settled_pushes=len(settled),
         push_agreements=len(settled) - len(misses),
+        physical_agreements=(
+            sum(p.agrees_physically for _trial, p in settled)
+            if any(p.same_physical is not None for _trial, p in settled)
+            else None
+        ),
         push_misses=misses,
         wall_time_s=wall,
         sim_time_s=sum(p.sim_time_s for _, p in pushes),

@@ -71,6 +71,24 @@ def success_words(successes: int, trials: int) -> str:
     )
 
 
+def push_words(agreements: int, settled: int, physical: int | None = None) -> str:
+    """``agreements`` of ``settled`` pushes ending where the push function says, and the
+    ``physical`` ones in the same physical state of the plan's model when more.
+
+    >>> push_words(22, 48, 48).split("; ")[1]
+    "48 of 48 (100.0%) in the same physical state (the plan's model merges states a ..."
+    """
+    rate = 100.0 * agreements / settled if settled else 100.0
+    out = f"{agreements} of {settled} settled pushes ({rate:.1f}%) end where the push function says"
+    if physical is not None and physical > agreements:
+        prate = 100.0 * physical / settled if settled else 100.0
+        out += (
+            f"; {physical} of {settled} ({prate:.1f}%) in the same physical state (the plan's "
+            "model merges states a vibration knocks over)"
+        )
+    return out
+
+
 @dataclass(frozen=True)
 class Certified:
     """What a plan holds: the largest rotation error (deg) and shape tolerance (mm) under which
@@ -227,11 +245,20 @@ class PushRecord:
     branch: int | None
     sim_time_s: float
     in_model: bool = True
+    same_physical: bool | None = None
+    """Whether the simulated state and the predicted one lie in one physical state of the
+    plan's model (which merges stable states whose barrier is below the vibration it
+    assumes, docs/planning.md "Strong plans"); None without the model or a settled state."""
 
     @property
     def agrees(self) -> bool:
         """Whether the simulated push ended where the push function says."""
         return self.settled and self.simulated_state == self.predicted_state
+
+    @property
+    def agrees_physically(self) -> bool:
+        """Whether it ended where the push function says, or in the same physical state."""
+        return self.agrees or bool(self.same_physical)
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
@@ -252,6 +279,7 @@ class PushRecord:
             "branch": self.branch,
             "sim_time_s": _r(self.sim_time_s),
             "in_model": self.in_model,
+            "same_physical": self.same_physical,
         }
 
 
@@ -425,6 +453,9 @@ class SimulationSummary:
     sim_time_s: float
     rejects: int = 0
     """Successes that ended in a reject leaf naming the member's landing (correct rejects)."""
+    physical_agreements: int | None = None
+    """Settled pushes that ended where the push function says or in the same physical state
+    of the plan's model (:attr:`PushRecord.agrees_physically`); None without the model."""
     certified: Certified | None = None
     """What the plan holds (:func:`certified_bounds`); None when not known."""
     width_warning: str | None = None
@@ -438,6 +469,12 @@ class SimulationSummary:
     def success_words(self) -> str:
         """Successes of trials, the rate and its 95 % Wilson interval, in words."""
         return success_words(self.successes, self.trials)
+
+    def push_words(self) -> str:
+        """The push agreement in words, with the pushes that ended in the predicted state's
+        physical state when that is more (a merged state's facets are one state to the
+        plan: ending on another of them is no miss)."""
+        return push_words(self.push_agreements, self.settled_pushes, self.physical_agreements)
 
     @property
     def beyond_certified(self) -> str | None:
@@ -511,6 +548,8 @@ class SimulationSummary:
             "settled_pushes": self.settled_pushes,
             "push_agreements": self.push_agreements,
             "push_agreement": _r(self.push_agreement, 6),
+            "physical_agreements": self.physical_agreements,
+            "push_words": self.push_words(),
             "push_misses": [m.to_dict() for m in self.push_misses],
             "parts": list(self.parts),
             "per_part": [

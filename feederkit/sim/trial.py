@@ -180,12 +180,16 @@ def run_trial(
         reading = plan.sensor.read(out.width_mm) if out.settled else None
         branch = node.follow(reading) if out.settled and sim_state is not None else None
         expected = _state_id(pp, nominal)
+        predicted = _state_id(pp, theta)
+        same_physical = None
         if model is None:
             in_model = sim_state == expected
             reads = True
         else:
             in_model = sim_state is not None and model.allows(state, node.action_deg, sim_state)
             reads = sim_state is None or model.reads(sim_state, reading)
+            if sim_state is not None:
+                same_physical = bool(model.physical(sim_state) & model.physical(predicted))
         rec = PushRecord(
             step=step,
             action_deg=node.action_deg,
@@ -194,7 +198,7 @@ def run_trial(
             divergent_distance_deg=divergent_distance(pp.pf, theta),
             predicted_margin_deg=divergent_distance(pp.pf, push(pp.pf, theta).normal_deg),
             expected_state=expected,
-            predicted_state=_state_id(pp, theta),
+            predicted_state=predicted,
             simulated_state=sim_state,
             edge=out.edge,
             settled=out.settled,
@@ -203,6 +207,7 @@ def run_trial(
             branch=branch,
             sim_time_s=out.sim_time_s,
             in_model=in_model and reads,
+            same_physical=same_physical,
         )
         records.append(rec)
         if not out.settled:
