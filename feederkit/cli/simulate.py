@@ -73,7 +73,8 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     for cause, n in s.by_cause().items():
         table.add_row(f"  {escape(cause)}", str(n))
     table.add_row("push agreement", s.push_words())
-    margin = "none (no rotations)" if s.min_margin_deg is None else f"{s.min_margin_deg:.3g} deg"
+    # As plan prints it (plan_render): the same digits in both places.
+    margin = "none (no rotations)" if s.min_margin_deg is None else f"±{s.min_margin_deg:.4f}°"
     table.add_row("plan's smallest margin", margin)
     if s.certified is not None:
         table.add_row("plan certifies", escape(s.certified.words()))
