@@ -164,6 +164,23 @@ def test_a_small_margin_is_warned_about(tri, capsys):
     assert json.loads(capsys.readouterr().out)["warnings"]
 
 
+def test_run_repeats_the_fragile_states_plan_warned_about(tmp_path, capsys):
+    """The l-bracket has a fragile state: ``run`` says it as ``plan`` did, once per part
+    (its two landings are mirror images, with the same states)."""
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parents[1] / "catalog" / "l-bracket.json"
+    plan = tmp_path / "lb.plan.json"
+    assert main(["plan", str(src), "--tolerance", "0.1", "-o", str(plan)]) == 0
+    planned = [ln for ln in capsys.readouterr().err.splitlines() if "fragile" in ln]
+    assert len(planned) == 1 and planned[0].startswith("warning: l-bracket: fragile states")
+    assert main(["run", str(plan), "--all", "--json"]) == 0
+    (warning,) = json.loads(capsys.readouterr().out)["warnings"]
+    assert "warning: " + warning == planned[0]
+    assert main(["run", str(plan), "--all"]) == 0
+    assert "fragile states" in capsys.readouterr().out
+
+
 def test_a_plan_file_over_the_size_limit_is_refused(tri, capsys):
     _, plan = tri
     err = one_line_error(capsys, ["run", str(plan), "--max-plan-mb", "0.0001"])

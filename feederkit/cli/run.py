@@ -76,7 +76,7 @@ def run_command(
                 indices.append(k)
     if not sources:
         indices = list(range(len(plan.parts)))
-    warnings = [w for w in (plan.low_margin_warning(),) if w]
+    warnings = [w for w in (plan.low_margin_warning(),) if w] + plan.fragile_warnings()
     if not json_out:
         for w in warnings:
             console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)

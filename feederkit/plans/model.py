@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.errors import InputError
+from feederkit.mechanics.analysis import fragile_warnings
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -456,6 +457,15 @@ class Plan:
             n.margin_deg for n, _ in self.walk() if isinstance(n, Step) and n.margin_deg is not None
         ]
         return min(margins) if margins else None
+
+    def fragile_warnings(self) -> list[str]:
+        """The fragile states of the plan's parts in words, as ``plan`` warned when it made
+        the plan (:func:`~feederkit.mechanics.analysis.fragile_warnings`): each part's first
+        member (a flat part's other landing is its mirror image, with the same states)."""
+        first: dict[str, PlanPart] = {}
+        for part in self.parts:
+            first.setdefault(part.name, part)
+        return fragile_warnings([push_function_of(p) for p in first.values()])
 
     def low_margin_warning(self) -> str | None:
         """A warning when the plan holds rotation errors below LOW_MARGIN_DEG (None otherwise).
