@@ -32,6 +32,7 @@ from feederkit.catalog.schema import transaction
 from feederkit.catalog.store import write_revision
 from feederkit.cli.app import app, main
 from feederkit.importers import ImportedOutline, ImportOptions, build_part, import_parts
+from feederkit.importers.budget import ImportLimits
 from feederkit.outline import make_outline
 
 
@@ -148,7 +149,10 @@ def run(parts: int, teeth: int, flank_lines: int) -> int:
         tmpdir = Path(tmp)
         gear = tmpdir / "fine-gear.dxf"
         entities = fine_gear(gear, teeth, flank_lines)
-        seconds, result = timed(lambda: import_parts(gear, ImportOptions()), 3)
+        # The default import budget stops at 10,000 entities (--max-entities): the gear is
+        # imported as a user would after raising it.
+        options = ImportOptions(limits=ImportLimits(entities=2 * entities))
+        seconds, result = timed(lambda: import_parts(gear, options), 3)
         ip = result[1][0]
         print(
             f"fine gear: {entities} entities, {len(ip.part.outline.vertices)} outline points, "
