@@ -187,7 +187,34 @@ def _make_plan(
         warnings.append(
             f"{margin}; ask for a minimum margin or check the plan with feederkit simulate"
         )
+    held = ideal_plan_words(unc, result.min_margin, result.certificate)
+    if held is not None:
+        warnings.append(held)
     return MadePlan(data, result, report, tuple(warnings + notes))
+
+
+def ideal_plan_words(
+    unc: Uncertainty, min_margin: float, certificate: Certificate | None
+) -> str | None:
+    """One line when a plan made on the ideal model holds less on a feeder that vibrates
+    than its margins say: the certificate is computed with the vibration the planner's
+    model has under any rotation error (fragile states merged, a push band at each hilltop,
+    ``strong.strong_model``), where an ideal plan may hold no rotation error at all.
+
+    >>> print(ideal_plan_words(IDEAL, 5.0, Certificate(3.0, 0.0, 2)))
+    the plan is the ideal model's: on a feeder that vibrates it holds rotation errors up to ±3° ...
+    """
+    if not unc.is_ideal or certificate is None or not math.isfinite(min_margin):
+        return None
+    held = certificate.max_rotation_error_deg
+    if held >= min_margin - 1e-9:
+        return None
+    what = "no rotation error at all" if held <= 0.0 else f"rotation errors up to ±{held:.4g}°"
+    return (
+        f"the plan is the ideal model's: on a feeder that vibrates it holds {what} (its "
+        f"margins say ±{min_margin:.4g}°: drops near a hilltop may go either way, fragile "
+        "states merge); plan with --rotation-error DEG for one that holds it"
+    )
 
 
 POST_SHARE = 0.15

@@ -36,6 +36,7 @@ from typing import Any
 from feederkit.errors import CheckFailed, InputError
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import snap_intervals
+from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mechanics.uncertain import (
@@ -124,19 +125,28 @@ def strong_model(
     *,
     vibration_mm: float | None = None,
     parts: Sequence[PushFunction] | None = None,
+    vibrating: bool = False,
 ) -> StrongModel:
     """The plan's parts rebuilt from its hulls and COMs, with their mechanics.
 
     ``uncertainty`` defaults to the declared one; ``vibration_mm`` to the mechanics' own
-    rule, except that a plan declared on the ideal model keeps vibration off (so a
-    certificate of an ideal plan speaks of that model).
+    rule, except that a plan declared on the ideal model keeps vibration off (the model it
+    was verified on) unless ``vibrating``: the feeder's vibration whatever the declared
+    uncertainty, as the planner's model has it under any rotation error (fragile states
+    merged, a push band at each hilltop). A certificate speaks of that feeder.
     """
     declared = declared_uncertainty(plan)
     unc = declared if uncertainty is None else uncertainty
-    if vibration_mm is None and declared.is_ideal:
+    if vibration_mm is None and declared.is_ideal and not vibrating:
         vibration_mm = 0.0
     pfs = list(parts) if parts is not None else _parts(plan)
-    mechs = tuple(uncertain_mechanics(pf.part, unc, vibration_mm=vibration_mm) for pf in pfs)
+
+    def vibration(pf: PushFunction) -> float | None:
+        if vibration_mm is None and vibrating:
+            return FRAGILE_BARRIER_REL * pf.part.size  # the mechanics' rule off the ideal
+        return vibration_mm
+
+    mechs = tuple(uncertain_mechanics(pf.part, unc, vibration_mm=vibration(pf)) for pf in pfs)
     eps = DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
     # The same outward-snapped intervals the machine's states read in (machine.build).
     ends = snap_intervals([s.diameter for m in mechs for s in m.states], eps)
@@ -511,10 +521,14 @@ def strong_holds(
     *,
     vibration_mm: float | None = None,
     parts: Sequence[PushFunction] | None = None,
+    vibrating: bool = False,
 ) -> bool:
-    """Whether every path of ``plan`` under ``uncertainty`` ends in a leaf naming its state."""
+    """Whether every path of ``plan`` under ``uncertainty`` ends in a leaf naming its state
+    (``vibrating``: as :func:`strong_model`)."""
     try:
-        model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
+        model = strong_model(
+            plan, uncertainty, vibration_mm=vibration_mm, parts=parts, vibrating=vibrating
+        )
     except InputError:
         return False
     run = _Run(plan, model)
@@ -536,7 +550,7 @@ def max_rotation_error_deg(
     new to it. Timeout when ``deadline`` passes first (a minimum over some nodes is no
     bound)."""
     deadline = deadline or Deadline()
-    model = strong_model(plan, parts=parts)
+    model = strong_model(plan, parts=parts, vibrating=True)
     run = _Run(plan, model)
     best = MAX_ROTATION_ERROR_DEG
     root = run.node(plan["root"])
@@ -602,13 +616,13 @@ def max_shape_tolerance_mm(
     deadline = deadline or Deadline()
     declared = declared_uncertainty(plan)
     pfs = list(parts) if parts is not None else _parts(plan)
-    vib = 0.0 if declared.is_ideal else None
     limit = min(shape_tolerance_limit(pf.part) for pf in pfs)
 
     def holds(t: float) -> bool:
+        # With the feeder's vibration, as every certificate (strong_model's ``vibrating``).
         deadline.check()
         unc = Uncertainty(declared.rotation_error_deg, t, declared.com_tolerance_mm)
-        return strong_holds(plan, unc, vibration_mm=vib, parts=pfs)
+        return strong_holds(plan, unc, parts=pfs, vibrating=True)
 
     lo = declared.shape_tolerance_mm
     hi = limit * (1.0 - 1e-9)
