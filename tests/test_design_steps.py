@@ -26,6 +26,10 @@ from feederkit.design.steps import (
     plan_evaluation,
 )
 from feederkit.errors import CheckFailed
+from feederkit.landing.model import landings_of_outline
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import verify_strong
 from feederkit.plans.verify import verify_plan
@@ -118,11 +122,32 @@ def test_the_table_stops_at_the_requested_tolerance_and_keeps_whole_steps():
 
 def test_each_step_reports_the_verified_plan_at_its_right_end():
     pfs = small_mix(5)
+    breaks = mix_breakpoints(pfs)
     steps = length_steps(pfs, None)
     for s in steps[:-1]:
-        ev = plan_evaluation(pfs, s.hi)
+        # Just below the right end: at it the two diameters that meet there read alike.
+        probe = interval_probe(breaks, breaks.index(s.hi))
+        assert s.hi * (1 - 1e-5) < probe < s.hi
+        ev = plan_evaluation(pfs, probe)
         assert ev.length == s.length and abs(ev.expected - s.expected) < 1e-9
         assert 1.0 <= s.expected <= s.length
+
+
+def test_a_step_ending_at_a_critical_tolerance_has_the_length_inside_it():
+    """A part's two landings read the same two diameters, so one reading cannot tell up from
+    down: two operations at every tolerance that tells them apart. At the pair's critical
+    tolerance itself the machine's reading intervals (snapped outward by a hair) already
+    meet, the landings are inseparable and one operation does: the step must not take that
+    length (it once said 1 up to the critical tolerance)."""
+    pts = [[14.528, 2.257], [5.55, 14.017], [-6.248, 15.482], [12.94, -14.047], [11.916, -11.234]]
+    part = make_part(make_outline("r08", pts))
+    pfs = [push_function(x.part) for x in landings_of_outline(part)]
+    steps = length_steps(pfs, None)
+    first = steps[0]
+    assert first.recognizable and first.length == 2
+    for e in (first.hi / 2.0, first.hi * (1 - 1e-4)):
+        assert optimal_length(pfs, e) == 2
+    assert optimal_length(pfs, first.hi) == 1  # the boundary itself: the landings lumped
 
 
 def test_a_disagreeing_verified_plan_is_a_failed_check():

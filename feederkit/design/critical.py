@@ -49,14 +49,28 @@ def pair_breakpoints(pf_a: PushFunction, pf_b: PushFunction) -> tuple[float, ...
     )
 
 
+PROBE_REL = 1e-6
+"""An interval's probe lies this far below its right end, relative (and at least this many
+mm), or at its middle when the interval is narrower."""
+
+
 def interval_probe(breaks: Sequence[float], k: int) -> float:
     """A tolerance inside interval ``k``: ``(b_{k-1}, b_k]`` (``b_{-1} = 0``), or past the last.
 
-    The closed right end ``b_k`` itself for ``k < len(breaks)``; twice the last breakpoint
-    (or 1 mm without breakpoints) for the unbounded last interval.
+    Just below the right end ``b_k`` for ``k < len(breaks)`` (``PROBE_REL``), not at it: the
+    machine snaps the reading intervals outward by a hair (``DIAMETER_REL_EPS`` of the
+    parts' size, so that exact ties survive rounding), so at ``b_k`` itself the two
+    diameters that meet there already read alike, as in the next interval (at a pair's
+    critical tolerance the pair is then inseparable and the plan shorter); twice the last
+    breakpoint (or 1 mm without breakpoints) for the unbounded last interval.
+
+    >>> interval_probe([0.5, 2.0], 1) < 2.0 < interval_probe([0.5, 2.0], 2)
+    True
     """
     if k < len(breaks):
-        return breaks[k]
+        hi = breaks[k]
+        lo = breaks[k - 1] if k else 0.0
+        return hi - min((hi - lo) / 2.0, max(PROBE_REL * hi, PROBE_REL))
     return 2.0 * breaks[-1] if breaks else 1.0
 
 

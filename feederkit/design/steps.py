@@ -36,8 +36,9 @@ own AND/OR oracle (:class:`LengthOracle`, no plan tree built); then, for a known
 binary search from the step's start finds its last interval (``O(log run)`` decisions, and
 the probes stay near the step, at its cheaper smaller tolerances); the next interval's
 length is the least ``L' > L`` that fits, at most the segment's last length. Each step's
-plan is then made and verified at its right end (:func:`plan_evaluation`), and must have
-the length the search found.
+plan is then made and verified just below its right end (:func:`plan_evaluation` at
+``interval_probe``: at the end itself the machine's outward-snapped reading intervals
+already meet), and must have the length the search found.
 
 The expected number of operations changes continuously inside an interval (reading
 probabilities depend on ``e``); each step reports it at the interval's right end, its
