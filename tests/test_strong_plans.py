@@ -491,10 +491,11 @@ def test_no_strong_plan_names_the_largest_rotation_error_with_one():
     with pytest.raises(PlanningError, match="largest rotation error with a strong plan is") as exc:
         make_plan([pf], NoSensor(), uncertainty=Uncertainty(15.0))
     text = str(exc.value)
-    r = float(text.split("strong plan is ")[1].split(" deg")[0])
-    assert 0.0 <= r < 15.0
+    r = float(text.split("strong plan is at least ")[1].split(" deg")[0])
+    width = float(text.split("(bisected to ")[1].split(" deg")[0])
+    assert 0.0 <= r < 15.0 and 0.0 < width < 15.0
     if r > 0.0:
-        plan(build_machine([pf], NoSensor(), Uncertainty(r * 0.999)))  # a plan exists there
+        plan(build_machine([pf], NoSensor(), Uncertainty(r)))  # printed rounded down: a plan
     assert "\n" not in text
 
 

@@ -49,7 +49,7 @@ from feederkit.plans.strong import (
 from feederkit.plans.verify import VerificationReport, check_plan
 from feederkit.sensors import Sensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
-from feederkit.words import plural
+from feederkit.words import at_most, plural
 
 DIAMETER_DIGITS = 9
 """Diameters (mm) equal to this many decimals are one diameter: a regular polygon's states
@@ -548,45 +548,49 @@ def largest_uncertainty(
             return None
         return found
 
-    def largest(make, top: float) -> tuple[float | None, bool]:
-        """The largest value with a plan (None: none, or undecided at 0) and whether the
-        bisection finished."""
+    def largest(make, top: float) -> tuple[float | None, bool, float]:
+        """The largest value with a plan (None: none, or undecided at 0), whether the
+        bisection finished, and its final bracket's width."""
         at_zero = exists(make(0.0))
         if not at_zero:
-            return None, at_zero is not None
+            return None, at_zero is not None, top
         lo, hi = 0.0, top
         for _ in range(BISECT_STEPS):
             mid = (lo + hi) / 2.0
             found = exists(make(mid))
             if found is None:
-                return lo, False
+                return lo, False, hi - lo
             lo, hi = (mid, hi) if found else (lo, mid)
-        return lo, True
+        return lo, True, hi - lo
 
-    def said(value: float, done: bool, what: str, unit: str) -> str:
+    def said(value: float, done: bool, what: str, unit: str, width: float = 0.0) -> str:
         if done and value > 0.0:
-            return f"the largest {what} with a strong plan is {value:.4g} {unit}"
+            # A bisection: a plan at ``value`` (printed rounded down), none a bracket above.
+            return (
+                f"the largest {what} with a strong plan is at least {at_most(value, 4)} {unit} "
+                f"(bisected to {width:.2g} {unit})"
+            )
         if done:
             return f"a strong plan exists only with no {what} at all (0 {unit})"
         return (
-            f"a strong plan exists at {what} {value:.4g} {unit} (larger values were not "
+            f"a strong plan exists at {what} {at_most(value, 4)} {unit} (larger values were not "
             "decided within the time limit)"
         )
 
     words = []
-    r, r_done = largest(
+    r, r_done, r_width = largest(
         lambda x: Uncertainty(x, u.shape_tolerance_mm, u.com_tolerance_mm), u.rotation_error_deg
     )
     if r is None and not r_done:
         return "the largest uncertainty with a strong plan was not found within the time limit"
     if r is not None:
-        words.append(said(r, r_done, "rotation error", "deg"))
+        words.append(said(r, r_done, "rotation error", "deg", r_width))
     if u.shape_tolerance_mm > 0.0:
-        t, t_done = largest(
+        t, t_done, t_width = largest(
             lambda x: Uncertainty(u.rotation_error_deg, x, u.com_tolerance_mm), u.shape_tolerance_mm
         )
         if t is not None:
-            words.append(said(t, t_done, "shape tolerance", "mm"))
+            words.append(said(t, t_done, "shape tolerance", "mm", t_width))
     if not words:
         return (
             "even a rotation error near 0 leaves no strong plan: the resting states the "
