@@ -97,15 +97,16 @@ def test_a_bound_of_the_inseparable_goal_is_stated_for_that_goal_when_lumping_ma
 def test_the_time_limit_note_names_the_objective_its_bound_is_not_about():
     worst = {"optimal": False, "length": 5, "lower_bound": 4, "objective": "worst"}
     assert time_limit_note(worst, 2.0) == (
-        "the time limit of 2 s was reached: this plan has 5 operations and is not proven "
-        "shortest; a plan needs at least 4 (allow more time with --time-limit S)"
+        "the search under the time limit of 2 s stopped short: this plan has 5 operations "
+        "and is not proven shortest; a plan needs at least 4 (allow more time with "
+        "--time-limit S)"
     )
     # A plan as long as its worst-case bound is not proven best for the expected objective.
     expected = {"optimal": False, "length": 4, "lower_bound": 4, "objective": "expected"}
     assert time_limit_note(expected, 1.0) == (
-        "the time limit of 1 s was reached: this plan (4 operations) is not proven best for "
-        "the expected objective; every plan needs at least 4 operations in the worst case "
-        "(allow more time with --time-limit S)"
+        "the search under the time limit of 1 s stopped short: this plan (4 operations) is "
+        "not proven best for the expected objective; every plan needs at least 4 operations "
+        "in the worst case (allow more time with --time-limit S)"
     )
     assert time_limit_note({**expected, "optimal": True}, 1.0) is None
     assert time_limit_note(expected, None) is None

@@ -348,9 +348,12 @@ def searching(what: str, time_limit: float | None) -> Iterator[None]:
 
 
 def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | None:
-    """One line when the search stopped at the time limit: the plan and the proven lower bound
-    (a worst-case number of operations whatever the objective: under ``expected`` or ``time``
-    the plan's length may meet it and the plan still not be proven best)."""
+    """One line when the search stopped under the time limit before proving the plan best
+    (at the limit, or earlier, when the exact search handed its share to the fallback
+    searches off course: docs/planning.md, "Time and memory limits"): the plan and the
+    proven lower bound (a worst-case number of operations whatever the objective: under
+    ``expected`` or ``time`` the plan's length may meet it and the plan still not be proven
+    best)."""
     if stats.get("optimal", True) or time_limit is None:
         return None
     objective = stats.get("objective") or "worst"
@@ -364,7 +367,7 @@ def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | No
             f"needs at least {plural(bound, 'operation')} in the worst case"
         )
     return (
-        f"the time limit of {time_limit:g} s was reached: {what} "
+        f"the search under the time limit of {time_limit:g} s stopped short: {what} "
         "(allow more time with --time-limit S)"
     )
 
