@@ -318,6 +318,30 @@ def test_box_mesh_plan_names_its_poses_and_runs_on_every_one(tmp_path, capsys, b
     run_all(tmp_path / "plan.json", capsys)
 
 
+def test_run_checks_every_mesh_pose_for_fragile_states_and_one_side_of_a_flat_part(
+    tmp_path, capsys, box_path, monkeypatch
+):
+    """``Plan.fragile_warnings`` (what ``run`` repeats of ``plan``'s warnings): a mesh's
+    poses are different shapes on the belt, a flat part's two sides mirror images."""
+    import feederkit.plans.model as plan_model
+
+    seen: list[int] = []
+    real = plan_model.fragile_warnings
+
+    def spy(pfs):
+        seen.append(len(pfs))
+        return real(pfs)
+
+    monkeypatch.setattr(plan_model, "fragile_warnings", spy)
+    box, _ = plan_cli(tmp_path, capsys, [str(box_path), "--tolerance", "0.5"], name="box.json")
+    assert plan_from_dict(box).fragile_warnings() == [] and seen == [3]  # the three poses
+    src = write_outline(tmp_path, "ell", [[0, 0], [30, 0], [30, 8], [8, 8], [8, 20], [0, 20]])
+    ell, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5"], name="ell.json")
+    assert [p["landing"] for p in ell["parts"]] == ["up", "down"]
+    plan_from_dict(ell).fragile_warnings()
+    assert seen == [3, 1]
+
+
 def test_box_mesh_plan_rejects_the_poses_not_accepted(tmp_path, capsys, box_path):
     plan, _ = plan_cli(tmp_path, capsys, [str(box_path), "--tolerance", "0.5", "--accept", "0"])
     rejected = {e.landing for leaf in leaves(plan) if leaf.reject for e in leaf.results}

@@ -311,6 +311,10 @@ def operations_below(root: Node) -> int:
     return memo[id(root)]
 
 
+REJECTED_WORDS = "rightly rejected (a reject leaf naming the landing)"
+"""How the simulator's outputs (the command line, the report) name the successes that ended
+in a reject leaf naming the member's landing (design.md, "Landings")."""
+
 LOW_MARGIN_DEG = 1.0
 """Below this smallest margin no robot holds the plan's rotations: every output warns."""
 
@@ -461,10 +465,13 @@ class Plan:
     def fragile_warnings(self) -> list[str]:
         """The fragile states of the plan's parts in words, as ``plan`` warned when it made
         the plan (:func:`~feederkit.mechanics.analysis.fragile_warnings`): each part's first
-        member (a flat part's other landing is its mirror image, with the same states)."""
-        first: dict[str, PlanPart] = {}
+        member (a flat part's other landing is its mirror image, with the same states), and
+        every pose of a mesh."""
+        first: dict[object, PlanPart] = {}
         for part in self.parts:
-            first.setdefault(part.name, part)
+            # A mesh's poses are different shapes on the belt: each says its own.
+            sides = part.landing is None or not part.landing.startswith("pose-")
+            first.setdefault(part.name if sides else (part.name, part.landing), part)
         return fragile_warnings([push_function_of(p) for p in first.values()])
 
     def low_margin_warning(self) -> str | None:
