@@ -30,6 +30,7 @@ from feederkit.cli.common import (
 )
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
+from feederkit.plans.model import REJECTED_WORDS
 from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
     DEFAULT_FRICTION_BELT_RANGE,
@@ -39,10 +40,6 @@ from feederkit.sim.api import (
 )
 from feederkit.sim.engine import require_mujoco
 from feederkit.sim.summary import SimulationSummary
-
-REJECTED = "rightly rejected"
-"""Successes that ended in a reject leaf naming the member (design.md, "Landings")."""
-REJECTED_WHY = "a reject leaf naming the landing"
 
 SHOWN_ROWS = 20
 """Failures and misses listed in the terminal (all of them are in ``--json``)."""
@@ -64,7 +61,7 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         for name, t, k in zip(s.parts, s.part_trials, s.part_successes, strict=True):
             table.add_row(f"  {escape(name)}", f"{k} of {t}")
     if s.rejects:
-        table.add_row(f"  of them {REJECTED}", f"{s.rejects} ({REJECTED_WHY})")
+        table.add_row("  of them", f"{s.rejects} {REJECTED_WORDS}")
     table.add_row("failures", str(len(s.failures)))
     if s.wrong_accepts:
         table.add_row("  wrong accepts", f"{s.wrong_accepts} (accepted, landing or state wrong)")

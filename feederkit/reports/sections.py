@@ -10,7 +10,7 @@ from typing import Any
 
 from feederkit.cell import expectation_words
 from feederkit.errors import InputError
-from feederkit.plans.model import Leaf, Plan
+from feederkit.plans.model import REJECTED_WORDS, Leaf, Plan
 from feederkit.reports.svgkit import esc, num
 from feederkit.reports.trace import Confusion
 from feederkit.reports.tree_html import Drawing, path_text
@@ -166,7 +166,7 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     if rejects:
         words = [
             f"successes: {success}, {successes - rejects} oriented correctly and {rejects} "
-            "rightly rejected (a reject leaf naming the landing)"
+            f"{REJECTED_WORDS}"
         ]
     else:
         words = [f"successes (oriented correctly): {success}"]
