@@ -52,6 +52,12 @@ def test_export_writes_the_stored_plan_byte_for_byte(db, tmp_path, capsys):
     cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(exported), "--catalog", str(db)])
     assert exported.read_bytes() == compiled.read_bytes()
     assert str(exported) in cap.out
+    cap = ok(
+        capsys,
+        ["changeover", "export", "fig27", "-o", str(exported), "--json", "--catalog", str(db)],
+    )
+    assert json.loads(cap.out)["up_to_date"] is True
+    assert exported.read_bytes() == compiled.read_bytes()
     ok(capsys, ["run", str(exported), "--all"])
     err = one_line_error(
         capsys, ["changeover", "export", "nope", "-o", str(exported), "--catalog", str(db)]
@@ -163,6 +169,16 @@ def test_a_newer_part_revision_is_warned_about(db, tmp_path, capsys):
     # A stale export is a result to act on (exit 1), the file still written.
     cap = ok(capsys, ["changeover", "export", "fig27", "-o", str(out), "--catalog", str(db)], 1)
     assert "latest is 2" in cap.err and out.is_file()
+    cap = ok(
+        capsys,
+        ["changeover", "export", "fig27", "-o", str(out), "--json", "--catalog", str(db)],
+        1,
+    )
+    exported = json.loads(cap.out)  # stdout is the JSON alone, the warning on stderr
+    assert exported["up_to_date"] is False and exported["warnings"] == shown["warnings"]
+    assert (
+        exported["output"] == str(out) and {"name": "octagon", "revision": 1} in (exported["parts"])
+    )
     # Compiling against the old revision on purpose says so, too.
     pinned = ["changeover", "compile", "old", "--mix", "octagon@1,rectangle-2x1"]
     cap = ok(capsys, [*pinned, "--tolerance", "0.01", "--json", "--catalog", str(db)])

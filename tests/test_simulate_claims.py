@@ -144,6 +144,9 @@ def test_a_sample_beyond_what_the_plan_certifies_gets_one_note() -> None:
     ideal = certified_bounds(IDEAL, 4.68, None)
     assert beyond_certified_note(2.34, 0.0, ideal) is None
     assert "(±4.68 deg)" in (beyond_certified_note(11.7, 0.0, ideal) or "")
+    # without a certificate the figure is a claim, not a certificate, and says so
+    assert "beyond what the plan claims" in (beyond_certified_note(11.7, 0.0, ideal) or "")
+    assert (ideal.verb, held.verb) == ("claims", "certifies")
 
 
 def test_the_summary_carries_the_note_in_its_json() -> None:

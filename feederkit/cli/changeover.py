@@ -472,7 +472,9 @@ OutputOpt = Annotated[
 
 
 @changeover_app.command("export")
-def export_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None) -> None:
+def export_command(
+    name: NameArg, output: OutputOpt, json_out: JsonOpt = False, catalog: CatalogOpt = None
+) -> None:
     """Write a stored changeover's plan file, for feederkit run or a controller.
 
     Exit 1 when a part has a newer revision than the changeover names: the file is still
@@ -482,7 +484,18 @@ def export_command(name: NameArg, output: OutputOpt, catalog: CatalogOpt = None)
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     write_files([OutputFile(output, plan_json(co.plan), "plan file")])
-    console.print(f"wrote the plan to {output}", highlight=False, markup=False, soft_wrap=True)
+    if json_out:
+        print_json(
+            {
+                "changeover": name,
+                "output": str(output),
+                "parts": [{"name": n, "revision": r} for n, r in co.info.parts],
+                "up_to_date": not co.warnings,
+                "warnings": list(co.warnings),
+            }
+        )
+    else:
+        console.print(f"wrote the plan to {output}", highlight=False, markup=False, soft_wrap=True)
     if co.warnings:
         raise CheckFailed(_stale_result(name, len(co.warnings)))
 

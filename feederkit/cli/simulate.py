@@ -74,7 +74,7 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     margin = "none (no rotations)" if s.min_margin_deg is None else f"±{s.min_margin_deg:.4f}°"
     table.add_row("plan's smallest margin", margin)
     if s.certified is not None:
-        table.add_row("plan certifies", escape(s.certified.words()))
+        table.add_row(f"plan {s.certified.verb}", escape(s.certified.words()))
     table.add_row(
         "wall time", f"{s.wall_time_s:.2f} s ({plural(s.pushes, 'push-align operation')})"
     )

@@ -105,6 +105,13 @@ class Certified:
     shape_tolerance_mm: float
     from_certificate: bool
 
+    @property
+    def verb(self) -> str:
+        """The verb for the figure: "certifies" (its certificate, proven on the feeder
+        model) or "claims" (no certificate: the declared figures plus the smallest margin,
+        which on the ideal model can overstate the feeder)."""
+        return "certifies" if self.from_certificate else "claims"
+
     def words(self) -> str:
         """The bounds in one line, saying where they come from."""
         rot = (
@@ -169,7 +176,8 @@ def beyond_certified_note(
     held = ", ".join(b for _, b in over)
     verb = "are" if len(over) > 1 else "is"
     return (
-        f"sampled {sampled} {verb} beyond what the plan certifies ({held}): failures are expected"
+        f"sampled {sampled} {verb} beyond what the plan {certified.verb} ({held}): failures are "
+        "expected"
     )
 
 
