@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import ast
+import itertools
+import math
 from pathlib import Path
 
 import pytest
@@ -292,3 +295,36 @@ def test_the_statistics_table_says_the_mix_shares_weigh_the_expectation(mix_plan
 
     assert "(over the mix shares, uniform start orientation)" in label(weighted)
     assert "(parts equally likely, uniform start orientation)" in label(mix_plan)
+
+
+def _block(text: str, start: str) -> str:
+    """The fenced block that opens with ``start`` (its body)."""
+    i = text.index(start) + len(start)
+    return text[i : text.index("```", i)]
+
+
+def _printed(text: str, after: str) -> list[str]:
+    """The indented lines of the first output block after ``after``."""
+    rest = text[text.index(after) + len(after) :].split("\n")[2:]
+    return [x[4:] for x in itertools.takewhile(lambda x: x.startswith("    "), rest)]
+
+
+def test_the_worked_example_prints_what_the_docs_say(tmp_path, monkeypatch, capsys):
+    """docs/cell.md's snippet, run with its profile: the printed figures are the page's."""
+    root = Path(__file__).resolve().parents[1]
+    docs = (root / "docs" / "cell.md").read_text(encoding="utf-8")
+    worked = docs[docs.index("## Worked example") :]
+    write(tmp_path, _block(worked, "```toml\n"))
+    (tmp_path / "catalog").symlink_to(root / "catalog")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(_block(worked, "```python\n"), "cell.md", "exec"), {})
+    got = capsys.readouterr().out.strip().split("\n")
+    want = _printed(worked, "prints (")
+    assert len(got) == len(want) == 6
+    for g, w in zip(got, want, strict=True):
+        if g.startswith("{"):
+            gd, wd = ast.literal_eval(g), ast.literal_eval(w)
+            assert gd.keys() == wd.keys()
+            assert all(math.isclose(gd[k], wd[k], abs_tol=1.5e-3) for k in gd), (g, w)
+        else:
+            assert g == w
