@@ -553,13 +553,39 @@ def max_rotation_error_deg(
     model = strong_model(plan, parts=parts, vibrating=True)
     run = _Run(plan, model)
     best = MAX_ROTATION_ERROR_DEG
+    # Per (node, part): the part's states the node's subtree handles after its rotation.
+    handled: dict[tuple[int, int], frozenset[int]] = {}
+    for node, new in _reaching(plan, run, deadline):
+        a = node.get("action_deg")
+        if a is None:
+            continue
+        by_part: dict[int, list[int]] = {}
+        for p, s in new:
+            by_part.setdefault(p, []).append(s)
+        for p, here in sorted(by_part.items()):
+            mech = model.mechanics[p]
+            allowed = handled.get((id(node), p))
+            if allowed is None:
+                allowed = frozenset(st.id for st in mech.states if run.settles(node, (p, st.id)))
+                handled[(id(node), p)] = allowed
+            here.sort()
+            r = max_rotation_error(mech, here, float(a), dict.fromkeys(here, allowed))
+            best = min(best, r)
+    return best
+
+
+def _reaching(
+    plan: Mapping[str, Any], run: _Run, deadline: Deadline
+) -> Iterator[tuple[Mapping[str, Any], set[State]]]:
+    """Each operation node (not a result) with states that reach it before its rotation, each
+    (node, state) pair once however many paths lead there: the states are propagated down
+    the plan's DAG, a node handling only the states new to it (a node may come more than
+    once, each time with new states). Polls ``deadline`` once per node taken."""
     root = run.node(plan["root"])
     nodes: dict[int, Mapping[str, Any]] = {id(root): root}
     reached: dict[int, set[State]] = {}
-    pending: dict[int, set[State]] = {id(root): set(model.states())}
+    pending: dict[int, set[State]] = {id(root): set(run.model.states())}
     work = [id(root)]
-    # Per (node, part): the part's states the node's subtree handles after its rotation.
-    handled: dict[tuple[int, int], frozenset[int]] = {}
     while work:
         deadline.check()
         key = work.pop()
@@ -568,22 +594,7 @@ def max_rotation_error_deg(
         if "result" in node:
             continue
         reached.setdefault(key, set()).update(new)
-        a = node.get("action_deg")
-        if a is not None:
-            by_part: dict[int, list[int]] = {}
-            for p, s in new:
-                by_part.setdefault(p, []).append(s)
-            for p, here in sorted(by_part.items()):
-                mech = model.mechanics[p]
-                allowed = handled.get((key, p))
-                if allowed is None:
-                    allowed = frozenset(
-                        st.id for st in mech.states if run.settles(node, (p, st.id))
-                    )
-                    handled[(key, p)] = allowed
-                here.sort()
-                r = max_rotation_error(mech, here, float(a), dict.fromkeys(here, allowed))
-                best = min(best, r)
+        yield node, new
         for y in {y for x in new for y in run.outcomes(node, x)}:
             for nxt in run.follows(node, y) or ():
                 n = run.node(nxt)
@@ -596,7 +607,89 @@ def max_rotation_error_deg(
                     bucket = pending[k] = set()
                     work.append(k)
                 bucket.add(y)
-    return best
+
+
+MARGIN_TOL_DEG = 1e-6
+"""A margin or certificate is checked this far inside what it claims (deg): the planner's
+ranges end exactly on cell boundaries, which rebuilding the mechanics from the file
+reproduces to about 1e-9."""
+
+
+def margin_problems(
+    plan: Mapping[str, Any],
+    *,
+    parts: Sequence[PushFunction] | None = None,
+    deadline: Deadline | None = None,
+) -> list[str]:
+    """The first action whose ``margin_deg`` a strong plan overstates, in words (empty when
+    every margin holds).
+
+    A strong plan's margin is slack beyond the declared rotation error r (docs/plans.md):
+    every rotation within ``action ± margin`` gives each state that reaches the node the
+    same outcome set, so a rotation error up to ``r + margin`` keeps its outcomes within the
+    set at r. Checked per (node, state) on the mechanics rebuilt from the file, at
+    ``r + margin - MARGIN_TOL_DEG``. A plan declaring the ideal model is checked by
+    :func:`~feederkit.plans.verify.verify_plan`, which follows the whole overlap range.
+    """
+    deadline = deadline or Deadline()
+    model = strong_model(plan, parts=parts)
+    run = _Run(plan, model)
+    for node, new in _reaching(plan, run, deadline):
+        a, m = node.get("action_deg"), node.get("margin_deg")
+        if a is None or m is None:
+            continue
+        for p, s in sorted(new):
+            mech = model.mechanics[p]
+            r = mech.uncertainty.rotation_error_deg
+            base = outcome_set(mech, s, float(a))
+            wide = outcome_set(mech, s, float(a), r + float(m) - MARGIN_TOL_DEG)
+            if wide <= base:
+                continue
+            keeps = max_rotation_error(mech, [s], float(a)) - r
+            return [
+                f"the margin ±{m:.6g}° of the rotation {a:.6g}° is more than it keeps "
+                f"(±{max(keeps, 0.0):.6g}° beyond the declared ±{r:g}°): with a rotation "
+                f"error of ±{r + m:.6g}° {model.label(p)} in physical state {s} can end in "
+                f"{sorted(wide - base)} besides {sorted(base)}"
+            ]
+    return []
+
+
+def certificate_problems(
+    plan: Mapping[str, Any],
+    *,
+    parts: Sequence[PushFunction] | None = None,
+    deadline: Deadline | None = None,
+) -> list[str]:
+    """What a plan's ``stats.certificate`` overstates, in words (empty when it holds or the
+    plan has none): its rotation error against :func:`max_rotation_error_deg` of the tree,
+    its shape tolerance by re-verifying the plan there (with the feeder's vibration, as the
+    certificate is computed). Its ideal length speaks of another plan and is not checked."""
+    cert = (plan.get("stats") or {}).get("certificate")
+    if not cert:
+        return []
+    deadline = deadline or Deadline()
+    pfs = list(parts) if parts is not None else _parts(plan)
+    out = []
+    rot = cert.get("max_rotation_error_deg")
+    if rot is not None:
+        held = max_rotation_error_deg(plan, parts=pfs, deadline=deadline)
+        if rot > held + MARGIN_TOL_DEG:
+            out.append(
+                f"the certificate's rotation error ±{rot:.6g}° is more than the plan holds "
+                f"(±{held:.6g}°)"
+            )
+    shape = cert.get("max_shape_tolerance_mm")
+    declared = declared_uncertainty(plan)
+    if shape is not None and shape > declared.shape_tolerance_mm:
+        deadline.check()
+        unc = Uncertainty(declared.rotation_error_deg, shape, declared.com_tolerance_mm)
+        if not strong_holds(plan, unc, parts=pfs, vibrating=True):
+            out.append(
+                f"the certificate's shape tolerance {shape:.6g} mm is more than the plan "
+                "holds: some path fails there"
+            )
+    return out
 
 
 def max_shape_tolerance_mm(
@@ -687,12 +780,15 @@ def finite_or_none(x: float) -> float | None:
 
 
 __all__ = [
+    "MARGIN_TOL_DEG",
     "MAX_ROTATION_ERROR_DEG",
     "StrongModel",
+    "certificate_problems",
     "declared_uncertainty",
     "finite_or_none",
     "ideal_view",
     "max_rotation_error_deg",
+    "margin_problems",
     "max_shape_tolerance_mm",
     "strong_holds",
     "strong_model",

@@ -517,27 +517,50 @@ def verify_declared(
     kinematic model (:func:`verify_plan`); any other is a strong plan (design.md,
     "Uncertainty"), checked for every outcome the declared uncertainty allows and every
     reading (:func:`feederkit.plans.strong.verify_strong`), together with the file's own
-    consistency (listed states and poses against the hulls and COMs). A failure is in the
-    report (``ok`` False, ``first_problem``), not raised; structural breakage is InputError.
+    consistency (listed states and poses against the hulls and COMs), its margins
+    (:func:`~feederkit.plans.strong.margin_problems`; the ideal verifier follows the whole
+    overlap range) and, for either, its certificate
+    (:func:`~feederkit.plans.strong.certificate_problems`): a margin or certificate larger
+    than the plan keeps is a false promise to the controller. A failure is in the report
+    (``ok`` False, ``first_problem``), not raised; structural breakage is InputError.
     """
     plan = as_plan(plan)
-    if plan.uncertainty.is_ideal:
-        return verify_plan(plan, part_indices)
-    from feederkit.plans.fileformat import plan_to_dict
-    from feederkit.plans.strong import verify_strong
+    old = sys.getrecursionlimit()
+    # The strong checks recurse a few frames per operation (``_Run.handles``, ``worst``).
+    sys.setrecursionlimit(max(old, 8 * plan.stats.length + 200))
+    try:
+        return _verify_declared(plan, part_indices)
+    finally:
+        sys.setrecursionlimit(old)
 
+
+def _verify_declared(plan: Plan, part_indices: Sequence[int] | None) -> VerificationReport:
+    """:func:`verify_declared` with room to recurse."""
+    from feederkit.plans.fileformat import plan_to_dict
+    from feederkit.plans.strong import certificate_problems, margin_problems, verify_strong
+
+    data = plan_to_dict(plan)
+    if plan.uncertainty.is_ideal:
+        report = verify_plan(plan, part_indices)
+        if not report.ok:
+            return report
+        claims = tuple(certificate_problems(data))
+        return replace(report, problems=report.problems + claims)
     indices = range(len(plan.parts)) if part_indices is None else part_indices
     problems = _pose_problems(plan) + reject_problems(plan)
     for p in indices:
         problems += _state_problems(plan, p)
     names = {plan.parts[p].key for p in indices}
     try:
-        strong = verify_strong(plan_to_dict(plan))
+        strong = verify_strong(data)
     except CheckFailed as exc:
         unc = plan.uncertainty_words()
         problems.append(f"at the declared uncertainty ({unc}): {exc}")
         # The strong check stops at the first failing path: no per-part counts to report.
         return VerificationReport((), (), tuple(problems))
+    if not problems:
+        # The claims beyond the paths: each margin, and the certificate.
+        problems += margin_problems(data) or certificate_problems(data)
     checks = tuple(c for c in strong.parts if (c.part, c.landing) in names)
     return VerificationReport(checks, (), tuple(problems))
 

@@ -1,0 +1,145 @@
+"""A strong plan's claims beyond its paths: each margin and the certificate (design.md, plan
+file; docs/plans.md). The verifier refuses a file that overstates them, and the margins the
+planner writes hold on the reference model of tests/test_strong_plans.py, which pushes the
+polygon itself."""
+
+from __future__ import annotations
+
+import copy
+import json
+import random
+from pathlib import Path
+
+import pytest
+from test_strong_plans import _usable, perturbed, random_pf, run_plan
+
+from feederkit.cli.app import main
+from feederkit.errors import PlanningError
+from feederkit.plans.make import make_plan
+from feederkit.plans.strong import certificate_problems, margin_problems
+from feederkit.plans.verify import verify_declared
+from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import Uncertainty
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+
+
+@pytest.fixture(scope="module")
+def bracket(tmp_path_factory) -> dict:
+    """The l-bracket over both landings with an LED array (three rotations, two of them
+    shared subplans), as `plan` writes it."""
+    path = tmp_path_factory.mktemp("claims") / "lb.plan.json"
+    args = ["plan", str(CATALOG / "l-bracket.json"), "--led-pitch", "0.5", "--noise", "0.1"]
+    assert main([*args, "-o", str(path)]) == 0
+    return json.loads(path.read_text())
+
+
+def tampered(plan: dict, edit) -> dict:
+    out = copy.deepcopy(plan)
+    edit(out)
+    return out
+
+
+def actions(plan: dict) -> list[dict]:
+    """The plan's distinct rotation nodes (shared subplans once), in the tree's order."""
+    shared = plan.get("nodes") or {}
+    out, seen, todo = [], set(), [plan["root"]]
+    while todo:
+        node = todo.pop(0)
+        while "ref" in node:
+            node = shared[node["ref"]]
+        if id(node) in seen or "result" in node:
+            continue
+        seen.add(id(node))
+        if node.get("action_deg") is not None:
+            out.append(node)
+        todo.extend(b["next"] for b in node["branches"])
+    return out
+
+
+def test_the_written_claims_hold(bracket):
+    assert len(actions(bracket)) >= 2
+    assert verify_declared(bracket).ok
+    assert margin_problems(bracket) == [] and certificate_problems(bracket) == []
+
+
+def test_an_inflated_margin_is_refused(bracket):
+    smallest = bracket["stats"]["min_margin_deg"]
+    wide = [k for k, a in enumerate(actions(bracket)) if a["margin_deg"] > smallest]
+    assert wide  # the smallest margin is also the stats' (the loader checks that)
+    for node in wide:
+        bad = tampered(bracket, lambda p, k=node: actions(p)[k].__setitem__("margin_deg", 179.0))
+        report = verify_declared(bad)
+        assert not report.ok and "more than it keeps" in report.first_problem()
+
+
+def test_a_shifted_rotation_keeps_no_false_margin(bracket):
+    """Moved 15 degrees, the rotation still orients (the paths pass) but keeps less slack."""
+
+    def shift(p):
+        a = actions(p)[0]
+        a["action_deg"] = (a["action_deg"] + 15.0) % 360.0
+
+    bad = tampered(bracket, shift)
+    problems = margin_problems(bad)
+    assert problems and "beyond the declared ±1°" in problems[0]
+    assert not verify_declared(bad).ok
+
+
+def test_an_overstated_certificate_is_refused(bracket):
+    cert = bracket["stats"]["certificate"]
+    rot = tampered(
+        bracket, lambda p: p["stats"]["certificate"].__setitem__("max_rotation_error_deg", 89.0)
+    )
+    assert "rotation error ±89°" in verify_declared(rot).first_problem()
+    just = tampered(
+        bracket,
+        lambda p: p["stats"]["certificate"].__setitem__(
+            "max_rotation_error_deg", cert["max_rotation_error_deg"] + 1e-3
+        ),
+    )
+    assert certificate_problems(just)
+    shape = tampered(
+        bracket, lambda p: p["stats"]["certificate"].__setitem__("max_shape_tolerance_mm", 3.0)
+    )
+    assert "shape tolerance 3 mm" in verify_declared(shape).first_problem()
+
+
+def test_run_all_exits_1_on_an_inflated_margin(bracket, tmp_path, capsys):
+    path = tmp_path / "bad.plan.json"
+    smallest = bracket["stats"]["min_margin_deg"]
+    k = next(k for k, a in enumerate(actions(bracket)) if a["margin_deg"] > smallest)
+    bad = tampered(bracket, lambda p: actions(p)[k].__setitem__("margin_deg", 179.0))
+    path.write_text(json.dumps(bad))
+    assert main(["run", str(path), "--all"]) == 1
+    assert "more than it keeps" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("chunk", range(2))
+def test_written_margins_hold_on_the_reference(chunk):
+    """Random parts' strong plans run on the reference with every rotation off by up to the
+    declared error plus 0.99 of the plan's smallest margin: every run ends in its result."""
+    planned, seed = 0, 20_000 * (chunk + 1)
+    unc = Uncertainty(1.0)
+    while planned < 12:
+        seed += 1
+        pf = random_pf(seed)
+        if not _usable(pf, unc):
+            continue
+        sensor = ToleranceSensor(0.05) if seed % 2 else NoSensor()
+        try:
+            made = make_plan([pf], sensor, uncertainty=unc, certify=False)
+        except PlanningError:
+            continue
+        margin = made.plan["stats"]["min_margin_deg"]
+        if margin is None:
+            continue
+        planned += 1
+        hull = [tuple(v) for v in made.plan["parts"][0]["hull"]]
+        com = tuple(made.plan["parts"][0]["com"])
+        rng = random.Random(seed)
+        err = unc.rotation_error_deg + 0.99 * margin
+        e = made.plan["sensor"].get("tolerance_mm", 0.0)
+        for _ in range(12):
+            poly, c = perturbed(hull, com, 0.0, 0.0, rng)
+            assert not run_plan(made.plan, 0, poly, c, err, e, rng), (seed, err)
