@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import bisect
 import weakref
+from collections.abc import Iterator
 from functools import cached_property
 
 import numpy as np
@@ -403,15 +404,24 @@ def inseparable(machine: PushAlignMachine) -> tuple[int, ...]:
     return search_space(machine).inseparable
 
 
-def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
-    """The cells ``[lo, hi, image]`` of a set, by a sweep in pure Python."""
-    machine = space.machine
-    targets = machine.targets
+def _sweep_clusters(
+    space: SearchSpace, idx: list[int]
+) -> tuple[list[tuple[float, int, int]], Iterator[tuple[float, float, int, int]]]:
+    """The sorted boundary events ``(angle, state, target)`` of a set's members and its
+    cells ``(lo, hi, first, end)``, whose events are ``evs[first:end]``, for the pure Python
+    sweeps.
+
+    The boundaries are clustered exactly as :func:`~feederkit.angles.merge_boundaries`
+    does. A last cluster within ANGLE_EPS of the first across 360 degrees wraps into it; its
+    events are dropped, since they only restart each member's last action range, where the
+    sweep starts. A cell whose last event is at or past its middle is narrower than its own
+    boundary cluster: there the swept image belongs to a neighbour, and callers ask the
+    machine for the image at the middle.
+    """
     triples = space.triples
     evs = [e for i in idx for e in triples[i]]
     evs.sort()
     eps = ANGLE_EPS
-    # Cluster the sorted boundaries exactly as merge_boundaries does.
     reps: list[float] = []
     starts: list[int] = []
     for k, (b, _i, _t) in enumerate(evs):
@@ -420,10 +430,19 @@ def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
             starts.append(k)
     n_ev = len(evs)
     if len(reps) > 1 and reps[0] + 360.0 - reps[-1] <= eps:
-        # The last cluster wraps into the first: its events restart each member's last range.
         reps.pop()
         n_ev = starts.pop()
-    m = len(reps)
+    if not reps:
+        return evs, iter(())
+    his = [*reps[1:], reps[0] + 360.0]
+    return evs, zip(reps, his, starts, [*starts[1:], n_ev], strict=True)
+
+
+def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
+    """The cells ``[lo, hi, image]`` of a set, by a sweep in pure Python."""
+    machine = space.machine
+    targets = machine.targets
+    evs, clusters = _sweep_clusters(space, idx)
     # Before the first boundary every member is in its last action range.
     count: dict[int, int] = {}
     cur: dict[int, int] = {}
@@ -436,14 +455,8 @@ def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
             img |= 1 << t
         count[t] = c + 1
     cells: list[list] = []
-    for k in range(m):
-        end = starts[k + 1] if k + 1 < m else n_ev
-        lo = reps[k]
-        hi = reps[k + 1] if k + 1 < m else reps[0] + 360.0
-        mid = (lo + hi) / 2.0
-        last_b = lo
-        for _b, i, t in evs[starts[k] : end]:
-            last_b = _b
+    for lo, hi, first, end in clusters:
+        for _b, i, t in evs[first:end]:
             old = cur[i]
             if old == t:
                 continue
@@ -456,7 +469,8 @@ def _cells_sweep(space: SearchSpace, mask: int, idx: list[int]) -> list[list]:
             if c == 0:
                 img |= 1 << t
             count[t] = c + 1
-        if last_b >= mid:  # a degenerate cell narrower than its own boundary cluster
+        mid = (lo + hi) / 2.0
+        if evs[end - 1][0] >= mid:  # a degenerate cell narrower than its own boundary cluster
             cells.append([lo, hi, machine.image(mask, norm360(mid))])
         else:
             cells.append([lo, hi, img])
@@ -471,21 +485,7 @@ def _cells_sweep_sets(space: SearchSpace, mask: int, idx: list[int]) -> list[lis
     """
     machine = space.machine
     outs = machine.outcomes_of
-    triples = space.triples
-    evs = [e for i in idx for e in triples[i]]
-    evs.sort()
-    eps = ANGLE_EPS
-    reps: list[float] = []
-    starts: list[int] = []
-    for k, (b, _i, _t) in enumerate(evs):
-        if not reps or b - reps[-1] > eps:
-            reps.append(b)
-            starts.append(k)
-    n_ev = len(evs)
-    if len(reps) > 1 and reps[0] + 360.0 - reps[-1] <= eps:
-        reps.pop()
-        n_ev = starts.pop()
-    m = len(reps)
+    evs, clusters = _sweep_clusters(space, idx)
     count = [0] * machine.n
     cur: dict[int, int] = {}
     img = 0
@@ -508,25 +508,73 @@ def _cells_sweep_sets(space: SearchSpace, mask: int, idx: list[int]) -> list[lis
         cur[i] = outs[i][-1]
         add(cur[i], 1)
     cells: list[list] = []
-    for k in range(m):
-        end = starts[k + 1] if k + 1 < m else n_ev
-        lo = reps[k]
-        hi = reps[k + 1] if k + 1 < m else reps[0] + 360.0
-        mid = (lo + hi) / 2.0
-        last_b = lo
-        for _b, i, t in evs[starts[k] : end]:
-            last_b = _b
+    for lo, hi, first, end in clusters:
+        for _b, i, t in evs[first:end]:
             old = cur[i]
             if old == t:
                 continue
             cur[i] = t
             add(old, -1)
             add(t, 1)
-        if last_b >= mid:  # a degenerate cell narrower than its own boundary cluster
+        mid = (lo + hi) / 2.0
+        if evs[end - 1][0] >= mid:  # a degenerate cell narrower than its own boundary cluster
             cells.append([lo, hi, machine.image(mask, norm360(mid))])
         else:
             cells.append([lo, hi, img])
     return cells
+
+
+def _numpy_sweep(
+    b: np.ndarray, st: np.ndarray, tg: np.ndarray, initial: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, float]]] | None:
+    """The sweep vectorised, for the numpy cells: sorted boundaries ``b``, at which member
+    row ``st`` takes value ``tg`` (a target or an outcome mask; ``initial`` before the first
+    boundary).
+
+    Returns the cells' ``lo`` and ``hi`` (clustered as in :func:`_sweep_clusters`), each
+    member's value per cell (``values[row, cell]``) and the cells narrower than their own
+    boundary cluster with their middles; None when a cluster spans more than ANGLE_EPS (a
+    chain of close boundaries, where merge_boundaries's rule differs: use the sweep).
+    """
+    eps = ANGLE_EPS
+    new = np.empty(len(b), dtype=bool)
+    new[0] = True
+    new[1:] = np.diff(b) > eps
+    first = np.flatnonzero(new)
+    last = np.append(first[1:] - 1, len(b) - 1)
+    if np.any(b[last] - b[first] > eps):
+        return None
+    cid = np.cumsum(new) - 1
+    reps = b[first]
+    m = len(reps)
+    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
+        keep = cid < m - 1
+        st, tg, cid = st[keep], tg[keep], cid[keep]
+        last = last[:-1]
+        m -= 1
+        reps = reps[:m]
+    grid = np.full((len(initial), m + 1), -1, dtype=np.int64)
+    grid[:, 0] = initial
+    grid[st, cid + 1] = tg
+    pos = np.where(grid >= 0, np.arange(m + 1), 0)
+    np.maximum.accumulate(pos, axis=1, out=pos)
+    values = np.take_along_axis(grid, pos, axis=1)[:, 1:]
+    his = np.append(reps[1:], reps[0] + 360.0)
+    mids = (reps + his) / 2.0
+    narrow = [(c, float(mids[c])) for c in np.flatnonzero(b[last] >= mids).tolist()]
+    return reps, his, values, narrow
+
+
+def _exact_images(
+    space: SearchSpace, mask: int, imgs: np.ndarray, narrow: list[tuple[int, float]]
+) -> np.ndarray:
+    """``imgs`` with each narrow cell's image (``(cell, middle)`` from :func:`_numpy_sweep`)
+    replaced by the set's image at its middle."""
+    if narrow:
+        imgs = imgs.astype(object)
+        for c, mid in narrow:
+            imgs[c] = space.machine.image(mask, norm360(mid))
+    return imgs
 
 
 def _cells_numpy_sets(space: SearchSpace, mask: int, idx: list[int], table) -> list[list] | None:
@@ -540,40 +588,13 @@ def _cells_numpy_sets(space: SearchSpace, mask: int, idx: list[int], table) -> l
     b = lo_s[order]
     row_of = np.full(space.machine.n, -1, dtype=np.int64)
     row_of[idx] = np.arange(len(idx))
-    st = row_of[st_s[order]]
-    tg = mk_s[order]
-    eps = ANGLE_EPS
     if len(b) == 0:
         return None
-    new = np.empty(len(b), dtype=bool)
-    new[0] = True
-    new[1:] = np.diff(b) > eps
-    first = np.flatnonzero(new)
-    lastk = np.append(first[1:] - 1, len(b) - 1)
-    if np.any(b[lastk] - b[first] > eps):
+    swept = _numpy_sweep(b, row_of[st_s[order]], mk_s[order], last[idx])
+    if swept is None:
         return None
-    cid = np.cumsum(new) - 1
-    reps = b[first]
-    m = len(reps)
-    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
-        k2 = cid < m - 1
-        st, tg, cid = st[k2], tg[k2], cid[k2]
-        lastk = lastk[:-1]
-        m -= 1
-        reps = reps[:m]
-    k = len(idx)
-    grid = np.full((k, m + 1), -1, dtype=np.int64)
-    grid[:, 0] = last[idx]
-    grid[st, cid + 1] = tg
-    pos = np.where(grid >= 0, np.arange(m + 1), 0)
-    np.maximum.accumulate(pos, axis=1, out=pos)
-    outs = np.take_along_axis(grid, pos, axis=1)[:, 1:]
-    imgs = np.bitwise_or.reduce(outs, axis=0)
-    his = np.append(reps[1:], reps[0] + 360.0)
-    mids = (reps + his) / 2.0
-    imgs = imgs.astype(object)
-    for c in np.flatnonzero(b[lastk] >= mids).tolist():  # a cell narrower than its cluster
-        imgs[c] = space.machine.image(mask, norm360(float(mids[c])))
+    reps, his, outs, narrow = swept
+    imgs = _exact_images(space, mask, np.bitwise_or.reduce(outs, axis=0), narrow)
     return [
         [lo, hi, int(im)]
         for lo, hi, im in zip(reps.tolist(), his.tolist(), imgs.tolist(), strict=True)
@@ -587,42 +608,15 @@ def _cells_numpy(space: SearchSpace, mask: int, idx: list[int], table) -> list[l
     sel = np.array(idx)
     lo_all = los[sel].ravel()
     order = np.argsort(lo_all, kind="stable")
-    b = lo_all[order]
     st = np.repeat(np.arange(k), r)[order]
-    tg = tgs[sel].ravel()[order]
-    eps = ANGLE_EPS
-    new = np.empty(len(b), dtype=bool)
-    new[0] = True
-    new[1:] = np.diff(b) > eps
-    first = np.flatnonzero(new)
-    last = np.append(first[1:] - 1, len(b) - 1)
-    if np.any(b[last] - b[first] > eps):
-        return None  # a chain of close boundaries: merge_boundaries's rule differs
-    cid = np.cumsum(new) - 1
-    reps = b[first]
-    m = len(reps)
-    if m > 1 and reps[0] + 360.0 - reps[-1] <= eps:
-        keep = cid < m - 1
-        st, tg, cid = st[keep], tg[keep], cid[keep]
-        last = last[:-1]
-        m -= 1
-        reps = reps[:m]
-    grid = np.full((k, m + 1), -1, dtype=np.int64)
-    grid[:, 0] = tgs[sel, -1]
-    grid[st, cid + 1] = tg
-    pos = np.where(grid >= 0, np.arange(m + 1), 0)
-    np.maximum.accumulate(pos, axis=1, out=pos)
-    targets = np.take_along_axis(grid, pos, axis=1)[:, 1:]
+    swept = _numpy_sweep(lo_all[order], st, tgs[sel].ravel()[order], tgs[sel, -1])
+    if swept is None:
+        return None
+    reps, his, targets, narrow = swept
     bits = np.left_shift(np.uint64(1), targets.astype(np.uint64))
-    imgs = np.bitwise_or.reduce(bits, axis=0)
-    his = np.append(reps[1:], reps[0] + 360.0)
-    mids = (reps + his) / 2.0
-    bad = np.flatnonzero(b[last] >= mids)
-    if len(bad):
-        imgs = imgs.astype(object)
-        for c in bad.tolist():  # a degenerate cell narrower than its own boundary cluster
-            imgs[c] = space.machine.image(mask, norm360(float(mids[c])))
+    imgs = _exact_images(space, mask, np.bitwise_or.reduce(bits, axis=0), narrow)
     # Merge neighbours with equal images here; overlap_cells merges the rest.
+    m = len(reps)
     keep = np.ones(m, dtype=bool)
     keep[1:] = imgs[1:] != imgs[:-1]
     starts = np.flatnonzero(keep)
