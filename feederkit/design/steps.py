@@ -262,6 +262,21 @@ def length_steps(
     }
     starts = sorted({0} | {c for c in changes if 0 < c <= last})
     below = recognizable_below(breaks, critical)
+    fit = _fit_memo(oracle, breaks, clock)
+    steps = []
+    for first, end in zip(starts, [*starts[1:], last + 1], strict=True):
+        runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate, clock)
+        for lo, hi, j, ev in _checked_runs(runs, breaks, "plan"):
+            steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < below))
+    return tuple(steps)
+
+
+def _fit_memo(
+    oracle: LengthOracle | StrongOracle, breaks: Sequence[float], clock: DesignClock
+) -> Callable[[int, int], bool]:
+    """``fit(k, length)``: whether interval ``k`` has a plan of at most ``length`` operations
+    (``oracle.within`` at the interval's probe), each question asked once per table (the
+    gallop and the next step's search ask again); ``clock`` is polled before each."""
     fits: dict[tuple[int, int], bool] = {}
 
     def fit(k: int, length: int) -> bool:
@@ -270,19 +285,26 @@ def length_steps(
             fits[k, length] = oracle.within(interval_probe(breaks, k), length)
         return fits[k, length]
 
-    steps = []
-    for first, end in zip(starts, [*starts[1:], last + 1], strict=True):
-        runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate, clock)
-        for i, j, length, ev in runs:
-            if ev.length != length:
-                raise CheckFailed(
-                    f"the verified plan at {interval_probe(breaks, j):g} mm has length "
-                    f"{ev.length}, the search over tolerances found {length}"
-                )
-            lo = 0.0 if i == 0 else breaks[i - 1]
-            hi = breaks[j] if j < len(breaks) else None
-            steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < below))
-    return tuple(steps)
+    return fit
+
+
+def _checked_runs(
+    runs: Sequence[tuple[int, int, int, Evaluation]], breaks: Sequence[float], plan: str
+) -> list[tuple[float, float | None, int, Evaluation]]:
+    """The runs of :func:`_segment_runs` as tolerances ``(lo, hi]`` (``hi`` None: unbounded)
+    with their last interval and verified plan; CheckFailed, naming the ``plan``, when a
+    verified plan's length is not the one the search found (the table must not lie)."""
+    out = []
+    for i, j, length, ev in runs:
+        if ev.length != length:
+            raise CheckFailed(
+                f"the verified {plan} at {interval_probe(breaks, j):g} mm has length "
+                f"{ev.length}, the search over tolerances found {length}"
+            )
+        out.append(
+            (0.0 if i == 0 else breaks[i - 1], breaks[j] if j < len(breaks) else None, j, ev)
+        )
+    return out
 
 
 def _segment_runs(

@@ -55,11 +55,12 @@ from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
 from feederkit.design.steps import (
     Evaluation,
     LengthStep,
+    _checked_runs,
     _first_at_or_above,
+    _fit_memo,
     _segment_runs,
     recognizable_below,
 )
-from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
 from feederkit.machine.build import build_machine
 from feederkit.machine.inseparable import inseparable_masks, kept_apart
@@ -568,14 +569,7 @@ def strong_length_steps(
     evaluate = evaluate or (lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e, clock))
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     below = recognizable_below(breaks, critical)
-    fits: dict[tuple[int, int], bool] = {}
-
-    def fit(k: int, length: int) -> bool:
-        if (k, length) not in fits:
-            clock.check()
-            fits[k, length] = oracle.within(interval_probe(breaks, k), length)
-        return fits[k, length]
-
+    fit = _fit_memo(oracle, breaks, clock)
     steps = []
     segments = goal_segments(oracle, breaks, last, clock)
     clock.begin(LENGTHS, last + 1)
@@ -587,14 +581,7 @@ def strong_length_steps(
             clock.advance(j_last + 1 - first)
             continue
         runs = _segment_runs(first, j_last, breaks, oracle, fit, evaluate, clock)
-        for i, j, length, ev in runs:
-            if ev.length != length:
-                raise CheckFailed(
-                    f"the verified strong plan at {interval_probe(breaks, j):g} mm has length "
-                    f"{ev.length}, the search over tolerances found {length}"
-                )
-            lo = 0.0 if i == 0 else breaks[i - 1]
-            hi = breaks[j] if j < len(breaks) else None
+        for lo, hi, j, ev in _checked_runs(runs, breaks, "strong plan"):
             ok = j < below and not ev.mixes_parts
             steps.append(LengthStep(lo, hi, ev.length, ev.expected, ok))
     return tuple(steps)
