@@ -102,12 +102,14 @@ def build_dag(
 
 @dataclass(frozen=True)
 class Certificate:
-    """What a strong plan guarantees beyond its declared uncertainty (design.md, plan file).
+    """What a strong plan guarantees beyond its declared uncertainty (design.md, plan file
+    ``stats.certificate``); the one value the planners' result and the plan model share.
 
     ``max_rotation_error_deg``: the largest rotation error (a supremum) under which the plan
     as written still reaches its results for every outcome; ``max_shape_tolerance_mm``: the
     largest shape tolerance likewise (to the bisection's resolution); ``ideal_length``: the
-    minimum length on the ideal model (zero uncertainty), what robustness costs.
+    minimum length on the ideal model (zero uncertainty; None when not computed), what
+    robustness costs.
     """
 
     max_rotation_error_deg: float
@@ -115,7 +117,7 @@ class Certificate:
     ideal_length: int | None
 
     def to_dict(self) -> dict[str, float | int | None]:
-        """The plan file's ``stats.certificate`` object."""
+        """The plan file's ``stats.certificate`` object (design.md's key order)."""
         return {
             "max_rotation_error_deg": self.max_rotation_error_deg,
             "max_shape_tolerance_mm": self.max_shape_tolerance_mm,

@@ -311,7 +311,7 @@ def plan_from_result(
         polygon_class=s["class"],
         class_bound=s["class_bound"],
         meets_bound=s["meets_bound"],
-        certificate=_certificate_of(result),
+        certificate=getattr(result, "certificate", None),
     )
     return Plan(
         sensor=machine.sensor,
@@ -323,18 +323,6 @@ def plan_from_result(
         stats=stats,
         conventions=CONVENTIONS,
         uncertainty=getattr(machine, "uncertainty", IDEAL) if uncertainty is None else uncertainty,
-    )
-
-
-def _certificate_of(result: PlanResult) -> Certificate | None:
-    """The plan model's certificate of a planner's result (None when it has none)."""
-    cert = getattr(result, "certificate", None)
-    if cert is None:
-        return None
-    return Certificate(
-        max_rotation_error_deg=cert.max_rotation_error_deg,
-        max_shape_tolerance_mm=cert.max_shape_tolerance_mm,
-        ideal_length=cert.ideal_length,
     )
 
 

@@ -31,6 +31,7 @@ from feederkit.mechanics.analysis import fragile_warnings
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning.tree import Certificate
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -270,26 +271,6 @@ class PlanStats:
     class_bound: int | None = None
     meets_bound: bool | None = None
     certificate: Certificate | None = None
-
-
-@dataclass(frozen=True)
-class Certificate:
-    """What a strong plan guarantees beyond its declared uncertainty (design.md, plan file
-    ``stats.certificate``): the largest rotation error (deg) and shape tolerance (mm) under
-    which the plan as written still reaches its results, and the minimum length on the ideal
-    model (None when not computed), what robustness costs."""
-
-    max_rotation_error_deg: float
-    max_shape_tolerance_mm: float
-    ideal_length: int | None
-
-    def to_dict(self) -> dict[str, float | int | None]:
-        """The plan file's ``stats.certificate`` object (design.md's key order)."""
-        return {
-            "max_rotation_error_deg": self.max_rotation_error_deg,
-            "max_shape_tolerance_mm": self.max_shape_tolerance_mm,
-            "ideal_length": self.ideal_length,
-        }
 
 
 def operations_below(root: Node) -> int:
