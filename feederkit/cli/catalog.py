@@ -80,6 +80,10 @@ SideOpt = Annotated[
     ),
 ]
 
+RevisionOpt = Annotated[
+    int | None,
+    typer.Option("--revision", min=1, metavar="N", help="Revision (default latest)."),
+]
 WaitOpt = Annotated[
     float,
     typer.Option(
@@ -443,10 +447,7 @@ def _tol(value: float | None) -> str:
 
 def cmd_show(
     name: Annotated[str, typer.Argument(help="Part name (NAME@REV for one revision).")],
-    revision: Annotated[
-        int | None,
-        typer.Option("--revision", min=1, metavar="N", help="Revision (default latest)."),
-    ] = None,
+    revision: RevisionOpt = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -539,10 +540,7 @@ def cmd_export(
         Path,
         typer.Option("-o", "--output", metavar="OUT.json", help="Outline file to write (.json)."),
     ],
-    revision: Annotated[
-        int | None,
-        typer.Option("--revision", min=1, metavar="N", help="Revision (default latest)."),
-    ] = None,
+    revision: RevisionOpt = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
