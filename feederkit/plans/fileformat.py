@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any
 
 from feederkit.errors import InputError, PlanningError
 from feederkit.jsonio import parse_json, write_text_atomic
+from feederkit.machine.model import members
 from feederkit.mechanics.push import PushFunction, StableState
 from feederkit.plans.model import (
     Branch,
@@ -110,14 +111,9 @@ _JSON_LEVELS_PER_OPERATION = 3
 # ---------------------------------------------------------------- from a planner's result
 
 
-def state_members(mask: int) -> list[int]:
-    """The machine states in a set (a bit mask), in increasing order."""
-    out = []
-    while mask:
-        low = mask & -mask
-        out.append(low.bit_length() - 1)
-        mask ^= low
-    return out
+state_members = members
+"""The machine states in a set (a bit mask), in increasing order: the machine's
+:func:`~feederkit.machine.model.members`, under the name this module has given it."""
 
 
 def _plan_part(
@@ -244,10 +240,6 @@ def _tree(
     root = built[id(result.root)]
     assert isinstance(root, Step)
     return root
-
-
-members = state_members
-"""The older name of :func:`state_members`."""
 
 
 def plan_from_result(
