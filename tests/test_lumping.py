@@ -14,7 +14,7 @@ import random
 from pathlib import Path
 
 import pytest
-from shared import outcome_mask, read_alike_sets, rotation_mids
+from test_strong_plans import strong_search
 
 import feederkit.planning.api as api
 from feederkit.machine import (
@@ -206,47 +206,11 @@ def test_the_apu_mount_drawing_plans_with_the_defaults_and_verifies(wired, senso
 
 def brute(machine: PushAlignMachine, tol: float | None, goal_pairs: set[tuple[int, int]]):
     """``solvable(mask)``: whether a strong plan takes ``mask`` to a set whose pairs are all
-    in ``goal_pairs`` (own code, see the module docstring)."""
-    n = machine.n
-    mids = rotation_mids(machine)
-
-    def out(i, a):
-        return outcome_mask(machine, i, a)
-
-    def sensed(i):
-        d = machine.states[i].sensed
-        return (d, d) if isinstance(d, float) else d
-
-    def children(mask):
-        if tol is None:
-            return [mask]
-        return read_alike_sets({i: (sensed(i)[0] - tol, sensed(i)[1] + tol) for i in members(mask)})
-
-    def goal(mask):
-        idx = members(mask)
-        return all((i, j) in goal_pairs for k, i in enumerate(idx) for j in idx[k + 1 :])
-
-    memo: dict[tuple[int, int], bool] = {}
-
-    def within(mask, k):
-        if goal(mask):
-            return True
-        if k == 0:
-            return False
-        key = (mask, k)
-        if key not in memo:
-            memo[key] = False
-            for a in mids:
-                img = 0
-                for i in members(mask):
-                    img |= out(i, a)
-                if all(within(c, k - 1) for c in children(img)):
-                    memo[key] = True
-                    break
-        return memo[key]
+    in ``goal_pairs`` (own code, see the module docstring), and the reading branches."""
+    within, children = strong_search(machine, tol, goal_pairs)
 
     def solvable(mask):
-        return within(mask, 1 << n)
+        return within(mask, 1 << machine.n)
 
     return solvable, children
 

@@ -13,6 +13,7 @@ import random
 from pathlib import Path
 
 import pytest
+from test_strong_plans import convex_hull
 
 from feederkit.angles import ActionRange
 from feederkit.machine import (
@@ -41,25 +42,6 @@ def catalog_pfs():
     for path in sorted(CATALOG.glob("*.json")):
         out.append(push_function(make_part(load_outline_json(path))))
     return out
-
-
-def convex_hull(pts):
-    """Andrew's monotone chain, counter-clockwise."""
-    pts = sorted(map(tuple, pts))
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
 
 
 def random_pf(seed: int, n: int = 6):

@@ -36,6 +36,7 @@ from feederkit.uncertainty import IDEAL, Uncertainty
 
 
 def convex_hull(pts):
+    """Andrew's monotone chain, counter-clockwise (also tests/test_strong_machine.py's)."""
     pts = sorted(map(tuple, pts))
 
     def cross(o, a, b):
@@ -281,42 +282,42 @@ def test_the_reference_push_agrees_with_the_plan_files_states():
 # --- exhaustive minimal length ---------------------------------------------------------------
 
 
-def exhaustive_length(machine, tol, lumped=()):
-    """Minimum worst-case length by exhaustive search over outcome sets (own code).
+def strong_search(machine, tol, pairs):
+    """``within(mask, k)``: whether a strong plan of at most ``k`` operations takes the set
+    ``mask`` to one whose every pair ``(i, j)``, ``i < j``, is in ``pairs``; and
+    ``children(mask)``: its reading branches (own code, shared with tests/test_lumping.py).
 
     Rotations: the middle of every cell between all action-range boundaries of all states;
-    outcomes looked up in the maps; reading branches: the cells of the states' open reading
-    intervals; goal: one state (the machines used have no inseparable pairs), or a set whose
-    every pair is in ``lumped`` (the pairs the planner lumps: planning.lumping, checked by
-    brute force in tests/test_lumping.py)."""
+    outcomes looked up in the maps; reading branches: the sets of states that can give one
+    reading through their open reading intervals (``tol``; None: sensorless); plain
+    depth-bounded recursion over outcome sets, memoised.
+    """
     n = machine.n
-    lumps = {frozenset(p) for p in lumped}
-
-    def goal(mask):
-        idx = [i for i in range(n) if mask >> i & 1]
-        return all(frozenset((a, b)) in lumps for k, a in enumerate(idx) for b in idx[k + 1 :])
-
     mids = rotation_mids(machine)
 
     def out(i, a):
         return outcome_mask(machine, i, a)
 
-    def intervals(mask):
-        return {
-            i: (machine.states[i].sensed[0] - tol, machine.states[i].sensed[1] + tol)
-            for i in range(n)
-            if mask >> i & 1
-        }
+    def members(mask):
+        return [i for i in range(n) if mask >> i & 1]
+
+    def sensed(i):
+        d = machine.states[i].sensed
+        return (d, d) if isinstance(d, float) else d
 
     def children(mask):
         if tol is None:
             return [mask]
-        return read_alike_sets(intervals(mask))
+        return read_alike_sets({i: (sensed(i)[0] - tol, sensed(i)[1] + tol) for i in members(mask)})
 
-    memo = {}
+    def goal(mask):
+        idx = members(mask)
+        return all((i, j) in pairs for k, i in enumerate(idx) for j in idx[k + 1 :])
+
+    memo: dict[tuple[int, int], bool] = {}
 
     def within(mask, k):
-        if mask & (mask - 1) == 0 or (lumps and goal(mask)):
+        if goal(mask):
             return True
         if k == 0:
             return False
@@ -325,14 +326,23 @@ def exhaustive_length(machine, tol, lumped=()):
             memo[key] = False
             for a in mids:
                 img = 0
-                for i in range(n):
-                    if mask >> i & 1:
-                        img |= out(i, a)
+                for i in members(mask):
+                    img |= out(i, a)
                 if all(within(c, k - 1) for c in children(img)):
                     memo[key] = True
                     break
         return memo[key]
 
+    return within, children
+
+
+def exhaustive_length(machine, tol, lumped=()):
+    """Minimum worst-case length by exhaustive search over outcome sets (:func:`strong_search`);
+    goal: one state (the machines used have no inseparable pairs), or a set whose every pair
+    is in ``lumped`` (the pairs the planner lumps: planning.lumping, checked by brute force in
+    tests/test_lumping.py)."""
+    n = machine.n
+    within, children = strong_search(machine, tol, {tuple(sorted(p)) for p in lumped})
     worst = 0
     for root in children((1 << n) - 1):
         k = 0
