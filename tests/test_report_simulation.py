@@ -46,8 +46,9 @@ def _trial(i: int, outcome: str, cause: str | None = None, rejected: bool = Fals
 def test_the_simulation_row_uses_the_simulators_summary() -> None:
     """The report says what ``simulate`` says: failures by cause (never all "a wrong pose"),
     the sampled uncertainty, the seed, the Wilson interval, the rightly rejected apart."""
+    from simsummaries import sim_summary
+
     from feederkit.reports.sections import simulation_text
-    from feederkit.sim.summary import SimSettings, SimulationSummary
     from feederkit.uncertainty import Uncertainty
 
     failures = (
@@ -55,22 +56,13 @@ def test_the_simulation_row_uses_the_simulators_summary() -> None:
         _trial(6, "failure", "reading in no branch"),
         _trial(7, "failure", "wrong result"),
     )
-    summary = SimulationSummary(
-        settings=SimSettings(40, 7, 1.0, 0.1, 0.5, 0.2, 0.002, sampled=Uncertainty(1.0, 0.0, 0.0)),
-        parts=("bracket (up)", "bracket (down)"),
-        part_trials=(20, 20),
-        part_successes=(18, 19),
-        scales=(1.0, 1.0),
+    summary = sim_summary(
+        {"bracket (up)": (18, 20), "bracket (down)": (19, 20)},
+        seed=7,
+        sampled=Uncertainty(1.0, 0.0, 0.0),
         min_margin_deg=3.0,
-        successes=37,
         failures=failures,
-        unsettled=(),
         pushes=80,
-        settled_pushes=80,
-        push_agreements=80,
-        push_misses=(),
-        wall_time_s=0.0,
-        sim_time_s=0.0,
         rejects=19,
     )
     text = simulation_text(summary.to_dict())

@@ -224,7 +224,9 @@ def test_a_leaf_names_a_member_by_its_landing() -> None:
 
 
 def test_wrong_accepts_are_counted_apart_from_rejects() -> None:
-    from feederkit.sim.summary import SimSettings, SimulationSummary, TrialResult
+    from simsummaries import sim_summary
+
+    from feederkit.sim.summary import TrialResult
 
     def trial(i: int, outcome: str, rejected: bool, cause: str | None = None) -> TrialResult:
         return TrialResult(
@@ -247,22 +249,10 @@ def test_wrong_accepts_are_counted_apart_from_rejects() -> None:
     no_branch = trial(4, "failure", False, "reading in no branch")
     assert wrong_accept.wrong_accept and not wrong_reject.wrong_accept
     assert not no_branch.wrong_accept and not trial(1, "success", True).wrong_accept
-    s = SimulationSummary(
-        settings=SimSettings(5, 0, 1.0, 0.1, 0.5, 0.2, 0.002),
-        parts=("bracket (up)", "bracket (down)"),
-        part_trials=(1, 4),
-        part_successes=(1, 1),
-        scales=(1.0, 1.0),
+    s = sim_summary(
+        {"bracket (up)": (1, 1), "bracket (down)": (1, 4)},
         min_margin_deg=None,
-        successes=2,
         failures=(wrong_accept, wrong_reject, no_branch),
-        unsettled=(),
-        pushes=0,
-        settled_pushes=0,
-        push_agreements=0,
-        push_misses=(),
-        wall_time_s=0.0,
-        sim_time_s=0.0,
         rejects=1,
     )
     d = s.to_dict()

@@ -14,6 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import pytest
+from simsummaries import sim_summary
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError
@@ -27,7 +28,6 @@ from feederkit.sim.summary import (
     WIDTH_ACCURACY_MM,
     Certified,
     SimSettings,
-    SimulationSummary,
     beyond_certified_note,
     certified_bounds,
     push_words,
@@ -40,26 +40,6 @@ from feederkit.sources import load_part
 from feederkit.uncertainty import IDEAL, Uncertainty
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _summary(successes: int, trials: int, **settings: object) -> SimulationSummary:
-    return SimulationSummary(
-        settings=SimSettings(trials, 0, 1.0, 0.1, 0.5, 0.2, 0.002, **settings),
-        parts=("part",),
-        part_trials=(trials,),
-        part_successes=(successes,),
-        scales=(1.0,),
-        min_margin_deg=2.0,
-        successes=successes,
-        failures=(),
-        unsettled=(),
-        pushes=0,
-        settled_pushes=0,
-        push_agreements=0,
-        push_misses=(),
-        wall_time_s=0.0,
-        sim_time_s=0.0,
-    )
 
 
 # ---------------------------------------------------------------- the interval
@@ -85,7 +65,7 @@ def test_success_words_name_the_wilson_interval_rounded_outward() -> None:
 
 
 def test_the_summary_json_carries_the_interval_and_its_method() -> None:
-    d = _summary(40, 40).to_dict()
+    d = sim_summary({"part": (40, 40)}).to_dict()
     lo, hi = d["success_interval_95"]
     assert lo == pytest.approx(0.912, abs=1e-3) and hi == 1.0
     assert d["interval_method"] == "wilson"
@@ -96,7 +76,7 @@ def test_the_summary_json_carries_the_interval_and_its_method() -> None:
 
 
 def test_the_sampled_rotation_error_is_the_one_drawn() -> None:
-    d = _summary(3, 4, sampled=Uncertainty(1.0, 0.0, 0.0)).to_dict()["settings"]
+    d = sim_summary({"part": (3, 4)}, sampled=Uncertainty(1.0, 0.0, 0.0)).to_dict()["settings"]
     assert d["sampled_uncertainty"]["rotation_error_deg"] == 1.0
     s = SimSettings(4, 0, 8.0, 0.1, 0.5, 0.2, 0.002, sampled=Uncertainty(1.0, 0.0, 0.0))
     assert s.to_dict()["sampled_uncertainty"]["rotation_error_deg"] == 8.0
@@ -152,7 +132,7 @@ def test_a_sample_beyond_what_the_plan_certifies_gets_one_note() -> None:
 def test_the_summary_carries_the_note_in_its_json() -> None:
     from dataclasses import replace
 
-    s = replace(_summary(3, 4), certified=Certified(3.15, 0.0, True))
+    s = replace(sim_summary({"part": (3, 4)}), certified=Certified(3.15, 0.0, True))
     assert s.to_dict()["beyond_certified"] is None
     loud = replace(s, settings=replace(s.settings, rotation_noise_deg=8.0))
     assert "beyond what the plan certifies (±3.15 deg)" in loud.to_dict()["beyond_certified"]
