@@ -336,3 +336,24 @@ def test_plan_refuses_an_unwritable_output_before_planning(tmp_path, capsys, mon
     else:
         assert err == f"error: {late_message(out, 'plan file')}\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == (["out.json"] if kind == "folder" else [])
+
+
+def test_the_accept_refusal_advises_a_sensor_only_where_one_helps(tmp_path, capsys):
+    """A sensor tells the bracket's sides apart; nothing tells the bracket's up side from its
+    mirror image's down side (the same outline): the advice says which."""
+    data = json_result(capsys, ["plan", L_BRACKET, "--accept", "up"])
+    assert data["error"].endswith("accept both or neither, or use a sensor (--accept)")
+    data = json_result(capsys, ["plan", L_BRACKET, "--accept", "up", "--tolerance", "40"])
+    assert data["error"].endswith("or use a finer sensor (--accept)")  # 40 mm reads nothing
+    bracket = json.loads(Path(L_BRACKET).read_text())
+    mirror = {
+        "name": "l-bracket-mirror",
+        "units": bracket["units"],
+        "vertices": [[-x, y] for x, y in reversed(bracket["vertices"])],
+        "holes": [[[-x, y] for x, y in reversed(h)] for h in bracket["holes"]],
+    }
+    path = tmp_path / "mirror.json"
+    path.write_text(json.dumps(mirror))
+    args = ["plan", L_BRACKET, str(path), "--tolerance", "0.01", "--accept", "up"]
+    data = json_result(capsys, [*args, "--rotation-error", "0"])
+    assert "no sensor tells them apart" in data["error"] and "finer" not in data["error"]

@@ -312,3 +312,32 @@ def test_an_ignored_ctrl_c_stays_ignored(capsys, monkeypatch):
     assert seen == [signal.SIG_IGN]
     assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     capsys.readouterr()
+
+
+def test_plan_and_report_may_not_be_one_file(tmp_path, capsys):
+    """``-o`` and ``--report`` naming one file (or a link to it): refused before any work, the
+    existing file untouched (the report would overwrite the plan)."""
+    same = tmp_path / "same.html"
+    same.write_text("keep")
+    err = one_line_error(capsys, ["plan", T_CLIP, "-o", str(same), "--report", str(same)])
+    assert "would be the same file" in err and same.read_text() == "keep"
+    link = tmp_path / "link.json"
+    link.symlink_to(same)
+    err = one_line_error(capsys, ["plan", T_CLIP, "-o", str(link), "--report", str(same)])
+    assert "would be the same file" in err and same.read_text() == "keep"
+
+
+def test_the_search_spinner_keeps_its_clock_on_a_narrow_terminal(monkeypatch):
+    """At 80 columns a long changeover name is cut, not the spinner and the elapsed time."""
+    import io
+
+    from rich.console import Console
+
+    import feederkit.cli.common as common
+
+    out = io.StringIO()
+    monkeypatch.setattr(common, "err_console", Console(width=80, force_terminal=True, file=out))
+    with common.searching("compiling changeover line3-week48-and-a-long-name", 60.0):
+        pass
+    frame = out.getvalue().split("\r")[1]
+    assert "0:00:00" in frame and "…" in frame and "compiling changeover" in frame

@@ -27,7 +27,7 @@ from rich.progress import (
     TextColumn,
     TimeElapsedColumn,
 )
-from rich.table import Table
+from rich.table import Column, Table
 
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
@@ -333,12 +333,19 @@ def print_warnings(lines: Iterable[str]) -> None:
 
 @contextmanager
 def searching(what: str, time_limit: float | None) -> Iterator[None]:
-    """A spinner with the elapsed time on stderr while a search runs, naming ``--time-limit``."""
+    """A spinner with the elapsed time on stderr while a search runs, naming ``--time-limit``.
+
+    The spinner and the elapsed time come first and the words are cut with an ellipsis when
+    the terminal is narrow: a search whose clock is squeezed out looks hung."""
     limit = "no time limit" if time_limit is None else f"time limit {time_limit:g} s"
     with Progress(
         SpinnerColumn(),
-        TextColumn(f"{escape(what)} ({limit}; set it with --time-limit S)"),
         TimeElapsedColumn(),
+        TextColumn(
+            f"{escape(what)} ({limit}; set it with --time-limit S)",
+            table_column=Column(no_wrap=True, overflow="ellipsis", ratio=1),
+        ),
+        expand=True,
         console=err_console,
         transient=True,
         disable=not err_console.is_terminal,
@@ -406,10 +413,19 @@ def check_outputs(*outputs: tuple[Path | None, str]) -> None:
     written (None: not asked for): its folder missing, a folder or a pipe at the path, a
     folder that takes no new file (read-only, no permission). The message is the one the
     write itself would give (:func:`feederkit.jsonio.check_writable`), exit 2: a result that
-    took a minute must not be lost to a typo in a file name."""
+    took a minute must not be lost to a typo in a file name. Two outputs that are one file
+    (the same path, or a link to it) are refused too: the second would overwrite the first."""
+    seen: dict[Path, str] = {}
     for path, what in outputs:
         if path is None:
             continue
+        same = path.resolve()
+        if same in seen:
+            raise InputError(
+                f"{path}: the {what} and the {seen[same]} would be the same file: give each "
+                "its own path"
+            )
+        seen[same] = what
         folder = path.parent
         if not folder.is_dir():
             why = "is not a folder" if folder.exists() else "does not exist"

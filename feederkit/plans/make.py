@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -48,7 +48,7 @@ from feederkit.plans.strong import (
     verify_strong,
 )
 from feederkit.plans.verify import VerificationReport, check_plan
-from feederkit.sensors import Sensor, sensor_warnings
+from feederkit.sensors import Sensor, ToleranceSensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 from feederkit.words import at_most, plural
 
@@ -142,7 +142,7 @@ def _make_plan(
     shares, rejected = _member_weights(named)
     machine = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
     if rejected:
-        _check_rejects_separable(machine, named)
+        _check_rejects_separable(machine, named, lambda: _finest_machine(pfs, unc))
     try:
         result = plan_machine(machine, opts, budget=_planner_budget(opts, started, certify))
     except NoStrongPlan as exc:
@@ -462,21 +462,51 @@ def _member_weights(
     return shares, frozenset(k for k, m in enumerate(named) if not m.accept)
 
 
-def _check_rejects_separable(machine: PushAlignMachine, named: Sequence[PlanMember]) -> None:
+FINEST_REL = 1e-6
+"""The sensor that stands for "any finer sensor": a tolerance of this fraction of the mix's
+largest part (as exact as readings get; closer diameters are one value to the machine)."""
+
+
+def _finest_machine(pfs: Sequence[PushFunction], unc: Uncertainty) -> PushAlignMachine:
+    """The mix's machine with the finest sensor (:data:`FINEST_REL`)."""
+    size = max(pf.part.size for pf in pfs)
+    return build_machine(pfs, ToleranceSensor(FINEST_REL * size), unc)
+
+
+def _check_rejects_separable(
+    machine: PushAlignMachine,
+    named: Sequence[PlanMember],
+    finest: Callable[[], PushAlignMachine],
+) -> None:
     """PlanningError when an accepted and a rejected member have states no plan can tell
-    apart (section 8.4): no plan can then accept the one and reject the other."""
+    apart (section 8.4): no plan can then accept the one and reject the other. The advice
+    names a finer sensor only when the pair comes apart with the finest one (``finest()``:
+    the same parts and uncertainty with :data:`FINEST_REL`'s sensor); otherwise no sensor
+    helps (the same push-diameter function, Lemma 8, or the same under the uncertainty)."""
     space = search_space(machine)
     bisimilar, rejected = space.bisimilar, space.rejected
     for i, s in enumerate(machine.states):
         if s.reject or not bisimilar[i] & rejected:
             continue
-        j = members(bisimilar[i] & rejected)[0]
-        a, b = named[s.part], named[machine.states[j].part]
+        other = machine.states[members(bisimilar[i] & rejected)[0]]
+        a, b = named[s.part], named[other.part]
+        fine = finest()
+        index = {(x.part, x.state): k for k, x in enumerate(fine.states)}
+        apart = (
+            not search_space(fine).bisimilar[index[(s.part, s.state)]]
+            >> index[(other.part, other.state)]
+            & 1
+        )
+        sensor = "a sensor" if not machine.sensor.informative else "a finer sensor"
+        advice = (
+            f"accept both or neither, or use {sensor}"
+            if apart
+            else "accept both or neither: no sensor tells them apart"
+        )
         raise PlanningError(
             f"{member_label(a.name, a.landing)} is accepted and "
             f"{member_label(b.name, b.landing)} rejected, but no plan can tell them apart "
-            "(their readings and push behaviour stay alike): accept both or neither, or use "
-            "a finer sensor"
+            f"(their readings and push behaviour stay alike): {advice}"
         )
 
 
