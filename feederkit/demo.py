@@ -25,13 +25,14 @@ from feederkit.catalog import add_outline, import_directory, list_parts, open_ca
 from feederkit.cell import CellSettings, annotate_cycle_time
 from feederkit.errors import InputError, PlanningError
 from feederkit.jsonio import OutputFile, write_files
+from feederkit.landing import landings_of_outline
+from feederkit.landing.plan import load_landings, plan_landings
 from feederkit.loading import load_parts
 from feederkit.mechanics.analysis import analyze_part
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import CompiledChangeover, compile_changeover, landing_rows
 from feederkit.mix.lookalike import build_lookalike
 from feederkit.plans.fileformat import plan_json
-from feederkit.plans.make import make_plan
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
@@ -97,7 +98,8 @@ class PartRow:
 
 @dataclass(frozen=True)
 class DemoPlan:
-    """One part planned sensorless and with the sensor, with its files and warnings."""
+    """One part planned in one landing, sensorless and with the sensor, with its files and
+    warnings."""
 
     name: str
     sensor: Sensor
@@ -105,11 +107,14 @@ class DemoPlan:
     sensed: dict[str, Any]
     files: tuple[Path, Path]
     warnings: tuple[str, ...]
+    landing: str | None = None
+    """The landing planned (``up`` for a flat part; a mesh's first pose)."""
 
     def to_dict(self) -> dict[str, Any]:
         """The ``plans`` entry of ``feederkit demo --json``."""
         return {
             "name": self.name,
+            "landing": self.landing,
             "sensorless": self.sensorless["stats"],
             "sensor": {**self.sensor.to_dict(), **self.sensed["stats"]},
             "files": [str(f) for f in self.files],
@@ -252,16 +257,28 @@ def analyse(pfs: list[PushFunction], percent: float) -> tuple[list[PartRow], lis
 
 
 def plan_parts(
-    pfs: list[PushFunction], percent: float, folder: Path, progress: Progress = _quiet
+    pfs: list[PushFunction],
+    percent: float,
+    folder: Path,
+    progress: Progress = _quiet,
+    catalog: Path | None = None,
 ) -> list[DemoPlan]:
-    """Plan each part sensorless and with its demo sensor; write both plan files."""
+    """Plan each part in its first landing (a flat part face up, the paper's setting; a mesh
+    its first pose), sensorless and with its demo sensor; write both plan files. The files
+    name the landing (design.md, "Landings": a plan covers every landing unless told
+    otherwise, and then says which); the changeovers plan over every landing."""
     plans = []
     for k, pf in enumerate(pfs):
         progress(f"planning {pf.part.name}", k, len(pfs))
         name = pf.part.name
+        first = (
+            load_landings([name], catalog=catalog).all[0]
+            if catalog is not None
+            else landings_of_outline(pf.part)[0]
+        )
         sensor = demo_sensor([pf], percent)
-        blind = make_plan([pf], NoSensor())
-        sensed = make_plan([pf], sensor)
+        blind = plan_landings([first], NoSensor()).made
+        sensed = plan_landings([first], sensor).made
         files = (folder / f"{name}.sensorless.json", folder / f"{name}.sensor.json")
         write_files(
             [
@@ -271,7 +288,9 @@ def plan_parts(
         )
         warnings = [f"{name} (sensorless): {w}" for w in blind.warnings]
         warnings += [f"{name} (sensor): {w}" for w in sensed.warnings]
-        plans.append(DemoPlan(name, sensor, blind.plan, sensed.plan, files, tuple(warnings)))
+        plans.append(
+            DemoPlan(name, sensor, blind.plan, sensed.plan, files, tuple(warnings), first.name)
+        )
     progress("planning", len(pfs), len(pfs))
     return plans
 
@@ -434,7 +453,7 @@ def run_demo(
         skipped = tuple(s.name for s in summaries if s.name not in loaded.names)
         pfs = list(loaded.push_functions)
         rows, notes = analyse(pfs, percent)
-        plans = plan_parts(pfs, percent, out / "plans", progress)
+        plans = plan_parts(pfs, percent, out / "plans", progress, catalog)
         mixes = demo_mixes(pfs)
         twin = add_lookalike(catalog, pfs)
         if twin is not None:

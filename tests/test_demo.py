@@ -34,8 +34,12 @@ def test_pipeline_plans_every_part_both_ways(few: DemoResult) -> None:
     assert [p.name for p in few.plans] == sorted(FEW)
     for p in few.plans:
         assert p.sensed["stats"]["length"] <= p.sensorless["stats"]["length"]
+        assert p.landing == "up" and p.to_dict()["landing"] == "up"
         for f in p.files:
             check_plan(read_plan(f))
+            # One landing planned, and the file says which (design.md, "Landings").
+            data = json.loads(f.read_text())
+            assert [x.get("landing") for x in data["parts"]] == ["up"]
     # The regular octagon's states share one diameter: no sensor is to blame for that.
     assert {p.name: p.warnings for p in few.plans}["octagon"] == ()
 

@@ -98,9 +98,12 @@ def plans_tables(plans: tuple[DemoPlan, ...]) -> tuple[Table, Table]:
     """Each part's sensorless plan, then its sensor plan with bound and certificate, in two
     tables narrow enough for 80 columns."""
     style = {"box": SIMPLE_HEAD, "pad_edge": False, "collapse_padding": True}
-    blind = Table(title="sensorless plans: worst-case length, expected, smallest margin", **style)
+    blind = Table(
+        title="sensorless plans, each part face up: worst-case length, expected, smallest margin",
+        **style,
+    )
     sensed = Table(
-        title="sensor plans; cert = certified rotation error, ideal = ideal-model length",
+        title="sensor plans, face up; cert = certified rotation error, ideal = ideal-model length",
         **style,
     )
     add_name_column(blind, "part")
