@@ -318,28 +318,34 @@ def test_box_mesh_plan_names_its_poses_and_runs_on_every_one(tmp_path, capsys, b
     run_all(tmp_path / "plan.json", capsys)
 
 
-def test_run_checks_every_mesh_pose_for_fragile_states_and_one_side_of_a_flat_part(
+def test_run_checks_every_landing_for_fragile_states_each_named_as_the_plan_names_it(
     tmp_path, capsys, box_path, monkeypatch
 ):
-    """``Plan.fragile_warnings`` (what ``run`` repeats of ``plan``'s warnings): a mesh's
-    poses are different shapes on the belt, a flat part's two sides mirror images."""
+    """``Plan.fragile_warnings`` (what ``run`` repeats of ``plan``'s warnings): every landing
+    says its own, labelled as the results name it, grouped by part: a mesh's poses are
+    different shapes on the belt, and a flat part's two sides, though mirror images, number
+    their states differently."""
     import feederkit.plans.model as plan_model
 
-    seen: list[int] = []
-    real = plan_model.fragile_warnings
+    seen: list[list[list[str]]] = []
+    real = plan_model.fragile_member_warnings
 
-    def spy(pfs):
-        seen.append(len(pfs))
-        return real(pfs)
+    def spy(parts):
+        seen.append([[label for label, _ in members] for members in parts])
+        return real(parts)
 
-    monkeypatch.setattr(plan_model, "fragile_warnings", spy)
+    monkeypatch.setattr(plan_model, "fragile_member_warnings", spy)
     box, _ = plan_cli(tmp_path, capsys, [str(box_path), "--tolerance", "0.5"], name="box.json")
-    assert plan_from_dict(box).fragile_warnings() == [] and seen == [3]  # the three poses
+    assert seen == [[["box (pose-0)", "box (pose-2)", "box (pose-4)"]]]  # what plan said
+    seen.clear()
+    assert plan_from_dict(box).fragile_warnings() == []
+    assert seen == [[["box (pose-0)", "box (pose-2)", "box (pose-4)"]]]  # what run says
     src = write_outline(tmp_path, "ell", [[0, 0], [30, 0], [30, 8], [8, 8], [8, 20], [0, 20]])
     ell, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5"], name="ell.json")
     assert [p["landing"] for p in ell["parts"]] == ["up", "down"]
+    seen.clear()
     plan_from_dict(ell).fragile_warnings()
-    assert seen == [3, 1]
+    assert seen == [[["ell (up)", "ell (down)"]]]
 
 
 def test_box_mesh_plan_rejects_the_poses_not_accepted(tmp_path, capsys, box_path):

@@ -165,15 +165,18 @@ def test_a_small_margin_is_warned_about(tri, capsys):
 
 
 def test_run_repeats_the_fragile_states_plan_warned_about(tmp_path, capsys):
-    """The l-bracket has a fragile state: ``run`` says it as ``plan`` did, once per part
-    (its two landings are mirror images, with the same states)."""
+    """The l-bracket has a fragile state: ``run`` says it as ``plan`` did, one line for the
+    part naming each landing's own state (its two landings are mirror images, as fragile,
+    but number their states differently)."""
     from pathlib import Path
 
     src = Path(__file__).resolve().parents[1] / "catalog" / "l-bracket.json"
     plan = tmp_path / "lb.plan.json"
     assert main(["plan", str(src), "--tolerance", "0.1", "-o", str(plan)]) == 0
     planned = [ln for ln in capsys.readouterr().err.splitlines() if "fragile" in ln]
-    assert len(planned) == 1 and planned[0].startswith("warning: l-bracket: fragile states")
+    assert len(planned) == 1 and planned[0].startswith(
+        "warning: l-bracket (up): fragile states 1; l-bracket (down): fragile states 3 ("
+    )
     assert main(["run", str(plan), "--all", "--json"]) == 0
     (warning,) = json.loads(capsys.readouterr().out)["warnings"]
     assert "warning: " + warning == planned[0]

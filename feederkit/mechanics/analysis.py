@@ -58,25 +58,80 @@ def fragile_states(pf: PushFunction, rel: float = FRAGILE_BARRIER_REL) -> tuple[
 
 def fragile_warning(pf: PushFunction) -> str | None:
     """One line naming a part's fragile states, or None when it has none."""
-    ids = fragile_states(pf)
-    if not ids:
-        return None
-    limit = FRAGILE_BARRIER_REL * pf.part.size
-    named = ", ".join(str(i) for i in ids[:8]) + (f" (+{len(ids) - 8})" if len(ids) > 8 else "")
-    return (
-        f"{pf.part.name}: fragile states {named} (barrier below {limit:.3g} mm): the part may "
-        "settle on a neighbour; check the plan with feederkit simulate"
-    )
+    lines = fragile_member_warnings([[(pf.part.name, pf)]])
+    return lines[0] if lines else None
 
 
 FRAGILE_LINES = 3
 """A mix with more parts than this that have fragile states gets one line for all of them."""
 
+FRAGILE_ADVICE = "may settle on a neighbour; check the plan with feederkit simulate"
+"""What every fragile-state warning ends with."""
+
+
+def _ids(ids: Sequence[int]) -> str:
+    """State ids in words: at most eight, then how many more."""
+    return ", ".join(str(i) for i in ids[:8]) + (f" (+{len(ids) - 8})" if len(ids) > 8 else "")
+
+
+def _limit(pf: PushFunction) -> str:
+    """The fragile barrier of ``pf``'s part in words."""
+    return f"barrier below {FRAGILE_BARRIER_REL * pf.part.size:.3g} mm"
+
+
+def fragile_member_warnings(
+    parts: Sequence[Sequence[tuple[str, PushFunction]]],
+) -> list[str]:
+    """The fragile states of a mix's parts in words, each member named by its label: the one
+    home of the fragile-state wording (``plan``, ``run``, reports, ``part analyze``).
+
+    ``parts`` holds each part's members as ``(label, push function)``: one member named by
+    the part's name, or in a plan over landings one per landing, labelled as the plan names
+    its members (``l-bracket (up)``, ``box (pose-2)``) because each landing numbers its
+    states its own way (a flat part's down side is the mirror image of its up side, with
+    the same barriers under other numbers). Up to ``FRAGILE_LINES`` parts with fragile
+    states get a line each, naming each member's fragile states::
+
+        l-bracket (up): fragile states 1; l-bracket (down): fragile states 3 (barrier below
+        0.06 mm): the part may settle on a neighbour; check the plan with feederkit simulate
+
+    (the barrier given with each member when the members' sizes differ, as a mesh's poses'
+    footprints do); more get one line naming each member with its states, so that a large
+    mix's warnings stay readable.
+    """
+    fragile = [
+        [(label, pf, ids) for label, pf in members if (ids := fragile_states(pf))]
+        for members in parts
+    ]
+    fragile = [members for members in fragile if members]
+    if len(fragile) > FRAGILE_LINES:
+        named = "; ".join(
+            f"{label} ({', '.join(map(str, ids))})"
+            for members in fragile
+            for label, _, ids in members
+        )
+        return [
+            f"{len(fragile)} parts have fragile states (barrier below "
+            f"{FRAGILE_BARRIER_REL:.1%} of the part's size): {named}: a part {FRAGILE_ADVICE}"
+        ]
+    lines = []
+    for members in fragile:
+        limits = {_limit(pf) for _, pf, _ in members}
+        each = len(limits) > 1
+        named = "; ".join(
+            f"{label}: fragile states {_ids(ids)}" + (f" ({_limit(pf)})" if each else "")
+            for label, pf, ids in members
+        )
+        shared = "" if each else f" ({limits.pop()})"
+        lines.append(f"{named}{shared}: the part {FRAGILE_ADVICE}")
+    return lines
+
 
 def fragile_warnings(pfs: Sequence[PushFunction]) -> list[str]:
-    """The fragile states of a mix's parts in words: a line per part (:func:`fragile_warning`)
-    for up to ``FRAGILE_LINES`` such parts, else one line naming each part with its states,
-    so that a large mix's warnings stay readable.
+    """The fragile states of a mix's parts in words, each named by its part's name
+    (:func:`fragile_member_warnings` with one member per part): a line per part
+    (:func:`fragile_warning`) for up to ``FRAGILE_LINES`` such parts, else one line naming
+    each part with its states.
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.outline import make_outline
@@ -85,16 +140,7 @@ def fragile_warnings(pfs: Sequence[PushFunction]) -> list[str]:
     >>> fragile_warnings([bar])
     []
     """
-    fragile = [(pf, fragile_states(pf)) for pf in pfs]
-    fragile = [(pf, ids) for pf, ids in fragile if ids]
-    if len(fragile) <= FRAGILE_LINES:
-        return [line for pf, _ in fragile if (line := fragile_warning(pf)) is not None]
-    named = "; ".join(f"{pf.part.name} ({', '.join(map(str, ids))})" for pf, ids in fragile)
-    return [
-        f"{len(fragile)} parts have fragile states (barrier below "
-        f"{FRAGILE_BARRIER_REL:.1%} of the part's size): {named}: a part may settle on a "
-        "neighbour; check the plan with feederkit simulate"
-    ]
+    return fragile_member_warnings([[(pf.part.name, pf)] for pf in pfs])
 
 
 @dataclass(frozen=True)

@@ -21,13 +21,17 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from feederkit.errors import InputError
-from feederkit.mechanics.analysis import fragile_warnings
+from feederkit.mechanics.analysis import (
+    fragile_member_warnings,
+    fragile_warning,
+    fragile_warnings,
+)
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -100,6 +104,41 @@ def push_function_of(part: PlanPart) -> PushFunction:
 def member_label(name: str, landing: str | None) -> str:
     """A member of a plan in words: ``NAME``, or ``NAME (LANDING)`` in a plan over landings."""
     return name if landing is None else f"{name} ({landing})"
+
+
+def member_fragile_warnings(
+    members: Iterable[tuple[str, str | None, PushFunction]],
+) -> list[str]:
+    """The fragile states of a plan's members ``(name, landing, push function)`` in words
+    (:func:`~feederkit.mechanics.analysis.fragile_member_warnings`), each member named by
+    :func:`member_label`: ``l-bracket: fragile states 1`` in a plan not over landings, and
+    in a plan over landings each landing with its own state numbers, one line per part
+    (``l-bracket (up): fragile states 1; l-bracket (down): fragile states 3``). Every
+    landing says its own: a flat part's down side is the mirror image of its up side, as
+    fragile, but numbers its states differently, and a mesh's poses are different shapes.
+    """
+    parts: dict[str, list[tuple[str, PushFunction]]] = {}
+    for name, landing, pf in members:
+        parts.setdefault(name, []).append((member_label(name, landing), pf))
+    return fragile_member_warnings(list(parts.values()))
+
+
+def landing_fragile_warnings(
+    warnings: Sequence[str],
+    parts: Sequence[PushFunction],
+    members: Sequence[tuple[str, str | None, PushFunction]],
+) -> list[str]:
+    """The ``warnings`` of loading ``parts`` (:func:`feederkit.loading.load_parts`, with the
+    mesh poses' of :func:`feederkit.mix.changeover.checked_landings`) for a plan over the
+    landings ``members`` (``(name, landing, push function)``): the fragile states said per
+    landing (:func:`member_fragile_warnings`), as the plan's results, ``run`` and the report
+    name them, instead of the loaded parts' lines (``l-bracket: fragile states 1``, the
+    numbers of the part as drawn, wrong for its face-down side) and the poses' (``box/pose-2``,
+    the landing's part name). The other warnings are kept, in order."""
+    said = set(fragile_warnings(parts))
+    said |= {w for _, _, pf in members if (w := fragile_warning(pf)) is not None}
+    kept = [w for w in warnings if w not in said]
+    return kept + member_fragile_warnings(members)
 
 
 @dataclass(frozen=True)
@@ -444,16 +483,11 @@ class Plan:
         return min(margins) if margins else None
 
     def fragile_warnings(self) -> list[str]:
-        """The fragile states of the plan's parts in words, as ``plan`` warned when it made
-        the plan (:func:`~feederkit.mechanics.analysis.fragile_warnings`): each part's first
-        member (a flat part's other landing is its mirror image, with the same states), and
-        every pose of a mesh."""
-        first: dict[object, PlanPart] = {}
-        for part in self.parts:
-            # A mesh's poses are different shapes on the belt: each says its own.
-            sides = part.landing is None or not part.landing.startswith("pose-")
-            first.setdefault(part.name if sides else (part.name, part.landing), part)
-        return fragile_warnings([push_function_of(p) for p in first.values()])
+        """The fragile states of the plan's members in words, as ``plan`` warned when it
+        made the plan (:func:`member_fragile_warnings`, from the hulls and COMs the plan
+        records): in a plan over landings, every landing named as the results name it, with
+        its own state numbers."""
+        return member_fragile_warnings((p.name, p.landing, push_function_of(p)) for p in self.parts)
 
     def low_margin_warning(self) -> str | None:
         """A warning when the plan holds rotation errors below LOW_MARGIN_DEG (None otherwise).

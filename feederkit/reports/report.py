@@ -6,7 +6,7 @@ and plots, the pairs the plan cannot tell apart, and the conventions. The plan i
 its declared uncertainty (:func:`feederkit.plans.verify.verify_declared`: a strong plan for
 every outcome and reading, an ideal one on the kinematic model) as it is drawn: a plan that
 fails gets a red banner at the top naming the first problem; a plan whose smallest margin is
-below 1 degree a warning (docs/reports.md).
+below 1 degree a warning, and so a plan whose members have fragile states (docs/reports.md).
 """
 
 from __future__ import annotations
@@ -91,7 +91,8 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
 
 
 def _banners(plan: Plan, report: VerificationReport) -> str:
-    """The verification verdict when it failed, and the low-margin warning."""
+    """The verification verdict when it failed, the low-margin warning, and the fragile
+    states of the plan's members (:meth:`Plan.fragile_warnings`)."""
     out = ""
     where = (
         "on the kinematic model"
@@ -107,6 +108,10 @@ def _banners(plan: Plan, report: VerificationReport) -> str:
     warning = plan.low_margin_warning()
     if warning:
         out += f'<div class="banner caution" id="low-margin">Warning: {esc(warning)}.</div>'
+    fragile = plan.fragile_warnings()  # the lines plan and run print, members as named here
+    if fragile:
+        lines = "<br>".join(f"Warning: {esc(w)}." for w in fragile)
+        out += f'<div class="banner caution" id="fragile-states">{lines}</div>'
     return out
 
 

@@ -1,0 +1,199 @@
+"""Fragile-state warnings in plans over landings: each landing named with its own states.
+
+A chiral flat part's down landing is the mirror image of its up landing: as fragile, but its
+stable states are numbered differently. A warning naming the part's fragile states by the up
+side's numbers points at a robust state of the down side, so in a plan over landings every
+landing is named as the plan's results name it (``bracket-a (down)``) with its own state
+numbers, the same words in ``plan``, ``run`` (terminal and ``--json``) and the HTML report.
+The down side's fragile state is checked against the mirrored drawing analysed on its own.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import ezdxf
+import pytest
+from fixtures_cad import prism, write_mesh
+
+from feederkit.cli.app import main
+from feederkit.importers import ImportOptions
+from feederkit.landing.mesh import landings_of_mesh
+from feederkit.mechanics.analysis import (
+    FRAGILE_LINES,
+    fragile_member_warnings,
+    fragile_states,
+    fragile_warning,
+)
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.plans.fileformat import plan_from_dict
+
+# An L bracket (legs 60 and 40 mm, 15 mm wide) with two 6.6 mm holes: its short end (edge
+# normal 0 deg) is a stable state 0.05 mm from tipping, below the fragile threshold of
+# 0.06 mm (1e-3 of its 60 mm size); its other states are robust.
+L_RING = [(0, 0), (60, 0), (60, 15), (15, 15), (15, 40), (0, 40)]
+L_HOLES = [((47.0, 7.5), 3.3), ((7.5, 30.0), 3.3)]
+
+
+def write_bracket(path: Path, mirror: bool = False) -> Path:
+    """The bracket as a DXF drawing in mm; ``mirror``: drawn turned over (x -> -x), as an
+    engineer would draw its back side, independently of feederkit's own mirroring."""
+    sign = -1.0 if mirror else 1.0
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(sign * x, y) for x, y in L_RING], close=True)
+    for (x, y), r in L_HOLES:
+        msp.add_circle((sign * x, y), r)
+    doc.saveas(path)
+    return path
+
+
+def _cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[str, str]:
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    return captured.out, captured.err
+
+
+def _fragile_lines(err: str) -> list[str]:
+    return [ln.removeprefix("warning: ") for ln in err.splitlines() if "fragile" in ln]
+
+
+def _analysis(path: Path, capsys: pytest.CaptureFixture[str]) -> dict:
+    out, _ = _cli(["part", "analyze", str(path), "--json"], capsys)
+    (part,) = json.loads(out)
+    return part
+
+
+def _signature(state: dict) -> tuple[float, float]:
+    """A state by its geometry, whatever its number: diameter and resting range width."""
+    lo, hi = state["resting_range_deg"]
+    return (round(state["diameter"], 6), round(hi - lo, 6))
+
+
+@pytest.fixture()
+def bracket(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> dict:
+    """The bracket's plan over both landings (the default), the warnings ``plan`` printed,
+    and the fragile state of each landing found independently: the drawing face up and the
+    drawing turned over, each analysed on its own by ``part analyze``, the down one found in
+    the plan's down member by its geometry (not by its number)."""
+    up = write_bracket(tmp_path / "bracket-a.dxf")
+    back = write_bracket(tmp_path / "bracket-a-back.dxf", mirror=True)
+    path = tmp_path / "bracket.plan.json"
+    _, err = _cli(["plan", str(up), "--tolerance", "0.2", "-o", str(path)], capsys)
+    plan = json.loads(path.read_text())
+    members = {p["landing"]: p for p in plan["parts"]}
+    assert set(members) == {"up", "down"}
+    (up_id,) = _analysis(up, capsys)["fragile_states"]  # one fragile state, the short end
+    turned = _analysis(back, capsys)
+    (back_id,) = turned["fragile_states"]
+    fragile = next(s for s in turned["stable_states"] if s["id"] == back_id)
+    (down_id,) = [
+        s["id"] for s in members["down"]["stable_states"] if _signature(s) == _signature(fragile)
+    ]
+    return {
+        "source": up,
+        "plan_path": path,
+        "plan": plan,
+        "up_id": up_id,
+        "down_id": down_id,
+        "warnings": _fragile_lines(err),
+    }
+
+
+def test_the_down_landing_is_warned_about_with_its_own_fragile_state(bracket):
+    up_id, down_id = bracket["up_id"], bracket["down_id"]
+    assert (up_id, down_id) == (1, 3)  # the point: face down, state 1 is another state
+    (line,) = bracket["warnings"]
+    assert line.startswith(
+        f"bracket-a (up): fragile states {up_id}; bracket-a (down): fragile states {down_id} "
+        "(barrier below 0.06 mm): the part may settle on a neighbour"
+    )
+    assert "bracket-a: " not in line  # never the bare part name, with the up side's numbers
+    # The down landing's state 1 is robust: a result names it, and no warning does.
+    leaves = plan_from_dict(bracket["plan"]).leaves()
+    assert ("bracket-a", "down", up_id) in [
+        (e.part, e.landing, e.state) for n in leaves for e in n.results
+    ]
+
+
+def test_run_and_the_report_say_the_same_per_landing(bracket, tmp_path, capsys):
+    (line,) = bracket["warnings"]
+    out, _ = _cli(["run", str(bracket["plan_path"]), "--all", "--json"], capsys)
+    assert json.loads(out)["warnings"] == [line]
+    out, _ = _cli(["run", str(bracket["plan_path"]), "--start-deg", "10"], capsys)
+    assert " ".join(f"warning: {line}".split()) in " ".join(out.split())  # however wrapped
+    report = tmp_path / "bracket.html"
+    _cli(["report", str(bracket["plan_path"]), "-o", str(report)], capsys)
+    page = report.read_text(encoding="utf-8")
+    banner = page.split('id="fragile-states">', 1)[1].split("</div>", 1)[0]
+    assert banner == f"Warning: {line}."  # nothing in it to escape
+
+
+def test_plan_face_down_only_names_the_down_state(bracket, capsys):
+    args = ["plan", str(bracket["source"]), "--tolerance", "0.2", "--landings", "down", "--json"]
+    _, err = _cli(args, capsys)
+    (line,) = _fragile_lines(err)
+    assert line.startswith(f"bracket-a (down): fragile states {bracket['down_id']} (barrier")
+
+
+BENT = 20.0 * math.tan(math.radians(0.5))
+BENT_BAR = [(0, 0), (20, -BENT), (40, 0), (40, 10), (0, 10)]
+"""A 40 x 10 bar whose bottom bends by 0.5 degrees: mirror-symmetric, two fragile states."""
+
+
+def test_a_plan_not_over_landings_keeps_the_part_name(tmp_path, capsys):
+    src = tmp_path / "bent-bar.json"
+    src.write_text(json.dumps({"name": "bent-bar", "units": "mm", "vertices": BENT_BAR}))
+    expected = fragile_warning(push_function(make_part(make_outline("bent-bar", BENT_BAR))))
+    assert expected is not None and expected.startswith("bent-bar: fragile states ")
+    plan = tmp_path / "bar.plan.json"
+    _, err = _cli(["plan", str(src), "--tolerance", "0.5", "-o", str(plan)], capsys)
+    assert "landing" not in plan.read_text()  # one landing: the plan of the part itself
+    assert _fragile_lines(err) == [expected]
+    out, _ = _cli(["run", str(plan), "--all", "--json"], capsys)
+    assert json.loads(out)["warnings"] == [expected]
+    # Named landings make a plan over landings, even of one: the label names it.
+    _, err = _cli(["plan", str(src), "--tolerance", "0.5", "--landings", "up", "--json"], capsys)
+    assert _fragile_lines(err) == [expected.replace("bent-bar:", "bent-bar (up):", 1)]
+
+
+def test_each_mesh_pose_is_named_as_the_plan_names_it(tmp_path, capsys):
+    # The bracket's plate extruded 3 mm: its two big faces are the flat part's two sides.
+    path = write_mesh(prism(L_RING, 3.0), tmp_path / "lplate.stl")
+    poses = {x.name: x for x in landings_of_mesh(path, ImportOptions(), "lplate")}
+    expected = {
+        name: fragile_states(push_function(poses[name].part)) for name in ("pose-0", "pose-1")
+    }
+    assert all(expected.values())
+    _, err = _cli(["plan", str(path), "--tolerance", "0.2", "--landings", "0,1", "--json"], capsys)
+    (line,) = _fragile_lines(err)
+    named = "; ".join(
+        f"lplate ({name}): fragile states {', '.join(map(str, ids))}"
+        for name, ids in expected.items()
+    )
+    assert line.startswith(named + " (barrier below")
+    assert "lplate/" not in line  # not the landing's part name
+
+
+def test_members_of_different_sizes_give_each_its_barrier_and_a_large_mix_counts_parts():
+    def bar(name: str, scale: float):
+        ring = [(x * scale, y * scale) for x, y in BENT_BAR]
+        return push_function(make_part(make_outline(name, ring)))
+
+    small, large = bar("s", 1.0), bar("l", 2.0)
+    (line,) = fragile_member_warnings([[("box (pose-0)", small), ("box (pose-1)", large)]])
+    assert line.startswith("box (pose-0): fragile states ")
+    assert "(barrier below 0.04 mm); box (pose-1): fragile states " in line
+    assert line.endswith(
+        "(barrier below 0.08 mm): the part may settle on a neighbour; check the plan with "
+        "feederkit simulate"
+    )
+    many = [[(f"p{k} (up)", small), (f"p{k} (down)", small)] for k in range(FRAGILE_LINES + 1)]
+    (line,) = fragile_member_warnings(many)
+    assert line.startswith(f"{FRAGILE_LINES + 1} parts have fragile states")
+    assert "p0 (up) (" in line and "p0 (down) (" in line
