@@ -197,3 +197,15 @@ def test_members_of_different_sizes_give_each_its_barrier_and_a_large_mix_counts
     (line,) = fragile_member_warnings(many)
     assert line.startswith(f"{FRAGILE_LINES + 1} parts have fragile states")
     assert "p0 (up) (" in line and "p0 (down) (" in line
+
+
+def test_changeover_compile_says_the_same_per_landing(bracket, tmp_path, capsys):
+    """The changeover's warnings (terminal and --json) are plan's words, not the part's."""
+    (line,) = bracket["warnings"]
+    db = str(tmp_path / "c.db")
+    _cli(["catalog", "init", "--catalog", db], capsys)
+    _cli(["catalog", "add", str(bracket["source"]), "--catalog", db], capsys)
+    args = ["changeover", "compile", "line", "--mix", "bracket-a", "--tolerance", "0.2"]
+    out, err = _cli([*args, "--json", "--catalog", db], capsys)
+    assert [w for w in json.loads(out)["warnings"] if "fragile" in w] == [line]
+    assert _fragile_lines(err) == [line]

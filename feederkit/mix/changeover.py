@@ -40,7 +40,7 @@ from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import as_plan, plan_json, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
-from feederkit.plans.model import PlanMember
+from feederkit.plans.model import PlanMember, landing_fragile_warnings
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
 
@@ -450,6 +450,9 @@ def compile_changeover(
             part_shares=shares,
         )
         pfs, made, witnesses, rejected = list(mix.parts), mix.made, mix.witnesses, mix.rejected
+        # Fragile states named per landing, with the landing's own numbers (as plan says).
+        landed = [(m.name, m.landing, pf) for m, pf in zip(mix.members, mix.parts, strict=True)]
+        warnings = landing_fragile_warnings(warnings, loaded.push_functions, landed)
     else:
         made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, weights=shares)
         witnesses = tuple(pairs)
