@@ -14,9 +14,9 @@ import pytest
 from test_strong_plans import _usable, perturbed, random_pf, run_plan
 
 from feederkit.cli.app import main
-from feederkit.errors import PlanningError
+from feederkit.errors import CheckFailed, PlanningError
 from feederkit.plans.make import make_plan
-from feederkit.plans.strong import certificate_problems, margin_problems
+from feederkit.plans.strong import certificate_problems, verify_strong
 from feederkit.plans.verify import verify_declared
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
@@ -60,7 +60,8 @@ def actions(plan: dict) -> list[dict]:
 def test_the_written_claims_hold(bracket):
     assert len(actions(bracket)) >= 2
     assert verify_declared(bracket).ok
-    assert margin_problems(bracket) == [] and certificate_problems(bracket) == []
+    verify_strong(bracket)  # the paths and the margins
+    assert certificate_problems(bracket) == []
 
 
 def test_an_inflated_margin_is_refused(bracket):
@@ -81,8 +82,8 @@ def test_a_shifted_rotation_keeps_no_false_margin(bracket):
         a["action_deg"] = (a["action_deg"] + 15.0) % 360.0
 
     bad = tampered(bracket, shift)
-    problems = margin_problems(bad)
-    assert problems and "beyond the declared ±1°" in problems[0]
+    with pytest.raises(CheckFailed, match="beyond the declared ±1°"):
+        verify_strong(bad)
     assert not verify_declared(bad).ok
 
 

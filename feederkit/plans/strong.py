@@ -60,6 +60,12 @@ from feederkit.words import plural
 MAX_ROTATION_ERROR_DEG = 90.0
 """The certificate of a plan with no rotation: every error design.md allows (below 90)."""
 
+MARGIN_TOL_DEG = 1e-6
+"""A margin or certificate is checked this far inside what it claims (deg): the planner's
+ranges end exactly on cell boundaries, which rebuilding the mechanics from the file
+reproduces to about 1e-9."""
+
+
 SHAPE_REL_TOL = 1e-3
 """The shape-tolerance certificate's bisection stops at this fraction of its bound."""
 
@@ -177,8 +183,9 @@ class _Run:
     a memo.
     """
 
-    def __init__(self, plan: Mapping[str, Any], model: StrongModel) -> None:
+    def __init__(self, plan: Mapping[str, Any], model: StrongModel, margins: bool = False) -> None:
         self.model = model
+        self.margins = margins
         self.shared = plan.get("nodes") or {}
         self.by_name = {n: p for p, n in enumerate(model.members)}
         self._worst: dict[tuple[int, State], int] = {}
@@ -213,9 +220,35 @@ class _Run:
         hit = self._outcomes.get(key)
         if hit is None:
             p, s = x
-            hit = [(p, t) for t in sorted(outcome_set(self.model.mechanics[p], s, float(a)))]
+            base = outcome_set(self.model.mechanics[p], s, float(a))
+            if self.margins:
+                self._check_margin(node, x, base)
+            hit = [(p, t) for t in sorted(base)]
             self._outcomes[key] = hit
         return hit
+
+    def _check_margin(self, node: Mapping[str, Any], x: State, base: frozenset[int]) -> None:
+        """CheckFailed when the node's ``margin_deg`` overstates what its rotation keeps for
+        state ``x``: a strong plan's margin is slack beyond the declared rotation error r
+        (docs/plans.md), so every rotation within ``action ± margin`` gives the state the same
+        outcome set and an error up to ``r + margin`` keeps its outcomes within ``base``, its
+        set at r (checked ``MARGIN_TOL_DEG`` inside)."""
+        m = node.get("margin_deg")
+        if m is None:
+            return
+        p, s = x
+        mech = self.model.mechanics[p]
+        a, r = float(node["action_deg"]), mech.uncertainty.rotation_error_deg
+        wide = outcome_set(mech, s, a, r + float(m) - MARGIN_TOL_DEG)
+        if wide <= base:
+            return
+        keeps = max(max_rotation_error(mech, [s], a) - r, 0.0)
+        raise CheckFailed(
+            f"the margin ±{m:.6g}° of the rotation {a:.6g}° is more than it keeps "
+            f"(±{keeps:.6g}° beyond the declared ±{r:g}°): with a rotation error of "
+            f"±{r + m:.6g}° {self.model.label(p)} in physical state {s} can end in "
+            f"{sorted(wide - base)} besides {sorted(base)}"
+        )
 
     def branches_of(
         self, node: Mapping[str, Any], x: State, sensor: Sensor | None = None
@@ -379,12 +412,15 @@ def verify_strong(
     """Execute every start, outcome and reading branch of ``plan`` on rebuilt mechanics.
 
     ``uncertainty`` defaults to the plan's declared one (another value re-verifies the plan
-    under it). Returns the report (per part: starts, paths, the worst operations); raises
-    CheckFailed with the first failing path, or when the worst path's length differs from
-    the stated one.
+    under it). At the declared uncertainty every action's margin is checked as well, per
+    (node, state) as the paths are followed (``_Run._check_margin``). Returns the report (per
+    part: starts, paths, the worst operations); raises CheckFailed with the first failing
+    path or margin, or when the worst path's length differs from the stated one.
     """
     model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
-    run = _Run(plan, model)
+    # The margins are claims at the declared uncertainty (the ideal verifier follows them).
+    margins = uncertainty is None and not declared_uncertainty(plan).is_ideal
+    run = _Run(plan, model, margins)
     root = plan["root"]
     checks = []
     overall = 0
@@ -609,52 +645,6 @@ def _reaching(
                 bucket.add(y)
 
 
-MARGIN_TOL_DEG = 1e-6
-"""A margin or certificate is checked this far inside what it claims (deg): the planner's
-ranges end exactly on cell boundaries, which rebuilding the mechanics from the file
-reproduces to about 1e-9."""
-
-
-def margin_problems(
-    plan: Mapping[str, Any],
-    *,
-    parts: Sequence[PushFunction] | None = None,
-    deadline: Deadline | None = None,
-) -> list[str]:
-    """The first action whose ``margin_deg`` a strong plan overstates, in words (empty when
-    every margin holds).
-
-    A strong plan's margin is slack beyond the declared rotation error r (docs/plans.md):
-    every rotation within ``action ± margin`` gives each state that reaches the node the
-    same outcome set, so a rotation error up to ``r + margin`` keeps its outcomes within the
-    set at r. Checked per (node, state) on the mechanics rebuilt from the file, at
-    ``r + margin - MARGIN_TOL_DEG``. A plan declaring the ideal model is checked by
-    :func:`~feederkit.plans.verify.verify_plan`, which follows the whole overlap range.
-    """
-    deadline = deadline or Deadline()
-    model = strong_model(plan, parts=parts)
-    run = _Run(plan, model)
-    for node, new in _reaching(plan, run, deadline):
-        a, m = node.get("action_deg"), node.get("margin_deg")
-        if a is None or m is None:
-            continue
-        for p, s in sorted(new):
-            mech = model.mechanics[p]
-            r = mech.uncertainty.rotation_error_deg
-            base = outcome_set(mech, s, float(a))
-            wide = outcome_set(mech, s, float(a), r + float(m) - MARGIN_TOL_DEG)
-            if wide <= base:
-                continue
-            keeps = max_rotation_error(mech, [s], float(a)) - r
-            return [
-                f"the margin ±{m:.6g}° of the rotation {a:.6g}° is more than it keeps "
-                f"(±{max(keeps, 0.0):.6g}° beyond the declared ±{r:g}°): with a rotation "
-                f"error of ±{r + m:.6g}° {model.label(p)} in physical state {s} can end in "
-                f"{sorted(wide - base)} besides {sorted(base)}"
-            ]
-    return []
-
-
 def certificate_problems(
     plan: Mapping[str, Any],
     *,
@@ -788,7 +778,6 @@ __all__ = [
     "finite_or_none",
     "ideal_view",
     "max_rotation_error_deg",
-    "margin_problems",
     "max_shape_tolerance_mm",
     "strong_holds",
     "strong_model",

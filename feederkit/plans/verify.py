@@ -517,9 +517,9 @@ def verify_declared(
     kinematic model (:func:`verify_plan`); any other is a strong plan (design.md,
     "Uncertainty"), checked for every outcome the declared uncertainty allows and every
     reading (:func:`feederkit.plans.strong.verify_strong`), together with the file's own
-    consistency (listed states and poses against the hulls and COMs), its margins
-    (:func:`~feederkit.plans.strong.margin_problems`; the ideal verifier follows the whole
-    overlap range) and, for either, its certificate
+    consistency (listed states and poses against the hulls and COMs), its margins (both
+    verifiers: the ideal one follows the whole overlap range) and, for either, its
+    certificate
     (:func:`~feederkit.plans.strong.certificate_problems`): a margin or certificate larger
     than the plan keeps is a false promise to the controller. A failure is in the report
     (``ok`` False, ``first_problem``), not raised; structural breakage is InputError.
@@ -537,7 +537,7 @@ def verify_declared(
 def _verify_declared(plan: Plan, part_indices: Sequence[int] | None) -> VerificationReport:
     """:func:`verify_declared` with room to recurse."""
     from feederkit.plans.fileformat import plan_to_dict
-    from feederkit.plans.strong import certificate_problems, margin_problems, verify_strong
+    from feederkit.plans.strong import certificate_problems, verify_strong
 
     data = plan_to_dict(plan)
     if plan.uncertainty.is_ideal:
@@ -559,8 +559,8 @@ def _verify_declared(plan: Plan, part_indices: Sequence[int] | None) -> Verifica
         # The strong check stops at the first failing path: no per-part counts to report.
         return VerificationReport((), (), tuple(problems))
     if not problems:
-        # The claims beyond the paths: each margin, and the certificate.
-        problems += margin_problems(data) or certificate_problems(data)
+        # The claim beyond the paths and margins (verify_strong checks those): the certificate.
+        problems += certificate_problems(data)
     checks = tuple(c for c in strong.parts if (c.part, c.landing) in names)
     return VerificationReport(checks, (), tuple(problems))
 
