@@ -20,13 +20,14 @@ read alike and give no breakpoint.
 from __future__ import annotations
 
 import bisect
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 
 from feederkit.design.limit import PAIRS, DesignClock
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.pairs import PairWitness, distinguishable
+from feederkit.plans.model import PlanMember
 from feederkit.sensors import ToleranceSensor
 
 
@@ -171,7 +172,8 @@ class MixCritical:
 
     The mix is recognizable (section 8.5) iff every pair of its parts is distinguishable,
     so its critical tolerance is the smallest of the pairs' (None when one pair has none:
-    no tolerance works; a single part has no pair and is recognizable with any).
+    no tolerance works; a single part has no pair and is recognizable with any). A mix
+    with rejected members holds the pairs a plan must tell apart (:func:`told_apart_pairs`).
     """
 
     pairs: tuple[PairCritical, ...]
@@ -196,18 +198,32 @@ class MixCritical:
         return tuple(p for p in self.pairs if p.critical_tolerance == c)
 
 
+def rejected_of(members: Sequence[PlanMember] | None) -> frozenset[int]:
+    """The indices of the members the next station does not take (``accept`` False)."""
+    return frozenset(k for k, m in enumerate(members or ()) if not m.accept)
+
+
+def told_apart_pairs(n: int, rejected: Collection[int] = ()) -> list[tuple[int, int]]:
+    """The pairs ``(i, j)``, ``i < j``, of ``n`` members that a plan must tell apart, in
+    member order: every pair but two rejected members (both end in reject results, design.md
+    "Landings"; :func:`feederkit.mix.changeover.reported_pairs`)."""
+    out = set(rejected)
+    return [(i, j) for i in range(n) for j in range(i + 1, n) if not (i in out and j in out)]
+
+
 def mix_critical_tolerance(
-    pfs: Sequence[PushFunction], clock: DesignClock | None = None
+    pfs: Sequence[PushFunction], clock: DesignClock | None = None, rejected: Collection[int] = ()
 ) -> MixCritical:
     """Every pair's exact critical tolerance, in part order, and so the mix's; ``clock``
-    (:mod:`feederkit.design.limit`) is polled and told of each pair decided."""
+    (:mod:`feederkit.design.limit`) is polled and told of each pair decided. ``rejected``:
+    the indices of members the plan rejects; two of them need not be told apart, so their
+    pair is left out (:func:`told_apart_pairs`)."""
     clock = clock or DesignClock()
-    n = len(pfs)
-    clock.begin(PAIRS, n * (n - 1) // 2)
+    wanted = told_apart_pairs(len(pfs), rejected)
+    clock.begin(PAIRS, len(wanted))
     pairs = []
-    for i in range(n):
-        for j in range(i + 1, n):
-            clock.check()
-            pairs.append(pair_critical_tolerance(pfs[i], pfs[j], clock))
-            clock.advance()
+    for i, j in wanted:
+        clock.check()
+        pairs.append(pair_critical_tolerance(pfs[i], pfs[j], clock))
+        clock.advance()
     return MixCritical(tuple(pairs))

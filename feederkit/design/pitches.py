@@ -15,12 +15,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from feederkit.design.critical import rejected_of
 from feederkit.design.limit import PITCHES, DesignClock
 from feederkit.design.strong import StrongMix, strong_pitch
 from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
+from feederkit.mix.changeover import reported_pairs
 from feederkit.mix.pairs import unrecognizable_pairs
 from feederkit.plans.make import make_plan
+from feederkit.plans.model import PlanMember
 from feederkit.sensors import LedSensor
 from feederkit.uncertainty import IDEAL
 
@@ -66,9 +69,13 @@ def pitch_row(
     noise: float,
     mix: StrongMix | None = None,
     clock: DesignClock | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> PitchRow:
     """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix
-    (for strong plans at ``mix``'s uncertainty when given), within ``clock``'s limit."""
+    (for strong plans at ``mix``'s uncertainty when given, with ``mix``'s members), within
+    ``clock``'s limit. ``members`` (the ideal model's) as
+    :func:`~feederkit.plans.make.make_plan` takes them: two rejected members need not be
+    told apart (:func:`~feederkit.mix.changeover.reported_pairs`)."""
     clock = clock or DesignClock()
     sensor = LedSensor(pitch, noise)
     if mix is not None:
@@ -76,11 +83,16 @@ def pitch_row(
         if got.unrecognizable or got.no_plan is not None:
             return PitchRow(pitch, noise, got.unrecognizable, no_plan=got.no_plan)
         return PitchRow(pitch, noise, (), got.length, got.expected)
-    bad = tuple((w.part_a, w.part_b) for w in unrecognizable_pairs(list(pfs), sensor))
+    rejected = rejected_of(members)
+    out = [pf.part.name for k, pf in enumerate(pfs) if k in rejected]
+    pairs = reported_pairs(unrecognizable_pairs(list(pfs), sensor), out)
+    bad = tuple((w.part_a, w.part_b) for w in pairs)
     if bad:
         return PitchRow(pitch, noise, bad)
     clock.check()
-    result = clock.plan(lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=IDEAL)).result
+    result = clock.plan(
+        lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=IDEAL, members=members)
+    ).result
     return PitchRow(pitch, noise, (), result.length, result.expected_length)
 
 
@@ -90,17 +102,19 @@ def pitch_rows(
     noise: float,
     mix: StrongMix | None = None,
     clock: DesignClock | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> tuple[PitchRow, ...]:
     """Every pitch of the list, ascending, each decided on its own (for strong plans at
-    ``mix``'s uncertainty when given, else on the ideal model); ``clock``
-    (:mod:`feederkit.design.limit`) is polled and told of each pitch decided."""
+    ``mix``'s uncertainty when given, else on the ideal model, for ``members``:
+    :func:`pitch_row`); ``clock`` (:mod:`feederkit.design.limit`) is polled and told of
+    each pitch decided."""
     clock = clock or DesignClock()
     ordered = sorted(set(pitches))
     clock.begin(PITCHES, len(ordered))
     rows = []
     for p in ordered:
         clock.check()
-        rows.append(pitch_row(pfs, p, noise, mix, clock))
+        rows.append(pitch_row(pfs, p, noise, mix, clock, members))
         clock.advance()
     return tuple(rows)
 

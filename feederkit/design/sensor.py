@@ -6,15 +6,25 @@ length as a step function of the tolerance up to it. For an LED array: the same,
 pitch. Every figure is for strong plans at the declared uncertainty (design.md,
 "Uncertainty"; :mod:`feederkit.design.strong`); with all three bounds zero it is the ideal
 model, decided by :mod:`feederkit.design.critical` and :mod:`feederkit.design.steps`.
+
+The members may be landings, some of them rejected (design.md, "Landings"; ``changeover
+compile --accept``): the design is then of the plans that tell the accepted landings apart
+from each other and from the rejected ones, and end the rejected ones in reject results, as
+:func:`feederkit.plans.make.make_plan` plans them (:func:`landing_design_members`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Collection, Mapping, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
-from feederkit.design.critical import MixCritical, PairCritical, mix_critical_tolerance
+from feederkit.design.critical import (
+    MixCritical,
+    PairCritical,
+    mix_critical_tolerance,
+    rejected_of,
+)
 from feederkit.design.limit import DesignClock, DesignTimeout, Progress
 from feederkit.design.pitches import PitchRow, pitch_rows
 from feederkit.design.steps import BREAKPOINT_REL_EPS, LengthStep, length_steps
@@ -25,8 +35,12 @@ from feederkit.design.strong import (
     uncertainty_words,
 )
 from feederkit.errors import InputError
+from feederkit.landing.model import Landing
 from feederkit.mechanics.push import PushFunction
+from feederkit.mix.changeover import landing_members, member_name, rejected_members
 from feederkit.planning.budget import Timeout
+from feederkit.plans.make import _check_members as check_plan_members
+from feederkit.plans.model import PlanMember
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import at_most
 
@@ -54,6 +68,72 @@ def _check_mix(pfs: Sequence[PushFunction]) -> None:
         )
 
 
+def landing_design_members(
+    landings: Sequence[Landing], accept: Collection[str] | None = None
+) -> tuple[PlanMember, ...]:
+    """The members of a design over ``landings``: ``changeover compile``'s
+    (:func:`feederkit.mix.changeover.landing_members`: the same names, accept/reject and
+    validation of ``accept``, the landing names the next station takes; None: every
+    landing), weighed alike (no shares: the design's expected figures weigh its members
+    alike, docs/design.md)."""
+    return tuple(replace(m, share=None) for m in landing_members(landings, accept))
+
+
+def plan_members(plan: Mapping[str, Any]) -> tuple[PlanMember, ...] | None:
+    """The members of a plan file (a stored changeover's) for its design: each part entry's
+    name and landing, accepted unless the plan's reject results name it
+    (:func:`feederkit.mix.changeover.rejected_members`), weighed alike; None for a plan of
+    parts (no landings, nothing rejected), designed as its parts."""
+    parts = list(plan.get("parts", []))
+    out = rejected_members(plan)
+    if not out and all(p.get("landing") is None for p in parts):
+        return None
+    return tuple(
+        PlanMember(
+            p["name"], p.get("landing"), None, member_name(p["name"], p.get("landing")) not in out
+        )
+        for p in parts
+    )
+
+
+def _checked_members(
+    members: Sequence[PlanMember] | None, pfs: Sequence[PushFunction]
+) -> tuple[PlanMember, ...] | None:
+    """``members`` as given, checked as :func:`~feederkit.plans.make.make_plan` checks them
+    (one per push function, each once, at least one accepted), so a design refuses what the
+    plans it describes would refuse, with the same words."""
+    if members is None:
+        return None
+    named = tuple(members)
+    check_plan_members(named, pfs)
+    return named
+
+
+LISTED_REJECTS = 6
+"""Rejected members the one-line answer names (the JSON's ``landings`` lists them all)."""
+
+
+def _rejected_words(parts: Sequence[str], members: Sequence[PlanMember] | None) -> str:
+    """``; the plan rejects A, B, C`` naming the rejected members (empty: none)."""
+    out = [parts[k] for k in sorted(rejected_of(members))]
+    if not out:
+        return ""
+    shown = ", ".join(out[:LISTED_REJECTS])
+    more = len(out) - LISTED_REJECTS
+    return f"; the plan rejects {shown}" + (f" and {more} more" if more > 0 else "")
+
+
+def landing_rows(members: Sequence[PlanMember] | None) -> list[dict[str, Any]]:
+    """The JSON's ``landings``: ``part``, ``landing`` and ``accept`` of each member that is a
+    landing, in member order (none for a design of parts), as ``changeover compile --json``
+    lists them."""
+    return [
+        {"part": m.name, "landing": m.landing, "accept": m.accept}
+        for m in members or ()
+        if m.landing is not None
+    ]
+
+
 def _pairs_words(pairs: Sequence[PairCritical], limit: int = 5) -> str:
     words = [f"{p.a} and {p.b}" for p in pairs[:limit]]
     more = len(pairs) - limit
@@ -76,6 +156,13 @@ class ToleranceDesign:
     stopped: str | None = None
     """A partial design (``design_tolerance(..., partial=True)`` at its limit): why the
     length table is missing, every pair being decided; None for a whole design."""
+    members: tuple[PlanMember, ...] | None = None
+    """The members as planned (landings, accept/reject; None: the parts, each accepted)."""
+
+    @property
+    def rejected(self) -> tuple[str, ...]:
+        """The members (named as ``parts``) the plans reject: they end in reject results."""
+        return tuple(self.parts[k] for k in sorted(rejected_of(self.members)))
 
     @property
     def complete(self) -> bool:
@@ -123,11 +210,14 @@ class ToleranceDesign:
         return None
 
     def _model_words(self) -> str:
+        """The answer's end: the members the plans reject, then the model they are for."""
         u = self.uncertainty
-        return "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+        words = "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+        return _rejected_words(self.parts, self.members) + words
 
     def answer(self) -> str:
-        """The design in one line, naming the uncertainty it is for."""
+        """The design in one line, naming the members it rejects and the uncertainty it is
+        for."""
         x = self.critical_tolerance
         pairs_x = self.critical.critical_tolerance
         if self.stopped is not None and pairs_x is not None:
@@ -167,6 +257,7 @@ class ToleranceDesign:
         return {
             "sensor_model": "tolerance",
             "parts": list(self.parts),
+            "landings": landing_rows(self.members),
             "critical_tolerance_mm": self.critical_tolerance,
             "pairs": [p.to_dict() for p in self.critical.pairs],
             "lengths": [s.to_dict() for s in self.steps],
@@ -195,6 +286,7 @@ def design_tolerance(
     progress: Progress | None = None,
     memory_limit_mb: float | None = None,
     partial: bool = False,
+    members: Sequence[PlanMember] | None = None,
 ) -> ToleranceDesign:
     """Critical tolerances and length steps at ``uncertainty`` (default the ideal model);
     the steps reach the mix's critical tolerance, or ``max_tolerance`` (mm) when given
@@ -208,14 +300,22 @@ def design_tolerance(
     (:attr:`ToleranceDesign.stopped` says why; under uncertainty its critical tolerance is
     then undecided, the pairs' bounding it from above). ``progress(what, done, total)`` is
     told of each pair, goal probe and run of the table.
+
+    ``members`` (one per push function, as :func:`~feederkit.plans.make.make_plan` takes
+    them and checks them, InputError alike; None: the parts, each accepted): the design is
+    then of the plans for those members, as ``changeover compile --accept`` makes them
+    (:func:`landing_design_members`): two rejected members need not be told apart, an
+    accepted one must be told from every other member, and a set of rejected members'
+    states only ends in a reject result.
     """
     _check_mix(pfs)
     if max_tolerance is not None and not max_tolerance > 0.0:
         raise InputError(f"--max-tolerance must be a positive number of mm, got {max_tolerance}")
     unc = _uncertainty(uncertainty)
+    named = _checked_members(members, pfs)
     clock = DesignClock(time_limit_s, progress, memory_limit_mb)
     try:
-        return _design_tolerance(pfs, max_tolerance, unc, clock, partial)
+        return _design_tolerance(pfs, max_tolerance, unc, clock, partial, named)
     except Timeout as exc:
         raise clock.timeout(exc.reason) from None
 
@@ -226,16 +326,17 @@ def _design_tolerance(
     unc: Uncertainty,
     clock: DesignClock,
     partial: bool = False,
+    members: tuple[PlanMember, ...] | None = None,
 ) -> ToleranceDesign:
     names = tuple(pf.part.name for pf in pfs)
     if unc.is_ideal:
-        critical = mix_critical_tolerance(pfs, clock)
+        critical = mix_critical_tolerance(pfs, clock, rejected_of(members))
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
 
         def table() -> tuple[LengthStep, ...]:
-            return length_steps(pfs, up_to, critical=critical, clock=clock)
+            return length_steps(pfs, up_to, critical=critical, clock=clock, members=members)
     else:
-        mix = StrongMix(pfs, unc)
+        mix = StrongMix(pfs, unc, members)
         critical = strong_mix_critical(mix, clock)
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
 
@@ -243,14 +344,14 @@ def _design_tolerance(
             return strong_length_steps(mix, up_to, critical, clock=clock)
 
     if up_to is None:
-        return ToleranceDesign(names, critical, (), unc)
+        return ToleranceDesign(names, critical, (), unc, members=members)
     try:
-        return ToleranceDesign(names, critical, table(), unc)
+        return ToleranceDesign(names, critical, table(), unc, members=members)
     except Timeout as exc:
         if not partial:
             raise
         stopped = str(clock.timeout(exc.reason, partial=True))
-        return ToleranceDesign(names, critical, (), unc, stopped)
+        return ToleranceDesign(names, critical, (), unc, stopped, members)
 
 
 @dataclass(frozen=True)
@@ -262,6 +363,13 @@ class PitchDesign:
     rows: tuple[PitchRow, ...]
     critical: MixCritical
     uncertainty: Uncertainty = IDEAL
+    members: tuple[PlanMember, ...] | None = None
+    """The members as planned (landings, accept/reject; None: the parts, each accepted)."""
+
+    @property
+    def rejected(self) -> tuple[str, ...]:
+        """The members (named as ``parts``) the plans reject: they end in reject results."""
+        return tuple(self.parts[k] for k in sorted(rejected_of(self.members)))
 
     @property
     def critical_pitch(self) -> float | None:
@@ -275,11 +383,14 @@ class PitchDesign:
         return self.critical_pitch is not None
 
     def _model_words(self) -> str:
+        """The answer's end: the members the plans reject, then the model they are for."""
         u = self.uncertainty
-        return "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+        words = "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
+        return _rejected_words(self.parts, self.members) + words
 
     def answer(self) -> str:
-        """The design in one line, naming the uncertainty it is for."""
+        """The design in one line, naming the members it rejects and the uncertainty it is
+        for."""
         y = self.critical_pitch
         if y is None:
             text = "no LED pitch in the list makes this mix recognizable"
@@ -304,6 +415,7 @@ class PitchDesign:
         return {
             "sensor_model": "led",
             "parts": list(self.parts),
+            "landings": landing_rows(self.members),
             "noise_mm": self.noise,
             "critical_pitch_mm": self.critical_pitch,
             "pitches": [r.to_dict() for r in self.rows],
@@ -324,26 +436,29 @@ def design_pitches(
     time_limit_s: float | None = None,
     progress: Progress | None = None,
     memory_limit_mb: float | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> PitchDesign:
     """Each pitch decided on its own at ``uncertainty`` (default the ideal model;
     :mod:`feederkit.design.pitches`), and the pairs' exact critical tolerances, which name
-    the pairs no sensor can separate. ``time_limit_s``, ``memory_limit_mb`` and
-    ``progress`` as for :func:`design_tolerance`."""
+    the pairs no sensor can separate. ``time_limit_s``, ``memory_limit_mb``, ``progress``
+    and ``members`` as for :func:`design_tolerance`."""
     _check_mix(pfs)
     if not pitches:
         raise InputError("--pitches is empty: give pitches in mm, e.g. 0.1,0.2,0.5")
     if noise < 0.0:
         raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
     unc = _uncertainty(uncertainty)
+    named = _checked_members(members, pfs)
     clock = DesignClock(time_limit_s, progress, memory_limit_mb)
     names = tuple(pf.part.name for pf in pfs)
     try:
         if unc.is_ideal:
-            rows = pitch_rows(pfs, pitches, noise, clock=clock)
-            return PitchDesign(names, noise, rows, mix_critical_tolerance(pfs, clock), unc)
-        mix = StrongMix(pfs, unc)
+            rows = pitch_rows(pfs, pitches, noise, clock=clock, members=named)
+            critical = mix_critical_tolerance(pfs, clock, rejected_of(named))
+            return PitchDesign(names, noise, rows, critical, unc, named)
+        mix = StrongMix(pfs, unc, named)
         rows = pitch_rows(pfs, pitches, noise, mix=mix, clock=clock)
-        return PitchDesign(names, noise, rows, strong_mix_critical(mix, clock), unc)
+        return PitchDesign(names, noise, rows, strong_mix_critical(mix, clock), unc, named)
     except Timeout as exc:
         raise clock.timeout(exc.reason) from None
 
@@ -357,27 +472,34 @@ def report_design(
     pfs: Sequence[PushFunction],
     uncertainty: Uncertainty | float | None = None,
     time_limit_s: float | None = REPORT_DESIGN_LIMIT_S,
+    members: Sequence[PlanMember] | None = None,
 ) -> dict[str, Any] | None:
     """The sensor design a changeover report shows (``ToleranceDesign.to_dict``) at the
     changeover's ``uncertainty`` (its plan file's; a number is a rotation error in degrees
     with exact shapes; None the ideal model), or None for a single part (nothing to tell
-    apart). DesignTimeout past ``time_limit_s`` (:func:`report_design_or_warning`)."""
+    apart). ``members``: the changeover's (:func:`plan_members` of its plan file), so the
+    design is of plans that reject what it rejects. DesignTimeout past ``time_limit_s``
+    (:func:`report_design_or_warning`)."""
     if len(pfs) < 2:
         return None
     if isinstance(uncertainty, int | float):
         uncertainty = Uncertainty(float(uncertainty), 0.0, 0.0)
-    return design_tolerance(list(pfs), uncertainty=uncertainty, time_limit_s=time_limit_s).to_dict()
+    return design_tolerance(
+        list(pfs), uncertainty=uncertainty, time_limit_s=time_limit_s, members=members
+    ).to_dict()
 
 
 def report_design_or_warning(
-    pfs: Sequence[PushFunction], uncertainty: Uncertainty | float | None = None
+    pfs: Sequence[PushFunction],
+    uncertainty: Uncertainty | float | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> tuple[dict[str, Any] | None, str | None]:
     """:func:`report_design` within ``REPORT_DESIGN_LIMIT_S``, or None with the one warning a
     report gives when the design is not decided by then: a report is written with the
     section or without it, never not at all (docs/reports.md)."""
     time_limit_s = REPORT_DESIGN_LIMIT_S
     try:
-        return report_design(pfs, uncertainty, time_limit_s), None
+        return report_design(pfs, uncertainty, time_limit_s, members), None
     except DesignTimeout:
         return None, (
             f"the report leaves out the sensor design: not decided within {time_limit_s:g} s "

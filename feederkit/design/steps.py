@@ -29,6 +29,13 @@ strong-plan table also splits its segments where they change. This module is the
 model's table; :mod:`feederkit.design.strong` builds the strong one from the same search
 (:func:`_segment_runs`).
 
+A plan that rejects some members (``changeover compile --accept``, design.md "Landings")
+has a coarser goal: every set of rejected members' states only is a goal (a reject result),
+whatever the tolerance, and pairs of two rejected members are not the mix's pairs
+(:func:`feederkit.design.critical.told_apart_pairs`). That part of the goal does not depend
+on the sensor, so the argument above holds unchanged on the machine whose rejected states
+are marked as :func:`feederkit.plans.make.make_plan` marks them.
+
 The search: within a segment, the length at the first interval is proven by the planner's
 own AND/OR oracle (:class:`LengthOracle`, no plan tree built); then, for a known length
 ``L``, monotonicity turns "how long is the plan here" into "is there a plan of at most
@@ -49,7 +56,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
 from typing import Protocol
 
@@ -59,11 +66,13 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
     mix_critical_tolerance,
+    rejected_of,
 )
 from feederkit.design.limit import LENGTHS, DesignClock
 from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, PushAlignMachine
 from feederkit.machine.build import build_machine
+from feederkit.machine.weights import weigh_members
 from feederkit.mechanics.push import PushFunction
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
@@ -73,6 +82,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
 from feederkit.plans.make import make_plan
+from feederkit.plans.model import PlanMember
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
 
@@ -139,15 +149,21 @@ def _first_at_or_above(breaks: Sequence[float], x: float) -> int:
 
 
 def plan_evaluation(
-    pfs: Sequence[PushFunction], tolerance: float, clock: DesignClock | None = None
+    pfs: Sequence[PushFunction],
+    tolerance: float,
+    clock: DesignClock | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> Evaluation:
     """Length and expected length of the verified optimal plan at ``tolerance`` mm (no
     certificate: the table needs neither its rotation error nor its shape tolerance),
-    within what is left of ``clock``'s limit (:meth:`DesignClock.plan`)."""
+    within what is left of ``clock``'s limit (:meth:`DesignClock.plan`); ``members`` as
+    :func:`~feederkit.plans.make.make_plan` takes them (landings, shares, accept/reject)."""
     sensor = ToleranceSensor(tolerance)
     clock = clock or DesignClock()
     made = clock.plan(
-        lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=IDEAL, certify=False)
+        lambda opts: make_plan(
+            list(pfs), sensor, opts, uncertainty=IDEAL, certify=False, members=members
+        )
     )
     return Evaluation(made.result.length, made.result.expected_length)
 
@@ -181,11 +197,19 @@ class LengthOracle:
     sensor, and with it the readings and the goal, change per tolerance. The oracle of the
     last tolerance asked is kept, so repeated questions share its proven bounds. Every
     search polls ``deadline`` (default: none) and raises Timeout when it passes.
+    ``rejected``: the indices of members the plan rejects (their states marked as
+    :func:`~feederkit.plans.make.make_plan` marks them, so a set of them only is a goal).
     """
 
-    def __init__(self, pfs: Sequence[PushFunction], deadline: Deadline | None = None) -> None:
+    def __init__(
+        self,
+        pfs: Sequence[PushFunction],
+        deadline: Deadline | None = None,
+        rejected: Collection[int] = (),
+    ) -> None:
         self.deadline = deadline or Deadline()
-        self.machine = build_machine(list(pfs), uncertainty=IDEAL)
+        built = build_machine(list(pfs), uncertainty=IDEAL)
+        self.machine = weigh_members(built, None, rejected)
         self._sorted, _old = by_diameter(self.machine)
         self._last: tuple[float, Problem, WorstCase, list[int]] | None = None
 
@@ -232,6 +256,7 @@ def length_steps(
     evaluate: Callable[[float], Evaluation] | None = None,
     critical: MixCritical | None = None,
     clock: DesignClock | None = None,
+    members: Sequence[PlanMember] | None = None,
 ) -> tuple[LengthStep, ...]:
     """The plan length's steps over tolerances ``(0, up_to]`` (None: every interval).
 
@@ -241,17 +266,20 @@ def length_steps(
     :func:`plan_evaluation`) and must agree with the search (else CheckFailed).
     ``critical``: the mix's pairs' critical tolerances, if already known. ``clock``
     (:mod:`feederkit.design.limit`): the time limit every search polls (the default
-    oracle's and plans'), told of each run of intervals decided.
+    oracle's and plans'), told of each run of intervals decided. ``members``: the plan's
+    members as :func:`~feederkit.plans.make.make_plan` takes them; the default oracle,
+    plans and pairs then plan for rejected members as ``changeover compile --accept`` does.
 
     The intervals are searched in segments between the pairs' critical tolerances (the
     goal changes there) and steps never span two segments; inside a segment the length is
     monotone (the module's docstring).
     """
     clock = clock or DesignClock()
-    oracle = oracle or LengthOracle(pfs, clock.deadline)
+    rejected = rejected_of(members)
+    oracle = oracle or LengthOracle(pfs, clock.deadline, rejected)
     breaks = machine_breakpoints(oracle.machine)
-    evaluate = evaluate or (lambda e: plan_evaluation(pfs, e, clock))
-    critical = critical or mix_critical_tolerance(pfs, clock)
+    evaluate = evaluate or (lambda e: plan_evaluation(pfs, e, clock, members))
+    critical = critical or mix_critical_tolerance(pfs, clock, rejected)
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     clock.begin(LENGTHS, last + 1)
     # Interval k is recognizable for a pair iff its right end is at most the pair's critical.

@@ -50,6 +50,8 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
     last_true_top_first,
+    rejected_of,
+    told_apart_pairs,
 )
 from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
 from feederkit.design.steps import (
@@ -64,6 +66,7 @@ from feederkit.design.steps import (
 from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
 from feederkit.machine.build import build_machine
 from feederkit.machine.inseparable import inseparable_masks, kept_apart
+from feederkit.machine.weights import weigh_members
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness, distinguishable
 from feederkit.planning.andor import WorstCase
@@ -77,6 +80,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.solvable import unsolvable
 from feederkit.plans.make import make_plan
+from feederkit.plans.model import PlanMember
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor, span
 from feederkit.uncertainty import Uncertainty, check_for_part
 
@@ -130,14 +134,27 @@ def _mask(r: ActionRange | OutcomeRange) -> int:
 
 class StrongMix:
     """The mix machine at a declared uncertainty (built once, without a sensor) and its
-    two-part sub-machines, for the pair tests."""
+    two-part sub-machines, for the pair tests.
 
-    def __init__(self, pfs: Sequence[PushFunction], uncertainty: Uncertainty) -> None:
+    ``members`` (one per push function, as :func:`~feederkit.plans.make.make_plan` takes
+    them; None: the parts, each accepted) say which members the plan rejects: ``planned``
+    is the machine with their states marked, as the planner plans it (a set of rejected
+    states only is a goal), and two rejected members are not a pair to tell apart."""
+
+    def __init__(
+        self,
+        pfs: Sequence[PushFunction],
+        uncertainty: Uncertainty,
+        members: Sequence[PlanMember] | None = None,
+    ) -> None:
         for pf in pfs:
             check_for_part(uncertainty, pf.part)
         self.pfs = list(pfs)
         self.uncertainty = uncertainty
+        self.members = None if members is None else tuple(members)
+        self.rejected = rejected_of(self.members)
         self.machine = build_machine(self.pfs, NoSensor(), uncertainty)
+        self.planned = weigh_members(self.machine, None, self.rejected)
 
     def pair(self, a: int, b: int) -> PushAlignMachine:
         """Parts ``a`` and ``b`` (states of a first) of the mix machine."""
@@ -362,17 +379,17 @@ def strong_pair_critical(
 
 
 def strong_mix_critical(mix: StrongMix, clock: DesignClock | None = None) -> MixCritical:
-    """Every pair's critical tolerance for strong plans, in part order, and so the mix's;
+    """Every pair's critical tolerance for strong plans, in part order, and so the mix's
+    (pairs of two rejected members left out, :func:`~feederkit.design.critical.told_apart_pairs`);
     ``clock`` (:mod:`feederkit.design.limit`) is polled and told of each pair decided."""
     clock = clock or DesignClock()
-    n = len(mix.pfs)
-    clock.begin(PAIRS, n * (n - 1) // 2)
+    wanted = told_apart_pairs(len(mix.pfs), mix.rejected)
+    clock.begin(PAIRS, len(wanted))
     pairs = []
-    for i in range(n):
-        for j in range(i + 1, n):
-            clock.check()
-            pairs.append(strong_pair_critical(mix, i, j, clock))
-            clock.advance()
+    for i, j in wanted:
+        clock.check()
+        pairs.append(strong_pair_critical(mix, i, j, clock))
+        clock.advance()
     return MixCritical(tuple(pairs))
 
 
@@ -393,13 +410,14 @@ class StrongLengthOracle:
     relation, or, when no strong plan reaches it, the lumped goal of
     :func:`~feederkit.planning.lumping.try_lumping` (None when neither has a strong plan).
     Every search polls ``deadline`` (default none) and raises Timeout when it passes; a
-    goal is recorded only when decided.
+    goal is recorded only when decided. The machine is the mix's as planned
+    (:attr:`StrongMix.planned`: rejected members' states marked).
     """
 
     def __init__(self, mix: StrongMix, deadline: Deadline | None = None) -> None:
         self.mix = mix
         self.deadline = deadline or Deadline()
-        self.machine = mix.machine
+        self.machine = mix.planned
         self._sorted, _old = by_diameter(self.machine)
         self._bisimilar: dict[float, tuple[int, ...]] = {}
         self._goals: dict[float, Goal] = {}
@@ -536,18 +554,38 @@ def strong_evaluation(
     uncertainty: Uncertainty,
     tolerance: float,
     clock: DesignClock | None = None,
+    plan_members: Sequence[PlanMember] | None = None,
 ) -> Evaluation:
     """Length and expected length of the verified optimal strong plan at ``tolerance`` mm,
-    and whether it lists states of two parts together (then it does not recognize the mix),
-    within what is left of ``clock``'s limit (:meth:`DesignClock.plan`)."""
+    and whether it lists states of two parts together (then it does not recognize the mix;
+    two rejected members may share a reject result), within what is left of ``clock``'s
+    limit (:meth:`DesignClock.plan`); ``plan_members`` as
+    :func:`~feederkit.plans.make.make_plan` takes them."""
     sensor = ToleranceSensor(tolerance)
     clock = clock or DesignClock()
     result = clock.plan(
-        lambda opts: make_plan(list(pfs), sensor, opts, uncertainty=uncertainty, certify=False)
+        lambda opts: make_plan(
+            list(pfs), sensor, opts, uncertainty=uncertainty, certify=False, members=plan_members
+        )
     ).result
-    states = result.machine.states
-    mixed = any(states[i].part != states[j].part for i, j in result.lumped_pairs)
-    return Evaluation(result.length, result.expected_length, mixed)
+    return Evaluation(
+        result.length,
+        result.expected_length,
+        bool(_cross_lumps(result.machine, result.lumped_pairs)),
+    )
+
+
+def _cross_lumps(
+    machine: PushAlignMachine, lumped: Sequence[tuple[int, int]]
+) -> set[tuple[int, int]]:
+    """The pairs of members ``(a, b)``, ``a < b``, whose states a strong plan lumps, but two
+    rejected members (both end in a reject result)."""
+    states = machine.states
+    return {
+        (min(states[i].part, states[j].part), max(states[i].part, states[j].part))
+        for i, j in lumped
+        if states[i].part != states[j].part and not (states[i].reject and states[j].reject)
+    }
 
 
 def strong_length_steps(
@@ -566,7 +604,9 @@ def strong_length_steps(
     clock = clock or DesignClock()
     oracle = oracle or StrongLengthOracle(mix, clock.deadline)
     breaks = machine_breakpoints(oracle.machine)
-    evaluate = evaluate or (lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e, clock))
+    evaluate = evaluate or (
+        lambda e: strong_evaluation(mix.pfs, mix.uncertainty, e, clock, mix.members)
+    )
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     below = recognizable_below(breaks, critical)
     fit = _fit_memo(oracle, breaks, clock)
@@ -600,10 +640,11 @@ class StrongPitch:
 
 def strong_pitch(mix: StrongMix, sensor: Sensor, clock: DesignClock | None = None) -> StrongPitch:
     """Decide one LED array (``sensor``) for strong plans: bisimilar cross pairs of the mix
-    machine, then (when there are none) a verified strong plan, whose results must not list
-    two parts together; every search polls ``clock``'s deadline."""
+    machine (but two rejected members'), then (when there are none) a verified strong plan,
+    whose results must not list two members together (but two rejected ones); every search
+    polls ``clock``'s deadline."""
     clock = clock or DesignClock()
-    machine = replace(mix.machine, sensor=sensor)
+    machine = replace(mix.planned, sensor=sensor)
     masks = inseparable_masks(machine, clock.check)
     states = machine.states
     names = machine.part_names
@@ -612,7 +653,7 @@ def strong_pitch(mix: StrongMix, sensor: Sensor, clock: DesignClock | None = Non
             (states[i].part, states[j].part)
             for i in range(machine.n)
             for j in members(masks[i])
-            if states[i].part < states[j].part
+            if states[i].part < states[j].part and not (states[i].reject and states[j].reject)
         }
     )
     if bad:
@@ -622,16 +663,16 @@ def strong_pitch(mix: StrongMix, sensor: Sensor, clock: DesignClock | None = Non
     if not exists:
         return StrongPitch((), None, None, NO_STRONG_PLAN)
     result = clock.plan(
-        lambda opts: make_plan(mix.pfs, sensor, opts, uncertainty=mix.uncertainty, certify=False)
+        lambda opts: make_plan(
+            mix.pfs,
+            sensor,
+            opts,
+            uncertainty=mix.uncertainty,
+            certify=False,
+            members=mix.members,
+        )
     ).result
-    rs = result.machine.states
-    lumped = sorted(
-        {
-            (min(rs[i].part, rs[j].part), max(rs[i].part, rs[j].part))
-            for i, j in result.lumped_pairs
-            if rs[i].part != rs[j].part
-        }
-    )
+    lumped = sorted(_cross_lumps(result.machine, result.lumped_pairs))
     return StrongPitch(
         tuple((names[a], names[b]) for a, b in lumped), result.length, result.expected_length
     )
