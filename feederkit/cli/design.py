@@ -4,7 +4,8 @@ A thin layer over :mod:`feederkit.design`: read the cell profile (``--cell FILE`
 ``./feederkit.toml``) and the command line's overrides, with the declared uncertainty
 (``--rotation-error``, ``--shape-tolerance``, ``--com-tolerance``, as ``plan`` takes them),
 load the parts with their landings (each landing one member of the mix, as ``plan`` plans
-it; ``--landings`` picks them), decide the critical tolerances (or each LED pitch) for
+it; ``--landings`` picks them, ``--accept`` names those the next station takes, exactly as
+``changeover compile`` reads them), decide the critical tolerances (or each LED pitch) for
 strong plans at that uncertainty, print the tables, the one-line answer, the profile and
 the uncertainty used, and exit 1 when no sensor in the range makes the mix recognizable
 (docs/design.md). While it runs, a progress bar on stderr (on a terminal only, so
@@ -24,6 +25,9 @@ from rich.table import Table
 
 from feederkit.cell import load_cell
 from feederkit.cli.common import (
+    FLAG_TERMS,
+    LANDING_TERMS,
+    AcceptOpt,
     CatalogOpt,
     ComToleranceOpt,
     JsonOpt,
@@ -48,6 +52,8 @@ from feederkit.design.sensor import (
     ToleranceDesign,
     design_pitches,
     design_tolerance,
+    landing_design_members,
+    landing_rows,
 )
 from feederkit.errors import InputError
 from feederkit.landing.plan import landing_names, load_landings
@@ -154,6 +160,7 @@ def sensor_command(
         ),
     ] = None,
     landings: LandingsOpt = None,
+    accept: AcceptOpt = None,
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -163,7 +170,9 @@ def sensor_command(
 
     Every landing of every part is a member of the mix, as ``plan`` plans it (a flat part
     face up and face down, a mesh in each resting pose; ``--landings up`` designs for the
-    parts face up only)."""
+    parts face up only). Landings not in ``--accept`` end in reject results, as ``changeover
+    compile --accept`` plans them: the design is then of plans that tell the accepted
+    landings apart from each other and from the rejected ones (docs/design.md)."""
     names = list(sources or [])
     if mix is not None:
         if names:
@@ -191,26 +200,33 @@ def sensor_command(
     with flag_words():
         check_limits(time_limit, memory_limit)
 
-    with flag_words():
+    terms = (*FLAG_TERMS, *LANDING_TERMS)
+    with flag_words(terms):
+        # As ``changeover compile`` reads them: the same parser, then the library's checks.
         which = "all" if landings in (None, "all") else landing_names(landings)
+        accepted = None if accept is None else landing_names(accept, "--accept")
         found = load_landings(names, catalog=catalog, which=which)
     loaded = found.parts
     # design.md: plans cover every landing unless told otherwise, so the design is of the
     # mix whose members are the landings, as ``plan`` and ``changeover compile`` plan it.
-    over_landings = plans_over_landings(found.landings, landings is not None, False)
+    over_landings = plans_over_landings(found.landings, landings is not None, accepted is not None)
+    members = None
     if over_landings:
         pfs = [push_function(x.part) for x in found.all]
+        with flag_words(terms):
+            members = landing_design_members(found.all, accepted)
     else:
         pfs = list(loaded.push_functions)
     json_found(
         parts=[pf.part.name for pf in pfs],
+        landings=landing_rows(members),
         cell_profile=profile.source,
         uncertainty=uncertainty.to_dict(),
     )
     # The design's expected figures weigh its members alike (plan weighs each part's landings).
-    members = "landings" if over_landings else "parts"
+    kind = "landings" if over_landings else "parts"
     design: ToleranceDesign | PitchDesign
-    with progress_bar() as bar, flag_words():
+    with progress_bar() as bar, flag_words(terms):
         tasks: dict[str, Any] = {}
 
         def progress(what: str, done: int, total: int) -> None:
@@ -228,6 +244,7 @@ def sensor_command(
                     time_limit_s=time_limit,
                     progress=progress,
                     memory_limit_mb=memory_limit,
+                    members=members,
                 )
             else:
                 design = design_tolerance(
@@ -238,6 +255,7 @@ def sensor_command(
                     progress=progress,
                     memory_limit_mb=memory_limit,
                     partial=True,
+                    members=members,
                 )
         except DesignTimeout as exc:
             hints = {"memory": "memory with --memory-limit MB", "time": "time with --time-limit S"}
@@ -256,10 +274,18 @@ def sensor_command(
             data["plot"] = str(plot)
         print_json(data)
     else:
+        if design.rejected:
+            console.print(
+                f"rejected {kind} (they end in reject results; two of them need not be told "
+                f"apart): {', '.join(design.rejected)}",
+                highlight=False,
+                markup=False,
+                soft_wrap=True,
+            )
         if isinstance(design, ToleranceDesign):
-            _print_tolerance(design, members)
+            _print_tolerance(design, kind)
         else:
-            _print_pitches(design, members)
+            _print_pitches(design, kind)
         model = "" if uncertainty.is_ideal else " (the figures are for strong plans)"
         console.print(
             f"cell profile: {profile.source}; uncertainty: "
@@ -292,6 +318,8 @@ def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
     title = "critical tolerance of each pair (the largest that still tells them apart)"
     if more > 0:
         title += f"; the {len(shown)} lowest of {len(pairs)}"
+    if design.rejected:
+        title += "; none of two rejected ones"
     table = Table(title=title)
     table.add_column("part a")
     table.add_column("part b")
