@@ -220,3 +220,19 @@ def test_the_library_refuses_what_make_plan_refuses(line):
         design_tolerance(pfs, members=none)
     with pytest.raises(InputError, match="plan members for"):
         design_tolerance(pfs, members=members[:3])
+
+
+def test_a_changeover_report_designs_the_sensor_for_what_the_plan_rejects(tmp_path, capsys):
+    """The report of a changeover compiled with --accept gives the design of that question:
+    the rejected landings named, and the length of a plan that rejects them."""
+    root = Path(__file__).resolve().parents[1] / "catalog"
+    db, report = str(tmp_path / "c.db"), tmp_path / "r.html"
+    assert main(["catalog", "init", "--catalog", db]) == 0
+    for name in ("l-bracket", "chamfered-plate"):
+        assert main(["catalog", "add", str(root / f"{name}.json"), "--catalog", db]) == 0
+    args = ["changeover", "compile", "line", "--mix", "l-bracket,chamfered-plate"]
+    args += ["--tolerance", "0.5", "--accept", "up", "--report", str(report)]
+    assert main([*args, "--rotation-error", "0", "--catalog", db]) == 0
+    capsys.readouterr()
+    html = report.read_text()
+    assert "the plan rejects l-bracket/down, chamfered-plate/down" in html

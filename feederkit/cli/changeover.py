@@ -197,10 +197,14 @@ def changeover_report(
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`feederkit.design.report_design`; docs/reports.md)."""
     from feederkit.design import report_design_or_warning
+    from feederkit.design.sensor import plan_members
     from feederkit.reports import render_report
 
     u = plan.get("uncertainty")
-    design, warning = report_design_or_warning(pfs, Uncertainty.from_dict(u) if u else None)
+    # The design of the plan's own question: its accepted landings told apart, the others
+    # rejected (as compile planned them).
+    unc = Uncertainty.from_dict(u) if u else None
+    design, warning = report_design_or_warning(pfs, unc, members=plan_members(plan))
     if warning is not None:
         print_warnings([warning])
     return render_report(

@@ -39,7 +39,7 @@ from feederkit.landing.model import Landing
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import landing_members, member_name, rejected_members
 from feederkit.planning.budget import Timeout
-from feederkit.plans.make import _check_members as check_plan_members
+from feederkit.plans.make import check_plan_members
 from feederkit.plans.model import PlanMember
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import at_most

@@ -137,7 +137,7 @@ def _make_plan(
     for pf in pfs:
         check_for_part(unc, pf.part)
     _check_resolution(sensor, pfs)
-    named = _check_members(_weighted_members(members, weights, pfs), pfs)
+    named = check_plan_members(_weighted_members(members, weights, pfs), pfs)
     shares, rejected = _member_weights(named)
     machine = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
     if rejected:
@@ -412,7 +412,7 @@ def _weighted_members(
     return tuple(replace(m, share=w) for m, w in zip(named, shares, strict=True))
 
 
-def _check_members(
+def check_plan_members(
     members_: Sequence[PlanMember] | None, push_functions: Sequence[PushFunction]
 ) -> tuple[PlanMember, ...] | None:
     """The members as given, checked; None when they change nothing (plain parts)."""
