@@ -162,10 +162,12 @@ def may_lump(machine: PushAlignMachine, i: int, j: int, rule: Lumping | str) -> 
 
     ``near-symmetric``: states of different parts, or of one part when each names the other
     in ``look_alike`` (``MachineState.alike``: a state that records nothing, built by hand,
-    allows any).
+    allows any). Never an accepted state with a rejected one, whatever the rule.
     """
     rule = _rule(rule)
-    if rule is Lumping.NONE:
+    if rule is Lumping.NONE or machine.states[i].reject != machine.states[j].reject:
+        # A leaf accepts or rejects all it lists: an accepted state listed with a rejected
+        # one would send a part the next station cannot take to it (design.md, "Landings").
         return False
     if rule is Lumping.ANY:
         return True
@@ -281,15 +283,25 @@ def _listed(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
 
 
 def unlike_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
-    """One clause naming unresolvable pairs the default rule would not lump (poses that do
-    not look alike), for a "no strong plan" message (empty when none)."""
-    if not pairs:
-        return ""
-    return (
-        f"no strong plan tells apart poses that do not look alike ({_listed(machine, pairs)}); "
-        "a plan that lists them together, leaving the part unoriented between them, may "
-        "exist with lumping 'any'"
-    )
+    """Clauses naming the unresolvable pairs that were not lumped, for a "no strong plan"
+    message (empty when none): an accepted state with a rejected one (no rule lumps those:
+    accept both or neither), then poses that do not look alike (lumping ``any`` might)."""
+    states = machine.states
+    mixed = [p for p in pairs if states[p[0]].reject != states[p[1]].reject]
+    unlike = [p for p in pairs if states[p[0]].reject == states[p[1]].reject]
+    out = []
+    if mixed:
+        out.append(
+            "no strong plan tells accepted states from rejected ones "
+            f"({_listed(machine, mixed)}): accept both landings of each pair or neither"
+        )
+    if unlike:
+        out.append(
+            f"no strong plan tells apart poses that do not look alike "
+            f"({_listed(machine, unlike)}); a plan that lists them together, leaving the part "
+            "unoriented between them, may exist with lumping 'any'"
+        )
+    return "; ".join(out)
 
 
 __all__ = [
