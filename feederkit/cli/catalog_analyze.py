@@ -7,7 +7,9 @@ The lead registers :func:`analyze_command` as ``analyze`` in the ``catalog`` gro
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Annotated
 
+import typer
 from rich.markup import escape
 from rich.table import Table
 
@@ -43,6 +45,7 @@ from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
+from feederkit.uncertainty import Uncertainty
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -96,11 +99,23 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]
     return pfs, skipped, True
 
 
+AnalyzeRotationErrorOpt = Annotated[
+    float,
+    typer.Option(
+        "--rotation-error",
+        metavar="DEG",
+        help="Also check the pairs the ideal model tells apart for strong plans under a "
+        "rotation error of ±DEG (default 0: section 8's ideal model only).",
+    ),
+]
+
+
 def analyze_command(
     sensorless: SensorlessOpt = False,
     tolerance: ToleranceOpt = None,
     led_pitch: LedPitchOpt = None,
     noise: NoiseOpt = None,
+    rotation_error: AnalyzeRotationErrorOpt = 0.0,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
 ) -> None:
@@ -112,16 +127,19 @@ def analyze_command(
     and face down: a part and its mirror image read alike face up against face down).
 
     The analysis is the ideal model's (exact rotations and diameters, as section 8 decides
-    it), and says so: under a rotation error a strong plan may tell fewer pairs apart, which
-    ``plan`` and ``changeover compile`` decide for a mix.
+    it), and says so: under a rotation error a strong plan may tell fewer pairs apart.
+    ``--rotation-error DEG`` checks the candidate pairs it tells apart again, each pair for
+    strong plans (``feederkit.mix.strongpairs``), and lists those told apart only on the
+    ideal model (a near-duplicate 0.05 mm longer is one).
 
     Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
+    unc = Uncertainty(rotation_error)
     pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
     with err_console.status("analyzing ..."):
-        result = analyze_mix(pfs, sensor)
+        result = analyze_mix(pfs, sensor, uncertainty=unc)
     if json_out:
         data = result.to_dict()
         data["skipped"] = skipped
@@ -131,19 +149,31 @@ def analyze_command(
         for line in skipped:
             err_console.print(f"warning: {line}", highlight=False, markup=False)
         _print_report(result, pfs, over_landings)
-    if result.pairs:
-        n = len(result.pairs)
-        named = "; ".join(f"{w.part_a} & {w.part_b}" for w in result.pairs[:5])
+    if result.pairs or result.strong_pairs:
+        found = (result.pairs or ()) + result.strong_pairs
+        n = len(found)
+        named = "; ".join(f"{w.part_a} & {w.part_b}" for w in found[:5])
         more = f" and {n - 5} more" if n > 5 else ""
+        under = (
+            ""
+            if unc.is_ideal
+            else f" (of them {len(result.strong_pairs)} only under the rotation error "
+            f"±{unc.rotation_error_deg:g} deg)"
+        )
         raise CheckFailed(
             f"{plural(n, 'pair')} of {'landings' if over_landings else 'parts'} no plan can tell "
-            f"apart with this sensor: {named}{more}; " + _advice({w.kind for w in result.pairs})
+            f"apart with this sensor{under}: {named}{more}; " + _advice({w.kind for w in found})
         )
 
 
 def _advice(kinds: set[str]) -> str:
     """What helps, by the witnesses' kinds: no sensor separates parts with the same
-    push-diameter function (Lemma 8), a finer one may separate the others."""
+    push-diameter function (Lemma 8), a finer one may separate the others; a pair told apart
+    only on the ideal model needs a smaller rotation error (or a finer sensor)."""
+    if "uncertainty" in kinds:
+        rest = _advice(kinds - {"uncertainty"}) if kinds - {"uncertainty"} else None
+        told = "the pairs told apart only on the ideal model need a smaller rotation error"
+        return told if rest is None else f"{rest}; {told}"
     if kinds == {"same-push-diameter"}:
         return "keep them out of one mix: no sensor tells them apart (same push-diameter function)"
     if "same-push-diameter" in kinds:
@@ -160,11 +190,14 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
     # Over landings each member is a part face up or face down (or a mesh pose).
     summary.add_row("landings" if over_landings else "parts", str(c["parts"]))
     summary.add_row("sensor", sensor_text(result.sensor))
+    unc = result.uncertainty
     summary.add_row(
         "declared uncertainty",
         "none: the ideal model (exact rotations and diameters, section 8); under a rotation "
-        "error plans may tell fewer pairs apart (feederkit plan and changeover compile decide "
-        "those)",
+        "error plans may tell fewer pairs apart (--rotation-error DEG checks the pairs again)"
+        if unc.is_ideal
+        else f"the ideal model (section 8), then each candidate pair it tells apart again for "
+        f"strong plans under a rotation error of ±{unc.rotation_error_deg:g} deg",
     )
     summary.add_row(
         "tolerances",
@@ -193,6 +226,12 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
             "unrecognizable pairs",
             f"{c['unrecognizable_pairs']} (exact test on {c['candidate_pairs']} candidate pairs)",
         )
+    if not unc.is_ideal and result.pairs is not None:
+        summary.add_row(
+            "apart only on the ideal model",
+            f"{len(result.strong_pairs)}"
+            + (f" ({result.undecided} undecided: too many sets)" if result.undecided else ""),
+        )
     console.print(summary)
     for title, classes in (
         ("parts with the same push function", result.shared_push),
@@ -212,14 +251,27 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
         console.print(t)
     if result.pairs:
         console.print(_pairs_table(result.pairs, pfs))
-    elif result.pairs is not None and not isinstance(result.sensor, NoSensor):
+    if result.strong_pairs:
+        console.print(
+            _pairs_table(
+                result.strong_pairs,
+                pfs,
+                "pairs told apart only on the ideal model: no strong plan tells them apart "
+                f"under a rotation error of ±{unc.rotation_error_deg:g} deg",
+            )
+        )
+    if not result.pairs and result.pairs is not None and not isinstance(result.sensor, NoSensor):
         console.print(
             "every pair of parts can be told apart by some plan on the ideal model (Theorem 11)"
         )
 
 
-def _pairs_table(pairs: tuple[PairWitness, ...], pfs: list[PushFunction]) -> Table:
-    t = Table(title="pairs no plan can tell apart (section 8.4)")
+def _pairs_table(
+    pairs: tuple[PairWitness, ...],
+    pfs: list[PushFunction],
+    title: str = "pairs no plan can tell apart (section 8.4)",
+) -> Table:
+    t = Table(title=title)
     add_name_column(t, "part A")
     add_name_column(t, "part B")
     t.add_column("inseparable states (A ~ B: edge, diameter mm)")

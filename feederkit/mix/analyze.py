@@ -8,15 +8,17 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
+from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
+from feederkit.mix.strongpairs import UNDECIDED, strong_pair_witness
 from feederkit.sensors import Sensor
-from feederkit.uncertainty import IDEAL
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 
 @dataclass(frozen=True)
@@ -26,7 +28,8 @@ class MixAnalysis:
     ``pairs`` is None without a sensor (every pair is unrecognizable). ``candidates`` is how
     many pairs the cheap tests (diameters and landing profiles,
     :func:`~feederkit.mix.pairs.candidate_pairs`) left for the exact fixpoint. ``seconds``
-    times each stage.
+    times each stage. Under a rotation error the candidates told apart are checked again for
+    strong plans (``strong_pairs``): section 8's test is the ideal model's.
     """
 
     names: tuple[str, ...]
@@ -38,6 +41,13 @@ class MixAnalysis:
     pairs: tuple[PairWitness, ...] | None
     candidates: int
     seconds: dict[str, float] = field(default_factory=dict)
+    uncertainty: Uncertainty = IDEAL
+    """The rotation error the candidate pairs were checked under besides the ideal model."""
+    strong_pairs: tuple[PairWitness, ...] = ()
+    """Pairs told apart on the ideal model that no strong plan tells apart under
+    ``uncertainty`` (:func:`~feederkit.mix.strongpairs.strong_pair_witness`)."""
+    undecided: int = 0
+    """Candidate pairs whose check under ``uncertainty`` ran out of sets."""
 
     @property
     def shared_push(self) -> list[BehaviourClass]:
@@ -62,6 +72,8 @@ class MixAnalysis:
             ),
             "candidate_pairs": self.candidates,
             "unrecognizable_pairs": n * (n - 1) // 2 if self.pairs is None else len(self.pairs),
+            "apart_only_on_the_ideal_model": len(self.strong_pairs),
+            "undecided_pairs": self.undecided,
         }
 
     def to_dict(self) -> dict[str, Any]:
@@ -75,14 +87,16 @@ class MixAnalysis:
 
         return {
             "sensor": self.sensor.to_dict(),
-            # The exact analysis of section 8 is the ideal model's: say so (design.md).
-            "uncertainty": IDEAL.to_dict(),
+            # The exact analysis of section 8 is the ideal model's; the pairs checked again
+            # under a rotation error say which (design.md).
+            "uncertainty": self.uncertainty.to_dict(),
             "tolerances": {"angle_deg": self.angle_tol_deg, "diameter_mm": self.length_tol_mm},
             "counts": self.counts(),
             "push_classes": [cls(c) for c in self.shared_push],
             "push_diameter_classes": [cls(c) for c in self.shared_push_diameter],
             "all_pairs_unrecognizable": self.pairs is None and len(self.names) > 1,
             "unrecognizable_pairs": [] if self.pairs is None else [w.to_dict() for w in self.pairs],
+            "apart_only_on_the_ideal_model": [w.to_dict() for w in self.strong_pairs],
         }
 
 
@@ -92,8 +106,17 @@ def analyze_mix(
     *,
     angle_tol: float = ANGLE_TOL_DEG,
     length_tol: float = LENGTH_TOL_MM,
+    uncertainty: Uncertainty | None = None,
 ) -> MixAnalysis:
-    """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs."""
+    """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs; with
+    a rotation error (``uncertainty``, shape and COM tolerances zero: the candidates are the
+    readings' pairs), also the candidate pairs only the ideal model tells apart."""
+    unc = IDEAL if uncertainty is None else uncertainty
+    if unc.shape_tolerance_mm or unc.com_tolerance_mm:
+        raise InputError(
+            "the catalog analysis takes a rotation error only (its candidate pairs are "
+            "those whose diameters can read alike)"
+        )
     t0 = time.perf_counter()
     sigs = [signature(pf) for pf in pfs]
     t1 = time.perf_counter()
@@ -107,6 +130,18 @@ def analyze_mix(
         cand = len(todo)
         pairs = tuple(unrecognizable_pairs(pfs, sensor, todo, signatures=sigs))
     t3 = time.perf_counter()
+    strong: list[PairWitness] = []
+    undecided = 0
+    if pairs is not None and not unc.is_ideal:
+        confused = {(w.index_a, w.index_b) for w in pairs}
+        for i, j in todo:
+            if (i, j) in confused:
+                continue
+            w = strong_pair_witness(pfs[i], pfs[j], sensor, unc)
+            if w == UNDECIDED:
+                undecided += 1
+            elif isinstance(w, PairWitness):
+                strong.append(replace(w, index_a=i, index_b=j))
     return MixAnalysis(
         names=tuple(pf.part.name for pf in pfs),
         sensor=sensor,
@@ -116,5 +151,13 @@ def analyze_mix(
         push_diameter_classes=tuple(pdc),
         pairs=pairs,
         candidates=cand,
-        seconds={"signatures": t1 - t0, "classes": t2 - t1, "pairs": t3 - t2},
+        seconds={
+            "signatures": t1 - t0,
+            "classes": t2 - t1,
+            "pairs": t3 - t2,
+            "strong_pairs": time.perf_counter() - t3,
+        },
+        uncertainty=unc,
+        strong_pairs=tuple(strong),
+        undecided=undecided,
     )

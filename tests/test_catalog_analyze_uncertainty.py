@@ -1,0 +1,87 @@
+"""``catalog analyze --rotation-error``: the pairs section 8 tells apart on the ideal model
+that no strong plan tells apart under a rotation error, decided per pair as ``changeover
+compile`` decides a mix (feederkit.mix.strongpairs)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from shared import no_stray_profile  # noqa: F401 (autouse)
+
+from feederkit.cli.app import main
+from feederkit.cli.catalog_analyze import _advice
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+
+
+def run(capsys, *args: str) -> tuple[int, str, str]:
+    rc = main(list(args))
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+@pytest.fixture()
+def db(tmp_path, capsys) -> str:
+    """The L bracket, a copy of it 0.05 mm longer (a near-duplicate), and the T clip."""
+    path = str(tmp_path / "c.db")
+    bracket = json.loads((CATALOG / "l-bracket.json").read_text())
+    near = {**bracket, "name": "l-bracket-near"}
+    near["vertices"] = [[x + 0.05 if x > 30 else x, y] for x, y in bracket["vertices"]]
+    (tmp_path / "near.json").write_text(json.dumps(near))
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    for source in (CATALOG / "l-bracket.json", tmp_path / "near.json", CATALOG / "t-clip.json"):
+        assert run(capsys, "catalog", "add", str(source), "--catalog", path)[0] == 0
+    return path
+
+
+def test_a_near_duplicate_is_apart_only_on_the_ideal_model(db, capsys):
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--json", "--catalog", db)
+    rc, out, _ = run(capsys, *args)
+    ideal = json.loads(out)
+    assert rc == 0 and ideal["unrecognizable_pairs"] == []
+    assert ideal["apart_only_on_the_ideal_model"] == []
+    assert ideal["uncertainty"]["rotation_error_deg"] == 0.0
+    rc, out, err = run(capsys, *args, "--rotation-error", "1")
+    data = json.loads(out)
+    assert rc == 1 and "only under the rotation error ±1 deg" in err
+    found = {(w["part_a"], w["part_b"]) for w in data["apart_only_on_the_ideal_model"]}
+    assert found == {
+        ("l-bracket/up", "l-bracket-near/up"),
+        ("l-bracket/down", "l-bracket-near/down"),
+    }
+    assert data["uncertainty"]["rotation_error_deg"] == 1.0
+    assert data["counts"]["apart_only_on_the_ideal_model"] == 2
+
+
+def test_compile_agrees_pair_by_pair(db, capsys):
+    """What the analysis lists, compile reports for the pair; what it clears, compile plans."""
+    base = ("changeover", "compile")
+    rc, out, _ = run(
+        capsys, *base, "near", "--mix", "l-bracket,l-bracket-near", "--tolerance", "0.5",
+        "--json", "--catalog", db,
+    )  # fmt: skip
+    assert rc == 1
+    pairs = {(w["part_a"], w["part_b"]) for w in json.loads(out)["unrecognizable_pairs"]}
+    assert ("l-bracket/up", "l-bracket-near/up") in pairs
+    rc, _, _ = run(
+        capsys, *base, "far", "--mix", "l-bracket,t-clip", "--tolerance", "0.5", "--catalog", db
+    )
+    assert rc == 0
+
+
+def test_shape_tolerance_is_refused_by_the_library():
+    from feederkit.errors import InputError
+    from feederkit.mix.analyze import analyze_mix
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    with pytest.raises(InputError, match="rotation error only"):
+        analyze_mix([], ToleranceSensor(0.5), uncertainty=Uncertainty(1.0, 0.01))
+
+
+def test_the_advice_names_the_rotation_error():
+    assert "smaller rotation error" in _advice({"uncertainty"})
+    both = _advice({"uncertainty", "tolerance"})
+    assert both.startswith("keep them out of one mix or use a finer sensor;")
