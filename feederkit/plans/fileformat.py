@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from feederkit.errors import InputError, PlanningError
+from feederkit.hull import Point
 from feederkit.jsonio import parse_json, write_text_atomic
 from feederkit.machine.model import members
 from feederkit.mechanics.push import PushFunction, StableState
@@ -743,6 +744,67 @@ def _check_landing(c: _Checker, value: object, where: str) -> str | None:
     return value
 
 
+def _check_hull(c: _Checker, raw: object, where: str) -> tuple[Point, ...]:
+    """A part's ``hull`` exactly as design.md fixes it ("Conventions"): at least three
+    vertices, counter-clockwise, strictly convex, vertex 0 the lowest-then-leftmost.
+
+    A controller takes edge i to join vertex i to vertex i + 1 of the file; feederkit
+    rebuilds the part from the same list, so the two agree only when the list is already
+    that hull, vertex for vertex (:func:`_hull_problem`).
+    """
+    hull = tuple(c.pair(v, f"{where} hull vertex") for v in c.lst(raw, f"{where} hull"))
+    if len(hull) < 3:
+        raise c.fail(f"{where} hull has fewer than three vertices")
+    twice_area = sum(
+        a[0] * b[1] - b[0] * a[1] for a, b in zip(hull, hull[1:] + hull[:1], strict=True)
+    )
+    if not math.isfinite(twice_area):
+        raise c.fail(f"{where} hull is too large to compute with")
+    if not twice_area > 0.0:  # design.md: counter-clockwise, so edges and normals agree
+        raise c.fail(f"{where} hull is not counter-clockwise (its signed area is not positive)")
+    problem = _hull_problem(hull)
+    if problem is not None:
+        raise c.fail(f"{where} hull: {problem} (design.md, Conventions)")
+    return hull
+
+
+def _hull_problem(hull: Sequence[Point]) -> str | None:
+    """Why a counter-clockwise ring is not a strictly convex hull numbered from its
+    lowest-then-leftmost vertex, in words; None when it is one.
+
+    Exact, with no length tolerance, as the writer's hull is (:func:`feederkit.hull.
+    contact_hull`: at ``--hull-tolerance 0`` it keeps every vertex that turns left at all,
+    even 1e-14 mm off its neighbours' line, and such a plan is right), and with the turn
+    computed as its :func:`~feederkit.hull.convex_hull` computes it: every plan feederkit
+    writes passes.
+    """
+    n = len(hull)
+    for i in range(n):
+        if hull[i] == hull[(i + 1) % n]:
+            return f"vertex {(i + 1) % n} {_point(hull[i])} repeats vertex {i}"
+    for i in range(n):
+        a, b, d = hull[i - 1], hull[i], hull[(i + 1) % n]
+        cross = (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0])
+        if cross <= 0.0:
+            chord = math.hypot(d[0] - a[0], d[1] - a[1])
+            side = "on" if cross == 0.0 or chord == 0.0 else f"{-cross / chord:.3g} mm inside"
+            return (
+                f"vertex {i} {_point(b)} is no corner: it lies {side} the line of vertices "
+                f"{(i - 1) % n} and {(i + 1) % n}"
+            )
+    low = min(range(n), key=lambda i: (hull[i][1], hull[i][0]))
+    if low != 0:
+        return (
+            f"vertex 0 {_point(hull[0])} is not the lowest-then-leftmost vertex; vertex {low} "
+            f"{_point(hull[low])} is, and edge i joins vertex i to vertex i + 1 counted from it"
+        )
+    return None
+
+
+def _point(p: Point) -> str:
+    return f"({p[0]:g}, {p[1]:g})"
+
+
 def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     d = c.obj(raw, f"part {index}")
     name = c.str_(c.key(d, "name", f"part {index}"), f"part {index} name")
@@ -757,14 +819,7 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     if rev is not None and (isinstance(rev, bool) or not isinstance(rev, str | int)):
         raise c.fail(f"{where} 'revision' must be a string, an integer or null")
     com = c.pair(c.key(d, "com", where), f"{where} com")
-    hull = tuple(c.pair(v, f"{where} hull vertex") for v in c.lst(c.key(d, "hull", where), where))
-    if len(hull) < 3:
-        raise c.fail(f"{where} hull has fewer than three vertices")
-    twice_area = sum(
-        a[0] * b[1] - b[0] * a[1] for a, b in zip(hull, hull[1:] + hull[:1], strict=True)
-    )
-    if not twice_area > 0.0:  # design.md: counter-clockwise, so edges and normals agree
-        raise c.fail(f"{where} hull is not counter-clockwise (its signed area is not positive)")
+    hull = _check_hull(c, c.key(d, "hull", where), where)
     raw_states = c.lst(c.key(d, "stable_states", where), f"{where} stable_states")
     if not raw_states:
         raise c.fail(f"{where} has no stable states")
@@ -789,9 +844,11 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
         states.append(StableState(sid, edge, normal, (lo, hi), diameter, pose))
     part = PlanPart(name, rev, com, hull, tuple(states), landing, share)
     try:
-        push_function_of(part)  # the hull and COM must make a part (cached for later use)
+        rebuilt = push_function_of(part).part.hull  # cached for later use
     except InputError as exc:
         raise c.fail(f"{where}: {exc}") from None
+    if rebuilt != hull:  # the guarantee _check_hull's rules give, stated directly
+        raise c.fail(f"{where} hull is not the convex hull of its vertices, numbered from 0")
     return part
 
 

@@ -1,0 +1,235 @@
+"""The plan file's contract with the robot controller (design.md, "Plan file"), as the loader
+(``plan_from_dict``) enforces it: a file that breaks it is refused with one line (exit 2),
+and every plan feederkit itself writes still loads.
+
+Each refusal test loads a plan ``feederkit plan`` wrote, edits one thing, and checks the
+message; without the rule the edited file loads (the reviewer's cases exited 0).
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import trimesh
+from shared import no_stray_profile, one_line_error  # noqa: F401 (an autouse fixture)
+
+from feederkit.cli.app import main
+from feederkit.errors import InputError
+from feederkit.plans.fileformat import plan_from_dict, read_plan
+
+ROOT = Path(__file__).resolve().parents[1]
+CATALOG = ROOT / "catalog"
+
+Edit = Callable[[dict[str, Any]], object]
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """The reviewer's plan: the l-bracket over its two landings, an LED array (0.5 mm
+    pitch, 0.1 mm noise)."""
+    out = tmp_path_factory.mktemp("plan") / "F.json"
+    args = ["plan", str(CATALOG / "l-bracket.json"), "--led-pitch", "0.5", "--noise", "0.1"]
+    assert main([*args, "-o", str(out)]) == 0
+    return json.loads(out.read_text(encoding="utf-8"))
+
+
+def edited(plan: dict[str, Any], edit: Edit) -> dict[str, Any]:
+    """A deep copy of ``plan`` with ``edit`` applied."""
+    out = copy.deepcopy(plan)
+    edit(out)
+    return out
+
+
+def refused(plan: dict[str, Any], edit: Edit) -> str:
+    """The one-line message the loader refuses the edited plan with."""
+    bad = edited(plan, edit)
+    with pytest.raises(InputError) as err:
+        plan_from_dict(bad, "F.json")
+    message = str(err.value)
+    assert message.startswith("F.json: ") and "\n" not in message
+    return message
+
+
+def part0(d: dict[str, Any]) -> dict[str, Any]:
+    return d["parts"][0]
+
+
+def test_the_written_plan_loads(written: dict[str, Any]) -> None:
+    assert plan_from_dict(written).parts[0].hull == tuple(map(tuple, part0(written)["hull"]))
+
+
+# ---------------------------------------------------------------- the hull (design.md, Conventions)
+
+
+def _rotate(d: dict[str, Any]) -> None:
+    hull = part0(d)["hull"]
+    part0(d)["hull"] = hull[1:] + hull[:1]
+
+
+def test_a_hull_not_numbered_from_its_lowest_then_leftmost_vertex_is_refused(written) -> None:
+    message = refused(written, _rotate)
+    assert "part 'l-bracket (up)' hull: vertex 0 (60, 0)" in message
+    assert "not the lowest-then-leftmost vertex; vertex 4 (0, 0) is" in message
+
+
+def test_a_reflex_vertex_is_refused(written) -> None:
+    message = refused(written, lambda d: part0(d)["hull"].insert(2, [40.0, 10.0]))
+    assert "vertex 2 (40, 10) is no corner: it lies 20 mm inside the line of vertices 1 and 3" in (
+        message
+    )
+
+
+@pytest.mark.parametrize(("off", "side"), [(0.0, "on"), (1e-13, "1e-13 mm inside")])
+def test_a_vertex_on_or_inside_an_edge_is_refused(written, off: float, side: str) -> None:
+    """Edge 0 runs from (0, 0) to (60, 0); the part lies above it."""
+    message = refused(written, lambda d: part0(d)["hull"].insert(1, [30.0, off]))
+    words = f"vertex 1 (30, {off:g}) is no corner: it lies {side} the line of vertices 0 and 2"
+    assert words in message
+
+
+@pytest.mark.parametrize(
+    ("copy_of", "words"),
+    [
+        ([60.0, 15.0], "vertex 3 (60, 15) repeats vertex 2"),
+        ([60.0, 15.000000000001], "vertex 2 (60, 15) is no corner: it lies on the line"),
+    ],
+)
+def test_a_duplicate_vertex_is_refused(written, copy_of: list[float], words: str) -> None:
+    assert words in refused(written, lambda d: part0(d)["hull"].insert(2, copy_of))
+
+
+def test_a_vertex_a_hair_outside_is_a_hull_the_verifier_judges(written) -> None:
+    """The rule is exact, as the writer's hull is: a vertex 1e-13 mm outside edge 0 makes a
+    strictly convex hull that feederkit and a controller number alike. It is not this
+    plan's hull, so verification fails the plan (exit 1), naming the state."""
+    from feederkit.plans.verify import verify_declared
+
+    def hair(d: dict[str, Any]) -> None:
+        hull = part0(d)["hull"]  # the new vertex is the lowest: vertex 0
+        part0(d)["hull"] = [[30.0, -1e-13], *hull[1:], hull[0]]
+
+    plan = plan_from_dict(edited(written, hair))
+    report = verify_declared(plan)
+    assert not report.ok and "its hull and COM give edge 1" in report.first_problem()
+
+
+def test_a_plan_written_at_hull_tolerance_0_loads(tmp_path: Path) -> None:
+    """Why the hull rule has no length tolerance: at ``--hull-tolerance 0`` the writer keeps
+    a vertex 1e-14 mm off the line of its neighbours (an outline edge split at a point off
+    it by rounding), and the plan is right; any positive tolerance would refuse it."""
+    outline = tmp_path / "split.json"
+    ring = [[0, 0], [7, -1e-14], [20, 0], [40, 0], [40, 20], [0, 20]]
+    outline.write_text(json.dumps({"name": "split", "units": "mm", "vertices": ring}))
+    path = tmp_path / "split.plan.json"
+    args = ["plan", str(outline), "--tolerance", "0.5", "--hull-tolerance", "0", "-o", str(path)]
+    assert main(args) in (0, 1)  # 1: its two sides cannot be told apart
+    plan = read_plan(path)
+    assert plan.parts[0].hull[0] == (7.0, -1e-14)
+    assert main(["run", str(path), "--all"]) == 0
+
+
+def test_a_hull_breaking_the_contract_exits_2_from_run(written, tmp_path, capsys) -> None:
+    path = tmp_path / "F.json"
+    path.write_text(json.dumps(edited(written, _rotate)), encoding="utf-8")
+    err = one_line_error(capsys, ["run", str(path), "--all"])
+    assert "lowest-then-leftmost" in err and "l-bracket (up)" in err
+
+
+# ---------------------------------------------------------------- every plan feederkit writes loads
+
+
+GOLDEN = sorted(
+    p
+    for p in (ROOT / "tests").rglob("*.json")
+    if '"feederkit-plan"' in p.read_text(encoding="utf-8")[:200]
+)
+
+
+@pytest.mark.parametrize("path", GOLDEN, ids=lambda p: str(p.relative_to(ROOT / "tests")))
+def test_every_stored_plan_loads(path: Path) -> None:
+    read_plan(path)
+
+
+L_RING = [(0, 0), (40, 0), (40, 10), (10, 10), (10, 25), (0, 25)]
+
+
+@pytest.fixture(scope="module")
+def plans_written(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    """Plans the commands write: ``plan`` for every catalog part (sensorless and with an
+    LED array), a DXF plate with arcs (a simplified hull), a box and an L prism as meshes
+    (their resting poses), ``changeover compile`` over a catalog and ``demo``."""
+    import fixtures_cad as fx
+
+    tmp = tmp_path_factory.mktemp("written")
+    out: list[Path] = []
+
+    def plan(name: str, *args: str) -> None:
+        path = tmp / f"{name}.plan.json"
+        assert main(["plan", *args, "-o", str(path)]) in (0, 1)
+        out.append(path)
+
+    for src in sorted(CATALOG.glob("*.json")):
+        plan(src.stem, str(src))
+        plan(f"{src.stem}-led", str(src), "--led-pitch", "0.5", "--noise", "0.1")
+    plate = fx.write_plate(tmp / "plate.dxf")
+    plan("plate", str(plate), "--tolerance", "0.5")
+    box = tmp / "box.stl"
+    trimesh.creation.box((10.0, 20.0, 30.0)).export(box)
+    plan("box", str(box), "--tolerance", "0.5")
+    ell = fx.write_mesh(fx.prism(L_RING, 3.0), tmp / "ell.stl")
+    plan("ell", str(ell), "--tolerance", "0.5")
+
+    db = tmp / "parts.db"
+    assert main(["catalog", "init", "--catalog", str(db)]) == 0
+    assert main(["catalog", "import", str(CATALOG), "--catalog", str(db)]) in (0, 1)
+    mix = ["changeover", "compile", "mix", "--mix", "t-clip,l-bracket,isosceles-right-triangle"]
+    compiled = tmp / "mix.plan.json"
+    assert main([*mix, "--tolerance", "0.1", "-o", str(compiled), "--catalog", str(db)]) == 0
+    out.append(compiled)
+
+    parts = tmp / "few"
+    parts.mkdir()
+    for name in ("isosceles-right-triangle", "octagon", "quadrilateral", "rectangle-2x1"):
+        shutil.copy(CATALOG / f"{name}.json", parts)
+    demo = tmp / "demo"
+    assert main(["demo", "--catalog-dir", str(parts), "-o", str(demo), "--json"]) == 0
+    out += sorted(demo.rglob("*.json"))
+    return out
+
+
+def test_every_plan_the_commands_write_loads(plans_written: list[Path]) -> None:
+    names = {p.name for p in plans_written}
+    assert {"plate.plan.json", "box.plan.json", "ell.plan.json", "mix.plan.json"} <= names
+    loaded = 0
+    for path in plans_written:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if data.get("format") == "feederkit-plan":
+            plan_from_dict(data, str(path))
+            loaded += 1
+    assert loaded >= 25
+
+
+def test_a_hull_a_billionth_of_its_size_off_a_line_is_written_and_loads() -> None:
+    """The closest call the writer makes: a 2 x 1 rectangle whose bottom sags by 1e-8 mm
+    keeps a vertex 1.9e-9 mm off the line of its neighbours (below its own cleaning
+    tolerance, which measures against the original points), far above the loader's."""
+    import math
+
+    from feederkit.mechanics.push import push_function
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+    from feederkit.plans.make import make_plan
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    bottom = [(2.0 * i / 40, -1e-8 * math.sin(math.pi * i / 40)) for i in range(41)]
+    part = make_part(make_outline("bulge", [*bottom, (2.0, 1.0), (0.0, 1.0)]))
+    made = make_plan([push_function(part)], ToleranceSensor(0.1), uncertainty=Uncertainty(0.0))
+    assert len(made.plan["parts"][0]["hull"]) == 7
+    plan_from_dict(made.plan)
