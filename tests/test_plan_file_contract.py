@@ -233,3 +233,78 @@ def test_a_hull_a_billionth_of_its_size_off_a_line_is_written_and_loads() -> Non
     made = make_plan([push_function(part)], ToleranceSensor(0.1), uncertainty=Uncertainty(0.0))
     assert len(made.plan["parts"][0]["hull"]) == 7
     plan_from_dict(made.plan)
+
+
+# ---------------------------------------------------------------- numbers no part has
+
+
+def state0(d: dict[str, Any]) -> dict[str, Any]:
+    return part0(d)["stable_states"][0]
+
+
+def first_result(d: dict[str, Any]) -> dict[str, Any]:
+    """The first result node of the plan, the shared subplans' included."""
+    stack = [d["root"], *d.get("nodes", {}).values()]
+    while stack:
+        node = stack.pop(0)
+        if "result" in node:
+            return node
+        stack += [b["next"] for b in node.get("branches", [])]
+    raise AssertionError("the plan has no result")
+
+
+def test_a_diameter_wider_than_the_part_is_refused_and_report_says_so(
+    written, tmp_path, capsys
+) -> None:
+    """A hand-edited diameter of 1e308 made ``report`` fail with an overflow in the LED
+    counts; the part (60 x 40 mm) is at most 72.111 mm across."""
+    edit = lambda d: state0(d).update(diameter=1e308)  # noqa: E731
+    message = refused(written, edit)
+    assert "part 'l-bracket (up)' stable state 0 diameter 1e+308 mm is not in (0, 72.111]" in (
+        message
+    )
+    path = tmp_path / "F.json"
+    path.write_text(json.dumps(edited(written, edit)), encoding="utf-8")
+    err = one_line_error(capsys, ["report", str(path), "-o", str(tmp_path / "r.html")])
+    assert "stable state 0 diameter" in err and "too large" not in err
+
+
+def test_a_diameter_the_part_could_have_is_the_verifiers_question(written) -> None:
+    """A plan whose listed states disagree with its own hull and COM fails verification
+    (exit 1; ``report`` draws it under a red banner), as docs/plans.md says: the loader
+    refuses only numbers no part of that hull has."""
+    from feederkit.plans.verify import verify_declared
+
+    plan = plan_from_dict(edited(written, lambda d: state0(d).update(diameter=45.0)))
+    assert "diameter 45" in verify_declared(plan).first_problem()
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: state0(d).update(normal_deg=360.0), "stable state 0 normal_deg 360 is not"),
+        (lambda d: state0(d).update(pose_deg=-90.0), "stable state 0 pose_deg -90 is not"),
+        (lambda d: first_result(d)["result"][0].update(pose_deg=720.0), "pose_deg 720 is not"),
+    ],
+    ids=["normal", "pose", "result pose"],
+)
+def test_an_angle_outside_0_360_is_refused(written, edit: Edit, words: str) -> None:
+    message = refused(written, edit)
+    assert words in message and "in [0, 360)" in message
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: d["root"]["branches"][2].update(reading=[59.5, 1e308]), "[59.5, 1e+308]"),
+        (lambda d: d["sensor"].update(noise_mm=1e308), "sensor noise_mm 1e+308"),
+        (lambda d: d["sensor"].update(pitch_mm=5e-324), "pitch_mm 4.94066e-324"),
+        (lambda d: d["sensor"].update(noise_mm=0.0, pitch_mm=1e-300), "diameter 40 mm"),
+    ],
+    ids=["reading", "noise", "pitch", "pitch for a diameter"],
+)
+def test_an_led_width_of_more_than_2_53_beams_is_refused(written, edit: Edit, words: str) -> None:
+    """Beam counts of absurd widths overflowed (``run --all`` and ``report``, exit 2 with
+    'a number is too large to compute with')."""
+    message = refused(written, edit)
+    assert words in message and "more than 2**53 beams" in message

@@ -56,7 +56,7 @@ from feederkit.plans.model import (
     member_label,
     push_function_of,
 )
-from feederkit.sensors import Grouping, Sensor, sensor_from_dict
+from feederkit.sensors import Grouping, LedSensor, Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty, max_shape_tolerance
 from feederkit.words import plural
 
@@ -805,6 +805,44 @@ def _point(p: Point) -> str:
     return f"({p[0]:g}, {p[1]:g})"
 
 
+def _check_state(c: _Checker, raw: object, sw: str, hull: Sequence[Point]) -> StableState:
+    """One listed stable state: its fields, and numbers that part of this hull can have.
+
+    Whether they are the states its hull and COM give is the verifier's question (a plan
+    that disagrees with its own geometry fails verification, exit 1, and ``report`` draws
+    it under a red banner). Refused here are numbers no part of this hull has, so that no
+    consumer computes with them: angles outside [0, 360) (design.md: pose is taken mod
+    360), a resting range not holding its normal, a diameter not positive or wider than the
+    hull's bounding box is across (a diameter of 1e308 overflowed the LED beam counts).
+    """
+    sd = c.obj(raw, sw)
+    sid = c.int_(c.key(sd, "id", sw), f"{sw} id")
+    edge = c.int_(c.key(sd, "edge", sw), f"{sw} edge")
+    if not 0 <= edge < len(hull):
+        raise c.fail(f"{sw} names edge {edge}, but the hull has {len(hull)} edges")
+    normal = _angle(c, c.key(sd, "normal_deg", sw), f"{sw} normal_deg")
+    lo, hi = c.pair(c.key(sd, "resting_range_deg", sw), f"{sw} resting_range_deg")
+    if not lo < normal < hi or hi - lo >= 360.0:
+        raise c.fail(f"{sw} resting range [{lo}, {hi}] does not hold its normal {normal}")
+    diameter = c.num(c.key(sd, "diameter", sw), f"{sw} diameter")
+    across = math.hypot(*(max(v[k] for v in hull) - min(v[k] for v in hull) for k in (0, 1)))
+    if not 0.0 < diameter <= across * (1.0 + 1e-9):
+        raise c.fail(
+            f"{sw} diameter {diameter:g} mm is not in (0, {across:.6g}]: no width of the part "
+            "is more than its hull's bounding box is across"
+        )
+    pose = _angle(c, c.key(sd, "pose_deg", sw), f"{sw} pose_deg")
+    return StableState(sid, edge, normal, (lo, hi), diameter, pose)
+
+
+def _angle(c: _Checker, value: object, what: str) -> float:
+    """A direction in degrees, in [0, 360) as the writer gives it (design.md: mod 360)."""
+    a = c.num(value, what)
+    if not 0.0 <= a < 360.0:
+        raise c.fail(f"{what} {a:g} is not in [0, 360)")
+    return a
+
+
 def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     d = c.obj(raw, f"part {index}")
     name = c.str_(c.key(d, "name", f"part {index}"), f"part {index} name")
@@ -825,23 +863,10 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
         raise c.fail(f"{where} has no stable states")
     states: list[StableState] = []
     for k, s in enumerate(raw_states):
-        sw = f"{where} stable state {k}"
-        sd = c.obj(s, sw)
-        sid = c.int_(c.key(sd, "id", sw), f"{sw} id")
-        if any(t.id == sid for t in states):
-            raise c.fail(f"{where} lists stable state {sid} twice")
-        edge = c.int_(c.key(sd, "edge", sw), f"{sw} edge")
-        if not 0 <= edge < len(hull):
-            raise c.fail(f"{sw} names edge {edge}, but the hull has {len(hull)} edges")
-        normal = c.num(c.key(sd, "normal_deg", sw), f"{sw} normal_deg")
-        lo, hi = c.pair(c.key(sd, "resting_range_deg", sw), f"{sw} resting_range_deg")
-        if not lo < normal < hi or hi - lo >= 360.0:
-            raise c.fail(f"{sw} resting range [{lo}, {hi}] does not hold its normal {normal}")
-        diameter = c.num(c.key(sd, "diameter", sw), f"{sw} diameter")
-        if diameter <= 0.0:
-            raise c.fail(f"{sw} diameter must be positive")
-        pose = c.num(c.key(sd, "pose_deg", sw), f"{sw} pose_deg")
-        states.append(StableState(sid, edge, normal, (lo, hi), diameter, pose))
+        state = _check_state(c, s, f"{where} stable state {k}", hull)
+        if any(t.id == state.id for t in states):
+            raise c.fail(f"{where} lists stable state {state.id} twice")
+        states.append(state)
     part = PlanPart(name, rev, com, hull, tuple(states), landing, share)
     try:
         rebuilt = push_function_of(part).part.hull  # cached for later use
@@ -894,7 +919,7 @@ def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) 
         sid = c.int_(c.key(ed, "state", f"{where} result entry"), f"{where} result state")
         if sid not in known.ids[(part, landing)]:
             raise c.fail(f"{where} names state {sid}, which part {member.label!r} does not list")
-        pose = c.num(c.key(ed, "pose_deg", f"{where} result entry"), f"{where} result pose_deg")
+        pose = _angle(c, c.key(ed, "pose_deg", f"{where} result entry"), f"{where} result pose_deg")
         out.append(ResultEntry(part, sid, pose, landing))
     return Leaf(tuple(out), reject)
 
@@ -1047,6 +1072,39 @@ def _check_step_fields(
     return action, margin, out
 
 
+MAX_BEAMS = 2**53
+"""An LED array's reading is a whole number of beams; a float counts them exactly below
+this, and a width this many pitches wide is no reading (x / pitch may even overflow)."""
+
+
+def _check_beams(c: _Checker, plan: Plan) -> None:
+    """With an LED array, every width the consumers turn into beam counts is a countable
+    number of pitches: the noise, each state's diameter plus the noise, each reading bound.
+    A hand-edited 1e308 (or a pitch of 5e-324) made them crash with an overflow."""
+    sensor = plan.sensor
+    if not isinstance(sensor, LedSensor):
+        return
+    if not sensor.noise / sensor.pitch < MAX_BEAMS:
+        raise c.fail(
+            f"sensor noise_mm {sensor.noise:g} is more than 2**53 beams of its pitch_mm "
+            f"{sensor.pitch:g}"
+        )
+    for part in plan.parts:
+        for k, s in enumerate(part.states):
+            if not (s.diameter + sensor.noise) / sensor.pitch < MAX_BEAMS:
+                raise c.fail(
+                    f"part {part.label!r} stable state {k} diameter {s.diameter:g} mm is more "
+                    f"than 2**53 beams of the LED array's pitch {sensor.pitch:g} mm"
+                )
+    for node, number in plan.walk():
+        for b in node.branches if isinstance(node, Step) else ():
+            if b.reading is not None and not max(map(abs, b.reading)) / sensor.pitch < MAX_BEAMS:
+                raise c.fail(
+                    f"a reading of operation {number}, [{b.reading[0]:g}, {b.reading[1]:g}], "
+                    f"is more than 2**53 beams of the LED array's pitch {sensor.pitch:g} mm"
+                )
+
+
 def _check_stats(c: _Checker, raw: object, plan: Plan) -> PlanStats:
     """The ``stats`` object, checked against the tree it describes."""
     d = c.obj(raw, "'stats'")
@@ -1165,6 +1223,7 @@ def plan_from_dict(data: object, source: str = "plan", max_depth: int = MAX_PLAN
         uncertainty=unc,
         uncertainty_declared=declared,
     )
+    _check_beams(c, draft)
     stats = _check_stats(c, c.key(data, "stats", "the plan"), draft)
     return replace(draft, stats=stats)
 
