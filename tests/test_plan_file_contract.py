@@ -308,3 +308,90 @@ def test_an_led_width_of_more_than_2_53_beams_is_refused(written, edit: Edit, wo
     'a number is too large to compute with')."""
     message = refused(written, edit)
     assert words in message and "more than 2**53 beams" in message
+
+
+# ---------------------------------------------------------------- the grammar (design.md)
+
+
+def test_a_result_that_is_also_an_operation_is_refused(written) -> None:
+    def both(d: dict[str, Any]) -> None:
+        first_result(d).update(action_deg=90.0, margin_deg=1.0, branches=[])
+
+    message = refused(written, both)
+    assert "has 'action_deg', but a result has only 'result', 'reject'" in message
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (lambda d: d["root"].update(reject=False), "the root has 'reject', but an operation"),
+        (lambda d: d["root"]["branches"][0].update(note="x"), "branch 0 has 'note', but a branch"),
+        (
+            lambda d: first_result(d)["result"][0].update(edge=0),
+            "result entry has 'edge', but an entry has only 'part', 'landing', 'state'",
+        ),
+    ],
+    ids=["operation", "branch", "result entry"],
+)
+def test_a_key_outside_a_nodes_form_is_refused(written, edit: Edit, words: str) -> None:
+    assert words in refused(written, edit)
+
+
+@pytest.mark.parametrize("value", [0, 9])
+def test_a_polygon_class_outside_1_8_is_refused(written, value: int) -> None:
+    message = refused(written, lambda d: d["stats"].update({"class": value}))
+    assert f"stats class {value} is not a polygon class 1-8" in message
+
+
+def test_an_unknown_objective_is_refused(written) -> None:
+    message = refused(written, lambda d: d["stats"].update(objective="fastest"))
+    assert "stats objective 'fastest' is not one of worst, expected, time, worst-time" in message
+
+
+def test_class_and_objective_may_be_null_or_any_of_design_mds(written) -> None:
+    """Null: a mix's plan has no class; the objectives are the planner's (``--objective``)."""
+    from feederkit.planning.options import Objective
+    from feederkit.plans.fileformat import OBJECTIVES
+
+    assert set(OBJECTIVES) == {o.value for o in Objective}
+    for objective in (None, *OBJECTIVES):
+        for value in (None, 1, 8):
+            plan = copy.deepcopy(written)
+            plan["stats"].update({"class": value, "objective": objective})
+            plan_from_dict(plan)
+
+
+def test_a_part_without_a_revision_is_refused_and_null_is_one(written) -> None:
+    message = refused(written, lambda d: part0(d).pop("revision"))
+    assert "part 'l-bracket (up)' has no 'revision' (null when the part has none)" in message
+    assert part0(written)["revision"] is None
+    plan_from_dict(written)
+
+
+@pytest.mark.parametrize(
+    ("sensor", "words"),
+    [
+        (
+            {"model": "led", "pitch_mm": 0.5, "noise_mm": 0.1, "tolerance_mm": 0.2},
+            "'sensor' has 'tolerance_mm', but the 'led' sensor has only 'model', 'pitch_mm'",
+        ),
+        ({"model": "none", "pitch_mm": 0.5}, "but the 'none' sensor has only 'model'"),
+    ],
+)
+def test_a_sensor_key_of_another_model_is_refused(written, sensor: dict, words: str) -> None:
+    assert words in refused(written, lambda d: d.update(sensor=sensor))
+
+
+def test_the_sensor_parameters_are_the_ones_the_models_write() -> None:
+    from feederkit.plans.fileformat import SENSOR_PARAMETERS
+    from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
+
+    for sensor in (NoSensor(), ToleranceSensor(0.1), LedSensor(0.5, 0.1)):
+        written_keys = sensor.to_dict()
+        assert set(written_keys) == {"model", *SENSOR_PARAMETERS[written_keys["model"]]}
+
+
+def test_a_version_1_file_still_loads() -> None:
+    """design.md: version-1 files stay readable (no declared uncertainty, no landings)."""
+    plan = read_plan(ROOT / "tests" / "golden" / "v1" / "equilateral-triangle.tolerance.json")
+    assert not plan.uncertainty_declared

@@ -645,6 +645,16 @@ class _Checker:
             raise self.fail(f"{where} has no {name!r}")
         return d[name]
 
+    def only(self, d: dict[str, Any], keys: tuple[str, ...], where: str, form: str) -> None:
+        """Refuse a key of ``d`` that design.md's grammar does not give ``form``: a node
+        that is both an operation and a result means two things to a controller."""
+        extra = next((k for k in d if k not in keys), None)
+        if extra is not None:
+            allowed = ", ".join(repr(k) for k in keys)
+            raise self.fail(
+                f"{where} has {extra!r}, but {form} has only {allowed} (design.md, Plan file)"
+            )
+
 
 def _shown(value: object) -> str:
     """A value in a message, clipped to one short line."""
@@ -652,9 +662,17 @@ def _shown(value: object) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
+SENSOR_PARAMETERS = {"none": (), "tolerance": ("tolerance_mm",), "led": ("pitch_mm", "noise_mm")}
+"""Each sensor model's parameters (design.md, "Cell profile" and "Plan file"): a key of
+another model (an LED array with a ``tolerance_mm``) would mean something to a reader."""
+
+
 def _check_sensor(c: _Checker, raw: object) -> Sensor:
     d = c.obj(raw, "'sensor'")
     model = c.str_(c.key(d, "model", "'sensor'"), "sensor model")
+    keys = SENSOR_PARAMETERS.get(model)
+    if keys is not None:  # an unknown model is sensor_from_dict's to refuse
+        c.only(d, ("model", *keys), "'sensor'", f"the {model!r} sensor")
     for name, value in d.items():
         if name != "model" and c.num(value, f"sensor {name}") < 0.0:
             raise c.fail(f"sensor {name} must not be negative, got {value!r}")
@@ -853,7 +871,9 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
         share = c.num(share, f"{where} share")
         if not 0.0 < share <= 1.0:
             raise c.fail(f"{where} share {share:g} is not in (0, 1]")
-    rev = d.get("revision")
+    if "revision" not in d:  # design.md lists it in every part; older writers wrote it too
+        raise c.fail(f"{where} has no 'revision' (null when the part has none)")
+    rev = d["revision"]
     if rev is not None and (isinstance(rev, bool) or not isinstance(rev, str | int)):
         raise c.fail(f"{where} 'revision' must be a string, an integer or null")
     com = c.pair(c.key(d, "com", where), f"{where} com")
@@ -892,6 +912,7 @@ class _Members:
 
 
 def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) -> Leaf:
+    c.only(node, ("result", "reject"), where, "a result")
     entries = c.lst(node["result"], f"{where} result")
     if not entries:
         raise c.fail(f"{where} has an empty result")
@@ -902,6 +923,7 @@ def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) 
     out = []
     for e in entries:
         ed = c.obj(e, f"{where} result entry")
+        c.only(ed, ("part", "landing", "state", "pose_deg"), f"{where} result entry", "an entry")
         part = c.key(ed, "part", f"{where} result entry")
         if not isinstance(part, str):
             raise c.fail(f"{where} result part must be a part's name, got {_shown(part)}")
@@ -1036,6 +1058,7 @@ def _check_tree(
 def _check_step_fields(
     c: _Checker, node: dict[str, Any], where: str, depth: int, sensorless: bool
 ) -> tuple[float | None, float | None, list[tuple[tuple[float, float] | None, object]]]:
+    c.only(node, ("action_deg", "margin_deg", "branches"), where, "an operation")
     action = c.key(node, "action_deg", where)
     margin = c.key(node, "margin_deg", where)
     if depth == 0:
@@ -1054,8 +1077,9 @@ def _check_step_fields(
     if sensorless and len(branches) != 1:
         raise c.fail(f"{where} branches on a reading, but the plan is sensorless")
     out: list[tuple[tuple[float, float] | None, object]] = []
-    for b in branches:
+    for k, b in enumerate(branches):
         bd = c.obj(b, f"{where} branch")
+        c.only(bd, ("reading", "next"), f"{where} branch {k}", "a branch")
         reading = c.key(bd, "reading", f"{where} branch")
         interval = None
         if sensorless and reading is not None:
@@ -1105,6 +1129,24 @@ def _check_beams(c: _Checker, plan: Plan) -> None:
                 )
 
 
+OBJECTIVES = ("worst", "expected", "time", "worst-time")
+"""The planner's objectives, as design.md's ``plan --objective`` names them."""
+
+POLYGON_CLASSES = range(1, 9)
+"""The polygon classes of Fig. 14 of the paper, 1-8 (design.md, ``part analyze``)."""
+
+
+def _check_class_and_objective(
+    c: _Checker, polygon_class: int | None, objective: str | None
+) -> None:
+    """``stats.class`` and ``stats.objective``, when given, within design.md's ranges (both
+    are feederkit's own fields, null or absent in a plan of a mix or a hand-made file)."""
+    if polygon_class is not None and polygon_class not in POLYGON_CLASSES:
+        raise c.fail(f"stats class {polygon_class} is not a polygon class 1-8 (Fig. 14)")
+    if objective is not None and objective not in OBJECTIVES:
+        raise c.fail(f"stats objective {objective!r} is not one of {', '.join(OBJECTIVES)}")
+
+
 def _check_stats(c: _Checker, raw: object, plan: Plan) -> PlanStats:
     """The ``stats`` object, checked against the tree it describes."""
     d = c.obj(raw, "'stats'")
@@ -1144,6 +1186,7 @@ def _check_stats(c: _Checker, raw: object, plan: Plan) -> PlanStats:
         if value is not None and (wrong or not isinstance(value, kind)):
             raise c.fail(f"stats {name} must be {kind.__name__} or null, got {_shown(value)}")
         extra[name] = value
+    _check_class_and_objective(c, extra["class"], extra["objective"])
     cert = d.get("certificate")
     certificate = None if cert is None else _check_certificate(c, cert, plan.uncertainty)
     return PlanStats(
@@ -1172,9 +1215,13 @@ def plan_from_dict(data: object, source: str = "plan", max_depth: int = MAX_PLAN
     and the certificate (at least the declared uncertainty), ranges (actions in
     [0, 360), margins in [0, 180), reading intervals lo <= hi), names (results name listed
     parts and states), the tree at most ``max_depth`` operations deep, and ``stats`` against
-    the tree (its length is the tree's depth, its smallest margin the tree's). Raises
-    InputError with one line naming ``source`` and the first problem found. Whether the plan
-    is right for its parts is :func:`feederkit.plans.verify.verify_plan`'s question.
+    the tree (its length is the tree's depth, its smallest margin the tree's). Also the
+    contract with a controller: each hull exactly design.md's (:func:`_check_hull`), no
+    number a part of it cannot have (:func:`_check_state`, :func:`_check_beams`), and
+    design.md's grammar (node forms, each sensor model's keys, a part's ``revision``,
+    ``stats`` class 1-8 and objective). Raises InputError with one line naming ``source``
+    and the first problem found. Whether the plan is right for its parts is
+    :func:`feederkit.plans.verify.verify_plan`'s question.
     """
     c = _Checker(source)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
