@@ -823,27 +823,27 @@ def _point(p: Point) -> str:
     return f"({p[0]:g}, {p[1]:g})"
 
 
-def _check_state(c: _Checker, raw: object, sw: str, hull: Sequence[Point]) -> StableState:
-    """One listed stable state: its fields, and numbers that part of this hull can have.
+def _check_state(c: _Checker, raw: object, sw: str, edges: int, across: float) -> StableState:
+    """One listed stable state of a hull of ``edges`` edges: its fields, and numbers its part
+    can have.
 
     Whether they are the states its hull and COM give is the verifier's question (a plan
     that disagrees with its own geometry fails verification, exit 1, and ``report`` draws
     it under a red banner). Refused here are numbers no part of this hull has, so that no
     consumer computes with them: angles outside [0, 360) (design.md: pose is taken mod
     360), a resting range not holding its normal, a diameter not positive or wider than the
-    hull's bounding box is across (a diameter of 1e308 overflowed the LED beam counts).
+    hull's bounding box is ``across`` (a diameter of 1e308 overflowed the LED beam counts).
     """
     sd = c.obj(raw, sw)
     sid = c.int_(c.key(sd, "id", sw), f"{sw} id")
     edge = c.int_(c.key(sd, "edge", sw), f"{sw} edge")
-    if not 0 <= edge < len(hull):
-        raise c.fail(f"{sw} names edge {edge}, but the hull has {len(hull)} edges")
+    if not 0 <= edge < edges:
+        raise c.fail(f"{sw} names edge {edge}, but the hull has {edges} edges")
     normal = _angle(c, c.key(sd, "normal_deg", sw), f"{sw} normal_deg")
     lo, hi = c.pair(c.key(sd, "resting_range_deg", sw), f"{sw} resting_range_deg")
     if not lo < normal < hi or hi - lo >= 360.0:
         raise c.fail(f"{sw} resting range [{lo}, {hi}] does not hold its normal {normal}")
     diameter = c.num(c.key(sd, "diameter", sw), f"{sw} diameter")
-    across = math.hypot(*(max(v[k] for v in hull) - min(v[k] for v in hull) for k in (0, 1)))
     if not 0.0 < diameter <= across * (1.0 + 1e-9):
         raise c.fail(
             f"{sw} diameter {diameter:g} mm is not in (0, {across:.6g}]: no width of the part "
@@ -881,9 +881,10 @@ def _check_part(c: _Checker, raw: object, index: int) -> PlanPart:
     raw_states = c.lst(c.key(d, "stable_states", where), f"{where} stable_states")
     if not raw_states:
         raise c.fail(f"{where} has no stable states")
+    across = math.hypot(*(max(v[k] for v in hull) - min(v[k] for v in hull) for k in (0, 1)))
     states: list[StableState] = []
     for k, s in enumerate(raw_states):
-        state = _check_state(c, s, f"{where} stable state {k}", hull)
+        state = _check_state(c, s, f"{where} stable state {k}", len(hull), across)
         if any(t.id == state.id for t in states):
             raise c.fail(f"{where} lists stable state {state.id} twice")
         states.append(state)
