@@ -144,3 +144,22 @@ def test_written_margins_hold_on_the_reference(chunk):
         for _ in range(12):
             poly, c = perturbed(hull, com, 0.0, 0.0, rng)
             assert not run_plan(made.plan, 0, poly, c, err, e, rng), (seed, err)
+
+
+def test_a_margin_the_rebuilt_readings_overstate_is_lowered_before_writing():
+    """At a critical tolerance the rebuilt model lets one more state read into a branch than
+    the planner's: the written margin is what the rotation keeps for it too, and holds."""
+    import numpy as np
+    from test_design_critical import random_pf as design_pf
+
+    from feederkit.design.strong import StrongMix, strong_mix_critical
+
+    rng = np.random.default_rng(10)
+    for k in range(3):
+        pfs = [design_pf(rng, f"a{k}"), design_pf(rng, f"b{k}")]
+    (pair,) = strong_mix_critical(StrongMix(pfs, Uncertainty(1.0))).pairs
+    made = make_plan(pfs, ToleranceSensor(pair.critical_tolerance), certify=False)
+    verify_strong(made.plan)  # every margin holds for every state that reaches its node
+    margins = [a["margin_deg"] for a in actions(made.plan)]
+    assert made.plan["stats"]["min_margin_deg"] == min(margins) == made.result.min_margin
+    assert any(abs(m - 32.5835) < 1e-3 for m in margins)  # lowered from 51.06 (state 1)

@@ -154,7 +154,12 @@ def _make_plan(
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
-        report = verify_strong(data)  # its paths and its margins
+        # Its paths and its margins: one a rebuilt reading lets one more state keep less
+        # is lowered to what that state keeps, so the file claims no more than holds.
+        report = verify_strong(data, tighten_margins=True)
+        written = data["stats"]["min_margin_deg"]
+        if written is not None and written < result.min_margin:
+            result = replace(result, min_margin=written)
     notes: list[str] = []
     if certify:
         output_s = _output_s(data)

@@ -183,9 +183,17 @@ class _Run:
     a memo.
     """
 
-    def __init__(self, plan: Mapping[str, Any], model: StrongModel, margins: bool = False) -> None:
+    def __init__(
+        self,
+        plan: Mapping[str, Any],
+        model: StrongModel,
+        margins: bool = False,
+        tighten: bool = False,
+    ) -> None:
         self.model = model
         self.margins = margins
+        self.tighten = tighten
+        self.lowered = 0  # margins lowered to what their rotation keeps (``tighten``)
         self.shared = plan.get("nodes") or {}
         self.by_name = {n: p for p, n in enumerate(model.members)}
         self._worst: dict[tuple[int, State], int] = {}
@@ -243,6 +251,12 @@ class _Run:
         if wide <= base:
             return
         keeps = max(max_rotation_error(mech, [s], a) - r, 0.0)
+        if self.tighten:
+            # A plan being made: its margin is what the rotation keeps for every state that
+            # reaches the node (a lower margin only eases the states checked before).
+            node["margin_deg"] = min(float(m), keeps)  # type: ignore[index]
+            self.lowered += 1
+            return
         raise CheckFailed(
             f"the margin ±{m:.6g}° of the rotation {a:.6g}° is more than it keeps "
             f"(±{keeps:.6g}° beyond the declared ±{r:g}°): with a rotation error of "
@@ -408,6 +422,7 @@ def verify_strong(
     *,
     vibration_mm: float | None = None,
     parts: Sequence[PushFunction] | None = None,
+    tighten_margins: bool = False,
 ) -> VerificationReport:
     """Execute every start, outcome and reading branch of ``plan`` on rebuilt mechanics.
 
@@ -416,11 +431,16 @@ def verify_strong(
     (node, state) as the paths are followed (``_Run._check_margin``). Returns the report (per
     part: starts, paths, the worst operations); raises CheckFailed with the first failing
     path or margin, or when the worst path's length differs from the stated one.
+    ``tighten_margins`` (a plan being made, not yet written): a margin larger than what its
+    rotation keeps for some state that reaches the node is lowered to that, in ``plan``
+    itself, with ``stats.min_margin_deg``. The planner's margin is over the states its model
+    puts at the node; at a reading interval's end (a tolerance at a critical value) the
+    rebuilt model may let one more state read into the branch.
     """
     model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
     # The margins are claims at the declared uncertainty (the ideal verifier follows them).
     margins = uncertainty is None and not declared_uncertainty(plan).is_ideal
-    run = _Run(plan, model, margins)
+    run = _Run(plan, model, margins, tighten=tighten_margins)
     root = plan["root"]
     checks = []
     overall = 0
@@ -439,6 +459,10 @@ def verify_strong(
             f"the plan's length is {stated}, but its worst path under the declared uncertainty "
             f"takes {plural(overall, 'operation')}"
         )
+    if run.lowered:
+        plan["stats"]["min_margin_deg"] = min(  # type: ignore[index]
+            float(n["margin_deg"]) for n in _action_nodes(plan, run)
+        )
     clash = reject_clash(plan)
     if clash is not None:
         raise CheckFailed(
@@ -456,6 +480,20 @@ def verify_strong(
                 f"it is {expected:.10g}"
             )
     return VerificationReport(tuple(checks))
+
+
+def _action_nodes(plan: Mapping[str, Any], run: _Run) -> list[Mapping[str, Any]]:
+    """The plan's distinct rotation nodes (shared subplans once)."""
+    out, seen, todo = [], set(), [plan["root"]]
+    while todo:
+        node = run.node(todo.pop())
+        if id(node) in seen or "result" in node:
+            continue
+        seen.add(id(node))
+        if node.get("action_deg") is not None:
+            out.append(node)
+        todo.extend(b["next"] for b in node["branches"])
+    return out
 
 
 def reject_clash(plan: Mapping[str, Any]) -> tuple[str, str | None] | None:
