@@ -20,19 +20,32 @@ def _cross(o: Point, a: Point, b: Point) -> float:
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
 
+COLLINEAR_REL = 1e-11
+"""A vertex this close to the line of its neighbours (relative to the points' size) is
+collinear with them: two edges whose normals differ by rounding alone cannot be told stable
+or not by the push function (a vertex 1e-11 mm off a 10 mm edge failed it)."""
+
+
 def convex_hull(points: Iterable[Sequence[float]]) -> list[Point]:
-    """Andrew's monotone chain: the hull vertices counter-clockwise, collinear points dropped."""
+    """Andrew's monotone chain: the hull vertices counter-clockwise, collinear points dropped
+    (within ``COLLINEAR_REL`` of the points' size of their neighbours' line)."""
     pts = sorted({(float(p[0]), float(p[1])) for p in points})
     if len(pts) <= 2:
         return pts
+    eps = COLLINEAR_REL * size_of(pts)
+
+    def turns(o: Point, a: Point, b: Point) -> bool:
+        # Left of the line o -> b by more than eps (the cross product over the base length).
+        return _cross(o, a, b) > eps * math.hypot(b[0] - o[0], b[1] - o[1])
+
     lower: list[Point] = []
     for p in pts:
-        while len(lower) >= 2 and _cross(lower[-2], lower[-1], p) <= 0:
+        while len(lower) >= 2 and not turns(lower[-2], lower[-1], p):
             lower.pop()
         lower.append(p)
     upper: list[Point] = []
     for p in reversed(pts):
-        while len(upper) >= 2 and _cross(upper[-2], upper[-1], p) <= 0:
+        while len(upper) >= 2 and not turns(upper[-2], upper[-1], p):
             upper.pop()
         upper.append(p)
     return lower[:-1] + upper[:-1]

@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from feederkit.hull import contact_hull, number_hull
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
 
 
 def _bulged_rectangle(bulge: float, points: int = 41) -> list[tuple[float, float]]:
@@ -66,3 +70,17 @@ def test_a_plan_for_a_bulged_rectangle_passes_its_own_verification() -> None:
     part = make_part(make_outline("bulge", _bulged_rectangle(1e-8)))
     made = make_plan([push_function(part)], ToleranceSensor(0.1), uncertainty=Uncertainty(0.0))
     assert made.result.length >= 1
+
+
+@pytest.mark.parametrize("off", [1e-11, 1e-12, 1e-13])
+def test_a_vertex_off_an_edge_by_rounding_is_collinear_at_tolerance_zero(off) -> None:
+    """Two edges whose normals differ by rounding alone cannot be classified by the push
+    function ("3 stable edges but 4 divergent orientations", a crash of plan
+    --hull-tolerance 0): such a vertex is collinear (``COLLINEAR_REL``) and dropped; one a
+    billionth of the size off is kept."""
+    ring = [(0.0, 0.0), (5.0, -off), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)]
+    hull = contact_hull(ring, 0.0)
+    assert hull == ((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0))
+    part = make_part(make_outline("hair", [list(p) for p in ring]), hull_tolerance=0.0)
+    assert push_function(part).n == 4
+    assert len(contact_hull([(0, 0), (5, -1e-8), (10, 0), (10, 6), (0, 6)], 0.0)) == 5
