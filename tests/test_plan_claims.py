@@ -16,7 +16,7 @@ from test_strong_plans import _usable, perturbed, random_pf, run_plan
 from feederkit.cli.app import main
 from feederkit.errors import CheckFailed, PlanningError
 from feederkit.plans.make import make_plan
-from feederkit.plans.strong import certificate_problems, verify_strong
+from feederkit.plans.strong import action_nodes, certificate_problems, verify_strong
 from feederkit.plans.verify import verify_declared
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
@@ -42,19 +42,7 @@ def tampered(plan: dict, edit) -> dict:
 
 def actions(plan: dict) -> list[dict]:
     """The plan's distinct rotation nodes (shared subplans once), in the tree's order."""
-    shared = plan.get("nodes") or {}
-    out, seen, todo = [], set(), [plan["root"]]
-    while todo:
-        node = todo.pop(0)
-        while "ref" in node:
-            node = shared[node["ref"]]
-        if id(node) in seen or "result" in node:
-            continue
-        seen.add(id(node))
-        if node.get("action_deg") is not None:
-            out.append(node)
-        todo.extend(b["next"] for b in node["branches"])
-    return out
+    return action_nodes(plan)
 
 
 def test_the_written_claims_hold(bracket):

@@ -461,7 +461,7 @@ def verify_strong(
         )
     if run.lowered:
         plan["stats"]["min_margin_deg"] = min(  # type: ignore[index]
-            float(n["margin_deg"]) for n in _action_nodes(plan, run)
+            float(n["margin_deg"]) for n in action_nodes(plan)
         )
     clash = reject_clash(plan)
     if clash is not None:
@@ -482,11 +482,23 @@ def verify_strong(
     return VerificationReport(tuple(checks))
 
 
-def _action_nodes(plan: Mapping[str, Any], run: _Run) -> list[Mapping[str, Any]]:
-    """The plan's distinct rotation nodes (shared subplans once)."""
+def action_nodes(plan: Mapping[str, Any]) -> list[Mapping[str, Any]]:
+    """A plan file's distinct rotation nodes (shared subplans once), as objects of ``plan``
+    (editing one edits the plan).
+
+    >>> plan = {"root": {"action_deg": None, "margin_deg": None, "branches": [
+    ...     {"reading": None, "next": {"ref": "n1"}}]},
+    ...     "nodes": {"n1": {"action_deg": 90.0, "margin_deg": 5.0, "branches": [
+    ...         {"reading": None, "next": {"result": []}}]}}}
+    >>> [n["action_deg"] for n in action_nodes(plan)]
+    [90.0]
+    """
+    shared = plan.get("nodes") or {}
     out, seen, todo = [], set(), [plan["root"]]
     while todo:
-        node = run.node(todo.pop())
+        node = todo.pop()
+        while "ref" in node:
+            node = shared[node["ref"]]
         if id(node) in seen or "result" in node:
             continue
         seen.add(id(node))
@@ -811,6 +823,7 @@ __all__ = [
     "MARGIN_TOL_DEG",
     "MAX_ROTATION_ERROR_DEG",
     "StrongModel",
+    "action_nodes",
     "certificate_problems",
     "declared_uncertainty",
     "finite_or_none",
