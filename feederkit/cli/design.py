@@ -53,7 +53,7 @@ from feederkit.design.sensor import (
     design_pitches,
     design_tolerance,
     landing_design_members,
-    landing_rows,
+    member_landing_rows,
 )
 from feederkit.errors import InputError
 from feederkit.landing.plan import landing_names, load_landings
@@ -219,7 +219,7 @@ def sensor_command(
         pfs = list(loaded.push_functions)
     json_found(
         parts=[pf.part.name for pf in pfs],
-        landings=landing_rows(members),
+        landings=member_landing_rows(members),
         cell_profile=profile.source,
         uncertainty=uncertainty.to_dict(),
     )

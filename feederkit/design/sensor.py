@@ -123,7 +123,7 @@ def _rejected_words(parts: Sequence[str], members: Sequence[PlanMember] | None) 
     return f"; the plan rejects {shown}" + (f" and {more} more" if more > 0 else "")
 
 
-def landing_rows(members: Sequence[PlanMember] | None) -> list[dict[str, Any]]:
+def member_landing_rows(members: Sequence[PlanMember] | None) -> list[dict[str, Any]]:
     """The JSON's ``landings``: ``part``, ``landing`` and ``accept`` of each member that is a
     landing, in member order (none for a design of parts), as ``changeover compile --json``
     lists them."""
@@ -257,7 +257,7 @@ class ToleranceDesign:
         return {
             "sensor_model": "tolerance",
             "parts": list(self.parts),
-            "landings": landing_rows(self.members),
+            "landings": member_landing_rows(self.members),
             "critical_tolerance_mm": self.critical_tolerance,
             "pairs": [p.to_dict() for p in self.critical.pairs],
             "lengths": [s.to_dict() for s in self.steps],
@@ -415,7 +415,7 @@ class PitchDesign:
         return {
             "sensor_model": "led",
             "parts": list(self.parts),
-            "landings": landing_rows(self.members),
+            "landings": member_landing_rows(self.members),
             "noise_mm": self.noise,
             "critical_pitch_mm": self.critical_pitch,
             "pitches": [r.to_dict() for r in self.rows],
