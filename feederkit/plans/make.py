@@ -161,6 +161,13 @@ def _make_plan(
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
     notes: list[str] = []
+    floor = opts.min_margin_deg
+    if floor > 0.0 and math.isfinite(result.min_margin) and result.min_margin < floor - 1e-9:
+        notes.append(
+            f"a rotation keeps ±{result.min_margin:.4g}° for a state that a reading at the end "
+            f"of its interval lets reach it, less than --min-margin {floor:g}: the file says "
+            "what holds"
+        )
     if certify:
         output_s = _output_s(data)
         cert, cut = _certificate(data, unc, opts, started, output_s)
