@@ -151,3 +151,26 @@ def test_a_margin_the_rebuilt_readings_overstate_is_lowered_before_writing():
     margins = [a["margin_deg"] for a in actions(made.plan)]
     assert made.plan["stats"]["min_margin_deg"] == min(margins) == made.result.min_margin
     assert any(abs(m - 32.5835) < 1e-3 for m in margins)  # lowered from 51.06 (state 1)
+
+
+def test_a_margin_lowered_below_the_floor_is_said(monkeypatch):
+    """Should the lowering take a margin below --min-margin, the plan says so (the file keeps
+    what holds)."""
+    import feederkit.plans.make as make
+
+    real = make.verify_strong
+
+    def lowering(plan, *args, **kwargs):
+        report = real(plan, *args, **kwargs)
+        for node in action_nodes(plan):
+            node["margin_deg"] = 0.5
+        plan["stats"]["min_margin_deg"] = 0.5
+        return report
+
+    monkeypatch.setattr(make, "verify_strong", lowering)
+    pf = random_pf(20_001)
+    from feederkit.planning.options import PlanningOptions
+
+    made = make_plan([pf], NoSensor(), PlanningOptions(min_margin_deg=1.0), certify=False)
+    assert made.result.min_margin == 0.5
+    assert any("less than --min-margin 1" in w for w in made.warnings)
