@@ -790,11 +790,11 @@ def _hull_problem(hull: Sequence[Point]) -> str | None:
     """Why a counter-clockwise ring is not a strictly convex hull numbered from its
     lowest-then-leftmost vertex, in words; None when it is one.
 
-    Exact, with no length tolerance, as the writer's hull is (:func:`feederkit.hull.
-    contact_hull`: at ``--hull-tolerance 0`` it keeps every vertex that turns left at all,
-    even 1e-14 mm off its neighbours' line, and such a plan is right), and with the turn
-    computed as its :func:`~feederkit.hull.convex_hull` computes it: every plan feederkit
-    writes passes.
+    Exact, with no length tolerance: a vertex a billionth of the part's size off its
+    neighbours' line is a corner (at ``--hull-tolerance 0`` the writer keeps it, and such a
+    plan is right). Closer than rounding (:data:`feederkit.hull.COLLINEAR_REL`) the writer
+    drops it, so the rebuilt hull differs and :func:`_check_part` refuses the list: every
+    plan feederkit writes passes.
     """
     n = len(hull)
     for i in range(n):
