@@ -519,10 +519,10 @@ def verify_declared(
     reading (:func:`feederkit.plans.strong.verify_strong`), together with the file's own
     consistency (listed states and poses against the hulls and COMs), its margins (both
     verifiers: the ideal one follows the whole overlap range) and, for either, its
-    certificate
-    (:func:`~feederkit.plans.strong.certificate_problems`): a margin or certificate larger
-    than the plan keeps is a false promise to the controller. A failure is in the report
-    (``ok`` False, ``first_problem``), not raised; structural breakage is InputError.
+    certificate (:func:`~feederkit.plans.strong.certificate_problems`): a margin or
+    certificate larger than the plan keeps is a false promise to the controller. A failure
+    is in the report (``ok`` False, ``first_problem``), not raised; structural breakage is
+    InputError.
     """
     plan = as_plan(plan)
     old = sys.getrecursionlimit()
