@@ -85,3 +85,30 @@ def test_the_advice_names_the_rotation_error():
     assert "smaller rotation error" in _advice({"uncertainty"})
     both = _advice({"uncertainty", "tolerance"})
     assert both.startswith("keep them out of one mix or use a finer sensor;")
+
+
+def test_a_pair_whose_largest_widths_read_apart_is_checked_too(tmp_path, capsys):
+    """Two 4 mm bars, 40 and 39.36 mm long: their long widths read apart at 0.2 mm, so the
+    ideal analysis does not even make them candidates (a plan can always turn a bar onto its
+    end there); under 1 degree the end is a state no strong plan relies on, and compile
+    cannot tell them apart. The screen lists them, as compile reports them."""
+    folder = tmp_path / "bars"
+    folder.mkdir()
+    for name, length in (("c40", 40.0), ("c39", 39.36)):
+        ring = [[0, 0], [length, 0], [length, 4], [0, 4]]
+        (folder / f"{name}.json").write_text(
+            json.dumps({"name": name, "units": "mm", "vertices": ring})
+        )
+    db = str(tmp_path / "bars.db")
+    assert run(capsys, "catalog", "init", "--catalog", db)[0] == 0
+    assert run(capsys, "catalog", "import", str(folder), "--catalog", db)[0] == 0
+    args = ("catalog", "analyze", "--tolerance", "0.2", "--json", "--catalog", db)
+    rc, out, _ = run(capsys, *args, "--rotation-error", "1")
+    data = json.loads(out)
+    assert rc == 1 and data["counts"]["candidate_pairs"] == 0
+    assert [{w["part_a"], w["part_b"]} for w in data["apart_only_on_the_ideal_model"]] == [
+        {"c40", "c39"}
+    ]
+    compile_args = ("changeover", "compile", "bars", "--mix", "c40,c39", "--tolerance", "0.2")
+    rc, _, err = run(capsys, *compile_args, "--catalog", db)
+    assert rc == 1 and "cannot tell these apart" in err

@@ -33,6 +33,7 @@ from feederkit.cli.common import (
     plural,
     print_json,
     progress_bar,
+    uncertainty_option,
 )
 from feederkit.cli.plan_render import sensor_text
 from feederkit.errors import CheckFailed, InputError
@@ -45,7 +46,6 @@ from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
-from feederkit.uncertainty import Uncertainty
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -136,7 +136,7 @@ def analyze_command(
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    unc = Uncertainty(rotation_error)
+    unc = uncertainty_option(rotation_error, 0.0, 0.0)  # errors name --rotation-error
     pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
     with err_console.status("analyzing ..."):
         result = analyze_mix(pfs, sensor, uncertainty=unc)
@@ -196,8 +196,12 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
         "none: the ideal model (exact rotations and diameters, section 8); under a rotation "
         "error plans may tell fewer pairs apart (--rotation-error DEG checks the pairs again)"
         if unc.is_ideal
-        else f"the ideal model (section 8), then each candidate pair it tells apart again for "
-        f"strong plans under a rotation error of ±{unc.rotation_error_deg:g} deg",
+        else f"the ideal model (section 8), then each pair it tells apart whose states may "
+        f"read alike again for strong plans under a rotation error of "
+        f"±{unc.rotation_error_deg:g} deg"
+        if result.pairs is not None
+        else f"rotation error ±{unc.rotation_error_deg:g} deg: without a sensor no pair is "
+        "told apart anyway (section 8.6)",
     )
     summary.add_row(
         "tolerances",

@@ -16,7 +16,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
-from feederkit.mix.strongpairs import UNDECIDED, strong_pair_witness
+from feederkit.mix.strongpairs import UNDECIDED, reading_pairs, strong_pair_witness
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -134,7 +134,7 @@ def analyze_mix(
     undecided = 0
     if pairs is not None and not unc.is_ideal:
         confused = {(w.index_a, w.index_b) for w in pairs}
-        for i, j in todo:
+        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor)):
             if (i, j) in confused:
                 continue
             w = strong_pair_witness(pfs[i], pfs[j], sensor, unc)

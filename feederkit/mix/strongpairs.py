@@ -7,11 +7,14 @@ there, and confused by every plan at a rotation error of 1 degree. For one pair 
 :func:`strong_pair_witness` builds the machine of the two under the uncertainty and takes
 the pairs of their physical states that no strong plan resolves: the bisimilar ones and the
 unresolvable ones (:func:`feederkit.planning.lumping.unresolvable_pairs`), across the two
-parts, exactly what ``changeover compile`` reports for a mix holding both
-(:func:`feederkit.mix.changeover.strong_witnesses`).
+parts: the pairs ``changeover compile`` reports for a mix of the two
+(:func:`feederkit.mix.changeover.strong_witnesses`; the states named may differ, compile
+naming those its whole plan lumps). :func:`reading_pairs` gives the pairs worth checking.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
@@ -26,6 +29,22 @@ from feederkit.uncertainty import Uncertainty
 
 UNDECIDED = "undecided"
 """What :func:`strong_pair_witness` answers when its search ran out of sets."""
+
+
+def reading_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> set[tuple[int, int]]:
+    """The pairs ``(i, j)``, ``i < j``, of parts with some states that may read alike (in one
+    connected component of the sensor's overlap relation over all their states, Definition
+    10): the only pairs a strong plan may fail to tell apart. The ideal analysis's
+    candidates are fewer (its grid looks at the smallest and largest diameters), since on
+    the ideal model a plan can always rotate into the states that read apart; under a
+    rotation error it may not reach them (a bar standing on its end)."""
+    owner = [k for k, pf in enumerate(pfs) for _ in pf.states]
+    diameters = [s.diameter for pf in pfs for s in pf.states]
+    out: set[tuple[int, int]] = set()
+    for component in sensor.indistinguishable_sets(diameters):
+        parts = sorted({owner[i] for i in component})
+        out.update((a, b) for x, a in enumerate(parts) for b in parts[x + 1 :])
+    return out
 
 
 def strong_pair_witness(
@@ -49,4 +68,4 @@ def strong_pair_witness(
     return witnesses[0] if witnesses else None
 
 
-__all__ = ["UNDECIDED", "strong_pair_witness"]
+__all__ = ["UNDECIDED", "reading_pairs", "strong_pair_witness"]

@@ -362,7 +362,11 @@ def _lump_shapes(
     if worst == 0.0:
         return ""
     share = 100.0 * worst / size
-    words = f"; their outlines differ by at most {worst:.3g} mm ({share:.2g} % of the part)"
+    # Pairs of different members (parts, landings, mesh poses) are the mix's pairs, named
+    # apart: the figure speaks of the states of one member only.
+    across = any(machine.states[i].part != machine.states[j].part for i, j in pairs)
+    whose = "the states of one part among them" if across else "their outlines"
+    words = f"; {whose} differ by at most {worst:.3g} mm ({share:.2g} % of the part)"
     if worst > NEAR_SYMMETRIC_REL * size:
         words += (
             ": not near-symmetric, so the plan does not orient them apart; a smaller "
