@@ -28,8 +28,9 @@ class MixAnalysis:
     ``pairs`` is None without a sensor (every pair is unrecognizable). ``candidates`` is how
     many pairs the cheap tests (diameters and landing profiles,
     :func:`~feederkit.mix.pairs.candidate_pairs`) left for the exact fixpoint. ``seconds``
-    times each stage. Under a rotation error the candidates told apart are checked again for
-    strong plans (``strong_pairs``): section 8's test is the ideal model's.
+    times each stage. Under a rotation error the pairs told apart whose states may read alike
+    are checked again for strong plans (``strong_pairs``): section 8's test is the ideal
+    model's.
     """
 
     names: tuple[str, ...]
@@ -42,12 +43,12 @@ class MixAnalysis:
     candidates: int
     seconds: dict[str, float] = field(default_factory=dict)
     uncertainty: Uncertainty = IDEAL
-    """The rotation error the candidate pairs were checked under besides the ideal model."""
+    """The rotation error the pairs were checked under besides the ideal model."""
     strong_pairs: tuple[PairWitness, ...] = ()
     """Pairs told apart on the ideal model that no strong plan tells apart under
     ``uncertainty`` (:func:`~feederkit.mix.strongpairs.strong_pair_witness`)."""
     undecided: int = 0
-    """Candidate pairs whose check under ``uncertainty`` ran out of sets."""
+    """Pairs whose check under ``uncertainty`` ran out of sets."""
 
     @property
     def shared_push(self) -> list[BehaviourClass]:
@@ -109,12 +110,13 @@ def analyze_mix(
     uncertainty: Uncertainty | None = None,
 ) -> MixAnalysis:
     """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs; with
-    a rotation error (``uncertainty``, shape and COM tolerances zero: the candidates are the
-    readings' pairs), also the candidate pairs only the ideal model tells apart."""
+    a rotation error (``uncertainty``, shape and COM tolerances zero: the pairs checked are
+    the readings' pairs, :func:`~feederkit.mix.strongpairs.reading_pairs`), also the pairs
+    only the ideal model tells apart."""
     unc = IDEAL if uncertainty is None else uncertainty
     if unc.shape_tolerance_mm or unc.com_tolerance_mm:
         raise InputError(
-            "the catalog analysis takes a rotation error only (its candidate pairs are "
+            "the catalog analysis takes a rotation error only (the pairs it checks are "
             "those whose diameters can read alike)"
         )
     t0 = time.perf_counter()
