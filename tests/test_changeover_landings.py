@@ -181,6 +181,7 @@ def test_accepting_a_side_no_plan_tells_from_the_other_is_one_line_exit_1(db, ca
     ("args", "words"),
     [
         (["--landings", "pose-7"], "ell has no landing pose-7"),
+        (["--landings", "pose-7"], "name the ones the next station takes with --accept"),
         (["--landings", "down"], "bar has no landing down (it is the same shape as up)"),
         (["--landings", "sideways"], "--landings: invalid landing"),
         (["--accept", "pose-1"], "no landing pose-1 to accept"),

@@ -229,7 +229,8 @@ def select_landings(
     """The landings named by ``which``: ``"all"``, or landing names (``up``, ``pose-2``, ...).
 
     A name that is not a landing of the part (including one merged into another) is bad
-    input, naming the landings there are.
+    input, naming the landings there are and pointing to ``--accept`` (a mix of a mesh and a
+    flat part has no landing name in common).
     """
     if which == "all":
         return tuple(landings)
@@ -243,7 +244,11 @@ def select_landings(
             where = f" (it is the same shape as {merged[0]})" if merged else ""
             known = ", ".join(by_name)
             part = landings[0].part_name if landings else "the part"
-            raise InputError(f"{part} has no landing {n}{where}; its landings: {known}")
+            raise InputError(
+                f"{part} has no landing {n}{where}; its landings: {known} (the landings "
+                "named are planned for every part; to plan every landing and reject some, "
+                "name the ones the next station takes with --accept)"
+            )
         if by_name[n] not in out:
             out.append(by_name[n])
     return tuple(out)
