@@ -539,13 +539,13 @@ def _verify_declared(plan: Plan, part_indices: Sequence[int] | None) -> Verifica
     from feederkit.plans.fileformat import plan_to_dict
     from feederkit.plans.strong import certificate_problems, verify_strong
 
-    data = plan_to_dict(plan)
     if plan.uncertainty.is_ideal:
         report = verify_plan(plan, part_indices)
-        if not report.ok:
+        if not report.ok or plan.stats.certificate is None:
             return report
-        claims = tuple(certificate_problems(data))
+        claims = tuple(certificate_problems(plan_to_dict(plan)))
         return replace(report, problems=report.problems + claims)
+    data = plan_to_dict(plan)
     indices = range(len(plan.parts)) if part_indices is None else part_indices
     problems = _pose_problems(plan) + reject_problems(plan)
     for p in indices:
