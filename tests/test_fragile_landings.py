@@ -209,3 +209,12 @@ def test_changeover_compile_says_the_same_per_landing(bracket, tmp_path, capsys)
     out, err = _cli([*args, "--json", "--catalog", db], capsys)
     assert [w for w in json.loads(out)["warnings"] if "fragile" in w] == [line]
     assert _fragile_lines(err) == [line]
+
+
+def test_design_sensor_says_the_same_per_landing(bracket, capsys):
+    """The sensor design over both landings warns as plan does (it printed the part's lines,
+    numbered as drawn, before)."""
+    (line,) = bracket["warnings"]
+    args = ["design", "sensor", str(bracket["source"]), "--rotation-error", "0", "--json"]
+    main(args)
+    assert _fragile_lines(capsys.readouterr().err) == [line]

@@ -261,7 +261,8 @@ def sensor_command(
             hints = {"memory": "memory with --memory-limit MB", "time": "time with --time-limit S"}
             more = hints[exc.reason]
             raise DesignTimeout(f"{exc}; allow more {more}", exc.reason) from None
-    print_warnings(loaded.warnings)  # stderr, with --json too; after bad options are refused
+    # stderr, with --json too; after bad options are refused; fragile states per landing
+    print_warnings(found.warnings(over_landings))
     if plot is not None:
         from feederkit.design.plot import plot_design
 

@@ -68,7 +68,7 @@ from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.match import leaf_part_pairs
-from feederkit.plans.model import landing_fragile_warnings, member_label
+from feederkit.plans.model import member_label
 from feederkit.uncertainty import check_for_part
 
 
@@ -239,8 +239,7 @@ def plan_command(
         names = {x.name for x in every} | {m for x in every for m in x.merged}
         taken = _accepted_names(accept, names)  # bad input: one line, before any warning
         pfs = [push_function(x.part) for x in every]
-        members = [(x.part_name, x.name, pf) for x, pf in zip(every, pfs, strict=True)]
-        print_warnings(landing_fragile_warnings(loaded.warnings, loaded.push_functions, members))
+        print_warnings(found.warnings(over_landings=True))
         json_found(members=[x.label for x in every])
         with searching("planning and verifying", options.time_limit_s), flag_words(terms):
             planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)

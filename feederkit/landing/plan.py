@@ -31,7 +31,7 @@ from feederkit.landing.model import (
     select_landings,
 )
 from feederkit.loading import LoadedParts, load_parts
-from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.changeover import accepted_lumps, checked_landings, plan_landing_members
 from feederkit.mix.changeover import landing_members as landing_members  # re-exported
 from feederkit.mix.pairs import PairWitness
@@ -39,6 +39,7 @@ from feederkit.part import Part
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.make import MadePlan
+from feederkit.plans.model import landing_fragile_warnings
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import Uncertainty
 
@@ -198,6 +199,15 @@ class LoadedLandings:
     def several(self) -> bool:
         """Whether some part has more than one landing selected."""
         return any(len(lands) > 1 for lands in self.landings)
+
+    def warnings(self, over_landings: bool) -> list[str]:
+        """The loading's warnings as a plan names its members: over landings the fragile
+        states of each landing with its own numbers (:func:`landing_fragile_warnings`: a
+        flat part's face-down side numbers its states otherwise), else as loaded."""
+        if not over_landings:
+            return list(self.parts.warnings)
+        members = [(x.part_name, x.name, push_function(x.part)) for x in self.all]
+        return landing_fragile_warnings(self.parts.warnings, self.parts.push_functions, members)
 
 
 def landing_names(text: str, what: str = "--landings") -> tuple[str, ...]:
