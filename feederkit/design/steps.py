@@ -290,16 +290,16 @@ def length_steps(
     }
     starts = sorted({0} | {c for c in changes if 0 < c <= last})
     below = recognizable_below(breaks, critical)
-    fit = _fit_memo(oracle, breaks, clock)
+    fit = fit_memo(oracle, breaks, clock)
     steps = []
     for first, end in zip(starts, [*starts[1:], last + 1], strict=True):
         runs = _segment_runs(first, end - 1, breaks, oracle, fit, evaluate, clock)
-        for lo, hi, j, ev in _checked_runs(runs, breaks, "plan"):
+        for lo, hi, j, ev in checked_runs(runs, breaks, "plan"):
             steps.append(LengthStep(lo, hi, ev.length, ev.expected, j < below))
     return tuple(steps)
 
 
-def _fit_memo(
+def fit_memo(
     oracle: LengthOracle | StrongOracle, breaks: Sequence[float], clock: DesignClock
 ) -> Callable[[int, int], bool]:
     """``fit(k, length)``: whether interval ``k`` has a plan of at most ``length`` operations
@@ -316,7 +316,7 @@ def _fit_memo(
     return fit
 
 
-def _checked_runs(
+def checked_runs(
     runs: Sequence[tuple[int, int, int, Evaluation]], breaks: Sequence[float], plan: str
 ) -> list[tuple[float, float | None, int, Evaluation]]:
     """The runs of :func:`_segment_runs` as tolerances ``(lo, hi]`` (``hi`` None: unbounded)

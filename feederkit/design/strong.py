@@ -57,10 +57,10 @@ from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
 from feederkit.design.steps import (
     Evaluation,
     LengthStep,
-    _checked_runs,
     _first_at_or_above,
-    _fit_memo,
     _segment_runs,
+    checked_runs,
+    fit_memo,
     recognizable_below,
 )
 from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
@@ -609,7 +609,7 @@ def strong_length_steps(
     )
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     below = recognizable_below(breaks, critical)
-    fit = _fit_memo(oracle, breaks, clock)
+    fit = fit_memo(oracle, breaks, clock)
     steps = []
     segments = goal_segments(oracle, breaks, last, clock)
     clock.begin(LENGTHS, last + 1)
@@ -621,7 +621,7 @@ def strong_length_steps(
             clock.advance(j_last + 1 - first)
             continue
         runs = _segment_runs(first, j_last, breaks, oracle, fit, evaluate, clock)
-        for lo, hi, j, ev in _checked_runs(runs, breaks, "strong plan"):
+        for lo, hi, j, ev in checked_runs(runs, breaks, "strong plan"):
             ok = j < below and not ev.mixes_parts
             steps.append(LengthStep(lo, hi, ev.length, ev.expected, ok))
     return tuple(steps)
