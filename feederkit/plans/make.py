@@ -154,8 +154,8 @@ def _make_plan(
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
-        # Its paths and its margins: one a rebuilt reading lets one more state keep less
-        # is lowered to what that state keeps, so the file claims no more than holds.
+        # Its paths and its margins: a margin the rebuilt model finds more than some state at
+        # the node keeps is lowered to what it keeps, so the file claims no more than holds.
         report = verify_strong(data, tighten_margins=True)
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
