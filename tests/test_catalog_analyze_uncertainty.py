@@ -112,3 +112,18 @@ def test_a_pair_whose_largest_widths_read_apart_is_checked_too(tmp_path, capsys)
     compile_args = ("changeover", "compile", "bars", "--mix", "c40,c39", "--tolerance", "0.2")
     rc, _, err = run(capsys, *compile_args, "--catalog", db)
     assert rc == 1 and "cannot tell these apart" in err
+
+
+def test_a_pair_the_search_cannot_decide_is_counted_not_cleared(db, capsys, monkeypatch):
+    """A pair whose unresolvable-pairs search runs out of sets is neither listed nor cleared:
+    the analysis counts it undecided, in the table and in the JSON."""
+    import feederkit.mix.strongpairs as strongpairs
+
+    monkeypatch.setattr(strongpairs, "unresolvable_pairs", lambda problem, deadline=None: None)
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--rotation-error", "1", "--catalog", db)
+    rc, out, _ = run(capsys, *args, "--json")
+    data = json.loads(out)
+    assert data["apart_only_on_the_ideal_model"] == []
+    assert data["counts"]["undecided_pairs"] >= 2  # the bracket and its near-duplicate, both sides
+    rc, out, _ = run(capsys, *args)
+    assert "undecided: too many sets" in out

@@ -16,7 +16,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
-from feederkit.mix.strongpairs import UNDECIDED, reading_pairs, strong_pair_witness
+from feederkit.mix.strongpairs import check_strong_pair, reading_pairs
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -46,7 +46,7 @@ class MixAnalysis:
     """The rotation error the pairs were checked under besides the ideal model."""
     strong_pairs: tuple[PairWitness, ...] = ()
     """Pairs told apart on the ideal model that no strong plan tells apart under
-    ``uncertainty`` (:func:`~feederkit.mix.strongpairs.strong_pair_witness`)."""
+    ``uncertainty`` (:func:`~feederkit.mix.strongpairs.check_strong_pair`)."""
     undecided: int = 0
     """Pairs whose check under ``uncertainty`` ran out of sets."""
 
@@ -139,11 +139,11 @@ def analyze_mix(
         for i, j in sorted(set(todo) | reading_pairs(pfs, sensor)):
             if (i, j) in confused:
                 continue
-            w = strong_pair_witness(pfs[i], pfs[j], sensor, unc)
-            if w == UNDECIDED:
+            check = check_strong_pair(pfs[i], pfs[j], sensor, unc)
+            if not check.decided:
                 undecided += 1
-            elif isinstance(w, PairWitness):
-                strong.append(replace(w, index_a=i, index_b=j))
+            elif check.witness is not None:
+                strong.append(replace(check.witness, index_a=i, index_b=j))
     return MixAnalysis(
         names=tuple(pf.part.name for pf in pfs),
         sensor=sensor,

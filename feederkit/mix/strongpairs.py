@@ -4,7 +4,7 @@ a declared uncertainty (design.md, "Uncertainty").
 The exact test of section 8 assumes exact rotations: two parts that differ only by resting
 ranges a fraction of a degree apart (a near-duplicate drawn 0.05 mm longer) are told apart
 there, and confused by every plan at a rotation error of 1 degree. For one pair of parts,
-:func:`strong_pair_witness` builds the machine of the two under the uncertainty and takes
+:func:`check_strong_pair` builds the machine of the two under the uncertainty and takes
 the pairs of their physical states that no strong plan resolves: the bisimilar ones and the
 unresolvable ones (:func:`feederkit.planning.lumping.unresolvable_pairs`), across the two
 parts: the pairs ``changeover compile`` reports for a mix of the two
@@ -15,6 +15,7 @@ naming those its whole plan lumps). :func:`reading_pairs` gives the pairs worth 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
@@ -27,8 +28,15 @@ from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import Uncertainty
 
-UNDECIDED = "undecided"
-"""What :func:`strong_pair_witness` answers when its search ran out of sets."""
+
+@dataclass(frozen=True)
+class StrongPairCheck:
+    """Whether some strong plan tells two parts apart: ``witness`` the pair of their states
+    no strong plan resolves (None when one does), ``decided`` False when the search ran out
+    of sets before it knew (``witness`` is then None)."""
+
+    witness: PairWitness | None
+    decided: bool = True
 
 
 def reading_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> set[tuple[int, int]]:
@@ -47,25 +55,24 @@ def reading_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> set[tuple[int,
     return out
 
 
-def strong_pair_witness(
+def check_strong_pair(
     a: PushFunction,
     b: PushFunction,
     sensor: Sensor,
     uncertainty: Uncertainty,
     deadline: Deadline | None = None,
-) -> PairWitness | None | str:
-    """The witness that no strong plan tells ``a`` from ``b`` under ``uncertainty`` with
-    ``sensor`` (its states: the ideal members of the physical states confused), None when
-    some strong plan can, :data:`UNDECIDED` when the search ran out of sets. Timeout when
-    ``deadline`` passes."""
+) -> StrongPairCheck:
+    """Whether a strong plan tells ``a`` from ``b`` under ``uncertainty`` with ``sensor``;
+    where none does, the witness (its states: the ideal members of the physical states
+    confused). Timeout when ``deadline`` passes."""
     machine, _old = by_diameter(build_machine([a, b], sensor, uncertainty))
     found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
     if found is None:
-        return UNDECIDED
+        return StrongPairCheck(None, decided=False)
     states = machine.states
     across = [(i, j) for i, j in found if states[i].part != states[j].part]
     witnesses = strong_witnesses(machine, across)
-    return witnesses[0] if witnesses else None
+    return StrongPairCheck(witnesses[0] if witnesses else None)
 
 
-__all__ = ["UNDECIDED", "reading_pairs", "strong_pair_witness"]
+__all__ = ["StrongPairCheck", "check_strong_pair", "reading_pairs"]
