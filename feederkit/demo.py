@@ -32,7 +32,7 @@ from feederkit.mechanics.analysis import analyze_part
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import CompiledChangeover, compile_changeover, landing_rows
 from feederkit.mix.lookalike import build_lookalike
-from feederkit.plans.fileformat import plan_json
+from feederkit.plans.fileformat import plan_file_text
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
@@ -282,8 +282,8 @@ def plan_parts(
         files = (folder / f"{name}.sensorless.json", folder / f"{name}.sensor.json")
         write_files(
             [
-                OutputFile(files[0], plan_json(blind.plan), "plan file"),
-                OutputFile(files[1], plan_json(sensed.plan), "plan file"),
+                OutputFile(files[0], plan_file_text(blind.plan), "plan file"),
+                OutputFile(files[1], plan_file_text(sensed.plan), "plan file"),
             ]
         )
         warnings = [f"{name} (sensorless): {w}" for w in blind.warnings]
@@ -369,7 +369,7 @@ def compile_demo_changeover(
     def outputs(c: CompiledChangeover) -> list[OutputFile]:
         if cell is not None:
             annotate_cycle_time(c.made, cell)  # before the plan is written and stored
-        files = [OutputFile(plan_path, plan_json(c.plan), "plan file")]
+        files = [OutputFile(plan_path, plan_file_text(c.plan), "plan file")]
         if report:
             files.append(OutputFile(report_path, _report(c, report_notes), "report"))
         return files

@@ -393,3 +393,45 @@ def test_a_version_1_file_still_loads() -> None:
     """design.md: version-1 files stay readable (no declared uncertainty, no landings)."""
     plan = read_plan(ROOT / "tests" / "golden" / "v1" / "equilateral-triangle.tolerance.json")
     assert not plan.uncertainty_declared
+
+
+# ---------------------------------------------------------------- what feederkit writes
+
+
+def test_a_plan_its_own_loader_refuses_is_never_written(written, tmp_path, monkeypatch) -> None:
+    """Every written plan is read back as a reader will before anything is written: a file
+    the loader refuses is a bug (exit 70) and no file, not a written plan that ``run`` then
+    refuses."""
+    from feederkit.plans.fileformat import plan_file_text, plan_from_text
+
+    assert plan_from_text(plan_file_text(written)).parts[0].name == "l-bracket"
+    with pytest.raises(AssertionError, match="its own loader refuses: .*revision"):
+        plan_file_text(edited(written, lambda d: part0(d).pop("revision")))
+
+    import feederkit.plans.make as make
+
+    real = make._plan_dict
+
+    def without_revision(*args, **kwargs):
+        data = real(*args, **kwargs)
+        for part in data["parts"]:
+            part.pop("revision")
+        return data
+
+    monkeypatch.setattr(make, "_plan_dict", without_revision)
+    out, report = tmp_path / "P.json", tmp_path / "P.html"
+    args = ["plan", str(CATALOG / "t-clip.json"), "--tolerance", "0.5"]
+    assert main([*args, "-o", str(out), "--report", str(report)]) == 70
+    assert not out.exists() and not report.exists()
+
+
+def test_a_plan_as_deep_as_the_loader_takes_parses() -> None:
+    """A stored changeover's plan is parsed as deep as a plan file may be (three JSON levels
+    per operation), not to the JSON files' general limit."""
+    from feederkit.jsonio import MAX_JSON_DEPTH, parse_json
+    from feederkit.plans.fileformat import parse_plan_text
+
+    text = "[" * (MAX_JSON_DEPTH + 50) + "]" * (MAX_JSON_DEPTH + 50)
+    with pytest.raises(InputError):
+        parse_json(text, "deep")
+    assert isinstance(parse_plan_text(text, "deep"), list)

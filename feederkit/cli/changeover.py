@@ -83,7 +83,7 @@ from feederkit.mix.changeover import (
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.fileformat import as_plan, plan_json
+from feederkit.plans.fileformat import as_plan, plan_file_text
 from feederkit.uncertainty import Uncertainty
 
 changeover_app = typer.Typer(
@@ -296,7 +296,7 @@ def compile_command(
     def outputs(c) -> list[OutputFile]:
         # Runs before the changeover is stored: its plan file carries the cycle time.
         annotate_cycle_time(c.made, settings)
-        files = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
+        files, _view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
         if report is not None:
             html = changeover_report(c.plan, list(c.parts), list(c.witnesses))
             files.append(OutputFile(report, html, "report"))
@@ -487,7 +487,7 @@ def export_command(
     """
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    write_files([OutputFile(output, plan_json(co.plan), "plan file")])
+    write_files([OutputFile(output, plan_file_text(co.plan), "plan file")])
     if json_out:
         print_json(
             {

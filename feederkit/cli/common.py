@@ -36,7 +36,8 @@ from feederkit.jsonio import OutputFile, check_writable
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.fileformat import plan_json
+from feederkit.plans.fileformat import read_back
+from feederkit.plans.model import Plan
 from feederkit.sensors import Sensor, make_sensor
 from feederkit.uncertainty import Uncertainty
 from feederkit.words import plural
@@ -398,14 +399,17 @@ def plan_outputs(
     witnesses: Sequence[PairWitness],
     output: Path | None,
     report: Path | None,
-) -> list[OutputFile]:
-    """The files ``-o`` and ``--report`` ask for (the report rendered here, before any write)."""
+) -> tuple[list[OutputFile], Plan]:
+    """The files ``-o`` and ``--report`` ask for (rendered here, before any write) and the
+    plan as its file reads back (:func:`~feederkit.plans.fileformat.read_back`: what the
+    file holds is what the command shows)."""
+    text, view = read_back(plan)
     files = []
     if output is not None:
-        files.append(OutputFile(output, plan_json(plan), "plan file"))
+        files.append(OutputFile(output, text, "plan file"))
     if report is not None:
-        files.append(OutputFile(report, report_html(plan, pfs, witnesses), "report"))
-    return files
+        files.append(OutputFile(report, report_html(view, pfs, witnesses), "report"))
+    return files, view
 
 
 def check_outputs(*outputs: tuple[Path | None, str]) -> None:

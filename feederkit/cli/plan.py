@@ -66,7 +66,6 @@ from feederkit.landing.plan import LandingPlan, landing_names, load_landings, pl
 from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.fileformat import as_plan
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label
 from feederkit.uncertainty import check_for_part
@@ -246,7 +245,8 @@ def plan_command(
         made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]
     plan = made.plan
     cycle = annotate_cycle_time(made, settings)  # stats.cycle_time, before anything is written
-    write_files(plan_outputs(plan, pfs, witnesses, output, report))
+    files, view = plan_outputs(plan, pfs, witnesses, output, report)
+    write_files(files)
     notes = [*made.warnings]
     note = time_limit_note(plan["stats"], options.time_limit_s)
     if note is not None:
@@ -259,7 +259,6 @@ def plan_command(
         words = None if planned is None else _landings_text(planned)
         console.print(escape(settings.describe()), highlight=False)
         console.print(_header(plan, sensor_given, words), highlight=False)
-        view = as_plan(plan)  # the file's object read once, for the drawing and the table
         console.print(plan_tree(view))
         console.print(stats_table(view, made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)

@@ -29,7 +29,7 @@ from feederkit.catalog import (
 )
 from feederkit.errors import InputError
 from feederkit.importers.orientable import orientability
-from feederkit.jsonio import OutputFile, StagedFiles, parse_json
+from feederkit.jsonio import OutputFile, StagedFiles
 from feederkit.landing.model import Landing, landings_of_outline, select_landings
 from feederkit.loading import load_parts
 from feederkit.machine import PushAlignMachine, members, search_space
@@ -38,7 +38,7 @@ from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.fileformat import as_plan, plan_json, validate_plan
+from feederkit.plans.fileformat import as_plan, parse_plan_text, plan_file_text, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
 from feederkit.plans.model import PlanMember, landing_fragile_warnings
 from feederkit.sensors import Sensor, sensor_from_dict
@@ -468,7 +468,7 @@ def compile_changeover(
                 name,
                 revisions,
                 sensor.to_dict(),
-                plan_json(made.plan),
+                plan_file_text(made.plan),
                 replace=replace,
                 before_commit=staged.commit,
             )
@@ -492,7 +492,8 @@ def load_changeover(catalog: str | os.PathLike[str], name: str) -> StoredChangeo
     A changeover planned over landings has one part per landing (``PART/LANDING``), rebuilt
     from the revisions' stored landings."""
     co = get_changeover(catalog, name)
-    plan = validate_plan(parse_json(co.plan_json, f"changeover {name!r}"), f"changeover {name!r}")
+    where = f"changeover {name!r}"
+    plan = validate_plan(parse_plan_text(co.plan_json, where), where)
     loaded = load_parts([f"{n}@{r}" for n, r in co.info.parts], catalog=catalog)
     warnings = stale_revisions(catalog, co.info.parts)
     pfs = loaded.push_functions

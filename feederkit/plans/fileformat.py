@@ -591,7 +591,7 @@ def write_plan(
     else:
         target, value = plan, path
     assert isinstance(target, str | os.PathLike)
-    write_text_atomic(target, plan_json(value), what="plan file")  # type: ignore[arg-type]
+    write_text_atomic(target, plan_file_text(value), what="plan file")  # type: ignore[arg-type]
 
 
 # ---------------------------------------------------------------- from a dict: the validator
@@ -1329,15 +1329,42 @@ def read_plan(
     except (OSError, UnicodeDecodeError) as exc:
         reason = "not UTF-8 text" if isinstance(exc, UnicodeDecodeError) else exc.strerror
         raise InputError(f"{p}: cannot read the plan file ({reason})") from None
+    return plan_from_text(text, str(p), max_depth)
+
+
+def parse_plan_text(text: str, source: str = "plan", max_depth: int = MAX_PLAN_DEPTH) -> object:
+    """A plan file's JSON value, nested as deep as a plan of ``max_depth`` operations may be
+    (not checked: :func:`plan_from_dict`); InputError naming ``source`` otherwise."""
     levels = _JSON_LEVELS_PER_OPERATION * max_depth + 8
     try:
         with _recursion_room(levels):
-            data = parse_json(text, str(p), max_depth=levels)
+            return parse_json(text, source, max_depth=levels)
     except InputError as exc:
         if "nested deeper" not in str(exc):
             raise
-        raise InputError(_too_deep(str(p), max_depth)) from None
-    return plan_from_dict(data, str(p), max_depth)
+        raise InputError(_too_deep(source, max_depth)) from None
+
+
+def plan_from_text(text: str, source: str = "plan", max_depth: int = MAX_PLAN_DEPTH) -> Plan:
+    """A plan file's text parsed and checked (:func:`plan_from_dict`), as :func:`read_plan`
+    reads a file: InputError naming ``source`` for anything the file format refuses."""
+    return plan_from_dict(parse_plan_text(text, source, max_depth), source, max_depth)
+
+
+def plan_file_text(plan: Plan | Mapping[str, Any]) -> str:
+    """The text every plan feederkit writes (:func:`plan_json`), read back as a reader will
+    (:func:`read_back`) before anything is written."""
+    return read_back(plan)[0]
+
+
+def read_back(plan: Plan | Mapping[str, Any]) -> tuple[str, Plan]:
+    """A plan's file text and the :class:`Plan` a reader gets from it (:func:`plan_from_text`):
+    a file the loader refuses is a bug in feederkit, never a written file (AssertionError)."""
+    text = plan_json(plan)
+    try:
+        return text, plan_from_text(text, "the plan to write")
+    except InputError as exc:
+        raise AssertionError(f"feederkit made a plan file its own loader refuses: {exc}") from None
 
 
 def _too_deep(source: str, max_depth: int) -> str:
