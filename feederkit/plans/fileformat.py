@@ -1352,19 +1352,22 @@ def plan_from_text(text: str, source: str = "plan", max_depth: int = MAX_PLAN_DE
 
 
 def plan_file_text(plan: Plan | Mapping[str, Any]) -> str:
-    """The text every plan feederkit writes (:func:`plan_json`), read back as a reader will
-    (:func:`read_back`) before anything is written."""
+    """The text every plan feederkit writes (:func:`plan_json`), checked as a reader will
+    check it (:func:`read_back`) before anything is written."""
     return read_back(plan)[0]
 
 
 def read_back(plan: Plan | Mapping[str, Any]) -> tuple[str, Plan]:
-    """A plan's file text and the :class:`Plan` a reader gets from it (:func:`plan_from_text`):
-    a file the loader refuses is a bug in feederkit, never a written file (AssertionError)."""
-    text = plan_json(plan)
+    """A plan's file text and the :class:`Plan` a reader gets from it: the object the text
+    is written from, checked by the loader's validator (:func:`plan_from_dict`; the writer
+    writes exactly it, and parsing an 11 MB plan again would cost a command its deadline). A
+    file the loader refuses is a bug in feederkit, never a written file (AssertionError)."""
+    value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
     try:
-        return text, plan_from_text(text, "the plan to write")
+        view = plan_from_dict(value, "the plan to write")
     except InputError as exc:
         raise AssertionError(f"feederkit made a plan file its own loader refuses: {exc}") from None
+    return plan_json(value), view
 
 
 def _too_deep(source: str, max_depth: int) -> str:
