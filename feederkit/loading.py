@@ -25,16 +25,25 @@ from feederkit.sources import load_parts_with_warnings
 class LoadedParts:
     """The push functions of the parts to plan for, in the order given.
 
-    ``warnings``: one line each from the imports (prefixed with the SOURCE) and for fragile
-    states; ``left_out``: one line per part that is not orientable by pushing (only when
-    such parts are left out rather than refused); ``origins``: the SOURCE each push function
-    came from (a drawing read with ``all_parts`` gives several).
+    ``import_warnings``: one line each from the imports (prefixed with the SOURCE);
+    ``fragile_warnings``: the parts' fragile states, each part named and numbered as drawn
+    (a plan over landings names each landing's own instead, so they are kept apart);
+    ``left_out``: one line per part that is not orientable by pushing (only when such parts
+    are left out rather than refused); ``origins``: the SOURCE each push function came from
+    (a drawing read with ``all_parts`` gives several).
     """
 
     push_functions: tuple[PushFunction, ...]
-    warnings: tuple[str, ...] = ()
+    import_warnings: tuple[str, ...] = ()
+    fragile_warnings: tuple[str, ...] = ()
     left_out: tuple[str, ...] = ()
     origins: tuple[str, ...] = ()
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Every warning of the loading as a plan of the parts themselves says them: the
+        imports', then the fragile states'."""
+        return self.import_warnings + self.fragile_warnings
 
     @property
     def names(self) -> list[str]:
@@ -75,7 +84,7 @@ def load_parts(
     db = None if catalog is None else str(Path(catalog))
     pfs: list[PushFunction] = []
     origins: list[str] = []
-    warnings: list[str] = []
+    import_warnings: list[str] = []
     left_out: list[str] = []
     for source in sources:
         every = load_parts_with_warnings(source, catalog=db, options=options)
@@ -87,12 +96,17 @@ def load_parts(
                     raise InputError(line)
                 left_out.append(line)
                 continue
-            warnings += [f"{where}: {w}" for w in loaded.warnings]
+            import_warnings += [f"{where}: {w}" for w in loaded.warnings]
             pfs.append(push_function(loaded.part))
             origins.append(source)
-    warnings += fragile_warnings(pfs)  # one line for a large mix's fragile parts
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:
             raise InputError(f"the part {name!r} is named twice: a mix names each part once")
-    return LoadedParts(tuple(pfs), tuple(warnings), tuple(left_out), tuple(origins))
+    return LoadedParts(
+        tuple(pfs),
+        import_warnings=tuple(import_warnings),
+        fragile_warnings=tuple(fragile_warnings(pfs)),
+        left_out=tuple(left_out),
+        origins=tuple(origins),
+    )

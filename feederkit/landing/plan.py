@@ -39,7 +39,7 @@ from feederkit.part import Part
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.make import MadePlan
-from feederkit.plans.model import landing_fragile_warnings
+from feederkit.plans.model import member_fragile_warnings
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import Uncertainty
 
@@ -201,13 +201,14 @@ class LoadedLandings:
         return any(len(lands) > 1 for lands in self.landings)
 
     def warnings(self, over_landings: bool) -> list[str]:
-        """The loading's warnings as a plan names its members: over landings the fragile
-        states of each landing with its own numbers (:func:`landing_fragile_warnings`: a
-        flat part's face-down side numbers its states otherwise), else as loaded."""
+        """The loading's warnings as a plan names its members: over landings the imports',
+        then each landing's fragile states with its own numbers
+        (:func:`member_fragile_warnings`: a flat part's face-down side numbers its states
+        otherwise), else as loaded."""
         if not over_landings:
             return list(self.parts.warnings)
         members = [(x.part_name, x.name, push_function(x.part)) for x in self.all]
-        return landing_fragile_warnings(self.parts.warnings, self.parts.push_functions, members)
+        return [*self.parts.import_warnings, *member_fragile_warnings(members)]
 
 
 def landing_names(text: str, what: str = "--landings") -> tuple[str, ...]:
@@ -271,11 +272,8 @@ def load_landings(
     """
     loaded = load_parts(sources, catalog=catalog, options=options)
     db = None if catalog is None else str(Path(catalog))
-    per_part = []
-    warnings = list(loaded.warnings)
-    for source, pf in zip(loaded.origins, loaded.push_functions, strict=True):
-        lands = select_landings(_landings_of(source, pf, db, options), which)
-        checked_landings(source, lands, warnings)
-        per_part.append(lands)
-    parts = LoadedParts(loaded.push_functions, tuple(warnings), loaded.left_out, loaded.origins)
-    return LoadedLandings(parts, tuple(per_part))
+    per_part = [
+        checked_landings(source, select_landings(_landings_of(source, pf, db, options), which))
+        for source, pf in zip(loaded.origins, loaded.push_functions, strict=True)
+    ]
+    return LoadedLandings(loaded, tuple(per_part))

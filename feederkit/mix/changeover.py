@@ -34,13 +34,12 @@ from feederkit.landing.model import Landing, landings_of_outline, select_landing
 from feederkit.loading import load_parts
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.weights import normalised_shares
-from feederkit.mechanics.analysis import fragile_warning
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import as_plan, parse_plan_text, plan_file_text, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
-from feederkit.plans.model import PlanMember, landing_fragile_warnings
+from feederkit.plans.model import PlanMember, member_fragile_warnings
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
 
@@ -279,12 +278,9 @@ def plans_over_landings(
     return landings_given or accept_given or any(len(lands) > 1 for lands in per_part)
 
 
-def checked_landings(
-    source: str, landings: Sequence[Landing], warnings: list[str]
-) -> tuple[Landing, ...]:
-    """``landings`` when pushing can orient each one; a fragile mesh pose's warning is added
-    to ``warnings`` (once). InputError for a mesh pose on a round face, pointing to
-    ``--landings``."""
+def checked_landings(source: str, landings: Sequence[Landing]) -> tuple[Landing, ...]:
+    """``landings`` when pushing can orient each one. InputError for a mesh pose on a round
+    face, pointing to ``--landings``."""
     for x in landings:
         if not x.name.startswith("pose-"):
             continue
@@ -294,9 +290,6 @@ def checked_landings(
                 f"{source}: landing {x.name} is not orientable by pushing: "
                 f"{verdict.reason}; choose the landings to plan with --landings"
             )
-        fragile = fragile_warning(push_function(x.part))
-        if fragile is not None and fragile not in warnings:
-            warnings.append(fragile)
     return tuple(landings)
 
 
@@ -430,12 +423,9 @@ def compile_changeover(
     loaded = load_parts([_source(m) for m in members], catalog=catalog)
     pfs = list(loaded.push_functions)
     revisions = loaded.revisions  # InputError for a part given as a file
-    warnings = list(loaded.warnings)
     per_part = [
         checked_landings(
-            f"{n}@{r}",
-            select_landings(_stored_landings(catalog, n, r, pf), landings or "all"),
-            warnings,
+            f"{n}@{r}", select_landings(_stored_landings(catalog, n, r, pf), landings or "all")
         )
         for (n, r), pf in zip(revisions, pfs, strict=True)
     ]
@@ -452,10 +442,11 @@ def compile_changeover(
         pfs, made, witnesses, rejected = list(mix.parts), mix.made, mix.witnesses, mix.rejected
         # Fragile states named per landing, with the landing's own numbers (as plan says).
         landed = [(m.name, m.landing, pf) for m, pf in zip(mix.members, mix.parts, strict=True)]
-        warnings = landing_fragile_warnings(warnings, loaded.push_functions, landed)
+        warnings = [*loaded.import_warnings, *member_fragile_warnings(landed)]
     else:
         made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, weights=shares)
         witnesses = tuple(pairs)
+        warnings = list(loaded.warnings)
     warnings += [*made.warnings, *stale_revisions(catalog, revisions)]
     compiled = CompiledChangeover(
         name, tuple(revisions), tuple(pfs), made, tuple(witnesses), tuple(warnings), rejected

@@ -21,17 +21,13 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from feederkit.errors import InputError
-from feederkit.mechanics.analysis import (
-    fragile_member_warnings,
-    fragile_warning,
-    fragile_warnings,
-)
+from feederkit.mechanics.analysis import fragile_member_warnings
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -121,24 +117,6 @@ def member_fragile_warnings(
     for name, landing, pf in members:
         parts.setdefault(name, []).append((member_label(name, landing), pf))
     return fragile_member_warnings(list(parts.values()))
-
-
-def landing_fragile_warnings(
-    warnings: Sequence[str],
-    parts: Sequence[PushFunction],
-    members: Sequence[tuple[str, str | None, PushFunction]],
-) -> list[str]:
-    """The ``warnings`` of loading ``parts`` (:func:`feederkit.loading.load_parts`, with the
-    mesh poses' of :func:`feederkit.mix.changeover.checked_landings`) for a plan over the
-    landings ``members`` (``(name, landing, push function)``): the fragile states said per
-    landing (:func:`member_fragile_warnings`), as the plan's results, ``run`` and the report
-    name them, instead of the loaded parts' lines (``l-bracket: fragile states 1``, the
-    numbers of the part as drawn, wrong for its face-down side) and the poses' (``box/pose-2``,
-    the landing's part name). The other warnings are kept, in order."""
-    said = set(fragile_warnings(parts))
-    said |= {w for _, _, pf in members if (w := fragile_warning(pf)) is not None}
-    kept = [w for w in warnings if w not in said]
-    return kept + member_fragile_warnings(members)
 
 
 @dataclass(frozen=True)
