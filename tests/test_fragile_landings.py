@@ -21,6 +21,7 @@ from fixtures_cad import prism, write_mesh
 from feederkit.cli.app import main
 from feederkit.importers import ImportOptions
 from feederkit.landing.mesh import landings_of_mesh
+from feederkit.landing.plan import load_landings
 from feederkit.mechanics.analysis import (
     FRAGILE_LINES,
     fragile_member_warnings,
@@ -31,6 +32,7 @@ from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.plans.fileformat import plan_from_dict
+from feederkit.plans.model import member_fragile_warnings
 
 # An L bracket (legs 60 and 40 mm, 15 mm wide) with two 6.6 mm holes: its short end (edge
 # normal 0 deg) is a stable state 0.05 mm from tipping, below the fragile threshold of
@@ -218,3 +220,63 @@ def test_design_sensor_says_the_same_per_landing(bracket, capsys):
     args = ["design", "sensor", str(bracket["source"]), "--rotation-error", "0", "--json"]
     main(args)
     assert _fragile_lines(capsys.readouterr().err) == [line]
+
+
+def _lplate_with_com(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> tuple[str, str]:
+    """The 3 mm L plate as a catalog part added with ``--com``: its one landing is the pose
+    imported, so plans for it are not over landings. The catalog and the line
+    ``part analyze`` gives its one fragile state."""
+    path = write_mesh(prism(L_RING, 3.0), tmp_path / "lplate.stl")
+    db = str(tmp_path / "c.db")
+    _cli(["catalog", "init", "--catalog", db], capsys)
+    com = make_part(make_outline("lplate", L_RING)).com
+    _cli(["catalog", "add", str(path), "--com", *map(str, com), "--catalog", db], capsys)
+    out, err = _cli(["part", "analyze", "lplate", "--catalog", db, "--json"], capsys)
+    assert json.loads(out)[0]["fragile_states"] == [1]
+    (line,) = _fragile_lines(err)
+    assert line.startswith("lplate: fragile states 1 (barrier")
+    return db, line
+
+
+def test_a_mesh_with_one_landing_names_its_fragile_state_once_by_the_part_name(tmp_path, capsys):
+    """Not over landings, the plan's member is the part: its fragile states are said once,
+    by the part's name (they were said again under the pose's part name, ``lplate/pose-0``)."""
+    db, line = _lplate_with_com(tmp_path, capsys)
+    plan = tmp_path / "lplate.plan.json"
+    _, err = _cli(
+        ["plan", "lplate", "--catalog", db, "--tolerance", "0.2", "-o", str(plan)], capsys
+    )
+    assert "landing" not in plan.read_text()
+    assert _fragile_lines(err) == [line]
+    out, _ = _cli(["run", str(plan), "--all", "--json"], capsys)
+    assert json.loads(out)["warnings"] == [line]
+    args = ["changeover", "compile", "line", "--mix", "lplate", "--tolerance", "0.2"]
+    out, err = _cli([*args, "--json", "--catalog", db], capsys)
+    assert [w for w in json.loads(out)["warnings"] if "fragile" in w] == [line]
+    assert _fragile_lines(err) == [line]
+    # Named, the one landing makes a plan over landings: its line names it, once.
+    _, err = _cli(["plan", "lplate", "--catalog", db, "--landings", "0", "--json"], capsys)
+    assert _fragile_lines(err) == [line.replace("lplate:", "lplate (pose-0):", 1)]
+
+
+def test_over_landings_the_loaded_fragile_lines_give_way_to_the_landings_own(bracket, tmp_path):
+    """The loading keeps its fragile lines apart from the imports' warnings: a plan of the
+    parts themselves says both, a plan over landings every import warning, in order, then
+    each landing's fragile states, and no line numbered as a part is drawn."""
+    mesh = write_mesh(prism(L_RING, 3.0), tmp_path / "lplate.stl")
+    found = load_landings([str(bracket["source"]), str(mesh)])
+    loaded = found.parts
+    assert loaded.import_warnings == (
+        f"{mesh}: mesh files carry no units: read as mm (use --units)",
+    )
+    assert [w.split(":", 1)[0] for w in loaded.fragile_warnings] == ["bracket-a", "lplate"]
+    assert loaded.warnings == loaded.import_warnings + loaded.fragile_warnings
+    assert found.warnings(over_landings=False) == list(loaded.warnings)
+    over = found.warnings(over_landings=True)
+    members = [(x.part_name, x.name, push_function(x.part)) for x in found.all]
+    assert over == [*loaded.import_warnings, *member_fragile_warnings(members)]
+    assert not set(over) & set(loaded.fragile_warnings)
+    (bracket_line, lplate_line) = over[1:]
+    assert bracket_line.startswith("bracket-a (up): fragile states 1; bracket-a (down): ")
+    assert lplate_line.startswith("lplate (pose-0): fragile states 1")
+    assert "lplate/" not in lplate_line
