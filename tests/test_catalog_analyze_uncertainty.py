@@ -127,3 +127,27 @@ def test_a_pair_the_search_cannot_decide_is_counted_not_cleared(db, capsys, monk
     assert data["counts"]["undecided_pairs"] >= 2  # the bracket and its near-duplicate, both sides
     rc, out, _ = run(capsys, *args)
     assert "undecided: too many sets" in out
+
+
+def test_reading_pairs_under_a_shape_tolerance():
+    """Rotation error alone keeps the nominal pairs; a shape tolerance adds the pairs whose
+    physical states' diameter intervals may read alike (not those chained through a third:
+    c reads alike a only), and keeps the nominal ones."""
+    from feederkit.mechanics.push import push_function
+    from feederkit.mix.strongpairs import reading_pairs
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    def rect(name: str, length: float, width: float):
+        ring = [(0, 0), (length, 0), (length, width), (0, width)]
+        return push_function(make_part(make_outline(name, ring)))
+
+    pfs = [rect("a", 40, 10), rect("b", 41.1, 11.1), rect("c", 39.5, 20), rect("d", 60, 30)]
+    sensor = ToleranceSensor(0.5)
+    nominal = reading_pairs(pfs, sensor)
+    assert nominal == {(0, 2)} == reading_pairs(pfs, sensor, Uncertainty(1.0))
+    assert reading_pairs(pfs, sensor, Uncertainty(1.0, 0.05)) == {(0, 1), (0, 2)}
+    assert reading_pairs(pfs, sensor, Uncertainty(0.0, 0.04, 0.01)) == {(0, 1), (0, 2)}
+    assert reading_pairs(pfs, sensor, Uncertainty(1.0, 0.0, 0.05)) == {(0, 2)}

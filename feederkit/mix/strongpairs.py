@@ -14,18 +14,22 @@ naming those its whole plan lumps). :func:`reading_pairs` gives the pairs worth 
 
 from __future__ import annotations
 
+import bisect
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.mix.changeover import strong_witnesses
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.budget import Deadline
 from feederkit.planning.lumping import unresolvable_pairs
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
-from feederkit.sensors import Sensor
+from feederkit.sensors import Diameter, Sensor, span
 from feederkit.uncertainty import Uncertainty
 
 
@@ -39,19 +43,76 @@ class StrongPairCheck:
     decided: bool = True
 
 
-def reading_pairs(pfs: Sequence[PushFunction], sensor: Sensor) -> set[tuple[int, int]]:
-    """The pairs ``(i, j)``, ``i < j``, of parts with some states that may read alike (in one
-    connected component of the sensor's overlap relation over all their states, Definition
-    10): the only pairs a strong plan may fail to tell apart. The ideal analysis's
+def reading_pairs(
+    pfs: Sequence[PushFunction], sensor: Sensor, uncertainty: Uncertainty | None = None
+) -> set[tuple[int, int]]:
+    """The pairs ``(i, j)``, ``i < j``, of parts with some states that may read alike: the
+    only pairs a strong plan may fail to tell apart.
+
+    On the parts' nominal diameters these are the pairs in one connected component of the
+    sensor's overlap relation over all their states (Definition 10). The ideal analysis's
     candidates are fewer (its grid looks at the smallest and largest diameters), since on
     the ideal model a plan can always rotate into the states that read apart; under a
-    rotation error it may not reach them (a bar standing on its end)."""
+    rotation error it may not reach them (a bar standing on its end). Under a shape or COM
+    tolerance a physical state reads anything its diameter interval can
+    (:func:`physical_diameters`), so the pairs with two such states that may read alike
+    (:func:`range_pairs`) are added: a pair no strong plan tells apart has, in the machine
+    of the two, states "with overlapping sensor ranges" (section 5; every pair of states
+    the strong analysis keeps together can read alike), and these intervals hold theirs.
+    Rotation error alone keeps the nominal pairs (no mechanics computed).
+    """
     owner = [k for k, pf in enumerate(pfs) for _ in pf.states]
     diameters = [s.diameter for pf in pfs for s in pf.states]
     out: set[tuple[int, int]] = set()
     for component in sensor.indistinguishable_sets(diameters):
         parts = sorted({owner[i] for i in component})
         out.update((a, b) for x, a in enumerate(parts) for b in parts[x + 1 :])
+    if uncertainty is not None and uncertainty.radius_error_mm > 0.0:
+        out |= range_pairs(physical_diameters(pfs, uncertainty), sensor)
+    return out
+
+
+def physical_diameters(
+    pfs: Sequence[PushFunction], uncertainty: Uncertainty
+) -> list[list[tuple[float, float]]]:
+    """Per part, its physical resting states' diameter intervals under ``uncertainty``
+    (:func:`~feederkit.mechanics.uncertain.uncertain_mechanics`), each widened by twice the
+    largest snap any machine of these parts makes (``DIAMETER_REL_EPS`` of the largest part:
+    :func:`~feederkit.machine.build.snap_intervals` moves an end outward by at most that),
+    so each holds what the state reads in the machine of any two of them. Raises InputError
+    naming the part for a tolerance too large for it."""
+    if not pfs:
+        return []
+    pad = 2.0 * DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
+    return [
+        [(lo - pad, hi + pad) for lo, hi in (s.diameter for s in mech.states)]
+        for mech in (uncertain_mechanics(pf.part, uncertainty) for pf in pfs)
+    ]
+
+
+def range_pairs(diameters: Sequence[Sequence[Diameter]], sensor: Sensor) -> set[tuple[int, int]]:
+    """The pairs ``(i, j)``, ``i < j``, of parts ``diameters[i]`` and ``diameters[j]`` with a
+    state each that may read alike (:meth:`~feederkit.sensors.Sensor.can_read_alike`).
+
+    A sweep in order of the intervals' lower ends: a state meets only the later states whose
+    lower end lies within the sensor's reach (:meth:`~feederkit.sensors.Sensor.reading_reach`)
+    of its upper end.
+
+    >>> from feederkit.sensors import ToleranceSensor
+    >>> sorted(range_pairs([[10.0], [(10.8, 11.0)], [11.5]], ToleranceSensor(0.5)))
+    [(0, 1), (1, 2)]
+    """
+    states = sorted((*span(d), k) for k, ds in enumerate(diameters) for d in ds)
+    los = [lo for lo, _hi, _k in states]
+    reach = sensor.reading_reach()
+    out: set[tuple[int, int]] = set()
+    for x, (lo, hi, k) in enumerate(states):
+        # The bound only prunes (with a rounding margin): can_read_alike decides.
+        bound = hi + reach + 1e-9 * (abs(hi) + reach)
+        end = len(states) if math.isinf(reach) else bisect.bisect_right(los, bound)
+        for lo2, hi2, k2 in states[x + 1 : end]:
+            if k2 != k and sensor.can_read_alike((lo, hi), (lo2, hi2)):
+                out.add((min(k, k2), max(k, k2)))
     return out
 
 
@@ -75,4 +136,10 @@ def check_strong_pair(
     return StrongPairCheck(witnesses[0] if witnesses else None)
 
 
-__all__ = ["StrongPairCheck", "check_strong_pair", "reading_pairs"]
+__all__ = [
+    "StrongPairCheck",
+    "check_strong_pair",
+    "physical_diameters",
+    "range_pairs",
+    "reading_pairs",
+]
