@@ -1,6 +1,7 @@
-"""``catalog analyze --rotation-error``: the pairs section 8 tells apart on the ideal model
-that no strong plan tells apart under a rotation error, decided per pair as ``changeover
-compile`` decides a mix (feederkit.mix.strongpairs)."""
+"""``catalog analyze --rotation-error [--shape-tolerance] [--com-tolerance]``: the pairs
+section 8 tells apart on the ideal model that no strong plan tells apart under the declared
+uncertainty, decided per pair as ``changeover compile`` decides a mix
+(feederkit.mix.strongpairs)."""
 
 from __future__ import annotations
 
@@ -71,14 +72,21 @@ def test_compile_agrees_pair_by_pair(db, capsys):
     assert rc == 0
 
 
-def test_shape_tolerance_is_refused_by_the_library():
+def test_a_tolerance_too_large_for_a_part_is_refused_by_the_library():
+    """Before any work, naming the part, as ``plan`` refuses it."""
     from feederkit.errors import InputError
+    from feederkit.mechanics.push import push_function
     from feederkit.mix.analyze import analyze_mix
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
     from feederkit.sensors import ToleranceSensor
     from feederkit.uncertainty import Uncertainty
 
-    with pytest.raises(InputError, match="rotation error only"):
-        analyze_mix([], ToleranceSensor(0.5), uncertainty=Uncertainty(1.0, 0.01))
+    bar = push_function(make_part(make_outline("bar", [(0, 0), (40, 0), (40, 4), (0, 4)])))
+    with pytest.raises(InputError, match="^bar: shape tolerance 2 mm must be below"):
+        analyze_mix([bar], ToleranceSensor(0.5), uncertainty=Uncertainty(1.0, 2.0))
+    with pytest.raises(InputError, match="^bar: COM tolerance 2 mm must be below"):
+        analyze_mix([bar], ToleranceSensor(0.5), uncertainty=Uncertainty(0.0, 0.0, 2.0))
 
 
 def test_the_advice_names_the_rotation_error():

@@ -11,14 +11,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from feederkit.errors import InputError
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
 from feederkit.mix.strongpairs import check_strong_pair, reading_pairs
 from feederkit.sensors import Sensor
-from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 
 
 @dataclass(frozen=True)
@@ -28,9 +27,9 @@ class MixAnalysis:
     ``pairs`` is None without a sensor (every pair is unrecognizable). ``candidates`` is how
     many pairs the cheap tests (diameters and landing profiles,
     :func:`~feederkit.mix.pairs.candidate_pairs`) left for the exact fixpoint. ``seconds``
-    times each stage. Under a rotation error the pairs told apart whose states may read alike
-    are checked again for strong plans (``strong_pairs``): section 8's test is the ideal
-    model's.
+    times each stage. Under a declared uncertainty the pairs told apart whose states may read
+    alike are checked again for strong plans (``strong_pairs``): section 8's test is the
+    ideal model's.
     """
 
     names: tuple[str, ...]
@@ -43,7 +42,8 @@ class MixAnalysis:
     candidates: int
     seconds: dict[str, float] = field(default_factory=dict)
     uncertainty: Uncertainty = IDEAL
-    """The rotation error the pairs were checked under besides the ideal model."""
+    """The uncertainty (rotation error, shape and COM tolerances) the pairs were checked
+    under besides the ideal model."""
     strong_pairs: tuple[PairWitness, ...] = ()
     """Pairs told apart on the ideal model that no strong plan tells apart under
     ``uncertainty`` (:func:`~feederkit.mix.strongpairs.check_strong_pair`)."""
@@ -89,7 +89,7 @@ class MixAnalysis:
         return {
             "sensor": self.sensor.to_dict(),
             # The exact analysis of section 8 is the ideal model's; the pairs checked again
-            # under a rotation error say which (design.md).
+            # under the declared uncertainty say which (design.md).
             "uncertainty": self.uncertainty.to_dict(),
             "tolerances": {"angle_deg": self.angle_tol_deg, "diameter_mm": self.length_tol_mm},
             "counts": self.counts(),
@@ -109,16 +109,18 @@ def analyze_mix(
     length_tol: float = LENGTH_TOL_MM,
     uncertainty: Uncertainty | None = None,
 ) -> MixAnalysis:
-    """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs; with
-    a rotation error (``uncertainty``, shape and COM tolerances zero: the pairs checked are
-    the readings' pairs, :func:`~feederkit.mix.strongpairs.reading_pairs`), also the pairs
-    only the ideal model tells apart."""
+    """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs; under
+    a declared ``uncertainty`` (rotation error, shape and COM tolerances: design.md), also
+    the pairs only the ideal model tells apart, each pair that may read alike
+    (:func:`~feederkit.mix.strongpairs.reading_pairs`, the physical states' diameter
+    intervals under a shape or COM tolerance) checked for strong plans on its own.
+
+    Raises InputError naming the part when a tolerance is too large for one
+    (:func:`~feederkit.uncertainty.check_for_part`), before any work, as ``plan`` does."""
     unc = IDEAL if uncertainty is None else uncertainty
-    if unc.shape_tolerance_mm or unc.com_tolerance_mm:
-        raise InputError(
-            "the catalog analysis takes a rotation error only (the pairs it checks are "
-            "those whose diameters can read alike)"
-        )
+    if not unc.is_ideal:
+        for pf in pfs:
+            check_for_part(unc, pf.part)
     t0 = time.perf_counter()
     sigs = [signature(pf) for pf in pfs]
     t1 = time.perf_counter()
@@ -136,7 +138,7 @@ def analyze_mix(
     undecided = 0
     if pairs is not None and not unc.is_ideal:
         confused = {(w.index_a, w.index_b) for w in pairs}
-        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor)):
+        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor, unc)):
             if (i, j) in confused:
                 continue
             check = check_strong_pair(pfs[i], pfs[j], sensor, unc)
