@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 
 import pytest
-from shared import no_stray_profile  # noqa: F401 (autouse)
+from shared import no_stray_profile, one_line_error  # noqa: F401 (autouse)
 
 from feederkit.cli.app import main
 from feederkit.cli.catalog_analyze import _advice
@@ -90,9 +90,15 @@ def test_a_tolerance_too_large_for_a_part_is_refused_by_the_library():
 
 
 def test_the_advice_names_the_rotation_error():
+    from feederkit.uncertainty import Uncertainty
+
     assert "smaller rotation error" in _advice({"uncertainty"})
+    assert "tolerances" not in _advice({"uncertainty"}, Uncertainty(1.0))
     both = _advice({"uncertainty", "tolerance"})
     assert both.startswith("keep them out of one mix or use a finer sensor;")
+    shape = _advice({"uncertainty"}, Uncertainty(1.0, 0.05))
+    assert "smaller rotation error or tighter shape and COM tolerances" in shape
+    assert "rotation" not in _advice({"uncertainty"}, Uncertainty(0.0, 0.05))
 
 
 def test_a_pair_whose_largest_widths_read_apart_is_checked_too(tmp_path, capsys):
@@ -135,6 +141,110 @@ def test_a_pair_the_search_cannot_decide_is_counted_not_cleared(db, capsys, monk
     assert data["counts"]["undecided_pairs"] >= 2  # the bracket and its near-duplicate, both sides
     rc, out, _ = run(capsys, *args)
     assert "undecided: too many sets" in out
+
+
+@pytest.fixture()
+def rects(tmp_path, capsys) -> str:
+    """Two rectangles, 40 x 10 and 41.1 x 11.1 mm: at a sensor tolerance of 0.5 mm every
+    state reads apart from the other's (1.1 mm > 2 x 0.5), but under a shape tolerance of
+    0.05 mm the diameter intervals come within 2 x 0.5 (1.1 mm < 2 x 0.5 + 4 x 0.05)."""
+    folder = tmp_path / "rects"
+    folder.mkdir()
+    for name, (length, width) in {"r10": (40.0, 10.0), "r11": (41.1, 11.1)}.items():
+        ring = [[0, 0], [length, 0], [length, width], [0, width]]
+        (folder / f"{name}.json").write_text(
+            json.dumps({"name": name, "units": "mm", "vertices": ring})
+        )
+    path = str(tmp_path / "rects.db")
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    assert run(capsys, "catalog", "import", str(folder), "--catalog", path)[0] == 0
+    return path
+
+
+def _listed(capsys, db: str, *flags: str) -> tuple[int, dict]:
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--json", "--catalog", db, *flags)
+    rc, out, _ = run(capsys, *args)
+    return rc, json.loads(out)
+
+
+def test_a_shape_tolerance_lists_a_pair_that_reads_apart_nominally(rects, capsys):
+    """The pair reads apart on the nominal diameters, so the screen under a rotation error
+    alone never checks it; under the shape tolerance its diameter intervals read alike and
+    it is listed, as ``changeover compile`` with the same flags reports it."""
+    rc, data = _listed(capsys, rects, "--rotation-error", "1")
+    assert rc == 0 and data["apart_only_on_the_ideal_model"] == []
+    rc, data = _listed(capsys, rects, "--rotation-error", "1", "--shape-tolerance", "0.05")
+    assert rc == 1 and data["counts"]["candidate_pairs"] == 0
+    assert [(w["part_a"], w["part_b"]) for w in data["apart_only_on_the_ideal_model"]] == [
+        ("r10", "r11")
+    ]
+    assert "shape 0.05 mm" in data["apart_only_on_the_ideal_model"][0]["reason"]
+    base = ("changeover", "compile", "x", "--mix", "r10,r11", "--tolerance", "0.5", "--json")
+    rc, out, _ = run(capsys, *base, "--catalog", rects)
+    assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == []
+    rc, out, err = run(capsys, *base, "--replace", "--shape-tolerance", "0.05", "--catalog", rects)
+    assert rc == 1 and "cannot tell these apart" in err
+    pairs = json.loads(out)["unrecognizable_pairs"]
+    assert [(w["part_a"], w["part_b"]) for w in pairs] == [("r10", "r11")]
+
+
+def test_a_tolerance_without_a_rotation_error_takes_compiles_default(rects, capsys):
+    """``--shape-tolerance`` alone is checked at design.md's rotation error (1 degree), as
+    compile takes it without a cell profile; ``--rotation-error 0`` with it is the tolerance
+    alone, still checked for strong plans (not the ideal model), as compile plans it; no
+    flag at all stays the ideal analysis."""
+    rc, data = _listed(capsys, rects, "--shape-tolerance", "0.05")
+    assert rc == 1 and data["uncertainty"]["rotation_error_deg"] == 1.0
+    rc, data = _listed(capsys, rects, "--rotation-error", "0", "--shape-tolerance", "0.05")
+    assert rc == 1 and data["uncertainty"]["rotation_error_deg"] == 0.0
+    assert len(data["apart_only_on_the_ideal_model"]) == 1
+    base = ("changeover", "compile", "x", "--mix", "r10,r11", "--tolerance", "0.5")
+    flags = ("--rotation-error", "0", "--shape-tolerance", "0.05", "--catalog", rects)
+    rc, _, err = run(capsys, *base, *flags)
+    assert rc == 1 and "cannot tell these apart" in err
+    rc, data = _listed(capsys, rects)
+    assert rc == 0 and set(data["uncertainty"].values()) == {0.0}
+
+
+def test_the_json_states_the_whole_uncertainty(rects, capsys):
+    flags = ("--rotation-error", "0.5", "--shape-tolerance", "0.05", "--com-tolerance", "0.02")
+    _rc, data = _listed(capsys, rects, *flags)
+    assert data["uncertainty"] == {
+        "rotation_error_deg": 0.5,
+        "shape_tolerance_mm": 0.05,
+        "com_tolerance_mm": 0.02,
+    }
+
+
+def test_the_summary_and_the_result_name_the_tolerances(rects, capsys):
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.05")
+    rc, out, err = run(capsys, *args, "--catalog", rects)
+    assert rc == 1
+    assert "only under the rotation error ±1 deg, a shape tolerance of 0.05 mm" in err
+    assert "tighter shape and COM tolerances" in err
+    assert "shape tolerance of 0.05 mm" in " ".join(out.split())
+
+
+@pytest.mark.parametrize(
+    ("flags", "words"),
+    [
+        (("--shape-tolerance", "-1"), "shape tolerance must be a finite nonnegative"),
+        (("--shape-tolerance", "inf"), "(--shape-tolerance)"),
+        (("--com-tolerance", "nan"), "COM tolerance must be a finite nonnegative"),
+        (("--com-tolerance", "x"), "Invalid value for '--com-tolerance'"),
+        (("--rotation-error", "90", "--shape-tolerance", "0.1"), "(--rotation-error)"),
+        (("--shape-tolerance", "5"), "r10: shape tolerance 5 mm must be below half the"),
+        (("--com-tolerance", "5"), "r10: COM tolerance 5 mm must be below"),
+    ],
+)
+def test_bad_uncertainty_flags_are_one_line(rects, capsys, flags, words):
+    """The words ``plan`` and ``changeover compile`` say, a tolerance too large for a part
+    naming the part and the flag; exit 2."""
+    args = ["catalog", "analyze", "--tolerance", "0.5", *flags, "--catalog", rects]
+    err = one_line_error(capsys, args)
+    assert words in err
+    if "r10:" in words:
+        assert f"({flags[0]})" in err
 
 
 def test_reading_pairs_under_a_shape_tolerance():

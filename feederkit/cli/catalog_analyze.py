@@ -22,14 +22,17 @@ from feederkit.catalog import (
 )
 from feederkit.cli.common import (
     CatalogOpt,
+    ComToleranceOpt,
     JsonOpt,
     LedPitchOpt,
     NoiseOpt,
     SensorlessOpt,
+    ShapeToleranceOpt,
     ToleranceOpt,
     add_name_column,
     console,
     err_console,
+    flag_words,
     plural,
     print_json,
     progress_bar,
@@ -46,6 +49,7 @@ from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
+from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, Uncertainty, check_for_part
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -100,14 +104,32 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]
 
 
 AnalyzeRotationErrorOpt = Annotated[
-    float,
+    float | None,
     typer.Option(
         "--rotation-error",
         metavar="DEG",
         help="Also check the pairs the ideal model tells apart for strong plans under a "
-        "rotation error of ±DEG (default 0: section 8's ideal model only).",
+        "rotation error of ±DEG (default 0: section 8's ideal model only; 1, as plan and "
+        "changeover compile, with a shape or COM tolerance; the cell profile is not read).",
     ),
 ]
+
+
+def analysis_uncertainty(
+    rotation_error: float | None, shape_tolerance: float, com_tolerance: float
+) -> Uncertainty:
+    """The declared uncertainty the analysis checks the pairs under (errors name the flags).
+
+    Without any of the three flags the analysis is the ideal model's (section 8). A shape or
+    COM tolerance without ``--rotation-error`` takes design.md's default rotation error (1
+    degree), as ``plan`` and ``changeover compile`` do without a cell profile: the same flags
+    screen for the pairs compile reports. ``--rotation-error 0`` with a tolerance is that
+    tolerance alone, not the ideal model (``Uncertainty.is_ideal``), as in compile.
+    """
+    if rotation_error is None:
+        tolerant = bool(shape_tolerance) or bool(com_tolerance)
+        rotation_error = DEFAULT_ROTATION_ERROR_DEG if tolerant else 0.0
+    return uncertainty_option(rotation_error, shape_tolerance, com_tolerance)
 
 
 def analyze_command(
@@ -115,7 +137,9 @@ def analyze_command(
     tolerance: ToleranceOpt = None,
     led_pitch: LedPitchOpt = None,
     noise: NoiseOpt = None,
-    rotation_error: AnalyzeRotationErrorOpt = 0.0,
+    rotation_error: AnalyzeRotationErrorOpt = None,
+    shape_tolerance: ShapeToleranceOpt = 0.0,
+    com_tolerance: ComToleranceOpt = 0.0,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
 ) -> None:
@@ -127,19 +151,24 @@ def analyze_command(
     and face down: a part and its mirror image read alike face up against face down).
 
     The analysis is the ideal model's (exact rotations and diameters, as section 8 decides
-    it), and says so: under a rotation error a strong plan may tell fewer pairs apart.
-    ``--rotation-error DEG`` checks the candidate pairs it tells apart again, each pair for
-    strong plans (``feederkit.mix.strongpairs``), and lists those told apart only on the
-    ideal model (a near-duplicate 0.05 mm longer is one).
+    it), and says so: under a declared uncertainty a strong plan may tell fewer pairs apart.
+    ``--rotation-error DEG``, ``--shape-tolerance MM`` and ``--com-tolerance MM`` (the flags
+    of ``plan`` and ``changeover compile``) check the pairs it tells apart whose states may
+    read alike under them again, each pair for strong plans (``feederkit.mix.strongpairs``),
+    and list those told apart only on the ideal model (a near-duplicate 0.05 mm longer is
+    one at 1 degree).
 
     Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    unc = uncertainty_option(rotation_error, 0.0, 0.0)  # errors name --rotation-error
+    unc = analysis_uncertainty(rotation_error, shape_tolerance, com_tolerance)
     pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
-    with err_console.status("analyzing ..."):
-        result = analyze_mix(pfs, sensor, uncertainty=unc)
+    with flag_words():  # a tolerance too large for a part: one line naming it and the flag
+        for pf in pfs:
+            check_for_part(unc, pf.part)
+        with err_console.status("analyzing ..."):
+            result = analyze_mix(pfs, sensor, uncertainty=unc)
     if json_out:
         data = result.to_dict()
         data["skipped"] = skipped
@@ -157,22 +186,44 @@ def analyze_command(
         under = (
             ""
             if unc.is_ideal
-            else f" (of them {len(result.strong_pairs)} only under the rotation error "
-            f"±{unc.rotation_error_deg:g} deg)"
+            else f" (of them {len(result.strong_pairs)} only under {_under(unc)})"
         )
         raise CheckFailed(
             f"{plural(n, 'pair')} of {'landings' if over_landings else 'parts'} no plan can tell "
-            f"apart with this sensor{under}: {named}{more}; " + _advice({w.kind for w in found})
+            f"apart with this sensor{under}: {named}{more}; "
+            + _advice({w.kind for w in found}, unc)
         )
 
 
-def _advice(kinds: set[str]) -> str:
+def _under(unc: Uncertainty, article: str = "the") -> str:
+    """The declared uncertainty in words: the rotation error, and the shape and COM
+    tolerances when either is given (``article``: "the" or "a")."""
+    words = (
+        f"the rotation error ±{unc.rotation_error_deg:g} deg"
+        if article == "the"
+        else f"a rotation error of ±{unc.rotation_error_deg:g} deg"
+    )
+    if unc.radius_error_mm > 0.0:
+        words += (
+            f", a shape tolerance of {unc.shape_tolerance_mm:g} mm and a COM tolerance of "
+            f"{unc.com_tolerance_mm:g} mm"
+        )
+    return words
+
+
+def _advice(kinds: set[str], unc: Uncertainty | None = None) -> str:
     """What helps, by the witnesses' kinds: no sensor separates parts with the same
     push-diameter function (Lemma 8), a finer one may separate the others; a pair told apart
-    only on the ideal model needs a smaller rotation error (or a finer sensor)."""
+    only on the ideal model needs a smaller rotation error or tighter shape and COM
+    tolerances (those ``unc`` declares; None: the rotation error)."""
     if "uncertainty" in kinds:
         rest = _advice(kinds - {"uncertainty"}) if kinds - {"uncertainty"} else None
-        told = "the pairs told apart only on the ideal model need a smaller rotation error"
+        less = []
+        if unc is None or unc.rotation_error_deg > 0.0:
+            less.append("a smaller rotation error")
+        if unc is not None and unc.radius_error_mm > 0.0:
+            less.append("tighter shape and COM tolerances")
+        told = f"the pairs told apart only on the ideal model need {' or '.join(less)}"
         return told if rest is None else f"{rest}; {told}"
     if kinds == {"same-push-diameter"}:
         return "keep them out of one mix: no sensor tells them apart (same push-diameter function)"
@@ -194,14 +245,13 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
     summary.add_row(
         "declared uncertainty",
         "none: the ideal model (exact rotations and diameters, section 8); under a rotation "
-        "error plans may tell fewer pairs apart (--rotation-error DEG checks the pairs again)"
+        "error or a shape tolerance plans may tell fewer pairs apart (--rotation-error DEG, "
+        "--shape-tolerance MM, --com-tolerance MM check the pairs again)"
         if unc.is_ideal
         else f"the ideal model (section 8), then each pair it tells apart whose states may "
-        f"read alike again for strong plans under a rotation error of "
-        f"±{unc.rotation_error_deg:g} deg"
+        f"read alike again for strong plans under {_under(unc, 'a')}"
         if result.pairs is not None
-        else f"rotation error ±{unc.rotation_error_deg:g} deg: without a sensor no pair is "
-        "told apart anyway (section 8.6)",
+        else f"{_under(unc, 'a')}: without a sensor no pair is told apart anyway (section 8.6)",
     )
     summary.add_row(
         "tolerances",
@@ -261,7 +311,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
                 result.strong_pairs,
                 pfs,
                 "pairs told apart only on the ideal model: no strong plan tells them apart "
-                f"under a rotation error of ±{unc.rotation_error_deg:g} deg",
+                f"under {_under(unc, 'a')}",
             )
         )
     if not result.pairs and result.pairs is not None and not isinstance(result.sensor, NoSensor):
