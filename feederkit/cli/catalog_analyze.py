@@ -49,7 +49,7 @@ from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, make_sensor
-from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, Uncertainty, check_for_part
+from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, Uncertainty
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -164,11 +164,9 @@ def analyze_command(
     )
     unc = analysis_uncertainty(rotation_error, shape_tolerance, com_tolerance)
     pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
-    with flag_words():  # a tolerance too large for a part: one line naming it and the flag
-        for pf in pfs:
-            check_for_part(unc, pf.part)
-        with err_console.status("analyzing ..."):
-            result = analyze_mix(pfs, sensor, uncertainty=unc)
+    # A tolerance too large for a member is refused first: one line naming it and the flag.
+    with flag_words(), err_console.status("analyzing ..."):
+        result = analyze_mix(pfs, sensor, uncertainty=unc)
     if json_out:
         data = result.to_dict()
         data["skipped"] = skipped
