@@ -1363,11 +1363,11 @@ def read_back(plan: Plan | Mapping[str, Any]) -> tuple[str, Plan]:
     writes exactly it, and parsing an 11 MB plan again would cost a command its deadline). A
     file the loader refuses is a bug in feederkit, never a written file (AssertionError)."""
     value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
+    text = plan_json(value)  # ValueError for a NaN or an infinity, which JSON cannot hold
     try:
-        view = plan_from_dict(value, "the plan to write")
+        return text, plan_from_dict(value, "the plan to write")
     except InputError as exc:
         raise AssertionError(f"feederkit made a plan file its own loader refuses: {exc}") from None
-    return plan_json(value), view
 
 
 def _too_deep(source: str, max_depth: int) -> str:
