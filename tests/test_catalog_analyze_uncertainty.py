@@ -269,3 +269,66 @@ def test_reading_pairs_under_a_shape_tolerance():
     assert reading_pairs(pfs, sensor, Uncertainty(1.0, 0.05)) == {(0, 1), (0, 2)}
     assert reading_pairs(pfs, sensor, Uncertainty(0.0, 0.04, 0.01)) == {(0, 1), (0, 2)}
     assert reading_pairs(pfs, sensor, Uncertainty(1.0, 0.0, 0.05)) == {(0, 2)}
+
+
+def test_a_member_no_strong_plan_orients_alone_is_listed_once_not_in_every_pair(tmp_path, capsys):
+    """The 2 x 1 mm rectangle under a shape tolerance of 0.05 mm has no strong plan even
+    alone (compile says so): the analysis lists it as such and checks none of its pairs, where
+    each pair with it used to be listed as a pair no strong plan tells apart."""
+    path = str(tmp_path / "c.db")
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    for name in ("rectangle-2x1", "t-clip", "l-bracket"):
+        assert (
+            run(capsys, "catalog", "add", str(CATALOG / f"{name}.json"), "--catalog", path)[0] == 0
+        )
+    flags = ("--tolerance", "0.5", "--rotation-error", "1", "--shape-tolerance", "0.05")
+    rc, out, err = run(capsys, "catalog", "analyze", *flags, "--json", "--catalog", path)
+    data = json.loads(out)
+    assert rc == 1 and "no strong plan orients even alone" in err
+    alone = {x["part"]: x["states"] for x in data["no_strong_plan_alone"]}
+    assert set(alone) == {"rectangle-2x1/up", "rectangle-2x1/down"}
+    assert all(alone.values())
+    assert data["counts"]["no_strong_plan_alone"] == 2
+    listed = {n for w in data["apart_only_on_the_ideal_model"] for n in (w["part_a"], w["part_b"])}
+    assert not any(n.startswith("rectangle-2x1") for n in listed)
+    # compile agrees: the rectangle alone has no strong plan; the other two have one
+    compile_ = ("changeover", "compile", "x", "--catalog", path, *flags)
+    rc, _, err = run(capsys, *compile_, "--mix", "rectangle-2x1")
+    assert rc == 1 and "no strong plan" in err
+    rc, _, _ = run(capsys, *compile_, "--mix", "t-clip")
+    assert rc == 0
+    rc, out, _ = run(capsys, "catalog", "analyze", *flags, "--catalog", path)
+    assert "no strong plan orients these even alone" in out and "rectangle-2x1/up" in out
+
+
+def test_check_alone_agrees_with_plan(tmp_path):
+    """check_alone says "no strong plan" exactly where plan does, on the sample parts at two
+    shape tolerances (a brute check of the library's verdict against the planner's)."""
+    from feederkit.errors import PlanningError
+    from feederkit.mechanics.push import push_function
+    from feederkit.mix.strongpairs import check_alone
+    from feederkit.outline import load_outline_json
+    from feederkit.part import make_part
+    from feederkit.plans.make import make_plan
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    sensor = ToleranceSensor(0.5)
+    disagree: list[tuple[str, float, bool]] = []
+    seen: set[bool] = set()
+    for path in sorted(CATALOG.glob("*.json")):
+        pf = push_function(make_part(load_outline_json(path)))
+        for shape in (0.0, 0.05):
+            unc = Uncertainty(1.0, shape)
+            verdict = check_alone(pf, sensor, unc)
+            assert verdict.decided
+            try:
+                make_plan([pf], sensor, uncertainty=unc, certify=False)
+                planned = True
+            except PlanningError as exc:
+                assert "no strong plan" in str(exc)
+                planned = False
+            seen.add(planned)
+            if planned != verdict.orients:
+                disagree.append((path.stem, shape, planned))
+    assert not disagree and seen == {True, False}

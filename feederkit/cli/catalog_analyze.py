@@ -176,6 +176,8 @@ def analyze_command(
         for line in skipped:
             err_console.print(f"warning: {line}", highlight=False, markup=False)
         _print_report(result, pfs, over_landings)
+    what = "landings" if over_landings else "parts"
+    problems = []
     if result.pairs or result.strong_pairs:
         found = (result.pairs or ()) + result.strong_pairs
         n = len(found)
@@ -186,11 +188,21 @@ def analyze_command(
             if unc.is_ideal
             else f" (of them {len(result.strong_pairs)} only under {_under(unc)})"
         )
-        raise CheckFailed(
-            f"{plural(n, 'pair')} of {'landings' if over_landings else 'parts'} no plan can tell "
-            f"apart with this sensor{under}: {named}{more}; "
-            + _advice({w.kind for w in found}, unc)
+        problems.append(
+            f"{plural(n, 'pair')} of {what} no plan can tell apart with this sensor{under}: "
+            f"{named}{more}; " + _advice({w.kind for w in found}, unc)
         )
+    if result.alone:
+        n = len(result.alone)
+        named = ", ".join(result.names[i] for i, _states in result.alone[:5])
+        more = f" and {n - 5} more" if n > 5 else ""
+        problems.append(
+            f"{n} of the {what} no strong plan orients even alone under {_under(unc)}: "
+            f"{named}{more}; every mix holding one fails (a finer sensor, tighter tolerances "
+            "or leaving them out of strong plans)"
+        )
+    if problems:
+        raise CheckFailed("; and ".join(problems))
 
 
 def _under(unc: Uncertainty, article: str = "the") -> str:
@@ -280,9 +292,23 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
         )
     if not unc.is_ideal and result.pairs is not None:
         summary.add_row(
+            "no strong plan orients alone",
+            f"{len(result.alone)}"
+            + (
+                f" ({result.undecided_alone} undecided: too many sets)"
+                if result.undecided_alone
+                else ""
+            ),
+        )
+        summary.add_row(
             "apart only on the ideal model",
             f"{len(result.strong_pairs)}"
-            + (f" ({result.undecided} undecided: too many sets)" if result.undecided else ""),
+            + (f" ({result.undecided} undecided: too many sets)" if result.undecided else "")
+            + (
+                " (pairs with a member no strong plan orients alone not checked)"
+                if result.alone
+                else ""
+            ),
         )
     console.print(summary)
     for title, classes in (
@@ -312,6 +338,17 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
                 f"under {_under(unc, 'a')}",
             )
         )
+    if result.alone:
+        t = Table(title=f"no strong plan orients these even alone under {_under(unc, 'a')}")
+        add_name_column(t, "part")
+        t.add_column("states no strong plan tells apart (edge, diameter mm)")
+        for i, states in result.alone:
+            ss = pfs[i].states
+            t.add_row(
+                escape(result.names[i]),
+                ", ".join(f"{k} (e{ss[k].edge} {ss[k].diameter:.4g})" for k in states),
+            )
+        console.print(t)
     if not result.pairs and result.pairs is not None and not isinstance(result.sensor, NoSensor):
         console.print(
             "every pair of parts can be told apart by some plan on the ideal model (Theorem 11)"

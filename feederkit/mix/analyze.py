@@ -15,7 +15,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
-from feederkit.mix.strongpairs import check_strong_pair, reading_pairs
+from feederkit.mix.strongpairs import check_alone, check_strong_pair, reading_pairs
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 
@@ -49,6 +49,12 @@ class MixAnalysis:
     ``uncertainty`` (:func:`~feederkit.mix.strongpairs.check_strong_pair`)."""
     undecided: int = 0
     """Pairs whose check under ``uncertainty`` ran out of sets."""
+    alone: tuple[tuple[int, tuple[int, ...]], ...] = ()
+    """The members no strong plan orients even alone under ``uncertainty``, each with its
+    states no strong plan tells apart (:func:`~feederkit.mix.strongpairs.check_alone`): every
+    mix holding one fails, so its pairs are not checked."""
+    undecided_alone: int = 0
+    """Members whose check alone ran out of sets (their pairs are checked)."""
 
     @property
     def shared_push(self) -> list[BehaviourClass]:
@@ -75,6 +81,8 @@ class MixAnalysis:
             "unrecognizable_pairs": n * (n - 1) // 2 if self.pairs is None else len(self.pairs),
             "apart_only_on_the_ideal_model": len(self.strong_pairs),
             "undecided_pairs": self.undecided,
+            "no_strong_plan_alone": len(self.alone),
+            "undecided_alone": self.undecided_alone,
         }
 
     def to_dict(self) -> dict[str, Any]:
@@ -98,6 +106,9 @@ class MixAnalysis:
             "all_pairs_unrecognizable": self.pairs is None and len(self.names) > 1,
             "unrecognizable_pairs": [] if self.pairs is None else [w.to_dict() for w in self.pairs],
             "apart_only_on_the_ideal_model": [w.to_dict() for w in self.strong_pairs],
+            "no_strong_plan_alone": [
+                {"part": self.names[i], "states": list(states)} for i, states in self.alone
+            ],
         }
 
 
@@ -113,7 +124,9 @@ def analyze_mix(
     a declared ``uncertainty`` (rotation error, shape and COM tolerances: design.md), also
     the pairs only the ideal model tells apart, each pair that may read alike
     (:func:`~feederkit.mix.strongpairs.reading_pairs`, the physical states' diameter
-    intervals under a shape or COM tolerance) checked for strong plans on its own.
+    intervals under a shape or COM tolerance) checked for strong plans on its own, after
+    each member alone (:func:`~feederkit.mix.strongpairs.check_alone`): a pair holding a
+    member no strong plan orients alone is that member's failure, not the pair's.
 
     Raises InputError naming the part when a tolerance is too large for one
     (:func:`~feederkit.uncertainty.check_for_part`), before any work, as ``plan`` does."""
@@ -135,11 +148,19 @@ def analyze_mix(
         pairs = tuple(unrecognizable_pairs(pfs, sensor, todo, signatures=sigs))
     t3 = time.perf_counter()
     strong: list[PairWitness] = []
-    undecided = 0
+    undecided = undecided_alone = 0
+    alone: list[tuple[int, tuple[int, ...]]] = []
     if pairs is not None and not unc.is_ideal:
+        for i, pf in enumerate(pfs):
+            verdict = check_alone(pf, sensor, unc)
+            undecided_alone += not verdict.decided
+            if verdict.states:
+                alone.append((i, verdict.states))
+        # A mix holding a member no strong plan orients alone fails whatever the other part.
         confused = {(w.index_a, w.index_b) for w in pairs}
+        hopeless = {i for i, _states in alone}
         for i, j in sorted(set(todo) | reading_pairs(pfs, sensor, unc)):
-            if (i, j) in confused:
+            if (i, j) in confused or i in hopeless or j in hopeless:
                 continue
             check = check_strong_pair(pfs[i], pfs[j], sensor, unc)
             if not check.decided:
@@ -164,4 +185,6 @@ def analyze_mix(
         uncertainty=unc,
         strong_pairs=tuple(strong),
         undecided=undecided,
+        alone=tuple(alone),
+        undecided_alone=undecided_alone,
     )

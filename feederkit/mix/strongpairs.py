@@ -26,7 +26,7 @@ from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.mix.changeover import strong_witnesses
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.budget import Deadline
-from feederkit.planning.lumping import unresolvable_pairs
+from feederkit.planning.lumping import try_lumping, unresolvable_pairs
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import Diameter, Sensor, span
@@ -41,6 +41,24 @@ class StrongPairCheck:
 
     witness: PairWitness | None
     decided: bool = True
+
+
+@dataclass(frozen=True)
+class AloneCheck:
+    """Whether some strong plan orients one member on its own (a mix of it alone): ``states``
+    its resting states that no strong plan tells apart even when the plan may list
+    near-symmetric states together (the default lumping rule of ``plan`` and ``changeover
+    compile``), empty when one does; ``decided`` False when the search ran out of sets
+    (``states`` then empty). Every mix holding such a member has no strong plan, whatever the
+    other parts."""
+
+    states: tuple[int, ...]
+    decided: bool = True
+
+    @property
+    def orients(self) -> bool:
+        """Whether a strong plan is known to orient the member alone."""
+        return self.decided and not self.states
 
 
 def reading_pairs(
@@ -136,8 +154,43 @@ def check_strong_pair(
     return StrongPairCheck(witnesses[0] if witnesses else None)
 
 
+def check_alone(
+    pf: PushFunction, sensor: Sensor, uncertainty: Uncertainty, deadline: Deadline | None = None
+) -> AloneCheck:
+    """Whether a strong plan orients ``pf`` alone under ``uncertainty`` with ``sensor``: no
+    pair of its physical states is unresolvable, or every such pair is one the default rule
+    lets a plan list together and the lumped goal is reached
+    (:func:`~feederkit.planning.lumping.try_lumping`, as ``plan`` decides "no strong plan
+    exists"). The states named are the ideal members of the pairs left. Timeout when
+    ``deadline`` passes.
+
+    >>> from feederkit.mechanics.push import push_function
+    >>> from feederkit.outline import make_outline
+    >>> from feederkit.part import make_part
+    >>> from feederkit.sensors import ToleranceSensor
+    >>> box = make_part(make_outline("box", [(0, 0), (40, 0), (40, 10), (0, 10)]))
+    >>> check_alone(push_function(box), ToleranceSensor(0.5), Uncertainty(1.0)).orients
+    True
+    """
+    machine, _old = by_diameter(build_machine([pf], sensor, uncertainty))
+    found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
+    if found is None:
+        return AloneCheck((), decided=False)
+    if not found:
+        return AloneCheck(())
+    tried = try_lumping(machine, deadline=deadline)
+    if tried.goal is not None:
+        return AloneCheck(())
+    if not tried.decided:
+        return AloneCheck((), decided=False)
+    left = tried.unlike or found
+    return AloneCheck(tuple(sorted({machine.states[k].state for pair in left for k in pair})))
+
+
 __all__ = [
+    "AloneCheck",
     "StrongPairCheck",
+    "check_alone",
     "check_strong_pair",
     "physical_diameters",
     "range_pairs",
