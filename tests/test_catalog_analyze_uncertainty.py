@@ -299,36 +299,46 @@ def test_a_member_no_strong_plan_orients_alone_is_listed_once_not_in_every_pair(
     assert rc == 0
     rc, out, _ = run(capsys, "catalog", "analyze", *flags, "--catalog", path)
     assert "no strong plan orients these even alone" in out and "rectangle-2x1/up" in out
+    # without a sensor no pair is listed (section 8.6), and the members are still checked
+    blind = ("--sensorless", "--rotation-error", "1", "--shape-tolerance", "0.05", "--json")
+    rc, out, _ = run(capsys, "catalog", "analyze", *blind, "--catalog", path)
+    names = {x["part"] for x in json.loads(out)["no_strong_plan_alone"]}
+    assert rc == 1 and {"rectangle-2x1/up", "rectangle-2x1/down"} <= names
 
 
-def test_check_alone_agrees_with_plan(tmp_path):
-    """check_alone says "no strong plan" exactly where plan does, on the sample parts at two
-    shape tolerances (a brute check of the library's verdict against the planner's)."""
+def test_check_alone_agrees_with_plan():
+    """check_alone says "no strong plan" exactly where plan does (a brute check of the
+    library's verdict against the planner's): the sample parts and a near-square trapezoid
+    whose every pair of states has a strong plan while the whole set has none, at two shape
+    tolerances, with a sensor and without."""
     from feederkit.errors import PlanningError
     from feederkit.mechanics.push import push_function
     from feederkit.mix.strongpairs import check_alone
-    from feederkit.outline import load_outline_json
+    from feederkit.outline import load_outline_json, make_outline
     from feederkit.part import make_part
     from feederkit.plans.make import make_plan
-    from feederkit.sensors import ToleranceSensor
+    from feederkit.sensors import NoSensor, ToleranceSensor
     from feederkit.uncertainty import Uncertainty
 
-    sensor = ToleranceSensor(0.5)
-    disagree: list[tuple[str, float, bool]] = []
+    square = [(12.40, -10.92), (12.42, 12.31), (-12.42, 12.31), (-12.40, -10.92)]
+    pfs = [push_function(make_part(load_outline_json(p))) for p in sorted(CATALOG.glob("*.json"))]
+    pfs.append(push_function(make_part(make_outline("nsq", square, com=(0.0, -0.97)))))
+    disagree: list[tuple[str, float, str, bool]] = []
     seen: set[bool] = set()
-    for path in sorted(CATALOG.glob("*.json")):
-        pf = push_function(make_part(load_outline_json(path)))
-        for shape in (0.0, 0.05):
-            unc = Uncertainty(1.0, shape)
-            verdict = check_alone(pf, sensor, unc)
-            assert verdict.decided
-            try:
-                make_plan([pf], sensor, uncertainty=unc, certify=False)
-                planned = True
-            except PlanningError as exc:
-                assert "no strong plan" in str(exc)
-                planned = False
-            seen.add(planned)
-            if planned != verdict.orients:
-                disagree.append((path.stem, shape, planned))
+    for pf in pfs:
+        for sensor in (ToleranceSensor(0.5), ToleranceSensor(1.0), NoSensor()):
+            for shape in (0.0, 0.05):
+                unc = Uncertainty(1.0, shape)
+                verdict = check_alone(pf, sensor, unc)
+                assert verdict.decided
+                try:
+                    make_plan([pf], sensor, uncertainty=unc, certify=False)
+                    planned = True
+                except PlanningError as exc:
+                    assert "no strong plan" in str(exc)
+                    planned = False
+                    assert verdict.states  # the states to blame are named
+                seen.add(planned)
+                if planned != verdict.orients:
+                    disagree.append((pf.part.name, shape, type(sensor).__name__, planned))
     assert not disagree and seen == {True, False}

@@ -158,7 +158,11 @@ def analyze_command(
     and list those told apart only on the ideal model (a near-duplicate 0.05 mm longer is
     one at 1 degree).
 
-    Exit 1 when some pair cannot be told apart (design.md: a result to act on)."""
+    Under a declared uncertainty each member is checked alone first: one no strong plan
+    orients even alone is listed once and its pairs are not checked.
+
+    Exit 1 when some pair cannot be told apart, or some member has no strong plan alone
+    (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
@@ -198,8 +202,9 @@ def analyze_command(
         more = f" and {n - 5} more" if n > 5 else ""
         problems.append(
             f"{n} of the {what} no strong plan orients even alone under {_under(unc)}: "
-            f"{named}{more}; every mix holding one fails (a finer sensor, tighter tolerances "
-            "or leaving them out of strong plans)"
+            f"{named}{more}; no mix that plans one has a strong plan (a finer sensor or tighter "
+            "tolerances may help; else leave it out of the mix or, for a landing, reject it: "
+            "changeover compile --accept)"
         )
     if problems:
         raise CheckFailed("; and ".join(problems))
@@ -290,7 +295,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
             "unrecognizable pairs",
             f"{c['unrecognizable_pairs']} (exact test on {c['candidate_pairs']} candidate pairs)",
         )
-    if not unc.is_ideal and result.pairs is not None:
+    if not unc.is_ideal:
         summary.add_row(
             "no strong plan orients alone",
             f"{len(result.alone)}"
@@ -300,6 +305,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
                 else ""
             ),
         )
+    if not unc.is_ideal and result.pairs is not None:
         summary.add_row(
             "apart only on the ideal model",
             f"{len(result.strong_pairs)}"
@@ -341,7 +347,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
     if result.alone:
         t = Table(title=f"no strong plan orients these even alone under {_under(unc, 'a')}")
         add_name_column(t, "part")
-        t.add_column("states no strong plan tells apart (edge, diameter mm)")
+        t.add_column("states no strong plan orients together (edge, diameter mm)")
         for i, states in result.alone:
             ss = pfs[i].states
             t.add_row(

@@ -150,12 +150,13 @@ def analyze_mix(
     strong: list[PairWitness] = []
     undecided = undecided_alone = 0
     alone: list[tuple[int, tuple[int, ...]]] = []
-    if pairs is not None and not unc.is_ideal:
+    if not unc.is_ideal:
         for i, pf in enumerate(pfs):
             verdict = check_alone(pf, sensor, unc)
             undecided_alone += not verdict.decided
-            if verdict.states:
+            if verdict.decided and not verdict.orients:
                 alone.append((i, verdict.states))
+    if pairs is not None and not unc.is_ideal:
         # A mix holding a member no strong plan orients alone fails whatever the other part.
         confused = {(w.index_a, w.index_b) for w in pairs}
         hopeless = {i for i, _states in alone}

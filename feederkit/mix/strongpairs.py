@@ -19,6 +19,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from feederkit.machine import members
 from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
@@ -28,7 +29,9 @@ from feederkit.mix.pairs import PairWitness
 from feederkit.planning.budget import Deadline
 from feederkit.planning.lumping import try_lumping, unresolvable_pairs
 from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
+from feederkit.planning.solvable import solve
 from feederkit.sensors import Diameter, Sensor, span
 from feederkit.uncertainty import Uncertainty
 
@@ -45,20 +48,17 @@ class StrongPairCheck:
 
 @dataclass(frozen=True)
 class AloneCheck:
-    """Whether some strong plan orients one member on its own (a mix of it alone): ``states``
-    its resting states that no strong plan tells apart even when the plan may list
-    near-symmetric states together (the default lumping rule of ``plan`` and ``changeover
-    compile``), empty when one does; ``decided`` False when the search ran out of sets
-    (``states`` then empty). Every mix holding such a member has no strong plan, whatever the
-    other parts."""
+    """Whether some strong plan orients one member on its own (a mix of it alone), even when
+    the plan may list near-symmetric states together (the default lumping rule of ``plan``
+    and ``changeover compile``): ``orients``; where none does, ``states`` names the member's
+    ideal resting states to blame (those of the pairs no strong plan resolves, else those of
+    the reading sets no strong plan orients together). ``decided`` False when the search ran
+    out of sets (``orients`` is then False and ``states`` empty). A mix that plans such a
+    member has no strong plan, whatever the other parts."""
 
-    states: tuple[int, ...]
+    orients: bool
+    states: tuple[int, ...] = ()
     decided: bool = True
-
-    @property
-    def orients(self) -> bool:
-        """Whether a strong plan is known to orient the member alone."""
-        return self.decided and not self.states
 
 
 def reading_pairs(
@@ -157,12 +157,12 @@ def check_strong_pair(
 def check_alone(
     pf: PushFunction, sensor: Sensor, uncertainty: Uncertainty, deadline: Deadline | None = None
 ) -> AloneCheck:
-    """Whether a strong plan orients ``pf`` alone under ``uncertainty`` with ``sensor``: no
-    pair of its physical states is unresolvable, or every such pair is one the default rule
-    lets a plan list together and the lumped goal is reached
-    (:func:`~feederkit.planning.lumping.try_lumping`, as ``plan`` decides "no strong plan
-    exists"). The states named are the ideal members of the pairs left. Timeout when
-    ``deadline`` passes.
+    """Whether a strong plan orients ``pf`` alone under ``uncertainty`` with ``sensor``, as
+    ``plan`` decides "no strong plan exists": every reading set of the first alignment has a
+    strong plan (:func:`~feederkit.planning.solvable.solve`, exact), or else the lumped goal
+    of the default rule has one (:func:`~feederkit.planning.lumping.try_lumping`). Every pair
+    of states may have a strong plan while the whole set has none. Timeout when ``deadline``
+    passes.
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.outline import make_outline
@@ -173,18 +173,26 @@ def check_alone(
     True
     """
     machine, _old = by_diameter(build_machine([pf], sensor, uncertainty))
-    found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
-    if found is None:
-        return AloneCheck((), decided=False)
-    if not found:
-        return AloneCheck(())
+    problem = Problem(machine, "exact", 0.0)
+    roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
+    value = solve(problem, roots, deadline)
+    if value is None:
+        return AloneCheck(False, decided=False)
+    if all(math.isfinite(value[r]) for r in roots):
+        return AloneCheck(True)
     tried = try_lumping(machine, deadline=deadline)
     if tried.goal is not None:
-        return AloneCheck(())
+        return AloneCheck(True)
     if not tried.decided:
-        return AloneCheck((), decided=False)
-    left = tried.unlike or found
-    return AloneCheck(tuple(sorted({machine.states[k].state for pair in left for k in pair})))
+        return AloneCheck(False, decided=False)
+    blamed = [k for pair in tried.unlike for k in pair]
+    if not blamed:
+        found = unresolvable_pairs(problem, deadline) or ()
+        blamed = [k for pair in found for k in pair]
+    if not blamed:
+        blamed = [k for r in roots if not math.isfinite(value[r]) for k in members(r)]
+    ideal = {i for k in blamed for i in machine.states[k].ideal_states}
+    return AloneCheck(False, tuple(sorted(ideal)))
 
 
 __all__ = [
