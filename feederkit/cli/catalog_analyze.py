@@ -213,11 +213,14 @@ def analyze_command(
 def _under(unc: Uncertainty, article: str = "the") -> str:
     """The declared uncertainty in words: the rotation error, and the shape and COM
     tolerances when either is given (``article``: "the" or "a")."""
-    words = (
-        f"the rotation error ±{unc.rotation_error_deg:g} deg"
-        if article == "the"
-        else f"a rotation error of ±{unc.rotation_error_deg:g} deg"
-    )
+    if unc.rotation_error_deg == 0.0:
+        words = "exact rotations"
+    else:
+        words = (
+            f"the rotation error ±{unc.rotation_error_deg:g} deg"
+            if article == "the"
+            else f"a rotation error of ±{unc.rotation_error_deg:g} deg"
+        )
     if unc.radius_error_mm > 0.0:
         words += (
             f", a shape tolerance of {unc.shape_tolerance_mm:g} mm and a COM tolerance of "

@@ -4,7 +4,8 @@ verification on geometry; plans over landings (reject results) and shared subpla
 - :mod:`~feederkit.plans.model`: the one immutable :class:`Plan` (parts, sensor, tree, stats).
 - :mod:`~feederkit.plans.fileformat`: the only maker and writer of a Plan:
   ``plan_from_result``, ``plan_from_dict``, ``read_plan`` (size and depth limits),
-  ``plan_to_dict``, ``plan_json``, ``write_plan`` (atomic).
+  ``plan_to_dict``, ``plan_json``, ``plan_file_text`` and ``read_back`` (checked before
+  anything is written), ``write_plan`` (atomic).
 - :mod:`~feederkit.plans.stats`: the ``stats`` object (length, margins, Fig. 14 class bound).
 - :mod:`~feederkit.plans.execute`: ``execute`` a plan on the kinematic model rebuilt from
   the plan's hulls and COMs, giving a ``Trace``.
@@ -21,10 +22,12 @@ from feederkit.plans.fileformat import (
     MAX_PLAN_DEPTH,
     VERSION,
     as_plan,
+    plan_file_text,
     plan_from_dict,
     plan_from_result,
     plan_json,
     plan_to_dict,
+    read_back,
     read_plan,
     validate_plan,
     write_plan,
@@ -67,12 +70,14 @@ __all__ = [
     "execute",
     "leaf_part_pairs",
     "match_part",
+    "plan_file_text",
     "plan_from_dict",
     "plan_from_result",
     "plan_json",
     "plan_stats",
     "plan_to_dict",
     "push_function_of",
+    "read_back",
     "read_plan",
     "validate_plan",
     "verify_plan",

@@ -581,7 +581,9 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
 def write_plan(
     plan: Plan | str | os.PathLike[str], path: str | os.PathLike[str] | Plan | Mapping[str, Any]
 ) -> None:
-    """Write a plan file atomically (a temporary file beside it, then a rename).
+    """Write a plan file atomically (a temporary file beside it, then a rename), its text
+    checked first (:func:`plan_file_text`: ValueError for a NaN or an infinity,
+    AssertionError for a plan the loader would refuse; no file either way).
 
     ``write_plan(plan, path)``; the older order ``write_plan(path, plan_dict)`` is accepted
     while callers move to the :class:`Plan`.
