@@ -342,3 +342,18 @@ def test_check_alone_agrees_with_plan():
                 if planned != verdict.orients:
                     disagree.append((pf.part.name, shape, type(sensor).__name__, planned))
     assert not disagree and seen == {True, False}
+
+
+def test_two_landings_of_one_part_get_their_own_advice(tmp_path, capsys):
+    """A pair that is one part's two sides cannot be kept out of one mix: the line says to
+    plan one landing or reject the others."""
+    path = str(tmp_path / "c.db")
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    for name in ("rectangle-2x1", "l-bracket"):
+        assert (
+            run(capsys, "catalog", "add", str(CATALOG / f"{name}.json"), "--catalog", path)[0] == 0
+        )
+    rc, _, err = run(capsys, "catalog", "analyze", "--tolerance", "1", "--catalog", path)
+    assert rc == 1 and "rectangle-2x1/up & rectangle-2x1/down" in err
+    assert "1 of them two landings of one part" in err and "--landings" in err
+    assert "only under" not in err  # the ideal model's pair: no rotation error declared

@@ -63,9 +63,12 @@ def catalog_file(option: Path | None) -> Path:
     return path
 
 
-def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]:
+def load_catalog_parts(
+    path: Path,
+) -> tuple[list[PushFunction], list[str], tuple[str, ...] | None]:
     """Push functions of every landing of every orientable part's latest revision, a
-    warning per part (or mesh pose) left out, and whether the members are the landings.
+    warning per part (or mesh pose) left out, and, when the members are the landings, the
+    part each belongs to (None: the members are the parts).
 
     design.md, "Landings": plans cover every landing unless told otherwise, so the analysis
     is of the mix ``plan`` would plan: when some part has several landings, each landing is
@@ -92,15 +95,17 @@ def load_catalog_parts(path: Path) -> tuple[list[PushFunction], list[str], bool]
     finally:
         conn.close()
     if not plans_over_landings([lands for _, lands in per_part], False, False):
-        return [push_function(part) for part, _ in per_part], skipped, False
+        return [push_function(part) for part, _ in per_part], skipped, None
     pfs = []
-    for _, lands in per_part:
+    owners = []
+    for part, lands in per_part:
         for x in lands:
             if x.name.startswith("pose-") and not orientability(x.part, None).orientable:
                 skipped.append(f"{x.label}: not orientable by pushing, left out")
                 continue
             pfs.append(push_function(x.part))
-    return pfs, skipped, True
+            owners.append(part.name)
+    return pfs, skipped, tuple(owners)
 
 
 AnalyzeRotationErrorOpt = Annotated[
@@ -167,7 +172,8 @@ def analyze_command(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
     unc = analysis_uncertainty(rotation_error, shape_tolerance, com_tolerance)
-    pfs, skipped, over_landings = load_catalog_parts(catalog_file(catalog))
+    pfs, skipped, owners = load_catalog_parts(catalog_file(catalog))
+    over_landings = owners is not None
     # A tolerance too large for a member is refused first: one line naming it and the flag.
     with flag_words(), err_console.status("analyzing ..."):
         result = analyze_mix(pfs, sensor, uncertainty=unc)
@@ -189,12 +195,20 @@ def analyze_command(
         more = f" and {n - 5} more" if n > 5 else ""
         under = (
             ""
-            if unc.is_ideal
+            if unc.is_ideal or not result.strong_pairs
             else f" (of them {len(result.strong_pairs)} only under {_under(unc)})"
+        )
+        sides = [w for w in found if owners and owners[w.index_a] == owners[w.index_b]]
+        one_part = (
+            f"; {len(sides)} of them two landings of one part, which no mix keeps apart: "
+            "plan only one of them (--landings) or reject the others (changeover compile "
+            "--accept)"
+            if sides
+            else ""
         )
         problems.append(
             f"{plural(n, 'pair')} of {what} no plan can tell apart with this sensor{under}: "
-            f"{named}{more}; " + _advice({w.kind for w in found}, unc)
+            f"{named}{more}; " + _advice({w.kind for w in found}, unc) + one_part
         )
     if result.alone:
         n = len(result.alone)
