@@ -13,8 +13,9 @@ one per machine, once.
 from __future__ import annotations
 
 import bisect
+import operator
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from functools import cached_property
 
 import numpy as np
@@ -48,6 +49,8 @@ class SearchSpace:
     def __init__(self, machine: PushAlignMachine) -> None:
         self._machine = weakref.ref(machine)
         self._rows: dict[int, list[int]] = {}
+        self._bit_rows: dict[int, list[int]] = {}
+        self._pickers: dict[int, Callable[[list[int]], tuple[int, ...]]] = {}
 
     @property
     def machine(self) -> PushAlignMachine:
@@ -171,6 +174,22 @@ class SearchSpace:
         if row is None:
             row = rows[at] = self.cell_table[3][at].tolist()  # type: ignore[index]
         return [row[i] for i in members(mask)]
+
+    def target_masks_at(self, mask: int, rotation: float) -> tuple[int, ...] | None:
+        """:meth:`targets_at` as outcome masks (``1 << target`` per member), the tuple the
+        planners' ``Choices.targets`` holds; None without the table. Each row's masks and
+        each set's picker of its members' columns are made once."""
+        starts = self._cell_starts
+        if starts is None:
+            return None
+        at = bisect.bisect_right(starts, rotation) - 1
+        row = self._bit_rows.get(at)
+        if row is None:
+            row = self._bit_rows[at] = [1 << t for t in self.cell_table[3][at].tolist()]  # type: ignore[index]
+        pick = self._pickers.get(mask)
+        if pick is None:
+            pick = self._pickers[mask] = _picker(members(mask))
+        return pick(row)
 
     def cells_and_images(self, mask: int) -> tuple[np.ndarray, np.ndarray, list[int]] | None:
         """The set's cells (``lo``, ``hi`` arrays: consecutive boundaries of its members
@@ -353,6 +372,14 @@ def _per_cell(
         rows[:, i] = per_range[at]
     assert rows is not None
     return b[order], own[order], distinct, rows
+
+
+def _picker(idx: list[int]) -> Callable[[list[int]], tuple[int, ...]]:
+    """A function taking a row's entries at ``idx`` (in that order) as a tuple."""
+    if len(idx) == 1:
+        i = idx[0]
+        return lambda row: (row[i],)
+    return operator.itemgetter(*idx)  # type: ignore[return-value]
 
 
 _spaces: dict[int, SearchSpace] = {}

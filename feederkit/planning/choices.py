@@ -86,6 +86,8 @@ class Choices:
         self._lazy: dict[int, list] = {}
         self._targets: dict[tuple[int, float], tuple[int, ...]] = {}
         self._fixed: dict[int, list[tuple[float, float, int]]] = {}
+        self._ordered: dict[int, list[tuple[float, float, int]]] = {}
+        self._branch_keys: dict[int, tuple[int, int]] = {}
 
     def fixed_cells(self, mask: int) -> list[tuple[float, float, int]]:
         """The set's cells as ``(lo, hi, image)``, in angular order (cached; see the module).
@@ -335,9 +337,28 @@ class Choices:
             children = (img,) if readings.sensorless else readings.children(img)
             if any(c & mask == mask for c in children):
                 continue
-            out.append((search_key(cell, children), n, cell, children))
+            out.append((self.search_key(cell), n, cell, children))
         out.sort()
         return [(cell, children) for _key, _n, cell, children in out]
+
+    def search_order(self, mask: int) -> list[tuple[float, float, int]]:
+        """Every cell of the set (``cells(mask, useful=False)``) in the length search's
+        order (:meth:`search_key`; ties in the cells' own order), cached: a stable sort, so
+        any of its sublists is in the order a sort of that sublist gives."""
+        out = self._ordered.get(mask)
+        if out is None:
+            out = self._ordered[mask] = sorted(self.cells(mask, useful=False), key=self.search_key)
+        return out
+
+    def search_key(self, cell: tuple[float, float, int]) -> tuple[int, int, int, float]:
+        """:func:`search_key` of a cell with its image's maximal branches (the image itself
+        without a sensor), their :func:`children_key` cached per image."""
+        img = cell[2]
+        key = self._branch_keys.get(img)
+        if key is None:
+            children = (img,) if self.readings.sensorless else self.readings.children(img)
+            key = self._branch_keys[img] = children_key(children)
+        return (*key, img.bit_count(), cell[0] - cell[1])
 
     def targets(self, mask: int, sa: OverlapRange) -> tuple[int, ...]:
         """Where each member of ``mask`` (ascending) can go under the range's representative:
@@ -351,9 +372,9 @@ class Choices:
     def _outcomes_at(self, mask: int, x: float) -> tuple[int, ...]:
         """Each member's outcome set (a mask) under the rotation ``x``: from the search
         space's table when it has one, else from the machine."""
-        row = self._space.targets_at(mask, x)
+        row = self._space.target_masks_at(mask, x)
         if row is not None:
-            return tuple(1 << j for j in row)
+            return row
         return tuple(self.machine.outcomes(i, x) for i in members(mask))
 
 

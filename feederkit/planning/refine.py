@@ -47,7 +47,7 @@ from collections.abc import Callable
 from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
-from feederkit.planning.choices import search_key, spread
+from feederkit.planning.choices import spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.refuted import RefutedSets
@@ -329,9 +329,7 @@ class Refiner:
         so the length search (its memo, pair bounds and refuted sets) is asked of each
         range's branches first.
         """
-        cells = self._search_order(
-            [c for c in self.p.choices.cells(mask, useful=False) if _wide(c, x, strict)]
-        )
+        cells = (c for c in self.p.choices.search_order(mask) if _wide(c, x, strict))
         for cell in cells:
             m = (cell[1] - cell[0]) / 2.0
             if self.p.sensorless:
@@ -358,16 +356,6 @@ class Refiner:
             else:
                 return val, cell
         return None
-
-    def _search_order(self, cells: list[Cell]) -> list[Cell]:
-        """``cells`` in the length search's order
-        (:func:`~feederkit.planning.choices.search_key`)."""
-
-        def key(cell: Cell) -> tuple[int, int, int, float]:
-            img = cell[2]
-            return search_key(cell, (img,) if self.p.sensorless else self.p.readings.children(img))
-
-        return sorted(cells, key=key)
 
     def margin(self, mask: int, k: int) -> float:
         """The largest smallest margin of plans for ``mask`` within ``k`` operations (inf
