@@ -337,6 +337,40 @@ class Readings:
         self._open[image] = out
         return out
 
+    def open_mass(self, image: int, moved: dict[int, float]) -> float | None:
+        """``sum(w * open_probability(image)[t] for t, w in moved.items())``, the same float
+        (``moved``: mass per state of ``image``, every state of it a key), or None where
+        :meth:`open_probability` is None.
+
+        Each state's figure is its (previous, state, next) triple's, the neighbours found
+        by bit operations on ``image``: no member list or per-image table, since the sets
+        a search meets seldom share an image.
+        """
+        if not self._window:
+            return None
+        if image & self._paired and any(self.insep[i] & image for i in members(image)):
+            return None
+        win = self._window
+        shared = self._shared
+        total = 0
+        for s, w in moved.items():
+            before = image & ((1 << s) - 1)
+            a = before.bit_length() - 1 if before else -1
+            if a >= 0 and not win[a] >> s & 1:
+                a = -1
+            after = image >> (s + 1)
+            b = s + (after & -after).bit_length() if after else -1
+            if b >= 0 and not win[s] >> b & 1:
+                b = -1
+            key = (a, s, b)
+            p = shared.get(key, _UNSET)
+            if p is _UNSET:
+                p = shared[key] = self._shared_one(key)
+            if p is None:
+                return None
+            total += w * p
+        return total
+
     def _shared_one(self, key: tuple[int, int, int]) -> float | None:
         """The sensor's closed form for the middle state of ``(previous, state, next)``
         (-1: none), or None when it has none."""

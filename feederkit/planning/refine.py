@@ -559,9 +559,9 @@ class Refiner:
     def _open_mass(self, mask: int, masses: Masses, sa: OverlapRange) -> float:
         """Probability that a reading after the action leaves a set not yet oriented."""
         moved = spread(masses, self.p.choices.targets(mask, sa))
-        fast = self.p.readings.open_probability(sa.image)
+        fast = self.p.readings.open_mass(sa.image, moved)
         if fast is not None:
-            return sum(w * fast[t] for t, w in moved.items())
+            return fast
         total = 0.0
         for b, idx, probs in self.p.readings.branch_table(sa.image):
             if not self.p.is_goal(b.mask):
