@@ -31,6 +31,10 @@ _NUMPY_MIN_EVENTS = 256
 _CELL_TABLE_MIN = 100
 """Machines with fewer action-range boundaries in all keep the pure Python cells (faster)."""
 
+_LIST_CELLS_MAX = 64
+"""Sets with fewer action-range boundaries than this get their cells in pure Python
+(:meth:`SearchSpace.cell_lists`)."""
+
 _CELL_TABLE_MAX = 10_000_000
 """The most entries (cells times states, 4 bytes each) of :attr:`SearchSpace.cell_table`."""
 
@@ -190,6 +194,53 @@ class SearchSpace:
         if pick is None:
             pick = self._pickers[mask] = _picker(members(mask))
         return pick(row)
+
+    def cell_lists(self, mask: int) -> tuple[list[float], list[float], list[int]] | None:
+        """:meth:`cells_and_images` as lists, in pure Python, for a set of a deterministic
+        machine whose members have fewer than ``_LIST_CELLS_MAX`` boundaries in all (numpy's
+        fixed cost per call is then most of the work); None otherwise, or where
+        :meth:`cells_and_images` is None. The same floats: the same subtractions, middles
+        and lookups, one cell at a time."""
+        table = self.cell_table
+        if table is None or not mask:
+            return None
+        starts = self.machine.starts
+        idx = members(mask)
+        sb = [x for i in idx for x in starts[i]]
+        if len(sb) >= _LIST_CELLS_MAX:
+            return None
+        sb.sort()
+        distinct = self._cell_starts
+        assert distinct is not None
+        rows = self._bit_rows
+        los: list[float] = []
+        his: list[float] = []
+        images: list[int] = []
+        pick = self._pickers.get(mask)
+        if pick is None:
+            pick = self._pickers[mask] = _picker(idx)
+        last = len(sb) - 1
+        for j, lo in enumerate(sb):
+            hi = sb[j + 1] if j < last else sb[0] + 360.0
+            width = hi - lo
+            if width <= ANGLE_EPS:
+                continue
+            if width <= 4.0 * ANGLE_EPS:
+                return None
+            mid = (lo + hi) / 2.0
+            if mid >= 360.0:
+                mid -= 360.0
+            at = bisect.bisect_right(distinct, mid) - 1
+            row = rows.get(at)
+            if row is None:
+                row = rows[at] = [1 << t for t in table[3][at].tolist()]
+            img = 0
+            for bit in pick(row):
+                img |= bit
+            los.append(lo)
+            his.append(hi)
+            images.append(img)
+        return los, his, images
 
     def cells_and_images(self, mask: int) -> tuple[np.ndarray, np.ndarray, list[int]] | None:
         """The set's cells (``lo``, ``hi`` arrays: consecutive boundaries of its members

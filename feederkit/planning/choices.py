@@ -180,6 +180,10 @@ class Choices:
             return cells
         best: dict[object, tuple[float, float, int]] = {}
         floor = 2.0 * self.min_margin
+        if not self.distinct_maps:
+            listed = self._space.cell_lists(mask)
+            if listed is not None:
+                return self._keep_cells(mask, useful, _widest_per_image(*listed, floor))
         fast = None if self.distinct_maps else self._space.cells_and_images(mask)
         if fast is not None:
             # The same cells and images as fixed_cells, from the machine's cell table.
@@ -363,10 +367,15 @@ class Choices:
     def targets(self, mask: int, sa: OverlapRange) -> tuple[int, ...]:
         """Where each member of ``mask`` (ascending) can go under the range's representative:
         its outcome set, a mask (one bit in the ideal model)."""
-        key = (mask, sa.lo)
+        return self.targets_at(mask, sa.lo, sa.representative)
+
+    def targets_at(self, mask: int, lo: float, rotation: float) -> tuple[int, ...]:
+        """:meth:`targets` of the set's cell that begins at ``lo``, ``rotation`` its
+        representative (cached per set and cell)."""
+        key = (mask, lo)
         t = self._targets.get(key)
         if t is None:
-            t = self._targets[key] = self._outcomes_at(mask, sa.representative)
+            t = self._targets[key] = self._outcomes_at(mask, rotation)
         return t
 
     def _outcomes_at(self, mask: int, x: float) -> tuple[int, ...]:
@@ -411,6 +420,42 @@ def spread(masses, outcomes) -> dict[int, float]:
         for t in ts:
             moved[t] = moved.get(t, 0.0) + share
     return moved
+
+
+def _widest_per_image(
+    los: list[float], his: list[float], imgs: list[int], floor: float
+) -> list[tuple[float, float, int]]:
+    """:meth:`Choices.cells` from a set's cells as lists (``SearchSpace.cell_lists``): the
+    widest cell of each image at least ``floor`` wide (then the smaller rotation), widest
+    first; the same steps as its numpy path, one cell at a time."""
+    keys = [
+        (-round((hi - lo) * 1e9), k)
+        for k, (lo, hi) in enumerate(zip(los, his, strict=True))
+        if hi - lo >= floor
+    ]
+    keys.sort()
+    if all(a[0] < b[0] for a, b in itertools.pairwise(keys)):
+        # No two widths alike: the first cell of each image is its widest, in final order.
+        seen: set[int] = set()
+        out = []
+        for _w, k in keys:
+            img = imgs[k]
+            if img not in seen:
+                seen.add(img)
+                out.append((los[k], his[k], img))
+        return out
+    best: dict[int, tuple[float, float, int]] = {}
+    for _w, k in keys:
+        cell = (los[k], his[k], imgs[k])
+        old = best.get(cell[2])
+        if old is None or _wider(cell, old):
+            best[cell[2]] = cell
+    keyed = [
+        (-width_key(hi - lo), norm360((lo + hi) / 2.0), img, lo, hi)
+        for lo, hi, img in best.values()
+    ]
+    keyed.sort()
+    return [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
 
 
 def _wider(a: tuple[float, float, int], b: tuple[float, float, int]) -> bool:

@@ -453,10 +453,10 @@ class Refiner:
                 self._bounds += 1
                 if self._bounds % BOUNDS_PER_POLL == 0:
                     self.deadline.check()
-                sa = OverlapRange(*cell)
-                step = 1.0 if self.costs is None else self._step(Act(sa, ()))[0]
-                bound = step + least * self._open_mass(mask, masses, sa)
-                options.append((bound, sa.representative, cell))
+                rot = norm360((cell[0] + cell[1]) / 2.0)  # the range's representative
+                step = 1.0 if self.costs is None else self._step(Act(OverlapRange(*cell), ()))[0]
+                bound = step + least * self._open_mass(mask, masses, cell, rot)
+                options.append((bound, rot, cell))
         options.sort(key=lambda o: (o[0], o[1]))
         # Cheapest bound first; whether a plan within k can start with the action is only
         # asked of actions that could still win.
@@ -556,14 +556,16 @@ class Refiner:
         self._wsec[key] = out
         return out
 
-    def _open_mass(self, mask: int, masses: Masses, sa: OverlapRange) -> float:
-        """Probability that a reading after the action leaves a set not yet oriented."""
-        moved = spread(masses, self.p.choices.targets(mask, sa))
-        fast = self.p.readings.open_mass(sa.image, moved)
+    def _open_mass(self, mask: int, masses: Masses, cell: Cell, rotation: float) -> float:
+        """Probability that a reading after the action of ``cell`` (its representative
+        ``rotation``) leaves a set not yet oriented."""
+        image = cell[2]
+        moved = spread(masses, self.p.choices.targets_at(mask, cell[0], rotation))
+        fast = self.p.readings.open_mass(image, moved)
         if fast is not None:
             return fast
         total = 0.0
-        for b, idx, probs in self.p.readings.branch_table(sa.image):
+        for b, idx, probs in self.p.readings.branch_table(image):
             if not self.p.is_goal(b.mask):
                 total += sum(moved.get(s, 0.0) * p for s, p in zip(idx, probs, strict=True))
         return total
