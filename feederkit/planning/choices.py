@@ -444,17 +444,15 @@ def _widest_per_image(
                 seen.add(img)
                 out.append((los[k], his[k], img))
         return out
-    best: dict[int, tuple[float, float, int]] = {}
-    for _w, k in keys:
-        cell = (los[k], his[k], imgs[k])
-        old = best.get(cell[2])
-        if old is None or _wider(cell, old):
-            best[cell[2]] = cell
-    keyed = [
-        (-width_key(hi - lo), norm360((lo + hi) / 2.0), img, lo, hi)
-        for lo, hi, img in best.values()
-    ]
-    keyed.sort()
+    # Per image the wider cell, then the smaller rotation (_wider), the first of equals.
+    best: dict[int, tuple[int, float, int, float, float]] = {}
+    for w, k in keys:
+        lo, hi, img = los[k], his[k], imgs[k]
+        entry = (w, norm360((lo + hi) / 2.0), img, lo, hi)
+        old = best.get(img)
+        if old is None or entry[:2] < old[:2]:
+            best[img] = entry
+    keyed = sorted(best.values())
     return [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
 
 
