@@ -21,6 +21,8 @@ import numpy as np
 
 _START = 256
 """Rows the index starts with (doubled as it fills)."""
+_PYTHON_ROWS = 48
+"""A query with at most this many rows to scan scans them in pure Python."""
 MAX_ROWS = 32768
 """Sets kept at most: a query scans every row (about 0.03 ms per thousand rows of one word),
 and a search opens a set for about a millisecond, so more would cost more than it saves."""
@@ -52,6 +54,8 @@ class RefutedSets:
         self._cols = np.zeros((self._words, _START), dtype=np.uint64)
         self._lb = np.zeros(_START, dtype=np.float64)
         self._count = 0
+        self._masks: list[int] = []
+        self._bounds: list[float] = []
         # mask -> (need, rows): no set among the first ``rows`` inside ``mask`` has a bound
         # of at least ``need``.
         self._clear: dict[int, tuple[float, int]] = {}
@@ -73,6 +77,8 @@ class RefutedSets:
             self._lb = np.concatenate([self._lb, np.zeros_like(self._lb)])
         self._cols[:, self._count] = self._split(mask)
         self._lb[self._count] = lb
+        self._masks.append(mask)
+        self._bounds.append(float(self._lb[self._count]))
         self._count += 1
 
     def bound(self, mask: int, need: float) -> float | None:
@@ -87,6 +93,8 @@ class RefutedSets:
             # The rows before hold nothing of at least clear[0] <= need: scan the new ones
             # at clear[0], so that what is remembered stays as strong.
             start, floor = clear[1], clear[0]
+        if n - start <= _PYTHON_ROWS:
+            return self._scan(mask, need, start, floor)
         lbs = self._lb[start:n]
         hard = lbs >= floor
         if hard.any():
@@ -100,4 +108,18 @@ class RefutedSets:
                     return float(found)
                 floor = need  # held below ``need`` only: remember the weaker fact
         self._clear[mask] = (floor, n)
+        return None
+
+    def _scan(self, mask: int, need: float, start: int, floor: float) -> float | None:
+        """:meth:`bound` over the rows from ``start`` on, one at a time (few rows: numpy's
+        fixed cost per call would be most of the work)."""
+        found = None
+        for row, lb in zip(self._masks[start:], self._bounds[start:], strict=True):
+            if lb >= floor and not row & ~mask and (found is None or lb > found):
+                found = lb
+        if found is not None:
+            if found >= need:
+                return found
+            floor = need  # held below ``need`` only: remember the weaker fact
+        self._clear[mask] = (floor, self._count)
         return None
