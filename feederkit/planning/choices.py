@@ -86,7 +86,6 @@ class Choices:
         self._lazy: dict[int, list] = {}
         self._targets: dict[tuple[int, float], tuple[int, ...]] = {}
         self._fixed: dict[int, list[tuple[float, float, int]]] = {}
-        self._ordered: dict[int, list[tuple[float, float, int]]] = {}
         self._branch_keys: dict[int, tuple[int, int]] = {}
 
     def fixed_cells(self, mask: int) -> list[tuple[float, float, int]]:
@@ -344,15 +343,6 @@ class Choices:
             out.append((self.search_key(cell), n, cell, children))
         out.sort()
         return [(cell, children) for _key, _n, cell, children in out]
-
-    def search_order(self, mask: int) -> list[tuple[float, float, int]]:
-        """Every cell of the set (``cells(mask, useful=False)``) in the length search's
-        order (:meth:`search_key`; ties in the cells' own order), cached: a stable sort, so
-        any of its sublists is in the order a sort of that sublist gives."""
-        out = self._ordered.get(mask)
-        if out is None:
-            out = self._ordered[mask] = sorted(self.cells(mask, useful=False), key=self.search_key)
-        return out
 
     def search_key(self, cell: tuple[float, float, int]) -> tuple[int, int, int, float]:
         """:func:`search_key` of a cell with its image's maximal branches (the image itself

@@ -329,7 +329,11 @@ class Refiner:
         so the length search (its memo, pair bounds and refuted sets) is asked of each
         range's branches first.
         """
-        cells = (c for c in self.p.choices.search_order(mask) if _wide(c, x, strict))
+        choices = self.p.choices
+        cells = sorted(
+            (c for c in choices.cells(mask, useful=False) if _wide(c, x, strict)),
+            key=choices.search_key,
+        )
         for cell in cells:
             m = (cell[1] - cell[0]) / 2.0
             if self.p.sensorless:
