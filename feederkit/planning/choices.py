@@ -419,7 +419,7 @@ def _widest_per_image(
     widest cell of each image at least ``floor`` wide (then the smaller rotation), widest
     first; the same steps as its numpy path, one cell at a time."""
     keys = [
-        (-round((hi - lo) * 1e9), k)
+        (-width_key(hi - lo), k)
         for k, (lo, hi) in enumerate(zip(los, his, strict=True))
         if hi - lo >= floor
     ]
