@@ -355,7 +355,7 @@ def compile_command(
             f"uncertainty: {uncertainty_text(plan.get('uncertainty'))}",
             highlight=False,
         )
-        view = as_plan(plan)  # the file's object read once, for the drawing and the table
+        view = compiled.view or as_plan(plan)  # checked once, for the drawing and the table
         console.print(plan_tree(view))
         console.print(stats_table(view, compiled.made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)

@@ -14,6 +14,7 @@ through :func:`feederkit.landing.plan.plan_landings`; docs/landings.md).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
@@ -37,9 +38,9 @@ from feederkit.machine.weights import normalised_shares
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.pairs import PairWitness, unrecognizable_pairs
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.fileformat import as_plan, parse_plan_text, plan_file_text, validate_plan
+from feederkit.plans.fileformat import as_plan, parse_plan_text, read_back, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
-from feederkit.plans.model import PlanMember, member_fragile_warnings
+from feederkit.plans.model import Plan, PlanMember, member_fragile_warnings
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
 
@@ -59,6 +60,9 @@ class CompiledChangeover:
     warnings: tuple[str, ...] = ()
     rejected: frozenset[str] = frozenset()
     """The landings (``PART/LANDING``) the next station does not take: reject results."""
+    view: Plan | None = None
+    """The plan as stored, checked by the loader's validator (:func:`read_back`) before it
+    was stored: what the command shows, without checking it again."""
 
     @property
     def plan(self) -> dict[str, Any]:
@@ -454,19 +458,20 @@ def compile_changeover(
     files = [] if outputs is None else list(outputs(compiled))
     with StagedFiles(files) as staged:
         try:
+            text, view = read_back(made.plan)  # after ``outputs``, which may annotate it
             save_changeover(
                 catalog,
                 name,
                 revisions,
                 sensor.to_dict(),
-                plan_file_text(made.plan),
+                text,
                 replace=replace,
                 before_commit=staged.commit,
             )
         except BaseException:
             staged.undo()
             raise
-    return compiled
+    return dataclasses.replace(compiled, view=view)
 
 
 def _stored_landings(
