@@ -357,3 +357,21 @@ def test_two_landings_of_one_part_get_their_own_advice(tmp_path, capsys):
     assert rc == 1 and "rectangle-2x1/up & rectangle-2x1/down" in err
     assert "1 of them two landings of one part" in err and "--landings" in err
     assert "only under" not in err  # the ideal model's pair: no rotation error declared
+
+
+def test_a_member_beyond_the_set_budget_is_undecided_and_its_pairs_still_checked(
+    db, capsys, monkeypatch
+):
+    """check_alone explores at most ALONE_SETS sets per search (a screen must not hang on one
+    member): beyond it the member is undecided, counted, and its pairs are checked as
+    before, so the near-duplicate bracket is still listed."""
+    import feederkit.mix.strongpairs as strongpairs
+
+    monkeypatch.setattr(strongpairs, "ALONE_SETS", 1)
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--rotation-error", "1", "--json")
+    rc, out, _ = run(capsys, *args, "--catalog", db)
+    data = json.loads(out)
+    assert data["counts"]["undecided_alone"] >= 1
+    assert data["no_strong_plan_alone"] == []
+    found = {(w["part_a"], w["part_b"]) for w in data["apart_only_on_the_ideal_model"]}
+    assert ("l-bracket/up", "l-bracket-near/up") in found
