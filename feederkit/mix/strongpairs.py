@@ -167,8 +167,9 @@ def check_alone(
     ``plan`` decides "no strong plan exists": every reading set of the first alignment has a
     strong plan (:func:`~feederkit.planning.solvable.solve`, exact), or else the lumped goal
     of the default rule has one (:func:`~feederkit.planning.lumping.try_lumping`). Every pair
-    of states may have a strong plan while the whole set has none. Each search explores at
-    most ``ALONE_SETS`` sets (undecided beyond). Timeout when ``deadline`` passes.
+    of states may have a strong plan while the whole set has none. The searches for a plan
+    explore at most ``ALONE_SETS`` sets (undecided beyond); the pairs to lump are decided at
+    compile's budget. Timeout when ``deadline`` passes.
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.outline import make_outline
@@ -186,7 +187,9 @@ def check_alone(
         return AloneCheck(False, decided=False)
     if all(math.isfinite(value[r]) for r in roots):
         return AloneCheck(True)
-    tried = try_lumping(machine, deadline=deadline, max_sets=ALONE_SETS, pair_sets=ALONE_SETS)
+    # The pair check at compile's own budget: past it try_lumping settles for fewer pairs,
+    # a verdict compile (which decides them) need not share.
+    tried = try_lumping(machine, deadline=deadline, max_sets=ALONE_SETS)
     if tried.goal is not None:
         return AloneCheck(True)
     if not tried.decided:
