@@ -15,7 +15,12 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
 from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
-from feederkit.mix.strongpairs import check_alone, check_strong_pair, reading_pairs
+from feederkit.mix.strongpairs import (
+    check_alone,
+    check_strong_pair,
+    physical_mechanics,
+    reading_pairs,
+)
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 
@@ -150,20 +155,21 @@ def analyze_mix(
     strong: list[PairWitness] = []
     undecided = undecided_alone = 0
     alone: list[tuple[int, tuple[int, ...]]] = []
-    if not unc.is_ideal:
+    mechs = None if unc.is_ideal else physical_mechanics(pfs, unc)  # once for every check
+    if mechs is not None:
         for i, pf in enumerate(pfs):
-            verdict = check_alone(pf, sensor, unc)
+            verdict = check_alone(pf, sensor, unc, mechanics=mechs[i])
             undecided_alone += not verdict.decided
             if verdict.decided and not verdict.orients:
                 alone.append((i, verdict.states))
-    if pairs is not None and not unc.is_ideal:
+    if pairs is not None and mechs is not None:
         # A mix holding a member no strong plan orients alone fails whatever the other part.
         confused = {(w.index_a, w.index_b) for w in pairs}
         hopeless = {i for i, _states in alone}
-        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor, unc)):
+        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor, unc, mechanics=mechs)):
             if (i, j) in confused or i in hopeless or j in hopeless:
                 continue
-            check = check_strong_pair(pfs[i], pfs[j], sensor, unc)
+            check = check_strong_pair(pfs[i], pfs[j], sensor, unc, mechanics=[mechs[i], mechs[j]])
             if not check.decided:
                 undecided += 1
             elif check.witness is not None:

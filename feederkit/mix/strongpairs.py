@@ -19,11 +19,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from feederkit.machine import members
-from feederkit.machine.build import build_machine
+from feederkit.machine import PushAlignMachine, members
+from feederkit.machine.build import build_machine, uncertain_machine
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
-from feederkit.mechanics.uncertain import uncertain_mechanics
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
 from feederkit.mix.changeover import strong_witnesses
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.budget import Deadline
@@ -68,7 +68,11 @@ class AloneCheck:
 
 
 def reading_pairs(
-    pfs: Sequence[PushFunction], sensor: Sensor, uncertainty: Uncertainty | None = None
+    pfs: Sequence[PushFunction],
+    sensor: Sensor,
+    uncertainty: Uncertainty | None = None,
+    *,
+    mechanics: Sequence[UncertainMechanics] | None = None,
 ) -> set[tuple[int, int]]:
     """The pairs ``(i, j)``, ``i < j``, of parts with some states that may read alike: the
     only pairs a strong plan may fail to tell apart.
@@ -83,7 +87,9 @@ def reading_pairs(
     (:func:`range_pairs`) are added: a pair no strong plan tells apart has, in the machine
     of the two, states "with overlapping sensor ranges" (section 5; every pair of states
     the strong analysis keeps together can read alike), and these intervals hold theirs.
-    Rotation error alone keeps the nominal pairs (no mechanics computed).
+    Rotation error alone keeps the nominal pairs (no mechanics computed). ``mechanics``:
+    the parts' :func:`~feederkit.mechanics.uncertain.uncertain_mechanics`, when the caller
+    has them (:func:`physical_mechanics`).
     """
     owner = [k for k, pf in enumerate(pfs) for _ in pf.states]
     diameters = [s.diameter for pf in pfs for s in pf.states]
@@ -92,26 +98,50 @@ def reading_pairs(
         parts = sorted({owner[i] for i in component})
         out.update((a, b) for x, a in enumerate(parts) for b in parts[x + 1 :])
     if uncertainty is not None and uncertainty.radius_error_mm > 0.0:
-        out |= range_pairs(physical_diameters(pfs, uncertainty), sensor)
+        mechs = mechanics or physical_mechanics(pfs, uncertainty)
+        out |= range_pairs(physical_diameters(pfs, mechs), sensor)
     return out
 
 
-def physical_diameters(
+def physical_mechanics(
     pfs: Sequence[PushFunction], uncertainty: Uncertainty
+) -> list[UncertainMechanics]:
+    """Each part's physical states, bands and fence cells under ``uncertainty``
+    (:func:`~feederkit.mechanics.uncertain.uncertain_mechanics`), computed once for every
+    check of a catalog (a part's machine is built again for each pair it is in). Raises
+    InputError naming the part for a tolerance too large for it."""
+    return [uncertain_mechanics(pf.part, uncertainty) for pf in pfs]
+
+
+def physical_diameters(
+    pfs: Sequence[PushFunction], mechanics: Sequence[UncertainMechanics]
 ) -> list[list[tuple[float, float]]]:
-    """Per part, its physical resting states' diameter intervals under ``uncertainty``
-    (:func:`~feederkit.mechanics.uncertain.uncertain_mechanics`), each widened by twice the
-    largest snap any machine of these parts makes (``DIAMETER_REL_EPS`` of the largest part:
+    """Per part, its physical resting states' diameter intervals (``mechanics``, the parts'
+    :func:`physical_mechanics`), each widened by twice the largest snap any machine of these
+    parts makes (``DIAMETER_REL_EPS`` of the largest part:
     :func:`~feederkit.machine.build.snap_intervals` moves an end outward by at most that),
-    so each holds what the state reads in the machine of any two of them. Raises InputError
-    naming the part for a tolerance too large for it."""
+    so each holds what the state reads in the machine of any two of them."""
     if not pfs:
         return []
     pad = 2.0 * DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
     return [
-        [(lo - pad, hi + pad) for lo, hi in (s.diameter for s in mech.states)]
-        for mech in (uncertain_mechanics(pf.part, uncertainty) for pf in pfs)
+        [(lo - pad, hi + pad) for lo, hi in (s.diameter for s in mech.states)] for mech in mechanics
     ]
+
+
+def _machine(
+    pfs: Sequence[PushFunction],
+    sensor: Sensor,
+    uncertainty: Uncertainty,
+    mechanics: Sequence[UncertainMechanics] | None,
+) -> PushAlignMachine:
+    """The machine of ``pfs`` numbered by diameter, as ``build_machine`` makes it, from the
+    parts' mechanics when given (:func:`physical_mechanics`)."""
+    if mechanics is None or uncertainty.is_ideal:
+        machine = build_machine(pfs, sensor, uncertainty)
+    else:
+        machine = uncertain_machine(pfs, mechanics, sensor)
+    return by_diameter(machine)[0]
 
 
 def range_pairs(diameters: Sequence[Sequence[Diameter]], sensor: Sensor) -> set[tuple[int, int]]:
@@ -146,11 +176,14 @@ def check_strong_pair(
     sensor: Sensor,
     uncertainty: Uncertainty,
     deadline: Deadline | None = None,
+    *,
+    mechanics: Sequence[UncertainMechanics] | None = None,
 ) -> StrongPairCheck:
     """Whether a strong plan tells ``a`` from ``b`` under ``uncertainty`` with ``sensor``;
     where none does, the witness (its states: the ideal members of the physical states
-    confused). Timeout when ``deadline`` passes."""
-    machine, _old = by_diameter(build_machine([a, b], sensor, uncertainty))
+    confused). ``mechanics``: the two parts' (:func:`physical_mechanics`). Timeout when
+    ``deadline`` passes."""
+    machine = _machine([a, b], sensor, uncertainty, mechanics)
     found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
     if found is None:
         return StrongPairCheck(None, decided=False)
@@ -161,7 +194,12 @@ def check_strong_pair(
 
 
 def check_alone(
-    pf: PushFunction, sensor: Sensor, uncertainty: Uncertainty, deadline: Deadline | None = None
+    pf: PushFunction,
+    sensor: Sensor,
+    uncertainty: Uncertainty,
+    deadline: Deadline | None = None,
+    *,
+    mechanics: UncertainMechanics | None = None,
 ) -> AloneCheck:
     """Whether a strong plan orients ``pf`` alone under ``uncertainty`` with ``sensor``, as
     ``plan`` decides "no strong plan exists": every reading set of the first alignment has a
@@ -169,7 +207,8 @@ def check_alone(
     of the default rule has one (:func:`~feederkit.planning.lumping.try_lumping`). Every pair
     of states may have a strong plan while the whole set has none. The searches for a plan
     explore at most ``ALONE_SETS`` sets (undecided beyond); the pairs to lump are decided at
-    compile's budget. Timeout when ``deadline`` passes.
+    compile's budget. ``mechanics``: the part's (:func:`physical_mechanics`). Timeout when
+    ``deadline`` passes.
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.outline import make_outline
@@ -179,7 +218,7 @@ def check_alone(
     >>> check_alone(push_function(box), ToleranceSensor(0.5), Uncertainty(1.0)).orients
     True
     """
-    machine, _old = by_diameter(build_machine([pf], sensor, uncertainty))
+    machine = _machine([pf], sensor, uncertainty, None if mechanics is None else [mechanics])
     problem = Problem(machine, "exact", 0.0)
     roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
     value = solve(problem, roots, deadline, ALONE_SETS)
@@ -211,6 +250,7 @@ __all__ = [
     "check_alone",
     "check_strong_pair",
     "physical_diameters",
+    "physical_mechanics",
     "range_pairs",
     "reading_pairs",
 ]
