@@ -375,3 +375,42 @@ def test_a_member_beyond_the_set_budget_is_undecided_and_its_pairs_still_checked
     assert data["no_strong_plan_alone"] == []
     found = {(w["part_a"], w["part_b"]) for w in data["apart_only_on_the_ideal_model"]}
     assert ("l-bracket/up", "l-bracket-near/up") in found
+
+
+def test_reading_pairs_under_rotation_error_span_the_states_vibration_merges():
+    """Under rotation error alone a near-round 64-gon's facets are one physical state a
+    breath of vibration carries across, reading anything between their diameters: a
+    12-gon whose one diameter falls between two of theirs, further from each than the
+    sensor reaches, is never told apart from it. The nominal diameters miss that pair; the
+    physical states' intervals find it."""
+    import math
+    import random
+
+    from feederkit.mechanics.push import push_function
+    from feederkit.mechanics.uncertain import uncertain_mechanics
+    from feederkit.mix.strongpairs import check_strong_pair, reading_pairs
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+    from feederkit.sensors import ToleranceSensor
+    from feederkit.uncertainty import Uncertainty
+
+    rng = random.Random(0)
+    ring = []
+    for k in range(64):
+        a, f = 2 * math.pi * k / 64, 13.0 * (1 + rng.uniform(-0.001, 0.001))
+        ring.append((f * math.cos(a), f * math.sin(a)))
+    round_ = push_function(make_part(make_outline("round", ring)))
+    rotation = Uncertainty(1.0)
+    assert uncertain_mechanics(round_.part, rotation).n < round_.n  # facets merged
+    ds = sorted(s.diameter for s in round_.states)
+    gap, mid = max((b - a, (a + b) / 2.0) for a, b in zip(ds, ds[1:], strict=False))
+    sensor = ToleranceSensor(0.0004)
+    assert gap / 2.0 > 2.0 * 0.0004  # no nominal diameter of the round part reads as mid
+    r = mid / 2.0 / math.cos(math.pi / 12)
+    ring12 = [(r * math.cos(k * math.pi / 6), r * math.sin(k * math.pi / 6)) for k in range(12)]
+    dodecagon = push_function(make_part(make_outline("dodecagon", ring12)))
+    pfs = [round_, dodecagon]
+    assert reading_pairs(pfs, sensor) == set()
+    assert reading_pairs(pfs, sensor, rotation) == {(0, 1)}
+    # A pair the screen must not miss: no strong plan tells the two apart.
+    assert check_strong_pair(round_, dodecagon, sensor, rotation).witness is not None

@@ -81,15 +81,17 @@ def reading_pairs(
     sensor's overlap relation over all their states (Definition 10). The ideal analysis's
     candidates are fewer (its grid looks at the smallest and largest diameters), since on
     the ideal model a plan can always rotate into the states that read apart; under a
-    rotation error it may not reach them (a bar standing on its end). Under a shape or COM
-    tolerance a physical state reads anything its diameter interval can
-    (:func:`physical_diameters`), so the pairs with two such states that may read alike
+    rotation error it may not reach them (a bar standing on its end). Off the ideal model a
+    physical state reads anything its diameter interval can (:func:`physical_diameters`):
+    under a shape or COM tolerance every state's, and under rotation error alone a state
+    holding ideal states a breath of vibration carries across (an arc's facets) spans their
+    diameters, so it may read alike a state of another part between two of them that no
+    nominal diameter reaches. The pairs with two such states that may read alike
     (:func:`range_pairs`) are added: a pair no strong plan tells apart has, in the machine
     of the two, states "with overlapping sensor ranges" (section 5; every pair of states
     the strong analysis keeps together can read alike), and these intervals hold theirs.
-    Rotation error alone keeps the nominal pairs (no mechanics computed). ``mechanics``:
-    the parts' :func:`~feederkit.mechanics.uncertain.uncertain_mechanics`, when the caller
-    has them (:func:`physical_mechanics`).
+    ``mechanics``: the parts' :func:`~feederkit.mechanics.uncertain.uncertain_mechanics`,
+    when the caller has them (:func:`physical_mechanics`).
     """
     owner = [k for k, pf in enumerate(pfs) for _ in pf.states]
     diameters = [s.diameter for pf in pfs for s in pf.states]
@@ -97,7 +99,7 @@ def reading_pairs(
     for component in sensor.indistinguishable_sets(diameters):
         parts = sorted({owner[i] for i in component})
         out.update((a, b) for x, a in enumerate(parts) for b in parts[x + 1 :])
-    if uncertainty is not None and uncertainty.radius_error_mm > 0.0:
+    if uncertainty is not None and not uncertainty.is_ideal:
         mechs = mechanics or physical_mechanics(pfs, uncertainty)
         out |= range_pairs(physical_diameters(pfs, mechs), sensor)
     return out
