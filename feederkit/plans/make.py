@@ -30,6 +30,7 @@ from feederkit.errors import InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
+from feederkit.mechanics.modelerror import Offset, offset_warning, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
@@ -47,6 +48,7 @@ from feederkit.plans.strong import (
     verify_strong,
 )
 from feederkit.plans.verify import VerificationReport, check_plan
+from feederkit.plans.widen import widen_readings
 from feederkit.sensors import Sensor, ToleranceSensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 from feederkit.words import at_most, plural
@@ -148,12 +150,18 @@ def _make_plan(
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
         raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
+    # The part itself may read a little off its simplified hull's diameters: the branches
+    # are widened for it where no sibling is in the way (plans.widen).
+    offsets = [reading_offsets(pf) for pf in pfs]
+    widenable = isinstance(sensor, ToleranceSensor)
     if unc.is_ideal:
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
+        widest, blocked = _widened(data, offsets, sensor) if widenable else (0.0, set())
         report = check_plan(data)
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
+        widest, blocked = _widened(data, offsets, sensor) if widenable else (0.0, set())
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
         report = verify_strong(data, tighten_margins=True)
@@ -161,6 +169,11 @@ def _make_plan(
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
     notes: list[str] = []
+    if widest > 0.0:
+        notes.append(
+            f"reading intervals widened by up to {widest:.3g} mm to hold the parts themselves "
+            "(their contact hulls simplify the outlines' arcs)"
+        )
     floor = opts.min_margin_deg
     if floor > 0.0 and math.isfinite(result.min_margin) and result.min_margin < floor - 1e-9:
         notes.append(
@@ -188,6 +201,13 @@ def _make_plan(
             )
     diameters = sorted({round(s.diameter, DIAMETER_DIGITS) for pf in pfs for s in pf.states})
     warnings = sensor_warnings(sensor, diameters)
+    for p, off in enumerate(offsets):
+        if not widenable or p in blocked:
+            m = None if named is None else named[p]
+            label = pfs[p].part.name if m is None else member_label(m.name, m.landing)
+            line = offset_warning(label, off, sensor, widened=widenable)
+            if line is not None:
+                warnings.append(line)
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
@@ -203,6 +223,14 @@ def _make_plan(
     if held is not None:
         warnings.append(held)
     return MadePlan(data, result, report, tuple(warnings + notes))
+
+
+def _widened(
+    data: dict[str, Any], offsets: list[tuple[Offset | None, ...]], sensor: Sensor
+) -> tuple[float, set[int]]:
+    """:func:`~feederkit.plans.widen.widen_readings` for a tolerance sensor."""
+    assert isinstance(sensor, ToleranceSensor)
+    return widen_readings(data, offsets, sensor.tolerance)
 
 
 def ideal_plan_words(

@@ -1,0 +1,103 @@
+"""How far a part's readings may stray from its model's: the part against its contact hull.
+
+Every plan is made on the part's contact hull, which import simplifies (``clean_hull``,
+``--hull-tolerance``: a flattened arc's many chords become a few). The part itself rests on
+its outline's hull: on an edge of it whose normal ``nu`` is a stable orientation of the
+outline's own push function (section 3), where it reads the outline's width, while the plan
+expects the diameter of the model's state whose resting range holds ``nu`` (the state a push
+from ``nu`` settles in on the model). Across a flattened arc the two differ by up to about
+twice the simplification error, and more where a longer chord turns the resting edge; a
+sensor finer than that can read a part made exactly to its drawing outside every branch of a
+plan made on its model (design.md: the executor must then stop).
+
+The plan file's diameters are the model's (design.md), so this module measures the offsets
+and the plan's warnings name them; a smaller ``--hull-tolerance`` shrinks them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from feederkit.angles import norm360
+from feederkit.hull import convex_hull
+from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.part import make_part
+from feederkit.sensors import Sensor
+
+OFFSET_SHARE = 0.25
+"""A part whose readings may stray from its model's by more than this share of the sensor's
+tolerance (half its reading reach) gets a warning."""
+
+Offset = tuple[float, float]
+
+
+def exact_push_function(model: PushFunction) -> PushFunction | None:
+    """The push function of ``model``'s part on its outline's exact hull (same COM), or None
+    when the contact hull already is that hull (nothing simplified beyond rounding)."""
+    part = model.part
+    if len(convex_hull(part.outline.vertices)) == len(part.hull):
+        return None
+    return push_function(make_part(part.outline, part.com))
+
+
+def state_offsets(model: PushFunction, exact: PushFunction) -> tuple[Offset | None, ...]:
+    """Per state of ``model``: the least and largest ``exact`` diameter minus the model's,
+    over the ``exact`` stable states whose normal lies in the model state's resting range
+    (where the part itself may rest when the model says it is in that state); None when
+    none does (a state of the simplification only, such as a chord's across an arc's top).
+    """
+    out: list[Offset | None] = []
+    for s in model.states:
+        lo, hi = s.resting_range_deg
+        ds = [e.diameter - s.diameter for e in exact.states if norm360(e.normal_deg - lo) < hi - lo]
+        out.append((min(ds), max(ds)) if ds else None)
+    return tuple(out)
+
+
+def reading_offsets(model: PushFunction) -> tuple[Offset | None, ...]:
+    """:func:`state_offsets` of ``model`` against its outline's exact hull; all None when
+    its contact hull is exact.
+
+    >>> import math
+    >>> from feederkit.outline import make_outline
+    >>> arc = [(30 + 10 * math.cos(a / 20), 10 + 10 * math.sin(a / 20)) for a in range(-31, 32)]
+    >>> d = make_outline("d", [(0.0, 0.0), (30.0, 0.0)] + arc + [(30.0, 20.0), (0.0, 20.0)])
+    >>> offsets = reading_offsets(push_function(make_part(d, hull_tolerance=0.05)))
+    >>> largest_offset(offsets)[0] > 0.01  # the arc's top cut by a chord
+    True
+    """
+    exact = exact_push_function(model)
+    if exact is None:
+        return (None,) * model.n
+    return state_offsets(model, exact)
+
+
+def largest_offset(offsets: Sequence[Offset | None]) -> tuple[float, int | None]:
+    """The largest of ``offsets`` in absolute value (mm) and its state; (0, None) when
+    there is none."""
+    worst, which = 0.0, None
+    for k, off in enumerate(offsets):
+        if off is not None and max(-off[0], off[1]) > worst:
+            worst, which = max(-off[0], off[1]), k
+    return worst, which
+
+
+def offset_warning(
+    label: str, offsets: Sequence[Offset | None], sensor: Sensor, widened: bool = False
+) -> str | None:
+    """One line when ``label``'s readings may stray from its model's by more than
+    ``OFFSET_SHARE`` of ``sensor``'s tolerance (``widened``: although the plan's intervals
+    were widened for it, a sibling branch was in the way); None sensorless."""
+    if not sensor.informative:
+        return None
+    tolerance = sensor.reading_reach() / 2.0
+    worst, state = largest_offset(offsets)
+    if state is None or worst <= OFFSET_SHARE * tolerance:
+        return None
+    where = "may read in another branch" if widened else "may read outside every branch"
+    return (
+        f"{label}: the part may read up to {worst:.3g} mm from its model's diameter (state "
+        f"{state}: its contact hull simplifies the outline's arcs), more than {OFFSET_SHARE:g} "
+        f"of the sensor's ±{tolerance:.3g} mm: a part made to the drawing {where}; import it "
+        f"with a smaller --hull-tolerance (such as {tolerance / 10.0:.2g})"
+    )

@@ -1,0 +1,90 @@
+"""Plans hold the part itself, not only its simplified contact hull (mechanics.modelerror,
+plans.widen): a D-shaped plate whose arc's top a chord cuts reads wider than its model."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from feederkit.mechanics.modelerror import largest_offset, reading_offsets, state_offsets
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.plans.make import make_plan
+from feederkit.plans.widen import widen_readings
+from feederkit.sensors import ToleranceSensor
+
+
+def d_shape():
+    """A 30 x 20 mm rectangle with an R10 half disc on its right: 40 mm across the arc."""
+    arc = [
+        (
+            30.0 + 10.0 * math.cos(math.pi * k / 64 - math.pi / 2),
+            10.0 + 10.0 * math.sin(math.pi * k / 64 - math.pi / 2),
+        )
+        for k in range(1, 64)
+    ]
+    return make_outline("d", [(0.0, 0.0), (30.0, 0.0), *arc, (30.0, 20.0), (0.0, 20.0)])
+
+
+def test_an_exact_hull_has_no_offsets():
+    pf = push_function(make_part(d_shape()))
+    assert reading_offsets(pf) == (None,) * pf.n
+
+
+def test_a_simplified_hull_reads_narrower_than_the_part():
+    model = push_function(make_part(d_shape(), hull_tolerance=0.05))
+    exact = push_function(make_part(d_shape()))
+    offsets = state_offsets(model, exact)
+    assert offsets == reading_offsets(model)
+    worst, state = largest_offset(offsets)
+    # The model's state across the arc reads less than the part's 40 mm.
+    assert state is not None and model.states[state].diameter < 40.0 - 1e-3
+    assert worst == pytest.approx(40.0 - model.states[state].diameter, abs=1e-9)
+
+
+def _branches(node):
+    return [tuple(b["reading"]) for b in node["branches"]]
+
+
+@pytest.mark.parametrize("tolerance", [0.01, 0.1])
+def test_every_reading_of_the_part_itself_lies_in_a_root_branch(tolerance):
+    """At the first alignment the part may rest in any of its own stable states: each of
+    its readings (its outline's width there, within the sensor's tolerance) must lie in a
+    branch, or the controller stops a good part. A plan on the simplified model alone puts
+    the 40 mm state's branch at 39.98 +- e."""
+    part = make_part(d_shape(), hull_tolerance=0.05)
+    exact = push_function(make_part(d_shape()))
+    made = make_plan([push_function(part)], ToleranceSensor(tolerance))
+    branches = _branches(made.plan["root"])
+    for s in exact.states:
+        lo, hi = s.diameter - tolerance * 0.999, s.diameter + tolerance * 0.999
+        assert any(a <= lo and hi <= b for a, b in branches), (s.diameter, branches)
+    assert any("widened" in w for w in made.warnings)
+
+
+def test_siblings_in_the_way_are_reported_and_never_overlap():
+    """Two branches 0.05 mm apart whose states may both stray 0.04 mm into the gap: they
+    meet in its middle, and both parts are named."""
+    leaf = {"result": []}
+    node = {
+        "action_deg": None,
+        "margin_deg": None,
+        "branches": [
+            {"reading": [9.9, 10.1], "next": leaf},
+            {"reading": [10.15, 10.35], "next": leaf},
+        ],
+    }
+    data = {
+        "parts": [
+            {"stable_states": [{"diameter": 10.0}]},
+            {"stable_states": [{"diameter": 10.25}]},
+        ],
+        "root": node,
+    }
+    widest, blocked = widen_readings(data, [[(0.0, 0.04)], [(-0.04, 0.0)]], 0.1)
+    assert blocked == {0, 1}
+    (a_lo, a_hi), (b_lo, b_hi) = _branches(node)
+    assert a_hi == pytest.approx(10.125) and b_lo == pytest.approx(10.125)
+    assert widest == pytest.approx(0.025)
