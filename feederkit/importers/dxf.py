@@ -30,7 +30,7 @@ from ezdxf.path import Command
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
 from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
-from feederkit.importers.loops import Region, drawing_from_lines
+from feederkit.importers.loops import Region, drawing_from_lines, merged_note
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
 from feederkit.outline import make_outline, unit_scale
@@ -106,22 +106,36 @@ def prescan(path: Path, budget: Budget) -> None:
 
 def read_document(path: Path) -> DxfDocument:
     """Open a DXF file (ASCII or binary, any version), recovering damaged files when possible."""
+    return open_document(path)[0]
+
+
+def open_document(path: Path) -> tuple[DxfDocument, str | None]:
+    """The document of a DXF file and, when ``ezdxf.readfile`` refused it and
+    ``ezdxf.recover`` repaired it, why it was refused (the damage), else None.
+
+    A repaired file may have lost entities (recover skips what it cannot parse, silently:
+    a LINE whose coordinate is ``abc`` is gone), so the damage is reported with the part, or
+    in the refusal when nothing readable is left.
+    """
     try:
-        return ezdxf.readfile(path)
+        return ezdxf.readfile(path), None
     except OSError as exc:
         if exc.errno is not None:
             raise InputError(f"{path}: cannot read the file ({exc.strerror})") from None
         raise InputError(f"{path}: not a DXF file") from None  # ezdxf's own verdict
-    except Exception:  # noqa: BLE001 - any parser failure: try the recover module
-        pass
+    except Exception as exc:  # noqa: BLE001 - any parser failure: try the recover module
+        damage = _reason(exc).removeprefix(f"{type(exc).__name__}: ").rstrip(".")
     try:
         doc, auditor = recover.readfile(path)
     except Exception as exc:  # noqa: BLE001 - ezdxf raises many types on broken input
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{path}: not a readable DXF file ({reason})") from None
+        raise InputError(f"{path}: not a readable DXF file ({_reason(exc)})") from None
     if auditor.has_errors:
         raise InputError(f"{path}: damaged DXF file ({len(auditor.errors)} unrecoverable errors)")
-    return doc
+    return doc, damage
+
+
+def _reason(exc: BaseException) -> str:
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
 
 
 def drawing_units(
@@ -400,9 +414,9 @@ def dxf_lines(
     scale: float,
     label: str,
     budget: Budget,
-) -> tuple[list[np.ndarray], list[str], Counter[str], list[str], float]:
-    """Outline polylines of the chosen space (mm), the entity (and layer) of each, skipped
-    types, warnings, flatten tolerance.
+) -> tuple[list[np.ndarray], list[str], list[str], Counter[str], list[str], float]:
+    """Outline polylines of the chosen space (mm), the entity (and layer) of each, the layer
+    of each, skipped types, warnings, flatten tolerance.
 
     With ``options.layers``, only entities on those layers (case-insensitive; block contents
     on layer "0" count on their reference's layer) are read. Every coordinate is checked as
@@ -418,6 +432,7 @@ def dxf_lines(
     _count_expanded(doc, layouts, budget)
     paths: list[tuple[DXFGraphic, dxfpath.Path]] = []
     owners: list[str] = []
+    owner_layers: list[str] = []
     lo = np.full(2, np.inf)
     hi = np.full(2, -np.inf)
     for layout in layouts:
@@ -452,6 +467,7 @@ def dxf_lines(
             lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
             paths.append((entity, path))
             owners.append(f"{_label(entity)} on layer {layer!r}")
+            owner_layers.append(layer)
     notes: list[str] = []
     if wanted and not paths and seen:
         names = ", ".join(sorted(seen))
@@ -459,7 +475,7 @@ def dxf_lines(
             f"{label}: no geometry on layer {', '.join(sorted(layers))} (layers: {names})"
         )
     if not paths:
-        return [], [], skipped, notes, options.flatten_tolerance
+        return [], [], [], skipped, notes, options.flatten_tolerance
     size_mm = float((hi - lo).max()) * scale
     flatten_mm = options.flatten_tolerance
     if REL_FLATTEN * size_mm > flatten_mm:
@@ -478,7 +494,8 @@ def dxf_lines(
         raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates") from None
     lines = [pts * scale for pieces in flat for pts in pieces]
     names = [owner for owner, pieces in zip(owners, flat, strict=True) for _ in pieces]
-    return lines, names, skipped, notes, flatten_mm
+    layers = [layer for layer, pieces in zip(owner_layers, flat, strict=True) for _ in pieces]
+    return lines, names, layers, skipped, notes, flatten_mm
 
 
 def _describe(region: Region) -> str:
@@ -498,19 +515,19 @@ def read_dxf(
     """
     budget = budget or Budget(options.limits, str(path))
     prescan(path, budget)
-    doc = read_document(path)
+    doc, damage = open_document(path)
     budget.check_time()
     try:
-        return _read_doc(doc, path, options, name, budget)
+        return _read_doc(doc, path, options, name, budget, damage)
     except DXFError as exc:  # malformed entities that ezdxf loaded but cannot interpret
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        reason = _reason(exc)
         raise InputError(f"{path}: malformed DXF ({reason})") from None
     except (AttributeError, KeyError, TypeError) as exc:
         # A structure ezdxf loaded from a broken file but cannot walk (e.g. a block record
         # without its attributes): malformed input when ezdxf itself raised it, our bug if not.
         if not _raised_in_ezdxf(exc):
             raise
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        reason = _reason(exc)
         raise InputError(f"{path}: malformed DXF ({reason})") from None
 
 
@@ -542,18 +559,35 @@ def _paper_space_hint(doc: DxfDocument, options: ImportOptions) -> str:
 
 
 def _read_doc(
-    doc: DxfDocument, path: Path, options: ImportOptions, name: str, budget: Budget
+    doc: DxfDocument,
+    path: Path,
+    options: ImportOptions,
+    name: str,
+    budget: Budget,
+    damage: str | None = None,
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
     unit_name, scale, warnings_ = drawing_units(doc, options.units, str(path))
-    lines, names, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
+    lines, names, layers, skipped, notes, flatten_mm = dxf_lines(
+        doc, options, scale, str(path), budget
+    )
     warnings_ += notes
     if not lines:
         what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
+        if damage is not None:
+            raise InputError(
+                f"{path}: damaged DXF file ({damage}): what ezdxf could recover holds no "
+                f"outline geometry (lines, arcs, curves) in the {options.space} space: {what}"
+            )
         raise InputError(
             f"{path}: no outline geometry (lines, arcs, curves) in the "
             f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget, names)
+    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget, names, layers)
+    if damage is not None:
+        warnings_.append(
+            f"damaged DXF file ({damage}): read what ezdxf could recover; entities it could "
+            "not parse are lost, so check the part"
+        )
     warnings_ += list(drawing.warnings)
     if drawing.frames:
         warnings_.append(f"skipped {drawing.frames} drawing frame(s) around the part")
@@ -582,6 +616,8 @@ def _read_doc(
         label = name if k == 0 else f"{name}-{k + 1}"
         outline = make_outline(label, region.shell, region.holes, options.com, "mm")
         size_notes = size_warnings(outline_size(outline), unit_name, options.units is not None)
+        if region.enclosed:
+            size_notes.append(merged_note(region.enclosed))
         outlines.append(
             ImportedOutline(
                 outline=outline, kind="dxf", source_units=unit_name, warnings=tuple(size_notes)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+import shapely.affinity
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -36,6 +37,10 @@ TITLE_BLOCK_SHARE = 0.7
 """In a single-line frame the empty sheet is at least this share of the loop; the rest are
 title-block cells (faces made by lines touching the border)."""
 
+FRAME_HOLE_SHARE = 0.1
+"""A rectangle holding one hole whose box is at most this share of its own may be a bare
+single-line drawing frame around one part: imported as a plate, with a warning."""
+
 HEAL_GAP_REL = 0.002
 """Gaps between open line ends up to this share of the drawing's size are closed (0.2 %)."""
 
@@ -48,6 +53,8 @@ class Region:
     holes: tuple[tuple[Point, ...], ...]
     area: float
     loop_area: float
+    enclosed: int = 0
+    """Faces merged into the outer loop that share no stretch of its outline (:class:`Loop`)."""
 
 
 @dataclass(frozen=True)
@@ -62,6 +69,17 @@ class Drawing:
     frames: int
     nested: int = 0
     warnings: tuple[str, ...] = ()
+
+
+def merged_note(enclosed: int) -> str:
+    """The warning for a part whose outline holds faces enclosed by lines inside it."""
+    return (
+        f"lines inside the part enclose {plural(enclosed, 'region')} touching its outline at "
+        "a point or joined to it by other lines (a hole drawn with lines and touching the "
+        "outline, or crossed by a centre line?): merged into the part, so its area and COM "
+        "may be off if they are holes; check the drawing or leave construction lines out "
+        "with --layer"
+    )
 
 
 def snap_endpoints(lines: Sequence[np.ndarray], gap: float) -> list[np.ndarray]:
@@ -126,12 +144,66 @@ class Loop:
     polygon: Polygon
     faces: int
     largest_face: float
+    enclosed: int = 0
+    """Faces merged into the loop that touch its outline nowhere or at points only: what lines
+    inside the part enclose (a hole drawn with lines that touch the outline or are crossed by
+    a centre line): merged, so the part may have lost a hole (a warning says so)."""
+
+
+def _inner_closed(
+    poly: Polygon,
+    mids: np.ndarray,
+    shared: np.ndarray,
+    rings: Sequence[Polygon],
+    eps: float,
+) -> list[Polygon]:
+    """The closed lines of a group (``rings``) that lie inside its merged loop ``poly`` and
+    share no stretch with its outline nor with any other line: holes, though they touch the
+    outline at a point or lines inside the part (centre lines) join them to it.
+
+    ``mids`` are the midpoints of the group's noded pieces (a piece lies on a ring when its
+    midpoint does); ``shared[i]`` says piece ``i`` lies on two or more of the drawing's lines.
+    A closed line that shares a stretch of the outline or of another line (a title-block
+    cell, a notch drawn closed, a tile of a grid) stays merged.
+    """
+    out: list[Polygon] = []
+    tiny = 1e-9 * poly.area
+    tree = shapely.STRtree(mids)
+    for ring in rings:
+        if ring.area >= poly.area - tiny or not poly.contains(ring.representative_point()):
+            continue
+        on = tree.query(ring.exterior, predicate="dwithin", distance=eps)
+        if shared[on].any() or shapely.dwithin(mids[on], poly.exterior, eps).any():
+            continue  # it shares a stretch of the outline or of another line
+        out.append(ring)
+    return out
+
+
+def _enclosed_faces(poly: Polygon, faces: Sequence[Polygon], eps: float) -> int:
+    """How many ``faces`` (of the loop ``poly``) share no stretch of its outline (longer than
+    ``eps``): a face touching it at points only is enclosed by lines inside the loop."""
+    if len(faces) < 2:
+        return 0
+    common = shapely.intersection(
+        shapely.get_exterior_ring(np.asarray(faces, dtype=object)), poly.exterior
+    )
+    return int((shapely.length(common) <= eps).sum())
 
 
 def closed_loops(
-    lines: Sequence[np.ndarray], budget: Budget | None = None
+    lines: Sequence[np.ndarray],
+    budget: Budget | None = None,
+    closed: Sequence[np.ndarray] = (),
 ) -> tuple[list[Loop], list[LineString]]:
-    """The closed loops the lines form, and the open lines (dangles) left over."""
+    """The closed loops the lines form, and the open lines (dangles) left over.
+
+    The faces of each connected group of lines are merged (a centre line does not cut a
+    part in two), except the closed lines (``closed``: circles, closed polylines) lying
+    inside a merged loop that share no stretch of its outline nor of another line
+    (:func:`_inner_closed`): each is a loop of its own (a hole tangent to the outline, or
+    one a centre line crosses), not merged away. ``Loop.enclosed`` counts the faces still
+    merged that touch the loop's outline at points only (:func:`_enclosed_faces`).
+    """
     lines = [ln for ln in lines if len(ln) >= 2]
     if not lines:
         return [], []
@@ -155,6 +227,18 @@ def closed_loops(
     labels = _components(pieces)
     if budget is not None:
         budget.need("loops", face_count(pieces, labels), "closed loops (parts and holes)")
+    x0, y0, x1, y1 = shapely.total_bounds(pieces)
+    eps = 1e-9 * max(x1 - x0, y1 - y0, 1.0)
+    rings = [Polygon(np.asarray(c, dtype=float)) for c in closed if len(c) >= 4]
+    rings = [r for r in rings if r.is_valid and r.area > 0.0]
+    ring_group: dict[int, list[Polygon]] = {}
+    if rings:  # each closed line's group: the group of the piece on its first vertex
+        lines_tree = shapely.STRtree(geoms)
+        tree = shapely.STRtree(pieces)
+        first = shapely.points([np.asarray(r.exterior.coords[0]) for r in rings])
+        near = tree.query_nearest(first, all_matches=False)[1]
+        for ring, k in zip(rings, near, strict=True):
+            ring_group.setdefault(int(labels[k]), []).append(ring)
     loops: list[Loop] = []
     dangles: list[LineString] = []
     for lab in np.unique(labels):
@@ -169,16 +253,32 @@ def closed_loops(
         if budget is not None:
             budget.loops(len(parts))
         merged = shapely.union_all(parts)
+        candidates = ring_group.get(int(lab), []) if len(parts) > 1 else []
+        if candidates:
+            mids = shapely.line_interpolate_point(group, 0.5, normalized=True)
+            hits = lines_tree.query(mids, predicate="dwithin", distance=eps)[0]
+            shared = np.bincount(hits, minlength=len(mids)) > 1
         for poly in shapely.get_parts(merged):
             if budget is not None:
                 budget.check_time()
-            if isinstance(poly, Polygon) and poly.area > 0.0:
-                inside = [f for f in parts if poly.contains(f.representative_point())]
+            if not (isinstance(poly, Polygon) and poly.area > 0.0):
+                continue
+            outline = Polygon(poly.exterior)
+            inner = _inner_closed(outline, mids, shared, candidates, eps) if candidates else []
+            for shape in [outline, *inner]:
+                inside = [f for f in parts if shape.contains(f.representative_point())]
+                own = [
+                    f
+                    for f in inside
+                    if shape is not outline
+                    or not any(h.contains(f.representative_point()) for h in inner)
+                ]
                 loops.append(
                     Loop(
-                        polygon=Polygon(poly.exterior),
-                        faces=len(inside),
-                        largest_face=max((f.area for f in inside), default=poly.area),
+                        polygon=shape,
+                        faces=len(own),
+                        largest_face=max((f.area for f in own), default=shape.area),
+                        enclosed=_enclosed_faces(shape, own, 1e3 * eps),
                     )
                 )
     return loops, dangles
@@ -284,6 +384,7 @@ def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = 
             holes=tuple(_ring(h) for h in hole_loops),
             area=float(area),
             loop_area=float(loop.area),
+            enclosed=loops[i].enclosed,
         )
         regions.append((i, region))
     regions.sort(key=lambda r: -r[1].loop_area)
@@ -420,12 +521,102 @@ def crossing_loop(
     return None
 
 
+def _without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple[list[Loop], str]:
+    """The loops that have an area, and a warning naming those left out (or "").
+
+    A loop is a sliver when it is on average no thicker than twice the flatten tolerance
+    ``gap`` (area at most ``gap`` times its perimeter) or no wider than the largest gap
+    closed (``bridged``): closing a gap beside a line end that overshoots makes such a
+    triangle, which is never a part (nor a hole).
+    """
+    keep: list[Loop] = []
+    out: list[Polygon] = []
+    for lp in loops:
+        poly = lp.polygon
+        x0, y0, x1, y1 = poly.bounds
+        if poly.area <= gap * poly.length or max(x1 - x0, y1 - y0) <= bridged:
+            out.append(poly)
+        else:
+            keep.append(lp)
+    if not out:
+        return keep, ""
+    where = "; ".join(
+        f"{p.area:.2g} mm2 at ({p.centroid.x:.1f}, {p.centroid.y:.1f})"
+        for p in sorted(out, key=lambda p: -p.area)[:3]
+    )
+    more = "; ..." if len(out) > 3 else ""
+    return keep, (
+        f"left out {plural(len(out), 'closed loop')} with no area to speak of ({where}{more}): "
+        f"no wider than the flatten tolerance ({gap:.3g} mm) or the gaps closed "
+        f"({bridged:.3g} mm); not a part"
+    )
+
+
+def _round(poly: Polygon) -> bool:
+    """Whether a loop is a circle or an axis-aligned ellipse (within 5 % of its area)."""
+    x0, y0, x1, y1 = poly.bounds
+    disk = shapely.affinity.scale(
+        shapely.Point((x0 + x1) / 2, (y0 + y1) / 2).buffer(0.5, 64), x1 - x0, y1 - y0
+    )
+    return float(poly.symmetric_difference(disk).area) <= 0.05 * poly.area
+
+
+def frame_doubt(
+    region: Region, lines: Sequence[np.ndarray], gap: float, layers: Sequence[str] | None
+) -> str:
+    """A warning when the imported part may be a bare single-line drawing frame, else "".
+
+    A rectangle with holes and without a title block cannot be told from a plate
+    (:func:`frame_kind`): it is imported as a plate, but said to be a likely frame when it is
+    drawn on a layer none of its holes is on, or when it holds a single hole whose box is
+    at most :data:`FRAME_HOLE_SHARE` of its own, is not round (a circle or an axis-aligned
+    ellipse: a plate's usual hole) and lies at least its own size away from the rectangle
+    (one part drawn in a sheet's frame).
+    """
+    shell = Polygon(region.shell)
+    if not region.holes or not _is_rectangle(shell):
+        return ""
+    x0, y0, x1, y1 = shell.bounds
+    box = (x1 - x0) * (y1 - y0)
+    holes = [Polygon(h) for h in region.holes]
+    hx0, hy0, hx1, hy1 = shapely.total_bounds(holes)
+    hole_box = (hx1 - hx0) * (hy1 - hy0)
+    small = (
+        len(holes) == 1
+        and hole_box <= FRAME_HOLE_SHARE * box
+        and not _round(holes[0])
+        and holes[0].distance(shell.exterior) >= max(hx1 - hx0, hy1 - hy0)
+    )
+    own: set[str] = set()
+    inner: set[str] = set()
+    if layers is not None and len(layers) >= len(lines):
+        tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
+        rings = [shell.exterior, *(h.exterior for h in holes)]
+        for k, ln in enumerate(lines):
+            pts = shapely.points(np.asarray(ln, dtype=float))
+            for j, ring in enumerate(rings):
+                if shapely.dwithin(pts, ring, tol).all():
+                    (own if j == 0 else inner).add(layers[k])
+                    break
+    apart = bool(own) and bool(inner) and not own & inner
+    if not (small or apart):
+        return ""
+    frame_layers = f" on layer {', '.join(sorted(own))}" if own else ""
+    keep = f" (--layer {' --layer '.join(sorted(inner))})" if apart else ""
+    return (
+        f"the part is a {x1 - x0:.4g} x {y1 - y0:.4g} mm rectangle{frame_layers} around "
+        f"{plural(len(holes), 'hole')}: if the rectangle is a drawing frame, the part is what "
+        f"it holds: leave the frame's layer out with --layer{keep}"
+    )
+
+
 def drawing_from_lines(
     lines: Sequence[np.ndarray],
     gap: float,
     label: str,
     budget: Budget | None = None,
     names: Sequence[str] | None = None,
+    layers: Sequence[str] | None = None,
 ) -> Drawing:
     """Parts of a drawing from its flattened lines (mm); InputError without a closed loop.
 
@@ -433,7 +624,9 @@ def drawing_from_lines(
     :data:`HEAL_GAP_REL` of the drawing's size apart are bridged, with a warning, before the
     loops and holes are chosen. A closed line that crosses itself, or crosses another loop
     (a hole across the outline), is refused, as an outline file with those faults is;
-    ``names[k]`` names line ``k`` in that error (an entity and its layer).
+    ``names[k]`` names line ``k`` in that error (an entity and its layer), ``layers[k]`` is
+    its layer (:func:`frame_doubt`). A loop with no area to speak of (:func:`_without_slivers`)
+    is left out with a warning.
     """
     if not lines:
         raise InputError(f"{label}: the drawing has no lines, arcs or curves")
@@ -454,7 +647,7 @@ def drawing_from_lines(
     healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
     if budget is not None:
         budget.check_time()
-    loops, dangles = closed_loops(healed, budget)
+    loops, dangles = closed_loops(healed, budget, [healed[k] for k in closed])
     if not loops:
         ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
         detail = f" ({plural(ends, 'open end')})" if ends else ""
@@ -465,9 +658,21 @@ def drawing_from_lines(
             f"{label}: a hole crosses the outline ({name(crossing)} crosses another loop; "
             "leave construction geometry out with --layer)"
         )
+    bridged = max((float(np.hypot(*(b[-1] - b[0]))) for b in healed[len(snapped) :]), default=0.0)
+    loops, slivers = _without_slivers(loops, gap, bridged)
+    if slivers:
+        if not loops:
+            raise InputError(
+                f"{label}: the outline has zero area (its closed loops are no wider than the "
+                f"flatten tolerance, {gap:.3g} mm)"
+            )
+        notes.append(slivers)
     drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
+    doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)
+    if doubt:
+        notes.append(doubt)
     x0, y0, x1, y1 = Polygon(drawing.regions[0].shell).bounds
     for d in dangles:
         dx0, dy0, dx1, dy1 = d.bounds
