@@ -194,6 +194,22 @@ def write_disk(path: Path, radius: float = 10.0) -> Path:
     return path
 
 
+def write_slot(path: Path) -> Path:
+    """A plain slot, 60 x 20 mm: two long flat sides (normals 90 and 270 degrees) and two
+    semicircular ends, the left one an ARC in an OCS with extrusion -Z (its centre (-10, 10)
+    there is (10, 10) in the drawing). Its tip states' normals come out 0 and 180 degrees up to
+    rounding (359.9999999999996 and 180.00000000000006)."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_line((10, 0), (50, 0))
+    msp.add_line((50, 20), (10, 20))
+    msp.add_arc((50, 10), 10, -90, 90)
+    msp.add_arc((-10, 10), 10, -90, 90, dxfattribs={"extrusion": (0, 0, -1)})
+    doc.saveas(path)
+    return path
+
+
 def write_entities(path: Path, build, units: int = 4) -> Path:
     """A drawing made by ``build(modelspace)``."""
     doc = ezdxf.new("R2010")

@@ -485,3 +485,72 @@ def test_push_bands_stop_at_a_shallow_neighbour_state() -> None:
         start = b.divergent_deg + (3.0 if b.left == tip.id else -3.0)
         assert mech.state_of[tip.id] in fence_outcomes(mech, start, start)
         assert mech.state_of[tip.id] not in fence_outcomes(ideal, start, start)
+
+
+# --- a push band clipped at a neighbouring state's normal --------------------------------------
+
+
+def _open_cell_at(mech, theta: float):  # noqa: ANN202
+    return next(c for c in mech.cells if not c.closed and c.lo < theta < c.hi)
+
+
+def test_a_slot_is_oriented_onto_a_flat_side_without_a_sensor(tmp_path: Path) -> None:
+    """A 60 x 20 mm slot: its tip states (0 and 180 degrees) are shallow, so the push bands of
+    the hilltops beside them end exactly at their normals. A push from deep inside a flat
+    side's basin crosses no hilltop and ends on that side only; rotating 45 degrees sends
+    every state onto one of the flat sides (the user's drawing; it once had no strong plan at
+    any rotation error above 0, the tips counted as reachable from the gap)."""
+    import fixtures_cad as fx
+
+    from feederkit.machine import build_machine
+    from feederkit.planning.api import plan
+    from feederkit.sensors import NoSensor
+
+    pf = push_function(load_part(str(fx.write_slot(tmp_path / "slot.dxf"))))
+    mech = uncertain_mechanics(pf.part, Uncertainty(1.0))
+    assert mech.n == pf.n == 4
+    tips = [s for s in pf.states if min(circ(s.normal_deg, 0.0), circ(s.normal_deg, 180.0)) < 1e-6]
+    flats = [s for s in pf.states if s not in tips]
+    assert len(tips) == len(flats) == 2
+    for flat in flats:
+        own = mech.state_of[flat.id]
+        cell = _open_cell_at(mech, flat.normal_deg)
+        assert cell.targets == {own}
+        assert cell.hi - cell.lo > 160.0  # the band ends: a tip's normal, 6.3 deg from it
+    for s in mech.states:  # no interval reversed by rounding at 0/360
+        assert s.rest_deg[0] <= s.rest_deg[1]
+    for b in mech.bands:  # t = c = 0: every hilltop is the drawn one
+        assert b.top_lo_deg == b.divergent_deg == b.top_hi_deg
+    for tip in tips:
+        # Both bands beside a tip end at its normal, and from a band the tip is reachable.
+        touching = [b for b in mech.bands if tip.id in (b.left, b.right)]
+        assert len(touching) == 2
+        for b in touching:
+            end = b.lo_deg if b.left == tip.id else b.hi_deg
+            assert circ(end, tip.normal_deg) < 1e-9
+            mid = (b.lo_deg + b.hi_deg) / 2.0
+            assert mech.state_of[tip.id] in fence_outcomes(mech, mid, mid)
+    for flat in flats:
+        assert outcome_set(mech, mech.state_of[flat.id], 45.0) == {
+            mech.state_of[f.id] for f in flats if circ(f.normal_deg, flat.normal_deg - 45.0) < 90
+        }
+    result = plan(build_machine([pf], NoSensor(), Uncertainty(1.0)))
+    assert result.length == 2
+
+
+def test_a_push_from_a_gap_does_not_reach_a_state_beyond_a_clipped_push_band() -> None:
+    """The l-bracket at shape 0.005 mm, COM 0.01 mm: the push band of the hilltop at 3 degrees
+    is clipped at state 1's normal (0 degrees), whose normal arc (+-0.04 degrees) reaches past
+    that end. A push starting between the bands cannot pass the hilltop (F2: within
+    2.96-3.00 degrees), so it ends on state 2 only; from inside the band either side."""
+    part = catalog_part("l-bracket")
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, Uncertainty(1.0, 0.005, 0.01))
+    band = next(b for b in mech.bands if circ(b.divergent_deg, 3.0) < 0.5)
+    assert circ(band.lo_deg, pf.states[band.left].normal_deg) < 1e-9
+    left, right = mech.state_of[band.left], mech.state_of[band.right]
+    deep = pf.states[band.right].normal_deg
+    assert _open_cell_at(mech, deep).targets == {right}
+    start = (band.lo_deg + band.hi_deg) / 2.0
+    assert {left, right} <= fence_outcomes(mech, start, start)
+    assert band.lo_deg < band.top_lo_deg <= band.divergent_deg <= band.top_hi_deg < band.hi_deg

@@ -324,3 +324,64 @@ def test_price_of_conservatism(capsys) -> None:  # noqa: ANN001
             f"{sw.mean():.4f} mm (mean widening {(cw - sw).mean():.4f} mm)"
         )
     assert (comp >= samp).all()
+
+
+# --- every fence cell against the reference: pushes from inside it end in its targets -------
+
+
+SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "samples"
+
+
+def _slot_outline(facets: int = 19):  # noqa: ANN202
+    """A 60 x 20 slot, each semicircular end flattened to ``facets`` edges (one at its tip)."""
+    pts = []
+    for cx, a0 in ((50.0, -90.0), (10.0, 90.0)):
+        for k in range(facets + 1):
+            a = math.radians(a0 + 180.0 * k / facets)
+            pts.append((cx + 10.0 * math.cos(a), 10.0 + 10.0 * math.sin(a)))
+    return make_part(make_outline("slot", pts))
+
+
+@pytest.mark.parametrize(
+    ("source", "unc"),
+    [
+        ("slot.dxf", Uncertainty(1.0)),
+        ("slot-outline", Uncertainty(1.0)),
+        ("l-bracket", Uncertainty(1.0, 0.005, 0.01)),
+        ("l-bracket", Uncertainty(2.0, 0.02, 0.05)),
+        ("cadquery__gear.dxf", Uncertainty(1.0)),
+    ],
+)
+def test_pushes_sampled_in_each_fence_cell_end_in_its_targets(source, unc, tmp_path) -> None:
+    """Orientations sampled in every fence cell (the bands' push bands too, where the
+    reference's plain descent is one of the outcomes), each pushed on a shape perturbed within
+    the tolerance: the rest lies in a target of the cell, and at t = c = 0 the ideal push's
+    state is a target. The slot's and the l-bracket's push bands end at a neighbouring state's
+    normal (the cells narrowed to what no push from them can leave)."""
+    from feederkit.mechanics import push, push_function
+
+    if source == "slot.dxf":
+        import fixtures_cad as fx
+
+        part = load_part(str(fx.write_slot(tmp_path / source)))
+    elif source == "slot-outline":
+        part = _slot_outline()
+    elif source.endswith(".dxf"):
+        if not (SAMPLES / source).exists():
+            pytest.skip(f"sample drawing not found: {SAMPLES / source}")
+        part = load_part(str(SAMPLES / source))
+    else:
+        part = load_part(str(CATALOG / f"{source}.json"))
+    mech = uncertain_mechanics(part, unc)
+    pf = push_function(part)
+    ideal = unc.shape_tolerance_mm == unc.com_tolerance_mm == 0.0
+    rng = np.random.default_rng(11)
+    for cell in mech.cells:
+        if cell.hi - cell.lo < 1e-9:
+            continue
+        for theta in rng.uniform(cell.lo, cell.hi, 12).tolist():
+            shape = perturb(part.hull, part.com, unc.shape_tolerance_mm, unc.com_tolerance_mm, rng)
+            nu = shape.rest_from(theta, mech.vibration_mm)
+            assert set(states_at(mech, nu)) & cell.targets, (cell, theta, nu)
+            if ideal:
+                assert mech.state_of[push(pf, theta).id] in cell.targets, (cell, theta)

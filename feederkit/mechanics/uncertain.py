@@ -94,11 +94,13 @@ class Band:
     """The band around the divergent orientation ``divergent_deg`` (a hilltop of the radius
     function between ideal states ``left`` and ``right``, counter-clockwise).
 
-    Every perturbed shape has a local maximum of its radius function in ``[lo_deg, hi_deg]``
-    (``lo <= divergent <= hi``, ``hi`` may pass 360): a push starting inside may end on either
-    side, one starting outside never crosses it. With the vibration on it is widened by the
-    push band (:data:`PUSH_BAND_DEG`, or the depth rule beside a shallow state: :func:`_bands`);
-    at ``t = c = 0`` and vibration 0 it is the point.
+    Every perturbed shape has a local maximum of its radius function in ``[top_lo_deg,
+    top_hi_deg]`` (the F2 band; ``top_lo <= divergent <= top_hi``, ``top_hi`` may pass 360):
+    no push ends beyond it. ``[lo_deg, hi_deg]`` holds it (``lo <= top_lo``, ``top_hi <= hi``):
+    a push starting inside may end on either side, one starting outside never crosses it.
+    With the vibration on it is the F2 band widened by the push band (:data:`PUSH_BAND_DEG`,
+    or the depth rule beside a shallow state: :func:`_bands`); at ``t = c = 0`` and vibration 0
+    both are the point.
     """
 
     divergent_deg: float
@@ -106,6 +108,8 @@ class Band:
     hi_deg: float
     left: int
     right: int
+    top_lo_deg: float
+    top_hi_deg: float
 
     @property
     def half_width_deg(self) -> float:
@@ -357,7 +361,7 @@ def _bands(
     d = div[ks]
     lo, hi = d.copy(), d.copy()
     if eps == 0.0 and vibration == 0.0:
-        return _band_list(d, lo, hi, left, right)
+        return _band_list(d, lo, hi, left, right, lo, hi)
     h = np.asarray(pf.part.hull, dtype=float)
     com = np.asarray(pf.part.com, dtype=float)
     lpsi = d - np.mod(d - psi[left], 360.0)
@@ -379,6 +383,7 @@ def _bands(
             if keep.any():
                 lo[j] = d[j] + min(float(a_lo[keep].min()), 0.0)
                 hi[j] = d[j] + max(float(a_hi[keep].max()), 0.0)
+    top_lo, top_hi = lo.copy(), hi.copy()  # the F2 band: every perturbed hilltop
     if vibration > 0.0:
         w_lo = np.full(len(ks), PUSH_BAND_DEG)
         w_hi = np.full(len(ks), PUSH_BAND_DEG)
@@ -392,14 +397,28 @@ def _bands(
             w_hi[near] = np.maximum(w_hi[near], p_hi - d[near])
         lo = np.maximum(lpsi, lo - w_lo)
         hi = np.minimum(rpsi, hi + w_hi)
-    return _band_list(d, lo, hi, left, right)
+    return _band_list(d, lo, hi, left, right, top_lo, top_hi)
 
 
 def _band_list(
-    d: np.ndarray, lo: np.ndarray, hi: np.ndarray, left: np.ndarray, right: np.ndarray
+    d: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    left: np.ndarray,
+    right: np.ndarray,
+    top_lo: np.ndarray,
+    top_hi: np.ndarray,
 ) -> list[Band]:
     return [
-        Band(float(d[j]), float(lo[j]), float(hi[j]), int(left[j]), int(right[j]))
+        Band(
+            float(d[j]),
+            float(lo[j]),
+            float(hi[j]),
+            int(left[j]),
+            int(right[j]),
+            float(top_lo[j]),
+            float(top_hi[j]),
+        )
         for j in range(len(d))
     ]
 
@@ -482,7 +501,9 @@ def _arc_hull(arcs: Sequence[tuple[float, float]], ref: float) -> tuple[float, f
         hi += 360.0
     while hi - lo > span + 1e-6:
         hi -= 360.0
-    return lo, hi
+    # norm360 puts an end within 1e-12 below 360 at 0 (a normal of 359.9999999999996 is 0):
+    # the other end, from its own arc, would then lie that rounding below it, reversed.
+    return lo, max(hi, lo)
 
 
 @dataclass(frozen=True)
@@ -522,8 +543,10 @@ def _cell_targets(
     if hi - lo >= 360.0:
         basins = np.unique(arr.basin).tolist()
     else:
-        x = norm360(lo)
-        y = x + (hi - lo)
+        # Shift by whole turns only (norm360 would put a ``lo`` just below 0 at 0 and so
+        # move the arc's far end past a candidate lying exactly there).
+        x = lo - 360.0 * math.floor(lo / 360.0)
+        y = hi - 360.0 * math.floor(lo / 360.0)
         a = int(np.searchsorted(arr.ext_normal, x - arr.widest, side="left"))
         b = int(np.searchsorted(arr.ext_normal, y + arr.widest, side="right"))
         nrm, half = arr.ext_normal[a:b], arr.ext_half[a:b]
@@ -668,8 +691,14 @@ def _fence_cells(
 ) -> tuple[FenceCell, ...]:
     """The circle of fence orientations cut at the band ends, each cell with its targets.
 
-    From a gap between bands ``j`` and ``j + 1`` the push stays between them (it cannot pass a
-    local maximum); from inside band ``j`` it stays between bands ``j - 1`` and ``j + 1``.
+    A push cannot pass a local maximum of the perturbed radius function, and every one lies
+    in a band's F2 part (``top_lo_deg .. top_hi_deg``). From a gap between bands ``j`` and
+    ``j + 1`` the push starts outside both push bands, so it crosses neither hilltop: it rests
+    between band ``j``'s F2 start and band ``j + 1``'s F2 end. From inside band ``j`` it may
+    cross hilltop ``j`` but no other: it rests between band ``j - 1``'s F2 start and band
+    ``j + 1``'s F2 end. (A push band reaches at most the neighbouring state's normal, so a
+    state just beyond it, at that normal, is not reached from the gap: the push band only says
+    where a push may be carried over *its own* hilltop.)
     """
     arr = _candidate_arrays(cands)
     if not bands:
@@ -677,21 +706,23 @@ def _fence_cells(
     base = bands[0].lo_deg
     lo = [base + norm360(b.lo_deg - base) for b in bands]
     hi = [lo[j] + (b.hi_deg - b.lo_deg) for j, b in enumerate(bands)]
+    top_lo = [lo[j] + (b.top_lo_deg - b.lo_deg) for j, b in enumerate(bands)]
+    top_hi = [lo[j] + (b.top_hi_deg - b.lo_deg) for j, b in enumerate(bands)]
     q = len(bands)
 
-    def at(j: int) -> tuple[float, float]:
+    def at(j: int) -> tuple[float, float, float, float]:
         turn = 360.0 * (j // q)
-        return lo[j % q] + turn, hi[j % q] + turn
+        k = j % q
+        return lo[k] + turn, hi[k] + turn, top_lo[k] + turn, top_hi[k] + turn
 
     cells: list[FenceCell] = []
     for j in range(q):
-        b_lo, b_hi = at(j)
-        prev_lo, _ = at(j - 1)
-        _, next_hi = at(j + 1)
-        region = (b_lo, b_lo + 360.0) if q == 1 else (prev_lo, next_hi)
+        b_lo, b_hi, t_lo, _ = at(j)
+        _, _, prev_top_lo, _ = at(j - 1)
+        n_lo, _, _, next_top_hi = at(j + 1)
+        region = (b_lo, b_lo + 360.0) if q == 1 else (prev_top_lo, next_top_hi)
         cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
-        n_lo, _ = at(j + 1)
-        gap_region = (b_lo, b_lo + 360.0) if q == 1 else (b_lo, next_hi)
+        gap_region = (b_lo, b_lo + 360.0) if q == 1 else (t_lo, next_top_hi)
         cells.append(FenceCell(b_hi, n_lo, False, _cell_targets(arr, dest, *gap_region)))
     return tuple(cells)
 
