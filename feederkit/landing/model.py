@@ -8,11 +8,13 @@ planners (Akella & Mason, section 8): see :mod:`feederkit.landing.plan` and docs
 
 Two landings are the same landing when their outlines are **congruent**: a rigid motion of
 the plane (rotation and translation, no reflection) maps one outline, with its holes and its
-COM, onto the other. The test is exact up to a length tolerance: the motion must take the COM
-to the COM and each hull vertex to a hull vertex in the same cyclic order, so the candidate
-rotations are the few that take hull vertex 0 to a hull vertex at the same distance from the
-COM; each is checked on the whole hull and then on the outline with its holes (their
-symmetric difference). The push functions' rotation-invariant signature
+COM, onto the other. The test is exact up to a length tolerance: the motion must take the
+COM to the COM and each hull vertex to a hull vertex in the same cyclic order, so the
+candidate rotations are the few that take hull vertex 0 to a hull vertex at the same
+distance from the COM; each is checked on the whole hull and then on the outline with its
+holes (their symmetric difference). The hull is the outline's exact hull
+(:func:`exact_hull`), never the simplified contact hull, which need not keep the outline's
+mirror symmetry. The push functions' rotation-invariant signature
 (:mod:`feederkit.mix.signatures`) would not do: it sees the hull and the COM only, so two
 sides that differ by a hole or a notch inside the hull would wrongly be merged. Landings
 that are not congruent but that the fence and sensor cannot tell apart are kept apart and
@@ -23,13 +25,13 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from shapely import affinity
 
 from feederkit.errors import InputError
-from feederkit.hull import Point, number_hull
+from feederkit.hull import Point, convex_hull, number_hull
 from feederkit.outline import Outline
 from feederkit.part import Part
 
@@ -131,24 +133,29 @@ def _rotate(p: Point, c: float, s: float) -> Point:
     return (c * p[0] - s * p[1], s * p[0] + c * p[1])
 
 
-def congruence_rotations(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) -> list[float]:
-    """Rotations (deg, about the COM) that map part ``a`` onto part ``b``; empty when none.
+def exact_hull(part: Part) -> tuple[Point, ...]:
+    """The exact convex hull of the part's outline (collinear points dropped, nothing else).
 
-    A rotation counts when it takes every hull vertex of ``a`` (about its COM) to the hull
-    vertex of ``b`` (about its COM) in the same cyclic order within ``rel_tol`` of the size,
-    and the outlines with their holes then differ by at most ``rel_tol`` of the area.
+    Congruence is decided on it, not on ``part.hull``: a simplified hull (``--hull-tolerance``)
+    depends on the order in which :func:`feederkit.hull.clean_hull` merges an arc's chords,
+    so a mirror-symmetric outline's simplified hull need not be symmetric (a 60 x 20 slot
+    gave 40 vertices whose mirror image is another 40-gon), and a hull and its mirror would
+    differ by up to the hull tolerance where the outlines coincide.
     """
-    ha, hb = _centred(a.hull, a.com), _centred(b.hull, b.com)
+    return number_hull(convex_hull(part.outline.vertices))
+
+
+def _rotations(a: Part, b: Part, rel_tol: float) -> Iterator[float]:
+    ha, hb = _centred(exact_hull(a), a.com), _centred(exact_hull(b), b.com)
     n = len(ha)
-    if n != len(hb):
-        return []
+    if n != len(hb) or n < 3:
+        return
     size = max(a.size, b.size)
     tol = rel_tol * size
     area_a, area_b = a.outline.polygon().area, b.outline.polygon().area
     if abs(area_a - area_b) > rel_tol * max(area_a, area_b):
-        return []
+        return
     r0 = math.hypot(*ha[0])
-    out = []
     for j in range(n):
         if abs(math.hypot(*hb[j]) - r0) > tol:
             continue
@@ -157,8 +164,18 @@ def congruence_rotations(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) 
         if all(
             math.dist(_rotate(ha[i], c, s), hb[(i + j) % n]) <= tol for i in range(n)
         ) and _same_outline(a, b, phi, rel_tol * max(area_a, area_b) + tol * size):
-            out.append(math.degrees(phi) % 360.0)
-    return out
+            yield math.degrees(phi) % 360.0
+
+
+def congruence_rotations(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) -> list[float]:
+    """Rotations (deg, about the COM) that map part ``a`` onto part ``b``; empty when none.
+
+    A rotation counts when it takes every vertex of the exact hull of ``a``'s outline (about
+    its COM, see :func:`exact_hull`) to the vertex of ``b``'s in the same cyclic order within
+    ``rel_tol`` of the size, and the outlines with their holes then differ by at most
+    ``rel_tol`` of the area.
+    """
+    return list(_rotations(a, b, rel_tol))
 
 
 def _same_outline(a: Part, b: Part, phi: float, area_tol: float) -> bool:
@@ -170,7 +187,7 @@ def _same_outline(a: Part, b: Part, phi: float, area_tol: float) -> bool:
 
 def congruent(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) -> bool:
     """Whether a rigid motion of the plane maps ``a`` (outline, holes, COM) onto ``b``."""
-    return bool(congruence_rotations(a, b, rel_tol))
+    return next(_rotations(a, b, rel_tol), None) is not None
 
 
 def landings_of_outline(
