@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from feederkit.catalog import (
     could_be_part_name,
     default_catalog_path,
     get_revision,
+    landings_for,
     part_from_revision,
 )
 from feederkit.errors import InputError
@@ -63,7 +65,31 @@ def _from_catalog(source: str, com: Point | None, catalog: str | None) -> Loaded
     notes = [w for w in revision.warnings if not w.startswith(NOT_ORIENTABLE)]
     if not verdict.orientable:
         notes.append(f"{NOT_ORIENTABLE}: {verdict.reason}")
-    return LoadedPart(part, tuple(notes), verdict, f"catalog {db}")
+    loaded = LoadedPart(part, tuple(notes), verdict, f"catalog {db}")
+    if not verdict.orientable and revision.source_kind == "mesh":
+        lands = [(x.name, x.part) for x in revision.landings]
+        return _by_landings(loaded, lands, revision.hull_tolerance)
+    return loaded
+
+
+def _by_landings(
+    loaded: LoadedPart, landings: Sequence[tuple[str, Part]], hull_tolerance: float | None
+) -> LoadedPart:
+    """A mesh part whose imported pose pushing cannot orient (a cylinder standing on its
+    round end) is still a part to plan when another of its landings can: that landing's
+    verdict, with a warning naming the pose that cannot (plans over landings check each
+    selected one: ``--landings`` leaves it out). ``landings``: (name, part) of each;
+    ``loaded`` itself when none can."""
+    for name, part in landings:
+        verdict = orientability(part, hull_tolerance)
+        if verdict.orientable:
+            notes = [w for w in loaded.warnings if not w.startswith(NOT_ORIENTABLE)]
+            notes.append(
+                f"the imported pose is {NOT_ORIENTABLE} ({loaded.orientability.reason}); "
+                f"landing {name} is: leave the others out with --landings"
+            )
+            return LoadedPart(loaded.part, tuple(notes), verdict, loaded.origin)
+    return loaded
 
 
 def load_parts_with_warnings(
@@ -90,7 +116,14 @@ def load_parts_with_warnings(
         raise InputError(f"{source[:80]}: cannot be a file ({exc.strerror or exc})") from None
     if is_file:
         _, parts = import_parts(path, opts)
-        return tuple(LoadedPart(p.part, p.warnings, p.orientability, str(path)) for p in parts)
+        out = []
+        for p in parts:
+            loaded = LoadedPart(p.part, p.warnings, p.orientability, str(path))
+            if not p.orientability.orientable and p.source.kind == "mesh":
+                lands = [(x.name, x.part) for x in landings_for(p, opts, path)]
+                loaded = _by_landings(loaded, lands, p.hull_tolerance)
+            out.append(loaded)
+        return tuple(out)
     if exists:
         raise InputError(f"{source}: not a file")
     if not could_be_part_name(source):
