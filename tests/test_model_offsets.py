@@ -64,6 +64,16 @@ def test_every_reading_of_the_part_itself_lies_in_a_root_branch(tolerance):
     assert any("widened" in w for w in made.warnings)
 
 
+def test_led_branches_take_the_counts_the_part_itself_blocks():
+    """An LED array of 0.05 mm pitch: the model's 39.987 mm state blocks 799 beams, the part
+    itself, 40 mm across, 800; the branch holding the state reaches 40.0 mm."""
+    from feederkit.sensors import LedSensor
+
+    part = make_part(d_shape(), hull_tolerance=0.05)
+    made = make_plan([push_function(part)], LedSensor(0.05))
+    assert any(hi >= 40.0 - 1e-9 for _lo, hi in _branches(made.plan["root"]))
+
+
 def test_siblings_in_the_way_are_reported_and_never_overlap():
     """Two branches 0.05 mm apart whose states may both stray 0.04 mm into the gap: they
     meet in its middle, and both parts are named."""
@@ -83,7 +93,7 @@ def test_siblings_in_the_way_are_reported_and_never_overlap():
         ],
         "root": node,
     }
-    widest, blocked = widen_readings(data, [[(0.0, 0.04)], [(-0.04, 0.0)]], 0.1)
+    widest, blocked = widen_readings(data, [[(0.0, 0.04)], [(-0.04, 0.0)]], ToleranceSensor(0.1))
     assert blocked == {0, 1}
     (a_lo, a_hi), (b_lo, b_hi) = _branches(node)
     assert a_hi == pytest.approx(10.125) and b_lo == pytest.approx(10.125)

@@ -18,7 +18,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from feederkit.angles import norm360
+import numpy as np
+
 from feederkit.hull import convex_hull
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.part import make_part
@@ -40,16 +41,38 @@ def exact_push_function(model: PushFunction) -> PushFunction | None:
     return push_function(make_part(part.outline, part.com))
 
 
+def _distances(points: np.ndarray, ring: np.ndarray) -> np.ndarray:
+    """Distance of each point (rows) to each edge of the ring (columns, edge ``i`` from
+    vertex ``i`` to ``i + 1``)."""
+    a, b = ring, np.roll(ring, -1, axis=0)
+    d = b - a
+    rel = points[:, None, :] - a[None, :, :]
+    len2 = np.maximum((d * d).sum(axis=1), 1e-300)
+    t = np.clip((rel * d[None, :, :]).sum(axis=2) / len2[None, :], 0.0, 1.0)
+    gap = rel - t[..., None] * d[None, :, :]
+    return np.sqrt((gap * gap).sum(axis=2))
+
+
 def state_offsets(model: PushFunction, exact: PushFunction) -> tuple[Offset | None, ...]:
     """Per state of ``model``: the least and largest ``exact`` diameter minus the model's,
-    over the ``exact`` stable states whose normal lies in the model state's resting range
-    (where the part itself may rest when the model says it is in that state); None when
-    none does (a state of the simplification only, such as a chord's across an arc's top).
+    over the ``exact`` stable states resting on an edge the model's edge stands for (both
+    its ends within the simplification's reach of the model's edge: ``slack``, twice the
+    furthest the outline's hull strays from the model's, a little more for rounding), where
+    the part itself rests when the model says it is in that state; None when none does (a
+    state of the simplification only, such as a chord's across an arc's top).
     """
+    mh = np.asarray(model.part.hull, dtype=float)
+    eh = np.asarray(exact.part.hull, dtype=float)
+    dist = _distances(eh, mh)  # exact vertex x model edge
+    slack = 2.0 * float(dist.min(axis=1).max()) + 1e-9 * model.part.size
+    n = len(eh)
     out: list[Offset | None] = []
     for s in model.states:
-        lo, hi = s.resting_range_deg
-        ds = [e.diameter - s.diameter for e in exact.states if norm360(e.normal_deg - lo) < hi - lo]
+        ds = [
+            e.diameter - s.diameter
+            for e in exact.states
+            if dist[e.edge, s.edge] <= slack and dist[(e.edge + 1) % n, s.edge] <= slack
+        ]
         out.append((min(ds), max(ds)) if ds else None)
     return tuple(out)
 
@@ -82,22 +105,20 @@ def largest_offset(offsets: Sequence[Offset | None]) -> tuple[float, int | None]
     return worst, which
 
 
-def offset_warning(
-    label: str, offsets: Sequence[Offset | None], sensor: Sensor, widened: bool = False
-) -> str | None:
-    """One line when ``label``'s readings may stray from its model's by more than
-    ``OFFSET_SHARE`` of ``sensor``'s tolerance (``widened``: although the plan's intervals
-    were widened for it, a sibling branch was in the way); None sensorless."""
+def offset_warning(label: str, offsets: Sequence[Offset | None], sensor: Sensor) -> str | None:
+    """One line for ``label``, a member whose plan could not widen a branch for it (a
+    sibling branch in the way), when its readings may stray from its model's by more than
+    ``OFFSET_SHARE`` of ``sensor``'s tolerance (half its reading reach); None sensorless."""
     if not sensor.informative:
         return None
     tolerance = sensor.reading_reach() / 2.0
     worst, state = largest_offset(offsets)
     if state is None or worst <= OFFSET_SHARE * tolerance:
         return None
-    where = "may read in another branch" if widened else "may read outside every branch"
     return (
         f"{label}: the part may read up to {worst:.3g} mm from its model's diameter (state "
         f"{state}: its contact hull simplifies the outline's arcs), more than {OFFSET_SHARE:g} "
-        f"of the sensor's ±{tolerance:.3g} mm: a part made to the drawing {where}; import it "
-        f"with a smaller --hull-tolerance (such as {tolerance / 10.0:.2g})"
+        f"of the sensor's ±{tolerance:.3g} mm, and the plan's branches beside it leave no room "
+        "for that: a part made to the drawing may read in another branch; import it with a "
+        f"smaller --hull-tolerance (such as {tolerance / 10.0:.2g})"
     )

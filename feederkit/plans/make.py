@@ -20,13 +20,14 @@ soon as the plan knows the part will be rejected.
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-from feederkit.errors import InputError, PlanningError
+from feederkit.errors import CheckFailed, InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
@@ -153,18 +154,17 @@ def _make_plan(
     # The part itself may read a little off its simplified hull's diameters: the branches
     # are widened for it where no sibling is in the way (plans.widen).
     offsets = [reading_offsets(pf) for pf in pfs]
-    widenable = isinstance(sensor, ToleranceSensor)
     if unc.is_ideal:
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
-        widest, blocked = _widened(data, offsets, sensor) if widenable else (0.0, set())
-        report = check_plan(data)
+        data, report, widest, blocked = _widened(data, offsets, sensor, check_plan)
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
-        widest, blocked = _widened(data, offsets, sensor) if widenable else (0.0, set())
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
-        report = verify_strong(data, tighten_margins=True)
+        data, report, widest, blocked = _widened(
+            data, offsets, sensor, lambda d: verify_strong(d, tighten_margins=True)
+        )
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
@@ -201,13 +201,12 @@ def _make_plan(
             )
     diameters = sorted({round(s.diameter, DIAMETER_DIGITS) for pf in pfs for s in pf.states})
     warnings = sensor_warnings(sensor, diameters)
-    for p, off in enumerate(offsets):
-        if not widenable or p in blocked:
-            m = None if named is None else named[p]
-            label = pfs[p].part.name if m is None else member_label(m.name, m.landing)
-            line = offset_warning(label, off, sensor, widened=widenable)
-            if line is not None:
-                warnings.append(line)
+    for p in sorted(blocked):
+        m = None if named is None else named[p]
+        label = pfs[p].part.name if m is None else member_label(m.name, m.landing)
+        line = offset_warning(label, offsets[p], sensor)
+        if line is not None:
+            warnings.append(line)
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
@@ -226,11 +225,27 @@ def _make_plan(
 
 
 def _widened(
-    data: dict[str, Any], offsets: list[tuple[Offset | None, ...]], sensor: Sensor
-) -> tuple[float, set[int]]:
-    """:func:`~feederkit.plans.widen.widen_readings` for a tolerance sensor."""
-    assert isinstance(sensor, ToleranceSensor)
-    return widen_readings(data, offsets, sensor.tolerance)
+    data: dict[str, Any],
+    offsets: list[tuple[Offset | None, ...]],
+    sensor: Sensor,
+    verify: Callable[[dict[str, Any]], VerificationReport],
+) -> tuple[dict[str, Any], VerificationReport, float, set[int]]:
+    """The plan with its branches widened for the parts themselves
+    (:func:`~feederkit.plans.widen.widen_readings`), verified; the plan as made, verified,
+    when the widened one fails (a widened branch would take a reading the verification
+    finds some state giving there), its members with offsets then all named. Returns the
+    plan, its report, the largest widening and the members left unwidened."""
+    if not any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for os_ in offsets for o in os_):
+        return data, verify(data), 0.0, set()
+    wide = copy.deepcopy(data)
+    widest, blocked = widen_readings(wide, offsets, sensor)
+    if widest == 0.0:
+        return data, verify(data), 0.0, blocked
+    try:
+        return wide, verify(wide), widest, blocked
+    except CheckFailed:
+        named = {p for p, os_ in enumerate(offsets) if any(o is not None for o in os_)}
+        return data, verify(data), 0.0, named
 
 
 def ideal_plan_words(

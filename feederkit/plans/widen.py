@@ -15,26 +15,29 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from feederkit.mechanics.modelerror import Offset
+from feederkit.sensors import Sensor
 
 StateOffsets = Sequence[Sequence[Offset | None]]
 """Per part of the plan file, per stable state: its reading offset (mm) or None."""
 
 
 def widen_readings(
-    data: dict[str, Any], offsets: StateOffsets, tolerance: float
+    data: dict[str, Any], offsets: StateOffsets, sensor: Sensor
 ) -> tuple[float, set[int]]:
-    """Widen ``data``'s branch intervals in place for a tolerance sensor of ``tolerance``
-    mm: a state whose open reading interval ``(d - e, d + e)`` meets a branch's may read
-    anywhere in ``(d + lo - e, d + hi + e)`` (its offset ``(lo, hi)``). Returns the largest
-    widening (mm) and the parts (indices into ``data["parts"]``) with a state that may still
-    read outside its branch, because a sibling branch's interval is in the way.
+    """Widen ``data``'s branch intervals in place: a state of diameter ``d`` that can read
+    in a branch may, as the part itself, give any reading ``sensor`` gives for a diameter
+    in ``[d + lo, d + hi]`` (its offset ``(lo, hi)``; for a tolerance ``e``, the interval
+    ``(d + lo - e, d + hi + e)``). Returns the largest widening (mm) and the parts (indices
+    into ``data["parts"]``) with a state that may still read outside its branch, because a
+    sibling branch's interval is in the way. Nothing changes sensorless.
 
     >>> leaf = {"result": []}
     >>> node = {"action_deg": None, "margin_deg": None, "branches": [
     ...     {"reading": [9.5, 10.5], "next": leaf}, {"reading": [19.5, 20.5], "next": leaf}]}
     >>> data = {"parts": [{"stable_states": [{"diameter": 10.0}, {"diameter": 20.0}]}],
     ...         "root": node}
-    >>> widest, blocked = widen_readings(data, [[(0.0, 0.02), None]], 0.5)
+    >>> from feederkit.sensors import ToleranceSensor
+    >>> widest, blocked = widen_readings(data, [[(0.0, 0.02), None]], ToleranceSensor(0.5))
     >>> round(widest, 9), blocked
     (0.02, set())
     >>> node["branches"][0]["reading"]
@@ -47,7 +50,7 @@ def widen_readings(
         if off is not None and (off[0] < 0.0 or off[1] > 0.0)
     ]
     widest, blocked = 0.0, set()
-    if not states:
+    if not states or not sensor.informative:
         return widest, blocked
     for node in _steps(data):
         readings = [b["reading"] for b in node["branches"]]
@@ -57,9 +60,10 @@ def widen_readings(
         for lo, hi in readings:
             new_lo, new_hi, who = lo, hi, []
             for p, d, (off_lo, off_hi) in states:
-                if d - tolerance < hi and d + tolerance > lo:  # it may read in this branch
-                    new_lo = min(new_lo, d + off_lo - tolerance)
-                    new_hi = max(new_hi, d + off_hi + tolerance)
+                if sensor.reads_into(d, lo, hi):  # it may read in this branch
+                    reach = sensor.reading_interval((d + off_lo, d + off_hi))
+                    assert reach is not None  # an informative sensor reads
+                    new_lo, new_hi = min(new_lo, reach[0]), max(new_hi, reach[1])
                     who.append(p)
             wanted.append((new_lo, new_hi, who))
         # Siblings in reading order: where two want the same gap (or more), they meet at
