@@ -35,3 +35,14 @@ def test_a_cylinder_in_the_catalog_plans_its_side_landing(tmp_path, capsys):
     assert main(["plan", "cyl", "--catalog", str(db), "--tolerance", "0.1", "--json"]) == 0
     out = capsys.readouterr().out
     assert '"pose-0"' in out  # the round end, its own landing
+
+
+def test_a_cylinder_plan_file_runs(tmp_path, capsys):
+    """The file's diameters are as planned on: snapped within DIAMETER_REL_EPS of the
+    largest landing (60 mm lying down), further than that share of the round end's own
+    size from what its hull gives; every reader of the file accepts them."""
+    path = cylinder(tmp_path)
+    out = tmp_path / "cyl.plan.json"
+    assert main(["plan", str(path), "--tolerance", "0.1", "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["run", str(out), "--all"]) == 0, capsys.readouterr().out

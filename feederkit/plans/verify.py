@@ -36,6 +36,7 @@ import numpy as np
 from feederkit.angles import angle_close, norm360
 from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, Step, member_label, push_function_of
@@ -314,7 +315,11 @@ def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
 
 
 def _state_problems(plan: Plan, p: int) -> list[str]:
-    """Differences between the plan's stable states and those its hull and COM give."""
+    """Differences between the plan's stable states and those its hull and COM give.
+
+    The diameters are as planned on: the machine snaps those equal within
+    ``DIAMETER_REL_EPS`` of the plan's largest part (``build_machine``), so a small part's
+    may differ from its own hull's by that much, more than its own size's share."""
     part = plan.parts[p]
     pf = push_function_of(part)
     listed = {s.id: s for s in part.states}
@@ -323,7 +328,8 @@ def _state_problems(plan: Plan, p: int) -> list[str]:
             f"part {part.label!r}: the plan lists stable states {sorted(listed)}, but its hull "
             f"and COM give {pf.n}"
         ]
-    eps_d = 1e-9 * pf.part.size + 1e-12
+    largest = max(push_function_of(q).part.size for q in plan.parts)
+    eps_d = DIAMETER_REL_EPS * largest + 1e-12
     out = []
     for s in pf.states:
         f = listed[s.id]
