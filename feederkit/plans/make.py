@@ -20,18 +20,18 @@ soon as the plan knows the part will be rejected.
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-from feederkit.errors import CheckFailed, InputError, PlanningError
+from feederkit.errors import InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
-from feederkit.mechanics.modelerror import Offset, offset_warning, reading_offsets
+from feederkit.machine.widths import widen_widths
+from feederkit.mechanics.modelerror import largest_offset, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
@@ -40,7 +40,7 @@ from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import Certificate, PlanResult
-from feederkit.plans.fileformat import plan_to_dict, result_nodes
+from feederkit.plans.fileformat import as_plan, plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.strong import (
     ideal_view,
@@ -49,7 +49,7 @@ from feederkit.plans.strong import (
     verify_strong,
 )
 from feederkit.plans.verify import VerificationReport, check_plan
-from feederkit.plans.widen import widen_readings
+from feederkit.plans.verify import expected_operations as file_expected
 from feederkit.sensors import Sensor, ToleranceSensor, sensor_warnings
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 from feederkit.words import at_most, plural
@@ -142,7 +142,12 @@ def _make_plan(
     _check_resolution(sensor, pfs)
     named = check_plan_members(_weighted_members(members, weights, pfs), pfs)
     shares, rejected = _member_weights(named)
-    machine = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
+    # The part itself may read a little off its simplified hull's diameters: the machine
+    # reads each state over them too (machine.widths), so no branch parts what the part
+    # itself cannot be told apart by.
+    offsets = [reading_offsets(pf) for pf in pfs]
+    unwidened = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
+    machine = widen_widths(unwidened, offsets)
     if rejected:
         _check_rejects_separable(machine, named, lambda: _finest_machine(pfs, unc))
     try:
@@ -151,28 +156,33 @@ def _make_plan(
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
         raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
-    # The part itself may read a little off its simplified hull's diameters: the branches
-    # are widened for it where no sibling is in the way (plans.widen).
-    offsets = [reading_offsets(pf) for pf in pfs]
+    # Planned on the parts' own widths, the plan's expected length is restated on the file's
+    # model (its diameters), the one every reader computes.
+    widened = machine is not unwidened
     if unc.is_ideal:
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
-        data, report, widest, blocked = _widened(data, offsets, sensor, check_plan)
+        if widened:
+            data["stats"]["expected_length"] = file_expected(as_plan(data))
+        report = check_plan(data)
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
+        ideal = widen_widths(ideal, offsets)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
-        data, report, widest, blocked = _widened(
-            data, offsets, sensor, lambda d: verify_strong(d, tighten_margins=True)
-        )
+        report = verify_strong(data, tighten_margins=True, restate_expected=widened)
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
+    if widened:
+        result = replace(result, expected_length=data["stats"]["expected_length"])
     notes: list[str] = []
-    if widest > 0.0:
+    widest = max((largest_offset(off)[0] for off in offsets), default=0.0)
+    if widest > 0.0 and sensor.informative:
         notes.append(
-            f"reading intervals widened by up to {widest:.3g} mm to hold the parts themselves "
-            "(their contact hulls simplify the outlines' arcs)"
+            f"each state read over up to {widest:.3g} mm more of widths, those of the parts "
+            "themselves (their contact hulls simplify the outlines' arcs; a smaller "
+            "--hull-tolerance narrows it)"
         )
     floor = opts.min_margin_deg
     if floor > 0.0 and math.isfinite(result.min_margin) and result.min_margin < floor - 1e-9:
@@ -201,12 +211,6 @@ def _make_plan(
             )
     diameters = sorted({round(s.diameter, DIAMETER_DIGITS) for pf in pfs for s in pf.states})
     warnings = sensor_warnings(sensor, diameters)
-    for p in sorted(blocked):
-        m = None if named is None else named[p]
-        label = pfs[p].part.name if m is None else member_label(m.name, m.landing)
-        line = offset_warning(label, offsets[p], sensor)
-        if line is not None:
-            warnings.append(line)
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
@@ -222,30 +226,6 @@ def _make_plan(
     if held is not None:
         warnings.append(held)
     return MadePlan(data, result, report, tuple(warnings + notes))
-
-
-def _widened(
-    data: dict[str, Any],
-    offsets: list[tuple[Offset | None, ...]],
-    sensor: Sensor,
-    verify: Callable[[dict[str, Any]], VerificationReport],
-) -> tuple[dict[str, Any], VerificationReport, float, set[int]]:
-    """The plan with its branches widened for the parts themselves
-    (:func:`~feederkit.plans.widen.widen_readings`), verified; the plan as made, verified,
-    when the widened one fails (a widened branch would take a reading the verification
-    finds some state giving there), its members with offsets then all named. Returns the
-    plan, its report, the largest widening and the members left unwidened."""
-    if not any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for os_ in offsets for o in os_):
-        return data, verify(data), 0.0, set()
-    wide = copy.deepcopy(data)
-    widest, blocked = widen_readings(wide, offsets, sensor)
-    if widest == 0.0:
-        return data, verify(data), 0.0, blocked
-    try:
-        return wide, verify(wide), widest, blocked
-    except CheckFailed:
-        named = {p for p, os_ in enumerate(offsets) if any(o is not None for o in os_)}
-        return data, verify(data), 0.0, named
 
 
 def ideal_plan_words(
