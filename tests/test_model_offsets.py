@@ -72,3 +72,21 @@ def test_led_branches_take_the_counts_the_part_itself_blocks():
     part = make_part(d_shape(), hull_tolerance=0.05)
     made = make_plan([push_function(part)], LedSensor(0.05))
     assert any(hi >= 40.0 - 1e-9 for _lo, hi in _branches(made.plan["root"]))
+
+
+def test_no_strong_plan_on_a_simplified_hull_points_to_the_hull_tolerance():
+    """A 60 x 54 mm ellipse whose simplified hull has stable states of the simplification
+    only has no strong plan at 0.1 mm; the refusal says a smaller --hull-tolerance may help
+    (at 0.005 mm it plans)."""
+    from feederkit.errors import PlanningError
+
+    ring = [
+        (30 * math.cos(2 * math.pi * k / 128), 27 * math.sin(2 * math.pi * k / 128))
+        for k in range(128)
+    ]
+    outline = make_outline("ellipse", ring)
+    coarse = push_function(make_part(outline, hull_tolerance=0.05))
+    with pytest.raises(PlanningError, match="smaller --hull-tolerance"):
+        make_plan([coarse], ToleranceSensor(0.1), certify=False)
+    fine = push_function(make_part(outline, hull_tolerance=0.005))
+    assert make_plan([fine], ToleranceSensor(0.1), certify=False).result.length >= 1

@@ -31,7 +31,7 @@ from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import widen_widths
-from feederkit.mechanics.modelerror import largest_offset, reading_offsets
+from feederkit.mechanics.modelerror import exact_push_function, largest_offset, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
@@ -155,6 +155,12 @@ def _make_plan(
     except NoStrongPlan as exc:
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
+        simplified = [pf.part.name for pf in pfs if exact_push_function(pf) is not None]
+        if simplified:
+            hint += (
+                f"; {simplified[0]}'s contact hull simplifies its outline (stable states of the "
+                "simplification only, widths it cuts): a smaller --hull-tolerance may help"
+            )
         raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
     # Planned on the parts' own widths, the plan's expected length is restated on the file's
     # model (its diameters), the one every reader computes.
