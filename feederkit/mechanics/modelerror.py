@@ -2,16 +2,17 @@
 
 Every plan is made on the part's contact hull, which import simplifies (``clean_hull``,
 ``--hull-tolerance``: a flattened arc's many chords become a few). The part itself rests on
-its outline's hull: on an edge of it whose normal ``nu`` is a stable orientation of the
-outline's own push function (section 3), where it reads the outline's width, while the plan
-expects the diameter of the model's state whose resting range holds ``nu`` (the state a push
-from ``nu`` settles in on the model). Across a flattened arc the two differ by up to about
-twice the simplification error, and more where a longer chord turns the resting edge; a
+its outline's hull: on a stable edge of the outline's own push function (section 3), where
+it reads the outline's width, while the plan expects the diameter of the model's state
+whose edge stands for that one (the outline's edges it replaced lie along it). Across a
+flattened arc the two differ by up to about twice the simplification error, and more where
+a longer chord turns the resting edge; a
 sensor finer than that can read a part made exactly to its drawing outside every branch of a
 plan made on its model (design.md: the executor must then stop).
 
-The plan file's diameters are the model's (design.md), so this module measures the offsets
-and the plan's warnings name them; a smaller ``--hull-tolerance`` shrinks them.
+The plan file's diameters are the model's (design.md); the machine reads each state over its
+offsets before planning (:mod:`feederkit.machine.widths`). A smaller ``--hull-tolerance``
+shrinks them.
 """
 
 from __future__ import annotations
@@ -23,11 +24,6 @@ import numpy as np
 from feederkit.hull import convex_hull
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.part import make_part
-from feederkit.sensors import Sensor
-
-OFFSET_SHARE = 0.25
-"""A part whose readings may stray from its model's by more than this share of the sensor's
-tolerance (half its reading reach) gets a warning."""
 
 Offset = tuple[float, float]
 
@@ -103,22 +99,3 @@ def largest_offset(offsets: Sequence[Offset | None]) -> tuple[float, int | None]
         if off is not None and max(-off[0], off[1]) > worst:
             worst, which = max(-off[0], off[1]), k
     return worst, which
-
-
-def offset_warning(label: str, offsets: Sequence[Offset | None], sensor: Sensor) -> str | None:
-    """One line for ``label``, a member whose plan could not widen a branch for it (a
-    sibling branch in the way), when its readings may stray from its model's by more than
-    ``OFFSET_SHARE`` of ``sensor``'s tolerance (half its reading reach); None sensorless."""
-    if not sensor.informative:
-        return None
-    tolerance = sensor.reading_reach() / 2.0
-    worst, state = largest_offset(offsets)
-    if state is None or worst <= OFFSET_SHARE * tolerance:
-        return None
-    return (
-        f"{label}: the part may read up to {worst:.3g} mm from its model's diameter (state "
-        f"{state}: its contact hull simplifies the outline's arcs), more than {OFFSET_SHARE:g} "
-        f"of the sensor's ±{tolerance:.3g} mm, and the plan's branches beside it leave no room "
-        "for that: a part made to the drawing may read in another branch; import it with a "
-        f"smaller --hull-tolerance (such as {tolerance / 10.0:.2g})"
-    )
