@@ -538,6 +538,88 @@ def test_a_slot_is_oriented_onto_a_flat_side_without_a_sensor(tmp_path: Path) ->
     assert result.length == 2
 
 
+def test_a_slot_with_shape_and_com_tolerance_keeps_its_hills_and_its_plan(tmp_path: Path) -> None:
+    """The slot at shape 0.005 mm, COM 0.01 mm: no hilltop is sure (each beside a tip is only
+    0.0044 mm above the tip state, below 2 (t + c) = 0.03 mm), but the tip state and its two
+    hilltops form one certain hill between the flat sides' wells (about 20 mm higher). Its band
+    holds every perturbed maximum, so a push from deep in a flat side's basin ends on that
+    side only, and rotating about 45 degrees still sends every state onto a flat side. (It had
+    no strong plan: without a band the circle was one cell.)"""
+    import fixtures_cad as fx
+
+    from feederkit.machine import build_machine
+    from feederkit.mechanics.uncertain import _radius
+    from feederkit.planning.api import plan
+    from feederkit.sensors import NoSensor
+
+    unc = Uncertainty(1.0, 0.005, 0.01)
+    eps = unc.shape_tolerance_mm + unc.com_tolerance_mm
+    pf = push_function(load_part(str(fx.write_slot(tmp_path / "slot.dxf"))))
+    mech = uncertain_mechanics(pf.part, unc)
+    h, com = np.asarray(pf.part.hull), np.asarray(pf.part.com)
+    peaks = _radius(h, com, np.asarray(pf.divergent_deg))
+    wells = _radius(h, com, np.asarray([pf.states[i].normal_deg for i in pf.range_state]))
+    m = len(peaks)
+    assert all(
+        peaks[k] - max(wells[k - 1], wells[k]) < 2.0 * eps for k in range(m)
+    )  # no hilltop is sure on its own
+    tips = [s for s in pf.states if min(circ(s.normal_deg, 0.0), circ(s.normal_deg, 180.0)) < 1e-6]
+    flats = [s for s in pf.states if s not in tips]
+    assert len(mech.bands) == 2
+    for b in mech.bands:
+        assert {b.left, b.right} == {f.id for f in flats}
+        tip = next(s for s in tips if circ(s.normal_deg, b.divergent_deg) < 2.0)
+        at = b.divergent_deg + (norm360(tip.normal_deg - b.divergent_deg + 180.0) - 180.0)
+        assert b.lo_deg < b.top_lo_deg < at < b.top_hi_deg < b.hi_deg
+    for flat in flats:
+        cell = next(
+            c
+            for c in mech.cells
+            if not c.closed and c.lo < c.lo + norm360(flat.normal_deg - c.lo) < c.hi
+        )
+        assert cell.targets == {mech.state_of[flat.id]}
+        assert cell.hi - cell.lo > 160.0
+        assert fence_outcomes(mech, flat.normal_deg, flat.normal_deg) == {mech.state_of[flat.id]}
+    result = plan(build_machine([pf], NoSensor(), unc))
+    assert result.length == 2
+
+
+def test_certain_hills_are_the_minimal_certain_runs() -> None:
+    """Against brute force on random profiles: every run of hilltops whose highest one stands
+    more than 2 eps above both its wells holds one of the returned runs, the returned runs are
+    certain, minimal and do not overlap, and a lone sure hilltop is a run of its own."""
+    from feederkit.mechanics.uncertain import _certain_hills
+
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        m = int(rng.integers(2, 9))
+        wells = rng.uniform(0.0, 1.0, m)
+        peaks = np.maximum(wells, np.roll(wells, 1)) + rng.uniform(0.0, 0.3, m)
+        eps = float(rng.uniform(0.01, 0.2))
+
+        def certain(k: int, e: int, peaks=peaks, wells=wells, eps=eps, m=m) -> bool:  # noqa: ANN001
+            top = max(peaks[i % m] for i in range(k, e + 1))
+            return top - max(wells[(k - 1) % m], wells[e % m]) > 2.0 * eps
+
+        runs = [(k, k + p) for k in range(m) for p in range(m - 1) if certain(k, k + p)]
+        minimal = {
+            (k, e)
+            for k, e in runs
+            if not any(
+                (k2 % m, e2) != (k, e) and k <= k2 + shift and e2 + shift <= e
+                for k2, e2 in runs
+                for shift in (0, m)
+            )
+        }
+        got = _certain_hills(peaks, wells, eps)
+        assert set(got) == minimal
+        covered = [i % m for k, e in got for i in range(k, e + 1)]
+        assert len(covered) == len(set(covered))
+        for k in range(m):
+            if certain(k, k):
+                assert (k, k) in got
+
+
 def test_a_push_from_a_gap_does_not_reach_a_state_beyond_a_clipped_push_band() -> None:
     """The l-bracket at shape 0.005 mm, COM 0.01 mm: the push band of the hilltop at 3 degrees
     is clipped at state 1's normal (0 degrees), whose normal arc (+-0.04 degrees) reaches past

@@ -346,10 +346,15 @@ def _slot_outline(facets: int = 19):  # noqa: ANN202
     ("source", "unc"),
     [
         ("slot.dxf", Uncertainty(1.0)),
+        ("slot.dxf", Uncertainty(1.0, 0.005, 0.01)),
         ("slot-outline", Uncertainty(1.0)),
+        ("slot-outline", Uncertainty(1.0, 0.005, 0.01)),
         ("l-bracket", Uncertainty(1.0, 0.005, 0.01)),
         ("l-bracket", Uncertainty(2.0, 0.02, 0.05)),
         ("cadquery__gear.dxf", Uncertainty(1.0)),
+        ("cadquery__gear.dxf", Uncertainty(1.0, 0.005, 0.01)),
+        ("cadquery__vslot-2020_1.dxf", Uncertainty(1.0, 0.005, 0.01)),
+        ("trimesh__wrench.dxf", Uncertainty(1.0, 0.005, 0.01)),
     ],
 )
 def test_pushes_sampled_in_each_fence_cell_end_in_its_targets(source, unc, tmp_path) -> None:

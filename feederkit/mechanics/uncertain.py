@@ -14,10 +14,12 @@ rotation is off by up to ``r`` degrees. Everything rests on three facts, with ``
   ``asin(2 t / |v_b - v_a|)`` of the chord's, and on which the COM's foot can fall.
 
 A push descends the perturbed radius function and can never pass one of its local maxima, so
-from a fence orientation it ends on a rest candidate (F3) between the nearest sure hilltops on
-either side (F1, F2); a push starting within ``PUSH_BAND_DEG`` of a hilltop, or beside a
-shallow state less than twice the vibration below it, may be carried over it (the push bands,
-measured in the physics check). With ``t = c = 0`` and no
+from a fence orientation it ends on a rest candidate (F3) between the nearest certain hills on
+either side (F1, F2: a hilltop whose barriers both exceed ``2 eps``, or a run of hilltops whose
+highest stands more than ``2 eps`` above the wells on either side), and never where the drawn
+radius is more than ``2 eps`` above its start (F1); a push starting within ``PUSH_BAND_DEG``
+of a hilltop, or beside a shallow state less than twice the vibration below it, may be carried
+over it (the push bands, measured in the physics check). With ``t = c = 0`` and no
 vibration every set here is the ideal one exactly; otherwise each is a superset of what the
 perturbed parts can do (provably conservative), and the docstrings say which.
 docs/uncertainty.md gives the derivations and the measured price of conservatism.
@@ -91,8 +93,10 @@ class RestCandidate:
 
 @dataclass(frozen=True)
 class Band:
-    """The band around the divergent orientation ``divergent_deg`` (a hilltop of the radius
-    function between ideal states ``left`` and ``right``, counter-clockwise).
+    """The band around a certain hill between ideal states ``left`` and ``right``
+    (counter-clockwise; :func:`_certain_hills`): one divergent orientation, or a run of them
+    with the states between (the slot's tip and its two hilltops); ``divergent_deg`` is its
+    highest hilltop.
 
     Every perturbed shape has a local maximum of its radius function in ``[top_lo_deg,
     top_hi_deg]`` (the F2 band; ``top_lo <= divergent <= top_hi``, ``top_hi`` may pass 360):
@@ -331,51 +335,123 @@ def _level_crossing(
     return a, b
 
 
+def _certain_hills(peaks: np.ndarray, wells: np.ndarray, eps: float) -> list[tuple[int, int]]:
+    """The certain hills: the minimal runs of hilltops that every perturbed part keeps.
+
+    Hilltop ``k`` lies between the wells ``wells[k - 1]`` and ``wells[k]`` (the drawn radius
+    at the normals of the states on either side). A run of hilltops ``k .. e`` (unwrapped,
+    ``k`` in [0, m), at most ``m - 1`` of them) between the wells ``A = wells[k - 1]`` and
+    ``B = wells[e]`` is **certain** when its highest hilltop ``R`` has ``R - max(A, B) > 2 eps``:
+    then (F1) every perturbed radius function is at least ``R - eps`` there and at most
+    ``max(A, B) + eps`` at the two wells' normals, so its maximum over the run is a local
+    maximum strictly inside, which no push passes. A single certain hilltop is a sure one
+    (both barriers above ``2 eps``); a run is certain also when its hilltops are not one by one,
+    as the slot's two low hilltops beside its shallow tip state, between the flat sides' wells.
+
+    Returns the **minimal** certain runs ``(k, e)`` (no shorter certain run inside), sorted by
+    ``k``. They never overlap: two certain runs sharing a hilltop without one holding the other
+    always hold a shorter certain run (docs/uncertainty.md, "Certain hills"). At ``eps = 0``
+    every hilltop is one (the ideal model).
+    """
+    m = len(peaks)
+    if m < 2:
+        return []
+    if eps == 0.0:
+        return [(k, k) for k in range(m)]
+    ends = np.full(2 * m, -1)
+    for k in range(m):
+        run = (k + np.arange(m - 1)) % m
+        top = np.maximum.accumulate(peaks[run])
+        ok = top - np.maximum(wells[(k - 1) % m], wells[run]) > 2.0 * eps
+        if ok.any():
+            ends[k] = k + int(np.argmax(ok))
+            ends[k + m] = ends[k] + m
+    hills: list[tuple[int, int]] = []
+    for k in range(m):
+        e = int(ends[k])
+        inner = ends[k + 1 : e + 1]
+        if e >= 0 and not ((inner >= 0) & (inner <= e)).any():
+            hills.append((k, e))
+    return hills
+
+
 def _bands(
     pf: PushFunction,
     eps: float,
-    sure: np.ndarray,
+    hills: Sequence[tuple[int, int]],
     peaks: np.ndarray,
     heights: np.ndarray,
     vibration: float = 0.0,
 ) -> list[Band]:
-    """Bands around the sure hilltops (F1, F2), widened by the push bands; the divergent
-    orientations when eps = 0 and ``vibration`` = 0.
+    """Bands around the certain hills (F1, F2: :func:`_certain_hills`), widened by the push
+    bands; the divergent orientations when eps = 0 and ``vibration`` = 0.
 
-    The F2 band holds every perturbed hilltop. With ``vibration > 0`` it is widened on each
-    flank (a push starting there may be carried over the hill: docs/uncertainty.md, "Push
-    bands") by :data:`PUSH_BAND_DEG`; at a hilltop beside a shallow state (a well on either
-    side less than :data:`SHALLOW_WELL_FACTOR` vibrations deep, ``heights`` the radius at
-    each state's normal) by how far the drawn radius stays within :data:`PUSH_BAND_FACTOR`
-    vibrations of the hilltop, if that is wider. Clipped to the neighbouring states' normals.
+    A hill's F2 band holds every perturbed hilltop that bounds the pushes: the maximum of the
+    perturbed radius over the hill (height at least ``R - eps``, ``R`` its highest hilltop)
+    lies where the drawn radius is at least ``R - 2 eps`` (from the first hilltop reaching that
+    level, on its rising flank, to the last one's falling flank) and near a vertex at least
+    that far out (F2). With ``vibration > 0`` it is widened on each flank (a push starting
+    there may be carried over the hill: docs/uncertainty.md, "Push bands") by the push band of
+    the outermost of those hilltops on that flank: :data:`PUSH_BAND_DEG`, or beside a shallow
+    state (a well on either side less than :data:`SHALLOW_WELL_FACTOR` vibrations deep,
+    ``heights`` the radius at each state's normal) as far as the drawn radius stays within
+    :data:`PUSH_BAND_FACTOR` vibrations of that hilltop, if that is wider. Clipped to the
+    normals of the wells on either side of the hill; and holding the band each of the hill's
+    lower hilltops would get if it were sure. A hill of one hilltop is the sure hilltop of
+    before, its band unchanged.
     """
     div = np.asarray(pf.divergent_deg, dtype=float)
     m = len(div)
     rs = pf.range_state
     psi = np.asarray([s.normal_deg for s in pf.states])
-    ks = np.flatnonzero(sure)
-    if len(ks) == 0:
+    if not hills:
         return []
-    left = np.asarray([rs[(k - 1) % m] for k in ks])
-    right = np.asarray([rs[k] for k in ks])
-    d = div[ks]
+    first_k = np.asarray([k for k, _ in hills])
+    last_k = np.asarray([e for _, e in hills])
+    ks = np.asarray([k + int(np.argmax(peaks[np.arange(k, e + 1) % m])) for k, e in hills])
+    left = np.asarray([rs[(k - 1) % m] for k in first_k])
+    right = np.asarray([rs[e % m] for e in last_k])
+
+    def pos(i: np.ndarray) -> np.ndarray:  # unwrapped divergent orientation of hilltop i
+        return div[i % m] + 360.0 * (i // m)
+
+    d = pos(ks)
+    top = peaks[ks % m]
     lo, hi = d.copy(), d.copy()
     if eps == 0.0 and vibration == 0.0:
         return _band_list(d, lo, hi, left, right, lo, hi)
     h = np.asarray(pf.part.hull, dtype=float)
     com = np.asarray(pf.part.com, dtype=float)
-    lpsi = d - np.mod(d - psi[left], 360.0)
-    rpsi = d + np.mod(psi[right] - d, 360.0)
+    # The outermost hilltops that may hold the perturbed maximum (drawn height >= R - 2 eps).
+    level = top - 2.0 * eps
+    outer_lo = np.asarray(
+        [
+            next(i for i in range(k, e + 1) if peaks[i % m] >= lv)
+            for (k, e), lv in zip(hills, level, strict=True)
+        ]
+    )
+    outer_hi = np.asarray(
+        [
+            next(i for i in range(e, k - 1, -1) if peaks[i % m] >= lv)
+            for (k, e), lv in zip(hills, level, strict=True)
+        ]
+    )
+    d_lo, d_hi = pos(outer_lo), pos(outer_hi)
+    lpsi = d_lo - np.mod(d_lo - psi[np.asarray([rs[(i - 1) % m] for i in outer_lo])], 360.0)
+    rpsi = d_hi + np.mod(psi[np.asarray([rs[i % m] for i in outer_hi])] - d_hi, 360.0)
+    well_lo = d - np.mod(d - psi[left], 360.0)  # the hill's ends: its wells' normals
+    well_hi = d + np.mod(psi[right] - d, 360.0)
     if eps > 0.0:
-        level = peaks[ks] - 2.0 * eps
-        lo, _ = _level_crossing(h, com, lpsi, d, level)
-        _, hi = _level_crossing(h, com, d, rpsi, level)
+        lo, _ = _level_crossing(h, com, lpsi, d_lo, level)
+        _, hi = _level_crossing(h, com, d_hi, rpsi, level)
         rho = np.hypot(*(h - com).T)
         alpha = np.degrees(np.arctan2(h[:, 1] - com[1], h[:, 0] - com[0]))
         spread = np.degrees(np.arcsin(np.minimum(1.0, eps / rho)))
         for j in range(len(ks)):
+            if max(d[j] - lo[j], hi[j] - d[j]) >= 90.0:
+                continue  # offsets within +-180 could wrap: keep the level crossings
             # F2: the highest point of the perturbed hill is near a vertex almost as far out.
-            far = rho >= peaks[ks[j]] - 2.0 * eps
+            far = rho >= level[j]
             off = np.mod(alpha[far] - d[j] + 180.0, 360.0) - 180.0
             a_lo = np.maximum(off - spread[far], lo[j] - d[j])
             a_hi = np.minimum(off + spread[far], hi[j] - d[j])
@@ -385,19 +461,58 @@ def _bands(
                 hi[j] = d[j] + max(float(a_hi[keep].max()), 0.0)
     top_lo, top_hi = lo.copy(), hi.copy()  # the F2 band: every perturbed hilltop
     if vibration > 0.0:
-        w_lo = np.full(len(ks), PUSH_BAND_DEG)
-        w_hi = np.full(len(ks), PUSH_BAND_DEG)
-        shallow = np.minimum(peaks[ks] - heights[left], peaks[ks] - heights[right])
-        near = np.flatnonzero(shallow < SHALLOW_WELL_FACTOR * vibration)
-        if len(near):
-            level = peaks[ks[near]] - PUSH_BAND_FACTOR * vibration
-            p_lo, _ = _level_crossing(h, com, lpsi[near], d[near], level)
-            _, p_hi = _level_crossing(h, com, d[near], rpsi[near], level)
-            w_lo[near] = np.maximum(w_lo[near], d[near] - p_lo)
-            w_hi[near] = np.maximum(w_hi[near], p_hi - d[near])
-        lo = np.maximum(lpsi, lo - w_lo)
-        hi = np.minimum(rpsi, hi + w_hi)
-    return _band_list(d, lo, hi, left, right, top_lo, top_hi)
+        w_lo = _push_band(pf, outer_lo, peaks, heights, vibration, d_lo, lpsi, rising=True)
+        w_hi = _push_band(pf, outer_hi, peaks, heights, vibration, d_hi, rpsi, rising=False)
+        lo = np.maximum(well_lo, lo - w_lo)
+        hi = np.minimum(well_hi, hi + w_hi)
+        for j, (k, e) in enumerate(hills):
+            # A hilltop of the hill too low to hold its maximum keeps its own push band (its
+            # band as if it were sure), so no push from outside the band is carried over it.
+            low = [i for i in range(k, e + 1) if not outer_lo[j] <= i <= outer_hi[j]]
+            if low:
+                own = _bands(pf, eps, [(i % m, i % m) for i in low], peaks, heights, vibration)
+                turns = [360.0 * (i // m) for i in low]
+                lo[j] = min(lo[j], *(b.lo_deg + tn for b, tn in zip(own, turns, strict=True)))
+                hi[j] = max(hi[j], *(b.hi_deg + tn for b, tn in zip(own, turns, strict=True)))
+    turn = 360.0 * np.floor(d / 360.0)  # a hill led by hilltop m - 1 may peak past 360
+    return _band_list(d - turn, lo - turn, hi - turn, left, right, top_lo - turn, top_hi - turn)
+
+
+def _push_band(
+    pf: PushFunction,
+    hilltops: np.ndarray,
+    peaks: np.ndarray,
+    heights: np.ndarray,
+    vibration: float,
+    d: np.ndarray,
+    flank_end: np.ndarray,
+    *,
+    rising: bool,
+) -> np.ndarray:
+    """The push band (deg) of each hilltop on one flank (``d`` its unwrapped orientation,
+    ``flank_end`` the neighbouring state's normal): :data:`PUSH_BAND_DEG`, or beside a shallow
+    state as far as the drawn radius stays within :data:`PUSH_BAND_FACTOR` vibrations of the
+    hilltop, if that is wider (docs/uncertainty.md, "Push bands")."""
+    m = len(peaks)
+    rs = pf.range_state
+    width = np.full(len(hilltops), PUSH_BAND_DEG)
+    k = hilltops % m
+    wells = np.minimum(
+        peaks[k] - heights[np.asarray([rs[(i - 1) % m] for i in k])],
+        peaks[k] - heights[np.asarray([rs[i] for i in k])],
+    )
+    near = np.flatnonzero(wells < SHALLOW_WELL_FACTOR * vibration)
+    if len(near):
+        h = np.asarray(pf.part.hull, dtype=float)
+        com = np.asarray(pf.part.com, dtype=float)
+        level = peaks[k[near]] - PUSH_BAND_FACTOR * vibration
+        if rising:
+            p, _ = _level_crossing(h, com, flank_end[near], d[near], level)
+            width[near] = np.maximum(width[near], d[near] - p)
+        else:
+            _, p = _level_crossing(h, com, d[near], flank_end[near], level)
+            width[near] = np.maximum(width[near], p - d[near])
+    return width
 
 
 def _band_list(
@@ -595,10 +710,6 @@ def uncertain_mechanics(
     peaks = _radius(h, com, div)
     left = np.asarray([rs[(k - 1) % m] for k in range(m)])
     right = np.asarray(rs)
-    barrier = peaks - np.maximum(heights[left], heights[right])
-    sure = np.ones(m, dtype=bool) if eps == 0.0 else barrier > 2.0 * eps
-    if m == 1:
-        sure[:] = False
     threshold = vibration_mm + 2.0 * eps
 
     cands = _rest_candidates(pf, t, c)
@@ -669,8 +780,10 @@ def uncertain_mechanics(
             diam = (max(min(w_lo, *exact) - 2.0 * t, 0.0), max(w_hi, *exact) + 2.0 * t)
         states.append(PhysicalState(pid, members, rest, (cap_lo, cap_hi), diam))
 
-    bands = _bands(pf, eps, sure, peaks, heights, vibration_mm)
-    cells = _fence_cells(bands, cands, destinations)
+    bands = _bands(
+        pf, eps, _certain_hills(peaks, heights[right], eps), peaks, heights, vibration_mm
+    )
+    cells = _fence_cells(bands, cands, destinations, _profile(pf, eps) if eps > 0.0 else None)
     return UncertainMechanics(
         push=pf,
         uncertainty=uncertainty,
@@ -686,8 +799,87 @@ def uncertain_mechanics(
     )
 
 
+@dataclass(frozen=True)
+class _Profile:
+    """The drawn radius function's extrema (hilltops and state normals, over three turns,
+    sorted; the radius is monotone between consecutive ones) and ``eps = t + c``."""
+
+    hull: np.ndarray
+    com: np.ndarray
+    pos: np.ndarray
+    val: np.ndarray
+    eps: float
+
+
+def _profile(pf: PushFunction, eps: float) -> _Profile:
+    h = np.asarray(pf.part.hull, dtype=float)
+    com = np.asarray(pf.part.com, dtype=float)
+    ext = np.mod([*pf.divergent_deg, *(s.normal_deg for s in pf.states)], 360.0)
+    ext = np.sort(ext)
+    pos = np.concatenate([ext - 360.0, ext, ext + 360.0])
+    return _Profile(h, com, pos, _radius(h, com, pos), eps)
+
+
+def _descent_reach(
+    prof: _Profile, start_lo: float, start_hi: float, reach_lo: float, reach_hi: float
+) -> tuple[float, float]:
+    """The reach ``(reach_lo, reach_hi)`` of pushes starting in ``[start_lo, start_hi]``, cut
+    where they would have to climb.
+
+    A push descends the perturbed radius function: from a start at most ``M + eps`` high (F1;
+    ``M`` the drawn radius's maximum over the starts) it never reaches an orientation where
+    the drawn radius exceeds ``M + 2 eps``. So the reach ends, on each side, at the first such
+    orientation past the starts (found by bisection on a monotone piece, rounded outward).
+
+    That is F1 alone for the quasi-static push. With the push bands (measured): a push from a
+    band may be carried over its hill, whose top lies in the band, so ``M`` covers it; a push
+    from outside a band is taken not to be carried over any maximum inside it (its push band
+    holds the push band of every drawn hilltop of the hill; for a maximum a perturbed shape
+    grows elsewhere in the band this is the model's reading of the push bands,
+    docs/uncertainty.md, "Cells stop where a push would have to climb").
+    """
+    r0 = _radius(prof.hull, prof.com, np.asarray([start_lo, start_hi]))
+    base = math.floor(start_lo / 360.0) * 360.0
+    inside = prof.val[(prof.pos > start_lo - base) & (prof.pos < start_hi - base)]
+    level = float(max(r0.max(), inside.max(initial=-math.inf))) + 2.0 * prof.eps
+    hi = _climb(prof, start_hi, reach_hi, level, base)
+    lo = _climb(prof, start_lo, reach_lo, level, base)
+    return (
+        reach_lo if lo is None else max(reach_lo, lo),
+        reach_hi if hi is None else min(reach_hi, hi),
+    )
+
+
+def _climb(prof: _Profile, start: float, limit: float, level: float, base: float) -> float | None:
+    """The first orientation from ``start`` toward ``limit`` where the drawn radius exceeds
+    ``level`` (the far end of its bisection bracket, plus ``BOUNDARY_EPS_DEG``), or None.
+
+    The radius at ``start`` is at most ``level``; it is monotone between consecutive extrema,
+    so the first extremum (or ``limit``) above the level closes the piece holding the crossing.
+    """
+    step = 1.0 if limit >= start else -1.0
+    s, lim = start - base, limit - base
+    ahead = (prof.pos - s) * step
+    mask = (ahead > 0.0) & ((lim - prof.pos) * step > 0.0)
+    pts, vals = prof.pos[mask][:: int(step)], prof.val[mask][:: int(step)]
+    pts = np.concatenate([pts, [lim]])
+    vals = np.concatenate([vals, _radius(prof.hull, prof.com, np.asarray([lim]))])
+    x0 = s
+    for p, v in zip(pts.tolist(), vals.tolist(), strict=True):
+        if v > level:
+            lo, hi = np.asarray([min(x0, p)]), np.asarray([max(x0, p)])
+            a, b = _level_crossing(prof.hull, prof.com, lo, hi, np.asarray([level]))
+            far = max(a[0], b[0]) if step > 0 else min(a[0], b[0])
+            return base + far + step * BOUNDARY_EPS_DEG
+        x0 = p
+    return None
+
+
 def _fence_cells(
-    bands: Sequence[Band], cands: Sequence[RestCandidate], dest: Sequence[frozenset[int]]
+    bands: Sequence[Band],
+    cands: Sequence[RestCandidate],
+    dest: Sequence[frozenset[int]],
+    profile: _Profile | None = None,
 ) -> tuple[FenceCell, ...]:
     """The circle of fence orientations cut at the band ends, each cell with its targets.
 
@@ -699,6 +891,9 @@ def _fence_cells(
     ``j + 1``'s F2 end. (A push band reaches at most the neighbouring state's normal, so a
     state just beyond it, at that normal, is not reached from the gap: the push band only says
     where a push may be carried over *its own* hilltop.)
+
+    With ``profile`` (``t + c > 0``) each reach is also cut where the push would have to
+    climb: :func:`_descent_reach`.
     """
     arr = _candidate_arrays(cands)
     if not bands:
@@ -721,8 +916,11 @@ def _fence_cells(
         _, _, prev_top_lo, _ = at(j - 1)
         n_lo, _, _, next_top_hi = at(j + 1)
         region = (b_lo, b_lo + 360.0) if q == 1 else (prev_top_lo, next_top_hi)
-        cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
         gap_region = (b_lo, b_lo + 360.0) if q == 1 else (t_lo, next_top_hi)
+        if profile is not None and q > 1:
+            region = _descent_reach(profile, b_lo, b_hi, *region)
+            gap_region = _descent_reach(profile, b_hi, n_lo, *gap_region)
+        cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
         cells.append(FenceCell(b_hi, n_lo, False, _cell_targets(arr, dest, *gap_region)))
     return tuple(cells)
 
