@@ -15,20 +15,35 @@ Distinguishability is monotone in ``e``: a larger tolerance only adds read-alike
 the greatest fixpoint of inseparable pairs only grows (the tests check it exhaustively on
 random pairs). Diameters equal within the library's relative ``DIAMETER_REL_EPS`` always
 read alike and give no breakpoint.
+
+Where import simplified a part's contact hull the planner reads each of its states over the
+part's own widths (:mod:`feederkit.machine.widths`, :func:`planned_machine`); a pair with
+such a part is decided on that machine, its states' intervals giving the breakpoints
+(:func:`widened_pair_critical`), so no critical tolerance rests on a difference only the
+simplification makes. Parts with exact hulls are decided on their diameters as above.
 """
 
 from __future__ import annotations
 
 import bisect
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from feederkit.angles import ActionRange
 from feederkit.design.limit import PAIRS, DesignClock
+from feederkit.machine import OutcomeRange, PushAlignMachine, members
+from feederkit.machine.build import build_machine
+from feederkit.machine.inseparable import inseparable_masks
+from feederkit.machine.widths import Offsets, widen_widths
+from feederkit.mechanics.modelerror import Offset, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.pairs import PairWitness, distinguishable
 from feederkit.plans.model import PlanMember
-from feederkit.sensors import ToleranceSensor
+from feederkit.sensors import NoSensor, Sensor, ToleranceSensor, span
+from feederkit.uncertainty import IDEAL, Uncertainty
+
+Span = tuple[float, float]
 
 
 def _eps(pfs: Sequence[PushFunction]) -> float:
@@ -48,6 +63,82 @@ def pair_breakpoints(pf_a: PushFunction, pf_b: PushFunction) -> tuple[float, ...
     return breakpoints_of(
         [s.diameter for s in pf_a.states], [s.diameter for s in pf_b.states], _eps([pf_a, pf_b])
     )
+
+
+def interval_gap(x: Span, y: Span) -> float:
+    """How far apart two diameter intervals are (negative or zero when they meet): they read
+    alike under a tolerance ``e`` iff the gap is below ``2e``."""
+    return max(x[0] - y[1], y[0] - x[1])
+
+
+def gap_breakpoints(spans_a: Sequence[Span], spans_b: Sequence[Span]) -> tuple[float, ...]:
+    """The sorted distinct ``gap / 2`` over the pairs of an interval of a and one of b whose
+    gap is positive: the tolerances at which their read-alike relation changes."""
+    return tuple(
+        sorted({g / 2.0 for x in spans_a for y in spans_b if (g := interval_gap(x, y)) > 0})
+    )
+
+
+def sub_machine(machine: PushAlignMachine, parts: Sequence[int]) -> PushAlignMachine:
+    """The states of ``parts`` (in that order of parts) of a mix machine, as a machine.
+
+    A part's outcomes are its own states, so the parts' states with their action maps
+    (outcome masks renumbered) are closed; intervals, weights and records stay the mix's.
+    """
+    keep = [i for p in parts for i, s in enumerate(machine.states) if s.part == p]
+    new = {old: k for k, old in enumerate(keep)}
+    part_of = {p: k for k, p in enumerate(parts)}
+
+    def moved(r: ActionRange | OutcomeRange) -> OutcomeRange:
+        out = 0
+        for t in members(_mask(r)):
+            out |= 1 << new[t]
+        return OutcomeRange(r.lo, r.hi, out)
+
+    states = tuple(replace(machine.states[i], part=part_of[machine.states[i].part]) for i in keep)
+    maps = tuple(tuple(moved(r) for r in machine.action_maps[i]) for i in keep)
+    return PushAlignMachine(
+        part_names=tuple(machine.part_names[p] for p in parts),
+        states=states,
+        action_maps=maps,
+        sensor=machine.sensor,
+        uncertainty=machine.uncertainty,
+    )
+
+
+def _mask(r: ActionRange | OutcomeRange) -> int:
+    return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
+
+
+def mix_offsets(pfs: Sequence[PushFunction]) -> list[tuple[Offset | None, ...]]:
+    """Each part's reading offsets (:func:`~feederkit.mechanics.modelerror.reading_offsets`:
+    how far the part itself may read from its simplified contact hull's diameters), computed
+    once per design and handed to every machine it builds (:func:`planned_machine`)."""
+    return [reading_offsets(pf) for pf in pfs]
+
+
+def planned_machine(
+    pfs: Sequence[PushFunction],
+    offsets: Offsets,
+    sensor: Sensor | None = None,
+    uncertainty: Uncertainty = IDEAL,
+) -> tuple[PushAlignMachine, frozenset[int]]:
+    """The machine :func:`~feederkit.plans.make.make_plan` plans on (before it weighs and
+    marks the members): ``build_machine``'s, each state read over its part's ``offsets``
+    (:func:`~feederkit.machine.widths.widen_widths`, :func:`mix_offsets`), and the parts
+    whose states that widens. With no part widened the machine is ``build_machine``'s own,
+    and every figure of the design is the one the parts' model gives."""
+    built = build_machine(list(pfs), NoSensor() if sensor is None else sensor, uncertainty)
+    machine = widen_widths(built, offsets)
+    wide = frozenset(
+        s.part for s, t in zip(machine.states, built.states, strict=True) if s is not t
+    )
+    return machine, wide
+
+
+def widens(offsets: Offsets) -> bool:
+    """Whether some offset may widen a state (a part whose contact hull is simplified)."""
+    return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for off in offsets for o in off)
 
 
 PROBE_REL = 1e-6
@@ -212,18 +303,104 @@ def told_apart_pairs(n: int, rejected: Collection[int] = ()) -> list[tuple[int, 
 
 
 def mix_critical_tolerance(
-    pfs: Sequence[PushFunction], clock: DesignClock | None = None, rejected: Collection[int] = ()
+    pfs: Sequence[PushFunction],
+    clock: DesignClock | None = None,
+    rejected: Collection[int] = (),
+    offsets: Offsets | None = None,
 ) -> MixCritical:
     """Every pair's exact critical tolerance, in part order, and so the mix's; ``clock``
     (:mod:`feederkit.design.limit`) is polled and told of each pair decided. ``rejected``:
     the indices of members the plan rejects; two of them need not be told apart, so their
-    pair is left out (:func:`told_apart_pairs`)."""
+    pair is left out (:func:`told_apart_pairs`). ``offsets``: the parts' reading offsets
+    (default :func:`mix_offsets`); a pair with a part they widen is decided on the machine
+    the planner plans on (:func:`widened_pair_critical`), the others on their diameters
+    (:func:`pair_critical_tolerance`)."""
     clock = clock or DesignClock()
+    offsets = mix_offsets(pfs) if offsets is None else offsets
+    machine, wide = planned_machine(pfs, offsets) if widens(offsets) else (None, frozenset())
     wanted = told_apart_pairs(len(pfs), rejected)
     clock.begin(PAIRS, len(wanted))
     pairs = []
     for i, j in wanted:
         clock.check()
-        pairs.append(pair_critical_tolerance(pfs[i], pfs[j], clock))
+        if machine is not None and (i in wide or j in wide):
+            pairs.append(widened_pair_critical(machine, pfs, i, j, clock))
+        else:
+            pairs.append(pair_critical_tolerance(pfs[i], pfs[j], clock))
         clock.advance()
     return MixCritical(tuple(pairs))
+
+
+HULL_REASON = (
+    "the parts themselves read alike: their contact hulls simplify the outlines' arcs, and "
+    "every action keeps states reading alike over the widths of the parts themselves (a "
+    "smaller --hull-tolerance may tell them apart)"
+)
+
+
+def cross_inseparable(
+    machine: PushAlignMachine, tolerance: float, clock: DesignClock | None = None
+) -> list[tuple[int, int]]:
+    """The inseparable (state of part 0, state of part 1) pairs of a two-part machine under
+    a tolerance sensor, as machine indices (:func:`~feederkit.machine.inseparable.
+    inseparable_masks`: on the ideal model the fixpoint of section 8.4 over the machine's
+    reading intervals); the fixpoint polls ``clock`` (default none)."""
+    check = None if clock is None else clock.check
+    masks = inseparable_masks(replace(machine, sensor=ToleranceSensor(tolerance)), check)
+    first = [i for i, s in enumerate(machine.states) if s.part == 0]
+    return [(i, j) for i in first for j in members(masks[i]) if machine.states[j].part == 1]
+
+
+def widened_pair_critical(
+    machine: PushAlignMachine,
+    pfs: Sequence[PushFunction],
+    a: int,
+    b: int,
+    clock: DesignClock | None = None,
+) -> PairCritical:
+    """:func:`pair_critical_tolerance` of parts ``a`` and ``b`` on the ideal ``machine``
+    the planner plans on (:func:`planned_machine`), whose states read over intervals: the
+    parts' own widths where import simplified a contact hull.
+
+    A state of diameter interval ``[lo, hi]`` reads anywhere in ``(lo - e, hi + e)``, so two
+    states read alike iff their gap is below ``2e``: the breakpoints are the gaps' halves
+    (:func:`gap_breakpoints`), and on them the same binary search with the same test (the
+    greatest fixpoint of inseparable cross pairs, on the pair's states of ``machine``), the
+    same Hausdorff start. Two states whose intervals meet read alike at every tolerance.
+    """
+    clock = clock or DesignClock()
+    m = sub_machine(machine, (a, b))
+    spans = [span(s.sensed) for s in m.states]
+    sa = [x for x, s in zip(spans, m.states, strict=True) if s.part == 0]
+    sb = [x for x, s in zip(spans, m.states, strict=True) if s.part == 1]
+    breaks = gap_breakpoints(sa, sb)
+    far = max(
+        max(min(interval_gap(x, y) for y in sb) for x in sa),
+        max(min(interval_gap(x, y) for x in sa) for y in sb),
+    )
+    # b <= far / 2: some state reads apart from every state of the other part.
+    sure = bisect.bisect_right(breaks, far / 2.0) - 1 if far > 0.0 else -1
+
+    def ok(k: int) -> bool:
+        if k <= sure:
+            return True
+        clock.check()
+        return not cross_inseparable(m, breaks[k], clock)
+
+    k = last_true(len(breaks), ok)
+    pa, pb = pfs[a], pfs[b]
+    if k >= 0:
+        return PairCritical(pa.part.name, pb.part.name, breaks[k])
+    probe = interval_probe(breaks, 0)
+    found = cross_inseparable(m, probe, clock)
+    ideal = distinguishable(pa, pb, ToleranceSensor(probe))
+    reason, kind = (HULL_REASON, "hull") if ideal is None else (ideal.reason, ideal.kind)
+    witness = PairWitness(
+        part_a=pa.part.name,
+        part_b=pb.part.name,
+        states_a=tuple(m.states[i].state for i, _ in found),
+        states_b=tuple(m.states[j].state for _, j in found),
+        reason=reason,
+        kind=kind,
+    )
+    return PairCritical(pa.part.name, pb.part.name, None, witness)

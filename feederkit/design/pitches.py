@@ -12,13 +12,16 @@ of parts with bisimilar states, then a verified strong plan, or "no strong plan"
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass, replace
 
-from feederkit.design.critical import rejected_of
+from feederkit.design.critical import mix_offsets, planned_machine, rejected_of, widens
 from feederkit.design.limit import PITCHES, DesignClock
 from feederkit.design.strong import StrongMix, strong_pitch
 from feederkit.errors import InputError
+from feederkit.machine import PushAlignMachine, members
+from feederkit.machine.inseparable import inseparable_masks
+from feederkit.machine.widths import Offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import reported_pairs
 from feederkit.mix.pairs import unrecognizable_pairs
@@ -70,12 +73,16 @@ def pitch_row(
     mix: StrongMix | None = None,
     clock: DesignClock | None = None,
     members: Sequence[PlanMember] | None = None,
+    widened: PushAlignMachine | None = None,
 ) -> PitchRow:
     """Decide one pitch: the exact pair test, then a verified plan when it recognizes the mix
     (for strong plans at ``mix``'s uncertainty when given, with ``mix``'s members), within
     ``clock``'s limit. ``members`` (the ideal model's) as
     :func:`~feederkit.plans.make.make_plan` takes them: two rejected members need not be
-    told apart (:func:`~feederkit.mix.changeover.reported_pairs`)."""
+    told apart (:func:`~feederkit.mix.changeover.reported_pairs`). ``widened``: the ideal
+    machine the planner plans on when it reads some part over its own widths
+    (:func:`~feederkit.design.critical.planned_machine`); the pair test is then its
+    (:func:`widened_pairs`)."""
     clock = clock or DesignClock()
     sensor = LedSensor(pitch, noise)
     if mix is not None:
@@ -84,9 +91,12 @@ def pitch_row(
             return PitchRow(pitch, noise, got.unrecognizable, no_plan=got.no_plan)
         return PitchRow(pitch, noise, (), got.length, got.expected)
     rejected = rejected_of(members)
-    out = [pf.part.name for k, pf in enumerate(pfs) if k in rejected]
-    pairs = reported_pairs(unrecognizable_pairs(list(pfs), sensor), out)
-    bad = tuple((w.part_a, w.part_b) for w in pairs)
+    if widened is not None:
+        bad = widened_pairs(widened, sensor, rejected, clock)
+    else:
+        out = [pf.part.name for k, pf in enumerate(pfs) if k in rejected]
+        pairs = reported_pairs(unrecognizable_pairs(list(pfs), sensor), out)
+        bad = tuple((w.part_a, w.part_b) for w in pairs)
     if bad:
         return PitchRow(pitch, noise, bad)
     clock.check()
@@ -96,6 +106,31 @@ def pitch_row(
     return PitchRow(pitch, noise, (), result.length, result.expected_length)
 
 
+def widened_pairs(
+    machine: PushAlignMachine,
+    sensor: LedSensor,
+    rejected: Collection[int] = (),
+    clock: DesignClock | None = None,
+) -> tuple[tuple[str, str], ...]:
+    """The pairs of parts (names, in part order) with inseparable states in ``machine`` read
+    by ``sensor`` (the fixpoint of section 8.4 over its reading intervals), but two rejected
+    members'."""
+    check = None if clock is None else clock.check
+    masks = inseparable_masks(replace(machine, sensor=sensor), check)
+    states = machine.states
+    bad = sorted(
+        {
+            (states[i].part, states[j].part)
+            for i in range(machine.n)
+            for j in members(masks[i])
+            if states[i].part < states[j].part
+            and not (states[i].part in rejected and states[j].part in rejected)
+        }
+    )
+    names = machine.part_names
+    return tuple((names[a], names[b]) for a, b in bad)
+
+
 def pitch_rows(
     pfs: Sequence[PushFunction],
     pitches: Sequence[float],
@@ -103,18 +138,27 @@ def pitch_rows(
     mix: StrongMix | None = None,
     clock: DesignClock | None = None,
     members: Sequence[PlanMember] | None = None,
+    offsets: Offsets | None = None,
 ) -> tuple[PitchRow, ...]:
     """Every pitch of the list, ascending, each decided on its own (for strong plans at
     ``mix``'s uncertainty when given, else on the ideal model, for ``members``:
     :func:`pitch_row`); ``clock`` (:mod:`feederkit.design.limit`) is polled and told of
-    each pitch decided."""
+    each pitch decided. ``offsets``: the parts' reading offsets on the ideal model (default
+    :func:`~feederkit.design.critical.mix_offsets`); where they widen a state the pairs are
+    decided on the machine the planner plans on."""
     clock = clock or DesignClock()
+    widened = None
+    if mix is None:
+        offsets = mix_offsets(pfs) if offsets is None else offsets
+        if widens(offsets):
+            machine, wide = planned_machine(pfs, offsets)
+            widened = machine if wide else None
     ordered = sorted(set(pitches))
     clock.begin(PITCHES, len(ordered))
     rows = []
     for p in ordered:
         clock.check()
-        rows.append(pitch_row(pfs, p, noise, mix, clock, members))
+        rows.append(pitch_row(pfs, p, noise, mix, clock, members, widened))
         clock.advance()
     return tuple(rows)
 

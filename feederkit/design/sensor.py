@@ -23,6 +23,7 @@ from feederkit.design.critical import (
     MixCritical,
     PairCritical,
     mix_critical_tolerance,
+    mix_offsets,
     rejected_of,
 )
 from feederkit.design.limit import DesignClock, DesignTimeout, Progress
@@ -330,11 +331,14 @@ def _design_tolerance(
 ) -> ToleranceDesign:
     names = tuple(pf.part.name for pf in pfs)
     if unc.is_ideal:
-        critical = mix_critical_tolerance(pfs, clock, rejected_of(members))
+        offsets = mix_offsets(pfs)  # the parts' own widths, as the plans read them
+        critical = mix_critical_tolerance(pfs, clock, rejected_of(members), offsets)
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
 
         def table() -> tuple[LengthStep, ...]:
-            return length_steps(pfs, up_to, critical=critical, clock=clock, members=members)
+            return length_steps(
+                pfs, up_to, critical=critical, clock=clock, members=members, offsets=offsets
+            )
     else:
         mix = StrongMix(pfs, unc, members)
         critical = strong_mix_critical(mix, clock)
@@ -453,8 +457,9 @@ def design_pitches(
     names = tuple(pf.part.name for pf in pfs)
     try:
         if unc.is_ideal:
-            rows = pitch_rows(pfs, pitches, noise, clock=clock, members=named)
-            critical = mix_critical_tolerance(pfs, clock, rejected_of(named))
+            offsets = mix_offsets(pfs)
+            rows = pitch_rows(pfs, pitches, noise, clock=clock, members=named, offsets=offsets)
+            critical = mix_critical_tolerance(pfs, clock, rejected_of(named), offsets)
             return PitchDesign(names, noise, rows, critical, unc, named)
         mix = StrongMix(pfs, unc, named)
         rows = pitch_rows(pfs, pitches, noise, mix=mix, clock=clock)

@@ -63,16 +63,19 @@ from typing import Protocol
 from feederkit.design.critical import (
     MixCritical,
     breakpoints_of,
+    gap_breakpoints,
     interval_probe,
     last_true,
     mix_critical_tolerance,
+    mix_offsets,
+    planned_machine,
     rejected_of,
 )
 from feederkit.design.limit import LENGTHS, DesignClock
 from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, PushAlignMachine
-from feederkit.machine.build import build_machine
 from feederkit.machine.weights import weigh_members
+from feederkit.machine.widths import Offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
@@ -83,7 +86,7 @@ from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
 from feederkit.plans.make import make_plan
 from feederkit.plans.model import PlanMember
-from feederkit.sensors import ToleranceSensor
+from feederkit.sensors import ToleranceSensor, span
 from feederkit.uncertainty import IDEAL
 
 
@@ -125,12 +128,20 @@ class Evaluation:
 
 
 def mix_breakpoints(pfs: Sequence[PushFunction]) -> tuple[float, ...]:
-    """Where the read-alike relation of the mix's states changes (the machine's diameters)."""
-    return machine_breakpoints(build_machine(list(pfs), uncertainty=IDEAL))
+    """Where the read-alike relation of the mix's states changes (the diameters of the
+    machine the planner plans on, :func:`~feederkit.design.critical.planned_machine`)."""
+    machine, wide = planned_machine(pfs, mix_offsets(pfs))
+    return machine_breakpoints(machine, bool(wide))
 
 
-def machine_breakpoints(machine: PushAlignMachine) -> tuple[float, ...]:
-    """:func:`mix_breakpoints` of an ideal machine already built."""
+def machine_breakpoints(machine: PushAlignMachine, widened: bool = False) -> tuple[float, ...]:
+    """:func:`mix_breakpoints` of an ideal machine already built: its diameters', or, when
+    ``widened`` (its states read over the parts' own widths), its reading intervals' gaps
+    (:func:`~feederkit.design.critical.gap_breakpoints`: two states whose intervals meet
+    read alike at every tolerance)."""
+    if widened:
+        spans = [span(s.sensed) for s in machine.states]
+        return gap_breakpoints(spans, spans)
     diameters = [s.diameter for s in machine.states]
     eps = 0.0  # the machine has already made equal diameters exactly equal
     return breakpoints_of(diameters, diameters, eps)
@@ -169,9 +180,10 @@ def plan_evaluation(
 
 
 def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
-    """The proven minimum worst-case length at ``tolerance`` mm, from a whole plan (the
-    reference the tests hold :class:`LengthOracle` to)."""
-    return plan(build_machine(list(pfs), ToleranceSensor(tolerance), uncertainty=IDEAL)).length
+    """The proven minimum worst-case length at ``tolerance`` mm, from a whole plan on the
+    machine the planner plans on (the reference the tests hold :class:`LengthOracle` to)."""
+    machine, _wide = planned_machine(pfs, mix_offsets(pfs), ToleranceSensor(tolerance))
+    return plan(machine).length
 
 
 class StrongOracle(Protocol):
@@ -199,6 +211,9 @@ class LengthOracle:
     search polls ``deadline`` (default: none) and raises Timeout when it passes.
     ``rejected``: the indices of members the plan rejects (their states marked as
     :func:`~feederkit.plans.make.make_plan` marks them, so a set of them only is a goal).
+    The machine is the one ``make_plan`` plans on: each state read over its part's reading
+    ``offsets`` (default :func:`~feederkit.design.critical.mix_offsets`); ``widened`` says
+    whether they widened any state (the breakpoints are then the intervals' gaps).
     """
 
     def __init__(
@@ -206,9 +221,12 @@ class LengthOracle:
         pfs: Sequence[PushFunction],
         deadline: Deadline | None = None,
         rejected: Collection[int] = (),
+        offsets: Offsets | None = None,
     ) -> None:
         self.deadline = deadline or Deadline()
-        built = build_machine(list(pfs), uncertainty=IDEAL)
+        offsets = mix_offsets(pfs) if offsets is None else offsets
+        built, wide = planned_machine(pfs, offsets)
+        self.widened = bool(wide)
         self.machine = weigh_members(built, None, rejected)
         self._sorted, _old = by_diameter(self.machine)
         self._last: tuple[float, Problem, WorstCase, list[int]] | None = None
@@ -257,6 +275,7 @@ def length_steps(
     critical: MixCritical | None = None,
     clock: DesignClock | None = None,
     members: Sequence[PlanMember] | None = None,
+    offsets: Offsets | None = None,
 ) -> tuple[LengthStep, ...]:
     """The plan length's steps over tolerances ``(0, up_to]`` (None: every interval).
 
@@ -269,6 +288,9 @@ def length_steps(
     oracle's and plans'), told of each run of intervals decided. ``members``: the plan's
     members as :func:`~feederkit.plans.make.make_plan` takes them; the default oracle,
     plans and pairs then plan for rejected members as ``changeover compile --accept`` does.
+    ``offsets``: the parts' reading offsets (default
+    :func:`~feederkit.design.critical.mix_offsets`), for the default oracle and pairs: both
+    read each state over the parts' own widths, as the plans do.
 
     The intervals are searched in segments between the pairs' critical tolerances (the
     goal changes there) and steps never span two segments; inside a segment the length is
@@ -276,10 +298,12 @@ def length_steps(
     """
     clock = clock or DesignClock()
     rejected = rejected_of(members)
-    oracle = oracle or LengthOracle(pfs, clock.deadline, rejected)
-    breaks = machine_breakpoints(oracle.machine)
+    if offsets is None and (oracle is None or critical is None):
+        offsets = mix_offsets(pfs)
+    oracle = oracle or LengthOracle(pfs, clock.deadline, rejected, offsets)
+    breaks = machine_breakpoints(oracle.machine, oracle.widened)
     evaluate = evaluate or (lambda e: plan_evaluation(pfs, e, clock, members))
-    critical = critical or mix_critical_tolerance(pfs, clock, rejected)
+    critical = critical or mix_critical_tolerance(pfs, clock, rejected, offsets)
     last = len(breaks) if up_to is None else _first_at_or_above(breaks, up_to)
     clock.begin(LENGTHS, last + 1)
     # Interval k is recognizable for a pair iff its right end is at most the pair's critical.

@@ -43,14 +43,19 @@ from dataclasses import dataclass, replace
 from functools import reduce
 from operator import or_
 
-from feederkit.angles import ActionRange
 from feederkit.design.critical import (
     MixCritical,
     PairCritical,
+    Span,
+    gap_breakpoints,
+    interval_gap,
     interval_probe,
     last_true,
     last_true_top_first,
+    mix_offsets,
+    planned_machine,
     rejected_of,
+    sub_machine,
     told_apart_pairs,
 )
 from feederkit.design.limit import GOALS, LENGTHS, PAIRS, DesignClock
@@ -63,8 +68,7 @@ from feederkit.design.steps import (
     fit_memo,
     recognizable_below,
 )
-from feederkit.machine import Grouping, OutcomeRange, PushAlignMachine, members
-from feederkit.machine.build import build_machine
+from feederkit.machine import Grouping, PushAlignMachine, members
 from feederkit.machine.inseparable import inseparable_masks, kept_apart
 from feederkit.machine.weights import weigh_members
 from feederkit.mechanics.push import PushFunction
@@ -84,53 +88,6 @@ from feederkit.plans.model import PlanMember
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor, span
 from feederkit.uncertainty import Uncertainty, check_for_part
 
-Span = tuple[float, float]
-
-
-def interval_gap(x: Span, y: Span) -> float:
-    """How far apart two diameter intervals are (negative or zero when they meet): they read
-    alike under a tolerance ``e`` iff the gap is below ``2e``."""
-    return max(x[0] - y[1], y[0] - x[1])
-
-
-def gap_breakpoints(spans_a: Sequence[Span], spans_b: Sequence[Span]) -> tuple[float, ...]:
-    """The sorted distinct ``gap / 2`` over the pairs of an interval of a and one of b whose
-    gap is positive: the tolerances at which their read-alike relation changes."""
-    return tuple(
-        sorted({g / 2.0 for x in spans_a for y in spans_b if (g := interval_gap(x, y)) > 0})
-    )
-
-
-def sub_machine(machine: PushAlignMachine, parts: Sequence[int]) -> PushAlignMachine:
-    """The states of ``parts`` (in that order of parts) of a mix machine, as a machine.
-
-    A part's outcomes are its own states, so the parts' states with their action maps
-    (outcome masks renumbered) are closed; intervals, weights and records stay the mix's.
-    """
-    keep = [i for p in parts for i, s in enumerate(machine.states) if s.part == p]
-    new = {old: k for k, old in enumerate(keep)}
-    part_of = {p: k for k, p in enumerate(parts)}
-
-    def moved(r: ActionRange | OutcomeRange) -> OutcomeRange:
-        out = 0
-        for t in members(_mask(r)):
-            out |= 1 << new[t]
-        return OutcomeRange(r.lo, r.hi, out)
-
-    states = tuple(replace(machine.states[i], part=part_of[machine.states[i].part]) for i in keep)
-    maps = tuple(tuple(moved(r) for r in machine.action_maps[i]) for i in keep)
-    return PushAlignMachine(
-        part_names=tuple(machine.part_names[p] for p in parts),
-        states=states,
-        action_maps=maps,
-        sensor=machine.sensor,
-        uncertainty=machine.uncertainty,
-    )
-
-
-def _mask(r: ActionRange | OutcomeRange) -> int:
-    return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
-
 
 class StrongMix:
     """The mix machine at a declared uncertainty (built once, without a sensor) and its
@@ -139,7 +96,12 @@ class StrongMix:
     ``members`` (one per push function, as :func:`~feederkit.plans.make.make_plan` takes
     them; None: the parts, each accepted) say which members the plan rejects: ``planned``
     is the machine with their states marked, as the planner plans it (a set of rejected
-    states only is a goal), and two rejected members are not a pair to tell apart."""
+    states only is a goal), and two rejected members are not a pair to tell apart.
+
+    As :func:`~feederkit.plans.make.make_plan` plans, each state reads over its part's
+    reading ``offsets`` (:func:`~feederkit.design.critical.planned_machine`: the part
+    itself may read a little off its simplified contact hull's diameters); ``widened``
+    names the parts whose states that widens."""
 
     def __init__(
         self,
@@ -153,7 +115,10 @@ class StrongMix:
         self.uncertainty = uncertainty
         self.members = None if members is None else tuple(members)
         self.rejected = rejected_of(self.members)
-        self.machine = build_machine(self.pfs, NoSensor(), uncertainty)
+        self.offsets = mix_offsets(self.pfs)
+        self.machine, self.widened = planned_machine(
+            self.pfs, self.offsets, NoSensor(), uncertainty
+        )
         self.planned = weigh_members(self.machine, None, self.rejected)
 
     def pair(self, a: int, b: int) -> PushAlignMachine:
