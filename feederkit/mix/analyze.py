@@ -18,6 +18,7 @@ from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
 from feederkit.mix.strongpairs import (
     check_alone,
     check_strong_pair,
+    part_offsets,
     physical_mechanics,
     reading_pairs,
 )
@@ -156,20 +157,30 @@ def analyze_mix(
     undecided = undecided_alone = 0
     alone: list[tuple[int, tuple[int, ...]]] = []
     mechs = None if unc.is_ideal else physical_mechanics(pfs, unc)  # once for every check
-    if mechs is not None:
+    # The parts' own widths, as make_plan reads each state (once for every check).
+    offs = None if mechs is None else part_offsets(pfs)
+    if mechs is not None and offs is not None:
         for i, pf in enumerate(pfs):
-            verdict = check_alone(pf, sensor, unc, mechanics=mechs[i])
+            verdict = check_alone(pf, sensor, unc, mechanics=mechs[i], offsets=offs[i])
             undecided_alone += not verdict.decided
             if verdict.decided and not verdict.orients:
                 alone.append((i, verdict.states))
-    if pairs is not None and mechs is not None:
+    if pairs is not None and mechs is not None and offs is not None:
         # A mix holding a member no strong plan orients alone fails whatever the other part.
         confused = {(w.index_a, w.index_b) for w in pairs}
         hopeless = {i for i, _states in alone}
-        for i, j in sorted(set(todo) | reading_pairs(pfs, sensor, unc, mechanics=mechs)):
+        near = reading_pairs(pfs, sensor, unc, mechanics=mechs, offsets=offs)
+        for i, j in sorted(set(todo) | near):
             if (i, j) in confused or i in hopeless or j in hopeless:
                 continue
-            check = check_strong_pair(pfs[i], pfs[j], sensor, unc, mechanics=[mechs[i], mechs[j]])
+            check = check_strong_pair(
+                pfs[i],
+                pfs[j],
+                sensor,
+                unc,
+                mechanics=[mechs[i], mechs[j]],
+                offsets=[offs[i], offs[j]],
+            )
             if not check.decided:
                 undecided += 1
             elif check.witness is not None:

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import build_machine, uncertain_machine
+from feederkit.machine.widths import Offsets, widen_widths
+from feederkit.mechanics.modelerror import Offset, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
@@ -73,6 +75,7 @@ def reading_pairs(
     uncertainty: Uncertainty | None = None,
     *,
     mechanics: Sequence[UncertainMechanics] | None = None,
+    offsets: Offsets | None = None,
 ) -> set[tuple[int, int]]:
     """The pairs ``(i, j)``, ``i < j``, of parts with some states that may read alike: the
     only pairs a strong plan may fail to tell apart.
@@ -91,7 +94,10 @@ def reading_pairs(
     of the two, states "with overlapping sensor ranges" (section 5; every pair of states
     the strong analysis keeps together can read alike), and these intervals hold theirs.
     ``mechanics``: the parts' :func:`~feederkit.mechanics.uncertain.uncertain_mechanics`,
-    when the caller has them (:func:`physical_mechanics`).
+    when the caller has them (:func:`physical_mechanics`). The planner reads each state over
+    its part's reading ``offsets`` too (:func:`part_offsets`, the widths of the part itself
+    where import simplified its contact hull: :mod:`feederkit.machine.widths`), so do these
+    intervals (:func:`widened_diameters`); None: no part's are known.
     """
     owner = [k for k, pf in enumerate(pfs) for _ in pf.states]
     diameters = [s.diameter for pf in pfs for s in pf.states]
@@ -99,9 +105,56 @@ def reading_pairs(
     for component in sensor.indistinguishable_sets(diameters):
         parts = sorted({owner[i] for i in component})
         out.update((a, b) for x, a in enumerate(parts) for b in parts[x + 1 :])
+    mechs = None
     if uncertainty is not None and not uncertainty.is_ideal:
         mechs = mechanics or physical_mechanics(pfs, uncertainty)
         out |= range_pairs(physical_diameters(pfs, mechs), sensor)
+    if offsets is not None and any(_widens(off) for off in offsets):
+        out |= range_pairs(widened_diameters(pfs, offsets, mechs), sensor)
+    return out
+
+
+def part_offsets(pfs: Sequence[PushFunction]) -> list[tuple[Offset | None, ...]]:
+    """Each part's reading offsets (:func:`~feederkit.mechanics.modelerror.reading_offsets`),
+    computed once for every check of a catalog, as ``make_plan`` computes them per plan."""
+    return [reading_offsets(pf) for pf in pfs]
+
+
+def _widens(offsets: Sequence[Offset | None]) -> bool:
+    return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for o in offsets)
+
+
+def _widened_span(
+    lo: float, hi: float, own: Sequence[Offset | None], ideal: Sequence[int]
+) -> tuple[float, float]:
+    """``[lo, hi]`` widened by the least and largest offsets of the ideal states ``ideal``
+    (never narrowed), as :func:`~feederkit.machine.widths.widen_widths` widens a state."""
+    found = [o for o in (own[i] for i in ideal) if o is not None]
+    a = min((o[0] for o in found), default=0.0)
+    b = max((o[1] for o in found), default=0.0)
+    return (lo + min(a, 0.0), hi + max(b, 0.0))
+
+
+def widened_diameters(
+    pfs: Sequence[PushFunction],
+    offsets: Offsets,
+    mechanics: Sequence[UncertainMechanics] | None = None,
+) -> list[list[tuple[float, float]]]:
+    """Per part, its states' diameter intervals read over its reading ``offsets`` (each
+    state over its ideal members' least and largest, as
+    :func:`~feederkit.machine.widths.widen_widths` widens them): the ideal states', and
+    with ``mechanics`` the physical states' (:func:`physical_diameters`) too."""
+    out = []
+    for k, pf in enumerate(pfs):
+        own = offsets[k]
+        spans = [_widened_span(s.diameter, s.diameter, own, (s.id,)) for s in pf.states]
+        if mechanics is not None:
+            phys = physical_diameters([pf], [mechanics[k]])[0]
+            ideal = [s.members for s in mechanics[k].states]
+            spans += [
+                _widened_span(lo, hi, own, m) for (lo, hi), m in zip(phys, ideal, strict=True)
+            ]
+        out.append(spans)
     return out
 
 
@@ -136,13 +189,17 @@ def _machine(
     sensor: Sensor,
     uncertainty: Uncertainty,
     mechanics: Sequence[UncertainMechanics] | None,
+    offsets: Offsets | None = None,
 ) -> PushAlignMachine:
-    """The machine of ``pfs`` numbered by diameter, as ``build_machine`` makes it, from the
-    parts' mechanics when given (:func:`physical_mechanics`)."""
+    """The machine of ``pfs`` numbered by diameter that ``make_plan`` plans on: as
+    ``build_machine`` makes it, from the parts' mechanics when given
+    (:func:`physical_mechanics`), each state read over its part's reading ``offsets``
+    (default :func:`part_offsets`; :func:`~feederkit.machine.widths.widen_widths`)."""
     if mechanics is None or uncertainty.is_ideal:
         machine = build_machine(pfs, sensor, uncertainty)
     else:
         machine = uncertain_machine(pfs, mechanics, sensor)
+    machine = widen_widths(machine, part_offsets(pfs) if offsets is None else offsets)
     return by_diameter(machine)[0]
 
 
@@ -180,12 +237,14 @@ def check_strong_pair(
     deadline: Deadline | None = None,
     *,
     mechanics: Sequence[UncertainMechanics] | None = None,
+    offsets: Offsets | None = None,
 ) -> StrongPairCheck:
     """Whether a strong plan tells ``a`` from ``b`` under ``uncertainty`` with ``sensor``;
     where none does, the witness (its states: the ideal members of the physical states
-    confused). ``mechanics``: the two parts' (:func:`physical_mechanics`). Timeout when
-    ``deadline`` passes."""
-    machine = _machine([a, b], sensor, uncertainty, mechanics)
+    confused). ``mechanics``: the two parts' (:func:`physical_mechanics`); ``offsets``:
+    their reading offsets (default :func:`part_offsets`): the check is on the machine
+    ``make_plan`` plans on. Timeout when ``deadline`` passes."""
+    machine = _machine([a, b], sensor, uncertainty, mechanics, offsets)
     found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
     if found is None:
         return StrongPairCheck(None, decided=False)
@@ -202,6 +261,7 @@ def check_alone(
     deadline: Deadline | None = None,
     *,
     mechanics: UncertainMechanics | None = None,
+    offsets: Sequence[Offset | None] | None = None,
 ) -> AloneCheck:
     """Whether a strong plan orients ``pf`` alone under ``uncertainty`` with ``sensor``, as
     ``plan`` decides "no strong plan exists": every reading set of the first alignment has a
@@ -209,8 +269,8 @@ def check_alone(
     of the default rule has one (:func:`~feederkit.planning.lumping.try_lumping`). Every pair
     of states may have a strong plan while the whole set has none. The searches for a plan
     explore at most ``ALONE_SETS`` sets (undecided beyond); the pairs to lump are decided at
-    compile's budget. ``mechanics``: the part's (:func:`physical_mechanics`). Timeout when
-    ``deadline`` passes.
+    compile's budget. ``mechanics``: the part's (:func:`physical_mechanics`); ``offsets``:
+    its reading offsets (default :func:`part_offsets`). Timeout when ``deadline`` passes.
 
     >>> from feederkit.mechanics.push import push_function
     >>> from feederkit.outline import make_outline
@@ -220,7 +280,13 @@ def check_alone(
     >>> check_alone(push_function(box), ToleranceSensor(0.5), Uncertainty(1.0)).orients
     True
     """
-    machine = _machine([pf], sensor, uncertainty, None if mechanics is None else [mechanics])
+    machine = _machine(
+        [pf],
+        sensor,
+        uncertainty,
+        None if mechanics is None else [mechanics],
+        None if offsets is None else [offsets],
+    )
     problem = Problem(machine, "exact", 0.0)
     roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
     value = solve(problem, roots, deadline, ALONE_SETS)
@@ -251,8 +317,10 @@ __all__ = [
     "StrongPairCheck",
     "check_alone",
     "check_strong_pair",
+    "part_offsets",
     "physical_diameters",
     "physical_mechanics",
     "range_pairs",
     "reading_pairs",
+    "widened_diameters",
 ]
