@@ -98,6 +98,88 @@ def test_a_centre_line_alone_still_does_not_cut_the_part(tmp_path):
     assert not any("merged" in w for w in ip.warnings)
 
 
+def _drawn(path: Path, build) -> Path:
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    build(doc.modelspace())
+    doc.saveas(path)
+    return path
+
+
+def _slot(msp):  # 60 x 20 mm: a 40 x 20 rectangle with round ends of radius 10
+    pts = [(-20, -10, 0), (20, -10, 1), (20, 10, 0), (-20, 10, 1)]
+    msp.add_lwpolyline(pts, format="xyb", close=True)
+
+
+SLOT = 800 + math.pi * 100
+
+
+def _less_hole(outer: float, radius: float, at: tuple[float, float]):
+    """Area and COM of an outline of area ``outer`` centred on the origin less a round hole
+    of ``radius`` centred ``at``: the COM from the moment of the hole."""
+    hole = math.pi * radius**2
+    return outer - hole, (-hole * at[0] / (outer - hole), -hole * at[1] / (outer - hole))
+
+
+DISK = 400 * math.pi
+
+
+@pytest.mark.parametrize(
+    ("build", "outer", "radius", "at"),
+    [
+        (lambda m: (m.add_circle((0, 0), 20), m.add_circle((12, 0), 8)), DISK, 8, (12, 0)),
+        (lambda m: (_slot(m), m.add_circle((24, 0), 6)), SLOT, 6, (24, 0)),  # at (30, 0)
+        (lambda m: (m.add_circle((0, 0), 20), m.add_circle((0, 12), 8)), DISK, 8, (0, 12)),
+        (lambda m: (m.add_circle((0, 0), 20), m.add_circle((0, 1), 19)), DISK, 19, (0, 1)),
+        (  # a centre line through the point of contact changes nothing
+            lambda m: (
+                m.add_circle((0, 0), 20),
+                m.add_circle((12, 0), 8),
+                m.add_line((-25, 0), (25, 0)),
+            ),
+            DISK,
+            8,
+            (12, 0),
+        ),
+    ],
+    ids=["disk", "slot-end-arc", "disk-at-90-deg", "disk-nearly-concentric", "disk-centre-line"],
+)
+def test_a_circle_tangent_inside_a_curved_outline_is_a_hole(tmp_path, build, outer, radius, at):
+    """Both curves flattened, the hole's chords cross the outline's by a sliver (review 51):
+    the hole was merged (a disk) or taken for a second part (the slot)."""
+    path = _drawn(tmp_path / "t.dxf", build)
+    want, com = _less_hole(outer, radius, at)
+    for every in (False, True):
+        (ip,) = parts(path, all_parts=every)
+        assert len(ip.part.outline.holes) == 1
+        assert area(ip) == pytest.approx(want, rel=2e-3)
+        assert ip.part.com == pytest.approx(com, abs=5e-3)
+        assert not any("merged" in w or "separate parts" in w for w in ip.warnings)
+
+
+@pytest.mark.parametrize(("radius", "degrees"), [(1, 13), (5, 37), (15, 90), (19, 101.3)])
+def test_a_hole_tangent_at_any_angle_to_a_curved_outline_is_a_hole(tmp_path, radius, degrees):
+    d = 20 - radius
+    at = (d * math.cos(math.radians(degrees)), d * math.sin(math.radians(degrees)))
+    path = _drawn(
+        tmp_path / "t.dxf", lambda m: (m.add_circle((0, 0), 20), m.add_circle(at, radius))
+    )
+    (ip,) = parts(path, all_parts=True)
+    want, com = _less_hole(DISK, radius, at)
+    assert len(ip.part.outline.holes) == 1
+    assert area(ip) == pytest.approx(want, rel=2e-3)
+    assert ip.part.com == pytest.approx(com, abs=5e-3)
+
+
+@pytest.mark.parametrize("depth", [0.05, 0.5, 2.0])  # beyond twice the flatten tolerance
+def test_a_hole_crossing_a_curved_outline_is_still_refused(tmp_path, depth):
+    path = _drawn(
+        tmp_path / "x.dxf", lambda m: (m.add_circle((0, 0), 20), m.add_circle((12 + depth, 0), 8))
+    )
+    with pytest.raises(InputError, match="a hole crosses the outline .CIRCLE 30"):
+        parts(path)
+
+
 # ---- 2. a bare single-line frame is said to be one ----------------------------------------
 
 

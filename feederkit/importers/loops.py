@@ -41,6 +41,13 @@ FRAME_HOLE_SHARE = 0.1
 """A rectangle holding one hole whose box is at most this share of its own may be a bare
 single-line drawing frame around one part: imported as a plate, with a warning."""
 
+TANGENT_SPREAD = 1.25
+"""A closed line that comes within ``t`` (twice the flatten tolerance) of other lines is
+tangent to them when its length within ``4 t`` of them is at least this many times its
+length within ``t`` (:func:`_tangent`): a curve leaves a tangent curve or line gradually
+(twice the length within four times the distance), a side drawn along another line stays
+on it and then turns away."""
+
 HEAL_GAP_REL = 0.002
 """Gaps between open line ends up to this share of the drawing's size are closed (0.2 %)."""
 
@@ -150,32 +157,95 @@ class Loop:
     a centre line): merged, so the part may have lost a hole (a warning says so)."""
 
 
+def _near(lines: np.ndarray, others: np.ndarray, tol: float) -> bool:
+    """Whether every point of ``lines`` lies within ``tol`` of one of ``others`` (checked on
+    points at most ``tol`` apart along them; their midpoints first, cheaply)."""
+    if len(others) == 0:
+        return False
+    tree = shapely.STRtree(others)
+    mids = shapely.line_interpolate_point(lines, 0.5, normalized=True)
+    if len(np.unique(tree.query(mids, predicate="dwithin", distance=tol)[0])) < len(mids):
+        return False
+    points = shapely.points(shapely.get_coordinates(shapely.segmentize(lines, tol)))
+    hit = tree.query(points, predicate="dwithin", distance=tol)[0]
+    return len(np.unique(hit)) == len(points)
+
+
+def _tangent(ring: Polygon, others: np.ndarray, tol: float) -> bool:
+    """Whether a closed line touching ``others`` within ``tol`` only touches them (a curve
+    tangent to the outline: chords crossing chords) rather than running along them (a
+    title-block cell's side drawn on the frame, a circle drawn over a round end): its length
+    within ``4 tol`` of them is at least :data:`TANGENT_SPREAD` times that within ``tol``."""
+    xy = shapely.get_coordinates(shapely.segmentize(ring.exterior, tol))
+    seg = np.hypot(*np.diff(xy, axis=0).T)
+    weight = (seg + np.roll(seg, 1)) / 2.0  # the length each vertex (not the last) stands for
+    points = shapely.points(xy[:-1])
+    k, j = shapely.STRtree(others).query(points, predicate="dwithin", distance=4.0 * tol)
+    dist = np.full(len(points), np.inf)
+    np.minimum.at(dist, k, shapely.distance(points[k], others[j]))
+    close = float(weight[dist <= tol].sum())
+    return close <= 0.0 or float(weight[dist <= 4.0 * tol].sum()) >= TANGENT_SPREAD * close
+
+
 def _inner_closed(
     poly: Polygon,
+    pieces: np.ndarray,
     mids: np.ndarray,
     shared: np.ndarray,
     rings: Sequence[Polygon],
     eps: float,
-) -> list[Polygon]:
+    gap: float = 0.0,
+) -> list[tuple[Polygon, list[Polygon]]]:
     """The closed lines of a group (``rings``) that lie inside its merged loop ``poly`` and
-    share no stretch with its outline nor with any other line: holes, though they touch the
-    outline at a point or lines inside the part (centre lines) join them to it.
+    share no stretch with its outline nor with any other line, each with its hole: holes,
+    though they touch the outline at a point or lines inside the part (centre lines) join
+    them to it.
 
-    ``mids`` are the midpoints of the group's noded pieces (a piece lies on a ring when its
-    midpoint does); ``shared[i]`` says piece ``i`` lies on two or more of the drawing's lines.
-    A closed line that shares a stretch of the outline or of another line (a title-block
-    cell, a notch drawn closed, a tile of a grid) stays merged.
+    ``pieces`` are the group's noded pieces and ``mids`` their midpoints (a piece lies on a
+    ring when its midpoint does); ``shared[i]`` says piece ``i`` lies on two or more of the
+    drawing's lines. A closed line that shares a stretch of the outline or of another line
+    (a title-block cell, a notch drawn closed, a tile of a grid) stays merged. A curve
+    tangent to a curved outline is flattened into chords that cross the outline's chords
+    (two polygons approximating tangent circles overlap in a sliver): the stretches of it
+    that the merged outline takes, or that noding merged with the outline's, are no stretch
+    of the outline when they lie within twice the flatten tolerance ``gap`` of the other
+    lines (:func:`_near`) and the curve leaves them as a tangent does (:func:`_tangent`),
+    not as a side drawn along them (without ``gap`` any touch is a shared stretch). The hole
+    is the closed line clipped to the loop shrunk by ``1000 eps`` (so a tangent hole never
+    pokes outside the part nor touches its outline: nesting by containment then holds in
+    floating point); it can split into pieces (a list, empty when nothing is left).
     """
-    out: list[Polygon] = []
+    out: list[tuple[Polygon, list[Polygon]]] = []
     tiny = 1e-9 * poly.area
     tree = shapely.STRtree(mids)
+    shrunk: Polygon | None = None
+    length = shapely.length(pieces)
     for ring in rings:
         if ring.area >= poly.area - tiny or not poly.contains(ring.representative_point()):
             continue
         on = tree.query(ring.exterior, predicate="dwithin", distance=eps)
-        if shared[on].any() or shapely.dwithin(mids[on], poly.exterior, eps).any():
-            continue  # it shares a stretch of the outline or of another line
-        out.append(ring)
+        common = shared[on].any()
+        outside = on[~shared[on] & shapely.dwithin(mids[on], poly.exterior, eps)]
+        if common or len(outside):
+            if gap <= 0.0:
+                continue  # it shares a stretch of another line or of the outline
+            if TANGENT_SPREAD * length[on[shared[on]]].sum() > ring.length:
+                continue  # it runs along other lines (a grid's tile, a title-block cell)
+            rest = np.ones(len(pieces), dtype=bool)
+            rest[on] = False
+            others = pieces[rest | shared]  # the other lines
+            tol = 2.0 * gap + eps
+            if len(outside) and not _near(pieces[outside], others, tol):
+                continue  # it is part of the outline
+            if not _tangent(ring, others, tol):
+                continue  # it runs along the outline or another line: drawn over it
+        if poly.contains_properly(ring):
+            out.append((ring, [ring]))
+            continue
+        if shrunk is None:
+            shrunk = poly.buffer(-1e3 * eps, join_style="mitre")
+        holes = shapely.get_parts(ring.intersection(shrunk))
+        out.append((ring, [h for h in holes if isinstance(h, Polygon) and h.area > tiny]))
     return out
 
 
@@ -194,6 +264,7 @@ def closed_loops(
     lines: Sequence[np.ndarray],
     budget: Budget | None = None,
     closed: Sequence[np.ndarray] = (),
+    gap: float = 0.0,
 ) -> tuple[list[Loop], list[LineString]]:
     """The closed loops the lines form, and the open lines (dangles) left over.
 
@@ -201,8 +272,10 @@ def closed_loops(
     part in two), except the closed lines (``closed``: circles, closed polylines) lying
     inside a merged loop that share no stretch of its outline nor of another line
     (:func:`_inner_closed`): each is a loop of its own (a hole tangent to the outline, or
-    one a centre line crosses), not merged away. ``Loop.enclosed`` counts the faces still
-    merged that touch the loop's outline at points only (:func:`_enclosed_faces`).
+    one a centre line crosses), not merged away; one whose flattened chords cross a curved
+    outline's by no more than twice the flatten tolerance ``gap`` is tangent too, and its
+    hole is clipped to the loop. ``Loop.enclosed`` counts the faces still merged that touch
+    the loop's outline at points only (:func:`_enclosed_faces`).
     """
     lines = [ln for ln in lines if len(ln) >= 2]
     if not lines:
@@ -264,14 +337,19 @@ def closed_loops(
             if not (isinstance(poly, Polygon) and poly.area > 0.0):
                 continue
             outline = Polygon(poly.exterior)
-            inner = _inner_closed(outline, mids, shared, candidates, eps) if candidates else []
-            for shape in [outline, *inner]:
-                inside = [f for f in parts if shape.contains(f.representative_point())]
+            inner = (
+                _inner_closed(outline, group, mids, shared, candidates, eps, gap)
+                if candidates
+                else []
+            )
+            rings_in = [ring for ring, _ in inner]
+            shapes = [(outline, rings_in), *((h, []) for _, hs in inner for h in hs)]
+            for shape, cut in shapes:
                 own = [
                     f
-                    for f in inside
-                    if shape is not outline
-                    or not any(h.contains(f.representative_point()) for h in inner)
+                    for f in parts
+                    if shape.contains(f.representative_point())
+                    and not any(r.contains(f.representative_point()) for r in cut)
                 ]
                 loops.append(
                     Loop(
@@ -470,10 +548,25 @@ def self_crossing(line: np.ndarray) -> str | None:
     return shapely.is_valid_reason(Polygon(ring.coords))
 
 
-def _overlap(a: Polygon, b: Polygon, tiny: float) -> bool:
-    """Whether two filled loops cross: they share area and neither holds the other."""
+def _overlap(a: Polygon, b: Polygon, tiny: float, reach: float = 0.0) -> bool:
+    """Whether two filled loops cross: they share area and neither holds the other.
+
+    What of one lies outside the other but within ``reach`` of it does not count: a curve
+    tangent inside a curved outline, both flattened, pokes out of it by a sliver.
+    """
     common = float(a.intersection(b).area)
-    return common > tiny and a.area - common > tiny and b.area - common > tiny
+    if not (common > tiny and a.area - common > tiny and b.area - common > tiny):
+        return False
+    return reach <= 0.0 or (_beyond(a, b, reach) and _beyond(b, a, reach))
+
+
+def _beyond(a: Polygon, b: Polygon, reach: float) -> bool:
+    """Whether some of ``a`` lies farther than ``reach`` outside ``b``."""
+    out = a.difference(b)
+    if out.area > reach * out.length:  # thicker on average than a sliver within reach
+        return True
+    edge = shapely.get_coordinates(shapely.segmentize(out.boundary, reach))
+    return bool((shapely.distance(shapely.points(edge), b) > reach).any())
 
 
 def crossing_loop(
@@ -516,7 +609,7 @@ def crossing_loop(
         others = [ln for i, ln in enumerate(lines) if i != k]
         loops, _ = closed_loops(others)
         tiny = 1e-9 * poly.area
-        if any(_overlap(poly, lp.polygon, tiny) for lp in loops):
+        if any(_overlap(poly, lp.polygon, tiny, 2.0 * gap) for lp in loops):
             return k
     return None
 
@@ -647,7 +740,7 @@ def drawing_from_lines(
     healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
     if budget is not None:
         budget.check_time()
-    loops, dangles = closed_loops(healed, budget, [healed[k] for k in closed])
+    loops, dangles = closed_loops(healed, budget, [healed[k] for k in closed], gap)
     if not loops:
         ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
         detail = f" ({plural(ends, 'open end')})" if ends else ""
