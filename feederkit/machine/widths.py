@@ -34,17 +34,32 @@ def widen_widths(machine: PushAlignMachine, offsets: Offsets) -> PushAlignMachin
     states = []
     changed = False
     for st in machine.states:
-        own = offsets[st.part]
-        found = [own[i] for i in (st.members or (st.state,)) if own[i] is not None]
-        lo = min((o[0] for o in found), default=0.0)  # type: ignore[index]
-        hi = max((o[1] for o in found), default=0.0)  # type: ignore[index]
-        if lo >= 0.0 and hi <= 0.0:
+        a, b = st.diameter_range or (st.diameter, st.diameter)
+        span = widened_span(a, b, offsets[st.part], st.members or (st.state,))
+        if span == (a, b):
             states.append(st)
             continue
-        a, b = st.diameter_range or (st.diameter, st.diameter)
-        states.append(replace(st, diameter_range=(a + min(lo, 0.0), b + max(hi, 0.0))))
+        states.append(replace(st, diameter_range=span))
         changed = True
     return replace(machine, states=tuple(states)) if changed else machine
 
 
-__all__ = ["Offsets", "widen_widths"]
+def widened_span(
+    lo: float,
+    hi: float,
+    own: Sequence[tuple[float, float] | None],
+    ideal: Sequence[int],
+) -> tuple[float, float]:
+    """``[lo, hi]`` widened by the least and largest of the ideal states ``ideal``'s offsets
+    (``own``: their part's), never narrowed: the one rule for a state's widths.
+
+    >>> widened_span(10.0, 10.0, [(0.01, 0.02), None, (-0.01, 0.0)], (0, 2))
+    (9.99, 10.02)
+    """
+    found = [o for o in (own[i] for i in ideal) if o is not None]
+    a = min((o[0] for o in found), default=0.0)
+    b = max((o[1] for o in found), default=0.0)
+    return (lo + min(a, 0.0), hi + max(b, 0.0))
+
+
+__all__ = ["Offsets", "widen_widths", "widened_span"]

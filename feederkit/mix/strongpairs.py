@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import build_machine, uncertain_machine
-from feederkit.machine.widths import Offsets, widen_widths
+from feederkit.machine.widths import Offsets, widen_widths, widened_span
 from feederkit.mechanics.modelerror import Offset, reading_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
@@ -124,17 +124,6 @@ def _widens(offsets: Sequence[Offset | None]) -> bool:
     return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for o in offsets)
 
 
-def _widened_span(
-    lo: float, hi: float, own: Sequence[Offset | None], ideal: Sequence[int]
-) -> tuple[float, float]:
-    """``[lo, hi]`` widened by the least and largest offsets of the ideal states ``ideal``
-    (never narrowed), as :func:`~feederkit.machine.widths.widen_widths` widens a state."""
-    found = [o for o in (own[i] for i in ideal) if o is not None]
-    a = min((o[0] for o in found), default=0.0)
-    b = max((o[1] for o in found), default=0.0)
-    return (lo + min(a, 0.0), hi + max(b, 0.0))
-
-
 def widened_diameters(
     pfs: Sequence[PushFunction],
     offsets: Offsets,
@@ -147,13 +136,11 @@ def widened_diameters(
     out = []
     for k, pf in enumerate(pfs):
         own = offsets[k]
-        spans = [_widened_span(s.diameter, s.diameter, own, (s.id,)) for s in pf.states]
+        spans = [widened_span(s.diameter, s.diameter, own, (s.id,)) for s in pf.states]
         if mechanics is not None:
             phys = physical_diameters([pf], [mechanics[k]])[0]
             ideal = [s.members for s in mechanics[k].states]
-            spans += [
-                _widened_span(lo, hi, own, m) for (lo, hi), m in zip(phys, ideal, strict=True)
-            ]
+            spans += [widened_span(lo, hi, own, m) for (lo, hi), m in zip(phys, ideal, strict=True)]
         out.append(spans)
     return out
 
