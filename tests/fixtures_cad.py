@@ -554,3 +554,18 @@ def write_hostile_curve(path: Path, kind: str, value: str) -> Path:
     assert str(s) in text
     path.write_text(text.replace(str(s), value))
     return path
+
+
+def d_shape_outline():
+    """A 30 x 20 mm rectangle with an R10 half disc on its right, the arc drawn with 63
+    points: 40 mm across the arc, which a simplified contact hull cuts."""
+    from feederkit.outline import make_outline
+
+    arc = [
+        (
+            30.0 + 10.0 * math.cos(math.pi * k / 64 - math.pi / 2),
+            10.0 + 10.0 * math.sin(math.pi * k / 64 - math.pi / 2),
+        )
+        for k in range(1, 64)
+    ]
+    return make_outline("d", [(0.0, 0.0), (30.0, 0.0), *arc, (30.0, 20.0), (0.0, 20.0)])

@@ -6,9 +6,8 @@ are the plans'."""
 
 from __future__ import annotations
 
-import math
-
 import pytest
+from fixtures_cad import d_shape_outline
 
 from feederkit.design.critical import mix_critical_tolerance
 from feederkit.design.sensor import design_pitches, design_tolerance
@@ -26,17 +25,7 @@ from feederkit.plans.make import make_plan
 from feederkit.sensors import LedSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
-
-def d_shape():
-    """A 30 x 20 mm rectangle with an R10 half disc on its right: 40 mm across the arc."""
-    arc = [
-        (
-            30.0 + 10.0 * math.cos(math.pi * k / 64 - math.pi / 2),
-            10.0 + 10.0 * math.sin(math.pi * k / 64 - math.pi / 2),
-        )
-        for k in range(1, 64)
-    ]
-    return make_outline("d", [(0.0, 0.0), (30.0, 0.0), *arc, (30.0, 20.0), (0.0, 20.0)])
+d_shape = d_shape_outline
 
 
 def rectangle():

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from fixtures_cad import d_shape_outline
 
 from feederkit.mechanics.modelerror import largest_offset, reading_offsets, state_offsets
 from feederkit.mechanics.push import push_function
@@ -14,17 +15,7 @@ from feederkit.part import make_part
 from feederkit.plans.make import make_plan
 from feederkit.sensors import ToleranceSensor
 
-
-def d_shape():
-    """A 30 x 20 mm rectangle with an R10 half disc on its right: 40 mm across the arc."""
-    arc = [
-        (
-            30.0 + 10.0 * math.cos(math.pi * k / 64 - math.pi / 2),
-            10.0 + 10.0 * math.sin(math.pi * k / 64 - math.pi / 2),
-        )
-        for k in range(1, 64)
-    ]
-    return make_outline("d", [(0.0, 0.0), (30.0, 0.0), *arc, (30.0, 20.0), (0.0, 20.0)])
+d_shape = d_shape_outline
 
 
 def test_an_exact_hull_has_no_offsets():
