@@ -23,6 +23,7 @@ import numpy as np
 
 from feederkit.hull import convex_hull
 from feederkit.mechanics.push import PushFunction, push_function
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.part import make_part
 
 Offset = tuple[float, float]
@@ -62,6 +63,7 @@ def state_offsets(model: PushFunction, exact: PushFunction) -> tuple[Offset | No
     dist = _distances(eh, mh)  # exact vertex x model edge
     slack = 2.0 * float(dist.min(axis=1).max()) + 1e-9 * model.part.size
     n = len(eh)
+    eps = DIAMETER_REL_EPS * model.part.size
     out: list[Offset | None] = []
     for s in model.states:
         ds = [
@@ -69,8 +71,13 @@ def state_offsets(model: PushFunction, exact: PushFunction) -> tuple[Offset | No
             for e in exact.states
             if dist[e.edge, s.edge] <= slack and dist[(e.edge + 1) % n, s.edge] <= slack
         ]
-        out.append((min(ds), max(ds)) if ds else None)
+        out.append((_rounded(min(ds), eps), _rounded(max(ds), eps)) if ds else None)
     return tuple(out)
+
+
+def _rounded(offset: float, eps: float) -> float:
+    """An offset within rounding of 0 (the machine's diameter snap) is 0."""
+    return 0.0 if abs(offset) <= eps else offset
 
 
 def reading_offsets(model: PushFunction) -> tuple[Offset | None, ...]:
