@@ -34,8 +34,8 @@ from feederkit.design.limit import PAIRS, DesignClock
 from feederkit.machine import OutcomeRange, PushAlignMachine, members
 from feederkit.machine.build import build_machine
 from feederkit.machine.inseparable import inseparable_masks
-from feederkit.machine.widths import Offsets, widen_widths
-from feederkit.mechanics.modelerror import Offset, reading_offsets
+from feederkit.machine.widths import Offsets, widen_widths, widens
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mix.pairs import PairWitness, distinguishable
@@ -110,13 +110,6 @@ def _mask(r: ActionRange | OutcomeRange) -> int:
     return r.targets if isinstance(r, OutcomeRange) else 1 << r.target
 
 
-def mix_offsets(pfs: Sequence[PushFunction]) -> list[tuple[Offset | None, ...]]:
-    """Each part's reading offsets (:func:`~feederkit.mechanics.modelerror.reading_offsets`:
-    how far the part itself may read from its simplified contact hull's diameters), computed
-    once per design and handed to every machine it builds (:func:`planned_machine`)."""
-    return [reading_offsets(pf) for pf in pfs]
-
-
 def planned_machine(
     pfs: Sequence[PushFunction],
     offsets: Offsets,
@@ -125,8 +118,9 @@ def planned_machine(
 ) -> tuple[PushAlignMachine, frozenset[int]]:
     """The machine :func:`~feederkit.plans.make.make_plan` plans on (before it weighs and
     marks the members): ``build_machine``'s, each state read over its part's ``offsets``
-    (:func:`~feederkit.machine.widths.widen_widths`, :func:`mix_offsets`), and the parts
-    whose states that widens. With no part widened the machine is ``build_machine``'s own,
+    (:func:`~feederkit.machine.widths.widen_widths`,
+    :func:`~feederkit.mechanics.modelerror.part_offsets`), and the parts whose states that
+    widens. With no part widened the machine is ``build_machine``'s own,
     and every figure of the design is the one the parts' model gives."""
     built = build_machine(list(pfs), NoSensor() if sensor is None else sensor, uncertainty)
     machine = widen_widths(built, offsets)
@@ -134,11 +128,6 @@ def planned_machine(
         s.part for s, t in zip(machine.states, built.states, strict=True) if s is not t
     )
     return machine, wide
-
-
-def widens(offsets: Offsets) -> bool:
-    """Whether some offset may widen a state (a part whose contact hull is simplified)."""
-    return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for off in offsets for o in off)
 
 
 PROBE_REL = 1e-6
@@ -312,11 +301,11 @@ def mix_critical_tolerance(
     (:mod:`feederkit.design.limit`) is polled and told of each pair decided. ``rejected``:
     the indices of members the plan rejects; two of them need not be told apart, so their
     pair is left out (:func:`told_apart_pairs`). ``offsets``: the parts' reading offsets
-    (default :func:`mix_offsets`); a pair with a part they widen is decided on the machine
-    the planner plans on (:func:`widened_pair_critical`), the others on their diameters
-    (:func:`pair_critical_tolerance`)."""
+    (default :func:`~feederkit.mechanics.modelerror.part_offsets`); a pair with a part they
+    widen is decided on the machine the planner plans on (:func:`widened_pair_critical`),
+    the others on their diameters (:func:`pair_critical_tolerance`)."""
     clock = clock or DesignClock()
-    offsets = mix_offsets(pfs) if offsets is None else offsets
+    offsets = part_offsets(pfs) if offsets is None else offsets
     machine, wide = planned_machine(pfs, offsets) if widens(offsets) else (None, frozenset())
     wanted = told_apart_pairs(len(pfs), rejected)
     clock.begin(PAIRS, len(wanted))

@@ -15,13 +15,14 @@ import math
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass, replace
 
-from feederkit.design.critical import mix_offsets, planned_machine, rejected_of, widens
+from feederkit.design.critical import planned_machine, rejected_of
 from feederkit.design.limit import PITCHES, DesignClock
 from feederkit.design.strong import StrongMix, strong_pitch
 from feederkit.errors import InputError
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.inseparable import inseparable_masks
-from feederkit.machine.widths import Offsets
+from feederkit.machine.widths import Offsets, widens
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import reported_pairs
 from feederkit.mix.pairs import unrecognizable_pairs
@@ -144,12 +145,12 @@ def pitch_rows(
     ``mix``'s uncertainty when given, else on the ideal model, for ``members``:
     :func:`pitch_row`); ``clock`` (:mod:`feederkit.design.limit`) is polled and told of
     each pitch decided. ``offsets``: the parts' reading offsets on the ideal model (default
-    :func:`~feederkit.design.critical.mix_offsets`); where they widen a state the pairs are
+    :func:`~feederkit.mechanics.modelerror.part_offsets`); where they widen a state the pairs are
     decided on the machine the planner plans on."""
     clock = clock or DesignClock()
     widened = None
     if mix is None:
-        offsets = mix_offsets(pfs) if offsets is None else offsets
+        offsets = part_offsets(pfs) if offsets is None else offsets
         if widens(offsets):
             machine, wide = planned_machine(pfs, offsets)
             widened = machine if wide else None

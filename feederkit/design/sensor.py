@@ -23,7 +23,6 @@ from feederkit.design.critical import (
     MixCritical,
     PairCritical,
     mix_critical_tolerance,
-    mix_offsets,
     rejected_of,
 )
 from feederkit.design.limit import DesignClock, DesignTimeout, Progress
@@ -37,6 +36,7 @@ from feederkit.design.strong import (
 )
 from feederkit.errors import InputError
 from feederkit.landing.model import Landing
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import landing_members, member_name, rejected_members
 from feederkit.planning.budget import Timeout
@@ -331,7 +331,7 @@ def _design_tolerance(
 ) -> ToleranceDesign:
     names = tuple(pf.part.name for pf in pfs)
     if unc.is_ideal:
-        offsets = mix_offsets(pfs)  # the parts' own widths, as the plans read them
+        offsets = part_offsets(pfs)  # the parts' own widths, as the plans read them
         critical = mix_critical_tolerance(pfs, clock, rejected_of(members), offsets)
         up_to = max_tolerance if max_tolerance is not None else critical.critical_tolerance
 
@@ -457,7 +457,7 @@ def design_pitches(
     names = tuple(pf.part.name for pf in pfs)
     try:
         if unc.is_ideal:
-            offsets = mix_offsets(pfs)
+            offsets = part_offsets(pfs)
             rows = pitch_rows(pfs, pitches, noise, clock=clock, members=named, offsets=offsets)
             critical = mix_critical_tolerance(pfs, clock, rejected_of(named), offsets)
             return PitchDesign(names, noise, rows, critical, unc, named)

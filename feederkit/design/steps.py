@@ -67,7 +67,6 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
     mix_critical_tolerance,
-    mix_offsets,
     planned_machine,
     rejected_of,
 )
@@ -76,6 +75,7 @@ from feederkit.errors import CheckFailed
 from feederkit.machine import Grouping, PushAlignMachine
 from feederkit.machine.weights import weigh_members
 from feederkit.machine.widths import Offsets
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
@@ -130,7 +130,7 @@ class Evaluation:
 def mix_breakpoints(pfs: Sequence[PushFunction]) -> tuple[float, ...]:
     """Where the read-alike relation of the mix's states changes (the diameters of the
     machine the planner plans on, :func:`~feederkit.design.critical.planned_machine`)."""
-    machine, wide = planned_machine(pfs, mix_offsets(pfs))
+    machine, wide = planned_machine(pfs, part_offsets(pfs))
     return machine_breakpoints(machine, bool(wide))
 
 
@@ -182,7 +182,7 @@ def plan_evaluation(
 def optimal_length(pfs: Sequence[PushFunction], tolerance: float) -> int:
     """The proven minimum worst-case length at ``tolerance`` mm, from a whole plan on the
     machine the planner plans on (the reference the tests hold :class:`LengthOracle` to)."""
-    machine, _wide = planned_machine(pfs, mix_offsets(pfs), ToleranceSensor(tolerance))
+    machine, _wide = planned_machine(pfs, part_offsets(pfs), ToleranceSensor(tolerance))
     return plan(machine).length
 
 
@@ -212,7 +212,7 @@ class LengthOracle:
     ``rejected``: the indices of members the plan rejects (their states marked as
     :func:`~feederkit.plans.make.make_plan` marks them, so a set of them only is a goal).
     The machine is the one ``make_plan`` plans on: each state read over its part's reading
-    ``offsets`` (default :func:`~feederkit.design.critical.mix_offsets`); ``widened`` says
+    ``offsets`` (default :func:`~feederkit.mechanics.modelerror.part_offsets`); ``widened`` says
     whether they widened any state (the breakpoints are then the intervals' gaps).
     """
 
@@ -224,7 +224,7 @@ class LengthOracle:
         offsets: Offsets | None = None,
     ) -> None:
         self.deadline = deadline or Deadline()
-        offsets = mix_offsets(pfs) if offsets is None else offsets
+        offsets = part_offsets(pfs) if offsets is None else offsets
         built, wide = planned_machine(pfs, offsets)
         self.widened = bool(wide)
         self.machine = weigh_members(built, None, rejected)
@@ -289,7 +289,7 @@ def length_steps(
     members as :func:`~feederkit.plans.make.make_plan` takes them; the default oracle,
     plans and pairs then plan for rejected members as ``changeover compile --accept`` does.
     ``offsets``: the parts' reading offsets (default
-    :func:`~feederkit.design.critical.mix_offsets`), for the default oracle and pairs: both
+    :func:`~feederkit.mechanics.modelerror.part_offsets`), for the default oracle and pairs: both
     read each state over the parts' own widths, as the plans do.
 
     The intervals are searched in segments between the pairs' critical tolerances (the
@@ -299,7 +299,7 @@ def length_steps(
     clock = clock or DesignClock()
     rejected = rejected_of(members)
     if offsets is None and (oracle is None or critical is None):
-        offsets = mix_offsets(pfs)
+        offsets = part_offsets(pfs)
     oracle = oracle or LengthOracle(pfs, clock.deadline, rejected, offsets)
     breaks = machine_breakpoints(oracle.machine, oracle.widened)
     evaluate = evaluate or (lambda e: plan_evaluation(pfs, e, clock, members))

@@ -52,7 +52,6 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
     last_true_top_first,
-    mix_offsets,
     planned_machine,
     rejected_of,
     sub_machine,
@@ -71,6 +70,7 @@ from feederkit.design.steps import (
 from feederkit.machine import Grouping, PushAlignMachine, members
 from feederkit.machine.inseparable import inseparable_masks, kept_apart
 from feederkit.machine.weights import weigh_members
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness, distinguishable
 from feederkit.planning.andor import WorstCase
@@ -115,7 +115,7 @@ class StrongMix:
         self.uncertainty = uncertainty
         self.members = None if members is None else tuple(members)
         self.rejected = rejected_of(self.members)
-        self.offsets = mix_offsets(self.pfs)
+        self.offsets = part_offsets(self.pfs)
         self.machine, self.widened = planned_machine(
             self.pfs, self.offsets, NoSensor(), uncertainty
         )

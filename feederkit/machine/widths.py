@@ -44,6 +44,11 @@ def widen_widths(machine: PushAlignMachine, offsets: Offsets) -> PushAlignMachin
     return replace(machine, states=tuple(states)) if changed else machine
 
 
+def widens(offsets: Offsets) -> bool:
+    """Whether some offset may widen a state (a part whose contact hull is simplified)."""
+    return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for off in offsets for o in off)
+
+
 def widened_span(
     lo: float,
     hi: float,
@@ -62,4 +67,4 @@ def widened_span(
     return (lo + min(a, 0.0), hi + max(b, 0.0))
 
 
-__all__ = ["Offsets", "widen_widths", "widened_span"]
+__all__ = ["Offsets", "widen_widths", "widened_span", "widens"]

@@ -98,6 +98,12 @@ def reading_offsets(model: PushFunction) -> tuple[Offset | None, ...]:
     return state_offsets(model, exact)
 
 
+def part_offsets(pfs: Sequence[PushFunction]) -> list[tuple[Offset | None, ...]]:
+    """Each part's :func:`reading_offsets`, computed once for every machine built from the
+    parts (a plan, a design, a catalog screen)."""
+    return [reading_offsets(pf) for pf in pfs]
+
+
 def largest_offset(offsets: Sequence[Offset | None]) -> tuple[float, int | None]:
     """The largest of ``offsets`` in absolute value (mm) and its state; (0, None) when
     there is none."""

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.behaviour import BehaviourClass, push_classes, push_diameter_classes
 from feederkit.mix.pairs import PairWitness, candidate_pairs, unrecognizable_pairs
@@ -18,7 +19,6 @@ from feederkit.mix.signatures import ANGLE_TOL_DEG, LENGTH_TOL_MM, signature
 from feederkit.mix.strongpairs import (
     check_alone,
     check_strong_pair,
-    part_offsets,
     physical_mechanics,
     reading_pairs,
 )

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import build_machine, uncertain_machine
-from feederkit.machine.widths import Offsets, widen_widths, widened_span
-from feederkit.mechanics.modelerror import Offset, reading_offsets
+from feederkit.machine.widths import Offsets, widen_widths, widened_span, widens
+from feederkit.mechanics.modelerror import Offset, part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
 from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
@@ -109,19 +109,9 @@ def reading_pairs(
     if uncertainty is not None and not uncertainty.is_ideal:
         mechs = mechanics or physical_mechanics(pfs, uncertainty)
         out |= range_pairs(physical_diameters(pfs, mechs), sensor)
-    if offsets is not None and any(_widens(off) for off in offsets):
+    if offsets is not None and widens(offsets):
         out |= range_pairs(widened_diameters(pfs, offsets, mechs), sensor)
     return out
-
-
-def part_offsets(pfs: Sequence[PushFunction]) -> list[tuple[Offset | None, ...]]:
-    """Each part's reading offsets (:func:`~feederkit.mechanics.modelerror.reading_offsets`),
-    computed once for every check of a catalog, as ``make_plan`` computes them per plan."""
-    return [reading_offsets(pf) for pf in pfs]
-
-
-def _widens(offsets: Sequence[Offset | None]) -> bool:
-    return any(o is not None and (o[0] < 0.0 or o[1] > 0.0) for o in offsets)
 
 
 def widened_diameters(
@@ -304,7 +294,6 @@ __all__ = [
     "StrongPairCheck",
     "check_alone",
     "check_strong_pair",
-    "part_offsets",
     "physical_diameters",
     "physical_mechanics",
     "range_pairs",

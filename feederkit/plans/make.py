@@ -31,7 +31,7 @@ from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import widen_widths
-from feederkit.mechanics.modelerror import exact_push_function, largest_offset, reading_offsets
+from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
@@ -145,7 +145,7 @@ def _make_plan(
     # The part itself may read a little off its simplified hull's diameters: the machine
     # reads each state over them too (machine.widths), so no branch parts what the part
     # itself cannot be told apart by.
-    offsets = [reading_offsets(pf) for pf in pfs]
+    offsets = part_offsets(pfs)
     unwidened = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
     machine = widen_widths(unwidened, offsets)
     if rejected:
