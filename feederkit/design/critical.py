@@ -384,12 +384,29 @@ def widened_pair_critical(
     found = cross_inseparable(m, probe, clock)
     ideal = distinguishable(pa, pb, ToleranceSensor(probe))
     reason, kind = (HULL_REASON, "hull") if ideal is None else (ideal.reason, ideal.kind)
-    witness = PairWitness(
+    witness = machine_witness(pa, pb, m, found, reason, kind)
+    return PairCritical(pa.part.name, pb.part.name, None, witness)
+
+
+def machine_witness(
+    pa: PushFunction,
+    pb: PushFunction,
+    m: PushAlignMachine,
+    pairs: Sequence[tuple[int, int]],
+    reason: str,
+    kind: str,
+    index_a: int = 0,
+    index_b: int = 1,
+) -> PairWitness:
+    """The witness that ``pa`` and ``pb`` are not told apart: the stable states of the pairs
+    ``(i, j)`` of the two-part machine ``m`` (part a's state, part b's) that stay together."""
+    return PairWitness(
         part_a=pa.part.name,
         part_b=pb.part.name,
-        states_a=tuple(m.states[i].state for i, _ in found),
-        states_b=tuple(m.states[j].state for _, j in found),
+        states_a=tuple(m.states[i].state for i, _ in pairs),
+        states_b=tuple(m.states[j].state for _, j in pairs),
         reason=reason,
         kind=kind,
+        index_a=index_a,
+        index_b=index_b,
     )
-    return PairCritical(pa.part.name, pb.part.name, None, witness)

@@ -52,6 +52,7 @@ from feederkit.design.critical import (
     interval_probe,
     last_true,
     last_true_top_first,
+    machine_witness,
     planned_machine,
     rejected_of,
     sub_machine,
@@ -72,7 +73,7 @@ from feederkit.machine.inseparable import inseparable_masks, kept_apart
 from feederkit.machine.weights import weigh_members
 from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
-from feederkit.mix.pairs import PairWitness, distinguishable
+from feederkit.mix.pairs import distinguishable
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import FIRST_LIMIT, goal_relation, strong_plan_exists
 from feederkit.planning.budget import Deadline
@@ -330,16 +331,7 @@ def strong_pair_critical(
     else:
         reason = STRONG_REASON.format(what=uncertainty_words(mix.uncertainty))
         kind = "uncertainty"
-    witness = PairWitness(
-        part_a=pa.part.name,
-        part_b=pb.part.name,
-        states_a=tuple(m.states[i].state for i, _ in pairs),
-        states_b=tuple(m.states[j].state for _, j in pairs),
-        reason=reason,
-        kind=kind,
-        index_a=a,
-        index_b=b,
-    )
+    witness = machine_witness(pa, pb, m, pairs, reason, kind, a, b)
     return PairCritical(pa.part.name, pb.part.name, None, witness)
 
 

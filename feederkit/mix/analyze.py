@@ -158,14 +158,14 @@ def analyze_mix(
     alone: list[tuple[int, tuple[int, ...]]] = []
     mechs = None if unc.is_ideal else physical_mechanics(pfs, unc)  # once for every check
     # The parts' own widths, as make_plan reads each state (once for every check).
-    offs = None if mechs is None else part_offsets(pfs)
-    if mechs is not None and offs is not None:
+    offs = [] if mechs is None else part_offsets(pfs)
+    if mechs is not None:
         for i, pf in enumerate(pfs):
             verdict = check_alone(pf, sensor, unc, mechanics=mechs[i], offsets=offs[i])
             undecided_alone += not verdict.decided
             if verdict.decided and not verdict.orients:
                 alone.append((i, verdict.states))
-    if pairs is not None and mechs is not None and offs is not None:
+    if pairs is not None and mechs is not None:
         # A mix holding a member no strong plan orients alone fails whatever the other part.
         confused = {(w.index_a, w.index_b) for w in pairs}
         hopeless = {i for i, _states in alone}

@@ -314,12 +314,16 @@ def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
     return norm360(mid + inside)
 
 
-def _state_problems(plan: Plan, p: int) -> list[str]:
-    """Differences between the plan's stable states and those its hull and COM give.
+def _diameter_eps(plan: Plan) -> float:
+    """How far a plan's diameters may lie from its hulls': they are as planned on, and the
+    machine snaps those equal within ``DIAMETER_REL_EPS`` of the plan's largest part
+    (``build_machine``), so a small part's may differ from its own hull's by that much."""
+    return DIAMETER_REL_EPS * max(push_function_of(q).part.size for q in plan.parts) + 1e-12
 
-    The diameters are as planned on: the machine snaps those equal within
-    ``DIAMETER_REL_EPS`` of the plan's largest part (``build_machine``), so a small part's
-    may differ from its own hull's by that much, more than its own size's share."""
+
+def _state_problems(plan: Plan, p: int, eps_d: float) -> list[str]:
+    """Differences between the plan's stable states and those its hull and COM give
+    (diameters within ``eps_d``, :func:`_diameter_eps`)."""
     part = plan.parts[p]
     pf = push_function_of(part)
     listed = {s.id: s for s in part.states}
@@ -328,8 +332,6 @@ def _state_problems(plan: Plan, p: int) -> list[str]:
             f"part {part.label!r}: the plan lists stable states {sorted(listed)}, but its hull "
             f"and COM give {pf.n}"
         ]
-    largest = max(push_function_of(q).part.size for q in plan.parts)
-    eps_d = DIAMETER_REL_EPS * largest + 1e-12
     out = []
     for s in pf.states:
         f = listed[s.id]
@@ -480,9 +482,10 @@ def verify_plan(
     length = plan.stats.length
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 4 * length + 200))  # the search recurses once per operation
+    eps_d = _diameter_eps(plan)
     try:
         for p in indices:
-            problems += _state_problems(plan, p)
+            problems += _state_problems(plan, p, eps_d)
             check, failed = _PartSearch(plan, p).run()
             if check.worst_operations > length:
                 problems.append(
@@ -554,8 +557,9 @@ def _verify_declared(plan: Plan, part_indices: Sequence[int] | None) -> Verifica
     data = plan_to_dict(plan)
     indices = range(len(plan.parts)) if part_indices is None else part_indices
     problems = _pose_problems(plan) + reject_problems(plan)
+    eps_d = _diameter_eps(plan)
     for p in indices:
-        problems += _state_problems(plan, p)
+        problems += _state_problems(plan, p, eps_d)
     names = {plan.parts[p].key for p in indices}
     try:
         strong = verify_strong(data)
