@@ -43,7 +43,7 @@ ALLOWED: dict[str, set[str]] = {
     "planning": {"errors", "angles", "words", "uncertainty", "machine"},
     "importers": _GEOMETRY | {"mechanics"},
     # Landings (docs/landings.md): the ways a part lands, from its outline or its mesh poses.
-    "landing": _GEOMETRY | {"importers"},
+    "landing": _GEOMETRY | {"mechanics", "importers"},
     # Planning over landings: each landing is one member of a mix (section 8).
     "landing.plan": _FILES | {"planning", "plans", "mix"},
     "catalog": _GEOMETRY | {"importers", "landing"},

@@ -53,7 +53,7 @@ def exactly_mirror_symmetric(outline) -> bool:
 @pytest.mark.parametrize("build", [slot, d_shape])
 def test_symmetric_curved_cad_part_has_one_landing(tmp_path, build):
     ip = imported(fx.write_entities(tmp_path / "part.dxf", build))
-    assert ip.hull_tolerance == pytest.approx(0.05)
+    assert 0.0 < ip.hull_tolerance <= 0.05  # simplified (below 0.05 where chords would hold it)
     assert exactly_mirror_symmetric(ip.part.outline)
     # The simplified hull and its mirror need not be congruent (the chords of an arc merge
     # in one order): the landings are decided on the outline's exact hull.

@@ -22,6 +22,7 @@ from feederkit.importers.model import (
 )
 from feederkit.importers.orientable import Orientability, orientability
 from feederkit.importers.plausible import outline_size
+from feederkit.mechanics.modelerror import KeptTolerance, kept_part
 from feederkit.outline import load_outline_json
 from feederkit.part import Part, make_part
 
@@ -132,6 +133,15 @@ def effective_hull_tolerance(
     return min(DEFAULT_HULL_TOLERANCE, REL_HULL_TOLERANCE * size_mm)
 
 
+def lowered_warning(kept: KeptTolerance) -> str:
+    """The import's note that it simplified the contact hull less than asked, and why."""
+    return (
+        f"hull tolerance {kept.tolerance:.3g} mm, not {kept.asked:.3g}: at {kept.asked:.3g} mm"
+        f" the simplified hull rests in {kept.model} states where the outline rests in"
+        f" {kept.outline} (chords across its arcs hold the part where it rolls)"
+    )
+
+
 def build_part(
     imported: ImportedOutline, options: ImportOptions, extra_warnings: tuple[str, ...] = ()
 ) -> ImportedPart:
@@ -142,15 +152,18 @@ def build_part(
     """
     size = outline_size(imported.outline)
     tol = effective_hull_tolerance(imported.kind, options, size)
+    notes = list(extra_warnings) + list(imported.warnings)
     try:
-        part = make_part(imported.outline, options.com, hull_tolerance=tol)
+        part, kept = kept_part(make_part(imported.outline, options.com), tol)
+        if kept is not None and kept.lowered:
+            tol = kept.tolerance
+            notes.append(lowered_warning(kept))
     except InputError as exc:
         doubts = [w for w in imported.warnings if "check the units" in w]
         if not doubts:
             raise
         raise InputError(f"{exc} ({doubts[0]})") from None
     verdict = orientability(part, tol)
-    notes = list(extra_warnings) + list(imported.warnings)
     if not verdict.orientable:
         notes.append(f"{NOT_ORIENTABLE}: {verdict.reason}")
     return ImportedPart(

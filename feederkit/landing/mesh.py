@@ -17,6 +17,7 @@ from feederkit.importers.budget import Budget
 from feederkit.importers.mesh import load_mesh, pose_outline, resting_poses, solid
 from feederkit.importers.model import ImportOptions
 from feederkit.landing.model import Landing, merge_congruent, renamed
+from feederkit.mechanics.modelerror import kept_part
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
 
@@ -34,7 +35,8 @@ def landings_of_mesh(
 ) -> tuple[Landing, ...]:
     """Every resting pose of the mesh file as a landing, congruent poses merged.
 
-    ``hull_tolerance`` simplifies each pose's hull as the import does (default: exact). With
+    ``hull_tolerance`` simplifies each pose's hull as the import does (default: exact; less
+    on a pose whose chords would hold it where it rolls, ``kept_part``). With
     ``options.com`` (a COM given for one pose) the other poses' COMs are unknown: the only
     landing is then the imported pose (``options.pose``, default 0).
     """
@@ -63,4 +65,5 @@ def landings_of_mesh(
 
 def _pose_part(s, pose, com2d, label: str, hull_tolerance: float | None) -> Part:
     ring, com, _transform = pose_outline(s, pose, com2d)
-    return make_part(make_outline(label, ring, (), com, "mm"), hull_tolerance=hull_tolerance)
+    exact = make_part(make_outline(label, ring, (), com, "mm"))
+    return kept_part(exact, hull_tolerance)[0]

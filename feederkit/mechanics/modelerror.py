@@ -10,6 +10,9 @@ a longer chord turns the resting edge; a
 sensor finer than that can read a part made exactly to its drawing outside every branch of a
 plan made on its model (design.md: the executor must then stop).
 
+A chord also rests where the arc rolls: :func:`keeping_tolerance` is the largest tolerance
+at which the simplified hull's resting states are the outline's own.
+
 The plan file's diameters are the model's (design.md); the machine reads each state over its
 offsets before planning (:mod:`feederkit.machine.widths`). A smaller ``--hull-tolerance``
 shrinks them.
@@ -18,13 +21,18 @@ shrinks them.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
+from feederkit.angles import norm360
 from feederkit.hull import convex_hull
+from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
-from feederkit.part import make_part
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
+from feederkit.part import Part, make_part
+from feederkit.uncertainty import IDEAL
 
 Offset = tuple[float, float]
 
@@ -112,3 +120,104 @@ def largest_offset(offsets: Sequence[Offset | None]) -> tuple[float, int | None]
         if off is not None and max(-off[0], off[1]) > worst:
             worst, which = max(-off[0], off[1]), k
     return worst, which
+
+
+KEEP_STEPS = 4
+"""How many times :func:`keeping_tolerance` halves a hull tolerance before taking the exact
+hull."""
+
+
+@dataclass(frozen=True)
+class KeptTolerance:
+    """The hull tolerance :func:`keeping_tolerance` chose, and why it is below the asked one.
+
+    ``split``: at ``asked`` mm, how many resting states the simplified hull had (``model``)
+    where the outline's own hull has ``outline`` (0 and 0 when nothing was lowered).
+    """
+
+    tolerance: float
+    asked: float
+    model: int = 0
+    outline: int = 0
+
+    @property
+    def lowered(self) -> bool:
+        """Whether the tolerance is below the asked one."""
+        return self.tolerance < self.asked
+
+
+def _resting(part: Part) -> UncertainMechanics:
+    """The part's physical resting states with a breath of vibration and nothing else
+    uncertain (section 3's stable states, those vibration carries across merged)."""
+    return uncertain_mechanics(part, IDEAL, vibration_mm=FRAGILE_BARRIER_REL * part.size)
+
+
+def splits(model: UncertainMechanics, outline: UncertainMechanics) -> bool:
+    """Whether ``model`` rests in two states where ``outline`` rests in one: two of its
+    physical states' resting normals in one of the outline's capture ranges (a chord across
+    an arc makes a stable edge the arc does not have; the part rolls over it).
+
+    >>> import math
+    >>> pts = [(30 * math.cos(k * math.pi / 64), 27 * math.sin(k * math.pi / 64))
+    ...        for k in range(128)]
+    >>> from feederkit.outline import make_outline
+    >>> ellipse = make_outline("e", pts)
+    >>> splits(_resting(make_part(ellipse, hull_tolerance=0.05)), _resting(make_part(ellipse)))
+    True
+    """
+    owner: set[int] = set()
+    for s in model.states:
+        normal = (s.rest_deg[0] + s.rest_deg[1]) / 2.0
+        for o in outline.states:
+            lo, hi = o.capture_deg
+            if norm360(normal - lo) < hi - lo or hi - lo >= 360.0:
+                if o.id in owner:
+                    return True
+                owner.add(o.id)
+                break
+    return False
+
+
+def kept_part(part: Part, tolerance: float | None) -> tuple[Part, KeptTolerance | None]:
+    """``part`` (on its outline's exact hull) with its contact hull simplified at
+    ``tolerance`` or the :func:`keeping_tolerance` below it, and that choice (None when
+    nothing is simplified: no tolerance, or no hull vertex to drop)."""
+    if tolerance is None or tolerance <= 0.0:
+        return _simplified(part, tolerance), None
+    first = _simplified(part, tolerance)
+    if len(first.hull) == len(part.hull):
+        return first, None
+    kept = keeping_tolerance(part, tolerance)
+    return (_simplified(part, kept.tolerance) if kept.lowered else first), kept
+
+
+def _simplified(part: Part, tolerance: float | None) -> Part:
+    return make_part(part.outline, part.com, hull_tolerance=tolerance, name=part.name)
+
+
+def keeping_tolerance(part: Part, tolerance: float) -> KeptTolerance:
+    """The largest of ``tolerance``, its halves (:data:`KEEP_STEPS` of them) and 0 at which
+    the part's simplified contact hull rests where its outline does (:func:`splits` false).
+
+    ``part`` is the part on its outline's exact hull. Simplifying a hull (``clean_hull``)
+    replaces an arc's facets by chords; on a near-round part a chord's stable edge holds
+    the part where the arc lets it roll (a 60 x 54 mm ellipse: 16 resting states at 0.05 mm
+    where it has 4), and a plan made on them fails on the belt.
+    """
+    if tolerance <= 0.0:
+        return KeptTolerance(0.0, tolerance)
+    exact = _resting(part)
+    first = None
+    tol = tolerance
+    for _ in range(KEEP_STEPS + 1):
+        model = _resting(_simplified(part, tol))
+        if not splits(model, exact):
+            break
+        if first is None:
+            first = model.n
+        tol /= 2.0
+    else:
+        tol = 0.0
+    if first is None:
+        return KeptTolerance(tolerance, tolerance)
+    return KeptTolerance(tol, tolerance, first, exact.n)
