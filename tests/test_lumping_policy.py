@@ -18,6 +18,7 @@ import pytest
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError, PlanningError
+from feederkit.hull import convex_hull
 from feederkit.machine import (
     MachineState,
     OutcomeRange,
@@ -101,6 +102,7 @@ def test_pose_difference_is_the_hausdorff_distance_of_the_outlines(seed):
     k = rng.randint(3, 9)
     angles = sorted(rng.uniform(0, 2 * math.pi) for _ in range(k))
     pts = [[10 * math.cos(a) * rng.uniform(0.5, 1), 6 * math.sin(a)] for a in angles]
+    pts = convex_hull(pts)  # the outline is its hull (a concave one: the next test)
     pf = push_function(make_part(make_outline("rnd", pts)))
     hull = [tuple(p) for p in pf.part.hull]
 
@@ -140,6 +142,60 @@ def test_look_alike_is_the_one_percent_bound(c, alike):
     assert (b in table[a]) is alike and (a in table[b]) is alike
     assert all(k not in table[k] for k in range(len(groups)))
     assert all(j in table[i] for i in range(len(groups)) for j in table[i])  # symmetric
+
+
+def _plate(hole_x: float | None = None, notch: bool = False):
+    """A 40 x 20 mm plate, with an R4 hole centred at (``hole_x``, 10) or a 1 x 1 mm notch in
+    its top right corner; its COM where the material puts it."""
+    outer = [[0, 0], [40, 0], [40, 20], [0, 20]]
+    if notch:
+        outer = [[0, 0], [40, 0], [40, 19], [39, 19], [39, 20], [0, 20]]
+    holes = []
+    if hole_x is not None:
+        holes = [[[hole_x + 4 * math.cos(k * math.pi / 32), 10 + 4 * math.sin(k * math.pi / 32)]
+                  for k in range(64)]]  # fmt: skip
+    outline = make_outline("plate", outer, holes=holes)
+    return push_function(make_part(outline))
+
+
+def _brute_outline_distance(pf, a: int, b: int, step: float = 0.02) -> float:
+    """The Hausdorff distance of the outline's boundary (outer ring and holes) in two poses,
+    from points every ``step`` mm of each to every point of the other (numpy, no shapely)."""
+    import numpy as np
+
+    def samples(i):
+        t = math.radians(pf.states[i].pose_deg)
+        rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+        hull = np.asarray(pf.part.hull) @ rot.T
+        shift = np.array([(hull[:, 0].min() + hull[:, 0].max()) / 2, hull[:, 1].min()])
+        out = []
+        for ring in (pf.part.outline.vertices, *pf.part.outline.holes):
+            r = np.asarray(ring) @ rot.T - shift
+            for p, q in zip(r, np.roll(r, -1, axis=0), strict=True):
+                n = max(int(math.ceil(np.hypot(*(q - p)) / step)), 1)
+                out.append(p + np.outer(np.arange(n) / n, q - p))
+        return np.vstack(out)
+
+    u, v = samples(a), samples(b)
+    d = np.sqrt(((u[:, None, :] - v[None, :, :]) ** 2).sum(axis=2))
+    return float(max(d.min(axis=1).max(), d.min(axis=0).max()))
+
+
+@pytest.mark.parametrize(
+    ("hole_x", "notch", "alike"), [(32, False, False), (None, True, False), (20, False, True)]
+)
+def test_holes_and_notches_the_hull_does_not_show_set_poses_apart(hole_x, notch, alike):
+    """The plate's two long-side poses have congruent hulls; an off-centre hole moves 24 mm
+    along the fence between them and a corner notch moves to the other end, which the next
+    station sees; a centred hole does not tell them apart."""
+    pf = _plate(hole_x, notch)
+    a, b = (s.id for s in pf.states if math.isclose(s.diameter, 20.0, abs_tol=1e-9))
+    d = pose_difference(pf, a, b)
+    brute = _brute_outline_distance(pf, a, b)
+    assert brute - 0.02 <= d <= brute + NEAR_SYMMETRIC_REL * pf.part.size / 8  # a bound, close
+    table = look_alike(pf, [[s.id] for s in pf.states])
+    assert (b in table[a]) is alike and (a in table[b]) is alike
+    assert (d <= NEAR_SYMMETRIC_REL * pf.part.size) is alike
 
 
 def test_the_machine_records_which_states_look_alike():

@@ -199,7 +199,10 @@ def test_a_bar_rests_across_its_two_bottom_edges() -> None:
 
 @pytest.mark.slow
 def test_the_wrench_rests_across_its_two_bottom_edges() -> None:
-    part = load_part(str(WRENCH))
+    # On its hull simplified at 0.05 mm, which has a fragile side state (the import keeps a
+    # smaller tolerance, on which that chord's state is gone: these are its mechanics).
+    drawn = load_part(str(WRENCH))
+    part = make_part(drawn.outline, drawn.com, hull_tolerance=0.05)
     pf = push_function(part)
     bottom = sorted(s.id for s in pf.states if circ(s.normal_deg, 268.5) < 3.0)
     assert len(bottom) == 2

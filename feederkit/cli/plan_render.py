@@ -198,7 +198,12 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
     cert = s.certificate
     if cert is not None:
         t.add_row("certified rotation error (largest)", f"±{cert.max_rotation_error_deg:.4g}°")
-        t.add_row("certified shape tolerance (largest)", f"{cert.max_shape_tolerance_mm:.4g} mm")
+        shape = f"{cert.max_shape_tolerance_mm:.4g} mm"
+        if plan.sensor.informative and cert.max_shape_tolerance_mm <= (
+            plan.uncertainty.shape_tolerance_mm
+        ):
+            shape += " (the declared: reading branches end at the declared widths)"
+        t.add_row("certified shape tolerance (largest)", shape)
         ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
         t.add_row("length: robust / ideal model", f"{s.length} / {ideal}")
     bound = "lower bound" if (s.objective or "worst") == "worst" else "worst-case length at least"

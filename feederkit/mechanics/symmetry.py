@@ -16,6 +16,7 @@ from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 
 from feederkit.angles import ANGLE_EPS
 from feederkit.mechanics.push import PushFunction
@@ -233,6 +234,55 @@ def _grid_support(pts: np.ndarray) -> np.ndarray:
     return np.max(pts @ u.T, axis=0)
 
 
+OUTLINE_SPACING_REL = NEAR_SYMMETRIC_REL / 8.0
+""":func:`_outline_gaps` samples the outline's boundary this finely (share of the part's
+size), and bounds the true distance by the sampled one plus half the spacing."""
+
+
+def _has_more_than_hull(pf: PushFunction) -> bool:
+    """Whether the outline shows more than its contact hull: holes, or a concave boundary
+    (the next station sees them; the fence does not)."""
+    outline = pf.part.outline
+    if outline.holes:
+        return True
+    edge = shapely.LinearRing(np.asarray(pf.part.hull, dtype=float))
+    points = shapely.points(np.asarray(outline.vertices, dtype=float))
+    return bool(np.max(shapely.distance(points, edge)) > OUTLINE_SPACING_REL * pf.part.size)
+
+
+def _placed_outline(pf: PushFunction, state: int) -> shapely.MultiLineString:
+    """The outline's boundary (outer ring and holes) placed as :func:`_placed` places the
+    hull, sampled every :data:`OUTLINE_SPACING_REL` of the part's size."""
+    hull = np.asarray(pf.part.hull, dtype=float)
+    t = math.radians(pf.states[state].pose_deg)
+    rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    pts = hull @ rot.T
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    shift = np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+    outline = pf.part.outline
+    rings = [np.asarray(r, dtype=float) for r in (outline.vertices, *outline.holes)]
+    lines = [np.vstack([r, r[:1]]) @ rot.T - shift for r in rings]
+    return shapely.segmentize(shapely.MultiLineString(lines), OUTLINE_SPACING_REL * pf.part.size)
+
+
+def _outline_gaps(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
+    """Per pair of stable states, an upper bound (mm) on the Hausdorff distance of the
+    outline's boundary in the two poses: the distance of its samples (the sampled points of
+    either to the other boundary) plus half the sampling spacing. Holes and notches a hull
+    does not show set poses apart for the next station (a plate's off-centre hole 24 mm
+    along the fence in its two flat poses)."""
+    placed: dict[int, shapely.MultiLineString] = {}
+    for i in {i for p in pairs for i in p}:
+        placed[i] = _placed_outline(pf, i)
+    half = OUTLINE_SPACING_REL * pf.part.size / 2.0
+    return np.array(
+        [
+            0.0 if a == b else shapely.hausdorff_distance(placed[a], placed[b]) + half
+            for a, b in pairs
+        ]
+    )
+
+
 def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
     """:func:`pose_difference` of every pair of stable states in ``pairs`` (mm), at once."""
     if not pairs:
@@ -244,14 +294,18 @@ def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.n
     parts = [
         _support_gaps(polys, local[k : k + EXACT_CHUNK]) for k in range(0, len(local), EXACT_CHUNK)
     ]
-    return np.concatenate(parts)
+    gaps = np.concatenate(parts)
+    if _has_more_than_hull(pf):
+        gaps = np.maximum(gaps, _outline_gaps(pf, pairs))
+    return gaps
 
 
 def pose_difference(pf: PushFunction, a: int, b: int) -> float:
     """How far apart (mm) the part looks resting in stable states ``a`` and ``b``: the
     Hausdorff distance of its hull in the two poses on the fence, each resting on the fence
     line and centred along it (the position along the fence is not observed), exact (the
-    largest difference of the two support functions, :func:`_support_gaps`). 0 for states
+    largest difference of the two support functions, :func:`_support_gaps`); for an outline
+    with holes or notches, at least the bound :func:`_outline_gaps` on its boundary's. 0 for states
     that a symmetry of the hull maps onto each other (definitions 3, 6); small for the
     near-symmetric states a plan under uncertainty may list together. It is at least the
     difference of the two diameters (the poses' heights above the fence).
@@ -324,6 +378,11 @@ def look_alike(
         ]
     )
     close = {p for p, d in zip(todo, gaps, strict=True) if d <= tol}
+    if close and _has_more_than_hull(pf):
+        # Holes and notches the hulls do not show: the outline's own distance decides.
+        hull_close = sorted(close)
+        outline = _outline_gaps(pf, [(ideal[i], ideal[j]) for i, j in hull_close])
+        close = {p for p, d in zip(hull_close, outline, strict=True) if d <= tol}
 
     def near(x: int, y: int) -> bool:
         i, j = row[x], row[y]
