@@ -7,6 +7,11 @@ exits 1 before any trial. Each trial samples the declared uncertainty and the fr
 failures are data: the command exits 0 whatever the success rate, unless
 ``--require-success`` names a rate the run must reach (then exit 1 below it).
 Without MuJoCo it exits 2 with one line saying to install ``feederkit[sim]``.
+
+``--part SOURCE`` (``NAME=SOURCE`` for a part of a mix, repeatable) simulates that member on
+the part a SOURCE holds, its outline's exact hull and its own COM, instead of the plan's
+hull, and judges its trials by where the part rests (docs/simulation.md, "A part's own
+outline"); a SOURCE that is not the plan's part is bad input (exit 2).
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from feederkit.cli.common import (
+    CatalogOpt,
     add_name_column,
     console,
     err_console,
@@ -30,6 +36,8 @@ from feederkit.cli.common import (
 )
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
+from feederkit.importers import ImportOptions
+from feederkit.part import Part
 from feederkit.plans.model import REJECTED_WORDS
 from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
@@ -39,6 +47,7 @@ from feederkit.sim.api import (
     simulate_plan,
 )
 from feederkit.sim.engine import require_mujoco
+from feederkit.sim.real import RealPart, real_parts
 from feederkit.sim.summary import SimulationSummary
 
 SHOWN_ROWS = 20
@@ -55,6 +64,15 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         highlight=False,
         soft_wrap=True,
     )
+    if s.real_parts:
+        for _name, words in s.geometry():
+            console.print(f"[bold]geometry[/] {escape(words)}", highlight=False, soft_wrap=True)
+        if s.pose_rule is not None:
+            console.print(
+                f"[bold]success rule[/] {escape(s.pose_rule.words())}",
+                highlight=False,
+                soft_wrap=True,
+            )
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_row("successes", escape(s.success_words()))
     if len(s.parts) > 1:
@@ -183,6 +201,28 @@ def simulate_command(
             metavar="RATE",
         ),
     ] = None,
+    parts: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--part",
+            metavar="[NAME=]SOURCE",
+            help="Simulate the plan's part NAME on the part SOURCE holds (an outline or CAD "
+            "file, or a catalog name): its outline's exact hull and own COM, judged by where it "
+            "rests. NAME= may be left out for a plan of one part; repeat for a mix.",
+            show_default=False,
+        ),
+    ] = None,
+    hull_tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--hull-tolerance",
+            metavar="MM",
+            help="With --part: the hull tolerance the plan's part was imported with, which the "
+            "match check allows (default a CAD import's for the part's size).",
+            show_default=False,
+        ),
+    ] = None,
+    catalog: CatalogOpt = None,
     json_out: Annotated[bool, json_option("Print the summary as JSON.")] = False,
     max_plan_mb: MaxPlanMbOpt = DEFAULT_MAX_PLAN_MB,
 ) -> None:
@@ -191,7 +231,15 @@ def simulate_command(
     if require_success is not None and not 0.0 <= require_success <= 1.0:
         raise InputError(f"--require-success must be a fraction in [0, 1], got {require_success:g}")
     check_rotation_noise(rotation_noise, ideal=ideal)  # before the plan: one line, exit 2
+    if hull_tolerance is not None and not parts:
+        raise InputError("--hull-tolerance goes with --part (the match check's allowance)")
     data = load_plan(plan, max_plan_mb)  # the one loader and validator
+    real: tuple[RealPart, ...] = ()
+    if parts:
+        db = None if catalog is None else str(catalog)
+        real = real_parts(
+            data, parts, catalog=db, hull_tolerance=hull_tolerance, landings=_landing_parts
+        )
     json_found(
         plan=str(plan),
         uncertainty=data.uncertainty.to_dict(),
@@ -225,6 +273,7 @@ def simulate_command(
             friction_fence=friction_fence,
             progress=advance,
             ideal=ideal,
+            real=real,
         )
     if json_out:
         print_json(
@@ -245,6 +294,16 @@ def simulate_command(
             f"{summary.successes} of {plural(summary.trials, 'trial')} succeeded "
             f"({100 * summary.success_rate:.1f}%), below the required {100 * require_success:g}%"
         )
+
+
+def _landing_parts(
+    source: str, held: tuple[str, ...], catalog: str | None, options: ImportOptions | None
+) -> dict[str, Part]:
+    """A SOURCE's part in each landing named, loaded as ``run`` checks a plan over landings."""
+    from feederkit.landing.plan import load_landings
+
+    found = load_landings([source], catalog=catalog, options=options, which=held)
+    return {x.name: x.part for x in found.all}
 
 
 def register(app: typer.Typer) -> None:

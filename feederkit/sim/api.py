@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
@@ -29,6 +29,7 @@ from feederkit.plans.fileformat import as_plan, plan_to_dict
 from feederkit.plans.model import Plan, push_function_of
 from feederkit.plans.verify import check_declared
 from feederkit.sim.pushalign import PushAligner, PushOutcome, SettleRule
+from feederkit.sim.real import REAL_SETTLE_RULE, RealPart
 from feederkit.sim.sampling import (
     FrictionRange,
     draw_rotation_error,
@@ -39,6 +40,7 @@ from feederkit.sim.sampling import (
 )
 from feederkit.sim.scene import SceneConfig
 from feederkit.sim.summary import (
+    PoseRuleWords,
     PushMiss,
     SimSettings,
     SimulationSummary,
@@ -47,7 +49,7 @@ from feederkit.sim.summary import (
     sensor_width_slack,
     width_accuracy_warning,
 )
-from feederkit.sim.trial import TrialModel, divergent_distance, run_trial
+from feederkit.sim.trial import PoseRule, TrialModel, divergent_distance, run_trial
 from feederkit.uncertainty import IDEAL
 
 DEFAULT_BELT_SPEED = 0.1
@@ -189,6 +191,8 @@ def simulate_plan(
     rule: SettleRule | None = None,
     check: bool = True,
     config: SceneConfig | None = None,
+    real: Sequence[RealPart] = (),
+    real_rule: SettleRule | None = None,
 ) -> SimulationSummary:
     """Simulate a plan (or a plan file's JSON object, checked) over ``trials`` trials.
 
@@ -206,6 +210,15 @@ def simulate_plan(
 
     The plan is verified at its declared uncertainty first (CheckFailed when it fails);
     ``check=False`` skips that, to watch how a plan known to be wrong fails physically.
+
+    ``real`` (:func:`feederkit.sim.real.real_parts`, ``simulate --part``): members simulated on
+    the part a SOURCE holds, its outline's exact hull and its own COM, instead of the plan's
+    hull; they settle by ``real_rule`` (default :data:`~feederkit.sim.real.REAL_SETTLE_RULE`)
+    on their outline's own resting ranges, nature's draw perturbs nothing of them (the same
+    draws are made, so starts, frictions and rotation errors are those of a run without it),
+    and their trials are judged by where the part rests (:class:`~feederkit.sim.trial.PoseRule`:
+    within the declared rotation error plus ``rule.align_tol_deg`` of the resting range of a
+    state the leaf names). Without ``real`` nothing changes.
     """
     if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
         raise InputError(f"--trials must be a positive integer, got {trials!r}")
@@ -235,8 +248,19 @@ def simulate_plan(
     )
     shapes = sampled.shape_tolerance_mm > 0.0 or sampled.com_tolerance_mm > 0.0
     members = list(sim_plan.parts)
-    aligners = [PushAligner(push_function_of(pp).part, base, rule) for pp in members]
+    own = {r.member: r for r in real}
+    if len(own) != len(real) or any(not 0 <= k < len(members) for k in own):
+        raise InputError("each real part must name a different member of the plan")
+    real_rule = real_rule or REAL_SETTLE_RULE
+    aligners = [
+        PushAligner(own[k].part, base, real_rule, rests=own[k].rests)
+        if k in own
+        else PushAligner(push_function_of(pp).part, base, rule)
+        for k, pp in enumerate(members)
+    ]
     models = _models(sim_plan)
+    limit = sim_plan.uncertainty.rotation_error_deg + real_rule.align_tol_deg
+    poses = {k: PoseRule.of(members[k], models[k], limit) for k in own}
     shares = _member_shares(sim_plan)
     landings = [getattr(pp, "landing", None) for pp in members]
     labels = [_label(pp.name, x) for pp, x in zip(members, landings, strict=True)]
@@ -263,7 +287,13 @@ def simulate_plan(
         else:
             nature = nature_rng(seed, i)
             draw = draw_trial(nature, len(pp.hull), sampled, fb, ff)
-            if shapes:
+            if k in own:  # the part itself: nothing of its shape is drawn
+                draw = replace(
+                    draw,
+                    vertex_offsets=tuple((0.0, 0.0) for _ in draw.vertex_offsets),
+                    com_offset=(0.0, 0.0),
+                )
+            elif shapes:
                 perturbed = perturbed_part(pp, push_function_of(pp), draw)
                 aligner = PushAligner(perturbed.part, base, rule, scale=aligners[k].scale)
                 edges = perturbed.basin_of_edge
@@ -282,6 +312,7 @@ def simulate_plan(
             model=models[k],
             state_of_edge=edges,
             landing=landings[k],
+            pose=poses.get(k),
         )
         results.append(replace(result, draw=draw))
         member_of_trial.append(k)
@@ -305,6 +336,10 @@ def simulate_plan(
         if not p.agrees
     )
 
+    reported = sampled
+    if own and len(own) == len(members):  # no member's shape was drawn
+        reported = replace(sampled, shape_tolerance_mm=0.0, com_tolerance_mm=0.0)
+
     def wrong(outcome: str) -> tuple[TrialResult, ...]:
         rows = [r for r in results if r.outcome == outcome]
         return tuple(sorted(rows, key=lambda r: (bool(r.predicted), r.index)))
@@ -318,7 +353,7 @@ def simulate_plan(
             friction_belt=fb.nominal,
             friction_fence=ff.nominal,
             timestep=base.timestep,
-            sampled=sampled,
+            sampled=reported,
             ideal=ideal,
             friction_belt_range=fb,
             friction_fence_range=ff,
@@ -356,6 +391,12 @@ def simulate_plan(
         push_misses=misses,
         wall_time_s=wall,
         sim_time_s=sum(p.sim_time_s for _, p in pushes),
+        real_parts=tuple(own[k] for k in sorted(own)),
+        pose_rule=(
+            PoseRuleWords(sim_plan.uncertainty.rotation_error_deg, real_rule.align_tol_deg)
+            if own
+            else None
+        ),
     )
 
 

@@ -13,6 +13,7 @@ part's world yaw is ``-90 - theta``; rotating the part by ``a`` counter-clockwis
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,7 +41,11 @@ class SettleRule:
     travelled ``window_sizes`` part sizes (at least ``min_window_s`` seconds). Lengths are
     counted in belt travel because quasi-static rotation depends on how far the belt has
     moved, not on how fast. A run not done after ``max_travel_sizes`` part sizes of belt
-    travel (at least ``min_max_time_s`` seconds) never settled.
+    travel (at least ``min_max_time_s`` seconds) never settled. With ``drift_tol_deg`` set,
+    the part is still when the mean orientation over the window's second half differs from
+    the mean over its first half by less than that, not when the window's range is below
+    ``still_tol_deg``: a part rolling on a gentle arc (its own outline, docs/simulation.md)
+    jitters by a degree or two about an orientation that drifts far less.
     """
 
     window_sizes: float = 0.5
@@ -50,6 +55,15 @@ class SettleRule:
     touch_tol_mm: float = 0.3
     max_travel_sizes: float = 20.0
     min_max_time_s: float = 2.0
+    drift_tol_deg: float | None = None
+
+    def still(self, recent: list[float]) -> bool:
+        """Whether the unwrapped orientations ``recent`` (one window) are still."""
+        if self.drift_tol_deg is None:
+            return max(recent) - min(recent) < self.still_tol_deg
+        half = len(recent) // 2
+        first, second = recent[:half], recent[half:]
+        return abs(sum(second) / len(second) - sum(first) / len(first)) < self.drift_tol_deg
 
     def window_s(self, size_m: float, belt_speed: float) -> float:
         """Length (s) of the still window for a part of ``size_m`` metres."""
@@ -85,6 +99,20 @@ def _signed_delta(a: float, b: float) -> float:
     return d - 360.0 if d > 180.0 else d
 
 
+def range_distance(theta_deg: float, lo_deg: float, hi_deg: float) -> float:
+    """Angular distance (deg) from ``theta`` to the arc ``[lo, hi]`` (``hi`` may pass 360;
+    0 inside it)."""
+    d = norm360(theta_deg - lo_deg)
+    width = hi_deg - lo_deg
+    if d <= width:
+        return 0.0
+    return min(d - width, 360.0 - d)
+
+
+def _range_distance(theta_deg: float, ranges: Sequence[tuple[float, float]]) -> float:
+    return min(range_distance(theta_deg, lo, hi) for lo, hi in ranges)
+
+
 def size_scale(part: Part, lo_mm: float = 20.0, hi_mm: float = 200.0) -> float:
     """Factor applied to the part's lengths in the physics: 1 for parts of 20-200 mm.
 
@@ -105,6 +133,15 @@ class PushAligner:
 
     Each operation starts from a fresh state (the robot picks the part up), so outcomes
     depend only on the drop orientation and the settings.
+
+    ``rests`` (a part on its own outline, docs/simulation.md: an arc drawn as many short
+    edges has no one edge to lie flush on) replaces "flush on an edge its COM's foot falls
+    on": each ``(lo, hi, rest)`` is a resting range of fence orientations (deg, ``hi`` may pass
+    360) and the orientation in it where the part lies lowest; the part has settled when it is
+    still within ``align_tol_deg`` of a ``rest``, or, when the belt has run its whole travel,
+    wherever it then lies within ``align_tol_deg`` of a range (a part creeping down a gentle
+    arc has rested when the fence ends). ``edge`` is then the hull edge nearest its
+    orientation.
     """
 
     def __init__(
@@ -113,6 +150,8 @@ class PushAligner:
         config: SceneConfig | None = None,
         rule: SettleRule | None = None,
         scale: float | None = None,
+        *,
+        rests: Sequence[tuple[float, float, float]] | None = None,
     ) -> None:
         mujoco = require_mujoco()
         self._mj = mujoco
@@ -133,6 +172,8 @@ class PushAligner:
         self._normals = np.asarray(edge_normals(part.hull))
         # Edges the part can rest on: the COM's foot lies on the edge (stable or metastable).
         self._restable = np.array([0.0 <= t <= 1.0 for t in com_feet(part.hull, part.com)])
+        self._rests = None if rests is None else [(float(a), float(b)) for a, b, _ in rests]
+        self._lowest = None if rests is None else [(float(c), float(c)) for _, _, c in rests]
         m = self.model
         part_joint = m.joint("part").id
         belt_joint = m.joint("belt").id
@@ -264,16 +305,32 @@ class PushAligner:
             if len(thetas) < window:
                 continue
             recent = thetas[-window:]
-            if max(recent) - min(recent) >= rule.still_tol_deg:
+            if not rule.still(recent):
                 continue
             mean = norm360(sum(recent) / window)
             edge, off = self._nearest_edge(mean)
-            if off <= rule.align_tol_deg and self._restable[edge]:
+            if self._lowest is not None:
+                ok = _range_distance(mean, self._lowest) <= rule.align_tol_deg
+            else:
+                ok = off <= rule.align_tol_deg and bool(self._restable[edge])
+            if ok:
                 return PushOutcome(
                     theta_start_deg=norm360(theta_deg),
                     settled=True,
                     theta_end_deg=mean,
                     edge=edge,
+                    width_mm=float(np.mean(widths[-window:])),
+                    sim_time_s=float(d.time),
+                    steps=steps,
+                )
+        if self._rests is not None and len(thetas) >= window:  # the end of the fence
+            mean = norm360(sum(thetas[-window:]) / window)
+            if _range_distance(mean, self._rests) <= rule.align_tol_deg:
+                return PushOutcome(
+                    theta_start_deg=norm360(theta_deg),
+                    settled=True,
+                    theta_end_deg=mean,
+                    edge=self._nearest_edge(mean)[0],
                     width_mm=float(np.mean(widths[-window:])),
                     sim_time_s=float(d.time),
                     steps=steps,

@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from feederkit.plans.model import Certificate
 from feederkit.sensors import LedSensor, Sensor, ToleranceSensor
 from feederkit.sim.sampling import FrictionRange, TrialDraw
 from feederkit.uncertainty import IDEAL, Uncertainty
+
+if TYPE_CHECKING:
+    from feederkit.sim.real import RealPart
 
 Z_95 = 1.959964
 """The normal quantile of a two-sided 95 % interval."""
@@ -299,7 +303,10 @@ class TrialResult:
     the push-align operation that went wrong (1 = the first alignment), ``reason`` says how,
     ``cause`` is what broke (``feederkit.sim.trial.CAUSES``) and ``predicted`` whether the
     plan's model allowed everything that happened (False: a model error). ``draw`` is nature's
-    draw for the trial (None under ``--ideal``: nothing drawn).
+    draw for the trial (None under ``--ideal``: nothing drawn). For a member simulated on its
+    own outline (``simulate --part``) ``final_deg`` is where it finally rested (fence
+    orientation, deg) and ``pose_error_deg`` how far that is from every state the leaf names
+    (:class:`feederkit.sim.trial.PoseRule`); both None otherwise, and then not in the JSON.
     """
 
     index: int
@@ -315,6 +322,8 @@ class TrialResult:
     draw: TrialDraw | None = None
     landing: str | None = None
     rejected: bool = False
+    final_deg: float | None = None
+    pose_error_deg: float | None = None
 
     @property
     def wrong_accept(self) -> bool:
@@ -324,7 +333,7 @@ class TrialResult:
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready form."""
-        return {
+        out: dict[str, object] = {
             "trial": self.index,
             "part": self.part,
             "landing": self.landing,
@@ -337,8 +346,13 @@ class TrialResult:
             "reason": self.reason,
             "draw": None if self.draw is None else self.draw.to_dict(),
             "final_state": self.final_state,
-            "pushes": [p.to_dict() for p in self.pushes],
         }
+        if self.final_deg is not None or self.pose_error_deg is not None:
+            out["final_deg"] = _r(self.final_deg)
+            err = self.pose_error_deg
+            out["pose_error_deg"] = None if err is None or math.isinf(err) else _r(err)
+        out["pushes"] = [p.to_dict() for p in self.pushes]
+        return out
 
 
 @dataclass(frozen=True)
@@ -468,6 +482,16 @@ class SimulationSummary:
     """What the plan holds (:func:`certified_bounds`); None when not known."""
     width_warning: str | None = None
     """The plan's sensor is finer than the simulated widths (:func:`width_accuracy_warning`)."""
+    real_parts: tuple[RealPart, ...] = ()
+    """The members simulated on their own outlines (``simulate --part``); empty: every member
+    on the plan's hull, and the JSON is as before."""
+    pose_rule: PoseRuleWords | None = None
+    """How those members' trials are judged (None without ``--part``)."""
+
+    def geometry(self) -> list[tuple[str, str]]:
+        """Each member and the geometry simulated for it, in words."""
+        real = {r.label: r for r in self.real_parts}
+        return [(p, real[p].words() if p in real else f"{p}: the plan's hull") for p in self.parts]
 
     @property
     def success_interval(self) -> tuple[float, float]:
@@ -572,4 +596,53 @@ class SimulationSummary:
             "settings": self.settings.to_dict(),
             "wall_time_s": _r(self.wall_time_s, 3),
             "sim_time_s": _r(self.sim_time_s, 3),
+            **self._geometry_dict(),
+        }
+
+    def _geometry_dict(self) -> dict[str, object]:
+        """``geometry`` and ``success_rule`` for a run with ``--part``; nothing otherwise."""
+        if not self.real_parts:
+            return {}
+        real = {r.label: r for r in self.real_parts}
+        return {
+            "geometry": [
+                real[p].to_dict()
+                if p in real
+                else {"part": p, "simulated": "plan hull", "source": None}
+                for p in self.parts
+            ],
+            "success_rule": None if self.pose_rule is None else self.pose_rule.to_dict(),
+        }
+
+
+@dataclass(frozen=True)
+class PoseRuleWords:
+    """The success rule of members simulated on their own outlines, as reported: the part must
+    finally rest within ``rotation_error_deg + settle_tolerance_deg`` of the resting range,
+    under the plan's declared uncertainty, of a state the leaf names."""
+
+    rotation_error_deg: float
+    settle_tolerance_deg: float
+
+    @property
+    def limit_deg(self) -> float:
+        """The allowed distance (deg) from a named state's resting range."""
+        return self.rotation_error_deg + self.settle_tolerance_deg
+
+    def words(self) -> str:
+        """The rule in one line."""
+        return (
+            f"a part on its own outline succeeds when it finally rests within "
+            f"{self.limit_deg:g} deg (declared rotation error {self.rotation_error_deg:g} + "
+            f"settle tolerance {self.settle_tolerance_deg:g}) of the resting range, under the "
+            "plan's declared uncertainty, of a state the result names"
+        )
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready form."""
+        return {
+            "limit_deg": _r(self.limit_deg, 6),
+            "rotation_error_deg": _r(self.rotation_error_deg, 6),
+            "settle_tolerance_deg": _r(self.settle_tolerance_deg, 6),
+            "words": self.words(),
         }

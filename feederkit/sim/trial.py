@@ -14,7 +14,8 @@ outcome the model did not predict is a model error, not a fault of the plan.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from feederkit.angles import norm360
@@ -22,7 +23,7 @@ from feederkit.mechanics.push import PushFunction, push
 from feederkit.mechanics.uncertain import UncertainMechanics, outcome_set
 from feederkit.plans.model import Leaf, Plan, PlanPart, Step, push_function_of
 from feederkit.sensors import Sensor
-from feederkit.sim.pushalign import PushAligner
+from feederkit.sim.pushalign import PushAligner, range_distance
 from feederkit.sim.summary import PushRecord, TrialResult
 
 CAUSES = ("never settled", "unstable edge", "reading in no branch", "wrong result")
@@ -111,6 +112,45 @@ class TrialModel:
         return any(self.sensor.consistent(self.diameters[x], reading) for x in self.physical(state))
 
 
+@dataclass(frozen=True)
+class PoseRule:
+    """Success judged by where the part rests, for a member simulated on its own outline
+    (``simulate --part``, docs/simulation.md "A part's own outline").
+
+    ``rest[s]`` holds the resting ranges (fence orientations, deg, ``hi`` may pass 360) the
+    plan's model gives ideal state ``s`` under the plan's declared uncertainty: those of the
+    physical states holding it (merged facets, widened by the shape and COM tolerances; the
+    states it surely moves on to when transient). A part resting at ``theta`` is in a state a
+    leaf names when ``theta`` lies within ``limit_deg`` (the declared rotation error plus the
+    simulator's settle tolerance) of one of that state's ranges.
+    """
+
+    limit_deg: float
+    rest: Mapping[int, tuple[tuple[float, float], ...]]
+
+    @classmethod
+    def of(cls, part: PlanPart, model: TrialModel | None, limit_deg: float) -> PoseRule:
+        """The rule for a plan member (without the model: each state's ideal normal)."""
+        rest: dict[int, tuple[tuple[float, float], ...]] = {}
+        for s in part.states:
+            if model is None:
+                rest[s.id] = ((s.normal_deg, s.normal_deg),)
+            else:
+                states = model.mechanics.states
+                rest[s.id] = tuple(states[x].rest_deg for x in sorted(model.physical(s.id)))
+        return cls(float(limit_deg), rest)
+
+    def distance(self, state: int, theta_deg: float) -> float:
+        """Angular distance (deg) from ``theta`` to the resting ranges of ideal ``state``."""
+        return min(range_distance(theta_deg, lo, hi) for lo, hi in self.rest[state])
+
+    def leaf_error(self, leaf: Leaf, name: str, landing: str | None, theta_deg: float) -> float:
+        """How far (deg) ``theta`` lies from every state ``leaf`` names for member ``(name,
+        landing)`` (infinite when it names none of its states)."""
+        states = [r.state for r in leaf.results if r.part == name and r.landing == landing]
+        return min((self.distance(s, theta_deg) for s in states), default=math.inf)
+
+
 def run_trial(
     plan: Plan,
     part_name: str,
@@ -122,6 +162,7 @@ def run_trial(
     model: TrialModel | None = None,
     state_of_edge: Sequence[int | None] | None = None,
     landing: str | None = None,
+    pose: PoseRule | None = None,
 ) -> TrialResult:
     """Execute ``plan`` on ``part_name`` dropped first at fence orientation ``start_deg``.
 
@@ -136,6 +177,12 @@ def run_trial(
     landings (design.md, "Landings"); a trial ending in a reject leaf that names the member's
     landing and state is a success with ``rejected`` set, one ending in a non-reject leaf that
     does not name them a ``wrong result`` failure (a wrong accept).
+
+    ``pose`` (a member simulated on its own outline): the part's state after each operation
+    is the plan's state whose resting range holds where it rests (its basin), an operation
+    resting farther than ``pose.limit_deg`` from that state's resting range under the plan's
+    uncertainty is outside the model, and the trial succeeds when the part finally rests
+    within ``pose.limit_deg`` of a state the leaf names (:class:`PoseRule`).
     """
     pp = _sim_part(member_of(plan, part_name, landing))
     edges = dict(pp.state_of_edge) if state_of_edge is None else dict(enumerate(state_of_edge))
@@ -143,6 +190,8 @@ def run_trial(
     records: list[PushRecord] = []
     unpredicted: tuple[int, str] | None = None
     rest_theta = start_deg
+    final_theta: float | None = None
+    pose_error: float | None = None
     state: int | None = None
 
     def finish(
@@ -166,6 +215,8 @@ def run_trial(
             predicted=predicted,
             landing=landing,
             rejected=rejected,
+            final_deg=final_theta,
+            pose_error_deg=pose_error,
         )
 
     while isinstance(node, Step):
@@ -176,7 +227,11 @@ def run_trial(
             nominal, err = norm360(rest_theta - node.action_deg), rotation_error()
         theta = norm360(nominal - err)
         out = aligner.align(theta)
-        sim_state = edges.get(out.edge) if out.edge is not None else None
+        if pose is not None:
+            sim_state = _state_id(pp, out.theta_end_deg) if out.settled else None
+            final_theta = out.theta_end_deg if out.settled else None
+        else:
+            sim_state = edges.get(out.edge) if out.edge is not None else None
         reading = plan.sensor.read(out.width_mm) if out.settled else None
         branch = node.follow(reading) if out.settled and sim_state is not None else None
         expected = _state_id(pp, nominal)
@@ -190,6 +245,10 @@ def run_trial(
             reads = sim_state is None or model.reads(sim_state, reading)
             if sim_state is not None:
                 same_physical = bool(model.physical(sim_state) & model.physical(predicted))
+        off_rest = None
+        if pose is not None and sim_state is not None:
+            off_rest = pose.distance(sim_state, out.theta_end_deg)
+            in_model = in_model and off_rest <= pose.limit_deg
         rec = PushRecord(
             step=step,
             action_deg=node.action_deg,
@@ -218,7 +277,14 @@ def run_trial(
                 "never settled",
                 f"the part never settled within {aligner.max_time_s:.3g} s",
             )
-        if unpredicted is None and not in_model:
+        if unpredicted is None and off_rest is not None and off_rest > pose.limit_deg:
+            unpredicted = (
+                step,
+                f"the part rests at {out.theta_end_deg:.2f} deg, {off_rest:.2f} deg from where "
+                f"the plan's model rests state {sim_state} (more than {pose.limit_deg:g}): its "
+                "outline rests elsewhere than the plan's hull",
+            )
+        elif unpredicted is None and not in_model:
             unpredicted = (step, _unpredicted_reason(rec, state, model))
         elif unpredicted is None and not reads:
             unpredicted = (step, f"the reading {reading:.4f} mm is outside what the model allows")
@@ -241,6 +307,24 @@ def run_trial(
         node = node.branches[branch].next
     assert isinstance(node, Leaf)
     reject = bool(getattr(node, "reject", False))
+    if pose is not None and final_theta is not None:
+        pose_error = pose.leaf_error(node, part_name, landing, final_theta)
+        if pose_error <= pose.limit_deg:
+            return finish("success", None, None, None, rejected=reject)
+        leaf = "reject result" if reject else "result"
+        far = (
+            f"{pose_error:.2f} deg from the resting range of the nearest state the plan's {leaf} "
+            f"names (allowed {pose.limit_deg:g} deg)"
+            if math.isfinite(pose_error)
+            else f"and the plan's {leaf} names none of its states"
+        )
+        return finish(
+            "failure",
+            len(records),
+            "wrong result",
+            f"the part rests at {final_theta:.2f} deg, {far}",
+            rejected=reject,
+        )
     if state is not None and leaf_holds(node, part_name, state, landing):
         return finish("success", None, None, None, rejected=reject)
     what = f"state {state}" if landing is None else f"landing {landing}, state {state}"
