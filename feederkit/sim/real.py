@@ -84,10 +84,10 @@ class RealPart:
 
     def words(self) -> str:
         """The geometry simulated, in one line."""
-        cx, cy = self.part.com
+        cx, cy = (round(c, 4) + 0.0 for c in self.part.com)  # no -0 nor 1e-16
         return (
             f"{self.label}: its own outline from {self.source} (exact hull, "
-            f"{len(self.part.hull)} vertices, COM ({cx:.4g}, {cy:.4g})); "
+            f"{len(self.part.hull)} vertices, COM ({cx:g}, {cy:g})); "
             f"{self.hull_distance_mm:.4g} mm from the plan's hull ({self.allowed_mm:.4g} allowed)"
         )
 
@@ -98,7 +98,7 @@ class RealPart:
             "simulated": "outline",
             "source": self.source,
             "hull_vertices": len(self.part.hull),
-            "com": [round(self.part.com[0], 6), round(self.part.com[1], 6)],
+            "com": [round(c, 6) + 0.0 for c in self.part.com],
             "hull_distance_mm": round(self.hull_distance_mm, 6),
             "allowed_mm": round(self.allowed_mm, 6),
             "com_distance_mm": round(self.com_distance_mm, 6),
