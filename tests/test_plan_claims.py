@@ -191,3 +191,14 @@ def test_a_margin_lowered_below_the_floor_is_said(monkeypatch):
     made = make_plan([pf], NoSensor(), PlanningOptions(min_margin_deg=1.0), certify=False)
     assert made.result.min_margin == 0.5
     assert any("less than --min-margin 1" in w for w in made.warnings)
+
+
+def test_a_sensed_certificate_at_the_declared_shape_tolerance_says_why(capsys):
+    """Reading branches end at the declared widths, so a sensed plan's certified shape
+    tolerance is the declared one; the table says so rather than only "largest"."""
+    args = ["plan", str(CATALOG / "t-clip.json"), "--tolerance", "0.1", "--shape-tolerance"]
+    assert main([*args, "0.05"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "0.05 mm (the declared: reading" in out
+    assert main([*args[:-3], "--sensorless", "--shape-tolerance", "0.05"]) in (0, 1)
+    assert "(the declared: reading" not in " ".join(capsys.readouterr().out.split())
