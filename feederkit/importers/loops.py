@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 import shapely.affinity
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from shapely.geometry import LineString, Polygon
@@ -120,6 +120,81 @@ def snap_endpoints(lines: Sequence[np.ndarray], gap: float) -> list[np.ndarray]:
     return out
 
 
+def _along(lines: np.ndarray | shapely.Geometry, other: shapely.Geometry, tol: float) -> np.ndarray:
+    """Which ``lines`` lie wholly within ``tol`` of ``other``: inside its buffer, so a chord's
+    middle counts as well as its ends."""
+    return shapely.covers(shapely.buffer(other, tol), lines)
+
+
+def _exact_repeats(lines: Sequence[np.ndarray]) -> list[int]:
+    """For each line, the first line with the same points (in either direction), or itself.
+
+    A CAD copy flattens to the very same floats; found by hashing, so a thousand copies of
+    one line cost no thousand squared comparisons.
+    """
+    first: dict[bytes, int] = {}
+    out = []
+    for k, ln in enumerate(lines):
+        pts = np.ascontiguousarray(ln, dtype=float)
+        key = min(pts.tobytes(), pts[::-1].tobytes())
+        out.append(first.setdefault(key, k))
+    return out
+
+
+def repeated_lines(
+    lines: Sequence[np.ndarray], tol: float, budget: Budget | None = None
+) -> list[int]:
+    """Indices of the lines that repeat an earlier line within ``tol``: each lies within
+    ``tol`` of the other (a circle drawn twice, a CIRCLE over a closed polyline of two
+    bulges, an outline LINE drawn twice).
+
+    A repeat adds no geometry, but left in, its every stretch lies on two lines, as a
+    title-block cell's side lies on the frame: a duplicated hole crossed by a centre line
+    was taken for a face sharing lines and merged into the part. Equal lines have bounds
+    equal within ``tol``, so only those pairs are compared; each line is compared with
+    the later lines, each kept line in turn (a thousand copies cost a thousand comparisons).
+    """
+    if len(lines) < 2:
+        return []
+    first = _exact_repeats(lines)
+    unique = [k for k, f in enumerate(first) if f == k and len(lines[k]) >= 2]
+    repeats = {k for k, f in enumerate(first) if f != k}
+    if tol <= 0.0 or len(unique) < 2:
+        return sorted(repeats)
+    bounds = _bounds([lines[k] for k in unique])
+    tree = cKDTree(bounds)
+    alone = tree.query_ball_point(bounds, tol, p=np.inf, return_length=True) == 1
+    geoms: dict[int, shapely.Geometry] = {}
+
+    def geom(k: int) -> shapely.Geometry:
+        if k not in geoms:
+            geoms[k] = shapely.linestrings(np.asarray(lines[k], dtype=float))
+        return geoms[k]
+
+    for a, i in enumerate(unique):  # i is kept: no kept line before it repeats it
+        if alone[a] or i in repeats:
+            continue
+        for b in tree.query_ball_point(bounds[a], tol, p=np.inf):
+            j = unique[b]
+            if budget is not None:
+                budget.check_time()
+            if j > i and j not in repeats and _same(geom(i), geom(j), tol):
+                repeats.add(j)
+    return sorted(repeats)
+
+
+def _bounds(lines: Sequence[np.ndarray]) -> np.ndarray:
+    """Each line's bounds (x0, y0, x1, y1), one row per line."""
+    pts = np.concatenate(lines).astype(float, copy=False)
+    starts = np.concatenate(([0], np.cumsum([len(ln) for ln in lines])[:-1]))
+    return np.hstack([np.minimum.reduceat(pts, starts), np.maximum.reduceat(pts, starts)])
+
+
+def _same(a: shapely.Geometry, b: shapely.Geometry, tol: float) -> bool:
+    """Whether two lines are equal within ``tol``: each lies within ``tol`` of the other."""
+    return bool(_along(a, b, tol)) and bool(_along(b, a, tol))
+
+
 def _components(pieces: np.ndarray) -> np.ndarray:
     """Label of the connected group of each noded line piece."""
     tree = shapely.STRtree(pieces)
@@ -187,11 +262,24 @@ def _tangent(ring: Polygon, others: np.ndarray, tol: float) -> bool:
     return close <= 0.0 or float(weight[dist <= 4.0 * tol].sum()) >= TANGENT_SPREAD * close
 
 
+def _on_other_lines(
+    ring: Polygon, on_line: csr_matrix, lines: np.ndarray, tol: float
+) -> np.ndarray:
+    """Whether each piece (a row of ``on_line``: the lines it lies on) lies on a line other
+    than ``ring``'s own: one not wholly within ``tol`` of the ring. A line along the ring is
+    the ring, or part of it, drawn again (ARCs under a CIRCLE): no stretch it shares with
+    another line, as a title-block cell's side on the frame is."""
+    cols = np.unique(on_line.indices)
+    other = ~_along(lines[cols], ring.exterior, tol)
+    return np.asarray(on_line[:, cols[other]].sum(axis=1)).ravel() > 0
+
+
 def _inner_closed(
     poly: Polygon,
     pieces: np.ndarray,
     mids: np.ndarray,
-    shared: np.ndarray,
+    on_line: csr_matrix,
+    lines: np.ndarray,
     rings: Sequence[Polygon],
     eps: float,
     gap: float = 0.0,
@@ -202,39 +290,41 @@ def _inner_closed(
     them to it.
 
     ``pieces`` are the group's noded pieces and ``mids`` their midpoints (a piece lies on a
-    ring when its midpoint does); ``shared[i]`` says piece ``i`` lies on two or more of the
-    drawing's lines. A closed line that shares a stretch of the outline or of another line
-    (a title-block cell, a notch drawn closed, a tile of a grid) stays merged. A curve
-    tangent to a curved outline is flattened into chords that cross the outline's chords
-    (two polygons approximating tangent circles overlap in a sliver): the stretches of it
-    that the merged outline takes, or that noding merged with the outline's, are no stretch
-    of the outline when they lie within twice the flatten tolerance ``gap`` of the other
-    lines (:func:`_near`) and the curve leaves them as a tangent does (:func:`_tangent`),
-    not as a side drawn along them (without ``gap`` any touch is a shared stretch). The hole
-    is the closed line clipped to the loop shrunk by ``1000 eps`` (so a tangent hole never
-    pokes outside the part nor touches its outline: nesting by containment then holds in
-    floating point); it can split into pieces (a list, empty when nothing is left).
+    ring when its midpoint does); row ``i`` of ``on_line`` marks the drawing's ``lines``
+    that piece ``i`` lies on. A closed line that shares a stretch of the outline or of
+    another line (a title-block cell, a notch drawn closed, a tile of a grid) stays merged;
+    a line running wholly along it (part of it drawn again, :func:`_on_other_lines`) is no
+    other line. A curve tangent to a curved outline is flattened into chords that cross the
+    outline's chords (two polygons approximating tangent circles overlap in a sliver): the
+    stretches of it that the merged outline takes, or that noding merged with the
+    outline's, are no stretch of the outline when they lie within twice the flatten
+    tolerance ``gap`` of the other lines (:func:`_near`) and the curve leaves them as a
+    tangent does (:func:`_tangent`), not as a side drawn along them (without ``gap`` any
+    touch is a shared stretch). The hole is the closed line clipped to the loop shrunk by
+    ``1000 eps`` (so a tangent hole never pokes outside the part nor touches its outline:
+    nesting by containment then holds in floating point); it can split into pieces (a
+    list, empty when nothing is left).
     """
     out: list[tuple[Polygon, list[Polygon]]] = []
     tiny = 1e-9 * poly.area
     tree = shapely.STRtree(mids)
     shrunk: Polygon | None = None
     length = shapely.length(pieces)
+    tol = 2.0 * gap + eps
     for ring in rings:
         if ring.area >= poly.area - tiny or not poly.contains(ring.representative_point()):
             continue
         on = tree.query(ring.exterior, predicate="dwithin", distance=eps)
-        common = shared[on].any()
-        outside = on[~shared[on] & shapely.dwithin(mids[on], poly.exterior, eps)]
-        if common or len(outside):
+        shared = _on_other_lines(ring, on_line[on], lines, tol)  # of the pieces ``on`` it
+        outside = on[~shared & shapely.dwithin(mids[on], poly.exterior, eps)]
+        if shared.any() or len(outside):
             if gap <= 0.0:
                 continue  # it shares a stretch of another line or of the outline
-            if TANGENT_SPREAD * length[on[shared[on]]].sum() > ring.length:
+            if TANGENT_SPREAD * length[on[shared]].sum() > ring.length:
                 continue  # it runs along other lines (a grid's tile, a title-block cell)
             rest = np.ones(len(pieces), dtype=bool)
-            rest[on] = False
-            others = pieces[rest | shared]  # the other lines
-            tol = 2.0 * gap + eps
+            rest[on[~shared]] = False
+            others = pieces[rest]  # the other lines
             if len(outside) and not _near(pieces[outside], others, tol):
                 continue  # it is part of the outline
             if not _tangent(ring, others, tol):
@@ -249,15 +339,22 @@ def _inner_closed(
     return out
 
 
-def _enclosed_faces(poly: Polygon, faces: Sequence[Polygon], eps: float) -> int:
+def _thin(polys: np.ndarray, gap: float) -> np.ndarray:
+    """Which polygons are on average no thicker than twice ``gap`` (area at most ``gap``
+    times the perimeter): slivers between two flattenings of one curve, never a part."""
+    return shapely.area(polys) <= gap * shapely.length(polys)
+
+
+def _enclosed_faces(poly: Polygon, faces: Sequence[Polygon], eps: float, gap: float = 0.0) -> int:
     """How many ``faces`` (of the loop ``poly``) share no stretch of its outline (longer than
-    ``eps``): a face touching it at points only is enclosed by lines inside the loop."""
+    ``eps``): a face touching it at points only is enclosed by lines inside the loop. Slivers
+    no thicker than twice the flatten tolerance ``gap`` (:func:`_thin`: an ARC drawn over a
+    CIRCLE, its chords beside the circle's) are no hole and not counted."""
     if len(faces) < 2:
         return 0
-    common = shapely.intersection(
-        shapely.get_exterior_ring(np.asarray(faces, dtype=object)), poly.exterior
-    )
-    return int((shapely.length(common) <= eps).sum())
+    polys = np.asarray(faces, dtype=object)
+    common = shapely.intersection(shapely.get_exterior_ring(polys), poly.exterior)
+    return int(((shapely.length(common) <= eps) & ~_thin(polys, gap)).sum())
 
 
 def closed_loops(
@@ -329,8 +426,10 @@ def closed_loops(
         candidates = ring_group.get(int(lab), []) if len(parts) > 1 else []
         if candidates:
             mids = shapely.line_interpolate_point(group, 0.5, normalized=True)
-            hits = lines_tree.query(mids, predicate="dwithin", distance=eps)[0]
-            shared = np.bincount(hits, minlength=len(mids)) > 1
+            piece, line = lines_tree.query(mids, predicate="dwithin", distance=eps)
+            on_line = csr_matrix(
+                (np.ones(len(piece), dtype=bool), (piece, line)), shape=(len(mids), len(geoms))
+            )
         for poly in shapely.get_parts(merged):
             if budget is not None:
                 budget.check_time()
@@ -338,7 +437,7 @@ def closed_loops(
                 continue
             outline = Polygon(poly.exterior)
             inner = (
-                _inner_closed(outline, group, mids, shared, candidates, eps, gap)
+                _inner_closed(outline, group, mids, on_line, geoms, candidates, eps, gap)
                 if candidates
                 else []
             )
@@ -356,7 +455,7 @@ def closed_loops(
                         polygon=shape,
                         faces=len(own),
                         largest_face=max((f.area for f in own), default=shape.area),
-                        enclosed=_enclosed_faces(shape, own, 1e3 * eps),
+                        enclosed=_enclosed_faces(shape, own, 1e3 * eps, gap),
                     )
                 )
     return loops, dangles
@@ -627,7 +726,7 @@ def _without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple
     for lp in loops:
         poly = lp.polygon
         x0, y0, x1, y1 = poly.bounds
-        if poly.area <= gap * poly.length or max(x1 - x0, y1 - y0) <= bridged:
+        if _thin(poly, gap) or max(x1 - x0, y1 - y0) <= bridged:
             out.append(poly)
         else:
             keep.append(lp)
@@ -703,6 +802,11 @@ def frame_doubt(
     )
 
 
+def _picked(values: Sequence[str] | None, keep: Sequence[int], n: int) -> list[str] | None:
+    """``values[k]`` for each ``k`` in ``keep``; None unless there is one value per line."""
+    return None if values is None or len(values) != n else [values[k] for k in keep]
+
+
 def drawing_from_lines(
     lines: Sequence[np.ndarray],
     gap: float,
@@ -713,7 +817,8 @@ def drawing_from_lines(
 ) -> Drawing:
     """Parts of a drawing from its flattened lines (mm); InputError without a closed loop.
 
-    Line ends closer than ``gap`` (the flatten tolerance) are joined; open ends up to
+    Line ends closer than ``gap`` (the flatten tolerance) are joined and a line repeating
+    another within ``gap`` is left out (:func:`repeated_lines`); open ends up to
     :data:`HEAL_GAP_REL` of the drawing's size apart are bridged, with a warning, before the
     loops and holes are chosen. A closed line that crosses itself, or crosses another loop
     (a hole across the outline), is refused, as an outline file with those faults is;
@@ -728,6 +833,10 @@ def drawing_from_lines(
     if float(extent.max()) == 0.0 or float(extent.min()) <= 1e-12 * float(extent.max()):
         raise InputError(f"{label}: the outline has zero area (all geometry lies on a line)")
     snapped = snap_endpoints(lines, gap)
+    repeats = set(repeated_lines(snapped, gap, budget))
+    keep = [k for k in range(len(snapped)) if k not in repeats]
+    snapped = [snapped[k] for k in keep]
+    names, layers = _picked(names, keep, len(lines)), _picked(layers, keep, len(lines))
 
     def name(k: int) -> str:
         return names[k] if names is not None and k < len(names) else f"closed line {k + 1}"
