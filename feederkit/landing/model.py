@@ -6,32 +6,34 @@ their orientation is kept). A mesh lands in one of its resting poses ``pose-K``
 (:mod:`feederkit.landing.mesh`). Each landing is one more member of a product mix for the
 planners (Akella & Mason, section 8): see :mod:`feederkit.landing.plan` and docs/landings.md.
 
-Two landings are the same landing when their outlines are **congruent**: a rigid motion of
-the plane (rotation and translation, no reflection) maps one outline, with its holes and its
-COM, onto the other. The test is exact up to a length tolerance: the motion must take the
-COM to the COM and each hull vertex to a hull vertex in the same cyclic order, so the
-candidate rotations are the few that take hull vertex 0 to a hull vertex at the same
-distance from the COM; each is checked on the whole hull and then on the outline with its
-holes (their symmetric difference). The hull is the outline's exact hull
-(:func:`exact_hull`), never the simplified contact hull, which need not keep the outline's
-mirror symmetry. The push functions' rotation-invariant signature
-(:mod:`feederkit.mix.signatures`) would not do: it sees the hull and the COM only, so two
-sides that differ by a hole or a notch inside the hull would wrongly be merged. Landings
-that are not congruent but that the fence and sensor cannot tell apart are kept apart and
-reported as indistinguishable (:func:`feederkit.landing.plan.plan_landings`).
+Two landings are the same landing when their outlines are **congruent**: a rotation about
+the COM (the motion must take COM to COM; no reflection) brings one outline, with its holes,
+within :data:`CONGRUENCE_TOL_MM` of the other (Hausdorff distance, of the regions and of their
+boundaries), the precision a drawing carries and far below what a feeder or the next station
+can tell. The rotation is found by branch and bound over the circle (:func:`congruent`), so
+the verdict does not depend on how the outlines' curves were chorded. The push functions'
+rotation-invariant signature (:mod:`feederkit.mix.signatures`) would not do: it sees the hull
+and the COM only, so two sides that differ by a hole or a notch inside the hull would wrongly
+be merged. Landings that are not congruent but that the fence and sensor cannot tell apart
+are kept apart and reported as indistinguishable
+(:func:`feederkit.landing.plan.plan_landings`).
 """
 
 from __future__ import annotations
 
+import heapq
 import math
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+import shapely
+from scipy.spatial import cKDTree
 from shapely import affinity
 
 from feederkit.errors import InputError
-from feederkit.hull import Point, convex_hull, number_hull
+from feederkit.hull import Point, number_hull
 from feederkit.outline import Outline
 from feederkit.part import Part
 
@@ -40,8 +42,42 @@ DOWN = "down"
 DEFAULT_SIDE_PROBABILITY = 0.5
 """The probability of ``up`` for a flat part unless the user gives another (design.md)."""
 
-CONGRUENCE_REL_TOL = 1e-6
-"""Lengths (of the part's size) and areas (of its area) within this are the same shape."""
+CONGRUENCE_TOL_MM = 0.005
+"""Outlines within this Hausdorff distance (mm) of each other, turned about the COM, are one
+shape: above what a drawing can tell, far below what a feeder can.
+
+A drawing's sides of one shape differ by about a micrometre: coordinates written to 0.001 mm
+lie up to 1.4 um from their mirror image's, a fine arc chorded from another angle by its
+sagitta (hex_nut.real.json's hole: 0.27 um), float32 mesh vertices by 0.01 um. The feeder's
+sensor reads to 0.1 mm and its contact hull is simplified to 0.05 mm, and the smallest real
+difference between two sides to keep (a 0.05 mm chamfer on one corner) lies 35 um from the
+mirror image, 7 times this tolerance.
+"""
+
+CONGRUENCE_REL_TOL = 1e-3
+"""Below 5 mm the tolerance is this share of the part's size instead (as the importers' hull
+tolerance shrinks for small parts): the sides of a 1 mm part must agree to 1 um."""
+
+CONGRUENCE_MAX_WORK = 4_000_000
+"""Vertex look-ups the rotation search makes at most (a few seconds; an outline of 1000
+vertices gets 2000 intervals, the real parts take a few hundred): beyond them the outlines
+count as different, two landings, as no outline is merged without a rotation that was
+checked. Only outlines round to within the tolerance everywhere but one rotation, such as a
+circle traced with noise of about the tolerance, come near it."""
+
+_START_INTERVALS = 16
+"""The circle of rotations is first cut into this many intervals."""
+
+_LEAF_SHARE = 0.2
+"""An interval is cut no further once turning by its half-width moves no vertex by more than
+this share of the tolerance: any rotation within 3/4 of the tolerance is then found (the
+grown outlines' chords take 0.5 % of it)."""
+
+_POLISH_STEPS = 40
+"""Golden-section steps that find the closest rotation of a run (0.618**40: 4e-9 of it)."""
+
+_MAX_SAMPLES = 20000
+"""At most this many points sample an outline's boundary for the search's bounds."""
 
 _LANDING_RE = re.compile(r"^(up|down|pose-(0|[1-9][0-9]*))$")
 
@@ -125,69 +161,186 @@ def renamed(part: Part, name: str) -> Part:
     )
 
 
-def _centred(pts: Sequence[Point], com: Point) -> list[Point]:
-    return [(x - com[0], y - com[1]) for x, y in pts]
+def congruence_tolerance(a: Part, b: Part) -> float:
+    """The Hausdorff distance (mm) within which ``a`` and ``b`` are one shape:
+    :data:`CONGRUENCE_TOL_MM`, or :data:`CONGRUENCE_REL_TOL` of the larger size when smaller."""
+    return min(CONGRUENCE_TOL_MM, CONGRUENCE_REL_TOL * max(a.size, b.size))
 
 
-def _rotate(p: Point, c: float, s: float) -> Point:
-    return (c * p[0] - s * p[1], s * p[0] + c * p[1])
+@dataclass(frozen=True)
+class _Shape:
+    """A part's outline about its COM, prepared for the rotation search."""
+
+    polygon: shapely.Polygon
+    points: np.ndarray  # (n, 2) the vertices of every ring
+    radii: np.ndarray  # (n,) their distances from the COM
+    samples: cKDTree  # the boundary, sampled every ``spacing`` at most
+    spacing: float
+    near: shapely.Geometry  # the region grown by the tolerance
+    band: shapely.Geometry  # the boundary grown by the tolerance
 
 
-def exact_hull(part: Part) -> tuple[Point, ...]:
-    """The exact convex hull of the part's outline (collinear points dropped, nothing else).
+def _shape(part: Part, tol: float) -> _Shape:
+    poly = affinity.translate(part.outline.polygon(), -part.com[0], -part.com[1])
+    boundary = poly.boundary
+    points = shapely.get_coordinates(boundary)
+    spacing = max(tol, boundary.length / _MAX_SAMPLES)
+    samples = cKDTree(shapely.get_coordinates(shapely.segmentize(boundary, spacing)))
+    near, band = shapely.buffer(poly, tol), shapely.buffer(boundary, tol)
+    shapely.prepare(near)
+    shapely.prepare(band)
+    radii = np.hypot(points[:, 0], points[:, 1])
+    return _Shape(poly, points, radii, samples, spacing, near, band)
 
-    Congruence is decided on it, not on ``part.hull``: a simplified hull (``--hull-tolerance``)
-    depends on the order in which :func:`feederkit.hull.clean_hull` merges an arc's chords,
-    so a mirror-symmetric outline's simplified hull need not be symmetric (a 60 x 20 slot
-    gave 40 vertices whose mirror image is another 40-gon), and a hull and its mirror would
-    differ by up to the hull tolerance where the outlines coincide.
+
+def _turned(points: np.ndarray, phi: float) -> np.ndarray:
+    c, s = math.cos(phi), math.sin(phi)
+    return points @ np.array([[c, s], [-s, c]])
+
+
+def _gaps(a: _Shape, b: _Shape, phi: float, reach: float) -> np.ndarray:
+    """Lower bounds on the distances from ``a``'s vertices turned by ``phi`` to ``b``'s
+    boundary (a sample lies within half the spacing of every boundary point); infinite for
+    the vertices farther than ``reach``."""
+    d = b.samples.query(_turned(a.points, phi), distance_upper_bound=reach + b.spacing)[0]
+    return d - b.spacing / 2
+
+
+def _bound(a: _Shape, b: _Shape, phi: float, h: float, tol: float) -> float | None:
+    """The largest of :func:`_gaps` at ``phi``, or None when no rotation within ``phi`` +-
+    ``h`` can bring every vertex of ``a`` within ``tol`` of ``b``'s boundary (a vertex at
+    radius r moves at most r h)."""
+    gaps = _gaps(a, b, phi, tol + float(a.radii.max()) * h)
+    if float(np.max(gaps - a.radii * h)) > tol:
+        return None
+    return float(gaps.max())
+
+
+def _within(a: _Shape, b: _Shape, phi: float) -> bool:
+    """Whether ``a`` turned by ``phi`` and ``b`` lie within the tolerance of each other,
+    as regions and as boundaries (exact up to the grown shapes' chords, which err inwards)."""
+    pa = affinity.rotate(a.polygon, phi, origin=(0.0, 0.0), use_radians=True)
+    pb = affinity.rotate(b.polygon, -phi, origin=(0.0, 0.0), use_radians=True)
+    return (
+        b.band.covers(pa.boundary)
+        and a.band.covers(pb.boundary)
+        and b.near.covers(pa)
+        and a.near.covers(pb)
+    )
+
+
+def _may_match(a: Part, b: Part, tol: float) -> bool:
+    """Necessary conditions, cheap: extents about the COM and areas that agree."""
+    pa, pb = a.outline.polygon(), b.outline.polygon()
+    ra = float(np.max(np.hypot(*(shapely.get_coordinates(pa.exterior) - a.com).T)))
+    rb = float(np.max(np.hypot(*(shapely.get_coordinates(pb.exterior) - b.com).T)))
+    n = len(shapely.get_coordinates(pa)) + len(shapely.get_coordinates(pb))
+    spread = 2.0 * tol * (pa.boundary.length + pb.boundary.length) + math.pi * tol * tol * n
+    return abs(ra - rb) <= tol and abs(pa.area - pb.area) <= spread
+
+
+def _search(a: Part, b: Part, tol: float, first: bool) -> list[float]:
+    """Rotations (rad) about the COMs that bring ``a`` within ``tol`` of ``b``.
+
+    Branch and bound over the circle: an interval is dropped when :func:`_bound` shows no
+    rotation in it can work, the others are examined closest first (the largest vertex gap
+    at their centre), within :data:`CONGRUENCE_MAX_WORK`; a rotation counts only when
+    :func:`_within` holds there. ``first``: stop at the first; else one rotation per run of
+    adjacent intervals that work, the closest within it (:func:`_polish`).
     """
-    return number_hull(convex_hull(part.outline.vertices))
+    if not _may_match(a, b, tol):
+        return []
+    sa, sb = _shape(a, tol), _shape(b, tol)
+    leaf = _LEAF_SHARE * tol / max(float(sa.radii.max()), float(sb.radii.max()))
+    h0 = math.pi / _START_INTERVALS
+    heap: list[tuple[float, float, float]] = []
+
+    def push(phi: float, h: float) -> None:
+        largest = _bound(sa, sb, phi, h, tol)
+        if largest is not None:
+            heapq.heappush(heap, (largest, phi, h))
+
+    for k in range(_START_INTERVALS):
+        push((2 * k + 1) * h0, h0)
+    found: list[tuple[float, float, float]] = []
+    for _ in range(max(1, CONGRUENCE_MAX_WORK // (2 * len(sa.points)))):
+        if not heap:
+            break
+        largest, phi, h = heapq.heappop(heap)
+        if largest <= tol and _within(sa, sb, phi):
+            found.append((phi, h, largest))
+            if first:
+                break
+        elif h > leaf:
+            push(phi - h / 2, h / 2)
+            push(phi + h / 2, h / 2)
+    if first:
+        return [phi for phi, _, _ in found]
+    return [_polish(sa, sb, run) for run in _runs(found)]
 
 
-def _rotations(a: Part, b: Part, rel_tol: float) -> Iterator[float]:
-    ha, hb = _centred(exact_hull(a), a.com), _centred(exact_hull(b), b.com)
-    n = len(ha)
-    if n != len(hb) or n < 3:
-        return
-    size = max(a.size, b.size)
-    tol = rel_tol * size
-    area_a, area_b = a.outline.polygon().area, b.outline.polygon().area
-    if abs(area_a - area_b) > rel_tol * max(area_a, area_b):
-        return
-    r0 = math.hypot(*ha[0])
-    for j in range(n):
-        if abs(math.hypot(*hb[j]) - r0) > tol:
-            continue
-        phi = math.atan2(hb[j][1], hb[j][0]) - math.atan2(ha[0][1], ha[0][0])
-        c, s = math.cos(phi), math.sin(phi)
-        if all(
-            math.dist(_rotate(ha[i], c, s), hb[(i + j) % n]) <= tol for i in range(n)
-        ) and _same_outline(a, b, phi, rel_tol * max(area_a, area_b) + tol * size):
-            yield math.degrees(phi) % 360.0
+def _runs(found: list[tuple[float, float, float]]) -> list[list[tuple[float, float, float]]]:
+    """The intervals that work, grouped into runs of adjacent ones around the circle."""
+    runs: list[list[tuple[float, float, float]]] = []
+    for item in sorted(found):
+        if runs and item[0] - item[1] <= runs[-1][-1][0] + runs[-1][-1][1] + 1e-12:
+            runs[-1].append(item)
+        else:
+            runs.append([item])
+    if len(runs) > 1:
+        (p0, h0, _), (p1, h1, _) = runs[0][0], runs[-1][-1]
+        if p0 - h0 <= 1e-12 and p1 + h1 >= 2 * math.pi - 1e-12:
+            runs[0] = runs.pop() + runs[0]
+    return runs
 
 
-def congruence_rotations(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) -> list[float]:
+def _polish(a: _Shape, b: _Shape, run: list[tuple[float, float, float]]) -> float:
+    """The rotation of a run that brings ``a`` closest to ``b``: a golden-section search of
+    shapely's Hausdorff distance over the run's span, kept only if it works (else the run's
+    best-scoring interval)."""
+    phis = [run[0][0]]
+    for phi, _, _ in run[1:]:
+        phis.append(phi + 2 * math.pi if phi < phis[-1] else phi)
+    lo, hi = phis[0] - run[0][1], phis[-1] + run[-1][1]
+
+    def gap(phi: float) -> float:
+        turned = affinity.rotate(a.polygon, phi, origin=(0.0, 0.0), use_radians=True)
+        return float(shapely.hausdorff_distance(turned, b.polygon))
+
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    f1, f2 = gap(x1), gap(x2)
+    for _ in range(_POLISH_STEPS):
+        if f1 <= f2:
+            hi, x2, f2 = x2, x1, f1
+            x1 = hi - g * (hi - lo)
+            f1 = gap(x1)
+        else:
+            lo, x1, f1 = x1, x2, f2
+            x2 = lo + g * (hi - lo)
+            f2 = gap(x2)
+    best = x1 if f1 <= f2 else x2
+    return best if _within(a, b, best) else min(run, key=lambda x: x[2])[0]
+
+
+def congruence_rotations(a: Part, b: Part, tol: float | None = None) -> list[float]:
     """Rotations (deg, about the COM) that map part ``a`` onto part ``b``; empty when none.
 
-    A rotation counts when it takes every vertex of the exact hull of ``a``'s outline (about
-    its COM, see :func:`exact_hull`) to the vertex of ``b``'s in the same cyclic order within
-    ``rel_tol`` of the size, and the outlines with their holes then differ by at most
-    ``rel_tol`` of the area.
+    A rotation counts when it brings ``a``'s outline (holes included) within ``tol`` (mm,
+    default :func:`congruence_tolerance`) of ``b``'s, as regions and as boundaries. One
+    rotation per run of rotations that work: six for a hex nut and its mirror image, one for
+    a part round within the tolerance.
     """
-    return list(_rotations(a, b, rel_tol))
+    t = congruence_tolerance(a, b) if tol is None else tol
+    degrees = (math.degrees(phi) % 360.0 for phi in _search(a, b, t, first=False))
+    return sorted(0.0 if d > 360.0 - 1e-9 else d for d in degrees)
 
 
-def _same_outline(a: Part, b: Part, phi: float, area_tol: float) -> bool:
-    pa = affinity.translate(a.outline.polygon(), -a.com[0], -a.com[1])
-    pa = affinity.rotate(pa, phi, origin=(0.0, 0.0), use_radians=True)
-    pb = affinity.translate(b.outline.polygon(), -b.com[0], -b.com[1])
-    return float(pa.symmetric_difference(pb).area) <= area_tol
-
-
-def congruent(a: Part, b: Part, rel_tol: float = CONGRUENCE_REL_TOL) -> bool:
-    """Whether a rigid motion of the plane maps ``a`` (outline, holes, COM) onto ``b``."""
-    return next(_rotations(a, b, rel_tol), None) is not None
+def congruent(a: Part, b: Part, tol: float | None = None) -> bool:
+    """Whether a rigid motion of the plane maps ``a`` (outline, holes, COM) onto ``b``, up to
+    ``tol`` (mm, default :func:`congruence_tolerance`; see :func:`congruence_rotations`)."""
+    t = congruence_tolerance(a, b) if tol is None else tol
+    return bool(_search(a, b, t, first=True))
 
 
 def landings_of_outline(
