@@ -411,3 +411,43 @@ def test_a_clearly_asymmetric_part_never_lumps(wired, pts):
     assert wired == []
     assert not any(inseparable(made.result.machine))
     assert all(mask.bit_count() == 1 for mask in leaf_masks(made.result.root))
+
+
+# Two landings of an L-bracket mesh (a 4 mm thick bracket lying on its 72 x 4 face and on its
+# 40 x 4 face), hulls and COMs as the catalog stored them: each is a long thin rectangle whose
+# long-side poses are near-symmetric (only the COM is off centre along it).
+BRACKET_POSES = {
+    "pose-3": (
+        [(45.849057, -25.471698), (47.791628, -21.975069), (-15.03856, 12.930591),
+         (-16.981132, 9.433962)],
+        (13.157745, -5.021941),
+    ),
+    "pose-4": ([(-4.0, 0.0), (0.0, 0.0), (0.0, 40.0), (-4.0, 40.0)], (-2.0, 13.382353)),
+}  # fmt: skip
+
+
+def test_parts_are_listed_together_only_when_lumping_their_own_states_is_not_enough():
+    """With a 0.05 mm sensor at 1 degree, pairs across the two poses are unresolvable on
+    the inseparable goal only because each pose's near-symmetric states must be told apart;
+    with those lumped, a strong plan tells the poses apart. The plan did list them together
+    (1 operation, "cannot tell these landings apart"), and the catalog screen named them;
+    now the plan recognizes both (3 operations, verified) and the screen agrees."""
+    from feederkit.mix.strongpairs import check_strong_pair
+    from feederkit.planning.lumping import within_first
+
+    pfs = [
+        push_function(make_part(make_outline(name, hull, com=com)))
+        for name, (hull, com) in BRACKET_POSES.items()
+    ]
+    sensor, unc = ToleranceSensor(0.05), Uncertainty(1.0)
+    machine = build_machine(pfs, sensor, unc)
+    states = machine.states
+    found = unresolvable_pairs(Problem(machine, "exact", 0.0))
+    assert any(states[i].part != states[j].part for i, j in found)  # across, at first
+    fewer = within_first(Problem(machine, "exact", 0.0), found)
+    assert fewer is not None and all(states[i].part == states[j].part for i, j in fewer)
+    made = make_plan(pfs, sensor, uncertainty=unc, certify=False)  # verified on the model
+    assert made.result.length == 3
+    for mask in leaf_masks(made.result.root):
+        assert len({made.result.machine.states[i].part for i in members(mask)}) == 1
+    assert check_strong_pair(pfs[0], pfs[1], sensor, unc).witness is None

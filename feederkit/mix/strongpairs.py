@@ -29,7 +29,8 @@ from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanic
 from feederkit.mix.changeover import strong_witnesses
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.budget import Deadline
-from feederkit.planning.lumping import try_lumping, unresolvable_pairs
+from feederkit.planning.lumping import may_lump, try_lumping, unresolvable_pairs, within_first
+from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
@@ -222,9 +223,17 @@ def check_strong_pair(
     their reading offsets (default :func:`part_offsets`): the check is on the machine
     ``make_plan`` plans on. Timeout when ``deadline`` passes."""
     machine = _machine([a, b], sensor, uncertainty, mechanics, offsets)
-    found = unresolvable_pairs(Problem(machine, "exact", 0.0), deadline)
+    problem = Problem(machine, "exact", 0.0)
+    found = unresolvable_pairs(problem, deadline)
     if found is None:
         return StrongPairCheck(None, decided=False)
+    # As ``plan`` lumps (planning.lumping.try_lumping): each part's near-symmetric states
+    # first, so a pair across the parts unresolvable only because those had to be told
+    # apart is no witness.
+    lumpable = [p for p in found if may_lump(machine, *p, Lumping.NEAR_SYMMETRIC)]
+    fewer = within_first(problem, lumpable, deadline)
+    if fewer is not None:
+        found = sorted(set(fewer) | (set(found) - set(lumpable)))
     states = machine.states
     across = [(i, j) for i, j in found if states[i].part != states[j].part]
     witnesses = strong_witnesses(machine, across)
