@@ -161,4 +161,6 @@ def test_analyze_exits_1_when_pairs_cannot_be_told_apart(tmp_path, db, capsys):
     # A result to act on (exit 1) is not an error of the input: no "error:" prefix.
     assert last.startswith("result: 2 pairs of landings") and "twin-a/up & twin-b/up" in last, err
     assert "error:" not in err
-    assert run(capsys, "catalog", "analyze", "--json", "--catalog", str(db))[0] == 0
+    # Without a sensor no pair is told apart (section 8.6): a result to act on too (rev53 #6).
+    code, _, err = run(capsys, "catalog", "analyze", "--json", "--catalog", str(db))
+    assert code == 1 and err.strip().splitlines()[-1].startswith("result: without a sensor")

@@ -71,10 +71,14 @@ OUTLINE_PEEK_BYTES = 1 << 20
 
 
 def is_outline_file(path: Path) -> bool:
-    """Whether a ``.json`` file is an outline file (design.md): a JSON object with "vertices".
+    """Whether a ``.json`` file is read as an outline file (design.md) by a folder import.
 
-    A folder of parts often holds other JSON (plans, settings, a package.json): those are
-    not parts and are left alone instead of being refused as broken outlines.
+    A folder of parts often holds other JSON (plans, settings, a package.json): a file that
+    parses as JSON and is not an object with "vertices" is not a part and is left alone
+    (ignored) instead of being refused as a broken outline. A file that does not parse (not
+    JSON, not UTF-8, truncated, empty) cannot be told to be something else, so it is read as
+    an outline and reported as a bad file with the reason. Beyond the first megabyte the file
+    is an outline when that megabyte holds the text ``"vertices"``.
     """
     try:
         with path.open("rb") as fh:
@@ -84,9 +88,9 @@ def is_outline_file(path: Path) -> bool:
     if len(head) > OUTLINE_PEEK_BYTES:
         return b'"vertices"' in head
     try:
-        data = json.loads(head.decode("utf-8"))
+        data = json.loads(head.decode("utf-8-sig"))
     except (UnicodeDecodeError, ValueError, RecursionError):
-        return b'"vertices"' in head  # broken JSON that meant to be an outline is reported
+        return True  # broken JSON: reported as a bad file, not silently ignored
     return isinstance(data, dict) and "vertices" in data
 
 
@@ -113,13 +117,22 @@ def source_files(directory: Path) -> tuple[list[Path], list[Path]]:
     return found, ignored
 
 
+FOLDER_NAME_ADVICE = (
+    "--revise makes this file the part's next revision; or rename the file, or change an "
+    'outline file\'s "name"'
+)
+"""What a folder import advises for a name the catalog has from another source: the options
+``catalog import`` has (it has no ``--name``; a part's name is the outline's "name", else the
+file's stem)."""
+
+
 def _bad_line(path: Path, exc: InputError) -> str:
     """One skipped file: ``path: reason``, a name clash with advice that works for a folder
     import (it has no ``--name``)."""
     if isinstance(exc, DuplicateNameError):
         return (
             f"{path}: duplicate name: part {exc.name!r} already exists from {exc.old_path} "
-            "(rename this part, or --revise makes this file its next revision)"
+            f"({FOLDER_NAME_ADVICE})"
         )
     reason = str(exc)
     return reason if str(path) in reason else f"{path}: {reason}"
@@ -194,6 +207,16 @@ def import_directory(
                         landings=lands,
                     )
                 )
+            except DuplicateNameError as exc:
+                if not skip_bad:
+                    # The single-file wording advises --name, which a folder import has not.
+                    raise InputError(
+                        f"{path}: duplicate name: part {exc.name!r} already exists from "
+                        f"{exc.old_path}; nothing imported ({FOLDER_NAME_ADVICE}; "
+                        "--skip-bad imports the rest)"
+                    ) from None
+                conn.execute("ROLLBACK TO import_part")
+                bad.append(_bad_line(path, exc))
             except InputError as exc:
                 if not skip_bad:
                     raise

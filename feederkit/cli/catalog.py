@@ -7,6 +7,8 @@ catalog is ``--catalog PATH``, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.d
 from __future__ import annotations
 
 import re
+import sqlite3
+import stat
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -109,6 +111,86 @@ def opened(option: Path | None, wait: float, *, create: bool = False) -> Iterato
         yield conn
     finally:
         conn.close()
+
+
+SIDE_FILES = ("-wal", "-shm", "-journal")
+"""SQLite's files beside a catalog ``DB``: ``DB-wal``, ``DB-shm``, ``DB-journal``."""
+
+
+@contextmanager
+def opened_for_import(option: Path | None, wait: float) -> Iterator[Connection]:
+    """The catalog connection of ``add`` and ``import``, which create a missing catalog.
+
+    When the command fails (any exception, an interrupt too) and the catalog file did not
+    exist before, or was an empty file, it is put back: removed (with the ``-wal``,
+    ``-shm`` and ``-journal`` files the command made), or emptied again. A failed command
+    leaves no new catalog behind, and an existing catalog is left as it was by its own
+    rolled-back transaction. A catalog that holds parts by then (another process wrote it
+    meanwhile) is kept.
+    """
+    path = catalog_path(option)
+    before = _file_state(path)
+    sides_before = {s for s in SIDE_FILES if _file_state(Path(f"{path}{s}")) is not None}
+    try:
+        conn = open_catalog(path, create=True, wait=wait)
+    except BaseException:
+        if before in (None, 0) and not _holds_data(path):
+            _put_back(path, before, sides_before)
+        raise
+    try:
+        yield conn
+    except BaseException:
+        conn.close()
+        if before in (None, 0) and not _holds_data(path):
+            _put_back(path, before, sides_before)
+        raise
+    conn.close()
+
+
+def _holds_data(path: Path) -> bool:
+    """Whether the catalog at ``path`` holds a part or a changeover (read-only look; a file
+    that cannot be read as a catalog holds none)."""
+    if not path.is_file():
+        return False
+    try:
+        look = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
+    except sqlite3.Error:
+        return False
+    try:
+        row = look.execute(
+            "SELECT (SELECT count(*) FROM parts) + (SELECT count(*) FROM changeovers)"
+        ).fetchone()
+        return bool(row and row[0])
+    except sqlite3.Error:
+        return False
+    finally:
+        look.close()
+
+
+def _file_state(path: Path) -> int | None:
+    """The size of the file at ``path``: None when there is none, -1 when it is no regular
+    file (a folder is never put back)."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_size if stat.S_ISREG(st.st_mode) else -1
+
+
+def _put_back(path: Path, before: int | None, sides_before: set[str]) -> None:
+    """Remove (``before`` None) or empty (``before`` 0) the catalog a failed command made,
+    and the SQLite side files it made; best effort, the command's error is what is said."""
+    try:
+        if before is None:
+            path.unlink(missing_ok=True)
+        else:
+            with path.open("r+b") as fh:
+                fh.truncate(0)
+        for side in SIDE_FILES:
+            if side not in sides_before:
+                Path(f"{path}{side}").unlink(missing_ok=True)
+    except OSError:
+        pass
 
 
 def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
@@ -217,7 +299,7 @@ def cmd_add(
     opts = with_com(import_opts, com)
     check_side_probability(side_probability)
     _check_source_file(file)
-    with opened(catalog, wait, create=True) as conn:
+    with opened_for_import(catalog, wait) as conn:
         outcomes = add_file(
             conn, file, opts, name=name, revise=revise, side_probability=side_probability
         )
@@ -279,7 +361,7 @@ def cmd_import(
                 tasks[phase] = bar.add_task(label, total=total, item="")
             bar.update(tasks[phase], completed=done, item=Path(item).name if item else "")
 
-        with opened(catalog, wait, create=True) as conn:
+        with opened_for_import(catalog, wait) as conn:
             result = import_directory(
                 conn,
                 directory,

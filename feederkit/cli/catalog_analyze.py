@@ -166,7 +166,8 @@ def analyze_command(
     Under a declared uncertainty each member is checked alone first: one no strong plan
     orients even alone is listed once and its pairs are not checked.
 
-    Exit 1 when some pair cannot be told apart, or some member has no strong plan alone
+    Exit 1 when some pair cannot be told apart (without a sensor: whenever there are two
+    members or more, as no pair is told apart), or some member has no strong plan alone
     (design.md: a result to act on)."""
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
@@ -188,6 +189,13 @@ def analyze_command(
         _print_report(result, pfs, over_landings)
     what = "landings" if over_landings else "parts"
     problems = []
+    if result.pairs is None and len(pfs) > 1:
+        # Sensorless: every pair is unrecognizable (section 8.6), as the table says.
+        problems.append(
+            f"without a sensor no pair of the {len(pfs)} {what} can be told apart (section "
+            "8.6): a sensorless plan orients them but cannot say which one it holds; give a "
+            "sensor (--tolerance MM or --led-pitch MM) to find the pairs no plan can tell apart"
+        )
     if result.pairs or result.strong_pairs:
         found = (result.pairs or ()) + result.strong_pairs
         n = len(found)
