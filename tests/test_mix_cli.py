@@ -78,7 +78,8 @@ def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys, tmp_path):
 
 
 def test_analyze_sensorless_lists_no_pairs_and_people_get_tables(db, capsys):
-    data = run_json(capsys, ["catalog", "analyze", "--json", "--catalog", str(db)])
+    # Exit 1: without a sensor no pair can be told apart (a result to act on).
+    data = run_json(capsys, ["catalog", "analyze", "--json", "--catalog", str(db)], code=1)
     assert data["all_pairs_unrecognizable"] is True
     assert data["unrecognizable_pairs"] == []
     assert main(["catalog", "analyze", "--tolerance", "0.01", "--catalog", str(db)]) == 1
