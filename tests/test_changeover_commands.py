@@ -119,7 +119,7 @@ def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, mon
     one_line_error(capsys, ["changeover", "report", "nope", "-o", str(html), "--catalog", str(db)])
 
 
-def test_a_design_past_its_limit_leaves_the_report_without_it(db, tmp_path, capsys, monkeypatch):
+def test_a_design_past_its_limit_is_cut_short_in_the_report(db, tmp_path, capsys, monkeypatch):
     import feederkit.design.sensor
     import feederkit.reports
 
@@ -134,12 +134,14 @@ def test_a_design_past_its_limit_leaves_the_report_without_it(db, tmp_path, caps
     monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 1e-9)
     html = tmp_path / "fig27.html"
     cap = ok(capsys, ["changeover", "report", "fig27", "-o", str(html), "--catalog", str(db)])
-    assert got == [None] and html.read_text() == "<p>report</p>"
+    assert html.read_text() == "<p>report</p>"
+    assert got[0]["complete"] is False and "time limit of 1e-09 s" in got[0]["stopped"]
     (line,) = [w for w in cap.err.splitlines() if "sensor design" in w]
     assert line.startswith("warning: ") and "1e-09 s" in line and "--time-limit" in line
     monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 60.0)
     ok(capsys, ["changeover", "report", "fig27", "-o", str(html), "--catalog", str(db)])
     assert got[1] is not None and got[1]["sensor_model"] == "tolerance"
+    assert got[1]["complete"] is True
 
 
 def test_remove_deletes_one_changeover_and_keeps_the_parts(db, capsys):

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import re
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -48,7 +49,6 @@ from feederkit.cli.common import (
     ProfileSensorlessOpt,
     ReportOpt,
     ShapeToleranceOpt,
-    TimeLimitOpt,
     ToleranceOpt,
     add_name_column,
     cell_planning_options,
@@ -84,7 +84,7 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import as_plan, plan_file_text
-from feederkit.uncertainty import Uncertainty
+from feederkit.uncertainty import IDEAL, Uncertainty
 
 changeover_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -190,21 +190,86 @@ def landings_text(plan: dict[str, Any], rejected: frozenset[str]) -> str | None:
     )
 
 
-def changeover_report(
-    plan: dict[str, Any], pfs: Sequence[PushFunction], witnesses: Sequence[PairWitness]
-) -> str:
-    """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
-    for a mix, the sensor design (critical tolerances and the plan length against the
-    tolerance, :func:`feederkit.design.report_design`; docs/reports.md)."""
-    from feederkit.design import report_design_or_warning
-    from feederkit.design.sensor import plan_members
-    from feederkit.reports import render_report
+REPORT_DESIGN_MIN_S = 1.0
+"""Seconds a report's sensor design gets at least, however little of ``--time-limit`` the plan
+left: a small mix's design still comes out; a large one's section says it was cut short."""
 
+
+def report_design_budget(time_limit_s: float | None, started: float) -> float:
+    """Seconds the report's sensor design may take in a command that started at ``started``
+    (``time.monotonic()``) under ``--time-limit`` ``time_limit_s``: what is left of it (at least
+    ``REPORT_DESIGN_MIN_S``), never more than ``REPORT_DESIGN_LIMIT_S``; with no time limit,
+    that (docs/reports.md)."""
+    from feederkit.design import sensor
+
+    cap = sensor.REPORT_DESIGN_LIMIT_S
+    if time_limit_s is None:
+        return cap
+    left = time_limit_s - (time.monotonic() - started)
+    return min(cap, max(REPORT_DESIGN_MIN_S, left))
+
+
+def changeover_design(
+    plan: dict[str, Any], pfs: Sequence[PushFunction], time_limit_s: float
+) -> tuple[dict[str, Any] | None, str | None]:
+    """The sensor design a changeover report shows (``ToleranceDesign.to_dict``; None for a
+    single part) within ``time_limit_s`` seconds, and a warning when it was cut short there.
+    Cut short after every pair is decided, it is the design without its length table (its
+    ``stopped`` says so); before that, a design of nothing but the one line of what was
+    decided (``stopped`` and ``answer``): the report's section says it was cut short and what
+    it found, as ``design sensor``'s own time limit does (docs/reports.md)."""
+    from feederkit.design import DesignTimeout, design_tolerance
+    from feederkit.design.sensor import model_note, plan_members
+
+    if len(pfs) < 2:
+        return None, None
     u = plan.get("uncertainty")
     # The design of the plan's own question: its accepted landings told apart, the others
     # rejected (as compile planned them).
     unc = Uncertainty.from_dict(u) if u else None
-    design, warning = report_design_or_warning(pfs, unc, members=plan_members(plan))
+    try:
+        design = design_tolerance(
+            list(pfs),
+            uncertainty=unc,
+            time_limit_s=time_limit_s,
+            members=plan_members(plan),
+            partial=True,
+        ).to_dict()
+    except DesignTimeout as exc:
+        design = {
+            "sensor_model": "tolerance",
+            "parts": [pf.part.name for pf in pfs],
+            "critical_tolerance_mm": None,
+            "pairs": [],
+            "lengths": [],
+            "complete": False,
+            "stopped": str(exc),
+            "model": model_note(unc or IDEAL),
+            "answer": f"not decided: {exc}",
+        }
+    if design.get("stopped") is None:
+        return design, None
+    return design, (
+        f"the report's sensor design was cut short at {time_limit_s:g} s (the command's "
+        f"--time-limit): {design['stopped']}; feederkit design sensor --time-limit S decides it"
+    )
+
+
+def changeover_report(
+    plan: dict[str, Any],
+    pfs: Sequence[PushFunction],
+    witnesses: Sequence[PairWitness],
+    design_limit_s: float | None = None,
+) -> str:
+    """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
+    for a mix, the sensor design (critical tolerances and the plan length against the
+    tolerance, :func:`changeover_design`; docs/reports.md) within ``design_limit_s`` seconds
+    (None: ``REPORT_DESIGN_LIMIT_S``)."""
+    from feederkit.design import sensor
+    from feederkit.reports import render_report
+
+    limit = sensor.REPORT_DESIGN_LIMIT_S if design_limit_s is None else design_limit_s
+    design, warning = changeover_design(plan, pfs, limit)
     if warning is not None:
         print_warnings([warning])
     return render_report(
@@ -231,6 +296,20 @@ def _pairs_table(witnesses: list[PairWitness], pfs: list[PushFunction]) -> Table
     return t
 
 
+CompileTimeLimitOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--time-limit",
+        metavar="S",
+        help=(
+            "Seconds for the plan, its verification and its file, then for a --report's sensor "
+            "design (what is left, at least 1 s; cut short, its section says so); then the "
+            "best plan found (optimal: false) and a proven lower bound."
+        ),
+    ),
+]
+
+
 @changeover_app.command("compile")
 def compile_command(
     name: NameArg,
@@ -249,7 +328,7 @@ def compile_command(
     noise: NoiseOpt = None,
     objective: ObjectiveOpt = "worst",
     min_margin: MinMarginOpt = 0.0,
-    time_limit: TimeLimitOpt = DEFAULT_TIME_LIMIT_S,
+    time_limit: CompileTimeLimitOpt = DEFAULT_TIME_LIMIT_S,
     memory_limit: MemoryLimitOpt = None,
     grouping: GroupingOpt = "exact",
     lumping: LumpingOpt = "near-symmetric",
@@ -280,6 +359,7 @@ def compile_command(
     (the plan is still written and stored), or when an accepted and a rejected landing
     cannot be.
     """
+    started = time.monotonic()  # --time-limit bounds the plan, then the report's design
     members, shares = parse_mix_shares(mix)
     check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
@@ -298,7 +378,8 @@ def compile_command(
         annotate_cycle_time(c.made, settings)
         files, _view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
         if report is not None:
-            html = changeover_report(c.plan, list(c.parts), list(c.witnesses))
+            budget = report_design_budget(options.time_limit_s, started)
+            html = changeover_report(c.plan, list(c.parts), list(c.witnesses), budget)
             files.append(OutputFile(report, html, "report"))
         return files
 
@@ -523,15 +604,30 @@ ReportOutputOpt = Annotated[
 
 
 @changeover_app.command("report")
-def report_command(name: NameArg, output: ReportOutputOpt, catalog: CatalogOpt = None) -> None:
+def report_command(
+    name: NameArg,
+    output: ReportOutputOpt,
+    time_limit: Annotated[
+        float | None,
+        typer.Option(
+            "--time-limit",
+            metavar="S",
+            help="Seconds for the report's sensor design (default 60); past them its section "
+            "is cut short and says what it decided.",
+        ),
+    ] = None,
+    catalog: CatalogOpt = None,
+) -> None:
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
+    from feederkit.design.limit import check_limits
     from feederkit.reports import check_report_path
 
+    design_limit, _ = check_limits(time_limit, None)  # InputError before any work
     check_report_path(output)  # a .txt or .pdf would hold HTML: refused before any work
     check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    html = changeover_report(co.plan, list(co.parts), co.witnesses())
+    html = changeover_report(co.plan, list(co.parts), co.witnesses(), design_limit)
     write_files([OutputFile(output, html, "report")])
     console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)
 

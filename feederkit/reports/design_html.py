@@ -27,7 +27,17 @@ def design_section(design: Mapping[str, Any]) -> str:
         raise InputError("the sensor design must be the JSON of 'feederkit design sensor'")
     answer = esc(design.get("answer", ""))
     pairs = _pairs_table(design.get("pairs") or [])
-    if design["sensor_model"] == "tolerance":
+    cut = ""
+    if design.get("stopped"):
+        cut = (
+            '<p class="banner caution" id="design-cut-short">Cut short: the sensor design '
+            "stopped at its time limit (the command's --time-limit), so this section shows "
+            "only what it decided by then (the line above). <code>feederkit design sensor "
+            "--time-limit S</code> decides it with the time it needs.</p>"
+        )
+    if design["sensor_model"] == "tolerance" and not design.get("lengths"):
+        table = plot = ""  # no length table: the design was cut short (or reaches no step)
+    elif design["sensor_model"] == "tolerance":
         rows = [
             (r["tolerance_mm"][0], r["tolerance_mm"][1], r["length"], r["expected"])
             for r in design.get("lengths") or []
@@ -40,7 +50,7 @@ def design_section(design: Mapping[str, Any]) -> str:
     note = esc(design.get("model", ""))
     return (
         '<section id="sensor-design"><h2>Sensor design</h2>'
-        f'<p><strong>{answer}</strong></p><p class="muted">{note}</p>'
+        f'<p><strong>{answer}</strong></p>{cut}<p class="muted">{note}</p>'
         f"{plot}{table}{pairs}</section>"
     )
 

@@ -1,0 +1,123 @@
+"""The report's sensor design takes its budget from the command's ``--time-limit``
+(docs/changeovers.md, docs/reports.md): ``changeover compile --time-limit S --report R``
+answers within about S, and a design cut short there gets a section that says so and what it
+decided; ``changeover report --time-limit S`` gives the design S seconds."""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+
+from feederkit.cli.app import main
+from feederkit.design.limit import DesignClock
+from feederkit.reports.design_html import design_section
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+MIX = "isosceles-right-triangle,octagon"
+SLOW_S = 8.0
+"""How long the stand-in design step runs when its clock does not stop it (the old fixed
+budget of 60 s would let it run this long)."""
+
+
+def ok(capsys, args: list[str], code: int = 0):
+    rc = main(args)
+    captured = capsys.readouterr()
+    assert rc == code, captured.err
+    return captured
+
+
+@pytest.fixture()
+def db(tmp_path, capsys) -> Path:
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    for name in MIX.split(","):
+        shutil.copy(CATALOG / f"{name}.json", folder)
+    path = tmp_path / "parts.db"
+    ok(capsys, ["catalog", "init", "--catalog", str(path)])
+    ok(capsys, ["catalog", "import", str(folder), "--catalog", str(path)])
+    return path
+
+
+@pytest.fixture()
+def slow_design(monkeypatch) -> list[float | None]:
+    """The design's pair step made slow: it polls its clock (as every design loop does) for up
+    to ``SLOW_S`` seconds. Returns the time limits the design's clocks were given."""
+    import feederkit.design.sensor as sensor
+
+    limits: list[float | None] = []
+
+    def slow(*args, **kwargs):
+        clock = next(a for a in (*args, *kwargs.values()) if isinstance(a, DesignClock))
+        limits.append(clock.time_limit_s)
+        clock.begin("deciding the pairs' critical tolerances", 3)
+        clock.advance()
+        end = time.monotonic() + SLOW_S
+        while time.monotonic() < end:
+            clock.check()
+            time.sleep(0.01)
+        raise AssertionError("the design's clock never stopped it")
+
+    monkeypatch.setattr(sensor, "strong_mix_critical", slow)
+    monkeypatch.setattr(sensor, "mix_critical_tolerance", slow)
+    return limits
+
+
+def test_compile_report_design_is_bounded_by_the_commands_time_limit(
+    db, tmp_path, capsys, slow_design
+):
+    html = tmp_path / "mix.html"
+    args = ["changeover", "compile", "mix", "--mix", MIX, "--tolerance", "0.01"]
+    started = time.monotonic()
+    cap = ok(capsys, [*args, "--time-limit", "2", "--report", str(html), "--catalog", str(db)])
+    elapsed = time.monotonic() - started
+    assert slow_design and slow_design[0] is not None and slow_design[0] <= 2.0
+    assert elapsed < 2.0 + 3.0, elapsed  # the limit plus a small constant, not 60 s
+    page = html.read_text()
+    section = page[page.index('<section id="sensor-design">') :]
+    section = section[: section.index("</section>")]
+    assert 'id="design-cut-short"' in section
+    assert "did not finish within the time limit" in section and "1 of 3 pairs" in section
+    (line,) = [w for w in cap.err.splitlines() if "sensor design" in w]
+    assert line.startswith("warning: ") and "cut short" in line and "--time-limit" in line
+
+
+def test_changeover_report_takes_a_time_limit_for_its_design(db, tmp_path, capsys, slow_design):
+    ok(
+        capsys,
+        ["changeover", "compile", "mix", "--mix", MIX, "--tolerance", "0.01", "--catalog", str(db)],
+    )
+    slow_design.clear()
+    html = tmp_path / "mix.html"
+    started = time.monotonic()
+    args = ["changeover", "report", "mix", "-o", str(html), "--time-limit", "0.5"]
+    cap = ok(capsys, [*args, "--catalog", str(db)])
+    assert time.monotonic() - started < 0.5 + 3.0
+    assert slow_design == [0.5]
+    assert 'id="design-cut-short"' in html.read_text()
+    assert "cut short at 0.5 s" in cap.err
+    bad = ["changeover", "report", "mix", "-o", str(html), "--time-limit", "0"]
+    assert main([*bad, "--catalog", str(db)]) == 2
+
+
+def test_a_partial_design_shows_what_it_decided_and_no_table():
+    design = {
+        "sensor_model": "tolerance",
+        "parts": ["a", "b"],
+        "critical_tolerance_mm": 0.2,
+        "pairs": [{"a": "a", "b": "b", "critical_tolerance_mm": 0.2}],
+        "lengths": [],
+        "complete": False,
+        "stopped": "the sensor design did not finish within the time limit of 1 s",
+        "model": "",
+        "answer": "recognizable up to 0.2 mm; the length table is left out",
+    }
+    html = design_section(design)
+    assert 'id="design-cut-short"' in html and "0.2 mm" in html
+    assert "design-steps" not in html and "design-plot" not in html
+    whole = {**design, "stopped": None, "complete": True}
+    whole["lengths"] = [{"tolerance_mm": [0.0, 0.2], "length": 2, "expected": 1.5}]
+    html = design_section(whole)
+    assert "design-cut-short" not in html and "design-steps" in html
