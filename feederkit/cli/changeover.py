@@ -250,8 +250,8 @@ def changeover_design(
     if design.get("stopped") is None:
         return design, None
     return design, (
-        f"the report's sensor design was cut short at {time_limit_s:g} s (the command's "
-        f"--time-limit): {design['stopped']}; feederkit design sensor --time-limit S decides it"
+        f"the report's sensor design was cut short by the command's --time-limit: "
+        f"{design['stopped']}; feederkit design sensor --time-limit S decides it"
     )
 
 
