@@ -121,3 +121,16 @@ def test_a_partial_design_shows_what_it_decided_and_no_table():
     whole["lengths"] = [{"tolerance_mm": [0.0, 0.2], "length": 2, "expected": 1.5}]
     html = design_section(whole)
     assert "design-cut-short" not in html and "design-steps" in html
+
+
+def test_the_design_budget_is_what_the_time_limit_leaves(monkeypatch):
+    import feederkit.design.sensor as sensor
+    from feederkit.cli.changeover import REPORT_DESIGN_MIN_S, report_design_budget
+
+    now = time.monotonic()
+    assert 6.0 < report_design_budget(10.0, now - 3.0) <= 7.0  # 10 s less the 3 s used
+    assert report_design_budget(5.0, now - 30.0) == REPORT_DESIGN_MIN_S  # plan overshot
+    assert report_design_budget(600.0, now) == sensor.REPORT_DESIGN_LIMIT_S  # capped
+    assert report_design_budget(None, now) == sensor.REPORT_DESIGN_LIMIT_S
+    monkeypatch.setattr(sensor, "REPORT_DESIGN_LIMIT_S", 0.25)
+    assert report_design_budget(5.0, now - 30.0) == 0.25
