@@ -134,3 +134,28 @@ def test_the_design_budget_is_what_the_time_limit_leaves(monkeypatch):
     assert report_design_budget(None, now) == sensor.REPORT_DESIGN_LIMIT_S
     monkeypatch.setattr(sensor, "REPORT_DESIGN_LIMIT_S", 0.25)
     assert report_design_budget(5.0, now - 30.0) == 0.25
+
+
+def test_a_design_the_mix_cannot_have_leaves_the_compile_and_its_report(
+    db, tmp_path, capsys, monkeypatch
+):
+    """A design step that refuses the mix (InputError: a step finer than the diameters are
+    known) ended ``compile --report`` with exit 2 after the plan was made; now the report
+    is written, its section says why there is no design, and one warning says so."""
+    import feederkit.design.sensor as sensor
+    from feederkit.errors import InputError
+
+    def refuse(*args, **kwargs):
+        raise InputError("the sensor's resolution is finer than the parts' diameters are known")
+
+    monkeypatch.setattr(sensor, "strong_mix_critical", refuse)
+    monkeypatch.setattr(sensor, "mix_critical_tolerance", refuse)
+    html = tmp_path / "mix.html"
+    args = ["changeover", "compile", "mix", "--mix", MIX, "--tolerance", "0.01"]
+    cap = ok(capsys, [*args, "--report", str(html), "--catalog", str(db)])
+    page = html.read_text()
+    section = page[page.index('<section id="sensor-design">') :]
+    assert "not made: the sensor" in section[: section.index("</section>")]
+    assert 'id="design-cut-short"' not in page
+    (line,) = [w for w in cap.err.splitlines() if "sensor design" in w]
+    assert line.startswith("warning: ") and "could not be made" in line

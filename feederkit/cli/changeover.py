@@ -235,7 +235,10 @@ def changeover_design(
             members=plan_members(plan),
             partial=True,
         ).to_dict()
-    except DesignTimeout as exc:
+    except (DesignTimeout, InputError) as exc:
+        # Cut short, or a design this mix cannot have (a step finer than the diameters are
+        # known): the plan is made and stored, so the report is written with what is known.
+        timeout = isinstance(exc, DesignTimeout)
         design = {
             "sensor_model": "tolerance",
             "parts": [pf.part.name for pf in pfs],
@@ -243,10 +246,12 @@ def changeover_design(
             "pairs": [],
             "lengths": [],
             "complete": False,
-            "stopped": str(exc),
+            "stopped": str(exc) if timeout else None,
             "model": model_note(unc or IDEAL),
-            "answer": f"not decided: {exc}",
+            "answer": f"not decided: {exc}" if timeout else f"not made: {exc}",
         }
+        if not timeout:
+            return design, f"the report's sensor design could not be made: {exc}"
     if design.get("stopped") is None:
         return design, None
     return design, (
