@@ -131,8 +131,8 @@ hull."""
 class KeptTolerance:
     """The hull tolerance :func:`keeping_tolerance` chose, and why it is below the asked one.
 
-    ``split``: at ``asked`` mm, how many resting states the simplified hull had (``model``)
-    where the outline's own hull has ``outline`` (0 and 0 when nothing was lowered).
+    ``model`` and ``outline``: at ``asked`` mm, how many resting states the simplified hull
+    had where the outline's own hull has ``outline`` (0 and 0 when nothing was lowered).
     """
 
     tolerance: float
@@ -192,7 +192,9 @@ def kept_part(part: Part, tolerance: float | None) -> tuple[Part, KeptTolerance 
 
 
 def _simplified(part: Part, tolerance: float | None) -> Part:
-    return make_part(part.outline, part.com, hull_tolerance=tolerance, name=part.name)
+    return make_part(
+        part.outline, part.com, hull_tolerance=tolerance, revision=part.revision, name=part.name
+    )
 
 
 def keeping_tolerance(part: Part, tolerance: float) -> KeptTolerance:
