@@ -36,6 +36,7 @@ from feederkit.sim.summary import (
     width_accuracy_warning,
     wilson,
 )
+from feederkit.sim.trial import CAUSES
 from feederkit.sources import load_part
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -267,3 +268,20 @@ def test_a_merged_states_facets_count_as_the_same_physical_state(tmp_path: Path,
     )
     assert main(["simulate", str(path), "--trials", "6"]) == 0
     assert "in the same physical state" in _words(capsys.readouterr().out)
+
+
+def test_no_branch_failures_under_a_fine_sensor_are_put_down_to_the_simulators_widths(capsys):
+    """With the width warning on, the cause row of 'reading in no branch' says it measures
+    the simulator's widths (they were listed as plain model errors)."""
+    import dataclasses
+
+    from feederkit.cli.simulate import _print_summary
+    from feederkit.sim.summary import TrialResult
+
+    miss = TrialResult(3, "part", 10.0, "failure", 2, "reading 26.86", None, (), CAUSES[2], False)
+    base = sim_summary({"part": (9, 10)}, failures=(miss,))
+    for warning, shown in ((None, False), ("the sensor is finer than the widths", True)):
+        _print_summary(dataclasses.replace(base, width_warning=warning), "declared")
+        out = " ".join(capsys.readouterr().out.split())
+        assert "reading in no branch" in out
+        assert ("(the simulator's widths: see the warning)" in out) is shown

@@ -49,6 +49,7 @@ from feederkit.sim.api import (
 from feederkit.sim.engine import require_mujoco
 from feederkit.sim.real import RealPart, real_parts
 from feederkit.sim.summary import SimulationSummary
+from feederkit.sim.trial import CAUSES
 
 SHOWN_ROWS = 20
 """Failures and misses listed in the terminal (all of them are in ``--json``)."""
@@ -86,7 +87,9 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
     table.add_row("never settled", str(len(s.unsettled)))
     table.add_row("model errors (not predicted)", str(s.model_errors))
     for cause, n in s.by_cause().items():
-        table.add_row(f"  {escape(cause)}", str(n))
+        # Finer than the simulated widths are accurate, such readings measure the simulator.
+        why = " (the simulator's widths: see the warning)" if cause == CAUSES[2] else ""
+        table.add_row(f"  {escape(cause)}", f"{n}{why if s.width_warning else ''}")
     table.add_row("push agreement", s.push_words())
     # As plan prints it (plan_render): the same digits in both places.
     margin = "none (no rotations)" if s.min_margin_deg is None else f"±{s.min_margin_deg:.4f}°"
