@@ -164,3 +164,18 @@ def test_analyze_exits_1_when_pairs_cannot_be_told_apart(tmp_path, db, capsys):
     # Without a sensor no pair is told apart (section 8.6): a result to act on too (rev53 #6).
     code, _, err = run(capsys, "catalog", "analyze", "--json", "--catalog", str(db))
     assert code == 1 and err.strip().splitlines()[-1].startswith("result: without a sensor")
+
+
+def test_a_missing_catalog_is_worded_alike_by_every_command(tmp_path, capsys):
+    missing = str(tmp_path / "none.db")
+    lines = set()
+    for args in (
+        ["list"],
+        ["show", "x"],
+        ["analyze"],
+        ["export", "x", "-o", str(tmp_path / "p.json")],
+    ):
+        assert main(["catalog", *args, "--catalog", missing]) == 2
+        lines.add(capsys.readouterr().err.strip())
+    want = f"error: {missing}: no catalog there (create one with 'feederkit catalog init')"
+    assert lines == {want}

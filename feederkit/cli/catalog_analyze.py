@@ -20,6 +20,7 @@ from feederkit.catalog import (
     part_from_revision,
     resolve_catalog_path,
 )
+from feederkit.catalog.schema import no_catalog
 from feederkit.cli.common import (
     CatalogOpt,
     ComToleranceOpt,
@@ -57,7 +58,7 @@ def catalog_file(option: Path | None) -> Path:
     path = resolve_catalog_path(option)
     try:
         if not path.is_file():
-            raise InputError(f"no catalog at {path} (create one with: feederkit catalog init)")
+            raise no_catalog(path)
     except OSError as exc:
         raise InputError(f"{path}: cannot open the catalog ({exc.strerror})") from None
     return path
