@@ -90,7 +90,8 @@ def test_the_import_lowers_the_tolerance_of_a_washer_with_a_flat(tmp_path):
     (ip,) = import_parts(path, ImportOptions())[1]
     assert ip.hull_tolerance < 0.05
     (note,) = [w for w in ip.warnings if w.startswith("hull tolerance")]
-    assert "not 0.05" in note and "where the outline rests in 2" in note
+    assert "not 0.05" in note and "rests in two states where the outline rests in one" in note
+    assert "simplified 33, outline 2" in note
     states = _resting(ip.part).states
     assert len(states) == 2  # the flat and the arc's lowest point, nothing between
     arc = next(s for s in states if s.rest_deg[0] < 270.0 < s.rest_deg[1])

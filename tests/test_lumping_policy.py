@@ -250,7 +250,7 @@ def test_lumping_any_plans_the_unlike_poses_and_warns(sensor):
     verify_strong(made.plan)
     assert made.result.lumped_pairs
     (words,) = (w for w in made.warnings if w.startswith("results list"))
-    assert "not near-symmetric" in words and "a smaller rotation error may" in words
+    assert "not near-symmetric" in words and "the default lumping says which" in words
     assert "--" not in words  # library words, no command-line flag
     assert strong_plan_exists(made.result.machine, options)
 

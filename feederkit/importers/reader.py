@@ -137,8 +137,9 @@ def lowered_warning(kept: KeptTolerance) -> str:
     """The import's note that it simplified the contact hull less than asked, and why."""
     return (
         f"hull tolerance {kept.tolerance:.3g} mm, not {kept.asked:.3g}: at {kept.asked:.3g} mm"
-        f" the simplified hull rests in {kept.model} states where the outline rests in"
-        f" {kept.outline} (chords across its arcs hold the part where it rolls)"
+        " the simplified hull rests in two states where the outline rests in one (chords"
+        " across its arcs hold the part where it rolls; resting states in all: simplified"
+        f" {kept.model}, outline {kept.outline})"
     )
 
 

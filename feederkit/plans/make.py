@@ -398,8 +398,8 @@ def _lump_shapes(
     words = f"; {whose} differ by at most {worst:.3g} mm ({share:.2g} % of the part)"
     if worst > NEAR_SYMMETRIC_REL * size:
         words += (
-            ": not near-symmetric, so the plan does not orient them apart; a smaller "
-            "rotation error may"
+            ": not near-symmetric, so the plan does not orient them apart (the default "
+            "lumping says which rotation error, if any, has a plan that does)"
         )
     return words
 
