@@ -59,6 +59,25 @@ def plan_part_entry(part: Part, revision: str | None = None) -> dict:
     }
 
 
+def run_cli(capsys, *args: str) -> tuple[int, str, str]:
+    """Run the command line in process: exit code, stdout, stderr."""
+    from feederkit.cli.app import main
+
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def cli_ok(capsys, args: list[str], code: int = 0):
+    """Run ``feederkit args``, which must exit ``code``; the captured output."""
+    from feederkit.cli.app import main
+
+    rc = main(args)
+    captured = capsys.readouterr()
+    assert rc == code, captured.err
+    return captured
+
+
 def one_line_error(capsys, args: list[str], code: int = 2) -> str:
     """Run ``feederkit args``: it exits ``code`` with one line on stderr, no traceback."""
     from feederkit.cli.app import main

@@ -10,9 +10,9 @@ import shutil
 from pathlib import Path
 
 import pytest
+from shared import run_cli
 
 import feederkit.catalog.bulk as bulk
-from feederkit.cli.app import main
 from feederkit.errors import InputError
 
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
@@ -27,11 +27,7 @@ def here(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path
 
 
-def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    """Run the command line in process: exit code, stdout, stderr."""
-    code = main(list(args))
-    out, err = capsys.readouterr()
-    return code, out, err
+run = run_cli  # (code, stdout, stderr) of the command line, in process
 
 
 def broken_folder(here: Path) -> Path:

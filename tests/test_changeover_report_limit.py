@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from shared import cli_ok
 
 from feederkit.cli.app import main
 from feederkit.design.limit import DesignClock
@@ -22,11 +23,7 @@ SLOW_S = 8.0
 budget of 60 s would let it run this long)."""
 
 
-def ok(capsys, args: list[str], code: int = 0):
-    rc = main(args)
-    captured = capsys.readouterr()
-    assert rc == code, captured.err
-    return captured
+ok = cli_ok  # feederkit ARGS exits CODE; the captured output
 
 
 @pytest.fixture()

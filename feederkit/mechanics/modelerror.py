@@ -182,7 +182,9 @@ def kept_part(part: Part, tolerance: float | None) -> tuple[Part, KeptTolerance 
     """``part`` (on its outline's exact hull) with its contact hull simplified at
     ``tolerance`` or the :func:`keeping_tolerance` below it, and that choice (None when
     nothing is simplified: no tolerance, or no hull vertex to drop)."""
-    if tolerance is None or tolerance <= 0.0:
+    if tolerance is None:
+        return part, None  # already on its exact hull
+    if tolerance <= 0.0:
         return _simplified(part, tolerance), None
     first = _simplified(part, tolerance)
     if len(first.hull) == len(part.hull):

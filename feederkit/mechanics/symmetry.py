@@ -153,15 +153,22 @@ next station (:func:`pose_difference`): the near-symmetric poses a plan under un
 list together (docs/planning.md, "Near-symmetric states under uncertainty")."""
 
 
-def _placed(pf: PushFunction, state: int) -> np.ndarray:
-    """The hull's vertices with the part resting in stable state ``state``: rotated by its
-    pose, on the fence line (y = 0) and centred along it."""
-    hull = np.asarray(pf.part.hull, dtype=float)
+def _pose_frame(pf: PushFunction, state: int) -> tuple[np.ndarray, np.ndarray]:
+    """The rotation (2 x 2) and the shift that place the part resting in stable state
+    ``state``: rotated by its pose, its hull on the fence line (y = 0) and centred along it;
+    a point ``p`` goes to ``rot @ p - shift``."""
     t = math.radians(pf.states[state].pose_deg)
     rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
-    pts = hull @ rot.T
+    pts = np.asarray(pf.part.hull, dtype=float) @ rot.T
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return pts - np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+    return rot, np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+
+
+def _placed(pf: PushFunction, state: int) -> np.ndarray:
+    """The hull's vertices with the part resting in stable state ``state``
+    (:func:`_pose_frame`)."""
+    rot, shift = _pose_frame(pf, state)
+    return np.asarray(pf.part.hull, dtype=float) @ rot.T - shift
 
 
 def _normals(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -253,12 +260,7 @@ def _has_more_than_hull(pf: PushFunction) -> bool:
 def _placed_outline(pf: PushFunction, state: int) -> shapely.MultiLineString:
     """The outline's boundary (outer ring and holes) placed as :func:`_placed` places the
     hull, sampled every :data:`OUTLINE_SPACING_REL` of the part's size."""
-    hull = np.asarray(pf.part.hull, dtype=float)
-    t = math.radians(pf.states[state].pose_deg)
-    rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
-    pts = hull @ rot.T
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    shift = np.array([(lo[0] + hi[0]) / 2.0, lo[1]])
+    rot, shift = _pose_frame(pf, state)
     outline = pf.part.outline
     rings = [np.asarray(r, dtype=float) for r in (outline.vertices, *outline.holes)]
     lines = [np.vstack([r, r[:1]]) @ rot.T - shift for r in rings]
