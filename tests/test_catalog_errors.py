@@ -7,6 +7,7 @@ The damaged-row cases edit a real SQLite file with ``UPDATE``; the busy case hol
 
 from __future__ import annotations
 
+import gc
 import os
 import sqlite3
 import threading
@@ -204,6 +205,39 @@ def test_unwritable_folder_is_not_called_a_foreign_file(tmp_path, monkeypatch):
     with pytest.raises(InputError) as exc:
         cat.open_catalog(tmp_path / ("x" * 300 + ".db"), create=True)
     assert "too long" in one_line(exc)
+
+
+def _folder_unwritable(monkeypatch, folder: Path) -> None:
+    """The folder reads as not writable (as a read-only mount does; root may write anyway)."""
+    real = os.access
+    monkeypatch.setattr(
+        "feederkit.catalog.schema.os.access",
+        lambda p, mode: False if Path(p) == folder and mode == os.W_OK else real(p, mode),
+    )
+
+
+def test_catalog_in_a_read_only_folder_is_read_not_written(db, monkeypatch):
+    gc.collect()  # the fixture's connection: closed, so the catalog has no -wal and -shm
+    before, files = snapshot(db), sorted(db.parent.iterdir())
+    assert files == [db]
+    _folder_unwritable(monkeypatch, db.parent)
+    # Reads work, without the -wal and -shm files SQLite could not make there.
+    assert [p.name for p in cat.list_parts(db)] == ["l-bracket"]
+    assert cat.get_part(db, "l-bracket").outline.name == "l-bracket"
+    assert sorted(db.parent.iterdir()) == files
+    # A write is refused with one line naming the folder; nothing changes.
+    with pytest.raises(InputError) as exc:
+        cat.add_outline(db, square("other"))
+    assert "not writable" in one_line(exc) and str(db.parent) in one_line(exc)
+    assert snapshot(db) == before
+
+
+def test_old_catalog_in_a_read_only_folder_says_to_copy_it(db, monkeypatch):
+    edit(db, "PRAGMA user_version = 1")
+    _folder_unwritable(monkeypatch, db.parent)
+    with pytest.raises(InputError) as exc:
+        cat.list_parts(db)
+    assert "schema version 1" in one_line(exc) and "copy" in one_line(exc)
 
 
 def test_full_disk_leaves_the_catalog_intact(db):

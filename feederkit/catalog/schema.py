@@ -284,6 +284,21 @@ def migrate(conn: sqlite3.Connection) -> int:
     return version
 
 
+def _readable_as_is(conn: sqlite3.Connection, p: Path) -> None:
+    """Refuse a catalog in a read-only folder whose schema this feederkit cannot read as it is
+    (an older one would need its migration written first)."""
+    version = schema_version(conn)
+    if version > SCHEMA_VERSION:
+        migrate(conn)  # the newer-schema error
+    if version < SCHEMA_VERSION:
+        folder = p.parent if str(p.parent) else Path(".")
+        raise InputError(
+            f"{p}: the catalog has schema version {version} and this feederkit reads "
+            f"{SCHEMA_VERSION}; upgrading it writes, and its folder {folder} is not writable: "
+            "open a copy in a writable folder"
+        )
+
+
 def _text(raw: bytes) -> str:
     """Text that is not UTF-8 is read with surrogate escapes, so each row's check can name it."""
     return raw.decode("utf-8", "surrogateescape")
@@ -327,9 +342,24 @@ def connect(
             raise InputError(f"{p}: cannot create the catalog: the folder {folder} does not exist")
         if not _writable_dir(p):
             raise InputError(f"{p}: cannot create the catalog: the folder {folder} is not writable")
+    # In a folder we cannot write, SQLite cannot make the -wal and -shm files a WAL
+    # catalog's reader needs: the catalog is opened read-only, and immutable when no
+    # write-ahead log is beside it (a closed catalog has none: its content is all in the
+    # file, and nobody writes it through this folder).
+    read_only = exists and not _writable_dir(p)
     try:
-        conn = sqlite3.connect(p, isolation_level=None, timeout=wait, factory=CatalogConnection)
-    except sqlite3.Error as exc:
+        if read_only:
+            log = p.with_name(p.name + "-wal")
+            flags = "mode=ro" if log.exists() and log.stat().st_size > 0 else "mode=ro&immutable=1"
+            uri = f"{p.resolve().as_uri()}?{flags}"
+            conn = sqlite3.connect(
+                uri, uri=True, isolation_level=None, timeout=wait, factory=CatalogConnection
+            )
+        else:
+            conn = sqlite3.connect(p, isolation_level=None, timeout=wait, factory=CatalogConnection)
+    except (sqlite3.Error, OSError) as exc:
+        if isinstance(exc, OSError):
+            raise InputError(f"{p}: cannot open the catalog ({exc.strerror})") from None
         raise catalog_error(exc, p) from None
     conn.path, conn.wait = p, wait
     conn.text_factory = _text
@@ -342,6 +372,9 @@ def connect(
                 raise InputError(f"{p}: an SQLite file but not a feederkit catalog")
             if not create:
                 raise no_catalog(p, "an SQLite file without tables")
+        if read_only:
+            _readable_as_is(conn, p)
+            return conn
         mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
         if str(mode).lower() != "wal":
             raise InputError(f"{p}: the catalog cannot use WAL journaling (got {mode})")
