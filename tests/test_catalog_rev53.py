@@ -206,3 +206,40 @@ def test_is_outline_file_decides_by_whether_the_text_parses(tmp_path) -> None:
         assert bulk.is_outline_file(path) is expected, text
     (tmp_path / "latin1.json").write_bytes(b'{"name": "\xe9"}')
     assert bulk.is_outline_file(tmp_path / "latin1.json")
+
+
+# 8e. A Ctrl-C while the results are printed, after the work is stored and written, says so.
+
+
+def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys, monkeypatch):
+    import feederkit.cli.changeover as changeover_cli
+
+    db = two_parts(here, capsys, "octagon.json", "isosceles-right-triangle.json")
+
+    def interrupt(*_args: object, **_kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(changeover_cli, "plan_tree", interrupt)  # drawn after the commit
+    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
+    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    assert code == 130
+    (line,) = err.splitlines()
+    assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
+    assert "wrote the plan to c1.json" in line and "only the printing was cut" in line
+    assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
+    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
+    assert code == 0 and [c["name"] for c in json.loads(out)] == ["c1"]
+
+
+def test_ctrl_c_before_anything_is_stored_says_only_interrupted(here, capsys, monkeypatch):
+    import feederkit.cli.changeover as changeover_cli
+
+    db = two_parts(here, capsys, "octagon.json", "isosceles-right-triangle.json")
+
+    def interrupt(*_args: object, **_kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(changeover_cli, "compile_changeover", interrupt)
+    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
+    code, _, err = run(capsys, *args, "--tolerance", "0.2", "--catalog", db)
+    assert (code, err) == (130, "error: interrupted\n")

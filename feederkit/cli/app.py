@@ -42,7 +42,13 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     import feederkit
     from feederkit.catalog import set_busy_notifier
     from feederkit.cli import helpstyle
-    from feederkit.cli.common import JSON_ANSWER, err_console, json_failure, print_json
+    from feederkit.cli.common import (
+        DONE_WORK,
+        JSON_ANSWER,
+        err_console,
+        json_failure,
+        print_json,
+    )
     from feederkit.errors import FeederkitError
 except KeyboardInterrupt:
     sys.stderr.write("error: interrupted\n")
@@ -339,21 +345,22 @@ def main(argv: list[str] | None = None) -> int:
     """
     set_busy_notifier(_notify_busy)
     JSON_ANSWER.reset()
+    DONE_WORK.reset()
     args = sys.argv[1:] if argv is None else list(argv)
     with _CtrlCWatch() as ctrl_c, _guarded_stdout():
         try:
             code = _run_app(args)
             if ctrl_c.seen and code != EXIT_INTERRUPTED:  # a library swallowed the interrupt
-                _say("interrupted")
+                _say(DONE_WORK.interrupted())
                 return EXIT_INTERRUPTED
             return code
         except Exception as exc:  # noqa: BLE001 - the boundary: every error becomes one line
             if ctrl_c.seen or _from_interrupt(exc):
-                _say("interrupted")
+                _say(DONE_WORK.interrupted())
                 return EXIT_INTERRUPTED
             return _error_exit(exc, args)
         except KeyboardInterrupt:
-            _say("interrupted")
+            _say(DONE_WORK.interrupted())
             return EXIT_INTERRUPTED
         finally:
             set_busy_notifier(None)
@@ -381,7 +388,7 @@ def _run_app(args: list[str]) -> int:
         if not isinstance(code, int):
             return 2
     if isinstance(code, int) and code == EXIT_INTERRUPTED:  # typer's Exit(130) for Ctrl-C
-        _say("interrupted")
+        _say(DONE_WORK.interrupted())
     return code if isinstance(code, int) else 0
 
 

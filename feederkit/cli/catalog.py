@@ -39,6 +39,7 @@ from feederkit.catalog import (
 )
 from feederkit.cli.catalog_analyze import analyze_command
 from feederkit.cli.common import (
+    DONE_WORK,
     CatalogOpt,
     JsonOpt,
     console,
@@ -205,6 +206,11 @@ def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
     }
 
 
+def _stored_words(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> str:
+    """What an import stored, in words: "3 parts in the catalog" (unchanged ones too)."""
+    return f"{len(outcomes)} part{'s' if len(outcomes) != 1 else ''} in the catalog"
+
+
 def _warn(outcomes: list[AddOutcome] | tuple[AddOutcome, ...]) -> None:
     for o in outcomes:
         for w in o.warnings:
@@ -303,6 +309,7 @@ def cmd_add(
         outcomes = add_file(
             conn, file, opts, name=name, revise=revise, side_probability=side_probability
         )
+    DONE_WORK.note(f"stored {_stored_words(outcomes)}")
     _warn(outcomes)
     if json_out:
         print_json([_outcome_dict(o) for o in outcomes])
@@ -371,6 +378,7 @@ def cmd_import(
                 skip_bad=skip_bad,
                 side_probability=side_probability,
             )
+    DONE_WORK.note(f"stored {_stored_words(result.outcomes)}")
     _warn(result.outcomes)
     for line in result.bad:
         err_console.print(f"[yellow]skipped:[/] {escape(line)}", highlight=False, soft_wrap=True)

@@ -29,6 +29,7 @@ from feederkit.catalog import list_changeovers, remove_changeover, resolve_catal
 from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
+    DONE_WORK,
     FLAG_TERMS,
     LANDING_TERMS,
     AcceptOpt,
@@ -59,6 +60,7 @@ from feederkit.cli.common import (
     cycle_line,
     flag_words,
     json_found,
+    note_written,
     plan_outputs,
     plural,
     print_json,
@@ -407,6 +409,8 @@ def compile_command(
             shares=shares,
             **over,
         )
+    DONE_WORK.note(f"stored changeover {name!r} in {path}")
+    note_written((output, "plan"), (report, "report"))
     plan, witnesses, pfs = compiled.plan, list(compiled.witnesses), list(compiled.parts)
     lands = landings_text(plan, compiled.rejected)
     cycle = plan["stats"].get("cycle_time")
@@ -574,6 +578,7 @@ def export_command(
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     write_files([OutputFile(output, plan_file_text(co.plan), "plan file")])
+    note_written((output, "plan"))
     if json_out:
         print_json(
             {
@@ -634,6 +639,7 @@ def report_command(
     print_warnings(co.warnings)
     html = changeover_report(co.plan, list(co.parts), co.witnesses(), design_limit)
     write_files([OutputFile(output, html, "report")])
+    note_written((output, "report"))
     console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)
 
 

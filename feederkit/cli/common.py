@@ -66,6 +66,31 @@ class JsonAnswer:
 JSON_ANSWER = JsonAnswer()
 
 
+class DoneWork:
+    """What this run has stored or written for good, in words, so that a Ctrl-C while the
+    results are printed says nothing is lost (a script need not redo the work)."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the previous run."""
+        self.done: list[str] = []
+
+    def note(self, what: str) -> None:
+        """``what`` is stored or written, e.g. ``"wrote the plan to P.json"``."""
+        self.done.append(what)
+
+    def interrupted(self) -> str:
+        """The line for a Ctrl-C now: ``interrupted``, and what was done before it."""
+        if not self.done:
+            return "interrupted"
+        return f"interrupted after it {'; '.join(self.done)} (only the printing was cut)"
+
+
+DONE_WORK = DoneWork()
+
+
 def _note_json(value: bool) -> bool:
     """The ``--json`` option's callback: note that machine-readable output was asked for."""
     if value:
@@ -446,6 +471,14 @@ def check_output_folders(output: Path | None, report: Path | None) -> None:
 
         check_report_path(report)
     check_outputs((output, "plan file"), (report, "report"))
+
+
+def note_written(*files: tuple[Path | None, str]) -> None:
+    """Note (:data:`DONE_WORK`) the files of this run now written: (path, what) pairs, a
+    None path not written."""
+    for path, what in files:
+        if path is not None:
+            DONE_WORK.note(f"wrote the {what} to {path}")
 
 
 def print_written(output: Path | None, report: Path | None) -> None:

@@ -48,6 +48,7 @@ from feederkit.cli.common import (
     flag_words,
     json_found,
     json_option,
+    note_written,
     plan_outputs,
     print_json,
     print_warnings,
@@ -247,6 +248,7 @@ def plan_command(
     cycle = annotate_cycle_time(made, settings)  # stats.cycle_time, before anything is written
     files, view = plan_outputs(plan, pfs, witnesses, output, report)
     write_files(files)
+    note_written((output, "plan"), (report, "report"))
     notes = [*made.warnings]
     note = time_limit_note(plan["stats"], options.time_limit_s)
     if note is not None:
