@@ -197,6 +197,45 @@ def test_one_tree_node_per_plan_node_and_one_leaf_per_final_pose(make):
     assert len(doc.with_class("final-pose")) == count_final_poses(plan["root"])
 
 
+class Nesting(HTMLParser):
+    """Whether every ``ul`` and ``li`` opened is closed, in order."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.open: list[str] = []
+        self.ok = True
+
+    def handle_starttag(self, tag, attrs):
+        if tag in ("ul", "li"):
+            self.open.append(tag)
+
+    def handle_endtag(self, tag):
+        if tag in ("ul", "li"):
+            self.ok = self.ok and bool(self.open) and self.open.pop() == tag
+
+
+@pytest.mark.parametrize("limit", [1, 3, 5])
+def test_a_tree_too_large_stops_and_says_what_it_left_out(monkeypatch, limit):
+    import feederkit.reports.tree_html as tree_html
+
+    plan = triangle_plan()
+    whole = parse(render_report(plan))
+    assert not whole.with_class("tree-stop")
+    monkeypatch.setattr(tree_html, "TREE_FIGURES", limit)
+    html = render_report(plan)
+    doc = parse(html)
+    (stop,) = doc.with_class("tree-stop")
+    drawn = doc.with_class("tree-node")
+    assert 0 < len(drawn) < count_nodes(plan["root"])
+    # Every distinct node is drawn or counted as left out (this plan shares none).
+    left = int(stop["data-operations"]) + int(stop["data-results"])
+    assert len(drawn) + left == count_nodes(plan["root"])
+    assert "the drawing stops after" in "".join(doc.text)
+    nesting = Nesting()
+    nesting.feed(html[html.index('<ul class="tree">') :])
+    assert nesting.ok
+
+
 def test_the_tree_shows_the_possible_states_at_each_node():
     doc = parse(render_report(triangle_plan()))
     by_id = {int(n["data-node-id"]): n for n in doc.with_class("tree-node")}
@@ -353,6 +392,17 @@ def test_per_part_section_has_a_state_table_and_an_embedded_plot():
     imgs = [a for t, a in doc.tags if t == "img"]
     assert len(imgs) == 1 and imgs[0]["src"].startswith("data:image/svg+xml;base64,")
     assert "Conventions as in design.md." in "".join(doc.text)
+
+
+def test_only_the_first_members_get_a_part_plot(monkeypatch):
+    import feederkit.reports.parts_html as parts_html
+
+    monkeypatch.setattr(parts_html, "PART_PLOTS", 1)
+    doc = parse(render_report(twin_plan()))
+    sections = doc.with_class("part")
+    assert len(sections) == 2 and len(doc.with_class("plot")) == 1
+    assert len(doc.with_class("plot-skipped")) == 1 and len(doc.with_class("states")) == 2
+    assert "feederkit part plot" in "".join(doc.text)
 
 
 def test_symmetric_leaves_and_twins_are_reported():

@@ -171,7 +171,7 @@ def plan_tree(plan: Plan | Mapping[str, Any], max_lines: int = PLAN_TREE_LINES) 
             Text(
                 f"... the drawing stops after {lines} lines: {plural(ops, 'more operation')} "
                 f"and {plural(results, 'more result')} are in the plan file (feederkit run "
-                "PLAN --all walks every path; feederkit report draws the whole plan)",
+                "PLAN --all walks every path; feederkit report draws more of it)",
                 style="cyan",
             )
         )

@@ -9,7 +9,8 @@ them), and each other place is one ``div.tree-ref`` with ``data-ref`` (the node 
 drawn state is a figure with ``data-part``, ``data-landing`` (empty when the plan is not over
 landings) and ``data-state``, a final pose of a leaf a ``figure.final-pose`` also with
 ``data-pose-deg``; each edge is one ``div.edge`` with ``data-action-deg`` (empty at the root)
-and ``data-reading`` (``lo..hi``, empty when sensorless).
+and ``data-reading`` (``lo..hi``, empty when sensorless). A drawing stopped by its size
+ends with one ``li.tree-stop`` with ``data-operations`` and ``data-results`` (left out).
 """
 
 from __future__ import annotations
@@ -26,6 +27,11 @@ STATE_PX = 56
 
 FINAL_PX = 72
 """Drawn size of a final pose in a leaf."""
+
+TREE_FIGURES = 10_000
+"""The tree stops drawing nodes once it has drawn this many states (about 1.4 KB of SVG
+each): the plan of a 50-part mix drew 111,656 of them, a 151 MB page no browser shows well.
+Its last item says how much it left out; the plan file has all of it."""
 
 
 @dataclass(frozen=True)
@@ -200,6 +206,20 @@ def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: 
     )
 
 
+def _stop_item(numbered: Sequence[Place], drawn: set[int], figures: int) -> str:
+    """The last item of a drawing that stopped after ``figures`` states: what it left out."""
+    left = [p for p in numbered if p.node_id not in drawn]
+    ops = sum(1 for p in left if isinstance(p.node, Step))
+    results = len(left) - ops
+    return (
+        f'<li class="tree-stop" data-operations="{ops}" data-results="{results}">'
+        f"... the drawing stops after {figures:,} drawn states: {ops:,} more "
+        f"operation{'s' if ops != 1 else ''} and {results:,} more "
+        f"result{'s' if results != 1 else ''} are in the plan file (feederkit run PLAN --all "
+        "walks every path)</li>"
+    )
+
+
 def _ref(place: Place, name: str | None) -> str:
     """Another place of a shared node: its name (a shared subplan) and node, drawn above."""
     what = "the result" if name is None else f"the shared subplan {esc(name)}"
@@ -209,14 +229,26 @@ def _ref(place: Place, name: str | None) -> str:
     )
 
 
-def tree_html(plan: Plan, numbered: Sequence[Place], trace: Trace, draw: Drawing) -> str:
-    """The whole plan as nested lists: operation nodes, labelled edges, leaves; each distinct
+def tree_html(
+    plan: Plan,
+    numbered: Sequence[Place],
+    trace: Trace,
+    draw: Drawing,
+    max_figures: int | None = None,
+) -> str:
+    """The plan as nested lists: operation nodes, labelled edges, leaves; each distinct
     node drawn once (at its first place; a shared subplan named ``S1``, ``S2``, ... and
-    referred to by name elsewhere, as ``plan_tree`` does), without recursion."""
+    referred to by name elsewhere, as ``plan_tree`` does), without recursion. After
+    ``max_figures`` (default ``TREE_FIGURES``) drawn states the drawing stops (the nodes
+    begun are closed) and a last item (``li.tree-stop``) says how many operations and
+    results it left out."""
+    max_figures = TREE_FIGURES if max_figures is None else max_figures
     out: list[str] = ['<ul class="tree">']
+    figures = 0
     stack: list[str | tuple[int, str]] = [(0, "")]
     names: dict[int, str | None] = {}
     drawn: set[int] = set()
+    subplans = 0
     while stack:
         item = stack.pop()
         if isinstance(item, str):
@@ -230,12 +262,22 @@ def tree_html(plan: Plan, numbered: Sequence[Place], trace: Trace, draw: Drawing
         drawn.add(number)
         shared = None
         if place.shared and isinstance(place.node, Step):
-            shared = f"S{sum(n is not None for n in names.values()) + 1}"
+            subplans += 1
+            shared = f"S{subplans}"
         names[number] = shared
-        if isinstance(place.node, Leaf):
-            out.append(f"<li>{edge}{_result_node(plan, trace, draw, place, shared)}</li>")
+        if figures >= max_figures:
+            drawn.discard(number)
+            stack = [x for x in stack if isinstance(x, str)]  # close the nodes begun
+            out.append(_stop_item(numbered, drawn, figures))
             continue
-        out.append(f"<li>{edge}{_op_node(plan, trace, draw, place, shared)}<ul>")
+        if isinstance(place.node, Leaf):
+            html = _result_node(plan, trace, draw, place, shared)
+            figures += html.count("<svg")
+            out.append(f"<li>{edge}{html}</li>")
+            continue
+        html = _op_node(plan, trace, draw, place, shared)
+        figures += html.count("<svg")
+        out.append(f"<li>{edge}{html}<ul>")
         stack.append("</ul></li>")
         step = place.node
         stack.extend(
