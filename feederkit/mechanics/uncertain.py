@@ -581,22 +581,23 @@ def _strong_components(edges: Sequence[set[int]]) -> list[int]:
 def _destinations(
     edges: Sequence[set[int]], comp: Sequence[int], pid_of: Mapping[int, int]
 ) -> list[frozenset[int]]:
-    """For each ideal state, the physical states it may stay in or vibration may take it to.
-
-    Kosaraju numbers the components in topological order, so the last ones are done first.
-    """
+    """For each ideal state, the physical states it may stay in or vibration may take it to:
+    every component reachable over ``edges`` (which may join components both ways)."""
     labels = max(comp) + 1
     succ: list[set[int]] = [set() for _ in range(labels)]
     for i, out in enumerate(edges):
         for j in out:
             if comp[j] != comp[i]:
                 succ[comp[i]].add(comp[j])
-    reach: list[frozenset[int]] = [frozenset()] * labels
-    for cc in range(labels - 1, -1, -1):
-        got = {pid_of[cc]} if cc in pid_of else set()
-        for nxt in succ[cc]:
-            got |= reach[nxt]
-        reach[cc] = frozenset(got)
+    reach: list[frozenset[int]] = []
+    for cc in range(labels):
+        seen, todo = {cc}, [cc]
+        while todo:
+            for nxt in succ[todo.pop()]:
+                if nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        reach.append(frozenset(pid_of[x] for x in seen if x in pid_of))
     return [reach[comp[i]] for i in range(len(edges))]
 
 
@@ -717,21 +718,37 @@ def uncertain_mechanics(
     # Crossing graph: ideal state i -> its neighbour across a hill when some rest candidate in
     # i's basin may lie less than the vibration below that hilltop for some shape (F1: its
     # resting height is within r(normal) +- rho_max * half-width, r's slope bound, +- eps).
-    edges: list[set[int]] = [set() for _ in range(pf.n)]
+    # ``wander`` holds the crossings from i's deepest candidate too: a part at rest anywhere
+    # in i may cross, so i and j are one state where they cross both ways. ``carry`` holds
+    # those from candidates near the hilltop only (a short chord of a fillet tilted by the
+    # shape tolerance): a push that ends there may end beyond, but a part at rest in i's
+    # well stays, and the readings still tell i from j.
+    wander: list[set[int]] = [set() for _ in range(pf.n)]
+    carry: list[set[int]] = [set() for _ in range(pf.n)]
     if threshold > 0.0 and cands:
         arr = _candidate_arrays(cands)
         slack = rho_max * np.radians(arr.half)
         height = np.asarray([x.height_mm for x in cands])
         top = height + 2.0 * t + slack
+        deepest = np.full(pf.n, np.inf)
+        np.minimum.at(deepest, arr.basin, top)
         range_of = np.empty(pf.n, dtype=int)
         range_of[np.asarray(rs)] = np.arange(m)
         k = range_of[arr.basin]
         for hill, beyond in ((k, left[k]), ((k + 1) % m, right[(k + 1) % m])):
             other = beyond != arr.basin
             cross = other & (peaks[hill] - top < threshold)
-            for i, j in set(zip(arr.basin[cross].tolist(), beyond[cross].tolist(), strict=True)):
-                edges[i].add(j)
-    comp = _strong_components(edges)
+            anywhere = peaks[hill] - deepest[arr.basin] < threshold
+            for i, j, w in set(
+                zip(
+                    arr.basin[cross].tolist(),
+                    beyond[cross].tolist(),
+                    anywhere[cross].tolist(),
+                    strict=True,
+                )
+            ):
+                (wander if w else carry)[i].add(j)
+    comp = _strong_components(wander)
     first_member: dict[int, int] = {}
     for i in range(pf.n):
         first_member.setdefault(comp[i], i)
@@ -742,7 +759,7 @@ def uncertain_mechanics(
     kept = sorted(set(comp), key=first_member.__getitem__)
     pid_of = {cc: p for p, cc in enumerate(kept)}
     state_of = [pid_of.get(comp[i]) for i in range(pf.n)]
-    destinations = _destinations(edges, comp, pid_of)
+    destinations = _destinations([w | x for w, x in zip(wander, carry, strict=True)], comp, pid_of)
 
     states: list[PhysicalState] = []
     by_basin: dict[int, list[RestCandidate]] = {}
