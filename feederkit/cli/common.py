@@ -248,7 +248,10 @@ ShapeToleranceOpt = Annotated[
     typer.Option(
         "--shape-tolerance",
         metavar="MM",
-        help="Every hull vertex lies within MM of its drawn position.",
+        help=(
+            "Every hull vertex lies within MM of its drawn position (a profile tolerance of "
+            "+-P moves a corner of angle B by P / sin(B/2): docs/uncertainty.md)."
+        ),
     ),
 ]
 ComToleranceOpt = Annotated[

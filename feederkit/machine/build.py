@@ -161,6 +161,7 @@ def uncertain_machine(
         # costs more than the build on a part of hundreds of near-round facets).
         unlike = any(len(alike[s.id]) < mech.n - 1 for s in mech.states)
         twins = ideal_twins(pf, mech) if unlike else [set()] * mech.n
+        wandering = unlike_members(pf, mech)
         for s in mech.states:
             lo, hi = ends[k]
             k += 1
@@ -175,6 +176,7 @@ def uncertain_machine(
                     look_alike=tuple(
                         mech.states[t].members[0] for t in sorted({*alike[s.id], *twins[s.id]})
                     ),
+                    unlike_members=s.id in wandering,
                 )
             )
             ranges = []
@@ -196,6 +198,39 @@ def uncertain_machine(
 TWIN_MAX_STATES = 64
 """Parts with more ideal stable states get no :func:`ideal_twins` (the pair fixpoint costs
 0.7 s at 114 states and 14 s at 429; such near-round parts' alike poses are near-congruent)."""
+
+
+def unlike_members(pf: PushFunction, mech: UncertainMechanics) -> set[int]:
+    """The physical states of ``mech`` holding two ideal members that neither look alike
+    (:func:`~feederkit.mechanics.symmetry.look_alike`) nor are told apart by no plan on the
+    ideal model (:func:`ideal_twins`' rule): a part at rest may wander between them (the
+    merge rule, docs/uncertainty.md), so a result holding such a state does not orient the
+    part."""
+    merged = [s for s in mech.states if len(s.members) > 1]
+    out: set[int] = set()
+    twins: tuple[int, ...] | None = None
+    index: dict[int, int] = {}
+    for s in merged:
+        alike = look_alike(pf, [(m,) for m in s.members])
+        far = [(a, b) for a in range(len(s.members)) for b in _alike_missing(alike, a)]
+        if not far:
+            continue
+        if pf.n > TWIN_MAX_STATES:
+            out.add(s.id)
+            continue
+        if twins is None:
+            ideal = build_machine([pf], NoSensor(), IDEAL)
+            twins = inseparable_masks(ideal)
+            index = {x.state: i for i, x in enumerate(ideal.states)}
+        rows = [index[m] for m in s.members]
+        if any(not twins[rows[a]] >> rows[b] & 1 for a, b in far):
+            out.add(s.id)
+    return out
+
+
+def _alike_missing(alike: Sequence[Sequence[int]], a: int) -> list[int]:
+    """The groups after ``a`` that ``alike[a]`` (:func:`look_alike`'s answer) does not name."""
+    return [b for b in range(a + 1, len(alike)) if b not in alike[a]]
 
 
 def ideal_twins(pf: PushFunction, mech: UncertainMechanics) -> list[set[int]]:

@@ -45,7 +45,9 @@ class MachineState:
     one part a leaf may list together, in the goal (``SearchSpace.alike``) and when no
     strong plan resolves them. The machine build records it under uncertainty; None (a
     machine built by hand, or the ideal model, where nothing is lumped) records nothing,
-    and then any pair may be listed.
+    and then any pair may be listed. ``unlike_members`` marks a physical state whose ideal
+    members include poses that do not look alike (a part at rest may wander between them
+    under the uncertainty: a leaf holding it does not orient the part).
     """
 
     part: int
@@ -56,6 +58,7 @@ class MachineState:
     members: tuple[int, ...] = ()
     reject: bool = False
     look_alike: tuple[int, ...] | None = None
+    unlike_members: bool = False
 
     @property
     def sensed(self) -> Diameter:

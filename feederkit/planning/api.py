@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import OverlapRange, PushAlignMachine, search_space
+from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
@@ -128,12 +128,16 @@ class NoStrongPlan(PlanningError):
         self.hint = hint
 
 
-def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
+def _uncertainty_words(machine: PushAlignMachine) -> str:
     u = machine.uncertainty
-    what = (
+    return (
         f"rotation error {u.rotation_error_deg:g} deg, shape tolerance "
         f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
     )
+
+
+def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
+    what = _uncertainty_words(machine)
     if undecided:
         return NoStrongPlan(f"no strong plan found within {_limit(machine)} operations ({what})")
     return NoStrongPlan(
@@ -158,9 +162,19 @@ def strong_plan_exists(
     options = options or PlanningOptions()
     if machine.n == 0:
         return False
+    budget = Deadline() if deadline is None else deadline
+    if options.lumping is not Lumping.ANY and any(s.unlike_members for s in machine.states):
+        # A plan may end only where the part does not wander between unlike poses, which the
+        # goal relation does not know (_refuse_wandering): the planner decides.
+        try:
+            plan(machine, replace(options, min_margin_deg=0.0), budget=budget)
+        except NoStrongPlan:
+            return False
+        except PlanningError:
+            return True  # undecided in time
+        return True
     if machine.deterministic:
         return True  # the ideal push machine: a part is always oriented up to inseparable states
-    budget = Deadline() if deadline is None else deadline
     sorted_machine, _old = by_diameter(machine)
     try:
         insep = goal_relation(sorted_machine, budget)
@@ -330,6 +344,8 @@ def _plan_machine(
             sorted_machine, options, budget, lumping.insep
         )
     share_bisimilar(machine, sorted_machine, old)
+    if options.lumping is not Lumping.ANY:
+        _refuse_wandering(sorted_machine, root)
     if sorted_machine is not machine:
         root = remap_tree(root, old)
     result = _result(
@@ -339,6 +355,37 @@ def _plan_machine(
     if lumping is None:
         return result
     return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
+
+
+def _refuse_wandering(machine: PushAlignMachine, root: Step | Leaf) -> None:
+    """Raise NoStrongPlan when a result of ``root`` holds a physical state whose members are
+    unlike poses a part at rest may wander between (``MachineState.unlike_members``): such a
+    result leaves the part unoriented, which only lumping ``any`` accepts."""
+    seen: set[int] = set()
+    todo: list[Step | Leaf] = [root]
+    while todo:
+        node = todo.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, Step):
+            todo.extend(child for _b, child in node.branches)
+            continue
+        for i in members(node.mask):
+            s = machine.states[i]
+            if s.unlike_members:
+                name = machine.part_names[s.part]
+                poses = ", ".join(str(m) for m in s.members)
+                raise NoStrongPlan(
+                    "no strong plan exists under the declared uncertainty "
+                    f"({_uncertainty_words(machine)}): under it a part at rest "
+                    f"may wander between unlike poses of {name} (states {poses}: their "
+                    "barriers lie below twice the shape and COM tolerances plus a breath of "
+                    "vibration, docs/uncertainty.md), and the plan found ends there",
+                    "a plan that lists them together, leaving the part unoriented between "
+                    "them, is given with lumping 'any'; a smaller --shape-tolerance or "
+                    "--com-tolerance may keep them apart",
+                )
 
 
 def _out_of_budget(options: PlanningOptions, reason: str) -> str:

@@ -1,0 +1,100 @@
+"""Physical resting states under a shape tolerance (docs/uncertainty.md, the merge rule): two
+states are one only where a part at rest anywhere in one may cross to the other; a result
+holding unlike poses a part may wander between is not an oriented part."""
+
+from __future__ import annotations
+
+import pytest
+from shapely.geometry import Polygon
+
+from feederkit.machine import build_machine
+from feederkit.machine.build import unlike_members
+from feederkit.mechanics import push_function
+from feederkit.mechanics.uncertain import uncertain_mechanics
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
+from feederkit.planning.options import Lumping, PlanningOptions
+from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.uncertainty import Uncertainty
+
+
+def filleted_bracket(quad_segs: int = 16):
+    """A 60 x 40 mm L-bracket with R3 fillets on its convex corners (arcs as short chords)."""
+    ell = Polygon([(0, 0), (60, 0), (60, 15), (15, 15), (15, 40), (0, 40)])
+    rounded = ell.buffer(-3, quad_segs=quad_segs).buffer(3, quad_segs=quad_segs)
+    return make_part(make_outline("lbf", list(rounded.exterior.coords)[:-1]))
+
+
+def quadrilateral():
+    pts = [(0.0, 0.0), (2.0, 0.0), (2.4, 1.6), (0.3, 2.0)]
+    return make_part(make_outline("quad", pts))
+
+
+@pytest.mark.parametrize("quad_segs", [8, 16, 32])
+@pytest.mark.parametrize("t", [0.03, 0.05])
+def test_fillet_chords_near_a_hilltop_do_not_merge_deep_wells(quad_segs, t):
+    # The fillets' short chords may tilt by asin(2t / chord) and rest near each hilltop, so a
+    # push ending there may end beyond it; the wells themselves (barriers of 2-15 mm) hold.
+    part = filleted_bracket(quad_segs)
+    mech = uncertain_mechanics(part, Uncertainty(1.0, t, 0.0))
+    assert all(len(s.members) == 1 for s in mech.states)
+    assert len(mech.states) == push_function(part).n
+    # ... and the neighbours beyond those hilltops are among the outcomes (conservative).
+    assert any(len(d) > 1 for d in mech.destinations)
+
+
+def test_the_filleted_bracket_gets_no_plan_listing_unlike_poses():
+    pf = push_function(filleted_bracket())
+    m = build_machine([pf], ToleranceSensor(0.1), Uncertainty(1.0, 0.03, 0.0))
+    try:
+        result = plan(m)
+    except NoStrongPlan:
+        return
+    for node in _leaves(result.root):
+        assert len(node) == 1 or all(m.states[i].alike(m.states[j]) for i in node for j in node)
+
+
+def _leaves(root):
+    from feederkit.machine import members
+    from feederkit.planning.tree import Leaf
+
+    todo, out = [root], []
+    while todo:
+        node = todo.pop()
+        if isinstance(node, Leaf):
+            out.append(members(node.mask))
+        else:
+            todo.extend(child for _b, child in node.branches)
+    return out
+
+
+def test_a_small_part_whose_wells_all_wander_is_not_oriented():
+    # 2 mm across, t = 0.1 and c = 0.2 mm: every barrier lies below 2 (t + c) plus the
+    # vibration, so the part at rest may wander between four unlike poses.
+    pf = push_function(quadrilateral())
+    unc = Uncertainty(1.0, 0.1, 0.2)
+    mech = uncertain_mechanics(pf.part, unc)
+    assert [len(s.members) for s in mech.states] == [pf.n]
+    assert unlike_members(pf, mech) == {0}
+    m = build_machine([pf], NoSensor(), unc)
+    assert m.states[0].unlike_members
+    with pytest.raises(NoStrongPlan, match="wander between unlike poses"):
+        plan(m)
+    assert not strong_plan_exists(m)
+    lumped = plan(m, PlanningOptions(lumping=Lumping.ANY))
+    assert lumped.length == 1
+    assert strong_plan_exists(m, PlanningOptions(lumping=Lumping.ANY))
+
+
+def test_merged_poses_that_look_alike_are_an_oriented_part():
+    # A regular octagon 1.8 mm across at t = 0.01, c = 0.02: its eight states are one (the
+    # barriers of about 0.07 mm wander), and its poses are congruent: a result may list them.
+    import math
+
+    pts = [(0.9 * math.cos(math.pi * k / 4), 0.9 * math.sin(math.pi * k / 4)) for k in range(8)]
+    pf = push_function(make_part(make_outline("oct", pts)))
+    unc = Uncertainty(1.0, 0.01, 0.02)
+    mech = uncertain_mechanics(pf.part, unc)
+    assert len(mech.states) == 1 and unlike_members(pf, mech) == set()
+    assert plan(build_machine([pf], NoSensor(), unc)).length == 1
