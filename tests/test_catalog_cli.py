@@ -293,3 +293,29 @@ def test_subprocess_exit_codes(tmp_path):
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
     usage = subprocess.run([*cmd, "catalog", "add"], capture_output=True, text=True)
     assert usage.returncode == 2 and "Traceback" not in usage.stderr
+
+
+def test_orientability_is_said_to_be_the_ideal_models(tmp_path, db, capsys):
+    """A part flagged orientable may have no strong plan at 1 degree: list, show and --json
+    say the flag is the ideal model's."""
+    square(tmp_path / "sq.json")
+    (added,) = run_json(capsys, "catalog", "add", str(tmp_path / "sq.json"), "--catalog", str(db))
+    assert added["orientable_ideal"] is True and added["orientable"] is True
+    (listed,) = run_json(capsys, "catalog", "list", "--catalog", str(db))
+    assert listed["orientable_ideal"] is True and listed["orientable"] is True
+    shown = run_json(capsys, "catalog", "show", "sq", "--catalog", str(db))
+    assert shown["orientable_ideal"] is True
+    code, out, _ = run(capsys, "catalog", "list", "--catalog", str(db))
+    assert code == 0 and "orient*" in out.splitlines()[0]
+    note = " ".join(out.split())
+    assert "* orient: pushing orients the part on the ideal model" in note
+    assert "catalog analyze --rotation-error DEG" in note and "under uncertainty" in note
+    assert out.splitlines()[-1] == "1 part"
+    assert max(len(line) for line in out.splitlines()) <= 80
+    code, out, _ = run(capsys, "catalog", "show", "sq", "--catalog", str(db))
+    assert code == 0 and "orientable (ideal)" in out
+
+
+def test_an_empty_list_has_no_footnote(db, capsys):
+    code, out, _ = run(capsys, "catalog", "list", "--catalog", str(db))
+    assert code == 0 and "ideal model" not in out and out.splitlines()[-1] == "0 parts"

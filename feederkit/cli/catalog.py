@@ -10,6 +10,7 @@ import re
 import sqlite3
 import stat
 import sys
+import textwrap
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -55,6 +56,32 @@ from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_sid
 
 RICH_TABLE_ROWS = 200
 """Longer tables are printed as plain columns."""
+
+ORIENTABLE_NOTE = (
+    "pushing orients the part on the ideal model (no rotation error, no vibration); "
+    "plan and catalog analyze --rotation-error DEG say whether it has a strong plan "
+    "under uncertainty"
+)
+"""What a part's stored ``orientable`` flag says: import judges it on the ideal push
+function, so a part flagged orientable may still have no strong plan at the default rotation
+error of 1 degree."""
+
+ORIENT_HEADER = "orient*"
+"""``catalog list``'s orientability column, marked for its footnote (the list keeps to 80
+columns for names up to 24 characters, so the header stays 7 wide)."""
+
+
+def orientable_fields(orientable: bool) -> dict[str, bool]:
+    """The JSON fields of a part's orientability: ``orientable_ideal``, and ``orientable``,
+    the same value under its older name."""
+    return {"orientable": orientable, "orientable_ideal": orientable}
+
+
+def orientable_footnote(width: int = 80) -> str:
+    """``catalog list``'s footnote on its :data:`ORIENT_HEADER` column, ``width`` wide."""
+    text = f"* {ORIENT_HEADER.rstrip('*')}: {ORIENTABLE_NOTE}"
+    return textwrap.fill(text, width=width, subsequent_indent="  ") + "\n"
+
 
 catalog_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -200,7 +227,7 @@ def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
         "revision": o.revision,
         "status": o.status,
         "source": o.source_path,
-        "orientable": o.orientable,
+        **orientable_fields(o.orientable),
         "warnings": list(o.warnings),
         "changes": list(o.changes),
     }
@@ -233,7 +260,7 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Pa
 
     Sources are shown relative to the imported folder ``root``.
     """
-    headers = ("part", "rev", "status", "orientable", "warnings", "file")
+    headers = ("part", "rev", "status", "orientable (ideal)", "warnings", "file")
     rows = [
         (
             o.name,
@@ -419,7 +446,7 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
                     "area": p.area,
                     "holes": p.n_holes,
                     "hull_vertices": p.n_hull,
-                    "orientable": p.orientable,
+                    **orientable_fields(p.orientable),
                     "updated_at": p.updated_at,
                 }
                 for p in parts
@@ -427,7 +454,7 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
         )
         return
     # Fits 80 columns for names up to 24 characters: units are in --json and catalog show.
-    headers = ("part", "rev", "kind", "mm2", "holes", "hull", "orient.", "updated")
+    headers = ("part", "rev", "kind", "mm2", "holes", "hull", ORIENT_HEADER, "updated")
     rows = [
         (
             p.name,
@@ -442,6 +469,8 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
         for p in parts
     ]
     sys.stdout.write(plain_table(headers, rows, right=(1, 3, 4, 5)))
+    if parts:
+        sys.stdout.write(orientable_footnote())
     sys.stdout.write(f"{plural(len(parts), 'part')}\n")
     sys.stdout.flush()
 
@@ -493,7 +522,7 @@ def revision_dict(
         "hull": [list(p) for p in rev.hull],
         "hull_tolerance": rev.hull_tolerance,
         "mesh_pose": None if rev.mesh_pose is None else dict(rev.mesh_pose),
-        "orientable": rev.orientable,
+        **orientable_fields(rev.orientable),
         "not_orientable_reason": rev.not_orientable_reason,
         "warnings": list(rev.warnings),
         "landings": [landing_dict(x) for x in rev.landings],
@@ -576,7 +605,10 @@ def cmd_show(
         ),
         *[("landing", _landing_line(x)) for x in rev.landings],
         *([("landings", rev.landings_note)] if rev.landings_note else []),
-        ("orientable", "yes" if rev.orientable else f"no: {rev.not_orientable_reason}"),
+        (
+            "orientable (ideal)",
+            "yes" if rev.orientable else f"no: {rev.not_orientable_reason}",
+        ),
         ("created", f"{rev.created_at} by {rev.created_by}"),
         ("revisions", ", ".join(f"{r} ({at})" for r, at, _, _ in history)),
         ("changeovers", ", ".join(users) or "-"),
