@@ -202,18 +202,21 @@ def sensor_width_slack(sensor: Sensor) -> tuple[float, str] | None:
 
 
 def width_accuracy_warning(slack: tuple[float, str] | None, scale: float = 1.0) -> str | None:
-    """One line when the plan's sensor absorbs less width error than the simulator's widths
+    """One line when the plan's sensor absorbs no more width error than the simulator's widths
     are accurate to (:data:`WIDTH_ACCURACY_MM` at the simulated size, divided by ``scale``, the
-    factor a part's lengths were multiplied by in the physics); None otherwise.
+    factor a part's lengths were multiplied by in the physics); None otherwise. At the
+    accuracy itself it warns: a width that far off reads at the end of the window, or past it.
 
-    >>> width_accuracy_warning((0.3, "tolerance ±0.3 mm")) is None
+    >>> width_accuracy_warning((0.31, "tolerance ±0.31 mm")) is None
     True
+    >>> print(width_accuracy_warning((0.3, "tolerance ±0.3 mm")))
+    tolerance ±0.3 mm is no coarser than the simulator's width accuracy (about 0.3 mm, ...
     """
     if slack is None:
         return None
     mm, words = slack
     accuracy = WIDTH_ACCURACY_MM / scale
-    if mm >= accuracy:
+    if mm > accuracy:
         return None
     scaled = (
         ""
@@ -221,7 +224,7 @@ def width_accuracy_warning(slack: tuple[float, str] | None, scale: float = 1.0) 
         else f"; {accuracy:.3g} mm at the plan's size, simulated {scale:.3g} times larger"
     )
     return (
-        f"{words} is finer than the simulator's width accuracy (about "
+        f"{words} is no coarser than the simulator's width accuracy (about "
         f"{WIDTH_ACCURACY_MM:g} mm, docs/simulation.md{scaled}): 'reading in no branch' "
         "failures then measure the simulator's width error, not the plan"
     )
