@@ -22,12 +22,12 @@ import pytest
 from feederkit.cli.app import main
 from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
-from feederkit.outline import make_outline
-from feederkit.part import make_part
+from feederkit.outline import make_outline, save_outline_json
+from feederkit.part import Part, make_part
 from feederkit.plans.fileformat import as_plan, plan_json
 from feederkit.plans.make import make_plan
 from feederkit.plans.model import Leaf, ResultEntry
-from feederkit.sensors import ToleranceSensor
+from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.sim.pushalign import SettleRule, range_distance
 from feederkit.sim.real import (
     REAL_SETTLE_RULE,
@@ -41,6 +41,7 @@ from feederkit.sim.real import (
 from feederkit.sim.summary import wilson
 from feederkit.sim.trial import PoseRule
 from feederkit.sources import load_part
+from feederkit.uncertainty import Uncertainty
 
 ROOT = Path(__file__).resolve().parents[1]
 CATALOG = ROOT / "catalog"
@@ -153,6 +154,9 @@ def test_the_match_check_accepts_the_plans_part_and_refuses_another(washer) -> N
     assert len(real.part.hull) > len(plan.parts[0].hull)
     # the plan's chords lie within the hull tolerance (plus the flattening) of the true arc
     assert 0.04 < real.hull_distance_mm <= real.allowed_mm == pytest.approx(0.05 + 0.01, abs=1e-4)
+    # beyond the declared shape tolerance 0 by more than the flattening: said (this plan names
+    # wrong poses for the true outline, docs/simulation.md)
+    assert real.beyond_tolerance and "declared shape tolerance of 0 mm" in real.tolerance_warning()
     assert real.com_distance_mm < 0.01
     # another part, the same part moved 1 mm, a COM elsewhere: refused, naming the distance
     disc = make_part(
@@ -179,6 +183,40 @@ def test_the_match_check_accepts_the_plans_part_and_refuses_another(washer) -> N
     with pytest.raises(InputError, match=r"\(allowed 0\.01\d* mm: shape tolerance 0 \+ hull "):
         check_match(plan, 0, part, str(washer), hull_tolerance=0.0)
     assert check_match(plan, 0, part, str(washer), hull_tolerance=0.1).allowed_mm > 0.1
+
+
+@lru_cache(maxsize=1)
+def _bracket_plan_at(shape_tolerance: float) -> str:
+    """The l-bracket's sensorless plan declaring ``shape_tolerance`` mm (COM 0.3 mm)."""
+    part = load_part(str(CATALOG / "l-bracket.json"))
+    unc = Uncertainty(1.0, shape_tolerance, 0.3)  # the moved corner moves the COM too
+    return plan_json(make_plan([push_function(part)], NoSensor(), uncertainty=unc).plan)
+
+
+def _bracket_corner_moved(dx: float) -> Part:
+    """The l-bracket with its corner (60, 0) moved ``dx`` mm along x: its hull lies ``dx``
+    from the drawn one."""
+    part = load_part(str(CATALOG / "l-bracket.json"))
+    vertices = [(x + dx, y) if (x, y) == (60.0, 0.0) else (x, y) for x, y in part.outline.vertices]
+    return make_part(make_outline(part.name, vertices, holes=part.outline.holes))
+
+
+def test_a_part_beyond_the_declared_shape_tolerance_is_simulated_with_a_warning() -> None:
+    """Within the match check's allowance (shape tolerance + a CAD hull tolerance + slack) but
+    beyond the shape tolerance the plan declares: accepted, and said in one line."""
+    plan = as_plan(json.loads(_bracket_plan_at(0.2)))
+    beyond = check_match(plan, 0, _bracket_corner_moved(0.25), "beyond.json")
+    assert beyond.hull_distance_mm == pytest.approx(0.25) and beyond.beyond_tolerance
+    line = beyond.tolerance_warning()
+    assert line is not None and "\n" not in line
+    assert "beyond.json's hull lies 0.25 mm from the plan's hull" in line
+    assert "declared shape tolerance of 0.2 mm" in line
+    assert "guaranteed only within its declared tolerance" in line
+    assert "its certificate: " in line and "up to 0.2601 mm is accepted" in line
+    assert beyond.to_dict()["warning"] == line
+    within = check_match(plan, 0, _bracket_corner_moved(0.2), "within.json")
+    assert not within.beyond_tolerance and within.tolerance_warning() is None
+    assert within.to_dict()["warning"] is None
 
 
 def test_part_values_name_a_member_of_the_plan() -> None:
@@ -238,8 +276,11 @@ def test_the_summary_and_json_name_the_outline_simulated(tmp_path: Path, washer,
     assert d["success_rule"]["limit_deg"] == 2.0  # rotation error 1 + settle tolerance 1
     assert d["settings"]["sampled_uncertainty"]["shape_tolerance_mm"] == 0.0
     assert d["trials"] == 2 and d["successes"] == 2
+    assert d["warnings"] == [] and geo["warning"] is None  # the import's hull: within slack
     assert main(args) == 0
-    out = _words(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    assert "shape tolerance" not in captured.err
+    out = _words(captured.out)
     assert f"geometry washer: its own outline from {washer} (exact hull" in out
     assert (
         "success rule a part on its own outline succeeds when it finally rests within 2 deg" in out
@@ -248,6 +289,25 @@ def test_the_summary_and_json_name_the_outline_simulated(tmp_path: Path, washer,
     assert main(["simulate", str(plan), "--trials", "2", "--json"]) == 0
     plain = json.loads(capsys.readouterr().out)
     assert "geometry" not in plain and "success_rule" not in plain
+
+
+@needs_mujoco
+def test_simulate_warns_of_a_part_beyond_the_declared_shape_tolerance(
+    tmp_path: Path, capsys
+) -> None:
+    plan = _write(tmp_path, "lb.plan.json", _bracket_plan_at(0.2))
+    source = tmp_path / "lb_beyond.json"
+    save_outline_json(_bracket_corner_moved(0.25).outline, source)
+    args = ["simulate", str(plan), "--trials", "1", "--part", str(source)]
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    (line,) = [w for w in _words(captured.err).split("warning: ") if "shape tolerance" in w]
+    assert "lies 0.25 mm from the plan's hull" in line and "tolerance of 0.2 mm" in line
+    assert main([*args, "--json"]) == 0
+    captured = capsys.readouterr()
+    (warning,) = json.loads(captured.out)["warnings"]
+    assert "lies 0.25 mm" in warning and "guaranteed only within its declared" in warning
+    assert "guaranteed only within its declared" in _words(captured.err)
 
 
 @needs_mujoco

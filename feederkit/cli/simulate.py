@@ -248,9 +248,9 @@ def simulate_command(
         uncertainty=data.uncertainty.to_dict(),
         uncertainty_declared=data.uncertainty_declared,
     )
-    warning = data.low_margin_warning()
-    if warning:
-        err_console.print(f"warning: {warning}", style="yellow", highlight=False, markup=False)
+    for line in [data.low_margin_warning(), *(r.tolerance_warning() for r in real)]:
+        if line:
+            err_console.print(f"warning: {line}", style="yellow", highlight=False, markup=False)
     columns = (
         TextColumn("simulating"),
         BarColumn(),

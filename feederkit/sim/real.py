@@ -12,7 +12,9 @@ A SOURCE must be the plan's part: its exact hull within the plan's shape toleran
 hull tolerance of the plan's import, plus :data:`MATCH_SLACK_MM`, of the plan's hull (their
 Hausdorff distance: for convex regions the largest difference of their radius functions, what
 the fence feels), and its COM within the COM tolerance plus the slack; anything else is bad
-input naming the distance (docs/simulation.md, "A part's own outline").
+input naming the distance (docs/simulation.md, "A part's own outline"). A hull beyond the
+declared shape tolerance plus the slack, though within the allowance, is simulated with a
+warning: the plan is guaranteed only within its declared tolerance.
 """
 
 from __future__ import annotations
@@ -69,7 +71,10 @@ class RealPart:
     ``NAME (LANDING)``); ``part`` the part with the exact hull of its outline and its own COM;
     ``rests`` where its outline rests (:func:`resting_ranges`: where it settles);
     ``hull_distance_mm`` the Hausdorff distance between its hull and the plan's, ``allowed_mm``
-    the most the match check allows; likewise the COM.
+    the most the match check allows; likewise the COM. ``shape_tolerance_mm`` is the plan's
+    declared shape tolerance and ``slack_mm`` the match check's slack: a distance beyond
+    both is accepted but warned of (:meth:`tolerance_warning`), naming ``certified_mm``, the
+    shape tolerance the plan's certificate holds (None: no certificate).
     """
 
     member: int
@@ -81,6 +86,31 @@ class RealPart:
     allowed_mm: float
     com_distance_mm: float
     allowed_com_mm: float
+    shape_tolerance_mm: float = 0.0
+    slack_mm: float = 0.0
+    certified_mm: float | None = None
+
+    @property
+    def beyond_tolerance(self) -> bool:
+        """Whether its hull lies farther from the plan's than the plan's declared shape
+        tolerance, more than the slack of a drawing's flattening."""
+        return self.hull_distance_mm > self.shape_tolerance_mm + self.slack_mm
+
+    def tolerance_warning(self) -> str | None:
+        """One line when the part lies beyond the plan's declared shape tolerance
+        (:attr:`beyond_tolerance`); None otherwise."""
+        if not self.beyond_tolerance:
+            return None
+        held = (
+            "" if self.certified_mm is None else f" (its certificate: {self.certified_mm:.4g} mm)"
+        )
+        return (
+            f"{self.label}: {self.source}'s hull lies {self.hull_distance_mm:.4g} mm from the "
+            f"plan's hull, beyond the plan's declared shape tolerance of "
+            f"{self.shape_tolerance_mm:g} mm: the plan is guaranteed only within its declared "
+            f"tolerance{held}; simulated anyway, as up to {self.allowed_mm:.4g} mm is accepted "
+            "for a plan whose hull may simplify a drawing"
+        )
 
     def words(self) -> str:
         """The geometry simulated, in one line."""
@@ -103,6 +133,8 @@ class RealPart:
             "allowed_mm": round(self.allowed_mm, 6),
             "com_distance_mm": round(self.com_distance_mm, 6),
             "allowed_com_mm": round(self.allowed_com_mm, 6),
+            "shape_tolerance_mm": round(self.shape_tolerance_mm, 6),
+            "warning": self.tolerance_warning(),
         }
 
 
@@ -170,7 +202,8 @@ def check_match(
     the match check: InputError, one line naming the distance, when the part's hull differs
     from the plan's by more than the plan's shape tolerance plus the hull tolerance of its
     import (:func:`plan_hull_tolerance`) plus the slack, or its COM by more than the COM
-    tolerance plus the slack."""
+    tolerance plus the slack. A hull within that allowance but beyond the shape tolerance plus
+    the slack is accepted with a warning (:meth:`RealPart.tolerance_warning`)."""
     pp = plan.parts[member]
     exact = exact_part(part, pp.name)
     unc = plan.uncertainty
@@ -203,7 +236,16 @@ def check_match(
         allowed_mm=allowed,
         com_distance_mm=dc,
         allowed_com_mm=allowed_com,
+        shape_tolerance_mm=unc.shape_tolerance_mm,
+        slack_mm=slack,
+        certified_mm=_certified_shape_tolerance(plan),
     )
+
+
+def _certified_shape_tolerance(plan: Plan) -> float | None:
+    """The largest shape tolerance the plan's certificate holds; None without one."""
+    cert = plan.stats.certificate
+    return None if cert is None else cert.max_shape_tolerance_mm
 
 
 def _import_options(source: str, pp: PlanPart) -> ImportOptions | None:

@@ -491,6 +491,12 @@ class SimulationSummary:
     pose_rule: PoseRuleWords | None = None
     """How those members' trials are judged (None without ``--part``)."""
 
+    def geometry_warnings(self) -> list[str]:
+        """The members simulated on a part beyond the plan's declared shape tolerance, one
+        line each (:meth:`~feederkit.sim.real.RealPart.tolerance_warning`)."""
+        found = (r.tolerance_warning() for r in self.real_parts)
+        return [w for w in found if w is not None]
+
     def geometry(self) -> list[tuple[str, str]]:
         """Each member and the geometry simulated for it, in words."""
         real = {r.label: r for r in self.real_parts}
@@ -615,6 +621,7 @@ class SimulationSummary:
                 for p in self.parts
             ],
             "success_rule": None if self.pose_rule is None else self.pose_rule.to_dict(),
+            "warnings": self.geometry_warnings(),
         }
 
 
