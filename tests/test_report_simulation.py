@@ -71,3 +71,5 @@ def test_the_simulation_row_uses_the_simulators_summary() -> None:
     assert "95 % Wilson interval" in text and summary.success_words() in text
     assert "18 oriented correctly and 19 rightly rejected" in text
     assert "sampled: rotation error ±1 deg per rotation" in text and "seed 7" in text
+    beyond = {**summary.to_dict(), "warnings": ["bracket (up): x.json's hull lies 0.25 mm"]}
+    assert simulation_text(beyond).endswith("; warning: bracket (up): x.json's hull lies 0.25 mm")

@@ -155,7 +155,8 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     (``SimulationSummary.to_dict``, docs/simulation.md), in the command line's words: the
     successes with their 95 % Wilson interval (the rightly rejected counted apart), what
     was sampled and the seed, the failures by cause, the model errors, per part, the push
-    agreement, and the notes on what the plan certifies and the simulator's width accuracy."""
+    agreement, and the notes on what the plan certifies, the simulator's width accuracy and a
+    part simulated beyond the plan's declared shape tolerance."""
     trials, successes = _int(simulation.get("trials")), _int(simulation.get("successes"))
     if trials is None or successes is None:
         raise InputError("simulation results need integer 'trials' and 'successes'")
@@ -209,6 +210,9 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
         text = simulation.get(key)
         if isinstance(text, str) and text:
             words.append(f"{label}: {text}")
+    geometry = simulation.get("warnings")  # with --part: a part beyond the shape tolerance
+    if isinstance(geometry, list):
+        words += [f"warning: {w}" for w in geometry if isinstance(w, str) and w]
     return "; ".join(words)
 
 
