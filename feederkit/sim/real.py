@@ -102,7 +102,9 @@ class RealPart:
         if not self.beyond_tolerance:
             return None
         held = (
-            "" if self.certified_mm is None else f" (its certificate: {self.certified_mm:.4g} mm)"
+            ""
+            if self.certified_mm is None
+            else f" (its certificate's largest shape tolerance: {self.certified_mm:.4g} mm)"
         )
         return (
             f"{self.label}: {self.source}'s hull lies {self.hull_distance_mm:.4g} mm from the "
