@@ -238,7 +238,7 @@ def test_unlike_poses_are_not_lumped_and_the_largest_rotation_error_is_named(sen
         make_plan([pf], sensor, certify=False)
     text = str(made.value)
     assert "no strong plan exists" in text and "\n" not in text
-    assert "only with no rotation error at all" in text or "largest rotation error" in text
+    assert "only on the ideal model" in text or "largest rotation error" in text
     assert text.endswith("may exist with lumping 'any'")  # the hint comes last
     assert not strong_plan_exists(m)
 

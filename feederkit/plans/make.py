@@ -34,6 +34,7 @@ from feederkit.machine.widths import widen_widths
 from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
+from feederkit.mechanics.uncertain import PUSH_BAND_DEG
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
@@ -597,6 +598,18 @@ def with_uncertainty(data: dict[str, Any], uncertainty: Uncertainty) -> dict[str
     return out
 
 
+VIBRATION_OBSTACLE = (
+    "a strong plan exists only on the ideal model (rotation error 0): what leaves none is not "
+    "the rotation error but the feeder's vibration, which any declared uncertainty switches "
+    f"on (a push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the "
+    "push bands, and fragile states merge: docs/uncertainty.md), so no smaller rotation error "
+    "helps; --rotation-error 0 plans on the ideal model, with no margin for that vibration"
+)
+"""The largest rotation error with a strong plan, in words, when it is 0 and nothing else is
+declared: every positive rotation error switches the vibration on (push bands, merged fragile
+states), and that is what no plan survives, however small the rotation error."""
+
+
 def largest_uncertainty(
     push_functions: Sequence[PushFunction],
     sensor: Sensor,
@@ -639,6 +652,8 @@ def largest_uncertainty(
         return lo, True, hi - lo
 
     def said(value: float, done: bool, what: str, unit: str, width: float = 0.0) -> str:
+        if done and value == 0.0 and what == "rotation error" and at_zero_is_ideal:
+            return VIBRATION_OBSTACLE
         if done and value > 0.0:
             # A bisection: a plan at ``value`` (printed rounded down), none a bracket above.
             return (
@@ -652,6 +667,7 @@ def largest_uncertainty(
             "decided within the time limit)"
         )
 
+    at_zero_is_ideal = Uncertainty(0.0, u.shape_tolerance_mm, u.com_tolerance_mm).is_ideal
     words = []
     r, r_done, r_width = largest(
         lambda x: Uncertainty(x, u.shape_tolerance_mm, u.com_tolerance_mm), u.rotation_error_deg
