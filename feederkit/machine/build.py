@@ -200,13 +200,25 @@ TWIN_MAX_STATES = 64
 0.7 s at 114 states and 14 s at 429; such near-round parts' alike poses are near-congruent)."""
 
 
+WANDER_ARC_DEG = 90.0
+"""A physical state whose resting orientations span at least this many degrees, with members
+that do not look alike, is a part that may rest on unlike sides (a small part under a large
+tolerance, a cam of shallow wells): no orientation. A narrower one (an arc's facets, two
+near-metastable neighbours) is design.md's physical state, oriented up to its interval."""
+
+
 def unlike_members(pf: PushFunction, mech: UncertainMechanics) -> set[int]:
-    """The physical states of ``mech`` holding two ideal members that neither look alike
+    """The physical states of ``mech`` whose resting orientations span ``WANDER_ARC_DEG`` or
+    more and that hold two ideal members that neither look alike
     (:func:`~feederkit.mechanics.symmetry.look_alike`) nor are told apart by no plan on the
-    ideal model (:func:`ideal_twins`' rule): a part at rest may wander between them (the
-    merge rule, docs/uncertainty.md), so a result holding such a state does not orient the
-    part."""
-    merged = [s for s in mech.states if len(s.members) > 1]
+    ideal model (:func:`ideal_twins`' rule): a part at rest may wander between unlike sides
+    (the merge rule, docs/uncertainty.md), so a result holding such a state does not orient
+    the part."""
+    merged = [
+        s
+        for s in mech.states
+        if len(s.members) > 1 and s.rest_deg[1] - s.rest_deg[0] >= WANDER_ARC_DEG
+    ]
     out: set[int] = set()
     twins: tuple[int, ...] | None = None
     index: dict[int, int] = {}
