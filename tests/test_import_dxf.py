@@ -472,7 +472,7 @@ def drawing_paths(path: Path) -> list:
 
     doc = dxf.read_document(path)
     found = dxf.explode(doc.modelspace(), "", 0, Counter(), Budget(ImportLimits(), str(path)))
-    return [p for p in (dxf.curve_path(e) for e, _ in found) if p is not None]
+    return [p for p in (dxf.curve_path(f.entity, f.matrix) for f in found) if p is not None]
 
 
 def ezdxf_flattening(paths, distance, budget=None):

@@ -15,6 +15,7 @@ import re
 import warnings
 from collections import Counter
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import ezdxf
@@ -24,7 +25,7 @@ from ezdxf import recover
 from ezdxf.document import Drawing as DxfDocument
 from ezdxf.entities import DXFGraphic
 from ezdxf.lldxf.const import DXFError
-from ezdxf.math import Vec2, Vec3
+from ezdxf.math import Matrix44, Vec2, Vec3
 from ezdxf.path import Command
 
 from feederkit.errors import InputError
@@ -39,6 +40,9 @@ logging.getLogger("ezdxf").addHandler(logging.NullHandler())  # a library never 
 
 CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"})
 """Entity types that make up an outline; everything else (text, dimensions, hatches) is skipped."""
+
+CONTINUOUS = "Continuous"
+BYLAYER = "ByLayer"
 
 MAX_BLOCK_DEPTH = 32
 """Deeper block nesting is taken as a reference cycle."""
@@ -208,14 +212,67 @@ def _count_expanded(doc: DxfDocument, layouts: list[object], budget: Budget) -> 
     return total
 
 
-def explode(
-    entities: object, layer: str, depth: int, skipped: Counter[str], budget: Budget
-) -> Iterator[tuple[DXFGraphic, str]]:
-    """Curve entities in world coordinates with their effective layer, block references exploded.
+@dataclass(frozen=True)
+class Placed:
+    """A curve entity of the drawing as CAD draws it: the entity as stored (in its block's
+    coordinates), its effective layer and linetype, the block-to-world ``matrix`` (None for
+    an entity of the layout itself) and the layout's block reference it comes from."""
 
-    Like ``ezdxf.disassemble.recursive_decompose`` but annotation inside blocks (dimensions,
-    leaders, text) is skipped instead of decomposed into lines. Entities of a block on layer
-    "0" take the layer of the reference, as CAD programs draw them.
+    entity: DXFGraphic
+    layer: str
+    linetype: str = CONTINUOUS
+    matrix: Matrix44 | None = None
+    ref: DXFGraphic | None = None
+
+
+def effective_linetype(entity: DXFGraphic, layer: str, block_linetype: str) -> str:
+    """The linetype ``entity`` is drawn with: its own, its layer's (BYLAYER, on the effective
+    ``layer``) or its block reference's (BYBLOCK, ``block_linetype``)."""
+    own = entity.dxf.get("linetype", BYLAYER) if entity.dxf.is_supported("linetype") else BYLAYER
+    name = str(own or BYLAYER)
+    if name.upper() == "BYBLOCK":
+        return block_linetype
+    if name.upper() != BYLAYER.upper():
+        return name
+    doc = entity.doc
+    if doc is None or not doc.layers.has_entry(layer or "0"):
+        return CONTINUOUS
+    return str(doc.layers.get(layer or "0").dxf.get("linetype", CONTINUOUS) or CONTINUOUS)
+
+
+def _block_references(entity: DXFGraphic, label: str) -> list[DXFGraphic]:
+    """The references an INSERT stands for: itself, or each cell of a MINSERT grid."""
+    if entity.mcount <= 1:
+        return [entity]
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            return list(entity.multi_insert())
+    except Exception as exc:  # noqa: BLE001 - broken block definitions
+        raise InputError(
+            f"{label}: cannot explode block {entity.dxf.get('name', '?')!r} ({exc})"
+        ) from None
+
+
+def explode(
+    entities: object,
+    layer: str,
+    depth: int,
+    skipped: Counter[str],
+    budget: Budget,
+    matrix: Matrix44 | None = None,
+    linetype: str = CONTINUOUS,
+    ref: DXFGraphic | None = None,
+) -> Iterator[Placed]:
+    """Curve entities with their effective layer, linetype and block-to-world matrix.
+
+    A block reference's matrix (``Insert.matrix44``) is composed with its parents', and each
+    curve is later transformed as a curve (:func:`curve_path`): ezdxf's ``virtual_entities``
+    re-derives a nested reference's rotation and scale, which turns a rotation inside a
+    non-uniform scale into the wrong shape, and re-interpolates a fit-point spline through
+    transformed fit points. Annotation inside blocks (dimensions, leaders, text) is
+    skipped. Entities of a block on layer "0" take the layer of the reference, as CAD
+    programs draw them.
     """
     for entity in entities:  # type: ignore[attr-defined]
         kind = entity.dxftype()
@@ -224,28 +281,24 @@ def explode(
             continue
         own = entity.dxf.get("layer", "0") if entity.dxf.is_supported("layer") else "0"
         eff = layer if (own == "0" and layer) else own
-        if kind == "INSERT":
-            if depth >= MAX_BLOCK_DEPTH:
-                raise InputError(
-                    f"{budget.label}: block references nested deeper than {MAX_BLOCK_DEPTH}"
-                )
-            check_finite(entity, budget.label)
-            try:
-                with warnings.catch_warnings(), np.errstate(all="ignore"):
-                    warnings.simplefilter("ignore")
-                    subs = (
-                        list(entity.multi_insert())
-                        if entity.mcount > 1
-                        else list(entity.virtual_entities())
-                    )
-            except Exception as exc:  # noqa: BLE001 - broken block definitions
-                raise InputError(
-                    f"{budget.label}: cannot explode block {entity.dxf.get('name', '?')!r} ({exc})"
-                ) from None
-            yield from explode(subs, eff, depth + 1, skipped, budget)
-        else:
+        drawn = effective_linetype(entity, eff, linetype)
+        if kind != "INSERT":
             budget.entities()
-            yield entity, eff
+            yield Placed(entity, eff, drawn, matrix, ref)
+            continue
+        if depth >= MAX_BLOCK_DEPTH:
+            raise InputError(
+                f"{budget.label}: block references nested deeper than {MAX_BLOCK_DEPTH}"
+            )
+        check_finite(entity, budget.label, ref)
+        block = entity.doc.blocks.get(entity.dxf.get("name", "")) if entity.doc else None
+        if block is None:
+            raise InputError(
+                f"{budget.label}: a reference to the undefined block {entity.dxf.get('name')!r}"
+            )
+        for cell in _block_references(entity, budget.label):
+            placed = cell.matrix44() if matrix is None else cell.matrix44() @ matrix
+            yield from explode(block, eff, depth + 1, skipped, budget, placed, drawn, ref or entity)
 
 
 def _point_count(entity: DXFGraphic) -> int:
@@ -260,13 +313,15 @@ def _point_count(entity: DXFGraphic) -> int:
     return 2
 
 
-def curve_path(entity: DXFGraphic) -> dxfpath.Path | None:
-    """The entity as an ezdxf path (cubic Bezier pieces), None for surfaces (polyface meshes)."""
+def curve_path(entity: DXFGraphic, matrix: Matrix44 | None = None) -> dxfpath.Path | None:
+    """The entity as an ezdxf path (cubic Bezier pieces) in world coordinates, transformed
+    as a curve by its block ``matrix``; None for surfaces (polyface meshes)."""
     if entity.dxftype() == "POLYLINE" and not (entity.is_2d_polyline or entity.is_3d_polyline):
         return None  # polyface and polygon meshes are surfaces, not outlines
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
-        return dxfpath.make_path(entity)
+        path = dxfpath.make_path(entity)
+        return path if matrix is None else path.transform(matrix)
 
 
 FLATTEN_CHUNK = 4096
@@ -346,18 +401,15 @@ def flatten_paths(
     return out
 
 
-def _label(entity: DXFGraphic) -> str:
-    """``ARC 47``; an entity of a block: ``ARC from block 'B' (INSERT 2F)``, the top reference."""
+def _label(entity: DXFGraphic, ref: DXFGraphic | None = None) -> str:
+    """``ARC 47``; an entity of a block: ``ARC 3A in block 'B' (INSERT 2F)``, with the
+    layout's reference ``ref`` it is drawn by."""
     kind = entity.dxftype()
     handle = entity.dxf.get("handle")
-    if handle:
-        return f"{kind} {handle}"
-    ref = entity.source_block_reference
-    while ref is not None and not ref.dxf.get("handle"):
-        ref = ref.source_block_reference
+    own = f"{kind} {handle}" if handle else kind
     if ref is None:
-        return kind
-    return f"{kind} from block {ref.dxf.get('name', '?')!r} (INSERT {ref.dxf.handle})"
+        return own
+    return f"{own} in block {ref.dxf.get('name', '?')!r} (INSERT {ref.dxf.get('handle', '?')})"
 
 
 def _first_non_finite(entity: DXFGraphic) -> str | None:
@@ -399,13 +451,12 @@ def _first_non_finite(entity: DXFGraphic) -> str | None:
     return None
 
 
-def check_finite(entity: DXFGraphic, label: str) -> None:
+def check_finite(entity: DXFGraphic, label: str, ref: DXFGraphic | None = None) -> None:
     """Refuse an entity with a NaN or infinite number in one line naming it and the value."""
     found = _first_non_finite(entity)
     if found is not None:
-        raise InputError(
-            f"{label}: {_label(entity)} has a NaN or infinite value ({found.replace('_', ' ')})"
-        )
+        what = found.replace("_", " ")
+        raise InputError(f"{label}: {_label(entity, ref)} has a NaN or infinite value ({what})")
 
 
 def dxf_lines(
@@ -430,43 +481,45 @@ def dxf_lines(
     seen: set[str] = set()
     layouts = space_layouts(doc, options.space)
     _count_expanded(doc, layouts, budget)
-    paths: list[tuple[DXFGraphic, dxfpath.Path]] = []
+    paths: list[tuple[str, dxfpath.Path]] = []
     owners: list[str] = []
     owner_layers: list[str] = []
     lo = np.full(2, np.inf)
     hi = np.full(2, -np.inf)
     for layout in layouts:
-        for entity, layer in explode(layout, "", 0, skipped, budget):
+        for placed in explode(layout, "", 0, skipped, budget):
+            entity, layer = placed.entity, placed.layer
             seen.add(layer)
             if wanted and layer.lower() not in wanted:
                 continue
+            name = _label(entity, placed.ref)
             budget.need("vertices", _point_count(entity), "points in one entity")
             budget.check_time()
-            check_finite(entity, label)
+            check_finite(entity, label, placed.ref)
             try:
-                path = curve_path(entity)
+                path = curve_path(entity, placed.matrix)
                 if path is None:
                     continue
                 cv = np.array([v.xyz for v in path.control_vertices()], dtype=float)
             except Exception as exc:  # noqa: BLE001 - degenerate curves in third-party files
-                raise InputError(f"{label}: cannot read {_label(entity)} ({exc})") from None
+                raise InputError(f"{label}: cannot read {name} ({exc})") from None
             if len(cv) == 0:
                 continue
             if not np.isfinite(cv).all():  # finite numbers whose curve overflows (radius 1e300)
                 raise InputError(
-                    f"{label}: {_label(entity)} has coordinates too large to compute, beyond "
+                    f"{label}: {name} has coordinates too large to compute, beyond "
                     "any part a feeder can hold (check the units)"
                 )
             far = float(np.abs(cv).max()) * scale
             if far > MAX_COORD_MM:
                 raise InputError(
-                    f"{label}: {_label(entity)} has a coordinate of {far:.3g} mm, beyond any "
+                    f"{label}: {name} has a coordinate of {far:.3g} mm, beyond any "
                     f"part a feeder can hold ({MAX_COORD_MM:g} mm; check the units)"
                 )
             xy = cv[:, :2]
             lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
-            paths.append((entity, path))
-            owners.append(f"{_label(entity)} on layer {layer!r}")
+            paths.append((name, path))
+            owners.append(f"{name} on layer {layer!r}")
             owner_layers.append(layer)
     notes: list[str] = []
     if wanted and not paths and seen:
@@ -490,8 +543,9 @@ def dxf_lines(
             warnings.simplefilter("ignore")
             flat = flatten_paths([p for _, p in paths], distance, budget)  # counts vertices
     except NonFiniteCurve as exc:
-        entity = paths[exc.piece][0]
-        raise InputError(f"{label}: {_label(entity)} has NaN or infinite coordinates") from None
+        raise InputError(
+            f"{label}: {paths[exc.piece][0]} has NaN or infinite coordinates"
+        ) from None
     lines = [pts * scale for pieces in flat for pts in pieces]
     names = [owner for owner, pieces in zip(owners, flat, strict=True) for _ in pieces]
     layers = [layer for layer, pieces in zip(owner_layers, flat, strict=True) for _ in pieces]
