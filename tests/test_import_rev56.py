@@ -6,6 +6,7 @@ Each drawing is built here with ezdxf and its part compared with the one shapely
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import ezdxf
@@ -14,7 +15,9 @@ import pytest
 from ezdxf import path as dxfpath
 from shapely import affinity
 from shapely.geometry import Point, Polygon
+from shared import run_cli
 
+from feederkit.errors import InputError
 from feederkit.importers import ImportOptions, import_parts
 
 L_BRACKET = [(0, 0), (60, 0), (60, 15), (15, 15), (15, 40), (0, 40)]
@@ -27,9 +30,9 @@ def new_doc() -> ezdxf.document.Drawing:
 
 
 def imported(path: Path, **options):
-    """The first part of ``path`` and the import's warnings (the part's and the file's)."""
-    result, parts = import_parts(path, ImportOptions(**options))
-    return parts[0], tuple(result.warnings) + tuple(parts[0].warnings)
+    """The first part of ``path`` and its warnings (the file's included)."""
+    _, parts = import_parts(path, ImportOptions(**options))
+    return parts[0], parts[0].warnings
 
 
 def polygon(ip) -> Polygon:
@@ -90,3 +93,122 @@ def test_minsert_cells_of_a_nested_block_land_in_their_cells(tmp_path):
     _, parts = import_parts(tmp_path / "grid.dxf", ImportOptions(all_parts=True))
     boxes = sorted(tuple(round(v, 6) for v in polygon(p).bounds) for p in parts)
     assert boxes == [(-8.0 + 100 * k, 0.0, 100.0 * k, 30.0) for k in range(3)]
+
+
+# Loops drawn in hidden, dashed or centre linetypes are no through holes.
+
+PLATE_PTS = [(0, 0), (80, 0), (80, 40), (0, 40)]
+PLATE_WITH_HOLE = Polygon(PLATE_PTS).difference(Point(60, 20).buffer(4, 512))
+
+
+def plate_with(path: Path, build) -> Path:
+    """An 80 x 40 plate with an R4 through hole at (60, 20), and what ``build`` adds."""
+    doc = new_doc()
+    doc.layers.add("HIDDEN", linetype="HIDDEN")
+    doc.layers.add("CENTER", linetype="CENTER")
+    msp = doc.modelspace()
+    msp.add_lwpolyline(PLATE_PTS, close=True)
+    msp.add_circle((60, 20), 4)
+    build(doc, msp)
+    doc.saveas(path)
+    return path
+
+
+def _hidden_layer(doc, msp):
+    return msp.add_circle((20, 20), 12, dxfattribs={"layer": "HIDDEN"})
+
+
+def _dashed_entity(doc, msp):
+    return msp.add_circle((20, 20), 12, dxfattribs={"linetype": "DASHEDX2"})
+
+
+def _iso_dashed(doc, msp):
+    doc.linetypes.add("ACAD_ISO02W100", pattern=[15.0, 12.0, -3.0], description="ISO dash")
+    return msp.add_circle((20, 20), 12, dxfattribs={"linetype": "ACAD_ISO02W100"})
+
+
+def _hidden_rectangle_of_lines(doc, msp):
+    corners = [(10, 10), (35, 10), (35, 30), (10, 30)]
+    lines = [
+        msp.add_line(a, b, dxfattribs={"layer": "HIDDEN", "linetype": "HIDDEN2"})
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True)
+    ]
+    return lines[0]
+
+
+def _byblock_in_a_block(doc, msp):
+    block = doc.blocks.new("POCKET")
+    circle = block.add_circle((0, 0), 12, dxfattribs={"linetype": "BYBLOCK"})
+    msp.add_blockref("POCKET", (20, 20), dxfattribs={"linetype": "PHANTOM"})
+    return circle
+
+
+def _bylayer_in_a_block_on_a_hidden_layer(doc, msp):
+    block = doc.blocks.new("POCKET")
+    circle = block.add_circle((0, 0), 12)  # layer "0", ByLayer: the reference's layer
+    msp.add_blockref("POCKET", (20, 20), dxfattribs={"layer": "HIDDEN"})
+    return circle
+
+
+@pytest.mark.parametrize(
+    ("build", "linetype"),
+    [
+        (_hidden_layer, "HIDDEN"),
+        (_dashed_entity, "DASHEDX2"),
+        (_iso_dashed, "ACAD_ISO02W100"),
+        (_hidden_rectangle_of_lines, "HIDDEN2"),
+        (_byblock_in_a_block, "PHANTOM"),
+        (_bylayer_in_a_block_on_a_hidden_layer, "HIDDEN"),
+    ],
+    ids=["layer", "entity", "iso", "lines", "byblock", "block-on-hidden-layer"],
+)
+def test_hidden_loops_are_left_out_with_a_warning(tmp_path, build, linetype):
+    drawn = []
+    path = plate_with(tmp_path / "hidden.dxf", lambda d, m: drawn.append(build(d, m)))
+    ip, warnings = imported(path)
+    assert_same_part(ip, PLATE_WITH_HOLE)
+    (note,) = [w for w in warnings if "hidden, dashed or centre linetype" in w]
+    entity = drawn[0]
+    assert f"{entity.dxftype()} {entity.dxf.handle}" in note
+    assert f"(linetype {linetype})" in note
+    assert f"--keep-linetype {linetype}" in note
+
+
+def test_keep_linetype_keeps_a_hidden_loop_as_a_hole(tmp_path):
+    path = plate_with(tmp_path / "hidden.dxf", _hidden_layer)
+    ip, warnings = imported(path, keep_linetypes=("hidden",))
+    assert_same_part(ip, PLATE_WITH_HOLE.difference(Point(20, 20).buffer(12, 512)))
+    assert not [w for w in warnings if "linetype" in w]
+
+
+def test_centre_lines_and_continuous_loops_are_read_as_before(tmp_path):
+    def centre_lines(doc, msp):
+        msp.add_line((-5, 20), (85, 20), dxfattribs={"layer": "CENTER"})
+        msp.add_circle((20, 20), 5, dxfattribs={"linetype": "Continuous", "layer": "HIDDEN"})
+
+    ip, warnings = imported(plate_with(tmp_path / "cl.dxf", centre_lines))
+    assert_same_part(ip, PLATE_WITH_HOLE.difference(Point(20, 20).buffer(5, 512)))
+    assert not [w for w in warnings if "linetype" in w]
+
+
+def test_a_drawing_all_in_hidden_lines_is_refused_naming_the_option(tmp_path):
+    doc = new_doc()
+    doc.modelspace().add_lwpolyline(PLATE_PTS, close=True, dxfattribs={"linetype": "DASHED"})
+    doc.saveas(tmp_path / "all.dxf")
+    with pytest.raises(InputError, match=r"hidden, dashed or centre .*--keep-linetype DASHED"):
+        imported(tmp_path / "all.dxf")
+    ip, _ = imported(tmp_path / "all.dxf", keep_linetypes=("DASHED",))
+    assert_same_part(ip, Polygon(PLATE_PTS))
+
+
+def test_keep_linetype_on_the_command_line(tmp_path, capsys):
+    path = plate_with(tmp_path / "hidden.dxf", _hidden_layer)
+    for args, expected in (
+        ((), PLATE_WITH_HOLE),
+        (("--keep-linetype", "HIDDEN"), PLATE_WITH_HOLE.difference(Point(20, 20).buffer(12, 512))),
+    ):
+        code, out, err = run_cli(capsys, "part", "analyze", str(path), "--json", *args)
+        assert code == 0
+        assert ("--keep-linetype HIDDEN" in err) == (not args)
+        com = json.loads(out)[0]["com"]
+        assert np.hypot(com[0] - expected.centroid.x, com[1] - expected.centroid.y) <= 0.02

@@ -1,10 +1,10 @@
 """The import options every command that takes a SOURCE shares, and how it prints import warnings.
 
-One place for the typer option types (``--units --layer --all-parts --pose --space`` and the
-import budgets, docs/import.md), the builder of :class:`~feederkit.importers.ImportOptions`
-and the printing of the importer's warnings (parts left out, frames skipped, gaps closed,
-units in doubt), so ``part analyze``, ``part plot``, ``lookalike``, ``plan`` and ``catalog``
-say the same thing about the same file.
+One place for the typer option types (``--units --layer --all-parts --pose --space
+--keep-linetype`` and the import budgets, docs/import.md), the builder of
+:class:`~feederkit.importers.ImportOptions` and the printing of the importer's warnings
+(parts left out, frames skipped, gaps closed, units in doubt), so ``part analyze``, ``part
+plot``, ``lookalike``, ``plan`` and ``catalog`` say the same thing about the same file.
 
 A command takes them all with :func:`takes_import_options`: it declares one parameter
 ``import_opts: ImportOptions`` and gets the options (same names, defaults and help on every
@@ -51,6 +51,15 @@ LayerOpt = Annotated[
     list[str] | None,
     typer.Option(
         "--layer", metavar="NAME", help="DXF layer to read (repeat for several; default all)."
+    ),
+]
+KeepLinetypeOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--keep-linetype",
+        metavar="NAME",
+        help="Keep closed DXF loops drawn in this hidden or centre linetype (e.g. HIDDEN) as "
+        "outline or holes; left out by default (repeat for several).",
     ),
 ]
 SpaceOpt = Annotated[
@@ -147,6 +156,7 @@ def import_options(
     allow_large: bool = False,
     *,
     space: str = "model",
+    keep_linetype: list[str] | None = None,
     max_entities: int = DEFAULT_MAX_ENTITIES,
     max_vertices: int = DEFAULT_MAX_VERTICES,
     max_loops: int = DEFAULT_MAX_LOOPS,
@@ -166,6 +176,7 @@ def import_options(
         com=None if com is None else (float(com[0]), float(com[1])),
         allow_large=allow_large,
         space=space,
+        keep_linetypes=tuple(keep_linetype or ()),
         limits=ImportLimits(
             entities=max_entities,
             vertices=max_vertices,
@@ -188,6 +199,7 @@ IMPORT_PARAMETERS: tuple[inspect.Parameter, ...] = (
     _option("units", UnitsOpt, None),
     _option("layer", LayerOpt, None),
     _option("space", SpaceOpt, "model"),
+    _option("keep_linetype", KeepLinetypeOpt, None),
     _option("all_parts", AllPartsOpt, False),
     _option("pose", PoseOpt, None),
     _option("flatten_tolerance", FlattenOpt, DEFAULT_FLATTEN_TOLERANCE),

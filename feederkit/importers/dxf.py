@@ -31,7 +31,13 @@ from ezdxf.path import Command
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
 from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
-from feederkit.importers.loops import Region, drawing_from_lines, merged_note
+from feederkit.importers.loops import (
+    Drawing,
+    Region,
+    closing_lines,
+    drawing_from_lines,
+    merged_note,
+)
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
 from feederkit.outline import make_outline, unit_scale
@@ -43,6 +49,17 @@ CURVES = frozenset({"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", 
 
 CONTINUOUS = "Continuous"
 BYLAYER = "ByLayer"
+
+HIDDEN_LINETYPE = re.compile(
+    r"HIDDEN|DASH|CENT(ER|RE)|PHANTOM|DOT|DIVIDE|BORDER|ACAD_ISO(0[2-9]|1[0-5])W|JIS_0[2-9]",
+    re.IGNORECASE,
+)
+"""Linetypes of hidden edges, centre and construction lines (HIDDEN2, DASHEDX2, CENTER,
+PHANTOM, DASHDOT, the ISO dashed types ACAD_ISO02W100 to ACAD_ISO15W100, ...): never a
+visible outline."""
+
+MAX_LISTED = 8
+"""Entities named at most in one warning."""
 
 MAX_BLOCK_DEPTH = 32
 """Deeper block nesting is taken as a reference cycle."""
@@ -459,15 +476,35 @@ def check_finite(entity: DXFGraphic, label: str, ref: DXFGraphic | None = None) 
         raise InputError(f"{label}: {_label(entity, ref)} has a NaN or infinite value ({what})")
 
 
+@dataclass(frozen=True)
+class DrawnLines:
+    """Flattened polylines (mm) and, for each, its entity (with layer), layer and linetype."""
+
+    lines: list[np.ndarray]
+    names: list[str]
+    layers: list[str]
+    linetypes: list[str]
+
+    def without(self, drop: set[int]) -> DrawnLines:
+        """These lines but those whose index is in ``drop``."""
+        keep = [k for k in range(len(self.lines)) if k not in drop]
+        return DrawnLines(
+            [self.lines[k] for k in keep],
+            [self.names[k] for k in keep],
+            [self.layers[k] for k in keep],
+            [self.linetypes[k] for k in keep],
+        )
+
+
 def dxf_lines(
     doc: DxfDocument,
     options: ImportOptions,
     scale: float,
     label: str,
     budget: Budget,
-) -> tuple[list[np.ndarray], list[str], list[str], Counter[str], list[str], float]:
-    """Outline polylines of the chosen space (mm), the entity (and layer) of each, the layer
-    of each, skipped types, warnings, flatten tolerance.
+) -> tuple[DrawnLines, Counter[str], list[str], float]:
+    """Outline polylines of the chosen space (mm) with their entities, layers and linetypes,
+    skipped types, warnings, flatten tolerance.
 
     With ``options.layers``, only entities on those layers (case-insensitive; block contents
     on layer "0" count on their reference's layer) are read. Every coordinate is checked as
@@ -484,6 +521,7 @@ def dxf_lines(
     paths: list[tuple[str, dxfpath.Path]] = []
     owners: list[str] = []
     owner_layers: list[str] = []
+    owner_linetypes: list[str] = []
     lo = np.full(2, np.inf)
     hi = np.full(2, -np.inf)
     for layout in layouts:
@@ -521,6 +559,7 @@ def dxf_lines(
             paths.append((name, path))
             owners.append(f"{name} on layer {layer!r}")
             owner_layers.append(layer)
+            owner_linetypes.append(placed.linetype)
     notes: list[str] = []
     if wanted and not paths and seen:
         names = ", ".join(sorted(seen))
@@ -528,7 +567,7 @@ def dxf_lines(
             f"{label}: no geometry on layer {', '.join(sorted(layers))} (layers: {names})"
         )
     if not paths:
-        return [], [], [], skipped, notes, options.flatten_tolerance
+        return DrawnLines([], [], [], []), skipped, notes, options.flatten_tolerance
     size_mm = float((hi - lo).max()) * scale
     flatten_mm = options.flatten_tolerance
     if REL_FLATTEN * size_mm > flatten_mm:
@@ -547,9 +586,40 @@ def dxf_lines(
             f"{label}: {paths[exc.piece][0]} has NaN or infinite coordinates"
         ) from None
     lines = [pts * scale for pieces in flat for pts in pieces]
-    names = [owner for owner, pieces in zip(owners, flat, strict=True) for _ in pieces]
-    layers = [layer for layer, pieces in zip(owner_layers, flat, strict=True) for _ in pieces]
-    return lines, names, layers, skipped, notes, flatten_mm
+    per_line = [
+        [value for value, pieces in zip(values, flat, strict=True) for _ in pieces]
+        for values in (owners, owner_layers, owner_linetypes)
+    ]
+    return DrawnLines(lines, *per_line), skipped, notes, flatten_mm
+
+
+def is_hidden_linetype(name: str, kept: tuple[str, ...] = ()) -> bool:
+    """Whether a linetype draws hidden edges or centre lines (:data:`HIDDEN_LINETYPE`), and
+    is not one of the ``kept`` names (case-insensitive)."""
+    if name.lower() in {k.lower() for k in kept}:
+        return False
+    return HIDDEN_LINETYPE.search(name) is not None
+
+
+def hidden_loops(drawn: DrawnLines, gap: float, kept: tuple[str, ...]) -> set[int]:
+    """The lines drawn in a hidden or centre linetype that close loops among themselves
+    (:func:`.loops.closing_lines`): hidden edges of pockets and far-side features, bolt
+    circles; a centre line across the part is left to the loop search."""
+    hidden = [k for k, lt in enumerate(drawn.linetypes) if is_hidden_linetype(lt, kept)]
+    closing = closing_lines([drawn.lines[k] for k in hidden], gap)
+    return {hidden[k] for k in closing}
+
+
+def hidden_note(drawn: DrawnLines, dropped: set[int]) -> tuple[str, str]:
+    """What was left out as hidden or centre lines (entities with layer and linetype) and
+    the ``--keep-linetype`` options that keep them."""
+    seen: dict[str, str] = {}
+    for k in sorted(dropped):
+        seen.setdefault(drawn.names[k], drawn.linetypes[k])
+    listed = [f"{name} (linetype {lt})" for name, lt in list(seen.items())[:MAX_LISTED]]
+    more = f" and {len(seen) - MAX_LISTED} more" if len(seen) > MAX_LISTED else ""
+    keep = " ".join(f"--keep-linetype {lt}" for lt in sorted(set(seen.values()), key=str.lower))
+    return "; ".join(listed) + more, keep
 
 
 def _describe(region: Region) -> str:
@@ -612,6 +682,40 @@ def _paper_space_hint(doc: DxfDocument, options: ImportOptions) -> str:
     )
 
 
+def _drawing(
+    drawn: DrawnLines,
+    gap: float,
+    label: str,
+    options: ImportOptions,
+    budget: Budget,
+    warnings_: list[str],
+) -> Drawing:
+    """The drawing's loops and parts, loops drawn in hidden or centre linetypes left out
+    (:func:`hidden_loops`), with a warning naming them in ``warnings_``."""
+    dropped = hidden_loops(drawn, gap, options.keep_linetypes)
+    if not dropped:
+        return drawing_from_lines(drawn.lines, gap, label, budget, drawn.names, drawn.layers)
+    listed, keep = hidden_note(drawn, dropped)
+    kept = drawn.without(dropped)
+    if not kept.lines:
+        raise InputError(
+            f"{label}: every closed loop is drawn in a hidden, dashed or centre linetype "
+            f"({listed}): if they are the part, keep them with {keep}"
+        )
+    try:
+        drawing = drawing_from_lines(kept.lines, gap, label, budget, kept.names, kept.layers)
+    except InputError as exc:
+        raise InputError(
+            f"{exc}; left out as hidden or centre lines: {listed} (keep them with {keep})"
+        ) from None
+    warnings_.append(
+        f"left out loops drawn in a hidden, dashed or centre linetype, taken for hidden edges "
+        f"(pockets, far-side features) or construction lines, not through holes: {listed}; "
+        f"if they are holes or outline, keep them with {keep}"
+    )
+    return drawing
+
+
 def _read_doc(
     doc: DxfDocument,
     path: Path,
@@ -621,11 +725,9 @@ def _read_doc(
     damage: str | None = None,
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
     unit_name, scale, warnings_ = drawing_units(doc, options.units, str(path))
-    lines, names, layers, skipped, notes, flatten_mm = dxf_lines(
-        doc, options, scale, str(path), budget
-    )
+    drawn, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
     warnings_ += notes
-    if not lines:
+    if not drawn.lines:
         what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
         if damage is not None:
             raise InputError(
@@ -636,7 +738,7 @@ def _read_doc(
             f"{path}: no outline geometry (lines, arcs, curves) in the "
             f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing = drawing_from_lines(lines, flatten_mm, str(path), budget, names, layers)
+    drawing = _drawing(drawn, flatten_mm, str(path), options, budget, warnings_)
     if damage is not None:
         warnings_.append(
             f"damaged DXF file ({damage}): read what ezdxf could recover; entities it could "

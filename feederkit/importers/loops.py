@@ -628,6 +628,24 @@ def heal_gaps(
     return list(lines) + bridges, [note]
 
 
+def closing_lines(lines: Sequence[np.ndarray], gap: float) -> list[int]:
+    """Indices of the ``lines`` that close loops among themselves: each is a closed line or
+    lies wholly on the rim of a face the lines enclose (ends closer than ``gap`` joined).
+
+    A rectangle of four LINEs counts, a centre line crossing a circle does not.
+    """
+    if not lines:
+        return []
+    snapped = snap_endpoints(lines, gap)
+    geoms = np.array([shapely.linestrings(np.asarray(ln, dtype=float)) for ln in snapped])
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(shapely.union_all(geoms))))
+    if len(faces) == 0:
+        return [k for k, ln in enumerate(snapped) if _is_closed(ln, gap)]
+    rims = shapely.union_all(shapely.boundary(faces))
+    on_rim = _along(geoms, rims, max(gap, 1e-9))
+    return [k for k, ln in enumerate(snapped) if on_rim[k] or _is_closed(ln, gap)]
+
+
 def _is_closed(line: np.ndarray, gap: float) -> bool:
     """Whether a polyline is a closed ring (its ends within ``gap``) with room for an area."""
     return len(line) >= 4 and float(np.hypot(*(line[0] - line[-1]))) <= gap

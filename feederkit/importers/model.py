@@ -41,8 +41,10 @@ class ImportOptions:
     most probable); ``com`` gives the center of mass in the outline frame; ``hull_tolerance``
     ``None`` means :data:`REL_HULL_TOLERANCE` of the part's size, at most
     :data:`DEFAULT_HULL_TOLERANCE`, for CAD and mesh files and an exact hull for outline
-    files; ``space`` is the DXF space read (``model`` or ``paper``); ``limits`` are the
-    import budgets (:mod:`.budget`).
+    files; ``space`` is the DXF space read (``model`` or ``paper``); ``keep_linetypes``
+    names hidden or centre linetypes whose closed loops are part of the outline (by default
+    they are left out: hidden edges, construction lines); ``limits`` are the import budgets
+    (:mod:`.budget`).
     """
 
     units: str | None = None
@@ -55,6 +57,7 @@ class ImportOptions:
     max_file_mb: float = DEFAULT_MAX_FILE_MB
     allow_large: bool = False
     space: str = "model"
+    keep_linetypes: tuple[str, ...] = ()
     limits: ImportLimits = field(default_factory=ImportLimits)
 
     def __post_init__(self) -> None:
@@ -65,14 +68,18 @@ class ImportOptions:
 
     def as_key(self) -> dict[str, object]:
         """The options that change the imported part (stored with a revision, compared later)."""
-        return {
-            "units": self.units,
-            "layers": sorted(self.layers),
-            "flatten_tolerance": self.flatten_tolerance,
-            "hull_tolerance": self.hull_tolerance,
-            "pose": self.pose,
-            "com": list(self.com) if self.com is not None else None,
-        } | ({"space": self.space} if self.space != "model" else {})
+        return (
+            {
+                "units": self.units,
+                "layers": sorted(self.layers),
+                "flatten_tolerance": self.flatten_tolerance,
+                "hull_tolerance": self.hull_tolerance,
+                "pose": self.pose,
+                "com": list(self.com) if self.com is not None else None,
+            }
+            | ({"space": self.space} if self.space != "model" else {})
+            | ({"keep_linetypes": sorted(self.keep_linetypes)} if self.keep_linetypes else {})
+        )
 
 
 @dataclass(frozen=True)
