@@ -212,3 +212,74 @@ def test_keep_linetype_on_the_command_line(tmp_path, capsys):
         assert ("--keep-linetype HIDDEN" in err) == (not args)
         com = json.loads(out)[0]["com"]
         assert np.hypot(com[0] - expected.centroid.x, com[1] - expected.centroid.y) <= 0.02
+
+
+# A hole drawn as concentric loops is a counterbore (or a construction circle) around the
+# through hole, not a part cut from the hole.
+
+
+def _circles(*radii: float, layer: str = "0"):
+    def build(doc, msp):
+        for r in radii:
+            msp.add_circle((20, 20), r, dxfattribs={"layer": layer})
+
+    return build
+
+
+def _slot(msp, r: float) -> None:
+    """A slot from (15, 20) to (25, 20) drawn as a closed polyline with two bulges."""
+    msp.add_lwpolyline(
+        [
+            (15, 20 - r, 0, 0, 0),
+            (25, 20 - r, 0, 0, 1),
+            (25, 20 + r, 0, 0, 0),
+            (15, 20 + r, 0, 0, 1),
+        ],
+        format="xyseb",
+        close=True,
+    )
+
+
+@pytest.mark.parametrize(
+    ("build", "through", "outer"),
+    [
+        (_circles(4, 7), 4, 7),
+        (_circles(4, 10, layer="CENTER_LINES"), 4, 10),  # a construction circle, Continuous
+        (_circles(4, 7, 10), 4, 10),
+    ],
+    ids=["counterbore", "construction-circle", "two-steps"],
+)
+def test_concentric_circles_make_the_inner_one_the_through_hole(tmp_path, build, through, outer):
+    ip, warnings = imported(plate_with(tmp_path / "cb.dxf", build))
+    expected = PLATE_WITH_HOLE.difference(Point(20, 20).buffer(through, 512))
+    assert_same_part(ip, expected)
+    (note,) = [w for w in warnings if "concentric loops" in w]
+    assert "counterbore" in note and "innermost loop" in note
+    assert f"{2 * outer:g} mm across" in note and f"{2 * through:g} mm across" in note
+    assert "linetype Continuous" in note and "on layer '" in note
+    cut = PLATE_WITH_HOLE.difference(Point(20, 20).buffer(outer, 512)).centroid
+    assert f"({cut.x:.2f}, {cut.y:.2f})" in note
+    assert not [w for w in warnings if "cut sheet" in w or "separate parts" in w]
+
+
+def test_a_counterbored_slot_is_a_slot_through(tmp_path):
+    def build(doc, msp):
+        _slot(msp, 3)
+        _slot(msp, 6)
+
+    ip, warnings = imported(plate_with(tmp_path / "slot.dxf", build))
+    slot = Point(15, 20).buffer(3, 512).union(Point(25, 20).buffer(3, 512))
+    slot = slot.union(Polygon([(15, 17), (25, 17), (25, 23), (15, 23)]))
+    assert_same_part(ip, PLATE_WITH_HOLE.difference(slot))
+    assert [w for w in warnings if "concentric loops" in w]
+
+
+def test_a_square_part_in_a_round_hole_is_still_a_cut_sheet(tmp_path):
+    def build(doc, msp):
+        msp.add_circle((20, 20), 12)
+        msp.add_lwpolyline([(15, 15), (25, 15), (25, 25), (15, 25)], close=True)
+
+    ip, warnings = imported(plate_with(tmp_path / "sheet.dxf", build))
+    assert_same_part(ip, PLATE_WITH_HOLE.difference(Point(20, 20).buffer(12, 512)))
+    assert [w for w in warnings if "cut sheet" in w]
+    assert not [w for w in warnings if "concentric" in w]

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import ezdxf
 import numpy as np
+import shapely
 from ezdxf import path as dxfpath
 from ezdxf import recover
 from ezdxf.document import Drawing as DxfDocument
@@ -27,14 +28,17 @@ from ezdxf.entities import DXFGraphic
 from ezdxf.lldxf.const import DXFError
 from ezdxf.math import Matrix44, Vec2, Vec3
 from ezdxf.path import Command
+from shapely.geometry import Polygon
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
 from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
 from feederkit.importers.loops import (
+    Counterbore,
     Drawing,
     Region,
     closing_lines,
+    counterbores,
     drawing_from_lines,
     merged_note,
 )
@@ -622,6 +626,52 @@ def hidden_note(drawn: DrawnLines, dropped: set[int]) -> tuple[str, str]:
     return "; ".join(listed) + more, keep
 
 
+def ring_owners(ring: Sequence[tuple[float, float]], drawn: DrawnLines, gap: float) -> str:
+    """The entities drawing a loop, each with its layer and linetype (or "a loop")."""
+    poly = Polygon(ring)
+    tol = max(2.0 * gap, 1e-9 * float(np.sqrt(poly.area)))
+    names: dict[str, str] = {}
+    for k, line in enumerate(drawn.lines):
+        if shapely.dwithin(shapely.points(line), poly.exterior, tol).all():
+            names.setdefault(drawn.names[k], drawn.linetypes[k])
+    listed = [f"{name}, linetype {lt}" for name, lt in list(names.items())[:MAX_LISTED]]
+    return " + ".join(listed) or "a loop"
+
+
+def counterbore_note(bore: Counterbore, drawing: Drawing, drawn: DrawnLines, gap: float) -> str:
+    """The warning for a hole drawn as concentric loops: which loops (entities, layers,
+    linetypes), the one taken as the through hole and where the COM may lie."""
+    outer = Polygon(bore.outer)
+    loops = "; ".join(
+        f"{ring_owners(r, drawn, gap)}, {_across(Polygon(r)):.4g} mm across" for r in bore.rings
+    )
+    where = f"({outer.centroid.x:.1f}, {outer.centroid.y:.1f})"
+    note = (
+        f"the hole at {where} is drawn as concentric loops ({loops}): taken for a "
+        "counterbore, countersink, chamfer or construction circle around a through hole, "
+        "not a part in the hole; the through hole is the innermost loop"
+    )
+    region = next((r for r in drawing.regions if bore.inner in r.holes), None)
+    if region is None:
+        return note
+    with_inner = Polygon(region.shell, region.holes)
+    holes = [bore.outer if h == bore.inner else h for h in region.holes]
+    with_outer = Polygon(region.shell, holes)
+    a, b = with_inner.centroid, with_outer.centroid
+    return (
+        f"{note}, so the part keeps the material under the counterbore: COM ({a.x:.2f}, "
+        f"{a.y:.2f}); with the outer loop cut through it would be ({b.x:.2f}, {b.y:.2f}), "
+        f"{a.distance(b):.2g} mm away: the true COM lies between, by the counterbore's depth "
+        "(give it with --com)"
+    )
+
+
+def _across(poly: Polygon) -> float:
+    """A loop's largest extent along x or y (a circle's diameter)."""
+    x0, y0, x1, y1 = poly.bounds
+    return max(x1 - x0, y1 - y0)
+
+
 def _describe(region: Region) -> str:
     xs = [p[0] for p in region.shell]
     ys = [p[1] for p in region.shell]
@@ -689,12 +739,13 @@ def _drawing(
     options: ImportOptions,
     budget: Budget,
     warnings_: list[str],
-) -> Drawing:
+) -> tuple[Drawing, DrawnLines]:
     """The drawing's loops and parts, loops drawn in hidden or centre linetypes left out
-    (:func:`hidden_loops`), with a warning naming them in ``warnings_``."""
+    (:func:`hidden_loops`) with a warning naming them in ``warnings_``, and the lines kept."""
     dropped = hidden_loops(drawn, gap, options.keep_linetypes)
     if not dropped:
-        return drawing_from_lines(drawn.lines, gap, label, budget, drawn.names, drawn.layers)
+        drawing = drawing_from_lines(drawn.lines, gap, label, budget, drawn.names, drawn.layers)
+        return drawing, drawn
     listed, keep = hidden_note(drawn, dropped)
     kept = drawn.without(dropped)
     if not kept.lines:
@@ -713,7 +764,7 @@ def _drawing(
         f"(pockets, far-side features) or construction lines, not through holes: {listed}; "
         f"if they are holes or outline, keep them with {keep}"
     )
-    return drawing
+    return drawing, kept
 
 
 def _read_doc(
@@ -738,13 +789,15 @@ def _read_doc(
             f"{path}: no outline geometry (lines, arcs, curves) in the "
             f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing = _drawing(drawn, flatten_mm, str(path), options, budget, warnings_)
+    drawing, drawn = _drawing(drawn, flatten_mm, str(path), options, budget, warnings_)
+    drawing, bores = counterbores(drawing, flatten_mm)
     if damage is not None:
         warnings_.append(
             f"damaged DXF file ({damage}): read what ezdxf could recover; entities it could "
             "not parse are lost, so check the part"
         )
     warnings_ += list(drawing.warnings)
+    warnings_ += [counterbore_note(b, drawing, drawn, flatten_mm) for b in bores]
     if drawing.frames:
         warnings_.append(f"skipped {drawing.frames} drawing frame(s) around the part")
     regions = list(drawing.regions)

@@ -11,7 +11,7 @@ crossing circle onto the outline.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import shapely
@@ -818,6 +818,84 @@ def frame_doubt(
         f"{plural(len(holes), 'hole')}: if the rectangle is a drawing frame, the part is what "
         f"it holds: leave the frame's layer out with --layer{keep}"
     )
+
+
+CONCENTRIC_CENTRE = 0.02
+"""Loops are concentric when their centroids lie within this share of the outer one's
+equivalent diameter (plus twice the flatten tolerance)."""
+
+CONCENTRIC_SPREAD = 1.1
+"""Concentric loops are parallel (a counterbore, not a square in a round hole) when the
+farthest point of one from the other is at most this many times their nearest distance."""
+
+
+@dataclass(frozen=True)
+class Counterbore:
+    """A hole drawn as concentric loops: the ``outer`` loop the part's hole was, the
+    ``inner`` loop taken as the through hole, and the loops of the stack (largest first)."""
+
+    outer: tuple[Point, ...]
+    inner: tuple[Point, ...]
+    rings: tuple[tuple[Point, ...], ...]
+
+
+def concentric(outer: Polygon, inner: Polygon, gap: float) -> bool:
+    """Whether ``inner`` (inside ``outer``) is concentric with it and parallel to it: their
+    centroids close (:data:`CONCENTRIC_CENTRE`), the band between them of even width
+    (:data:`CONCENTRIC_SPREAD`), as a counterbore, countersink or chamfer is drawn."""
+    size = 2.0 * np.sqrt(outer.area / np.pi)
+    if outer.centroid.distance(inner.centroid) > CONCENTRIC_CENTRE * size + 2.0 * gap:
+        return False
+    near = outer.exterior.distance(inner.exterior)
+    far = outer.exterior.hausdorff_distance(inner.exterior)
+    return near > 0.0 and far <= CONCENTRIC_SPREAD * near + 2.0 * gap
+
+
+def counterbores(drawing: Drawing, gap: float) -> tuple[Drawing, list[Counterbore]]:
+    """The drawing with each hole that holds only loops concentric with it and parallel to it
+    (:func:`concentric`) replaced by the smallest of them, those loops' parts dropped.
+
+    A disc in a hole, concentric with it, is a counterbore (or countersink, chamfer,
+    construction circle) drawn in a top view, not a part cut from a sheet: the through hole
+    is the innermost loop and the part keeps the material under the counterbore.
+    """
+    regions = list(drawing.regions)
+    dropped: set[int] = set()
+    found: list[Counterbore] = []
+    for i, region in enumerate(regions):
+        if i in dropped:
+            continue
+        holes = list(region.holes)
+        for h, hole in enumerate(holes):
+            outer = Polygon(hole)
+            inside = [
+                j
+                for j, other in enumerate(regions)
+                if j != i and j not in dropped and outer.contains(Polygon(other.shell))
+            ]
+            rings = [ring for j in inside for ring in (regions[j].shell, *regions[j].holes)]
+            if not rings or not all(concentric(outer, Polygon(r), gap) for r in rings):
+                continue
+            stack = sorted(rings, key=lambda r: -Polygon(r).area)
+            holes[h] = stack[-1]
+            dropped.update(inside)
+            found.append(Counterbore(outer=hole, inner=stack[-1], rings=(hole, *stack)))
+        if holes != list(region.holes):
+            polys = [Polygon(r) for r in holes]
+            area = Polygon(region.shell).area - sum(p.area for p in polys)
+            regions[i] = replace(region, holes=tuple(holes), area=float(area))
+    if not found:
+        return drawing, []
+    first = drawing.regions[0]
+    nested = drawing.nested - sum(1 for j in dropped if _inside(first, regions[j]))
+    kept = tuple(r for j, r in enumerate(regions) if j not in dropped)
+    return replace(drawing, regions=kept, nested=max(0, nested)), found
+
+
+def _inside(region: Region, other: Region) -> bool:
+    """Whether ``other`` lies in one of ``region``'s holes."""
+    shell = Polygon(other.shell)
+    return any(Polygon(h).contains(shell) for h in region.holes)
 
 
 def _picked(values: Sequence[str] | None, keep: Sequence[int], n: int) -> list[str] | None:
