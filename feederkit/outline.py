@@ -12,6 +12,7 @@ import json
 import math
 import numbers
 import os
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,6 +128,61 @@ def _ring(pts: tuple[Point, ...], what: str, name: str) -> tuple[Point, ...]:
     return tuple(out)
 
 
+GEOS_POINT = re.compile(r"\[\s*([-+0-9.eE]+)[\s,]+([-+0-9.eE]+)")
+"""The location GEOS appends to its reason a geometry is invalid: ``Self-intersection[5 5]``."""
+
+
+def near_point(reason: str) -> str:
+    """`` near (x, y)`` for the location in a GEOS reason, or ""."""
+    found = GEOS_POINT.search(reason)
+    return f" near ({float(found[1]):.6g}, {float(found[2]):.6g})" if found else ""
+
+
+def invalid_words(reason: str) -> str:
+    """GEOS's reason a ring is invalid, in words: ``crosses itself near (5, 5)``."""
+    kind = reason.split("[", 1)[0].strip().lower()
+    if kind == "ring self-intersection":
+        return f"touches itself{near_point(reason)}"
+    if "self-intersection" in kind:
+        return f"crosses itself{near_point(reason)}"
+    return f"is invalid ({kind}){near_point(reason)}"
+
+
+def _same_ring(a: Sequence[Point], b: Sequence[Point]) -> bool:
+    """Whether two rings have the same points (in any order or direction)."""
+    return sorted(a) == sorted(b)
+
+
+def hole_fault(shell: Polygon, holes: Sequence[Sequence[Point]]) -> str:
+    """What is wrong with the holes of a valid ``shell``, in words naming the holes (by their
+    index in the list): a hole crossing itself, listed twice, outside or across the
+    outline, inside or across another hole."""
+    polys = [Polygon(np.asarray(h)) for h in holes]
+    for i, poly in enumerate(polys):
+        if not poly.is_valid:
+            return f"hole {i} {invalid_words(shapely.is_valid_reason(poly))}"
+    for i, poly in enumerate(polys):
+        if not shell.intersects(poly) or shell.intersection(poly).area <= 0.0:
+            return f"hole {i} lies outside the outline"
+        if not shell.contains(poly):
+            where = shell.exterior.intersection(poly.exterior).representative_point()
+            return f"hole {i} crosses the outline near ({where.x:.6g}, {where.y:.6g})"
+    for j, b in enumerate(polys):
+        for i, a in enumerate(polys[:j]):
+            if _same_ring(holes[i], holes[j]):
+                return f"hole {j} is listed twice (the same points as hole {i})"
+            if not a.intersects(b):
+                continue
+            if a.contains(b) or b.contains(a):
+                inner, outer = (j, i) if a.contains(b) else (i, j)
+                return f"hole {inner} lies inside hole {outer}"
+            if a.intersection(b).area > 0.0:
+                where = a.exterior.intersection(b.exterior).representative_point()
+                return f"holes {i} and {j} overlap near ({where.x:.6g}, {where.y:.6g})"
+    reason = shapely.is_valid_reason(Polygon(shell.exterior, [list(h) for h in holes]))
+    return f"the holes and the outline touch along a line or cut the part apart{near_point(reason)}"
+
+
 def make_outline(
     name: str,
     vertices: Iterable[Sequence[float]],
@@ -170,13 +226,14 @@ def make_outline(
     if size <= 0.0 or shell.convex_hull.area <= tiny_area:
         raise InputError(f"{name}: the outline has zero area (its points are collinear)")
     if not shapely.is_valid(shell):
-        reason = shapely.is_valid_reason(shell)
-        raise InputError(f"{name}: the outline is self-intersecting ({reason})")
+        reason = invalid_words(shapely.is_valid_reason(shell))
+        raise InputError(f"{name}: the outline is self-intersecting (it {reason})")
     if shell.area <= tiny_area:
         raise InputError(f"{name}: the outline has zero area")
-    if hole_rings and not (poly := Polygon(outer, [list(h) for h in hole_rings])).is_valid:
+    if hole_rings and not Polygon(outer, [list(h) for h in hole_rings]).is_valid:
         raise InputError(
-            f"{name}: a hole crosses the outline or another hole ({shapely.is_valid_reason(poly)})"
+            f"{name}: {hole_fault(shell, hole_rings)} (each hole must lie inside the outline: "
+            "no hole crosses it or another hole)"
         )
     return Outline(name=name, vertices=outer, holes=hole_rings, com=com_pt, units="mm")
 

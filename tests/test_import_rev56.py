@@ -283,3 +283,107 @@ def test_a_square_part_in_a_round_hole_is_still_a_cut_sheet(tmp_path):
     assert_same_part(ip, PLATE_WITH_HOLE.difference(Point(20, 20).buffer(12, 512)))
     assert [w for w in warnings if "cut sheet" in w]
     assert not [w for w in warnings if "concentric" in w]
+
+
+# Messages: the loop named is the likeliest construction geometry, in words, with the file.
+
+
+def flange(path: Path, bore: bool, centre_lines: bool, layer: str = "0") -> Path:
+    """A disc R30 with four R3 bolt holes on an R20 circle drawn on ``layer`` (Continuous)."""
+    doc = new_doc()
+    msp = doc.modelspace()
+    msp.add_circle((0, 0), 30)
+    if bore:
+        msp.add_circle((0, 0), 8)
+    for x, y in ((20, 0), (0, 20), (-20, 0), (0, -20)):
+        msp.add_circle((x, y), 3)
+    msp.add_circle((0, 0), 20, dxfattribs={"layer": layer})
+    if centre_lines:
+        msp.add_line((-35, 0), (35, 0))
+        msp.add_line((0, -35), (0, 35))
+    doc.saveas(path)
+    return path
+
+
+def bolt_circle(path: Path) -> str:
+    doc = ezdxf.readfile(path)
+    (circle,) = [e for e in doc.modelspace() if e.dxftype() == "CIRCLE" and e.dxf.radius == 20]
+    return f"CIRCLE {circle.dxf.handle}"
+
+
+@pytest.mark.parametrize("centre_lines", [False, True])
+def test_the_bolt_circle_is_named_as_crossing_the_bolt_holes(tmp_path, centre_lines):
+    path = flange(tmp_path / "flange.dxf", False, centre_lines, layer="CENTER")
+    with pytest.raises(InputError) as err:
+        imported(path)
+    message = str(err.value)
+    assert message.startswith(f"{path}: ") and "\n" not in message
+    assert f"{bolt_circle(path)} on layer 'CENTER'" in message
+    assert "crosses 4 other loops" in message and "--layer" in message
+    assert "Self-intersection" not in message
+
+
+def test_crossing_loops_left_after_centre_lines_are_named_in_words(tmp_path):
+    path = flange(tmp_path / "flange.dxf", False, True)
+    with pytest.raises(InputError) as err:
+        imported(path)
+    message = str(err.value)
+    assert f"{bolt_circle(path)} on layer '0', linetype Continuous crosses 4 other loops" in (
+        message
+    )
+    assert "Self-intersection" not in message and "near (" in message
+
+
+def test_an_outline_drawn_twice_slightly_shifted_is_named(tmp_path):
+    doc = new_doc()
+    msp = doc.modelspace()
+    msp.add_lwpolyline(L_BRACKET, close=True)
+    msp.add_lwpolyline([(x + 0.03, y) for x, y in L_BRACKET], close=True)
+    msp.add_circle((47, 7.5), 3.5)
+    doc.saveas(tmp_path / "twice.dxf")
+    with pytest.raises(InputError, match=r"the outline seems drawn twice, 0\.03 mm apart"):
+        imported(tmp_path / "twice.dxf")
+
+
+HOLE = [[2, 2], [4, 2], [4, 4]]
+BIG = [[2, 2], [20, 2], [20, 20]]
+
+
+@pytest.mark.parametrize(
+    ("vertices", "holes", "words"),
+    [
+        ([[0, 0], [10, 0], [0, 10], [10, 10]], [], "crosses itself near (5, 5)"),
+        (PLATE_PTS, [HOLE, HOLE], "hole 1 is listed twice"),
+        (PLATE_PTS, [[[5, 5], [95, 5], [95, 8]]], "hole 0 crosses the outline near (80, "),
+        (PLATE_PTS, [[[90, 5], [95, 5], [95, 8]]], "hole 0 lies outside the outline"),
+        (PLATE_PTS, [[[2, 2], [9, 2], [9, 9]], [[5, 1], [8, 1], [8, 8]]], "holes 0 and 1 overlap"),
+        (PLATE_PTS, [BIG, [[9, 4], [12, 4], [12, 7]]], "hole 1 lies inside hole 0"),
+    ],
+)
+def test_outline_file_faults_in_words_naming_the_file(tmp_path, vertices, holes, words):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps({"name": "x", "vertices": vertices, "holes": holes}))
+    with pytest.raises(InputError) as err:
+        imported(path)
+    message = str(err.value)
+    assert message.startswith(f"{path}: x: ") and words in message
+    assert "Self-intersection" not in message and "[" not in message
+
+
+def test_a_com_outside_the_hull_names_the_file(tmp_path):
+    path = tmp_path / "com.json"
+    path.write_text(json.dumps({"name": "x", "vertices": PLATE_PTS, "com": [200, 5]}))
+    with pytest.raises(
+        InputError, match=rf"^{path}: x: the center of mass \(200, 5\) lies outside"
+    ):
+        imported(path)
+
+
+def test_a_bolt_circle_around_a_bore_is_a_construction_circle(tmp_path):
+    ip, warnings = imported(flange(tmp_path / "flange.dxf", True, True))
+    part = Point(0, 0).buffer(30, 512).difference(Point(0, 0).buffer(8, 512))
+    for x, y in ((20, 0), (0, 20), (-20, 0), (0, -20)):
+        part = part.difference(Point(x, y).buffer(3, 256))
+    assert_same_part(ip, part)
+    (note,) = [w for w in warnings if "concentric loops" in w]
+    assert "crossing other holes" in note and "construction circle" in note

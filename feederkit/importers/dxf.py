@@ -45,6 +45,7 @@ from feederkit.importers.loops import (
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
 from feederkit.outline import make_outline, unit_scale
+from feederkit.words import plural
 
 logging.getLogger("ezdxf").addHandler(logging.NullHandler())  # a library never prints
 
@@ -646,6 +647,13 @@ def counterbore_note(bore: Counterbore, drawing: Drawing, drawn: DrawnLines, gap
         f"{ring_owners(r, drawn, gap)}, {_across(Polygon(r)):.4g} mm across" for r in bore.rings
     )
     where = f"({outer.centroid.x:.1f}, {outer.centroid.y:.1f})"
+    if bore.crosses:
+        return (
+            f"the hole at {where} is drawn as concentric loops ({loops}), the outer one "
+            "crossing other holes: taken for a construction circle (a bolt circle) around a "
+            "through hole, the innermost loop; check the part, or leave the construction "
+            "circle's layer out with --layer"
+        )
     note = (
         f"the hole at {where} is drawn as concentric loops ({loops}): taken for a "
         "counterbore, countersink, chamfer or construction circle around a through hole, "
@@ -670,6 +678,32 @@ def _across(poly: Polygon) -> float:
     """A loop's largest extent along x or y (a circle's diameter)."""
     x0, y0, x1, y1 = poly.bounds
     return max(x1 - x0, y1 - y0)
+
+
+def region_fault(region: Region, drawn: DrawnLines, gap: float) -> str | None:
+    """Which loop of a part crosses others (entities, layers, linetypes, where), the one
+    crossing the most named first; None when its outline and holes make a valid polygon."""
+    if Polygon(region.shell, region.holes).is_valid:
+        return None
+    rings = [region.shell, *region.holes]
+    rims = [Polygon(r).exterior for r in rings]
+    pairs = [
+        (i, j)
+        for j in range(len(rims))
+        for i in range(j)
+        if rims[i].crosses(rims[j]) or rims[i].overlaps(rims[j])
+    ]
+    if not pairs:
+        return None
+    counts = Counter(k for pair in pairs for k in pair)
+    worst = max(counts, key=lambda k: (counts[k], -k))
+    others = [j if i == worst else i for i, j in pairs if worst in (i, j)]
+    where = rims[worst].intersection(rims[others[0]]).representative_point()
+    crossed = "; ".join(ring_owners(rings[k], drawn, gap) for k in others[:MAX_LISTED])
+    return (
+        f"{ring_owners(rings[worst], drawn, gap)} crosses {plural(len(others), 'other loop')} "
+        f"({crossed}), first near ({where.x:.4g}, {where.y:.4g})"
+    )
 
 
 def _describe(region: Region) -> str:
@@ -823,6 +857,12 @@ def _read_doc(
     outlines = []
     for k, region in enumerate(chosen):
         label = name if k == 0 else f"{name}-{k + 1}"
+        fault = region_fault(region, drawn, flatten_mm)
+        if fault is not None:
+            raise InputError(
+                f"{path}: loops of the part cross: {fault}; leave construction geometry out "
+                "with --layer"
+            )
         outline = make_outline(label, region.shell, region.holes, options.com, "mm")
         size_notes = size_warnings(outline_size(outline), unit_name, options.units is not None)
         if region.enclosed:

@@ -10,6 +10,7 @@ crossing circle onto the outline.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
@@ -23,6 +24,7 @@ from shapely.geometry import LineString, Polygon
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import Budget
+from feederkit.outline import invalid_words
 from feederkit.words import plural
 
 Point = tuple[float, float]
@@ -47,6 +49,9 @@ tangent to them when its length within ``4 t`` of them is at least this many tim
 length within ``t`` (:func:`_tangent`): a curve leaves a tangent curve or line gradually
 (twice the length within four times the distance), a side drawn along another line stays
 on it and then turns away."""
+
+NEAR_COPY_SHARE = 0.01
+"""Two closed lines within this share of their size of each other are one loop drawn twice."""
 
 HEAL_GAP_REL = 0.002
 """Gaps between open line ends up to this share of the drawing's size are closed (0.2 %)."""
@@ -686,20 +691,32 @@ def _beyond(a: Polygon, b: Polygon, reach: float) -> bool:
     return bool((shapely.distance(shapely.points(edge), b) > reach).any())
 
 
+CONSTRUCTION_LAYER = re.compile(r"CENT(ER|RE)|CONSTR|HIDDEN|PHANTOM|DASH|AUX", re.IGNORECASE)
+"""Layer names of construction geometry (bolt circles, centre lines, helper lines)."""
+
+MAX_CROSSING_CANDIDATES = 50
+"""Closed lines tried at most when naming the one that crosses other loops."""
+
+
 def crossing_loop(
     lines: Sequence[np.ndarray],
     closed: Sequence[int],
     shells: Sequence[Polygon],
     gap: float,
     budget: Budget | None = None,
-) -> int | None:
-    """The closed line (index into ``lines``) that crosses another loop, else None.
+    layers: Sequence[str] | None = None,
+) -> tuple[int, int] | None:
+    """The closed line (index into ``lines``) that crosses other loops and how many it
+    crosses, else None.
 
     Polygonizing merges crossing loops into one part, so a circle drawn across the outline
     (or two overlapping closed outlines) would silently change the part. A candidate is a
     closed line lying partly on a loop's boundary and partly inside it; it crosses when
-    the other lines, without it, close a loop that it overlaps. Smallest candidates first,
-    so a circle across the outline is named rather than the outline.
+    the other lines, without it, close a loop that it overlaps. Of those that cross, the
+    one named is the likeliest construction geometry: on a construction layer
+    (:data:`CONSTRUCTION_LAYER`, ``layers[k]`` is line ``k``'s), then crossing the most
+    loops (a bolt circle across its holes), then the smallest (a circle across the outline
+    rather than the outline).
     """
     if not shells:
         return None
@@ -720,14 +737,44 @@ def crossing_loop(
             if (dist <= gap).any() and (inside & (dist > gap)).any():
                 candidates.append((poly.area, k, poly))
                 break
-    for _, k, poly in sorted(candidates, key=lambda c: c[:2]):
+    ranked: list[tuple[bool, int, float, int]] = []
+    for area, k, poly in sorted(candidates, key=lambda c: c[:2])[:MAX_CROSSING_CANDIDATES]:
         if budget is not None:
             budget.check_time()
-        others = [ln for i, ln in enumerate(lines) if i != k]
-        loops, _ = closed_loops(others)
+        loops, _ = closed_loops([ln for i, ln in enumerate(lines) if i != k])
         tiny = 1e-9 * poly.area
-        if any(_overlap(poly, lp.polygon, tiny, 2.0 * gap) for lp in loops):
-            return k
+        crossed = sum(_overlap(poly, lp.polygon, tiny, 2.0 * gap) for lp in loops)
+        if crossed:
+            helper = (
+                layers is not None
+                and k < len(layers)
+                and bool(CONSTRUCTION_LAYER.search(layers[k]))
+            )
+            ranked.append((not helper, -crossed, area, k))
+    if not ranked:
+        return None
+    best = min(ranked)
+    return best[3], -best[1]
+
+
+def near_copy(
+    lines: Sequence[np.ndarray], closed: Sequence[int], k: int, gap: float
+) -> tuple[int, float] | None:
+    """Another closed line that line ``k`` nearly repeats (each within 1 % of its size of
+    the other, farther apart than ``gap``: an outline pasted twice, slightly shifted), with
+    their distance, else None."""
+    ring = Polygon(np.asarray(lines[k], dtype=float))
+    x0, y0, x1, y1 = ring.bounds
+    reach = NEAR_COPY_SHARE * max(x1 - x0, y1 - y0)
+    for j in closed:
+        if j == k:
+            continue
+        other = Polygon(np.asarray(lines[j], dtype=float))
+        if not other.is_valid or other.distance(ring) > reach:
+            continue
+        apart = float(ring.exterior.hausdorff_distance(other.exterior))
+        if gap < apart <= reach:
+            return j, apart
     return None
 
 
@@ -837,6 +884,8 @@ class Counterbore:
     outer: tuple[Point, ...]
     inner: tuple[Point, ...]
     rings: tuple[tuple[Point, ...], ...]
+    crosses: bool = False
+    """Whether the outer loop crosses other holes of the part (a bolt circle)."""
 
 
 def concentric(outer: Polygon, inner: Polygon, gap: float) -> bool:
@@ -879,7 +928,9 @@ def counterbores(drawing: Drawing, gap: float) -> tuple[Drawing, list[Counterbor
             stack = sorted(rings, key=lambda r: -Polygon(r).area)
             holes[h] = stack[-1]
             dropped.update(inside)
-            found.append(Counterbore(outer=hole, inner=stack[-1], rings=(hole, *stack)))
+            rim = outer.exterior
+            crosses = any(rim.crosses(Polygon(o)) for k, o in enumerate(holes) if k != h)
+            found.append(Counterbore(hole, stack[-1], (hole, *stack), crosses))
         if holes != list(region.holes):
             polys = [Polygon(r) for r in holes]
             area = Polygon(region.shell).area - sum(p.area for p in polys)
@@ -941,7 +992,9 @@ def drawing_from_lines(
     for k in closed:
         reason = self_crossing(snapped[k])
         if reason is not None:
-            raise InputError(f"{label}: the outline is self-intersecting ({name(k)}: {reason})")
+            raise InputError(
+                f"{label}: the outline is self-intersecting ({name(k)} {invalid_words(reason)})"
+            )
     healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
     if budget is not None:
         budget.check_time()
@@ -950,11 +1003,21 @@ def drawing_from_lines(
         ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
         detail = f" ({plural(ends, 'open end')})" if ends else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
-    crossing = crossing_loop(healed, closed, [lp.polygon for lp in loops], gap, budget)
-    if crossing is not None:
+    shells = [lp.polygon for lp in loops]
+    found = crossing_loop(healed, closed, shells, gap, budget, layers)
+    if found is not None:
+        crossing, crossed = found
+        copy = near_copy(healed, closed, crossing, gap)
+        if copy is not None:
+            largest = max(p.area for p in shells)
+            what = "the outline" if Polygon(healed[crossing]).area >= 0.9 * largest else "a loop"
+            raise InputError(
+                f"{label}: {what} seems drawn twice, {copy[1]:.2g} mm apart ({name(copy[0])} "
+                f"and {name(crossing)}): delete one copy"
+            )
         raise InputError(
-            f"{label}: a hole crosses the outline ({name(crossing)} crosses another loop; "
-            "leave construction geometry out with --layer)"
+            f"{label}: a hole crosses the outline ({name(crossing)} crosses "
+            f"{plural(crossed, 'other loop')}; leave construction geometry out with --layer)"
         )
     bridged = max((float(np.hypot(*(b[-1] - b[0]))) for b in healed[len(snapped) :]), default=0.0)
     loops, slivers = _without_slivers(loops, gap, bridged)

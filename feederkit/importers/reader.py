@@ -182,5 +182,10 @@ def import_parts(
     """Read a source file and build its part(s) (several only with ``options.all_parts``)."""
     result = read_source(path, options, name)
     shared = result.warnings + tuple(f"left out: {o}" for o in result.others)
-    built = [build_part(imp, options, shared) for imp in result.parts]
+    try:
+        built = [build_part(imp, options, shared) for imp in result.parts]
+    except InputError as exc:  # name the file, as every error reading it does
+        if str(exc).startswith(f"{path}:"):
+            raise
+        raise InputError(f"{path}: {exc}") from None
     return result, built
