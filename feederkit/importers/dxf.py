@@ -276,6 +276,19 @@ def _block_references(entity: DXFGraphic, label: str) -> list[DXFGraphic]:
         ) from None
 
 
+def _reference_matrix(ref: DXFGraphic, label: str) -> Matrix44:
+    """A block reference's block-to-parent matrix (``Insert.matrix44``); InputError when
+    ezdxf cannot make it (a broken reference)."""
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            return ref.matrix44()
+    except Exception as exc:  # noqa: BLE001 - ezdxf raises many types on broken input
+        raise InputError(
+            f"{label}: cannot explode block {ref.dxf.get('name', '?')!r} ({_reason(exc)})"
+        ) from None
+
+
 def explode(
     entities: object,
     layer: str,
@@ -319,7 +332,8 @@ def explode(
                 f"{budget.label}: a reference to the undefined block {entity.dxf.get('name')!r}"
             )
         for cell in _block_references(entity, budget.label):
-            placed = cell.matrix44() if matrix is None else cell.matrix44() @ matrix
+            own = _reference_matrix(cell, budget.label)
+            placed = own if matrix is None else own @ matrix
             yield from explode(block, eff, depth + 1, skipped, budget, placed, drawn, ref or entity)
 
 

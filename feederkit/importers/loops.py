@@ -695,7 +695,7 @@ CONSTRUCTION_LAYER = re.compile(r"CENT(ER|RE)|CONSTR|HIDDEN|PHANTOM|DASH|AUX", r
 """Layer names of construction geometry (bolt circles, centre lines, helper lines)."""
 
 MAX_CROSSING_CANDIDATES = 50
-"""Closed lines tried at most when naming the one that crosses other loops."""
+"""Closed lines tried at most, once one is found crossing, to name the likeliest one."""
 
 
 def crossing_loop(
@@ -738,7 +738,9 @@ def crossing_loop(
                 candidates.append((poly.area, k, poly))
                 break
     ranked: list[tuple[bool, int, float, int]] = []
-    for area, k, poly in sorted(candidates, key=lambda c: c[:2])[:MAX_CROSSING_CANDIDATES]:
+    for tried, (area, k, poly) in enumerate(sorted(candidates, key=lambda c: c[:2])):
+        if ranked and tried >= MAX_CROSSING_CANDIDATES:
+            break  # enough found to name one; a crossing is never missed
         if budget is not None:
             budget.check_time()
         loops, _ = closed_loops([ln for i, ln in enumerate(lines) if i != k])
