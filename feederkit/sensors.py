@@ -9,7 +9,9 @@ files, execution, reports and the simulator never ask which model they hold:
   ``(d - e, d + e)``.
 - :class:`LedSensor`: beams at heights ``k * pitch`` (k = 1, 2, ...) above the fence; a width
   ``w`` blocks the beams below it, ``count = #{k : k * pitch < w}``; with alignment noise ``e``
-  the width lies anywhere in ``[d - e, d + e]``. The reading is ``count * pitch`` mm.
+  the width lies anywhere in ``[d - e, d + e]``. The reading is ``count * pitch`` mm; a plan
+  file's branch over counts ``a..b`` holds ``[(a - 1/4) pitch, (b + 1/4) pitch]``
+  (:meth:`LedSensor.window`), so any arithmetic for the product matches.
 
 A state's diameter may be an interval ``(lo, hi)`` (a physical resting state under
 uncertainty, docs/uncertainty.md): it reads anything any diameter in the interval can read.
@@ -475,6 +477,24 @@ LED_EDGE_REL = 1e-6
 READING_EPS = 1e-9
 """Readings within this fraction of the pitch of a beam count are taken as that count."""
 
+LED_WINDOW_REL = 0.25
+"""A plan file's LED window reaches this fraction of the pitch beyond its outer beam counts
+(:meth:`LedSensor.window`)."""
+
+LED_WINDOW_DIGITS = 4
+"""An LED window's ends keep this many decimals beyond the pitch's first significant one
+(never fewer than 6: nanometres), :func:`led_window_decimals`."""
+
+
+def led_window_decimals(pitch: float) -> int:
+    """Decimals (mm) an LED window's ends are rounded to: 6, more for a pitch below 0.01 mm,
+    so the rounding stays within 1e-4 of the pitch.
+
+    >>> led_window_decimals(0.05), led_window_decimals(2.0), led_window_decimals(1e-4)
+    (6, 6, 8)
+    """
+    return max(6, math.ceil(-math.log10(pitch)) + LED_WINDOW_DIGITS)
+
 
 def led_count(pitch: float, width: float) -> int:
     """Number of beams at heights ``k * pitch`` (k >= 1) strictly below ``width``."""
@@ -510,18 +530,45 @@ class LedSensor:
         """The beam count a reading (mm) stands for."""
         return round(reading / self.pitch)
 
+    def window(self, c_lo: int, c_hi: int) -> tuple[float, float]:
+        """The closed reading interval a plan file gives a branch over beam counts
+        ``c_lo..c_hi``: ``[(c_lo - 1/4) p, (c_hi + 1/4) p]``, ends rounded to
+        :func:`led_window_decimals` and clipped at 0.
+
+        design.md: a controller follows the branch whose closed interval holds the reading,
+        the beam count times the pitch. However it computes that product (float64 or float32,
+        ``c / (1 / p)``, fixed-point micrometres, decimal), it lands within a quarter pitch of
+        ``c * p``, so in the window of its count. The windows of different branches stay half
+        a pitch apart: a reading half-way between the counts of two branches is in neither.
+
+        >>> LedSensor(0.05).window(17, 17), LedSensor(0.05).window(13, 14)
+        ((0.8375, 0.8625), (0.6375, 0.7125))
+        >>> LedSensor(0.05).window(0, 1)
+        (0.0, 0.0625)
+        """
+        q = LED_WINDOW_REL * self.pitch
+        digits = led_window_decimals(self.pitch)
+        return max(0.0, round(c_lo * self.pitch - q, digits)), round(c_hi * self.pitch + q, digits)
+
+    def counts_held(self, lo: float, hi: float) -> tuple[int, int]:
+        """The first and last beam count whose reading the closed ``[lo, hi]`` holds (empty
+        when first > last): a window of :meth:`window`, or an older file's zero-width one
+        at the float64 product ``c * p`` (within ``READING_EPS`` of the pitch)."""
+        p = self.pitch
+        return math.ceil(lo / p - READING_EPS), math.floor(hi / p + READING_EPS)
+
     def reading_interval(self, diameter: Diameter) -> tuple[float, float] | None:
         c0, c1 = self.counts(diameter)
         return c0 * self.pitch, c1 * self.pitch
 
     def branch_reach(self, diameter: Diameter) -> tuple[float, float] | None:
-        # reads_into: the branch holds a count c0..c1 (within READING_EPS of the pitch); a
-        # positive share: its widths (lo, hi + pitch] meet [d_lo - e, d_hi + e].
+        # reads_into: the branch holds a count c0..c1 (counts_held); a positive share: the
+        # widths (first * p, (last + 1) * p] of its counts meet [d_lo - e, d_hi + e].
         c0, c1 = self.counts(diameter)
         p, e = self.pitch, self.noise
         slack = 2.0 * READING_EPS * p
         d_lo, d_hi = span(diameter)
-        return min(c0 * p - slack, d_lo - e - p), max(c1 * p + slack, d_hi + e)
+        return min(c0 * p, d_lo - e - p) - slack, max(c1 * p, d_hi + e) + slack
 
     def consistent(self, diameter: Diameter, reading: float) -> bool:
         c0, c1 = self.counts(diameter)
@@ -529,8 +576,7 @@ class LedSensor:
 
     def reads_into(self, diameter: Diameter, lo: float, hi: float) -> bool:
         c0, c1 = self.counts(diameter)
-        first = math.ceil(lo / self.pitch - READING_EPS)
-        last = math.floor(hi / self.pitch + READING_EPS)
+        first, last = self.counts_held(lo, hi)
         return max(c0, first) <= min(c1, last)
 
     def can_read_alike(self, d1: Diameter, d2: Diameter) -> bool:
@@ -554,8 +600,11 @@ class LedSensor:
     def reading_probability(self, diameter: Diameter, lo: float | None, hi: float | None) -> float:
         if lo is None or hi is None:
             return 1.0
-        # Count c means c * p < width <= (c + 1) * p; the branch holds counts lo/p .. hi/p.
-        wlo, whi = lo, hi + self.pitch
+        # Count c means c * p < width <= (c + 1) * p; the branch holds counts first..last.
+        first, last = self.counts_held(lo, hi)
+        if first > last:
+            return 0.0
+        wlo, whi = first * self.pitch, (last + 1) * self.pitch
         e = self.noise
         d_lo, d_hi = span(diameter)
         if d_hi - d_lo + 2.0 * e <= 0.0:
@@ -566,13 +615,10 @@ class LedSensor:
         self, diameter: Diameter, intervals: Sequence[tuple[float, float]]
     ) -> float | None:
         c0, c1 = self.counts(diameter)
-        p = self.pitch
-        held = [
-            (math.ceil(a / p - READING_EPS), math.floor(b / p + READING_EPS)) for a, b in intervals
-        ]
+        held = [self.counts_held(a, b) for a, b in intervals]
         for c in range(c0, c1 + 1):
             if not any(a <= c <= b for a, b in held):
-                return c * p
+                return c * self.pitch
         return None
 
     def split(
@@ -581,10 +627,15 @@ class LedSensor:
         grouping: Grouping | str = Grouping.EXACT,
         labels: Labels = None,
     ) -> list[ReadingBranch]:
+        """The beam-count cells (each count, the states that can block it), neighbours with
+        equal states merged; each branch's interval is its counts' :meth:`window`."""
         if not diameters:
             return []
         if Grouping(grouping) is Grouping.COMPONENTS:
-            return _component_branches(self, diameters, labels)
+            return [
+                ReadingBranch(*self.window(*self.counts_held(b.lo, b.hi)), b.mask)
+                for b in _component_branches(self, diameters, labels)
+            ]
         n = len(diameters)
         extents = [self.counts(d) for d in diameters]
         c_lo = min(c for c, _ in extents)
@@ -594,7 +645,7 @@ class LedSensor:
             members = [i for i in range(n) if extents[i][0] <= c <= extents[i][1]]
             cells.append((float(c), float(c), _mask(members, labels)))
         return [
-            ReadingBranch(a * self.pitch, b * self.pitch, m)
+            ReadingBranch(*self.window(int(a), int(b)), m)
             for a, b, m in _merge_cells(cells, gap=1.0)
         ]
 

@@ -93,6 +93,23 @@ CONVENTIONS = (
     "entry is a correct answer."
 )
 
+LED_WINDOWS = (
+    "With an LED array of pitch p a branch over beam counts a..b holds [(a - 1/4) p, "
+    "(b + 1/4) p] (ends rounded, never below 0), so a reading computed as count times pitch "
+    "in any arithmetic (float32, fixed point, decimal) lies in its count's branch, and the "
+    "branches of different counts lie half a pitch apart: a reading half-way between the "
+    "counts of two branches is in neither."
+)
+"""What an LED plan's ``conventions`` adds: the rule of ``sensors.LedSensor.window``."""
+
+
+def conventions_for(sensor: Sensor) -> str:
+    """The ``conventions`` paragraph of a plan with this sensor (design.md): CONVENTIONS,
+    and for an LED array the rule its reading windows follow (:data:`LED_WINDOWS`)."""
+    if isinstance(sensor, LedSensor):
+        return f"{CONVENTIONS} {LED_WINDOWS}"
+    return CONVENTIONS
+
 
 MAX_FILE_NODES = 100_000
 """A plan whose file would hold more nodes than this is refused: no controller wants it.
@@ -314,7 +331,7 @@ def plan_from_result(
         ),
         root=root,
         stats=stats,
-        conventions=CONVENTIONS,
+        conventions=conventions_for(machine.sensor),
         uncertainty=getattr(machine, "uncertainty", IDEAL) if uncertainty is None else uncertainty,
     )
 
