@@ -110,6 +110,25 @@ def test_window_ends_are_short_decimals():
     assert LED_WINDOW_REL == 0.25 and "(a - 1/4) p" in LED_WINDOWS
 
 
+@pytest.mark.parametrize("grouping", ["exact", "components"])
+def test_both_groupings_write_windows_over_their_counts(grouping):
+    """Noise 0.01 mm: 0.8 mm blocks 15-16 beams, 0.85 mm 16-17, 2.0 mm 39-40."""
+    branches = LedSensor(0.05, 0.01).split([0.8, 0.85, 2.0], grouping)
+    got = [(b.lo, b.hi, b.members) for b in branches]
+    want = {
+        "exact": [
+            (0.7375, 0.7625, (0,)),
+            (0.7875, 0.8125, (0, 1)),
+            (0.8375, 0.8625, (1,)),
+            (1.9375, 2.0125, (2,)),
+        ],
+        "components": [(0.7375, 0.8625, (0, 1)), (1.9375, 2.0125, (2,))],
+    }[grouping]
+    assert [m for *_e, m in got] == [m for *_e, m in want]
+    for (lo, hi, _m), (want_lo, want_hi, _w) in zip(got, want, strict=True):
+        assert lo == pytest.approx(want_lo, abs=1e-12) and hi == pytest.approx(want_hi, abs=1e-12)
+
+
 # ------------------------------------------------------------------ plan files
 
 
