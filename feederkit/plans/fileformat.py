@@ -90,7 +90,11 @@ CONVENTIONS = (
     "right. A reading no branch holds means a foreign part or a sensor fault: stop. 'length' "
     "is the worst-case number of push-align operations, the first alignment counted as "
     "operation 1. A result with several entries lists poses no plan can tell apart; every "
-    "entry is a correct answer."
+    "entry is a correct answer. 'margin_deg': on the ideal model (no uncertainty declared) "
+    "the half-width of the action's overlap range, so any rotation within it of 'action_deg' "
+    "gives the same outcome; in a strong plan (a declared rotation error r > 0) the slack "
+    "beyond r: any rotation within r + margin_deg of 'action_deg' gives an outcome the plan "
+    "was made for."
 )
 
 LED_WINDOWS = (
