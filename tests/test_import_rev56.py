@@ -387,3 +387,19 @@ def test_a_bolt_circle_around_a_bore_is_a_construction_circle(tmp_path):
     assert_same_part(ip, part)
     (note,) = [w for w in warnings if "concentric loops" in w]
     assert "crossing other holes" in note and "construction circle" in note
+
+
+@pytest.mark.parametrize(
+    "linetype",
+    ["CENTER", "HIDDEN"],
+)
+@pytest.mark.parametrize("x", [15.0, 20.0, 60.0])
+def test_an_open_centre_or_hidden_line_across_a_plate_never_cuts_it(tmp_path, linetype, x):
+    # A centre line through a hole, or a pocket's hidden step, across the plate: left to the
+    # loop search it cut off a strip, the plate became a "drawing frame" and a hole the part.
+    def line(doc, msp):
+        msp.add_line((x, -5), (x, 45), dxfattribs={"layer": linetype})
+
+    ip, warnings = imported(plate_with(tmp_path / "line.dxf", line))
+    assert_same_part(ip, PLATE_WITH_HOLE)
+    assert not [w for w in warnings if "frame" in w or "linetype" in w]

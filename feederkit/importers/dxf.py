@@ -623,7 +623,7 @@ def is_hidden_linetype(name: str, kept: tuple[str, ...] = ()) -> bool:
 def hidden_loops(drawn: DrawnLines, gap: float, kept: tuple[str, ...]) -> set[int]:
     """The lines drawn in a hidden or centre linetype that close loops among themselves
     (:func:`.loops.closing_lines`): hidden edges of pockets and far-side features, bolt
-    circles; a centre line across the part is left to the loop search."""
+    circles (the other lines in those linetypes, centre lines, are left out quietly)."""
     hidden = [k for k, lt in enumerate(drawn.linetypes) if is_hidden_linetype(lt, kept)]
     closing = closing_lines([drawn.lines[k] for k in hidden], gap)
     return {hidden[k] for k in closing}
@@ -788,14 +788,23 @@ def _drawing(
     budget: Budget,
     warnings_: list[str],
 ) -> tuple[Drawing, DrawnLines]:
-    """The drawing's loops and parts, loops drawn in hidden or centre linetypes left out
-    (:func:`hidden_loops`) with a warning naming them in ``warnings_``, and the lines kept."""
+    """The drawing's loops and parts, lines drawn in hidden or centre linetypes left out
+    (the loops among them, :func:`hidden_loops`, with a warning naming them in
+    ``warnings_``), and the lines kept."""
     dropped = hidden_loops(drawn, gap, options.keep_linetypes)
-    if not dropped:
+    # Open lines in those linetypes (centre lines, a pocket's hidden step) are never outline
+    # either: left to the loop search, a centre line across a plate cut it into a "drawing
+    # frame" and a hole came in as the part.
+    lines_ = {
+        k
+        for k, lt in enumerate(drawn.linetypes)
+        if k not in dropped and is_hidden_linetype(lt, options.keep_linetypes)
+    }
+    if not dropped and not lines_:
         drawing = drawing_from_lines(drawn.lines, gap, label, budget, drawn.names, drawn.layers)
         return drawing, drawn
-    listed, keep = hidden_note(drawn, dropped)
-    kept = drawn.without(dropped)
+    listed, keep = hidden_note(drawn, dropped | lines_)
+    kept = drawn.without(dropped | lines_)
     if not kept.lines:
         raise InputError(
             f"{label}: every closed loop is drawn in a hidden, dashed or centre linetype "
@@ -807,11 +816,13 @@ def _drawing(
         raise InputError(
             f"{exc}; left out as hidden or centre lines: {listed} (keep them with {keep})"
         ) from None
-    warnings_.append(
-        f"left out loops drawn in a hidden, dashed or centre linetype, taken for hidden edges "
-        f"(pockets, far-side features) or construction lines, not through holes: {listed}; "
-        f"if they are holes or outline, keep them with {keep}"
-    )
+    if dropped:
+        loops, keep = hidden_note(drawn, dropped)
+        warnings_.append(
+            f"left out loops drawn in a hidden, dashed or centre linetype, taken for hidden "
+            f"edges (pockets, far-side features) or construction lines, not through holes: "
+            f"{loops}; if they are holes or outline, keep them with {keep}"
+        )
     return drawing, kept
 
 
