@@ -98,3 +98,22 @@ def test_merged_poses_that_look_alike_are_an_oriented_part():
     mech = uncertain_mechanics(pf.part, unc)
     assert len(mech.states) == 1 and unlike_members(pf, mech) == set()
     assert plan(build_machine([pf], NoSensor(), unc)).length == 1
+
+
+def test_a_result_on_a_merged_arc_names_the_spread_it_leaves():
+    import math
+    from pathlib import Path
+
+    from feederkit.outline import load_outline_json
+    from feederkit.plans.make import make_plan
+
+    catalog = Path(__file__).resolve().parents[1] / "catalog"
+    washer = push_function(make_part(load_outline_json(catalog / "d-washer.json")))
+    made = make_plan([washer], NoSensor(), certify=False)
+    (words,) = [w for w in made.warnings if "several stable states" in w]
+    assert "d-washer states 1, 2, 3, 4, 5, 6, 7, 8 over 28 degrees" in words
+    # Congruent merged poses (a small regular octagon under tolerances) are oriented: no word.
+    pts = [(0.9 * math.cos(math.pi * k / 4), 0.9 * math.sin(math.pi * k / 4)) for k in range(8)]
+    octagon = push_function(make_part(make_outline("oct", pts)))
+    made = make_plan([octagon], NoSensor(), uncertainty=Uncertainty(1.0, 0.01, 0.02), certify=False)
+    assert not [w for w in made.warnings if "several stable states" in w]

@@ -54,7 +54,15 @@ from feederkit.planning.stats import (
     tree_min_margin,
 )
 from feederkit.planning.subsets import subset_lower_bound
-from feederkit.planning.tree import Leaf, PlanResult, Step, branch_pairs, build_dag, root_step
+from feederkit.planning.tree import (
+    Leaf,
+    PlanResult,
+    Step,
+    branch_pairs,
+    build_dag,
+    leaf_masks,
+    root_step,
+)
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -361,30 +369,32 @@ def _refuse_wandering(machine: PushAlignMachine, root: Step | Leaf) -> None:
     """Raise NoStrongPlan when a result of ``root`` holds a physical state whose members are
     unlike poses a part at rest may wander between (``MachineState.unlike_members``): such a
     result leaves the part unoriented, which only lumping ``any`` accepts."""
-    seen: set[int] = set()
-    todo: list[Step | Leaf] = [root]
-    while todo:
-        node = todo.pop()
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if isinstance(node, Step):
-            todo.extend(child for _b, child in node.branches)
-            continue
-        for i in members(node.mask):
+    for mask in leaf_masks(root):
+        for i in members(mask):
             s = machine.states[i]
             if s.unlike_members:
                 name = machine.part_names[s.part]
                 poses = ", ".join(str(m) for m in s.members)
-                raise NoStrongPlan(
-                    "no strong plan exists under the declared uncertainty "
-                    f"({_uncertainty_words(machine)}): under it a part at rest "
-                    f"may wander between unlike poses of {name} (states {poses}: their "
-                    "barriers lie below twice the shape and COM tolerances plus a breath of "
-                    "vibration, docs/uncertainty.md), and the plan found ends there",
+                u = machine.uncertainty
+                toleranced = u.shape_tolerance_mm > 0.0 or u.com_tolerance_mm > 0.0
+                barriers = (
+                    "twice the shape and COM tolerances plus a breath of vibration"
+                    if toleranced
+                    else "a breath of vibration"
+                )
+                hint = (
                     "a plan that lists them together, leaving the part unoriented between "
-                    "them, is given with lumping 'any'; a smaller --shape-tolerance or "
-                    "--com-tolerance may keep them apart",
+                    "them, is given with lumping 'any'"
+                )
+                if toleranced:
+                    hint += "; a smaller --shape-tolerance or --com-tolerance may keep them apart"
+                raise NoStrongPlan(
+                    "no strong plan found under the declared uncertainty "
+                    f"({_uncertainty_words(machine)}): the shortest plan ends where a part at "
+                    f"rest may wander between unlike poses of {name} (states {poses}: their "
+                    f"barriers lie below {barriers}, docs/uncertainty.md); a longer plan that "
+                    "ends elsewhere may exist, which the planner does not look for",
+                    hint,
                 )
 
 

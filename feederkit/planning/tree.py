@@ -46,6 +46,23 @@ class Step:
 PlanTree = Step | Leaf
 
 
+def leaf_masks(root: Step | Leaf) -> list[int]:
+    """The masks of the distinct leaves of a plan tree (a DAG walked once per node)."""
+    seen: set[int] = set()
+    todo: list[Step | Leaf] = [root]
+    out: list[int] = []
+    while todo:
+        node = todo.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, Step):
+            todo.extend(child for _b, child in node.branches)
+        else:
+            out.append(node.mask)
+    return out
+
+
 def branch_pairs(branches: Iterable[tuple[ReadingBranch, object]]) -> int:
     """The (node, state) pairs a step's branches add to a plan: the states of each branch,
     those that can reach the node below it (what verifying the plan walks, and what a

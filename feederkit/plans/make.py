@@ -26,6 +26,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
+from feederkit.angles import norm360
 from feederkit.errors import InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
@@ -33,14 +34,14 @@ from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import widen_widths
 from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference
+from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, look_alike, poses_difference
 from feederkit.mechanics.uncertain import PUSH_BAND_DEG
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
-from feederkit.planning.tree import Certificate, PlanResult
+from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
 from feederkit.plans.fileformat import as_plan, plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.strong import (
@@ -221,6 +222,9 @@ def _make_plan(
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
         warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
+    spread = _spread_words(result, pfs)
+    if spread is not None:
+        warnings.append(spread)
     cut = _ties_cut_words(result, opts)
     if cut is not None:
         warnings.append(cut)
@@ -372,6 +376,38 @@ _MORE = {
 }
 """What a user can do when the choice among shortest plans was cut short, by its cause
 (``PlanResult.ties_cut_by``)."""
+
+
+def _spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
+    """A warning naming the results that end in a physical state of several unlike stable
+    states (shallow wells a breath of vibration crosses: a part resting anywhere over their
+    poses, docs/uncertainty.md), with the angle their normals span; None when there are
+    none. Congruent ones (a regular polygon's) orient the part and are not named."""
+    machine = result.machine
+    found: dict[int, float] = {}
+    for mask in leaf_masks(result.root):
+        for i in members(mask):
+            s = machine.states[i]
+            if len(s.members) < 2 or i in found:
+                continue
+            pf = pfs[s.part]
+            alike = look_alike(pf, [(m,) for m in s.members])
+            if all(len(a) == len(s.members) - 1 for a in alike):
+                continue
+            normals = [pf.states[m].normal_deg for m in s.members]
+            found[i] = norm360(normals[-1] - normals[0])
+    if not found:
+        return None
+    named = "; ".join(
+        f"{machine.part_names[machine.states[i].part]} states "
+        f"{', '.join(str(m) for m in machine.states[i].members)} over {spread:.3g} degrees"
+        for i, spread in sorted(found.items(), key=lambda kv: -kv[1])
+    )
+    return (
+        f"some results name a resting state made of several stable states, shallow wells a "
+        f"breath of vibration crosses (docs/uncertainty.md): {named}; there the part rests "
+        "anywhere over those poses, oriented only that far"
+    )
 
 
 def _lump_shapes(
