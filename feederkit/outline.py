@@ -246,6 +246,8 @@ def outline_from_dict(data: object, default_name: str = "part") -> Outline:
     if not isinstance(name, str):
         raise InputError(f"{default_name}: 'name' must be a string")
     if "vertices" not in data:
+        if data.get("format") == "feederkit-plan":
+            raise InputError(f"{default_name}: a feederkit plan file, not an outline file")
         raise InputError(f"{name}: the outline file has no 'vertices'")
     units = data.get("units", "mm")
     if not isinstance(units, str):

@@ -403,3 +403,21 @@ def test_an_open_centre_or_hidden_line_across_a_plate_never_cuts_it(tmp_path, li
     ip, warnings = imported(plate_with(tmp_path / "line.dxf", line))
     assert_same_part(ip, PLATE_WITH_HOLE)
     assert not [w for w in warnings if "frame" in w or "linetype" in w]
+
+
+def test_a_bolt_circle_across_its_holes_is_named_as_loops_crossing_inside(tmp_path):
+    # A flange: disc, bore and four bolt holes on layer 0, the bolt circle drawn Continuous.
+    doc = new_doc()
+    msp = doc.modelspace()
+    msp.add_circle((0, 0), 30)
+    msp.add_circle((0, 0), 8)
+    for x, y in ((20, 0), (0, 20), (-20, 0), (0, -20)):
+        msp.add_circle((x, y), 3)
+    bolt = msp.add_circle((0, 0), 20, dxfattribs={"layer": "CENTER"})
+    doc.saveas(tmp_path / "flange.dxf")
+    with pytest.raises(InputError) as exc:
+        imported(tmp_path / "flange.dxf")
+    text = str(exc.value)
+    assert "loops cross inside the outline" in text and "crosses the outline" not in text
+    assert f"CIRCLE {bolt.dxf.handle} on layer 'CENTER' crosses 4 other loops" in text
+    assert "--layer" in text

@@ -698,6 +698,25 @@ MAX_CROSSING_CANDIDATES = 50
 """Closed lines tried at most, once one is found crossing, to name the likeliest one."""
 
 
+def crosses_the_outline(
+    lines: Sequence[np.ndarray], closed: Sequence[int], shells: Sequence[Polygon], k: int
+) -> bool:
+    """Whether closed line ``k`` is a hole across the outline rather than a loop crossing
+    others inside it (a bolt circle across its holes): True unless the outline is one closed
+    line (holding nine tenths of the loops' area) and ``k`` lies inside it, or is it and no
+    closed line crosses it."""
+    rings = {j: Polygon(np.asarray(lines[j], dtype=float)) for j in closed}
+    rings = {j: p for j, p in rings.items() if p.is_valid and p.area > 0.0}
+    if k not in rings:
+        return True
+    outer = max(rings, key=lambda j: rings[j].area)
+    if rings[outer].area < 0.9 * shapely.unary_union(list(shells)).area:
+        return True  # the outline is drawn of several lines: say what was said before
+    if k == outer:
+        return any(rings[j].exterior.crosses(rings[outer].exterior) for j in rings if j != k)
+    return not rings[outer].contains(rings[k])
+
+
 def crossing_loop(
     lines: Sequence[np.ndarray],
     closed: Sequence[int],
@@ -1017,9 +1036,15 @@ def drawing_from_lines(
                 f"{label}: {what} seems drawn twice, {copy[1]:.2g} mm apart ({name(copy[0])} "
                 f"and {name(crossing)}): delete one copy"
             )
+        if crosses_the_outline(healed, closed, shells, crossing):
+            raise InputError(
+                f"{label}: a hole crosses the outline ({name(crossing)} crosses "
+                f"{plural(crossed, 'other loop')}; leave construction geometry out with --layer)"
+            )
         raise InputError(
-            f"{label}: a hole crosses the outline ({name(crossing)} crosses "
-            f"{plural(crossed, 'other loop')}; leave construction geometry out with --layer)"
+            f"{label}: loops cross inside the outline ({name(crossing)} crosses "
+            f"{plural(crossed, 'other loop')}: a bolt circle or other construction geometry? "
+            "leave it out with --layer, or draw it in a centre linetype)"
         )
     bridged = max((float(np.hypot(*(b[-1] - b[0]))) for b in healed[len(snapped) :]), default=0.0)
     loops, slivers = _without_slivers(loops, gap, bridged)

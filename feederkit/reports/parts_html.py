@@ -108,5 +108,7 @@ def _plot_figure(entry: PlanPart, outline: Outline | None) -> str:
 def _no_plot() -> str:
     return (
         f'<p class="muted plot-skipped">The report draws the plots of its first {PART_PLOTS} '
-        "members only; draw this one with <code>feederkit part plot</code>.</p>"
+        "members only; draw this one with <code>feederkit part plot SOURCE -o PLOT.svg</code> "
+        "(its outline or CAD file, or its catalog name with <code>--catalog</code>; a landing "
+        "of a mesh with <code>--pose K</code>).</p>"
     )
