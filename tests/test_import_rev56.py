@@ -7,6 +7,7 @@ Each drawing is built here with ezdxf and its part compared with the one shapely
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import ezdxf
@@ -421,3 +422,20 @@ def test_a_bolt_circle_across_its_holes_is_named_as_loops_crossing_inside(tmp_pa
     assert "loops cross inside the outline" in text and "crosses the outline" not in text
     assert f"CIRCLE {bolt.dxf.handle} on layer 'CENTER' crosses 4 other loops" in text
     assert "--layer" in text
+
+
+def test_a_plate_with_rounded_corners_is_never_called_a_drawing_frame(tmp_path):
+    # A 100 x 70 plate with R5 corners (bulges), a bore and a circle on another layer around
+    # it: a frame has straight sides and square corners; the warning advised --layer CENTER,
+    # which imported the circle as the part.
+    doc = new_doc()
+    msp = doc.modelspace()
+    b = math.tan(math.radians(90) / 4)  # a quarter-circle bulge
+    pts = [(5, 0, 0), (95, 0, b), (100, 5, 0), (100, 65, b), (95, 70, 0), (5, 70, b),
+           (0, 65, 0), (0, 5, b)]  # fmt: skip
+    msp.add_lwpolyline(pts, format="xyb", close=True)
+    msp.add_circle((50, 35), 8)
+    msp.add_circle((50, 35), 25, dxfattribs={"layer": "HOLES"})
+    doc.saveas(tmp_path / "rounded.dxf")
+    _ip, warnings = imported(tmp_path / "rounded.dxf")
+    assert not [w for w in warnings if "drawing frame" in w]

@@ -32,6 +32,10 @@ Point = tuple[float, float]
 FRAME_FILL = 0.9
 """A drawing frame fills at least this share of its bounding box (it is a rectangle)."""
 
+FRAME_STRAIGHT_REL = 1e-3
+"""A frame's sides are straight: its loop simplified to this share of its size has four
+corners (rounded corners keep their arcs' points)."""
+
 FRAME_MATERIAL = 0.2
 """A double-line frame border (outer minus inner rectangle) is at most this share of its box."""
 
@@ -467,10 +471,14 @@ def closed_loops(
 
 
 def _is_rectangle(loop: Polygon) -> bool:
-    """Whether a loop is close to its bounding box (a drawing frame or a rectangular plate)."""
+    """Whether a loop is close to its bounding box and has four corners (a drawing frame, or
+    a plate that could be one; a plate with rounded corners is no frame)."""
     x0, y0, x1, y1 = loop.bounds
     box = (x1 - x0) * (y1 - y0)
-    return box > 0.0 and loop.area >= FRAME_FILL * box
+    if not (box > 0.0 and loop.area >= FRAME_FILL * box):
+        return False
+    sides = shapely.simplify(loop, FRAME_STRAIGHT_REL * max(x1 - x0, y1 - y0))
+    return len(sides.exterior.coords) - 1 <= 4
 
 
 def nest(loops: Sequence[Polygon]) -> list[int]:
