@@ -117,3 +117,16 @@ def test_a_result_on_a_merged_arc_names_the_spread_it_leaves():
     octagon = push_function(make_part(make_outline("oct", pts)))
     made = make_plan([octagon], NoSensor(), uncertainty=Uncertainty(1.0, 0.01, 0.02), certify=False)
     assert not [w for w in made.warnings if "several stable states" in w]
+
+
+def test_no_plan_under_a_shape_tolerance_names_a_finely_drawn_arc():
+    from feederkit.errors import PlanningError
+    from feederkit.plans.make import make_plan, short_chords_words
+
+    box = Polygon([(0, 0), (40, 0), (40, 25), (0, 25)])
+    rounded = box.buffer(-2, quad_segs=16).buffer(2, quad_segs=16)
+    pf = push_function(make_part(make_outline("rr", list(rounded.exterior.coords)[:-1])))
+    with pytest.raises(PlanningError, match=r"edges as short as 0\.196 mm .* tilt by 17\.8"):
+        make_plan([pf], ToleranceSensor(0.1), uncertainty=Uncertainty(1.0, 0.03, 0.0))
+    assert short_chords_words([pf], 0.0) == ""
+    assert short_chords_words([pf], 0.0005) == ""  # 0.3 degrees: not named

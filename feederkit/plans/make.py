@@ -163,6 +163,7 @@ def _make_plan(
                 f"; {simplified[0]}'s contact hull simplifies its outline (stable states of the "
                 "simplification only, widths it cuts): a smaller --hull-tolerance may help"
             )
+        hint += short_chords_words(pfs, unc.shape_tolerance_mm)
         raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
     # Planned on the parts' own widths, the plan's expected length is restated on the file's
     # model (its diameters), the one every reader computes.
@@ -376,6 +377,38 @@ _MORE = {
 }
 """What a user can do when the choice among shortest plans was cut short, by its cause
 (``PlanResult.ties_cut_by``)."""
+
+
+SHORT_CHORD_TILT_DEG = 5.0
+"""A hull edge the shape tolerance may tilt by at least this much (``asin(2 t / length)``) is
+named when no strong plan exists: finely drawn arcs make them."""
+
+
+def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
+    """ "; ..." naming the part whose contact hull has the shortest edge the shape tolerance
+    ``t`` may tilt by ``SHORT_CHORD_TILT_DEG`` or more (an arc drawn as many short chords,
+    each a possible resting edge near a corner under the vertex model, docs/uncertainty.md);
+    "" when none has one."""
+    if t <= 0.0:
+        return ""
+    worst: tuple[float, str] | None = None
+    for pf in pfs:
+        hull = pf.part.hull
+        edges = [math.dist(hull[i], hull[(i + 1) % len(hull)]) for i in range(len(hull))]
+        shortest = min(edges)
+        if worst is None or shortest < worst[0]:
+            worst = (shortest, pf.part.name)
+    assert worst is not None
+    length, name = worst
+    tilt = math.degrees(math.asin(min(1.0, 2.0 * t / length)))
+    if tilt < SHORT_CHORD_TILT_DEG:
+        return ""
+    return (
+        f"; {name}'s contact hull has edges as short as {length:.3g} mm (an arc drawn as many "
+        f"chords?), which the shape tolerance may tilt by {tilt:.3g} degrees, each then a "
+        "possible resting edge near a corner: an outline with fewer arc points, or a drawing "
+        "imported with a coarser --hull-tolerance, may have a plan (docs/uncertainty.md)"
+    )
 
 
 def _spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
