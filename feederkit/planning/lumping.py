@@ -54,7 +54,7 @@ from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.solvable import MAX_SETS, candidate_pairs, solve
-from feederkit.planning.tree import PlanTree, Step
+from feederkit.planning.tree import PlanTree, leaf_masks
 
 Pair = tuple[int, int]
 
@@ -93,17 +93,8 @@ class LumpedGoal:
         the output must name), sorted."""
         lumped = set(self.pairs)
         found: set[Pair] = set()
-        seen: set[int] = set()
-        stack: list[PlanTree] = [root]
-        while stack:
-            node = stack.pop()
-            if id(node) in seen:
-                continue
-            seen.add(id(node))
-            if isinstance(node, Step):
-                stack.extend(sub for _b, sub in node.branches)
-                continue
-            idx = members(node.mask)
+        for mask in leaf_masks(root):
+            idx = members(mask)
             for a, i in enumerate(idx):
                 found.update((i, j) for j in idx[a + 1 :] if (i, j) in lumped)
         return tuple(sorted(found))
