@@ -469,6 +469,8 @@ def compile_command(
             f"changeover {name!r} orients every part but cannot tell these apart: {named}; "
             f"the plan's results list each candidate with its pose{side_note}"
         )
+    if compiled.made.unoriented is not None:
+        raise CheckFailed(f"changeover {name!r}: {compiled.made.unoriented}")
 
 
 def _part_of(member: str) -> str:

@@ -269,10 +269,12 @@ def plan_command(
         lumps = landing_lumps(planned)
         if planned.indistinguishable or lumps:
             raise CheckFailed(landing_pairs_message(planned, lumps))
-        return
-    lumped = leaf_part_pairs(plan)
-    if witnesses or lumped:
-        raise CheckFailed(pairs_message(witnesses, lumped))
+    else:
+        lumped = leaf_part_pairs(plan)
+        if witnesses or lumped:
+            raise CheckFailed(pairs_message(witnesses, lumped))
+    if made.unoriented is not None:
+        raise CheckFailed(made.unoriented)
 
 
 def register(app: typer.Typer) -> None:

@@ -69,6 +69,9 @@ class MadePlan:
     result: PlanResult
     report: VerificationReport
     warnings: tuple[str, ...] = ()
+    unoriented: str | None = None
+    """When some result lists poses of one part that do not look alike and that no plan can
+    tell apart (:func:`unlike_twins_words`): the words saying so (a command exits 1)."""
 
 
 BISECT_STEPS = 12
@@ -226,6 +229,7 @@ def _make_plan(
     spread = _spread_words(result, pfs)
     if spread is not None:
         warnings.append(spread)
+    unoriented = unlike_twins_words(result, pfs)
     cut = _ties_cut_words(result, opts)
     if cut is not None:
         warnings.append(cut)
@@ -237,7 +241,7 @@ def _make_plan(
     held = ideal_plan_words(unc, result.min_margin, result.certificate)
     if held is not None:
         warnings.append(held)
-    return MadePlan(data, result, report, tuple(warnings + notes))
+    return MadePlan(data, result, report, tuple(warnings + notes), unoriented)
 
 
 def ideal_plan_words(
@@ -408,6 +412,51 @@ def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
         f"chords?), which the shape tolerance may tilt by {tilt:.3g} degrees, each then a "
         "possible resting edge near a corner: an outline with fewer arc points, or a drawing "
         "imported with a coarser --hull-tolerance, may have a plan (docs/uncertainty.md)"
+    )
+
+
+def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
+    """Words naming the poses of one part that some result lists together though they do not
+    look alike (holes, slots or notches placed differently: ``look_alike`` compares the
+    outline) while no plan tells them apart (the contact hull, all the fence and the sensor
+    feel, is symmetric: the paper's indistinguishable poses); None when there are none.
+    Pairs the lumping already named (``lumped_pairs``) are left to its warning."""
+    machine = result.machine
+    lumped = set(result.lumped_pairs)
+    found: dict[tuple[int, int], None] = {}
+    for mask in leaf_masks(result.root):
+        by_part: dict[int, list[int]] = {}
+        for i in members(mask):
+            if not machine.states[i].reject:  # a reject result needs no telling apart
+                by_part.setdefault(machine.states[i].part, []).append(i)
+        for part, idx in by_part.items():
+            if len(idx) < 2:
+                continue
+            pf = pfs[part]
+            alike = look_alike(pf, [machine.states[i].ideal_states for i in idx])
+            for a in range(len(idx)):
+                for b in range(a + 1, len(idx)):
+                    pair = (idx[a], idx[b])
+                    if b not in alike[a] and pair not in lumped:
+                        found[pair] = None
+    if not found:
+        return None
+    named = []
+    for i, j in found:
+        a, b = machine.states[i], machine.states[j]
+        pf = pfs[a.part]
+        poses = [norm360(-90.0 - pf.states[x.state].normal_deg) for x in (a, b)]
+        named.append(
+            f"{machine.part_names[a.part]} states {a.state} and {b.state} (poses "
+            f"{poses[0]:.4g} and {poses[1]:.4g} degrees)"
+        )
+    return (
+        "no plan can tell apart poses that do not look alike: "
+        + "; ".join(named)
+        + ": pushing and reading cannot tell them apart (the paper's indistinguishable poses: "
+        "a symmetric contact hull with holes, slots or notches placed otherwise, or a push "
+        "function that repeats), so a result lists them and the part is not oriented between "
+        "them: check its pose by other means, or take it either way"
     )
 
 
