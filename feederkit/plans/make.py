@@ -161,12 +161,14 @@ def _make_plan(
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
         simplified = [pf.part.name for pf in pfs if exact_push_function(pf) is not None]
-        if simplified:
+        chords = short_chords_words(pfs, unc.shape_tolerance_mm)
+        if chords:
+            hint += chords  # short chords: a coarser hull helps, a finer one does not
+        elif simplified:
             hint += (
                 f"; {simplified[0]}'s contact hull simplifies its outline (stable states of the "
                 "simplification only, widths it cuts): a smaller --hull-tolerance may help"
             )
-        hint += short_chords_words(pfs, unc.shape_tolerance_mm)
         raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
     # Planned on the parts' own widths, the plan's expected length is restated on the file's
     # model (its diameters), the one every reader computes.
