@@ -218,7 +218,8 @@ def check_match(
             f"{source}: not the part the plan was made for: its outline's hull lies {d:.4g} mm "
             f"from the plan's hull of {pp.label} (allowed {allowed:.4g} mm: shape tolerance "
             f"{unc.shape_tolerance_mm:g} + hull tolerance {h:g} + slack {slack:.3g}; same "
-            "part frame)"
+            "part frame): if the plan's part was imported with a coarser hull tolerance, give "
+            "it with --hull-tolerance MM (catalog show names a revision's)"
         )
     allowed_com = unc.com_tolerance_mm + slack
     dc = math.dist(pp.com, exact.com)
