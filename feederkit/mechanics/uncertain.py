@@ -682,12 +682,14 @@ def uncertain_mechanics(
     Merge rule: the part resting in ideal state ``i`` can cross to the neighbour beyond a hill
     when a rest candidate of ``i``'s basin lies less than ``vibration + 2 (t + c)`` below the
     hilltop (F1: a barrier that high survives every shape and still holds against the
-    vibration). The physical states are the strong components of that crossing graph (states
-    the part may wander between); a push that ends in a component may also end in any
-    component it can reach. A state the part *should* leave (its barrier below the vibration)
-    is kept as one it may stay in: the feeder's vibration is not known, and the physics check
-    shows parts resting on such edges. ``vibration_mm`` defaults to the fragile
-    threshold (1e-3 of the part's size, a breath of vibration) unless the uncertainty is ideal,
+    vibration). The physical states are the strong components of the crossings from the
+    basin's deepest candidate too (a part at rest anywhere in ``i`` may wander to the
+    neighbour); a push that ends in a component may also end in any component those and the
+    crossings from near-top candidates only (a fillet's short chords) reach. A state the part
+    *should* leave (its barrier below the vibration) is kept as one it may stay in: the
+    feeder's vibration is not known, and the physics check shows parts resting on such edges.
+    ``vibration_mm`` defaults to the fragile threshold (1e-3 of the part's size, a breath of
+    vibration) unless the uncertainty is ideal,
     where it is 0 and every physical state is one ideal state. Bands: with the vibration on, a
     push starting within ``PUSH_BAND_DEG`` of a hilltop (wherever F2 puts it) may end on either
     side; at a hilltop beside a shallow state, within ``PUSH_BAND_FACTOR`` vibrations of its
