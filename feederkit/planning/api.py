@@ -165,7 +165,9 @@ def strong_plan_exists(
 
     Decided by :func:`~feederkit.planning.solvable.unsolvable`; True when undecided (too
     many sets, or ``deadline`` passed), so a bisection over uncertainties on it errs toward
-    the planner's own answer.
+    the planner's own answer. A machine with a state a part at rest may wander over unlike
+    poses in (``MachineState.unlike_members``) is asked of :func:`plan`, which refuses a
+    plan ending there, as the answer the planner gives.
     """
     options = options or PlanningOptions()
     if machine.n == 0:
