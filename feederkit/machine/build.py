@@ -17,7 +17,7 @@ from feederkit.machine.inseparable import inseparable_masks
 from feederkit.machine.model import MachineState, OutcomeRange, PushAlignMachine
 from feederkit.mechanics.actions import action_ranges
 from feederkit.mechanics.push import PushFunction, resting_widths
-from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, look_alike
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, look_alike, unlike_pairs
 from feederkit.mechanics.uncertain import UncertainMechanics, action_map, uncertain_mechanics
 from feederkit.sensors import NoSensor, Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -223,8 +223,7 @@ def unlike_members(pf: PushFunction, mech: UncertainMechanics) -> set[int]:
     twins: tuple[int, ...] | None = None
     index: dict[int, int] = {}
     for s in merged:
-        alike = look_alike(pf, [(m,) for m in s.members])
-        far = [(a, b) for a in range(len(s.members)) for b in _alike_missing(alike, a)]
+        far = unlike_pairs(pf, [(m,) for m in s.members])
         if not far:
             continue
         if pf.n > TWIN_MAX_STATES:
@@ -238,11 +237,6 @@ def unlike_members(pf: PushFunction, mech: UncertainMechanics) -> set[int]:
         if any(not twins[rows[a]] >> rows[b] & 1 for a, b in far):
             out.add(s.id)
     return out
-
-
-def _alike_missing(alike: Sequence[Sequence[int]], a: int) -> list[int]:
-    """The groups after ``a`` that ``alike[a]`` (:func:`look_alike`'s answer) does not name."""
-    return [b for b in range(a + 1, len(alike)) if b not in alike[a]]
 
 
 def ideal_twins(pf: PushFunction, mech: UncertainMechanics) -> list[set[int]]:

@@ -401,6 +401,17 @@ def look_alike(
     return tuple(tuple(x) for x in out)
 
 
+def unlike_pairs(
+    pf: PushFunction, groups: Sequence[Sequence[int]], rel: float = NEAR_SYMMETRIC_REL
+) -> list[tuple[int, int]]:
+    """The pairs ``(a, b)``, ``a < b``, of ``groups`` (as in :func:`look_alike`) whose poses do
+    not look alike."""
+    alike = look_alike(pf, groups, rel)
+    return [
+        (a, b) for a in range(len(groups)) for b in range(a + 1, len(groups)) if b not in alike[a]
+    ]
+
+
 def symmetry(pf: PushFunction, labels: Sequence[Hashable] | None = None) -> Symmetry:
     """Classify the push-diameter function by definitions 6-8 for the given state labels."""
     labels = exact_labels(pf) if labels is None else list(labels)

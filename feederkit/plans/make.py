@@ -34,7 +34,7 @@ from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import widen_widths
 from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, look_alike, poses_difference
+from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
 from feederkit.mechanics.uncertain import PUSH_BAND_DEG
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
@@ -434,13 +434,10 @@ def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str |
         for part, idx in by_part.items():
             if len(idx) < 2:
                 continue
-            pf = pfs[part]
-            alike = look_alike(pf, [machine.states[i].ideal_states for i in idx])
-            for a in range(len(idx)):
-                for b in range(a + 1, len(idx)):
-                    pair = (idx[a], idx[b])
-                    if b not in alike[a] and pair not in lumped:
-                        found[pair] = None
+            groups = [machine.states[i].ideal_states for i in idx]
+            for a, b in unlike_pairs(pfs[part], groups):
+                if (idx[a], idx[b]) not in lumped:
+                    found[(idx[a], idx[b])] = None
     if not found:
         return None
     named = []
@@ -475,8 +472,7 @@ def _spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None
             if len(s.members) < 2 or i in found:
                 continue
             pf = pfs[s.part]
-            alike = look_alike(pf, [(m,) for m in s.members])
-            if all(len(a) == len(s.members) - 1 for a in alike):
+            if not unlike_pairs(pf, [(m,) for m in s.members]):
                 continue
             normals = [pf.states[m].normal_deg for m in s.members]
             found[i] = norm360(normals[-1] - normals[0])
