@@ -18,9 +18,11 @@ from feederkit.reports.design_html import design_section
 
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
 MIX = "isosceles-right-triangle,octagon"
-SLOW_S = 8.0
+SLOW_S = 10.0
 """How long the stand-in design step runs when its clock does not stop it (the old fixed
-budget of 60 s would let it run this long)."""
+budget of 60 s would let it run this long). The tests assert the command ends well before
+it: a bound on the work, not on this machine's speed (a loaded machine stretches the 2 s
+limit's command, never by 8 s)."""
 
 
 ok = cli_ok  # feederkit ARGS exits CODE; the captured output
@@ -71,7 +73,7 @@ def test_compile_report_design_is_bounded_by_the_commands_time_limit(
     cap = ok(capsys, [*args, "--time-limit", "2", "--report", str(html), "--catalog", str(db)])
     elapsed = time.monotonic() - started
     assert slow_design and slow_design[0] is not None and slow_design[0] <= 2.0
-    assert elapsed < 2.0 + 3.0, elapsed  # the limit plus a small constant, not 60 s
+    assert elapsed < SLOW_S, elapsed  # the limit plus a small constant: the design stopped
     page = html.read_text()
     section = page[page.index('<section id="sensor-design">') :]
     section = section[: section.index("</section>")]
@@ -91,7 +93,7 @@ def test_changeover_report_takes_a_time_limit_for_its_design(db, tmp_path, capsy
     started = time.monotonic()
     args = ["changeover", "report", "mix", "-o", str(html), "--time-limit", "0.5"]
     cap = ok(capsys, [*args, "--catalog", str(db)])
-    assert time.monotonic() - started < 0.5 + 3.0
+    assert time.monotonic() - started < SLOW_S
     assert slow_design == [0.5]
     assert 'id="design-cut-short"' in html.read_text()
     assert "cut short by the command's --time-limit" in cap.err and "of 0.5 s" in cap.err
