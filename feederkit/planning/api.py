@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
+from feederkit.machine import OverlapRange, PushAlignMachine, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
@@ -60,9 +60,9 @@ from feederkit.planning.tree import (
     Step,
     branch_pairs,
     build_dag,
-    leaf_masks,
     root_step,
 )
+from feederkit.planning.wandering import split_wandering
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -165,24 +165,17 @@ def strong_plan_exists(
 
     Decided by :func:`~feederkit.planning.solvable.unsolvable`; True when undecided (too
     many sets, or ``deadline`` passed), so a bisection over uncertainties on it errs toward
-    the planner's own answer. A machine with a state a part at rest may wander over unlike
-    poses in (``MachineState.unlike_members``) is asked of :func:`plan`, which refuses a
-    plan ending there, as the answer the planner gives.
+    the planner's own answer. As in :func:`plan`, no result may hold a state a part at rest
+    wanders over unlike poses in (:func:`~feederkit.planning.wandering.split_wandering`)
+    unless ``options.lumping`` is ``any``.
     """
     options = options or PlanningOptions()
     if machine.n == 0:
         return False
     budget = Deadline() if deadline is None else deadline
-    if options.lumping is not Lumping.ANY and any(s.unlike_members for s in machine.states):
-        # A plan may end only where the part does not wander between unlike poses, which the
-        # goal relation does not know (_refuse_wandering): the planner decides.
-        try:
-            plan(machine, replace(options, min_margin_deg=0.0), budget=budget)
-        except NoStrongPlan:
-            return False
-        except PlanningError:
-            return True  # undecided in time
-        return True
+    if options.lumping is not Lumping.ANY:
+        # No result may hold a state a part at rest wanders over unlike poses in.
+        machine = split_wandering(machine)[0]
     if machine.deterministic:
         return True  # the ideal push machine: a part is always oriented up to inseparable states
     sorted_machine, _old = by_diameter(machine)
@@ -327,9 +320,14 @@ def _plan_machine(
     machine: PushAlignMachine, options: PlanningOptions, budget: Deadline
 ) -> PlanResult:
     """:func:`plan` with its options checked and its budget made."""
+    # A result may not hold a state where a part at rest wanders between unlike poses
+    # (feederkit.planning.wandering), unless lumping 'any' lists anything together.
+    split, twin_of = (machine, None) if options.lumping is Lumping.ANY else split_wandering(machine)
+    if split is machine:
+        twin_of = None
     # Plan with the states numbered by diameter (readings then pick runs of bits).
-    sorted_machine, old = by_diameter(machine)
-    share_bisimilar(machine, sorted_machine, old)
+    sorted_machine, old = by_diameter(split)
+    share_bisimilar(split, sorted_machine, old)
     lumping = None
     try:
         root, optimal, length, lower, ties, cut = _plan(sorted_machine, options, budget)
@@ -353,9 +351,9 @@ def _plan_machine(
         root, optimal, length, lower, ties, cut = _plan(
             sorted_machine, options, budget, lumping.insep
         )
-    share_bisimilar(machine, sorted_machine, old)
-    if options.lumping is not Lumping.ANY:
-        _refuse_wandering(sorted_machine, root)
+    share_bisimilar(split, sorted_machine, old)
+    if twin_of is not None:
+        old = [twin_of[i] for i in old]  # each twin is its wandering state again
     if sorted_machine is not machine:
         root = remap_tree(root, old)
     result = _result(
@@ -365,39 +363,6 @@ def _plan_machine(
     if lumping is None:
         return result
     return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
-
-
-def _refuse_wandering(machine: PushAlignMachine, root: Step | Leaf) -> None:
-    """Raise NoStrongPlan when a result of ``root`` holds a physical state whose members are
-    unlike poses a part at rest may wander between (``MachineState.unlike_members``): such a
-    result leaves the part unoriented, which only lumping ``any`` accepts."""
-    for mask in leaf_masks(root):
-        for i in members(mask):
-            s = machine.states[i]
-            if s.unlike_members:
-                name = machine.part_names[s.part]
-                poses = ", ".join(str(m) for m in s.members)
-                u = machine.uncertainty
-                toleranced = u.shape_tolerance_mm > 0.0 or u.com_tolerance_mm > 0.0
-                barriers = (
-                    "twice the shape and COM tolerances plus a breath of vibration"
-                    if toleranced
-                    else "a breath of vibration"
-                )
-                hint = (
-                    "a plan that lists them together, leaving the part unoriented between "
-                    "them, is given with lumping 'any'"
-                )
-                if toleranced:
-                    hint += "; a smaller --shape-tolerance or --com-tolerance may keep them apart"
-                raise NoStrongPlan(
-                    "no strong plan found under the declared uncertainty "
-                    f"({_uncertainty_words(machine)}): the shortest plan ends where a part at "
-                    f"rest may wander between unlike poses of {name} (states {poses}: their "
-                    f"barriers lie below {barriers}, docs/uncertainty.md); a longer plan that "
-                    "ends elsewhere may exist, which the planner does not look for",
-                    hint,
-                )
 
 
 def _out_of_budget(options: PlanningOptions, reason: str) -> str:

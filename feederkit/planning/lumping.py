@@ -55,6 +55,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.solvable import MAX_SETS, candidate_pairs, solve
 from feederkit.planning.tree import PlanTree, leaf_masks
+from feederkit.planning.wandering import is_twin_pair, wandering_words
 
 Pair = tuple[int, int]
 
@@ -81,12 +82,15 @@ class LumpedGoal:
 
     def renumbered(self, old: Sequence[int]) -> LumpedGoal:
         """The same lumping over the original numbering (``old[new_index]``, as
-        :func:`~feederkit.planning.reindex.by_diameter` returns it)."""
-        masks = [0] * len(self.insep)
+        :func:`~feederkit.planning.reindex.by_diameter` returns it, or several new states to
+        one old one, as :func:`~feederkit.planning.wandering.split_wandering` does)."""
+        masks = [0] * (max(old, default=-1) + 1)
         for k, m in enumerate(self.insep):
-            masks[old[k]] = sum(1 << old[j] for j in members(m))
-        pairs = sorted((min(old[i], old[j]), max(old[i], old[j])) for i, j in self.pairs)
-        return LumpedGoal(tuple(masks), tuple(pairs), self.exact)
+            for j in members(m):
+                masks[old[k]] |= 1 << old[j]
+        # A twin and its wandering state (feederkit.planning.wandering) are one state again.
+        pairs = sorted({(min(old[i], old[j]), max(old[i], old[j])) for i, j in self.pairs})
+        return LumpedGoal(tuple(masks), tuple(p for p in pairs if p[0] != p[1]), self.exact)
 
     def in_leaves(self, root: PlanTree) -> tuple[Pair, ...]:
         """The lumped pairs that some leaf of the plan ``root`` reports together (the ones
@@ -309,12 +313,16 @@ def _listed(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
 
 def unlike_words(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
     """Clauses naming the unresolvable pairs that were not lumped, for a "no strong plan"
-    message (empty when none): an accepted state with a rejected one (no rule lumps those:
-    accept both or neither), then poses that do not look alike (lumping ``any`` might)."""
+    message (empty when none): a state a part at rest wanders over unlike poses in, with its
+    twin (:mod:`feederkit.planning.wandering`), an accepted state with a rejected one (no rule
+    lumps those: accept both or neither), then poses that do not look alike (lumping ``any``
+    might)."""
     states = machine.states
+    twins = [p for p in pairs if is_twin_pair(machine, *p)]
+    pairs = [p for p in pairs if not is_twin_pair(machine, *p)]
     mixed = [p for p in pairs if states[p[0]].reject != states[p[1]].reject]
     unlike = [p for p in pairs if states[p[0]].reject == states[p[1]].reject]
-    out = []
+    out = [wandering_words(machine, twins)] if twins else []
     if mixed:
         out.append(
             "no strong plan tells accepted states from rejected ones "
