@@ -8,11 +8,13 @@ the tolerance (or per LED pitch) as a table, and the same as an inline SVG step 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from feederkit.errors import InputError
 from feederkit.reports.svgkit import esc, num
+from feederkit.sensors import LED_EDGE_REL, LedSensor, Sensor
 
 WIDTH, HEIGHT, PAD = 520, 220, 44
 """The plot's size and its left/bottom padding (px)."""
@@ -21,8 +23,10 @@ MAX_PAIRS = 12
 """Pairs listed in the table, tightest first (the rest are counted)."""
 
 
-def design_section(design: Mapping[str, Any]) -> str:
-    """The sensor design as an HTML section (answer, pairs, steps table and plot)."""
+def design_section(design: Mapping[str, Any], sensor: Sensor | None = None) -> str:
+    """The sensor design as an HTML section (answer, pairs, steps table and plot). A
+    tolerance design shown for a plan read by an LED array (``sensor``) also says it in the
+    array's terms (:func:`led_terms`) and gives each step its pitches."""
     if not isinstance(design, Mapping) or design.get("sensor_model") not in ("tolerance", "led"):
         raise InputError("the sensor design must be the JSON of 'feederkit design sensor'")
     answer = esc(design.get("answer", ""))
@@ -35,6 +39,10 @@ def design_section(design: Mapping[str, Any]) -> str:
             "only what it decided by then (the line above). <code>feederkit design sensor "
             "--time-limit S</code> decides it with the time it needs.</p>"
         )
+    led = sensor if isinstance(sensor, LedSensor) else None
+    terms = ""
+    if led is not None and design["sensor_model"] == "tolerance":
+        terms = f'<p id="led-terms">{esc(led_terms(led, design.get("critical_tolerance_mm")))}</p>'
     if design["sensor_model"] == "tolerance" and not design.get("lengths"):
         table = plot = ""  # no length table: the design was cut short (or reaches no step)
     elif design["sensor_model"] == "tolerance":
@@ -42,7 +50,7 @@ def design_section(design: Mapping[str, Any]) -> str:
             (r["tolerance_mm"][0], r["tolerance_mm"][1], r["length"], r["expected"])
             for r in design.get("lengths") or []
         ]
-        table = _steps_table(rows)
+        table = _steps_table(rows, led)
         plot = _step_plot(rows, design.get("critical_tolerance_mm"))
     else:
         table = _pitch_table(design.get("pitches") or [])
@@ -50,8 +58,71 @@ def design_section(design: Mapping[str, Any]) -> str:
     note = esc(design.get("model", ""))
     return (
         '<section id="sensor-design"><h2>Sensor design</h2>'
-        f'<p><strong>{answer}</strong></p>{cut}<p class="muted">{note}</p>'
+        f'<p><strong>{answer}</strong></p>{terms}{cut}<p class="muted">{note}</p>'
         f"{plot}{table}{pairs}</section>"
+    )
+
+
+LED_HALF = 0.5 + LED_EDGE_REL
+"""An LED array of pitch p and noise e reads diameters as finely as a tolerance of
+``LED_HALF * p + e``: :func:`led_tolerance`."""
+
+
+def led_tolerance(sensor: LedSensor) -> float:
+    """The tolerance (mm) an LED array reads diameters as finely as. A count of c beams
+    leaves the diameter in ``(c p - e', (c + 1) p + e']`` (:meth:`LedSensor.counts`, ``e'``
+    the noise plus the beam-edge slack ``LED_EDGE_REL * p``), so within ``p / 2 + e'`` of
+    ``(c + 1/2) p``: every plan that is strong for a tolerance sensor of at least that is
+    strong for the array, read at ``(c + 1/2) p`` (section 5, a reading consistent with
+    fewer diameters)."""
+    return LED_HALF * sensor.pitch + sensor.noise
+
+
+def led_pitch(tolerance: float, noise: float) -> float | None:
+    """The pitch (mm) of an array of alignment noise ``noise`` that reads as finely as
+    ``tolerance`` (:func:`led_tolerance` inverted); None when the noise alone reads coarser."""
+    if tolerance <= noise:
+        return None
+    return (tolerance - noise) / LED_HALF
+
+
+def _down(x: float, digits: int = 4) -> str:
+    """``x`` with ``digits`` significant digits, rounded down (a pitch bound is not
+    overstated by more than the beam-edge slack, ``LED_EDGE_REL``, which it forgives)."""
+    scale = 10.0 ** (digits - 1 - math.floor(math.log10(x)))
+    return f"{math.floor(x * scale * (1.0 + 10.0 * LED_EDGE_REL)) / scale:.{digits}g}"
+
+
+def led_terms(sensor: LedSensor, critical: float | None) -> str:
+    """The design for a plan read by an LED array, in the array's terms: the tolerance the
+    array reads as (:func:`led_tolerance`) against the mix's critical tolerance, and the
+    coarsest pitch at the array's noise that reads as finely. It is a bound: beam grids of
+    different pitches are not nested, so a coarser pitch may recognize the mix too
+    (docs/design.md; ``feederkit design sensor --pitches`` decides each pitch)."""
+    p, e = sensor.pitch, sensor.noise
+    reads = led_tolerance(sensor)
+    text = (
+        f"In this plan's LED array's terms (pitch {num(p, 6)} mm, noise {num(e, 6)} mm): an "
+        "array reads diameters as finely as a tolerance of half its pitch plus its noise, so "
+        f"this one reads as {num(reads, 4)} mm"
+    )
+    if critical is None:
+        return text + "."
+    coarsest = led_pitch(critical, e)
+    if reads < critical:
+        text += f", within the {num(critical, 6)} mm that keeps the mix recognizable"
+    else:
+        text += (
+            f", not within the {num(critical, 6)} mm up to which this design keeps the mix "
+            "recognizable"
+        )
+    if coarsest is None:
+        text += f"; at a noise of {num(e, 6)} mm no pitch reads that finely"
+    else:
+        text += f"; at this noise every pitch below {_down(coarsest)} mm keeps it recognizable"
+    return text + (
+        "; other pitches may too (beam grids of different pitches are not nested): feederkit "
+        "design sensor --pitches decides each on its own."
     )
 
 
@@ -84,10 +155,35 @@ def _pairs_table(pairs: Sequence[Mapping[str, Any]]) -> str:
     )
 
 
-def _steps_table(rows: Sequence[tuple[float, float | None, int | None, float | None]]) -> str:
+def _pitch_cell(lo: float, hi: float | None, led: LedSensor) -> str:
+    """The pitches of ``led``'s noise that read as finely as a tolerance in ``(lo, hi]``
+    (:func:`led_pitch`), and a mark on the step that holds ``led`` itself."""
+    top = None if hi is None else led_pitch(hi, led.noise)
+    bottom = led_pitch(lo, led.noise)
+    if hi is not None and top is None:
+        cell = "none at this noise"
+    elif top is None:
+        cell = "any" if bottom is None else f"above {_down(bottom)} mm"
+    elif bottom is None:
+        cell = f"below {_down(top)} mm"
+    else:
+        cell = f"{_down(bottom)} to {_down(top)} mm"
+    reads = led_tolerance(led)
+    if lo < reads and (hi is None or reads <= hi):
+        cell += f" <strong>(this plan's array: {num(led.pitch, 6)} mm)</strong>"
+    return f"<td>{cell}</td>"
+
+
+def _steps_table(
+    rows: Sequence[tuple[float, float | None, int | None, float | None]],
+    led: LedSensor | None = None,
+) -> str:
+    """The length steps as a table; for a plan read by ``led``, each step's pitches at its
+    noise (an array reading as finely needs at most that step's length)."""
     body = "".join(
         f"<tr><td>{num(lo, 6)} &lt; tolerance &le; "
         f"{'&infin;' if hi is None else num(hi, 6)} mm</td>"
+        + ("" if led is None else _pitch_cell(lo, hi, led))
         + (
             '<td colspan="2">no strong plan</td></tr>'
             if length is None
@@ -95,9 +191,14 @@ def _steps_table(rows: Sequence[tuple[float, float | None, int | None, float | N
         )
         for lo, hi, length, expected in rows
     )
+    pitch = (
+        ""
+        if led is None
+        else f"<th>LED pitch reading as finely (noise {num(led.noise, 6)} mm)</th>"
+    )
     return (
         '<table class="design-steps"><caption>Optimal plan length against the sensor '
-        "tolerance</caption><tr><th>tolerance</th><th>length (operations)</th>"
+        f"tolerance</caption><tr><th>tolerance</th>{pitch}<th>length (operations)</th>"
         "<th>expected operations at the upper end (parts equally likely, uniform start "
         f"orientation)</th></tr>{body}</table>"
     )

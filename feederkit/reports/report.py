@@ -6,7 +6,8 @@ and plots, the pairs the plan cannot tell apart, and the conventions. The plan i
 its declared uncertainty (:func:`feederkit.plans.verify.verify_declared`: a strong plan for
 every outcome and reading, an ideal one on the kinematic model) as it is drawn: a plan that
 fails gets a red banner at the top naming the first problem; a plan whose smallest margin is
-below 1 degree a warning, and so a plan whose members have fragile states (docs/reports.md).
+below 1 degree a warning, and so a plan whose members have fragile states, or a result that
+lists poses of one part that do not look alike (the part is not oriented; docs/reports.md).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from feederkit.reports.style import CSS
 from feederkit.reports.svgkit import Ring, esc
 from feederkit.reports.trace import Place, confusions, places, trace_plan
 from feederkit.reports.tree_html import drawing_for, tree_html
+from feederkit.reports.twins import TwinLeaf, twin_leaves, unoriented_words
 
 CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:"
 """The page may load nothing: inline styles and data-URI images only."""
@@ -82,17 +84,19 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
         '<h2>The plan</h2><p class="muted">Each box is a plan node with the states the part '
         "may be in, drawn on the fence. Each edge says the rotation the robot applies and the "
         "reading that leads there. Shaded boxes are the final poses: green one known pose, blue "
-        "poses no plan tells apart (symmetric or nearly so), red parts the plan cannot tell "
-        "apart, yellow a reject leaf: landings the next station cannot take, recirculated or "
-        "re-dropped.</p>"
+        "poses no plan tells apart that look alike (symmetric or nearly so), orange poses no "
+        "plan tells apart that do not look alike (the part is not oriented between them), red "
+        "parts the plan cannot tell apart, yellow a reject leaf: landings the next station "
+        "cannot take, recirculated or re-dropped.</p>"
         f'<p class="counts">{esc(counts)}.</p>'
         f"{tree}</section>"
     )
 
 
-def _banners(plan: Plan, report: VerificationReport) -> str:
-    """The verification verdict when it failed, the low-margin warning, and the fragile
-    states of the plan's members (:meth:`Plan.fragile_warnings`)."""
+def _banners(plan: Plan, report: VerificationReport, twins: Sequence[TwinLeaf] = ()) -> str:
+    """The verification verdict when it failed, the low-margin warning, the fragile
+    states of the plan's members (:meth:`Plan.fragile_warnings`), and the poses of one part
+    a result lists that do not look alike (:func:`unoriented_words`: not oriented)."""
     out = ""
     where = (
         "on the kinematic model"
@@ -112,6 +116,9 @@ def _banners(plan: Plan, report: VerificationReport) -> str:
     if fragile:
         lines = "<br>".join(f"Warning: {esc(w)}." for w in fragile)
         out += f'<div class="banner caution" id="fragile-states">{lines}</div>'
+    unoriented = unoriented_words(plan, twins)
+    if unoriented:
+        out += f'<div class="banner caution" id="unoriented">Warning: {esc(unoriented)}.</div>'
     return out
 
 
@@ -119,7 +126,17 @@ def plan_section(plan: Plan, outlines: Mapping[str, Outline] | None = None) -> s
     """The plan section alone (no part plots): what grows with the plan's distinct nodes."""
     numbered = places(plan)
     draw = drawing_for(plan, member_rings(plan, outlines))
-    return tree_section(numbered, tree_html(plan, numbered, trace_plan(plan, numbered), draw))
+    twins = {t.node_id: t for t in plan_twins(plan, numbered, outlines)}
+    tree = tree_html(plan, numbered, trace_plan(plan, numbered), draw, twins=twins)
+    return tree_section(numbered, tree)
+
+
+def plan_twins(
+    plan: Plan, numbered: Sequence[Place], outlines: Mapping[str, Outline] | None
+) -> list[TwinLeaf]:
+    """The leaves listing several poses of one member, compared with the caller's outlines
+    (:func:`~feederkit.reports.twins.twin_leaves`)."""
+    return twin_leaves(plan, numbered, [member_outline(p, outlines) for p in plan.parts])
 
 
 def _shares(plan: Plan) -> list[float | None]:
@@ -165,15 +182,16 @@ def render_report(
     trace = trace_plan(plan, numbered)
     draw = drawing_for(plan, member_rings(plan, outlines))
     names = ", ".join(dict.fromkeys(p.name for p in plan.parts))
-    symmetric = [(p.node_id, p.node) for p in numbered if isinstance(p.node, Leaf)]
+    twins = plan_twins(plan, numbered, outlines)
+    tree = tree_html(plan, numbered, trace, draw, twins={t.node_id: t for t in twins})
     body = "".join(
         [
             f"<h1>{'Changeover' if len(plan.parts) > 1 else 'Plan'} report: {esc(names)}</h1>",
-            _banners(plan, report),
+            _banners(plan, report, twins),
             mix_section(plan, draw),
-            tree_section(numbered, tree_html(plan, numbered, trace, draw)),
+            tree_section(numbered, tree),
             stats_section(plan, seconds_per_op, simulation, cycle_time),
-            "" if design is None else design_section(design),
+            "" if design is None else design_section(design, plan.sensor),
             '<section id="parts"><h2>Parts</h2>',
             "".join(
                 part_section(i, p, draw, member_outline(p, outlines), share)
@@ -181,7 +199,7 @@ def render_report(
             ),
             "</section>",
             lookalike_section(
-                plan, confusions(plan, numbered, trace), list(unrecognizable or []), symmetric
+                plan, confusions(plan, numbered, trace), list(unrecognizable or []), twins
             ),
             conventions_section(plan),
         ]

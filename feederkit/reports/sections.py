@@ -10,10 +10,11 @@ from typing import Any
 
 from feederkit.cell import expectation_words
 from feederkit.errors import InputError
-from feederkit.plans.model import REJECTED_WORDS, Leaf, Plan
+from feederkit.plans.model import REJECTED_WORDS, Plan
 from feederkit.reports.svgkit import esc, num
 from feederkit.reports.trace import Confusion
 from feederkit.reports.tree_html import Drawing, path_text
+from feederkit.reports.twins import TwinLeaf
 
 CONVENTIONS = (
     "Part frame: the outline's own coordinates, in millimetres; the contact polygon is the "
@@ -291,10 +292,11 @@ def lookalike_section(
     plan: Plan,
     confusions: Sequence[Confusion],
     given: Sequence[Mapping[str, Any]],
-    symmetric: Sequence[tuple[int, Leaf]] = (),
+    twins: Sequence[TwinLeaf] = (),
 ) -> str:
-    """Pairs of parts that cannot be told apart, with their witnesses, and symmetric leaves
-    (``symmetric``: the numbered leaves)."""
+    """Pairs of parts that cannot be told apart, with their witnesses, then the leaves that
+    list several poses of one part (``twins``): those that look alike, each a correct answer,
+    apart from those that do not, between which the part is not oriented."""
     rows = _rows(plan, confusions, given)
     if rows:
         body = (
@@ -311,22 +313,64 @@ def lookalike_section(
         )
     else:
         body = "<p>One part only: nothing to recognize.</p>"
-    sym = [
-        c
-        for c in symmetric
-        if not c[1].reject and len({r.key for r in c[1].results}) == 1 and len(c[1].results) > 1
-    ]
-    if sym:
-        items = "".join(
-            f"<li>{esc(plan.part(*leaf.results[0].key).label)}: states "
-            f"{esc(_states([r.state for r in leaf.results]))} at leaf {node_id}</li>"
-            for node_id, leaf in sym
-        )
-        body += (
-            "<p>Poses no plan tells apart (symmetric or nearly so; each is a correct answer):"
-            f"</p><ul>{items}</ul>"
-        )
+    body += _alike_poses(plan, [t for t in twins if t.oriented])
+    body += _unoriented_poses(plan, [t for t in twins if not t.oriented])
     return f'<section id="lookalikes"><h2>Parts the plan cannot tell apart</h2>{body}</section>'
+
+
+def _twin_items(plan: Plan, twins: Sequence[TwinLeaf]) -> str:
+    """One list item per leaf: the member, its states and the leaf (and, of more than two
+    poses, which do not look alike)."""
+    return "".join(
+        f"<li>{esc(plan.parts[t.member].label)}: states {esc(_states(t.states))} at leaf "
+        f"{t.node_id}{esc(_unlike_words(t))}</li>"
+        for t in twins
+    )
+
+
+def _alike_poses(plan: Plan, twins: Sequence[TwinLeaf]) -> str:
+    """The leaves whose listed poses of one part look alike: each is a correct answer.
+    Compared on the contact hull alone (no outline given: a plan file records none), they
+    are a correct answer only if the holes and notches look alike too, which is not known
+    here."""
+    seen = [t for t in twins if t.outline]
+    hull = [t for t in twins if not t.outline]
+    out = ""
+    if seen:
+        out += (
+            '<p id="alike-poses">Poses no plan tells apart that look alike (symmetric or '
+            f"nearly so; each is a correct answer):</p><ul>{_twin_items(plan, seen)}</ul>"
+        )
+    if hull:
+        out += (
+            '<p id="alike-hulls">Poses no plan tells apart whose contact hulls look alike '
+            "(symmetric or nearly so): each is a correct answer if the outlines, holes and "
+            "notches included, look alike too. The plan file records only the hull; plan and "
+            "changeover compile compare the outlines, name the poses that do not look alike "
+            f"and exit 1:</p><ul>{_twin_items(plan, hull)}</ul>"
+        )
+    return out
+
+
+def _unlike_words(twin: TwinLeaf) -> str:
+    """Which of a leaf's poses do not look alike, when it lists more than two."""
+    if len(twin.states) < 3:
+        return ""
+    return ", not alike: " + ", ".join(f"s{a} and s{b}" for a, b in twin.unlike)
+
+
+def _unoriented_poses(plan: Plan, twins: Sequence[TwinLeaf]) -> str:
+    """The leaves whose listed poses of one part do not look alike: not oriented between
+    them."""
+    if not twins:
+        return ""
+    items = _twin_items(plan, twins)
+    return (
+        '<p id="unoriented-poses" class="warn">Poses no plan tells apart that do not look '
+        "alike (holes, slots or notches placed otherwise, or a push function that repeats): "
+        "the part is not oriented between them; check its pose by other means, or take it "
+        f"either way:</p><ul>{items}</ul>"
+    )
 
 
 def conventions_section(plan: Plan) -> str:

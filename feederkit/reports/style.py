@@ -45,6 +45,7 @@ ul.tree ul > li::after { content: ""; position: absolute; left: 0; top: 1.3rem; 
   background: #fff; width: fit-content; max-width: 100%; }
 .tree-node.result { background: #eaf6ee; border-color: #8cc59c; }
 .tree-node.result.symmetric { background: #eef3fb; border-color: #8fa9d6; }
+.tree-node.result.unoriented { background: #fdf0e6; border-color: #d99a5e; }
 .tree-node.result.confused { background: #fbeeee; border-color: #d68f8f; }
 .tree-node.result.reject { background: #fdf6e3; border-color: #d6b36a; }
 .shared-tag { color: #0b5a8a; font-weight: 600; }

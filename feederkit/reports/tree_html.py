@@ -2,7 +2,9 @@
 
 Markup contract (tests and scripts rely on it): every distinct plan node is one element of
 class ``tree-node`` with ``data-node-id`` (pre-order of distinct nodes, root 0); operation
-nodes also have class ``op``, leaves class ``result`` (a reject leaf also ``reject``); a node
+nodes also have class ``op``, leaves class ``result`` and their kind: ``known``,
+``symmetric`` (poses of one part that look alike), ``unoriented`` (poses of one part that do
+not: :mod:`feederkit.reports.twins`), ``confused`` or ``reject``; a node
 several branches lead to (design.md's ``"nodes"``) is drawn once, at its first place (a shared
 subplan with ``data-shared``: ``S1``, ``S2``, ... in the order drawn, as ``plan_tree`` names
 them), and each other place is one ``div.tree-ref`` with ``data-ref`` (the node id); each
@@ -15,12 +17,13 @@ ends with one ``li.tree-stop`` with ``data-operations`` and ``data-results`` (le
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from feederkit.plans.model import Branch, Leaf, Plan, Step
 from feederkit.reports.svgkit import Ring, esc, num, part_colour, pose_svg, reach
 from feederkit.reports.trace import Place, StateKey, Trace, TraceStep, leaf_members
+from feederkit.reports.twins import TwinLeaf
 
 STATE_PX = 56
 """Drawn size of a possible state inside an operation node."""
@@ -126,6 +129,18 @@ def _shared_tag(name: str | None) -> tuple[str, str]:
     return f' data-shared="{esc(name)}"', note
 
 
+def unreached_words(plan: Plan) -> str:
+    """An operation node the trace reaches with no state, in words. In a strong plan that is
+    a branch for the declared uncertainty (design.md, "Uncertainty"): on the nominal push no
+    start reaches it, as its leaves say; on the ideal model no state should."""
+    if plan.uncertainty.is_ideal:
+        return "following the plan, no state reaches it"
+    return (
+        "on the nominal push (no rotation error) no start reaches it: the declared "
+        "uncertainty can bring states here"
+    )
+
+
 def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str | None) -> str:
     node = place.node
     assert isinstance(node, Step)
@@ -134,6 +149,8 @@ def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str 
     count = f"{len(here)} possible state{'s' if len(here) != 1 else ''}"
     if place.node_id == 0:
         count = f"any orientation: {len(here)} stable states after the first alignment"
+    elif not here:
+        count = unreached_words(plan)
     margin = "" if node.margin_deg is None else f" (margin \u00b1{num(node.margin_deg, 2)}\u00b0)"
     read = ", read" if any(b.reading is not None for b in node.branches) else ""
     if node.action_deg is None:
@@ -141,11 +158,12 @@ def _op_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str 
     else:
         step = f"next: {action_text(node.action_deg)}{margin}, align{read}"
     attr, note = _shared_tag(shared)
+    cls = "warn" if not here and plan.uncertainty.is_ideal else "muted"
     return (
         f'<div class="tree-node op" data-node-id="{place.node_id}" data-depth="{place.depth}" '
         f'data-states="{len(here)}"{attr}><div class="node-head">'
         f"<strong>operation {place.depth + 1}</strong> "
-        f'<span class="muted">node {place.node_id} \u00b7 {esc(count)}</span>{note}</div>'
+        f'<span class="{cls}">node {place.node_id} \u00b7 {esc(count)}</span>{note}</div>'
         f'<div class="poses">{figures}</div>'
         f'<div class="node-op">{esc(step)}</div></div>'
     )
@@ -155,7 +173,14 @@ REJECT_WORDS = "reject (recirculate or re-drop)"
 """A reject leaf in words: the next station cannot take these landings (docs/plans.md)."""
 
 
-def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: str | None) -> str:
+def _result_node(
+    plan: Plan,
+    trace: Trace,
+    draw: Drawing,
+    place: Place,
+    shared: str | None,
+    twin: TwinLeaf | None = None,
+) -> str:
     node = place.node
     assert isinstance(node, Leaf)
     keys = [(plan.part_index(r.part, r.landing), r.state) for r in node.results]
@@ -171,6 +196,13 @@ def _result_node(plan: Plan, trace: Trace, draw: Drawing, place: Place, shared: 
     elif len(node.results) == 1:
         head = f"done: {plan.parts[keys[0][0]].label} in state {keys[0][1]}"
         kind = "known"
+    elif len(members) == 1 and twin is not None and not twin.oriented:
+        label = plan.parts[next(iter(members))].label
+        head = (
+            f"not oriented: {label}, one of {len(node.results)} poses that no plan tells "
+            "apart and that do not look alike"
+        )
+        kind = "unoriented"
     elif len(members) == 1:
         label = plan.parts[next(iter(members))].label
         head = f"done: {label}, one of {len(node.results)} poses that no plan tells apart"
@@ -235,13 +267,16 @@ def tree_html(
     trace: Trace,
     draw: Drawing,
     max_figures: int | None = None,
+    twins: Mapping[int, TwinLeaf] | None = None,
 ) -> str:
     """The plan as nested lists: operation nodes, labelled edges, leaves; each distinct
     node drawn once (at its first place; a shared subplan named ``S1``, ``S2``, ... and
     referred to by name elsewhere, as ``plan_tree`` does), without recursion. After
     ``max_figures`` (default ``TREE_FIGURES``) drawn states the drawing stops (the nodes
     begun are closed) and a last item (``li.tree-stop``) says how many operations and
-    results it left out."""
+    results it left out. ``twins`` (by node id, :func:`~feederkit.reports.twins.twin_leaves`)
+    marks the leaves whose poses of one part do not look alike: the part is not oriented."""
+    twins = twins or {}
     max_figures = TREE_FIGURES if max_figures is None else max_figures
     out: list[str] = ['<ul class="tree">']
     figures = 0
@@ -271,7 +306,7 @@ def tree_html(
             out.append(_stop_item(numbered, drawn, figures))
             continue
         if isinstance(place.node, Leaf):
-            html = _result_node(plan, trace, draw, place, shared)
+            html = _result_node(plan, trace, draw, place, shared, twins.get(number))
             figures += html.count("<svg")
             out.append(f"<li>{edge}{html}</li>")
             continue
