@@ -44,13 +44,16 @@ from feederkit.errors import CheckFailed, InputError
 from feederkit.importers.orientable import orientability
 from feederkit.landing.model import Landing
 from feederkit.landing.plan import revision_landings
+from feederkit.machine.build import build_machine
+from feederkit.machine.widths import widen_widths
+from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mix.analyze import MixAnalysis, analyze_mix
 from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
-from feederkit.sensors import NoSensor, make_sensor
-from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, Uncertainty
+from feederkit.sensors import NoSensor, Sensor, make_sensor
+from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, IDEAL, Uncertainty
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -210,8 +213,9 @@ def analyze_command(
         sides = [w for w in found if owners and owners[w.index_a] == owners[w.index_b]]
         one_part = (
             f"; {len(sides)} of them two landings of one part, which no mix keeps apart: "
-            "plan only one of them (--landings) or reject the others (changeover compile "
-            "--accept)"
+            "plan only one of them (--landings); rejecting one (changeover compile --accept) "
+            "leaves no plan, as no plan tells an accepted landing from a rejected one it "
+            "cannot tell apart"
             if sides
             else ""
         )
@@ -361,6 +365,7 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
         console.print(t)
     if result.pairs:
         console.print(_pairs_table(result.pairs, pfs))
+    reads = _Readings(pfs, result.sensor, unc)
     if result.strong_pairs:
         console.print(
             _pairs_table(
@@ -368,40 +373,96 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
                 pfs,
                 "pairs told apart only on the ideal model: no strong plan tells them apart "
                 f"under {_under(unc, 'a')}",
+                reads,
             )
         )
     if result.alone:
         t = Table(title=f"no strong plan orients these even alone under {_under(unc, 'a')}")
         add_name_column(t, "part")
-        t.add_column("states no strong plan orients together (edge, diameter mm)")
+        t.add_column(f"states no strong plan orients together ({READS_HEADING})")
         for i, states in result.alone:
-            ss = pfs[i].states
-            t.add_row(
-                escape(result.names[i]),
-                ", ".join(f"{k} (e{ss[k].edge} {ss[k].diameter:.4g})" for k in states),
-            )
+            t.add_row(escape(result.names[i]), ", ".join(reads.state(i, k) for k in states))
         console.print(t)
     if not result.pairs and result.pairs is not None and not isinstance(result.sensor, NoSensor):
         console.print(
             "every pair of parts can be told apart by some plan on the ideal model (Theorem 11)"
         )
+        if unc.is_ideal:
+            console.print(IDEAL_ONLY_NOTE)
+
+
+IDEAL_ONLY_NOTE = (
+    "that is the ideal model (exact rotations and diameters); changeover compile plans under "
+    f"a rotation error of {DEFAULT_ROTATION_ERROR_DEG:g} degree by default, where fewer pairs "
+    "may be told apart and some parts may have no strong plan: --rotation-error "
+    f"{DEFAULT_ROTATION_ERROR_DEG:g} screens at compile's default"
+)
+"""The line after an ideal analysis that tells every pair apart: the analysis defaults to the
+ideal model (section 8), compile to design.md's rotation error, and a screen at the one is no
+verdict at the other."""
+
+READS_HEADING = "edge, reads: the diameters mm its physical state reads over"
+"""The witness columns' heading under a declared uncertainty (:class:`_Readings`)."""
+
+
+class _Readings:
+    """Each member's states in a witness table: on the ideal model the edge and exact
+    diameter; under a declared uncertainty the edge and the interval the machine reads the
+    physical state holding it over (its resting edge may turn, its fragile neighbours merge,
+    its contact hull simplifies the outline: :func:`~feederkit.machine.build.build_machine`,
+    :func:`~feederkit.machine.widths.widen_widths`), so that states whose nominal diameters
+    lie far apart show why they read alike. Each member's machine is built once, when
+    first named."""
+
+    def __init__(self, pfs: list[PushFunction], sensor: Sensor, unc: Uncertainty) -> None:
+        self.pfs, self.sensor, self.unc = pfs, sensor, unc
+        self._spans: dict[int, dict[int, tuple[float, float]]] = {}
+
+    def spans(self, member: int) -> dict[int, tuple[float, float]]:
+        """Ideal state -> the diameters its physical state reads over, for one member."""
+        if member not in self._spans:
+            pf = self.pfs[member]
+            machine = build_machine([pf], self.sensor, self.unc)
+            machine = widen_widths(machine, part_offsets([pf]))
+            self._spans[member] = {
+                k: s.diameter_range or (s.diameter, s.diameter)
+                for s in machine.states
+                for k in s.ideal_states
+            }
+        return self._spans[member]
+
+    def edge(self, member: int, state: int) -> str:
+        """``e7 15`` on the ideal model, ``e7, reads 12.78-15.63`` under uncertainty."""
+        s = self.pfs[member].states[state]
+        if self.unc.is_ideal:
+            return f"e{s.edge} {s.diameter:.4g}"
+        lo, hi = self.spans(member).get(state, (s.diameter, s.diameter))
+        span = f"{lo:.4g}" if f"{lo:.4g}" == f"{hi:.4g}" else f"{lo:.4g}-{hi:.4g}"
+        return f"e{s.edge}, reads {span}"
+
+    def state(self, member: int, state: int) -> str:
+        """One state of a member, numbered: ``1 (e2, reads 12.78-15.63)``."""
+        return f"{state} ({self.edge(member, state)})"
 
 
 def _pairs_table(
     pairs: tuple[PairWitness, ...],
     pfs: list[PushFunction],
     title: str = "pairs no plan can tell apart (section 8.4)",
+    reads: _Readings | None = None,
 ) -> Table:
+    """A table of pairs with their witnesses: ``reads`` None for the ideal model's (exact
+    diameters), else the reading intervals under the declared uncertainty."""
+    how = "edge, diameter mm" if reads is None else READS_HEADING
     t = Table(title=title)
     add_name_column(t, "part A")
     add_name_column(t, "part B")
-    t.add_column("inseparable states (A ~ B: edge, diameter mm)")
+    t.add_column(f"inseparable states (A ~ B: {how})")
     t.add_column("why")
+    exact = reads or _Readings(pfs, NoSensor(), IDEAL)
     for w in pairs:
-        sa, sb = pfs[w.index_a].states, pfs[w.index_b].states
         states = ", ".join(
-            f"{i}~{j} (e{sa[i].edge} {sa[i].diameter:.4g} / e{sb[j].edge} {sb[j].diameter:.4g})"
-            for i, j in w.pairs
+            f"{i}~{j} ({exact.edge(w.index_a, i)} / {exact.edge(w.index_b, j)})" for i, j in w.pairs
         )
         t.add_row(escape(w.part_a), escape(w.part_b), states, escape(w.reason))
     return t

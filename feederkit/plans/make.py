@@ -31,7 +31,7 @@ from feederkit.errors import InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
-from feederkit.machine.widths import widen_widths
+from feederkit.machine.widths import Offsets, widen_widths
 from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
@@ -158,10 +158,15 @@ def _make_plan(
     try:
         result = plan_machine(machine, opts, budget=_planner_budget(opts, started, certify))
     except NoStrongPlan as exc:
+        left = _left(opts, started)
+        blame = blocking_members(
+            pfs, sensor, unc, opts, offsets, named, None if left is None else left / 2.0
+        )
         largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
         hint = f"; {exc.hint}" if exc.hint else ""
-        simplified = [pf.part.name for pf in pfs if exact_push_function(pf) is not None]
-        chords = short_chords_words(pfs, unc.shape_tolerance_mm)
+        culprits = [pfs[k] for k in blame.members] or pfs
+        simplified = [pf.part.name for pf in culprits if exact_push_function(pf) is not None]
+        chords = short_chords_words(culprits, unc.shape_tolerance_mm)
         if chords:
             hint += chords  # short chords: a coarser hull helps, a finer one does not
         elif simplified:
@@ -169,7 +174,8 @@ def _make_plan(
                 f"; {simplified[0]}'s contact hull simplifies its outline (stable states of the "
                 "simplification only, widths it cuts): a smaller --hull-tolerance may help"
             )
-        raise PlanningError(f"{exc.reason}; {largest}{hint}") from None
+        who = f"; {blame.words}" if blame.words else ""
+        raise PlanningError(f"{exc.reason}{who}; {largest}{hint}") from None
     # Planned on the parts' own widths, the plan's expected length is restated on the file's
     # model (its diameters), the one every reader computes.
     widened = machine is not unwidened
@@ -737,7 +743,9 @@ def largest_uncertainty(
 
     Bisection over machine builds (a strong plan existing at an uncertainty exists at every
     smaller one: outcome sets and reading intervals shrink), ``BISECT_STEPS`` steps, or
-    fewer when ``seconds`` run out (the bound found so far is then a lower one).
+    fewer when ``seconds`` run out (the bound found so far is then a lower one). When
+    neither bisection finds a plan, the shape and COM tolerances leave none even with no
+    rotation error: :func:`_tolerance_words` says which to loosen.
     """
     u = uncertainty
     stop = None if seconds is None else time.monotonic() + max(seconds, 0.0)
@@ -745,62 +753,267 @@ def largest_uncertainty(
     def exists(unc: Uncertainty) -> bool | None:
         """Whether a strong plan exists at ``unc``; None when not decided in time."""
         left = None if stop is None else max(stop - time.monotonic(), 0.0)
-        machine = build_machine(push_functions, sensor, unc)
-        budget = Deadline(left)
-        found = strong_plan_exists(machine, options, budget)
-        if budget.end is not None and time.perf_counter() > budget.end:
-            return None
-        return found
+        return _decided_exists(build_machine(push_functions, sensor, unc), options, left)
 
-    def largest(make, top: float) -> tuple[float | None, bool, float]:
-        """The largest value with a plan (None: none, or undecided at 0), whether the
-        bisection finished, and its final bracket's width."""
-        at_zero = exists(make(0.0))
-        if not at_zero:
-            return None, at_zero is not None, top
-        lo, hi = 0.0, top
-        for _ in range(BISECT_STEPS):
-            mid = (lo + hi) / 2.0
-            found = exists(make(mid))
-            if found is None:
-                return lo, False, hi - lo
-            lo, hi = (mid, hi) if found else (lo, mid)
-        return lo, True, hi - lo
+    at_zero_is_ideal = Uncertainty(0.0, u.shape_tolerance_mm, u.com_tolerance_mm).is_ideal
+    words = []
+    r = _largest(
+        exists,
+        lambda x: Uncertainty(x, u.shape_tolerance_mm, u.com_tolerance_mm),
+        u.rotation_error_deg,
+    )
+    if r.value is None and not r.done:
+        return "the largest uncertainty with a strong plan was not found within the time limit"
+    if r.value is not None:
+        words.append(r.said("rotation error", "deg", vibration=at_zero_is_ideal))
+    if u.shape_tolerance_mm > 0.0:
+        t = _largest(
+            exists,
+            lambda x: Uncertainty(u.rotation_error_deg, x, u.com_tolerance_mm),
+            u.shape_tolerance_mm,
+        )
+        if t.value is not None:
+            words.append(t.said("shape tolerance", "mm"))
+    if not words:
+        return _tolerance_words(u, exists)
+    return " and ".join(words)
 
-    def said(value: float, done: bool, what: str, unit: str, width: float = 0.0) -> str:
-        if done and value == 0.0 and what == "rotation error" and at_zero_is_ideal:
+
+def _decided_exists(
+    machine: PushAlignMachine, options: PlanningOptions, seconds: float | None
+) -> bool | None:
+    """Whether a strong plan exists for ``machine`` (:func:`strong_plan_exists`); None when
+    not decided within ``seconds`` (None: no limit)."""
+    budget = Deadline(seconds)
+    found = strong_plan_exists(machine, options, budget)
+    if budget.end is not None and time.perf_counter() > budget.end:
+        return None
+    return found
+
+
+@dataclass(frozen=True)
+class _Largest:
+    """A bisection's answer: ``value`` the largest value with a plan (None: none, or
+    undecided at 0), ``done`` whether it finished, ``width`` its final bracket's width."""
+
+    value: float | None
+    done: bool
+    width: float
+
+    def said(self, what: str, unit: str, *, vibration: bool = False) -> str:
+        """In words; ``vibration``: 0 is the ideal model, so a plan only at 0 means the
+        vibration any positive value switches on leaves none (:data:`VIBRATION_OBSTACLE`)."""
+        value = self.value or 0.0
+        if self.done and value == 0.0 and vibration:
             return VIBRATION_OBSTACLE
-        if done and value > 0.0:
+        if self.done and value > 0.0:
             # A bisection: a plan at ``value`` (printed rounded down), none a bracket above.
             return (
                 f"the largest {what} with a strong plan is at least {at_most(value, 4)} {unit} "
-                f"(bisected to {width:.2g} {unit})"
+                f"(bisected to {self.width:.2g} {unit})"
             )
-        if done:
+        if self.done:
             return f"a strong plan exists only with no {what} at all (0 {unit})"
         return (
             f"a strong plan exists at {what} {at_most(value, 4)} {unit} (larger values were not "
             "decided within the time limit)"
         )
 
-    at_zero_is_ideal = Uncertainty(0.0, u.shape_tolerance_mm, u.com_tolerance_mm).is_ideal
-    words = []
-    r, r_done, r_width = largest(
-        lambda x: Uncertainty(x, u.shape_tolerance_mm, u.com_tolerance_mm), u.rotation_error_deg
+
+def _largest(
+    exists: Callable[[Uncertainty], bool | None],
+    make: Callable[[float], Uncertainty],
+    top: float,
+) -> _Largest:
+    """The largest value in [0, ``top``] at which ``make(value)`` has a strong plan, bisected
+    ``BISECT_STEPS`` times (``exists`` None: out of time, the bound so far is a lower one)."""
+    at_zero = exists(make(0.0))
+    if not at_zero:
+        return _Largest(None, at_zero is not None, top)
+    lo, hi = 0.0, top
+    for _ in range(BISECT_STEPS):
+        mid = (lo + hi) / 2.0
+        found = exists(make(mid))
+        if found is None:
+            return _Largest(lo, False, hi - lo)
+        lo, hi = (mid, hi) if found else (lo, mid)
+    return _Largest(lo, True, hi - lo)
+
+
+def _tolerance_words(u: Uncertainty, exists: Callable[[Uncertainty], bool | None]) -> str:
+    """In words, when no rotation error, however small, has a strong plan under the declared
+    shape and COM tolerances (nor any shape tolerance under the declared rotation error):
+    the tolerances are what is left to loosen. Names the COM tolerance when it alone leaves
+    none, and the largest rotation error with a plan once both are 0. Only when that is 0 is
+    the feeder's vibration, which any positive rotation error switches on, the cause
+    (tried first, at the bisection's smallest step: the one machine build it then takes)."""
+    declared = [
+        f"{what} {value:g} mm"
+        for what, value in (
+            ("shape tolerance", u.shape_tolerance_mm),
+            ("COM tolerance", u.com_tolerance_mm),
+        )
+        if value > 0.0
+    ]
+    lead = (
+        f"even with rotation error 0 the {' and '.join(declared)} "
+        f"{'leave' if len(declared) > 1 else 'leaves'} no strong plan"
     )
-    if r is None and not r_done:
-        return "the largest uncertainty with a strong plan was not found within the time limit"
-    if r is not None:
-        words.append(said(r, r_done, "rotation error", "deg", r_width))
-    if u.shape_tolerance_mm > 0.0:
-        t, t_done, t_width = largest(
-            lambda x: Uncertainty(u.rotation_error_deg, x, u.com_tolerance_mm), u.shape_tolerance_mm
+    if u.rotation_error_deg > 0.0:
+        least = u.rotation_error_deg / 2.0**BISECT_STEPS
+        if exists(Uncertainty(least)) is False:
+            return (
+                f"{lead}, nor does any rotation error without "
+                f"{'them' if len(declared) > 1 else 'it'}: {VIBRATION_ONLY}"
+            )
+    flags = "a smaller --shape-tolerance or --com-tolerance"
+    if u.shape_tolerance_mm == 0.0:
+        flags = "a smaller --com-tolerance"
+    elif u.com_tolerance_mm == 0.0:
+        flags = "a smaller --shape-tolerance"
+    elif exists(Uncertainty(0.0, 0.0, u.com_tolerance_mm)) is False:
+        flags = (
+            f"a smaller --com-tolerance: the COM tolerance {u.com_tolerance_mm:g} mm alone "
+            "leaves none"
         )
-        if t is not None:
-            words.append(said(t, t_done, "shape tolerance", "mm", t_width))
-    if not words:
+    words = f"{lead}: what is left to loosen is the tolerance{'s' * (len(declared) > 1)}, {flags}"
+    if u.rotation_error_deg == 0.0:
         return (
-            "even a rotation error near 0 leaves no strong plan: the resting states the "
-            "vibration merges cannot be told apart; plan on the ideal model (rotation error 0)"
+            f"{words}; with neither, on the ideal model, a plan exists, with no margin for "
+            "the feeder's vibration"
         )
-    return " and ".join(words)
+    them = "them" if len(declared) > 1 else "it"
+    if exists(Uncertainty(u.rotation_error_deg)):
+        return (
+            f"{words}; without {them} the declared rotation error {u.rotation_error_deg:g} deg "
+            "has a strong plan"
+        )
+    bare = _largest(exists, lambda x: Uncertainty(x), u.rotation_error_deg)
+    return f"{words}; without {them} {bare.said('rotation error', 'deg')}"
+
+
+VIBRATION_ONLY = (
+    "what leaves none is the feeder's vibration, which any declared uncertainty switches on (a "
+    f"push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the push "
+    "bands, and fragile states merge: docs/uncertainty.md); only the ideal model (rotation "
+    "error 0, no shape or COM tolerance) has a plan, with no margin for that vibration"
+)
+""":func:`_tolerance_words`' cause when no rotation error above 0 has a strong plan even
+without the declared tolerances (:data:`VIBRATION_OBSTACLE`'s case, the tolerances too)."""
+
+
+NAMED_MEMBERS = 6
+""":func:`blocking_members` names at most this many members, then counts the rest."""
+
+
+@dataclass(frozen=True)
+class Blame:
+    """Why a mix has no strong plan, member by member (:func:`blocking_members`): ``words``
+    for the message ("" when there is nothing to say) and ``members``, the indices of the
+    members blamed (none: the pairs between members, or nothing decided)."""
+
+    words: str = ""
+    members: tuple[int, ...] = ()
+
+
+def blocking_members(
+    pfs: Sequence[PushFunction],
+    sensor: Sensor,
+    unc: Uncertainty,
+    options: PlanningOptions,
+    offsets: Offsets,
+    named: Sequence[PlanMember] | None,
+    seconds: float | None = None,
+) -> Blame:
+    """The members of a mix with no strong plan that leave it none (section 8.5: the mix's
+    plan orients every member, so one no strong plan orients alone leaves the mix none,
+    whatever the others): the accepted members no strong plan orients even alone, then
+    the landings of one part that each have a plan alone but none together, both accepted
+    (only planning one side helps there: an accepted and a rejected landing no plan tells
+    apart leave no plan either, docs/changeovers.md). Each check is a machine of one or two
+    members, each read over its ``offsets`` as the mix's is; they stop when ``seconds`` run
+    out (an undecided member is not blamed). With everything decided and none to blame, the words
+    say that the pairs between members leave no plan."""
+    if len(pfs) < 2:
+        return Blame()
+    stop = None if seconds is None else time.monotonic() + max(seconds, 0.0)
+    rejected = set() if named is None else {k for k, m in enumerate(named) if not m.accept}
+
+    def exists(ks: tuple[int, ...]) -> bool | None:
+        left = None if stop is None else stop - time.monotonic()
+        if left is not None and left <= 0.0:
+            return None
+        machine = build_machine([pfs[k] for k in ks], sensor, unc)
+        machine = widen_widths(machine, [offsets[k] for k in ks])
+        return _decided_exists(machine, options, left)
+
+    verdicts = {k: exists((k,)) for k in range(len(pfs)) if k not in rejected}
+    alone = [k for k, found in verdicts.items() if found is False]
+    pairs = [p for p in _landing_pairs(named) if not set(p) & set(alone)]
+    together = {p: exists(p) for p in pairs}
+    sides = [p for p, found in together.items() if found is False]
+    decided = None not in verdicts.values() and None not in together.values()
+    words = []
+    if alone:
+        # A failing landing whose part has another landing in the mix: plan that one.
+        others = named is not None and any(
+            named[k].landing is not None and any(b in verdicts and b not in alone for b in p)
+            for k in alone
+            for p in _landing_pairs(named)
+            if k in p
+        )
+        words.append(_alone_words([pfs[k].part.name for k in alone], others))
+    if sides:
+        words.append(_sides_words(pfs, named, sides))
+    if not words and decided:
+        words.append(
+            "every member has a strong plan alone: what leaves none is states of different "
+            "members that must be told apart (the pairs between members)"
+        )
+    blamed = dict.fromkeys([*alone, *(k for p in sides for k in p)])
+    return Blame("; ".join(words), tuple(blamed))
+
+
+def _landing_pairs(named: Sequence[PlanMember] | None) -> list[tuple[int, int]]:
+    """The pairs of members that are two landings of one part."""
+    if named is None:
+        return []
+    return [
+        (a, b)
+        for a, m in enumerate(named)
+        for b in range(a + 1, len(named))
+        if m.landing is not None and named[b].landing is not None and named[b].name == m.name
+    ]
+
+
+def _alone_words(names: Sequence[str], landings: bool) -> str:
+    """The members no strong plan orients even alone, and what to do, in words
+    (``landings``: some is a landing whose part has another that may be planned)."""
+    shown = list(names[:NAMED_MEMBERS])
+    if len(names) > NAMED_MEMBERS:
+        shown.append(f"{len(names) - NAMED_MEMBERS} more")
+    one = len(names) == 1
+    listed = shown[0] if len(shown) == 1 else f"{', '.join(shown[:-1])} and {shown[-1]}"
+    out = "leave it out of the mix" if one else "leave them out of the mix"
+    if landings:
+        out += " (a landing: plan the others, --landings)"
+    return (
+        f"{listed} {'has' if one else 'have'} no strong plan even alone at the declared "
+        f"uncertainty: {out}, or loosen the declared uncertainty"
+    )
+
+
+def _sides_words(
+    pfs: Sequence[PushFunction],
+    named: Sequence[PlanMember] | None,
+    sides: Sequence[tuple[int, int]],
+) -> str:
+    """The landings of one part that each have a strong plan alone but none together, and
+    the one remedy: plan only one side (``--landings``)."""
+    assert named is not None
+    listed = "; ".join(f"{pfs[a].part.name} and {pfs[b].part.name}" for a, b in sides)
+    side = named[sides[0][0]].landing
+    return (
+        f"two landings of one part each have a strong plan alone but none together "
+        f"({listed}): plan only one side (--landings {side})"
+    )
