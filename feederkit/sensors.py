@@ -850,4 +850,39 @@ def sensor_warnings(sensor: Sensor, diameters: Sequence[float]) -> list[str]:
             f"states up to {reach:.4g} mm apart can read alike, "
             f"more than the largest diameter ({hi:.4g} mm)"
         )
+    if isinstance(sensor, LedSensor) and sensor.noise == 0.0 and not out:
+        near = near_beam(sensor.pitch, diameters)
+        if near:
+            d, gap = near[0]
+            out.append(
+                f"with no alignment noise (--noise 0) the plan trusts each beam count; "
+                f"{len(near)} diameter{' lies' if len(near) == 1 else 's lie'} within "
+                f"{LED_NEAR_BEAM_REL:.0%} of the pitch of a beam (the closest: {d:.4g} mm, "
+                f"{gap:.3g} mm from it): a part a little off flush or off size there blocks "
+                "one beam more or less, which no branch may read (the line stops); give the "
+                "array's alignment noise with --noise MM"
+            )
     return out
+
+
+LED_NEAR_BEAM_REL = 0.25
+"""With no alignment noise, a diameter closer than this fraction of the pitch to a beam's
+height (yet not on it, where both counts are read: ``LED_EDGE_REL``) is named by
+:func:`sensor_warnings`: its count is trusted, though a part a little off flush or off size
+flips it (a 60 mm part 0.25 degrees off flush reads 0.26 mm wider)."""
+
+
+def near_beam(pitch: float, diameters: Sequence[float]) -> list[tuple[float, float]]:
+    """The diameters within ``LED_NEAR_BEAM_REL * pitch`` of a beam's height ``k * pitch``
+    but farther than ``LED_EDGE_REL * pitch`` (those count both ways), with their distance,
+    closest first.
+
+    >>> near_beam(0.5, [40.0, 21.96, 33.25])
+    [(21.96, 0.04...)]
+    """
+    out = []
+    for d in diameters:
+        gap = abs(d - round(d / pitch) * pitch)
+        if LED_EDGE_REL * pitch < gap < LED_NEAR_BEAM_REL * pitch:
+            out.append((d, gap))
+    return sorted(out, key=lambda x: x[1])

@@ -303,6 +303,10 @@ def test_split_uses_the_labels_given():
         (LedSensor(50.0), [10.0, 12.0], ["every state reads alike", "largest diameter (12 mm)"]),
         (LedSensor(1.0), [10.0, 12.0], []),
         (LedSensor(20.0), [5.0], ["largest diameter"]),
+        # No alignment noise: 21.96 mm is 0.04 mm below a beam of a 0.5 mm array.
+        (LedSensor(0.5), [21.96, 33.3], ["1 diameter lies within 25% of the pitch"]),
+        (LedSensor(0.5, 0.02), [21.96, 33.3], []),
+        (LedSensor(0.5), [22.0, 33.3], []),  # on a beam: both counts are read
     ],
 )
 def test_sensor_warnings(sensor, diameters, expected):
