@@ -3,11 +3,13 @@
 Every file feederkit reads (outline files, plan files) and writes (plan files, outline files,
 reports, plots) goes through here: bad paths and bad JSON are bad input (``InputError``), and
 a written file is either the old one or the whole new one (a temporary file beside it, then
-a rename).
+a rename). A character device such as ``/dev/null`` is written as it is (nothing to rename:
+``-o /dev/null`` runs a command only for its checks).
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -154,13 +156,43 @@ def _cannot(path: object, what: str, exc: OSError) -> InputError:
     return InputError(f"{path}: cannot write the {what} ({_reason(exc)})")
 
 
+STANDARD_STREAMS = ("/dev/stdin", "/dev/stdout", "/dev/stderr")
+"""Paths that name the process's own streams (as do ``/dev/fd/N`` and ``/proc/self/fd/N``):
+not a file to write, for a command prints its own lines on its standard output."""
+
+
+def _is_stream(path: Path) -> bool:
+    """Whether ``path`` names one of the process's own streams (:data:`STANDARD_STREAMS`)."""
+    text = os.path.abspath(path)
+    return text in STANDARD_STREAMS or text.startswith(("/dev/fd/", "/proc/self/fd/"))
+
+
+def is_device(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is a character device such as ``/dev/null`` (through links), which
+    a write goes to as it is: no temporary file, no rename, no file name to check."""
+    given = Path(path)
+    if _is_stream(given):
+        return False
+    try:
+        return stat.S_ISCHR(os.stat(given).st_mode)
+    except OSError:
+        return False
+
+
 def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
     """Where a file written to ``path`` lands: through symbolic links to the file they name
     (a plan written to ``current.plan.json``, a link to a versioned file, updates that file,
-    as a plain ``open`` would; renaming over the link would replace the link instead), and
-    bad input when that is a folder, or exists and is not a regular file (a pipe, socket or
+    as a plain ``open`` would; renaming over the link would replace the link instead), or a
+    character device such as ``/dev/null`` (written as it is, :func:`is_device`). Bad input
+    when that is a folder, a standard stream (``/dev/stdout``: the command prints there too),
+    or exists and is neither a regular file nor a character device (a pipe, socket or block
     device, which a rename would replace)."""
     given = Path(path)
+    if _is_stream(given):
+        raise InputError(
+            f"{given}: cannot write the {what} to a standard stream (the command prints there "
+            "too): give a file, or /dev/null to run the command only for its checks"
+        )
     target = Path(os.path.realpath(given)) if given.is_symlink() else given
     try:
         st = os.stat(target)
@@ -168,10 +200,10 @@ def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
         return target  # not there yet (or not reachable: staging says why)
     if stat.S_ISDIR(st.st_mode):
         raise InputError(f"{given}: cannot write the {what} (a folder is there)")
-    if not stat.S_ISREG(st.st_mode):
+    if not (stat.S_ISREG(st.st_mode) or stat.S_ISCHR(st.st_mode)):
         raise InputError(
-            f"{given}: cannot write the {what} (not a regular file: a pipe, socket or device "
-            "is there)"
+            f"{given}: cannot write the {what} (not a regular file: a pipe, socket or block "
+            "device is there)"
         )
     return target
 
@@ -190,18 +222,40 @@ def check_writable(path: str | os.PathLike[str], what: str = "file") -> None:
     """Refuse now a ``path`` that writing it later would refuse, with the same message: a
     folder, pipe, socket or device there (:func:`destination`), or a folder that takes no
     new file. A command checks its outputs before long work with this; the temporary file
-    it makes to find out is removed at once."""
-    fd, tmp = _temporary(path, destination(path, what), what)
+    it makes to find out is removed at once. A character device (``/dev/null``) must only
+    take writing."""
+    target = destination(path, what)
+    if is_device(target):
+        if not os.access(target, os.W_OK):
+            raise _cannot(path, what, PermissionError(errno.EACCES, os.strerror(errno.EACCES)))
+        return
+    fd, tmp = _temporary(path, target, what)
     os.close(fd)
     os.unlink(tmp)
 
 
-def _stage(f: OutputFile, mode: int) -> tuple[Path, str]:
+def _bytes(f: OutputFile) -> bytes:
+    return f.data.encode("utf-8") if isinstance(f.data, str) else f.data
+
+
+def _write_device(f: OutputFile, target: Path) -> None:
+    """Write ``f`` straight to the character device ``target`` (``/dev/null``): there is no
+    file to rename onto; an error (``/dev/full``: no space) is bad input naming it."""
+    try:
+        with open(target, "wb") as fh:
+            fh.write(_bytes(f))
+    except OSError as exc:
+        raise _cannot(f.path, f.what, exc) from None
+
+
+def _stage(f: OutputFile, mode: int) -> tuple[Path, str | None]:
     """Write ``f`` in full to a temporary file beside its :func:`destination`; return that
-    destination and the temporary's path."""
+    destination and the temporary's path (None for a character device, written on commit)."""
     target = destination(f.path, f.what)
+    if is_device(target):
+        return target, None
     fd, tmp = _temporary(f.path, target, f.what)
-    data = f.data.encode("utf-8") if isinstance(f.data, str) else f.data
+    data = _bytes(f)
     try:
         with os.fdopen(fd, "wb") as fh:
             os.fchmod(fh.fileno(), mode)
@@ -225,12 +279,13 @@ class StagedFiles:
     discards the temporaries. ``mode`` sets the permissions; by default those of a newly
     created file (0666 less the umask), as a plain ``open(path, "w")`` gives, so a
     controller's account can read a plan file. A file a commit replaces is kept (a hard
-    link beside it) until the block ends, so :meth:`undo` can put it back.
+    link beside it) until the block ends, so :meth:`undo` can put it back. A character
+    device (``/dev/null``) is written on commit, as it is; nothing undoes that.
     """
 
     def __init__(self, files: Iterable[OutputFile], mode: int | None = None) -> None:
         mode = 0o666 & ~_umask() if mode is None else mode
-        self._staged: list[tuple[OutputFile, Path, str]] = []
+        self._staged: list[tuple[OutputFile, Path, str | None]] = []
         self._kept: dict[Path, str] = {}
         self._done: list[Path] = []
         self.committed = False
@@ -247,18 +302,31 @@ class StagedFiles:
         return [Path(f.path) for f, _, _ in self._staged]
 
     def commit(self) -> None:
-        """Rename every temporary onto its destination (a link's file), in order."""
+        """Rename every temporary onto its destination (a link's file), in order; a character
+        device is written instead. A failure puts back the files already replaced."""
         for f, target, tmp in self._staged:
-            self._keep(target, tmp)
             try:
-                os.replace(tmp, target)
-            except OSError as exc:
+                self._put(f, target, tmp)
+            except InputError:
                 self.committed = True
                 self.undo()  # the files already replaced come back: all or none
                 self.discard()
-                raise _cannot(f.path, f.what, exc) from None
-            self._done.append(target)
+                raise
+            if tmp is not None:
+                self._done.append(target)
         self.committed = True
+
+    def _put(self, f: OutputFile, target: Path, tmp: str | None) -> None:
+        """One file in place: its temporary renamed onto ``target`` (the old file kept), or
+        its content written to a character device (``tmp`` None)."""
+        if tmp is None:
+            _write_device(f, target)
+            return
+        self._keep(target, tmp)
+        try:
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _cannot(f.path, f.what, exc) from None
 
     def _keep(self, target: Path, tmp: str) -> None:
         """A hard link to the file at ``target``, if any, beside its temporary (best effort:
@@ -274,7 +342,7 @@ class StagedFiles:
     def discard(self) -> None:
         """Remove the temporaries not yet renamed, and the kept old files."""
         for _, _, tmp in self._staged:
-            if os.path.exists(tmp):
+            if tmp is not None and os.path.exists(tmp):
                 os.unlink(tmp)
         for kept in self._kept.values():
             if os.path.exists(kept):

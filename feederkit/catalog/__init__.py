@@ -6,6 +6,8 @@ is one transaction. See docs/catalog.md.
 
 from feederkit.catalog.bulk import BadFilesError, DirectoryImport, import_directory, source_files
 from feederkit.catalog.changeovers import (
+    UNREADABLE,
+    declared_uncertainties,
     get_changeover,
     list_changeovers,
     remove_changeover,
@@ -59,6 +61,7 @@ __all__ = [
     "DEFAULT_CATALOG",
     "DEFAULT_WAIT",
     "SCHEMA_VERSION",
+    "UNREADABLE",
     "AddOutcome",
     "BadFilesError",
     "CatalogLike",
@@ -73,6 +76,7 @@ __all__ = [
     "check_name",
     "connect",
     "could_be_part_name",
+    "declared_uncertainties",
     "default_catalog_path",
     "did_you_mean",
     "export_part",

@@ -159,6 +159,50 @@ def list_changeovers(catalog: CatalogLike) -> list[ChangeoverInfo]:
         return [_info(conn, row) for row in rows]
 
 
+UNREADABLE = object()
+"""The value :func:`declared_uncertainties` gives a changeover whose stored plan is not JSON."""
+
+
+def declared_uncertainties(catalog: CatalogLike) -> dict[str, object]:
+    """Each changeover's declared uncertainty: its plan file's ``"uncertainty"`` value
+    (design.md), None when the plan declares none (a version-1 plan, the ideal model), or
+    :data:`UNREADABLE` when the stored plan is not JSON. SQLite reads the one value, so a
+    listing does not load every plan (a plan may hold megabytes)."""
+    with _conn(catalog) as conn:
+        try:
+            rows = conn.execute(
+                "SELECT name, json_valid(plan_json), CASE WHEN json_valid(plan_json) THEN "
+                "json_extract(plan_json, '$.uncertainty') END FROM changeovers"
+            ).fetchall()
+        except sqlite3.OperationalError:  # an SQLite without JSON functions: Python reads
+            rows = [(n, *_uncertainty_of(t)) for n, t in conn.execute(_ALL_PLANS).fetchall()]
+    out: dict[str, object] = {}
+    for name, valid, raw in rows:
+        if not valid:
+            out[name] = UNREADABLE
+            continue
+        try:
+            out[name] = None if raw is None else parse_json(str(raw), "uncertainty")
+        except InputError:
+            out[name] = UNREADABLE
+    return out
+
+
+_ALL_PLANS = "SELECT name, plan_json FROM changeovers"
+
+
+def _uncertainty_of(plan_json: object) -> tuple[int, str | None]:
+    """``(valid, the "uncertainty" value as JSON text)`` of a stored plan, read in Python."""
+    try:
+        plan = json.loads(plan_json) if isinstance(plan_json, str) else None
+    except ValueError:
+        plan = None
+    if not isinstance(plan, dict):
+        return 0, None
+    value = plan.get("uncertainty")
+    return 1, None if value is None else json.dumps(value)
+
+
 def remove_changeover(catalog: CatalogLike, name: str) -> None:
     """Delete a changeover (its parts stay); InputError when there is none."""
     with _conn(catalog) as conn, transaction(conn):

@@ -18,14 +18,22 @@ import math
 import re
 import time
 from collections.abc import Sequence
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from rich.box import SIMPLE_HEAD
 from rich.markup import escape
 from rich.table import Table
 
-from feederkit.catalog import list_changeovers, remove_changeover, resolve_catalog_path
+from feederkit.catalog import (
+    UNREADABLE,
+    declared_uncertainties,
+    list_changeovers,
+    remove_changeover,
+    resolve_catalog_path,
+)
 from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
@@ -56,6 +64,7 @@ from feederkit.cli.common import (
     cell_settings,
     check_output_folders,
     check_outputs,
+    check_report_name,
     console,
     cycle_line,
     flag_words,
@@ -86,6 +95,7 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import as_plan, plan_file_text
+from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 
 changeover_app = typer.Typer(
@@ -492,33 +502,114 @@ def _shares(plan: dict[str, Any]) -> dict[str, float]:
     return out
 
 
+def listed_uncertainty(stored: object) -> tuple[Uncertainty | None, bool | None]:
+    """A listed changeover's declared uncertainty and whether its plan declares one: a
+    plan without one is the ideal model (a version-1 file); ``(None, None)`` when the stored
+    value cannot be read (:data:`~feederkit.catalog.UNREADABLE`, or not three bounds)."""
+    if stored is None:
+        return IDEAL, False
+    if stored is UNREADABLE:
+        return None, None
+    try:
+        return Uncertainty.from_dict(stored), True
+    except (InputError, TypeError, ValueError):
+        return None, None
+
+
+def uncertainty_cell(unc: Uncertainty | None, declared: bool | None) -> str:
+    """The declared uncertainty in a few words, for a table: two changeovers of one mix at
+    different tolerances must not look alike in ``list``."""
+    if unc is None:
+        return "unreadable"
+    if not declared:
+        return "ideal model (none declared)"
+    if unc.is_ideal:
+        return "ideal model (0)"
+    return (
+        f"±{unc.rotation_error_deg:g}°, shape {unc.shape_tolerance_mm:g} mm, "
+        f"COM {unc.com_tolerance_mm:g} mm"
+    )
+
+
+def sensor_cell(sensor: dict[str, Any]) -> str:
+    """The sensor in a few words, for a table (``show`` gives it in full)."""
+    try:
+        model = sensor_from_dict(sensor)
+    except InputError:
+        return "unreadable"
+    if isinstance(model, LedSensor):
+        return f"LED array {model.pitch:g} mm, noise {model.noise:g} mm"
+    if isinstance(model, ToleranceSensor):
+        return f"tolerance ±{model.tolerance:g} mm"
+    return "sensorless"
+
+
 @changeover_app.command("list")
 def list_command(json_out: JsonOpt = False, catalog: CatalogOpt = None) -> None:
-    """The stored changeovers: name, parts with revisions, sensor, when and by whom."""
+    """The stored changeovers: name, parts with revisions, sensor, declared uncertainty, when
+    and by whom."""
     path = resolve_catalog_path(catalog)
     infos = list_changeovers(path)
+    stored = declared_uncertainties(path) if infos else {}
+    declared = {i.name: listed_uncertainty(stored.get(i.name, UNREADABLE)) for i in infos}
     stale = {i.name: stale_revisions(path, i.parts) for i in infos}
     print_warnings(f"changeover {i.name}: {w}" for i in infos for w in stale[i.name])
     if json_out:
-        print_json([{**_info_dict(i), "warnings": stale[i.name]} for i in infos])
+        print_json([_listed_dict(i, declared[i.name], stale[i.name]) for i in infos])
         return
     if not infos:
         console.print("no changeovers in the catalog")
         return
-    t = Table(title="changeovers")
+    mixes = {i.name: [f"{n}@{r}" for n, r in i.parts] for i in infos}
+    widest = max(len(m) for parts in mixes.values() for m in parts)
+    # Narrow rules (as demo's tables): words wrap whole at 80 columns.
+    t = Table(title="changeovers", box=SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
     add_name_column(t, "name")
-    add_name_column(t, "parts")
-    for col in ("sensor", "created", "by"):
+    # One NAME@REV a line, kept whole: the words of the other columns wrap first.
+    t.add_column("parts", no_wrap=True, overflow="fold", min_width=min(widest, LIST_PARTS_WIDTH))
+    for col in ("sensor", "uncertainty", "created", "by"):
         t.add_column(col, overflow="fold")
     for i in infos:
         t.add_row(
             escape(i.name) + (" (newer revisions)" if stale[i.name] else ""),
-            escape(", ".join(f"{n}@{r}" for n, r in i.parts)),
-            sensor_text(dict(i.sensor)),
-            i.created_at,
+            escape("\n".join(mixes[i.name])),  # one part a line: names whole
+            escape(sensor_cell(dict(i.sensor))),
+            escape(uncertainty_cell(*declared[i.name])),
+            _when(i.created_at),
             escape(i.created_by),
         )
     console.print(t)
+
+
+LIST_PARTS_WIDTH = 40
+"""``list`` keeps a ``NAME@REV`` up to this long on one line (a longer one folds)."""
+
+
+def _when(created_at: str) -> str:
+    """A stored time (ISO 8601) in UTC to the minute, for a table (``--json`` keeps it
+    whole)."""
+    try:
+        when = datetime.fromisoformat(created_at)
+    except ValueError:
+        return escape(created_at)
+    if when.utcoffset() is not None:
+        when = when.astimezone(UTC)
+    return when.strftime("%Y-%m-%d %H:%M")
+
+
+def _listed_dict(
+    info, declared: tuple[Uncertainty | None, bool | None], warnings: list[str]
+) -> dict[str, Any]:
+    """One changeover of ``list --json``: its record, its declared uncertainty (the plan
+    file's names; the ideal model's when it declares none, null when unreadable) and
+    whether the plan declares one, and its warnings."""
+    unc, is_declared = declared
+    return {
+        **_info_dict(info),
+        "uncertainty": None if unc is None else unc.to_dict(),
+        "uncertainty_declared": is_declared,
+        "warnings": warnings,
+    }
 
 
 @changeover_app.command("show")
@@ -632,10 +723,9 @@ def report_command(
 ) -> None:
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
     from feederkit.design.limit import check_limits
-    from feederkit.reports import check_report_path
 
     design_limit, _ = check_limits(time_limit, None)  # InputError before any work
-    check_report_path(output)  # a .txt or .pdf would hold HTML: refused before any work
+    check_report_name(output)  # a .txt or .pdf would hold HTML: refused before any work
     check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)

@@ -32,7 +32,7 @@ from rich.table import Column, Table
 from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
-from feederkit.jsonio import OutputFile, check_writable
+from feederkit.jsonio import OutputFile, check_writable, is_device
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
@@ -446,13 +446,14 @@ def check_outputs(*outputs: tuple[Path | None, str]) -> None:
     folder that takes no new file (read-only, no permission). The message is the one the
     write itself would give (:func:`feederkit.jsonio.check_writable`), exit 2: a result that
     took a minute must not be lost to a typo in a file name. Two outputs that are one file
-    (the same path, or a link to it) are refused too: the second would overwrite the first."""
+    (the same path, or a link to it) are refused too: the second would overwrite the first;
+    not a character device such as /dev/null, which takes both."""
     seen: dict[Path, str] = {}
     for path, what in outputs:
         if path is None:
             continue
         same = path.resolve()
-        if same in seen:
+        if same in seen and not is_device(path):
             raise InputError(
                 f"{path}: the {what} and the {seen[same]} would be the same file: give each "
                 "its own path"
@@ -470,10 +471,18 @@ def check_output_folders(output: Path | None, report: Path | None) -> None:
     and a ``--report`` not named .html, before any work is done (nor may a page of HTML be
     written as ``report.txt``)."""
     if report is not None:
-        from feederkit.reports import check_report_path  # the report library, only when asked
-
-        check_report_path(report)
+        check_report_name(report)
     check_outputs((output, "plan file"), (report, "report"))
+
+
+def check_report_name(path: Path) -> None:
+    """Refuse a report path not named .html (:func:`feederkit.reports.check_report_path`),
+    unless it is a character device such as /dev/null, which keeps no name."""
+    if is_device(path):
+        return
+    from feederkit.reports import check_report_path  # the report library, only when asked
+
+    check_report_path(path)
 
 
 def note_written(*files: tuple[Path | None, str]) -> None:

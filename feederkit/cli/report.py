@@ -14,13 +14,19 @@ from typing import Annotated, Any
 
 import typer
 
-from feederkit.cli.common import check_outputs, console, plural, progress_bar
+from feederkit.cli.common import (
+    check_outputs,
+    check_report_name,
+    console,
+    plural,
+    progress_bar,
+)
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
-from feederkit.jsonio import read_json
+from feederkit.jsonio import read_json, write_text_atomic
 from feederkit.plans.model import Plan
 from feederkit.plans.verify import verify_declared
-from feederkit.reports import check_report_path, render_report, write_report
+from feederkit.reports import render_report
 
 
 def _simulate(plan: Plan, trials: int, seed: int) -> dict[str, Any]:
@@ -84,7 +90,7 @@ def report_command(
 
     A plan that fails verification is still drawn, under a red banner; exit 1 then.
     """
-    check_report_path(output)
+    check_report_name(output)  # .html, or a device such as /dev/null
     check_outputs((output, "report"))
     data = load_plan(plan, max_plan_mb)
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -103,7 +109,7 @@ def report_command(
         cycle_time=None if seconds_per_op is not None else _cycle_time(plan),
         verification=verdict,
     )
-    write_report(output, html)
+    write_text_atomic(output, html, what="report")  # its name checked above
     if simulation is not None:
         console.print(
             f"simulated {plural(simulation['successes'], 'success', 'successes')} in "
