@@ -18,6 +18,7 @@ from sqlite3 import Connection
 from typing import Annotated, Any
 
 import typer
+from rich.box import SIMPLE_HEAD
 from rich.markup import escape
 from rich.progress import TextColumn
 from rich.table import Table
@@ -255,12 +256,21 @@ def _relative(path: str, root: Path) -> str:
         return path
 
 
+IMPORT_HEADERS = ("part", "rev", "status", "orientable (ideal)", "warnings", "file")
+"""The import summary's columns."""
+
+WHOLE_COLUMNS = (0, 2, 5)
+"""The summary's columns never broken: part, status and file (the headers of the others
+wrap at their words)."""
+
+
 def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Path) -> None:
-    """The import summary: a rich table, or plain columns when it is long (rich is slow there).
+    """The import summary: a rich table, or plain columns when it is long (rich is slow there)
+    or when the terminal is too narrow for its names whole (a part or file name cut in two
+    reads as another name).
 
     Sources are shown relative to the imported folder ``root``.
     """
-    headers = ("part", "rev", "status", "orientable (ideal)", "warnings", "file")
     rows = [
         (
             o.name,
@@ -272,16 +282,35 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Pa
         )
         for o in outcomes
     ]
-    if len(rows) > RICH_TABLE_ROWS:
-        sys.stdout.write(plain_table(headers, rows, right=(1, 4)))
+    if len(rows) > RICH_TABLE_ROWS or _table_width(rows) > console.width:
+        sys.stdout.write(plain_table(IMPORT_HEADERS, rows, right=(1, 4)))
         return
-    table = Table(title="catalog import")
-    for col in headers:
-        table.add_column(col, overflow="fold")
+    table = Table(
+        title="catalog import",
+        box=SIMPLE_HEAD,
+        show_edge=False,
+        pad_edge=False,
+        collapse_padding=True,
+    )
+    for k, col in enumerate(IMPORT_HEADERS):
+        if k in WHOLE_COLUMNS:
+            table.add_column(col, no_wrap=True, min_width=max(len(r[k]) for r in rows))
+        else:
+            table.add_column(col, justify="right" if k in (1, 4) else "left")
     for row in rows:
         cells = [escape(c) for c in row]
         table.add_row(*cells[:3], cells[3] if row[3] == "yes" else "[red]no[/]", *cells[4:])
     console.print(table)
+
+
+def _table_width(rows: list[tuple[str, ...]]) -> int:
+    """The narrowest the summary table can be with every cell whole and each header broken
+    only between words: its columns and the two spaces between them."""
+    widths = [
+        max([len(r[k]) for r in rows] + [len(w) for w in header.split()])
+        for k, header in enumerate(IMPORT_HEADERS)
+    ]
+    return sum(widths) + 2 * (len(widths) - 1)
 
 
 def cmd_init(
