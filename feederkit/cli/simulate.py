@@ -11,7 +11,9 @@ Without MuJoCo it exits 2 with one line saying to install ``feederkit[sim]``.
 ``--part SOURCE`` (``NAME=SOURCE`` for a part of a mix, repeatable) simulates that member on
 the part a SOURCE holds, its outline's exact hull and its own COM, instead of the plan's
 hull, and judges its trials by where the part rests (docs/simulation.md, "A part's own
-outline"); a SOURCE that is not the plan's part is bad input (exit 2).
+outline"); a SOURCE that is not the plan's part is bad input (exit 2). The match check allows
+the hull tolerance stored with the catalog revision the plan was made from, when the catalog
+in use holds it (``--hull-tolerance`` overrides it).
 """
 
 from __future__ import annotations
@@ -221,7 +223,8 @@ def simulate_command(
             "--hull-tolerance",
             metavar="MM",
             help="With --part: the hull tolerance the plan's part was imported with, which the "
-            "match check allows (default a CAD import's for the part's size).",
+            "match check allows (default: the one stored with the catalog revision the plan "
+            "was made from, else a CAD import's for the part's size).",
             show_default=False,
         ),
     ] = None,

@@ -12,9 +12,13 @@ A SOURCE must be the plan's part: its exact hull within the plan's shape toleran
 hull tolerance of the plan's import, plus :data:`MATCH_SLACK_MM`, of the plan's hull (their
 Hausdorff distance: for convex regions the largest difference of their radius functions, what
 the fence feels), and its COM within the COM tolerance plus the slack; anything else is bad
-input naming the distance (docs/simulation.md, "A part's own outline"). A hull beyond the
-declared shape tolerance plus the slack, though within the allowance, is simulated with a
-warning: the plan is guaranteed only within its declared tolerance.
+input naming the distance (docs/simulation.md, "A part's own outline"). The hull tolerance is
+``--hull-tolerance`` when given, else the one stored with the catalog revision the plan's
+member was made from (:func:`plan_drawing`: the plan's revision, or a catalog SOURCE's, whose
+stored hull is the plan's), else a CAD import's default. A hull beyond the declared shape
+tolerance plus the slack, though within the allowance, is simulated with a warning that says
+how much of the distance is the import's simplification of the hull: the plan is guaranteed
+only within its declared tolerance.
 """
 
 from __future__ import annotations
@@ -27,6 +31,8 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from feederkit.catalog import could_be_part_name, default_catalog_path, get_revision
+from feederkit.catalog import part_from_revision as revision_part
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.importers.model import CAD_SUFFIXES, DEFAULT_FLATTEN_TOLERANCE
@@ -64,6 +70,36 @@ for tens of part sizes). Measured in docs/simulation.md."""
 
 
 @dataclass(frozen=True)
+class PlanDrawing:
+    """The catalog revision a plan member was made from (:func:`plan_drawing`): ``where``
+    names it (``NAME@REV in DB``), ``hull_tolerance_mm`` is the hull tolerance stored with it
+    (0: an exact hull), and ``part`` its drawing: the exact hull of its outline and its COM,
+    as the member lies (its landing)."""
+
+    where: str
+    hull_tolerance_mm: float
+    part: Part
+
+
+@dataclass(frozen=True)
+class HullAllowance:
+    """The hull tolerance the match check allows for the plan's import, and whence:
+    ``--hull-tolerance``, a catalog revision (``drawing``), or a CAD import's default."""
+
+    mm: float
+    drawing: PlanDrawing | None = None
+    given: bool = False
+
+    def words(self) -> str:
+        """Whence the hull tolerance, in a few words."""
+        if self.given:
+            return "given with --hull-tolerance"
+        if self.drawing is not None:
+            return f"stored with {self.drawing.where}"
+        return "a CAD import's default for the part's size"
+
+
+@dataclass(frozen=True)
 class RealPart:
     """A plan member simulated on the part a SOURCE holds.
 
@@ -74,7 +110,10 @@ class RealPart:
     the most the match check allows; likewise the COM. ``shape_tolerance_mm`` is the plan's
     declared shape tolerance and ``slack_mm`` the match check's slack: a distance beyond
     both is accepted but warned of (:meth:`tolerance_warning`), naming ``certified_mm``, the
-    shape tolerance the plan's certificate holds (None: no certificate).
+    shape tolerance the plan's certificate holds (None: no certificate). ``hull`` is the
+    hull tolerance allowed for the plan's import; with its catalog revision known,
+    ``simplified_mm`` is how far the plan's hull lies from that revision's drawing (the
+    import's simplification) and ``drawing_distance_mm`` how far the part's hull does.
     """
 
     member: int
@@ -89,6 +128,9 @@ class RealPart:
     shape_tolerance_mm: float = 0.0
     slack_mm: float = 0.0
     certified_mm: float | None = None
+    hull: HullAllowance = HullAllowance(0.0)
+    simplified_mm: float | None = None
+    drawing_distance_mm: float | None = None
 
     @property
     def beyond_tolerance(self) -> bool:
@@ -111,7 +153,24 @@ class RealPart:
             f"plan's hull, beyond the plan's declared shape tolerance of "
             f"{self.shape_tolerance_mm:g} mm: the plan is guaranteed only within its declared "
             f"tolerance{held}; simulated anyway, as up to {self.allowed_mm:.4g} mm is accepted "
-            "for a plan whose hull may simplify a drawing"
+            f"for a plan whose hull may simplify a drawing: {self.simplification_words()}"
+        )
+
+    def simplification_words(self) -> str:
+        """How much of the allowed distance is the hull simplification of the plan's import:
+        measured against its catalog revision's drawing when known, else the most it may be."""
+        h = self.hull
+        if self.simplified_mm is None or h.drawing is None:
+            return (
+                f"{h.mm:g} mm of it is the hull tolerance of the plan's import ({h.words()}), "
+                f"not a tolerance the plan declares, so the part may lie up to "
+                f"{self.allowed_mm - self.slack_mm:.4g} mm from its drawing unnoticed"
+            )
+        whence = "given with --hull-tolerance" if h.given else "stored with it"
+        return (
+            f"the plan's hull simplifies the drawing of {h.drawing.where} by "
+            f"{self.simplified_mm:.4g} mm (hull tolerance {h.mm:g} mm, {whence}), and "
+            f"{self.source}'s hull lies {self.drawing_distance_mm:.4g} mm from that drawing"
         )
 
     def words(self) -> str:
@@ -136,8 +195,16 @@ class RealPart:
             "com_distance_mm": round(self.com_distance_mm, 6),
             "allowed_com_mm": round(self.allowed_com_mm, 6),
             "shape_tolerance_mm": round(self.shape_tolerance_mm, 6),
+            "hull_tolerance_mm": round(self.hull.mm, 6),
+            "hull_tolerance_from": self.hull.words(),
+            "simplified_mm": _rounded(self.simplified_mm),
+            "drawing_distance_mm": _rounded(self.drawing_distance_mm),
             "warning": self.tolerance_warning(),
         }
+
+
+def _rounded(value: float | None) -> float | None:
+    return None if value is None else round(value, 6)
 
 
 def hull_distance(a: Sequence[Point], b: Sequence[Point]) -> float:
@@ -193,33 +260,96 @@ def plan_hull_tolerance(size_mm: float, hull_tolerance: float | None = None) -> 
     return 0.0 if tol is None else float(tol)
 
 
+def hull_allowance(
+    size_mm: float, hull_tolerance: float | None = None, drawing: PlanDrawing | None = None
+) -> HullAllowance:
+    """The hull tolerance the match check allows: ``--hull-tolerance`` when given, else the
+    one stored with the plan member's catalog revision (``drawing``), else a CAD import's
+    default (:func:`plan_hull_tolerance`)."""
+    if hull_tolerance is not None:
+        return HullAllowance(plan_hull_tolerance(size_mm, hull_tolerance), drawing, given=True)
+    if drawing is not None:
+        return HullAllowance(drawing.hull_tolerance_mm, drawing)
+    return HullAllowance(plan_hull_tolerance(size_mm))
+
+
+def plan_drawing(
+    plan: Plan, member: int, catalog: str | None, source: str | None = None
+) -> PlanDrawing | None:
+    """The catalog revision the plan's member ``member`` was made from, if the catalog in use
+    (``catalog``, else ``$FEEDERKIT_CATALOG`` or ``./feederkit.db``) holds it: the revision
+    the plan names, or the one a catalog SOURCE names, whose stored hull (in the member's
+    landing) is the plan's. None when there is no such revision (a plan from a file, another
+    catalog, a revision since re-imported): then nothing is known of the plan's import."""
+    pp = plan.parts[member]
+    db = Path(catalog) if catalog is not None else default_catalog_path()
+    if not db.is_file():
+        return None
+    wanted: list[tuple[str, object]] = [(pp.name, pp.revision)]
+    if source is not None and not Path(source).exists() and could_be_part_name(source):
+        name, at, rev = source.rpartition("@")
+        wanted.append((name, rev) if at else (source, None))
+    for name, rev in wanted:
+        found = _stored_drawing(db, pp, name, rev)
+        if found is not None:
+            return found
+    return None
+
+
+def _stored_drawing(db: Path, pp: PlanPart, name: str, rev: object) -> PlanDrawing | None:
+    """The revision ``name@rev`` (latest when ``rev`` is None) of catalog ``db`` as
+    :func:`plan_drawing` takes it: when its stored hull, in ``pp``'s landing, is ``pp``'s."""
+    try:
+        revision = get_revision(db, name, None if rev is None else int(str(rev)))
+    except (InputError, ValueError):
+        return None
+    part = _landing_part(revision, pp.landing)
+    if part is None or hull_distance(pp.hull, part.hull) > MATCH_REL_SLACK * pp.size:
+        return None  # another import of the part: its hull tolerance is not the plan's
+    return PlanDrawing(
+        f"{revision.name}@{revision.revision} in {db}",
+        float(revision.hull_tolerance or 0.0),
+        exact_part(part, pp.name),
+    )
+
+
+def _landing_part(revision, landing: str | None) -> Part | None:
+    """A stored revision's part as it lies in ``landing`` (None: as imported; ``up`` of a
+    revision stored without landings: as drawn)."""
+    if landing is None:
+        return revision_part(revision)
+    found = next((x.part for x in revision.landings if x.name == landing), None)
+    return revision_part(revision) if found is None and landing == UP else found
+
+
 def check_match(
     plan: Plan,
     member: int,
     part: Part,
     source: str,
     hull_tolerance: float | None = None,
+    drawing: PlanDrawing | None = None,
 ) -> RealPart:
     """The plan member ``member`` simulated on ``part`` (its exact hull is taken here), after
     the match check: InputError, one line naming the distance, when the part's hull differs
     from the plan's by more than the plan's shape tolerance plus the hull tolerance of its
-    import (:func:`plan_hull_tolerance`) plus the slack, or its COM by more than the COM
-    tolerance plus the slack. A hull within that allowance but beyond the shape tolerance plus
-    the slack is accepted with a warning (:meth:`RealPart.tolerance_warning`)."""
+    import (:func:`hull_allowance`; ``drawing``: the catalog revision the member was made
+    from, :func:`plan_drawing`) plus the slack, or its COM by more than the COM tolerance
+    plus the slack. A hull within that allowance but beyond the shape tolerance plus the
+    slack is accepted with a warning (:meth:`RealPart.tolerance_warning`)."""
     pp = plan.parts[member]
     exact = exact_part(part, pp.name)
     unc = plan.uncertainty
     slack = MATCH_SLACK_MM + MATCH_REL_SLACK * pp.size
-    h = plan_hull_tolerance(pp.size, hull_tolerance)
-    allowed = unc.shape_tolerance_mm + h + slack
+    h = hull_allowance(pp.size, hull_tolerance, drawing)
+    allowed = unc.shape_tolerance_mm + h.mm + slack
     d = hull_distance(pp.hull, exact.hull)
     if not d <= allowed:
         raise InputError(
             f"{source}: not the part the plan was made for: its outline's hull lies {d:.4g} mm "
             f"from the plan's hull of {pp.label} (allowed {allowed:.4g} mm: shape tolerance "
-            f"{unc.shape_tolerance_mm:g} + hull tolerance {h:g} + slack {slack:.3g}; same "
-            "part frame): if the plan's part was imported with a coarser hull tolerance, give "
-            "it with --hull-tolerance MM (catalog show names a revision's)"
+            f"{unc.shape_tolerance_mm:g} + hull tolerance {h.mm:g} ({h.words()}) + slack "
+            f"{slack:.3g}; same part frame){_refusal_hint(h, exact)}"
         )
     allowed_com = unc.com_tolerance_mm + slack
     dc = math.dist(pp.com, exact.com)
@@ -229,6 +359,7 @@ def check_match(
             f"plan's COM of {pp.label} (allowed {allowed_com:.4g} mm: COM tolerance "
             f"{unc.com_tolerance_mm:g} + slack {slack:.3g})"
         )
+    known = h.drawing
     return RealPart(
         member=member,
         label=pp.label,
@@ -242,6 +373,25 @@ def check_match(
         shape_tolerance_mm=unc.shape_tolerance_mm,
         slack_mm=slack,
         certified_mm=_certified_shape_tolerance(plan),
+        hull=h,
+        simplified_mm=None if known is None else hull_distance(pp.hull, known.part.hull),
+        drawing_distance_mm=None if known is None else hull_distance(known.part.hull, exact.hull),
+    )
+
+
+def _refusal_hint(h: HullAllowance, exact: Part) -> str:
+    """What a refused SOURCE may still need: the hull tolerance the plan's part was imported
+    with, when it is not known (no catalog revision, no --hull-tolerance); else how far the
+    part lies from the revision's drawing."""
+    if h.drawing is not None:
+        far = hull_distance(h.drawing.part.hull, exact.hull)
+        return f"; it lies {far:.4g} mm from the drawing of {h.drawing.where}"
+    if h.given:
+        return ""
+    return (
+        ": if the plan's part was imported with a coarser hull tolerance, give "
+        "--hull-tolerance MM with the value it was imported with (catalog show names a "
+        "revision's; --catalog DB, the plan's catalog, reads it)"
     )
 
 
@@ -312,7 +462,9 @@ def real_parts(
 ) -> tuple[RealPart, ...]:
     """The members ``--part`` values name (``SOURCE`` or ``NAME=SOURCE``, see
     :func:`split_spec`), each loaded (:func:`feederkit.sources.load_part`; a drawing's curves
-    flattened finely) and checked (:func:`check_match`), in the plan's order.
+    flattened finely) and checked (:func:`check_match`, against the catalog revision the
+    member was made from when ``catalog`` holds it: :func:`plan_drawing`), in the plan's
+    order.
 
     In a plan over landings a SOURCE stands for every landing of its part the plan holds, as
     ``landings`` loads them (default :func:`outline_landings`: up as drawn, down mirrored).
@@ -334,12 +486,14 @@ def real_parts(
             if landing in held:
                 k = plan.part_index(name, landing)
                 part = load_part(source, catalog=catalog, options=options)
-                out[k] = check_match(plan, k, part, source, hull_tolerance)
+                drawing = plan_drawing(plan, k, catalog, source)
+                out[k] = check_match(plan, k, part, source, hull_tolerance, drawing)
         if others:  # a plan over landings: down mirrored, a mesh's poses
             found = (landings or outline_landings)(source, others, catalog, options)
             for landing in others:
                 k = plan.part_index(name, landing)
-                out[k] = check_match(plan, k, found[landing], source, hull_tolerance)
+                drawing = plan_drawing(plan, k, catalog, source)
+                out[k] = check_match(plan, k, found[landing], source, hull_tolerance, drawing)
     return tuple(out[k] for k in sorted(out))
 
 
@@ -347,11 +501,15 @@ __all__ = [
     "FINE_FLATTEN_REL",
     "MATCH_SLACK_MM",
     "REAL_SETTLE_RULE",
+    "HullAllowance",
+    "PlanDrawing",
     "RealPart",
     "check_match",
     "exact_part",
+    "hull_allowance",
     "hull_distance",
     "outline_landings",
+    "plan_drawing",
     "plan_hull_tolerance",
     "real_parts",
     "resting_ranges",
