@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from scipy.spatial import cKDTree
 
 from feederkit.angles import ANGLE_EPS
 from feederkit.mechanics.push import PushFunction
@@ -241,9 +242,9 @@ def _grid_support(pts: np.ndarray) -> np.ndarray:
     return np.max(pts @ u.T, axis=0)
 
 
-OUTLINE_SPACING_REL = NEAR_SYMMETRIC_REL / 8.0
+OUTLINE_SPACING_REL = NEAR_SYMMETRIC_REL / 16.0
 """:func:`_outline_gaps` samples the outline's boundary this finely (share of the part's
-size), and bounds the true distance by the sampled one plus half the spacing."""
+size), and bounds the true distance by the samples' own plus half the spacing."""
 
 
 def _has_more_than_hull(pf: PushFunction) -> bool:
@@ -254,35 +255,38 @@ def _has_more_than_hull(pf: PushFunction) -> bool:
         return True
     edge = shapely.LinearRing(np.asarray(pf.part.hull, dtype=float))
     points = shapely.points(np.asarray(outline.vertices, dtype=float))
-    return bool(np.max(shapely.distance(points, edge)) > OUTLINE_SPACING_REL * pf.part.size)
+    return bool(np.max(shapely.distance(points, edge)) > 2.0 * OUTLINE_SPACING_REL * pf.part.size)
 
 
-def _placed_outline(pf: PushFunction, state: int) -> shapely.MultiLineString:
-    """The outline's boundary (outer ring and holes) placed as :func:`_placed` places the
-    hull, sampled every :data:`OUTLINE_SPACING_REL` of the part's size."""
+def _placed_samples(pf: PushFunction, state: int) -> np.ndarray:
+    """Points on the outline's boundary (outer ring and holes) placed as :func:`_placed`
+    places the hull, every :data:`OUTLINE_SPACING_REL` of the part's size or closer."""
     rot, shift = _pose_frame(pf, state)
     outline = pf.part.outline
     rings = [np.asarray(r, dtype=float) for r in (outline.vertices, *outline.holes)]
     lines = [np.vstack([r, r[:1]]) @ rot.T - shift for r in rings]
-    return shapely.segmentize(shapely.MultiLineString(lines), OUTLINE_SPACING_REL * pf.part.size)
+    dense = shapely.segmentize(shapely.MultiLineString(lines), OUTLINE_SPACING_REL * pf.part.size)
+    return shapely.get_coordinates(dense)
 
 
 def _outline_gaps(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
     """Per pair of stable states, an upper bound (mm) on the Hausdorff distance of the
-    outline's boundary in the two poses: the distance of its samples (the sampled points of
-    either to the other boundary) plus half the sampling spacing. Holes and notches a hull
+    outline's boundary in the two poses: the Hausdorff distance of the two sample sets
+    (:func:`_placed_samples`, nearest neighbours by k-d tree) plus half the sampling
+    spacing (every boundary point lies that close to a sample). Holes and notches a hull
     does not show set poses apart for the next station (a plate's off-centre hole 24 mm
     along the fence in its two flat poses)."""
-    placed: dict[int, shapely.MultiLineString] = {}
-    for i in {i for p in pairs for i in p}:
-        placed[i] = _placed_outline(pf, i)
+    used = {i for p in pairs for i in p}
+    samples = {i: _placed_samples(pf, i) for i in used}
+    trees = {i: cKDTree(samples[i]) for i in used}
     half = OUTLINE_SPACING_REL * pf.part.size / 2.0
-    return np.array(
-        [
-            0.0 if a == b else shapely.hausdorff_distance(placed[a], placed[b]) + half
-            for a, b in pairs
-        ]
-    )
+
+    def gap(a: int, b: int) -> float:
+        ab = trees[b].query(samples[a])[0].max()
+        ba = trees[a].query(samples[b])[0].max()
+        return float(max(ab, ba)) + half
+
+    return np.array([0.0 if a == b else gap(a, b) for a, b in pairs])
 
 
 def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
