@@ -258,35 +258,54 @@ def _has_more_than_hull(pf: PushFunction) -> bool:
     return bool(np.max(shapely.distance(points, edge)) > 2.0 * OUTLINE_SPACING_REL * pf.part.size)
 
 
-def _placed_samples(pf: PushFunction, state: int) -> np.ndarray:
+def _placed_samples(pf: PushFunction, state: int, spacing: float) -> np.ndarray:
     """Points on the outline's boundary (outer ring and holes) placed as :func:`_placed`
-    places the hull, every :data:`OUTLINE_SPACING_REL` of the part's size or closer."""
+    places the hull, every ``spacing`` mm or closer."""
     rot, shift = _pose_frame(pf, state)
     outline = pf.part.outline
     rings = [np.asarray(r, dtype=float) for r in (outline.vertices, *outline.holes)]
     lines = [np.vstack([r, r[:1]]) @ rot.T - shift for r in rings]
-    dense = shapely.segmentize(shapely.MultiLineString(lines), OUTLINE_SPACING_REL * pf.part.size)
-    return shapely.get_coordinates(dense)
+    return shapely.get_coordinates(shapely.segmentize(shapely.MultiLineString(lines), spacing))
 
 
-def _outline_gaps(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
+COARSE_SPACINGS = (8.0, 3.0)
+""":func:`_outline_gaps` deciding against a bound first samples the boundary this many
+times :data:`OUTLINE_SPACING_REL` apart (then at that spacing): most pairs are decided
+with a tenth of the points."""
+
+
+def _outline_gaps(
+    pf: PushFunction, pairs: Sequence[tuple[int, int]], tol: float | None = None
+) -> np.ndarray:
     """Per pair of stable states, an upper bound (mm) on the Hausdorff distance of the
-    outline's boundary in the two poses: the Hausdorff distance of the two sample sets
-    (:func:`_placed_samples`, nearest neighbours by k-d tree) plus half the sampling
-    spacing (every boundary point lies that close to a sample). Holes and notches a hull
-    does not show set poses apart for the next station (a plate's off-centre hole 24 mm
+    outline's boundary in the two poses: the Hausdorff distance ``H`` of the two sample sets
+    (:func:`_placed_samples`, nearest neighbours by k-d tree) plus half their spacing ``s``
+    (every boundary point lies that close to a sample; the true distance also lies above
+    ``H - s / 2``). With ``tol`` a pair is decided on coarser samples first
+    (:data:`COARSE_SPACINGS`) when their bounds lie both on one side of it: a bound at
+    most ``tol``, or one above it with the true distance above it too. Holes and notches a
+    hull does not show set poses apart for the next station (a plate's off-centre hole 24 mm
     along the fence in its two flat poses)."""
-    used = {i for p in pairs for i in p}
-    samples = {i: _placed_samples(pf, i) for i in used}
-    trees = {i: cKDTree(samples[i]) for i in used}
-    half = OUTLINE_SPACING_REL * pf.part.size / 2.0
-
-    def gap(a: int, b: int) -> float:
-        ab = trees[b].query(samples[a])[0].max()
-        ba = trees[a].query(samples[b])[0].max()
-        return float(max(ab, ba)) + half
-
-    return np.array([0.0 if a == b else gap(a, b) for a, b in pairs])
+    fine = OUTLINE_SPACING_REL * pf.part.size
+    levels = [fine] if tol is None else [k * fine for k in COARSE_SPACINGS] + [fine]
+    out = np.zeros(len(pairs))
+    todo = [k for k, (a, b) in enumerate(pairs) if a != b]
+    for level, spacing in enumerate(levels):
+        used = {i for k in todo for i in pairs[k]}
+        samples = {i: _placed_samples(pf, i, spacing) for i in used}
+        trees = {i: cKDTree(samples[i]) for i in used}
+        last = level == len(levels) - 1
+        undecided = []
+        for k in todo:
+            a, b = pairs[k]
+            h = max(trees[b].query(samples[a])[0].max(), trees[a].query(samples[b])[0].max())
+            out[k] = float(h) + spacing / 2.0
+            if not last and tol is not None and out[k] > tol >= float(h) - spacing / 2.0:
+                undecided.append(k)  # the bounds straddle tol: finer samples decide
+        todo = undecided
+        if not todo:
+            break
+    return out
 
 
 def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
@@ -387,7 +406,7 @@ def look_alike(
     if close and _has_more_than_hull(pf):
         # Holes and notches the hulls do not show: the outline's own distance decides.
         hull_close = sorted(close)
-        outline = _outline_gaps(pf, [(ideal[i], ideal[j]) for i, j in hull_close])
+        outline = _outline_gaps(pf, [(ideal[i], ideal[j]) for i, j in hull_close], tol)
         close = {p for p, d in zip(hull_close, outline, strict=True) if d <= tol}
 
     def near(x: int, y: int) -> bool:
