@@ -877,8 +877,8 @@ def near_beam(pitch: float, diameters: Sequence[float]) -> list[tuple[float, flo
     but farther than ``LED_EDGE_REL * pitch`` (those count both ways), with their distance,
     closest first.
 
-    >>> near_beam(0.5, [40.0, 21.96, 33.25])
-    [(21.96, 0.04...)]
+    >>> [(d, round(gap, 6)) for d, gap in near_beam(0.5, [40.0, 21.96, 33.25])]
+    [(21.96, 0.04)]
     """
     out = []
     for d in diameters:
