@@ -405,6 +405,19 @@ def test_only_the_first_members_get_a_part_plot(monkeypatch):
     assert "feederkit part plot" in "".join(doc.text)
 
 
+def test_a_skipped_part_plot_names_the_members_catalog_revision():
+    from dataclasses import replace
+
+    from feederkit.reports.parts_html import _no_plot
+
+    plan = twin_plan()
+    member = replace(plan.parts[0], revision=3, landing="pose-2")
+    assert "feederkit part plot " + member.name + "@3 -o " in _no_plot(member)
+    assert "--pose 2" in _no_plot(member)
+    assert "mirror image" in _no_plot(replace(member, landing="down"))
+    assert "SOURCE" in _no_plot(replace(member, revision=None))
+
+
 def test_symmetric_leaves_and_twins_are_reported():
     text = "".join(parse(render_report(rectangle_plan())).text)
     assert "Poses no plan tells apart" in text and "rect: states s0, s2" in text

@@ -91,7 +91,7 @@ def part_section(
             else ""
         )
         + f'<div class="part-grid"><div>{_states_table(index, entry, draw)}</div>'
-        f"{_plot_figure(entry, outline) if plot else _no_plot()}</div></section>"
+        f"{_plot_figure(entry, outline) if plot else _no_plot(entry)}</div></section>"
     )
 
 
@@ -105,10 +105,30 @@ def _plot_figure(entry: PlanPart, outline: Outline | None) -> str:
     )
 
 
-def _no_plot() -> str:
+def _no_plot(entry: PlanPart) -> str:
+    """The words in place of a member's part plot past :data:`PART_PLOTS`: the command that
+    draws it (its catalog revision when the plan names one)."""
+    if entry.revision is None:
+        how = (
+            "<code>feederkit part plot SOURCE -o PLOT.svg</code> (its outline or CAD file, or "
+            "its catalog name with <code>--catalog</code>; a landing of a mesh with "
+            "<code>--pose K</code>)"
+        )
+    else:
+        pose = ""
+        if entry.landing is not None and entry.landing.startswith("pose-"):
+            pose = f" --pose {entry.landing.removeprefix('pose-')}"
+        how = (
+            f"<code>feederkit part plot {esc(entry.name)}@{esc(str(entry.revision))} -o "
+            f"{esc(entry.name)}.svg{pose}</code> (with <code>--catalog</code> naming the "
+            "plan's catalog"
+            + (
+                "; it draws the part face up, this landing is its mirror image)"
+                if entry.landing == "down"
+                else ")"
+            )
+        )
     return (
         f'<p class="muted plot-skipped">The report draws the plots of its first {PART_PLOTS} '
-        "members only; draw this one with <code>feederkit part plot SOURCE -o PLOT.svg</code> "
-        "(its outline or CAD file, or its catalog name with <code>--catalog</code>; a landing "
-        "of a mesh with <code>--pose K</code>).</p>"
+        f"members only; draw this one with {how}.</p>"
     )
