@@ -408,9 +408,10 @@ def test_only_the_first_members_get_a_part_plot(monkeypatch):
 def test_a_skipped_part_plot_names_the_members_catalog_revision():
     from dataclasses import replace
 
+    from feederkit.plans.fileformat import plan_from_dict
     from feederkit.reports.parts_html import _no_plot
 
-    plan = twin_plan()
+    plan = plan_from_dict(twin_plan())
     member = replace(plan.parts[0], revision=3, landing="pose-2")
     assert "feederkit part plot " + member.name + "@3 -o " in _no_plot(member)
     assert "--pose 2" in _no_plot(member)
