@@ -131,6 +131,8 @@ def test_hull_tolerance_scales_with_a_small_part(tmp_path):
 
 @pytest.mark.parametrize("inverted", [True, False])
 def test_solid_with_a_cavity_is_one_part_with_its_com(tmp_path, inverted):
+    """An inner shell facing inward is a cavity; one facing outward is an inner body (an
+    insert), taken as the solid's own material with a warning, not subtracted."""
     mesh = fx.hollow_box(20.0, 6.0, (4.0, 0.0, 0.0))
     if not inverted:
         mesh = trimesh.util.concatenate([trimesh.creation.box((20.0,) * 3), _box_at(6.0, 4.0)])
@@ -138,8 +140,13 @@ def test_solid_with_a_cavity_is_one_part_with_its_com(tmp_path, inverted):
     m, _, _ = load_mesh(path, None)
     s = solid(m, False, str(path))
     want_x = -(6.0**3 * 4.0) / (20.0**3 - 6.0**3)  # the cavity's volume moved to the other side
-    assert s.com == pytest.approx((want_x, 0.0, 0.0), abs=1e-9)
-    assert any("1 internal void" in w for w in s.warnings)
+    if inverted:
+        assert s.com == pytest.approx((want_x, 0.0, 0.0), abs=1e-9)
+        assert any("1 internal void" in w for w in s.warnings)
+    else:
+        assert s.com == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+        assert any("an inner body" in w and "--com" in w for w in s.warnings)
+        assert not any("void" in w for w in s.warnings)
     (ip,) = parts(path)
     assert ip.source.pose.count == 6
     assert sorted(fx_extents(ip.part.hull)) == pytest.approx([20.0, 20.0], rel=1e-6)

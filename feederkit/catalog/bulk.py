@@ -138,6 +138,20 @@ def _bad_line(path: Path, exc: InputError) -> str:
     return reason if str(path) in reason else f"{path}: {reason}"
 
 
+def check_one_file_options(options: ImportOptions) -> None:
+    """Refuse a center of mass or a mesh pose for a folder: each belongs to one part, and
+    every file of the folder would get it (InputError)."""
+    given = [
+        o for o, v in (("--pose K", options.pose), ("--com X Y", options.com)) if v is not None
+    ]
+    if given:
+        said = " and ".join(given)
+        raise InputError(
+            f"{said}: a folder import would give {'them' if len(given) > 1 else 'it'} to every "
+            f"file; add that part's file alone with catalog add FILE {said}"
+        )
+
+
 def import_directory(
     catalog: CatalogLike,
     directory: str | os.PathLike[str],
@@ -159,6 +173,7 @@ def import_directory(
     :attr:`DirectoryImport.bad`.
     """
     check_side_probability(side_probability)
+    check_one_file_options(options)
     root = Path(directory)
     files, ignored = source_files(root)
     if not files:

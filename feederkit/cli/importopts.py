@@ -21,6 +21,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
+from feederkit.errors import InputError
 from feederkit.importers import (
     DEFAULT_FLATTEN_TOLERANCE,
     DEFAULT_HULL_TOLERANCE,
@@ -90,7 +91,13 @@ AllPartsOpt = Annotated[
 ]
 PoseOpt = Annotated[
     int | None,
-    typer.Option("--pose", min=0, metavar="K", help="Mesh resting pose K (0: the most probable)."),
+    typer.Option(
+        "--pose",
+        min=0,
+        metavar="K",
+        help="Mesh resting pose K to import (0: the most probable); plan picks poses with "
+        "--landings K.",
+    ),
 ]
 AllowLargeOpt = Annotated[
     bool, typer.Option("--allow-large", help=f"Read files over {DEFAULT_MAX_FILE_MB:g} MB.")
@@ -248,6 +255,7 @@ def takes_import_options(command: Command) -> Command:
         bound.apply_defaults()
         values = bound.arguments
         chosen = {p.name: values.pop(p.name) for p in IMPORT_PARAMETERS}
+        check_one_part_options(names, chosen["pose"], values.get("com"))
         values[IMPORT_OPTS] = import_options(**chosen)
         return command(**values)
 
@@ -256,6 +264,40 @@ def takes_import_options(command: Command) -> Command:
     if new_signature.return_annotation is not inspect.Signature.empty:
         run.__annotations__["return"] = new_signature.return_annotation
     return run  # type: ignore[return-value]
+
+
+PLANS_LANDINGS = "landings"
+"""The parameter of a command that plans over landings (``--landings``)."""
+
+READS_FOLDER = "directory"
+"""The parameter of a command that imports every file of a folder."""
+
+
+def check_one_part_options(
+    parameters: Iterable[str], pose: int | None, com: tuple[float, float] | None
+) -> None:
+    """Refuse ``--pose`` and ``--com`` where they cannot mean what they say (InputError).
+
+    A command that plans over landings (a ``landings`` parameter: ``plan``) covers every
+    resting pose of a mesh, so ``--pose K`` would pick nothing: the pose is ``--landings K``.
+    A command that reads a folder (a ``directory`` parameter: ``catalog import``) would give
+    one pose and one center of mass to every file of it.
+    """
+    names = set(parameters)
+    if pose is not None and PLANS_LANDINGS in names:
+        raise InputError(
+            f"--pose {pose}: plan covers every resting pose of a mesh; plan pose {pose} alone "
+            f"with --landings {pose}"
+        )
+    if READS_FOLDER in names:
+        given = [o for o, v in (("--pose K", pose), ("--com X Y", com)) if v is not None]
+        if given:
+            said = " and ".join(given)
+            verb = "describe" if len(given) > 1 else "describes"
+            raise InputError(
+                f"{said} {verb} one part, not every file of a folder: add that part's file "
+                f"alone with catalog add FILE {said}"
+            )
 
 
 def with_com(options: ImportOptions, com: tuple[float, float] | None) -> ImportOptions:

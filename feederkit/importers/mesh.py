@@ -20,9 +20,22 @@ import shapely
 from feederkit.errors import InputError
 from feederkit.hull import convex_hull
 from feederkit.importers.budget import MAX_COORD_MM, Budget, ImportLimits
+from feederkit.importers.meshbodies import (
+    SURFACE_EPS,
+    Shell,
+    close_shell,
+    describe_body,
+    edge_counts,
+    is_debris,
+    not_closed_reason,
+    separate_bodies_message,
+    surfaces_meet,
+    winding_number,
+)
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
 from feederkit.importers.plausible import size_warnings
 from feederkit.outline import make_outline, unit_scale
+from feederkit.words import plural
 
 if TYPE_CHECKING:
     import trimesh
@@ -32,8 +45,14 @@ DOWN = np.array([0.0, 0.0, -1.0])
 CHECK_EVERY = 65_536
 """Lines of a mesh file read between two checks of the import deadline."""
 
-POSE_KEY_DIGITS = 6
-"""Decimals of a pose's probability and normal compared when sorting poses."""
+PROBABILITY_TIE = 1e-6
+"""Probabilities of resting poses this close are a tie, ordered by the resting face's normal
+(:func:`pose_key`); real differences between poses are far larger."""
+
+NORMAL_GRID = 8
+"""Steps per unit of the grid on which tied poses' normals are compared (:func:`pose_key`):
+its cells' edges (odd sixteenths) lie away from the components of axis-aligned faces and of
+faces at 30, 45 and 60 degrees to them."""
 
 
 @dataclass(frozen=True)
@@ -173,49 +192,99 @@ def load_mesh(
     extent = mesh.extents
     if float(extent.min()) <= 1e-9 * float(extent.max()):
         raise InputError(f"{path}: the mesh is flat (zero volume)")
+    notes += drop_bad_faces(mesh)
     if scale != 1.0:
         mesh.apply_scale(scale)
     return mesh, unit_name, notes
 
 
+def drop_bad_faces(mesh: trimesh.Trimesh) -> list[str]:
+    """Drop, in place, triangles written twice and degenerate ones (no area): exporters leave
+    them, and they hold no volume but make a closed solid look open or non-manifold. The
+    trimesh masks ``unique_faces`` and ``nondegenerate_faces`` (what its ``validate`` drops,
+    without its ``fix_normals``: the file's own facing tells a cavity from an inner body)."""
+    unique = mesh.unique_faces()
+    proper = mesh.nondegenerate_faces()
+    if unique.all() and proper.all():
+        return []
+    mesh.update_faces(unique & proper)
+    mesh.remove_unreferenced_vertices()
+    said = [
+        plural(n, what)
+        for n, what in (
+            (int((~unique).sum()), "duplicate triangle"),
+            (int((unique & ~proper).sum()), "degenerate (zero-area) triangle"),
+        )
+        if n
+    ]
+    return [f"dropped {' and '.join(said)}: they hold no volume"]
+
+
 def open_edges(mesh: trimesh.Trimesh) -> int:
     """Edges of the surface that only one triangle uses: the border of its holes."""
-    import trimesh  # on first use: importing it costs every command about a second
-
-    return len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
+    return edge_counts(mesh)[0]
 
 
-def winding_number(mesh: trimesh.Trimesh, point: np.ndarray) -> float:
-    """How many times the closed surface winds around ``point`` (1 inside, 0 outside).
+OPEN_WITH_COM = (
+    "the mesh is not closed: resting poses use its convex hull's centroid, COM from --com"
+)
+"""The note of an open mesh imported with ``--com`` (its own center of mass is unknown)."""
 
-    The sum of the triangles' solid angles seen from the point over 4 pi (Van Oosterom and
-    Strackee's formula), exact for any closed surface, with no ray casting.
-    """
-    tri = np.asarray(mesh.triangles, dtype=float) - point
-    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-    la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
-    num = np.einsum("ij,ij->i", a, np.cross(b, c))
-    den = (
-        la * lb * lc
-        + np.einsum("ij,ij->i", a, b) * lc
-        + np.einsum("ij,ij->i", a, c) * lb
-        + np.einsum("ij,ij->i", b, c) * la
+REPAIR_NOTES = {
+    "filled": "the mesh was not closed: small holes were filled to compute its center of mass",
+    "rewound": "the mesh's triangles were not wound consistently: they were turned to face "
+    "outward to compute its center of mass",
+}
+"""The warning of each repair a shell may need (:class:`Shell`); ``flipped`` is said of the
+outer shell only (an inner one facing inward is a cavity)."""
+
+INSIDE_OUT = "the mesh is inside out (its triangles face inward): its normals were flipped"
+
+
+def _pieces(
+    mesh: trimesh.Trimesh, size: float, budget: Budget | None
+) -> tuple[list[Shell], list[trimesh.Trimesh], list[trimesh.Trimesh]]:
+    """The mesh's connected pieces: closed shells, open pieces, and flat debris (no volume)."""
+    shells, open_bodies, debris = [], [], []
+    for body in list(mesh.split(only_watertight=False)) or [mesh]:
+        if budget is not None:
+            budget.check_time()
+        shell = close_shell(body)
+        if shell is not None:
+            shells.append(shell)
+        elif is_debris(body, size):
+            debris.append(body)
+        else:
+            open_bodies.append(body)
+    return shells, open_bodies, debris
+
+
+def _debris_note(debris: list[trimesh.Trimesh]) -> str:
+    area = sum(float(d.area) for d in debris)
+    return (
+        f"left out {plural(len(debris), 'flat stray piece')} of no volume "
+        f"({plural(sum(len(d.faces) for d in debris), 'triangle')}, {area:.3g} mm2): "
+        "they carry no mass"
     )
-    return float(np.arctan2(num, den).sum() * 2.0 / (4.0 * np.pi))
 
 
-def _closed(body: trimesh.Trimesh) -> trimesh.Trimesh | None:
-    """The body as a closed volume with outward normals (small holes filled), or None."""
-    import trimesh  # on first use: importing it costs every command about a second
+def _open_edges(mesh: trimesh.Trimesh, debris: list[trimesh.Trimesh]) -> tuple[int, int]:
+    """Edges of the mesh, debris left out, that one triangle uses and that three or more do."""
+    border, branching = edge_counts(mesh)
+    return border - sum(edge_counts(d)[0] for d in debris), branching
 
-    if body.is_watertight and body.is_volume:
-        return body
-    fixed = body.copy()
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore")
-        trimesh.repair.fill_holes(fixed)
-        trimesh.repair.fix_normals(fixed)
-    return fixed if fixed.is_watertight and fixed.is_volume else None
+
+def _refuse_open(
+    mesh: trimesh.Trimesh, label: str, debris: list[trimesh.Trimesh], pieces: int
+) -> InputError:
+    """The refusal of a mesh that is not closed, saying what is wrong (holes or edges that
+    more than two triangles share) and the remedy."""
+    border, branching = _open_edges(mesh, debris)
+    reason = not_closed_reason(border, branching, pieces)
+    hint = "; give --com X Y" if pieces == 1 and not branching else ""
+    return InputError(
+        f"{label}: not a closed solid ({reason}), so its center of mass is unknown{hint}"
+    )
 
 
 def solid(
@@ -223,68 +292,104 @@ def solid(
 ) -> Solid:
     """The mesh as one solid for its COM: a closed volume, possibly with internal voids.
 
-    Small holes are filled (with a warning). Shells inside the outer shell are cavities
-    (and shells inside a cavity material again): one physical part, whose COM is that of
-    the solid with its cavities. Shells side by side are separate parts and refused; a
-    surface that is not closed is refused as "not a closed solid" unless ``--com`` is given.
-    A mesh of many bodies costs a repair per body and a winding number per pair of shells:
-    the deadline of ``budget`` is checked between them.
+    Small holes are filled, an inside-out mesh is turned outward, flat stray pieces (no
+    volume) are left out, each with a warning. Shells strictly inside the outer shell that
+    the file writes facing inward are cavities (and shells inside a cavity material again):
+    one physical part, whose COM is that of the solid with its cavities; an inner shell
+    facing outward is an inner body, taken as the solid's own material with a warning.
+    Shells side by side, touching or overlapping are separate parts and refused; a surface
+    that is not closed is refused as "not a closed solid" unless ``--com`` is given. A mesh
+    of many bodies costs a repair per body and a test per pair of shells: the deadline of
+    ``budget`` is checked between them.
     """
-    bodies = list(mesh.split(only_watertight=False)) or [mesh]
-    closed = []
-    for body in bodies:
-        if budget is not None:
-            budget.check_time()
-        closed.append(_closed(body))
-    if any(c is None for c in closed):
-        if com_given and len(bodies) == 1:
-            note = (
-                "the mesh is not closed: resting poses use its convex hull's centroid, "
-                "COM from --com"
-            )
-            return Solid(mesh, None, (note,))
-        pieces = f" in {len(bodies)} pieces" if len(bodies) > 1 else ""
-        raise InputError(
-            f"{label}: not a closed solid (an open surface with {open_edges(mesh)} border "
-            f"edges{pieces}), so its center of mass is unknown"
-            + ("; give --com X Y" if len(bodies) == 1 else "")
-        )
-    shells = [c for c in closed if c is not None]
-    filled = not (mesh.is_watertight and mesh.is_volume)  # split() itself may fill small holes
-    notes = (
-        ["the mesh was not closed: small holes were filled to compute its center of mass"]
-        if filled
-        else []
-    )
+    size = float(mesh.extents.max())
+    shells, open_bodies, debris = _pieces(mesh, size, budget)
+    notes = [_debris_note(debris)] if debris else []
+    if open_bodies:
+        if com_given and len(open_bodies) == 1 and not shells:
+            return Solid(open_bodies[0], None, (OPEN_WITH_COM, *notes))
+        raise _refuse_open(mesh, label, debris, len(open_bodies) + len(shells))
+    shells.sort(key=lambda sh: -float(sh.mesh.volume))
+    repairs = {sh.repair for sh in shells}
+    if _open_edges(mesh, debris)[0]:  # split() itself fills single-triangle holes
+        repairs.add("filled")
+    notes += [REPAIR_NOTES[r] for r in REPAIR_NOTES if r in repairs]
+    if shells[0].facing < 0:
+        notes.append(INSIDE_OUT)
     if len(shells) == 1:
-        return Solid(shells[0], np.asarray(shells[0].center_mass, dtype=float), tuple(notes))
-    shells.sort(key=lambda m: -float(m.volume))
-    outer = shells[0]
-    lo, hi = outer.bounds
-    depth = [0] * len(shells)
-    for k, shell in enumerate(shells[1:], start=1):
-        if budget is not None:
-            budget.check_time()
-        inside_box = bool((shell.bounds[0] >= lo).all() and (shell.bounds[1] <= hi).all())
-        if not inside_box or abs(winding_number(outer, shell.vertices[0])) < 0.5:
-            raise InputError(
-                f"{label}: the file holds {len(shells)} separate bodies; import one body per file"
-            )
-        depth[k] = sum(
-            abs(winding_number(shells[j], shell.vertices[0])) >= 0.5
-            for j in range(k)
-            if float(shells[j].volume) > float(shell.volume)
+        return Solid(
+            shells[0].mesh, np.asarray(shells[0].mesh.center_mass, dtype=float), tuple(notes)
         )
-    signs = np.array([(-1.0) ** d for d in depth])
-    volumes = np.array([float(s.volume) for s in shells]) * signs
-    centres = np.array([s.center_mass for s in shells], dtype=float)
+    inside = _nesting([sh.mesh for sh in shells], SURFACE_EPS * size, label, budget)
+    signs, inner_notes = _material_signs(shells, inside)
+    volumes = np.array([float(sh.mesh.volume) for sh in shells]) * signs
+    centres = np.array([sh.mesh.center_mass for sh in shells], dtype=float)
     com = (volumes[:, None] * centres).sum(axis=0) / volumes.sum()
     voids = int((signs < 0).sum())
-    notes.append(
-        f"the solid has {voids} internal void(s) (cavities): one part, its center of mass "
-        "computed with the cavities"
-    )
-    return Solid(outer, com, tuple(notes))
+    if voids:
+        notes.append(
+            f"the solid has {voids} internal void(s) (cavities): one part, its center of mass "
+            "computed with the cavities"
+        )
+    return Solid(shells[0].mesh, com, tuple(notes + inner_notes))
+
+
+def _nesting(
+    meshes: list[trimesh.Trimesh], eps: float, label: str, budget: Budget | None
+) -> dict[tuple[int, int], bool]:
+    """Whether shell k lies wholly inside shell j (j < k, shells by decreasing volume).
+
+    Every shell must lie inside the first (the outer one); shells whose surfaces cross or
+    touch are refused, naming the bodies. Two shells whose surfaces do not meet are nested
+    or apart as a whole, so one vertex's winding number decides which (a vertex on the
+    other's surface would not: a part tight in its nest fixture has every vertex on it).
+    """
+    inside: dict[tuple[int, int], bool] = {}
+    for k in range(1, len(meshes)):
+        for j in range(k):
+            if budget is not None:
+                budget.check_time()
+            how = surfaces_meet(meshes[k], meshes[j], eps)
+            if how is None:
+                nested = abs(winding_number(meshes[j], meshes[k].vertices[0])) >= 0.5
+                how = "inside" if nested else "apart"
+            if how != "inside" and (j == 0 or how != "apart"):
+                raise InputError(f"{label}: {separate_bodies_message(meshes, k, j, how)}")
+            inside[k, j] = how == "inside"
+    return inside
+
+
+def _material_signs(
+    shells: list[Shell], inside: dict[tuple[int, int], bool]
+) -> tuple[np.ndarray, list[str]]:
+    """+1 for material, -1 for a void, 0 for a shell left out, per shell; and the warnings.
+
+    A shell's depth (the kept shells around it) says what it should be: material at even
+    depth, a void at odd. The file's facing, relative to the outer shell's, says what it is
+    written as; where the two disagree (an inner body facing outward inside the material: an
+    insert, a pressed pin) the shell is taken as the material (or void) around it and named.
+    """
+    ref = shells[0].facing
+    signs = np.ones(len(shells))
+    notes = []
+    for k in range(1, len(shells)):
+        depth = sum(1 for j in range(k) if inside[k, j] and signs[j] != 0)
+        expected = -1 if depth % 2 else 1
+        written = shells[k].facing * ref
+        if written == 0 or written == expected:
+            signs[k] = expected
+            continue
+        signs[k] = 0
+        body = describe_body(k, shells[k].mesh)
+        notes.append(
+            f"an inner body ({body}) lies inside the solid, written as a body of its own, "
+            "not a cavity: taken as the solid's own material; give --com X Y if it is an "
+            "insert of another material"
+            if expected < 0
+            else f"an inner shell ({body}) inside a cavity faces inward: taken as part of "
+            "the cavity"
+        )
+    return signs, notes
 
 
 def hull_face_count(mesh: trimesh.Trimesh, limit: int) -> int:
@@ -309,19 +414,48 @@ def hull_face_count(mesh: trimesh.Trimesh, limit: int) -> int:
         raise InputError(f"the mesh has no convex hull ({str(exc).splitlines()[0]})") from None
 
 
-def rotation_to_down(normal: np.ndarray) -> np.ndarray:
-    """The smallest rotation taking the unit vector ``normal`` to straight down (-z)."""
-    n = normal / np.linalg.norm(normal)
+HALF_TURN_X = np.diag([1.0, -1.0, -1.0])
+"""The half turn about the x axis: how a face pointing straight up is turned over."""
+
+TURN_OVER_CONE_DEG = float(np.degrees(1.0))
+"""Resting faces whose outward normal lies within this angle (1 radian) of straight up are
+turned over about x once their tilt is removed; the others take the smallest rotation. No
+rule can be continuous for every normal (a rotation chosen continuously for each direction
+does not exist); this one puts the seam at an angle CAD models seldom draw a face at, far
+from straight up, down and sideways."""
+
+
+EXACT_SINE = 1e-12
+"""A normal this close (sine of the angle) to straight down or up is taken as exactly so."""
+
+
+def _smallest_rotation(n: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking the unit vector ``n`` to straight down: Rodrigues' formula
+    ``I + [v] + [v]^2 / (1 + c)`` with ``v = n x down``, ``c = n . down`` (exact for tiny
+    angles too). A normal within :data:`EXACT_SINE` of straight down gives the identity
+    exactly, and one of straight up (which has no smallest rotation) the half turn about x:
+    float noise in a normal must not tilt an axis-aligned model's outline by 1e-17."""
     c = float(n @ DOWN)
-    if c > 1.0 - 1e-12:
-        return np.eye(3)
-    if c < -1.0 + 1e-12:
-        return np.diag([1.0, -1.0, -1.0])  # half turn about x
-    axis = np.cross(n, DOWN)
-    s = float(np.linalg.norm(axis))
-    k = axis / s
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
+    v = np.cross(n, DOWN)
+    if float(np.linalg.norm(v)) < EXACT_SINE:
+        return np.eye(3) if c > 0 else HALF_TURN_X.copy()
+    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return np.eye(3) + vx + (vx @ vx) / (1.0 + c)
+
+
+def rotation_to_down(normal: np.ndarray) -> np.ndarray:
+    """Our rotation taking the resting face's outward ``normal`` straight down (-z).
+
+    A face pointing down or sideways takes the smallest rotation (a part modelled on its base
+    keeps the model's x and y). A face pointing up, within :data:`TURN_OVER_CONE_DEG`, is
+    turned over about x after the smallest rotation that removes its tilt: so the frame of
+    a face-up pose varies continuously with the model (a face tilted by 1e-4 degrees or by 3
+    degrees gets the frame of the face straight up, which is turned over about x).
+    """
+    n = normal / np.linalg.norm(normal)
+    if float(-n @ DOWN) >= np.cos(np.radians(TURN_OVER_CONE_DEG)):
+        return _smallest_rotation(HALF_TURN_X @ n) @ HALF_TURN_X
+    return _smallest_rotation(n)
 
 
 @dataclass(frozen=True)
@@ -334,7 +468,8 @@ class RestingPose:
 
 
 def resting_poses(s: Solid) -> list[RestingPose]:
-    """Stable resting poses of the solid on a plane, most probable first (ties by normal)."""
+    """Stable resting poses of the solid on a plane, most probable first (ties by normal,
+    :func:`sorted_poses`)."""
     import trimesh  # on first use: importing it costs every command about a second
 
     hull = s.mesh.convex_hull
@@ -352,18 +487,31 @@ def resting_poses(s: Solid) -> list[RestingPose]:
         poses.append(
             RestingPose(float(p), tuple(float(v) for v in normal), rotation_to_down(normal))
         )
-    poses.sort(key=pose_key)
-    return poses
+    return sorted_poses(poses)
+
+
+def sorted_poses(poses: list[RestingPose]) -> list[RestingPose]:
+    """The poses most probable first; poses whose probabilities tie (within
+    :data:`PROBABILITY_TIE`: opposite faces of a plate differ in the last digits, in an order
+    trimesh versions and tiny tilts of the model change) in the order of :func:`pose_key`."""
+    groups: list[list[RestingPose]] = []
+    for pose in sorted(poses, key=lambda p: -p.probability):
+        if groups and groups[-1][-1].probability - pose.probability <= PROBABILITY_TIE:
+            groups[-1].append(pose)
+        else:
+            groups.append([pose])
+    return [pose for group in groups for pose in sorted(group, key=pose_key)]
 
 
 def pose_key(pose: RestingPose) -> tuple[float, ...]:
-    """Sort key: decreasing probability, ties by the normal, both rounded (``POSE_KEY_DIGITS``).
+    """The order of tied poses: the normal on a grid of 1/:data:`NORMAL_GRID`, then exact.
 
-    Opposite faces of a box have equal probabilities up to the last digit, which trimesh
-    versions order differently; rounding makes the order a function of the solid alone.
+    On the grid a normal tilted by up to 3.5 degrees from an axis keeps its place: a plate's
+    face-down pose stays pose 0 before its face-up twin however slightly the model is tilted,
+    and exactly axis-aligned models keep the order of their exact normals.
     """
-    prob = round(pose.probability, POSE_KEY_DIGITS) + 0.0
-    return (-prob, *(round(v, POSE_KEY_DIGITS) + 0.0 for v in pose.normal))
+    grid = (round(v * NORMAL_GRID) / NORMAL_GRID + 0.0 for v in pose.normal)
+    return (*grid, *(float(v) for v in pose.normal))
 
 
 def pose_outline(
@@ -380,6 +528,30 @@ def pose_outline(
     transform[:3, :3] = pose.rotation
     transform[2, 3] = -float(pts[:, 2].min())
     return ring, com2d, transform
+
+
+def com_pose_note(s: Solid, poses: list[RestingPose], k: int) -> str:
+    """The warning of a mesh imported with ``--com``: only pose ``k`` is planned.
+
+    ``--com X Y`` is a point in pose k's plane; the other poses' outlines, edge poses and
+    probabilities need the solid's 3-D center of mass (Akella and Mason's stable poses),
+    which it does not give: their landings are left out, never silently (design.md: plans
+    cover every landing unless told otherwise).
+    """
+    name = f"pose-{k}"
+    if s.com is None:
+        return (
+            f"only the imported pose ({name}) is planned, with the COM from --com: the other "
+            "resting poses need the solid's center of mass, which an open mesh does not give "
+            "(close the mesh to plan every landing)"
+        )
+    others = len(poses) - 1
+    share = 100.0 * (1.0 - poses[k].probability)
+    return (
+        f"--com gives the center of mass of {name} only: the plan covers {name} only; the "
+        f"other {plural(others, 'pose')}, {share:.0f} % of drops, are left out: leave out "
+        "--com to plan every landing"
+    )
 
 
 def read_mesh(
@@ -409,6 +581,7 @@ def read_mesh(
         raise InputError(
             f"{path}: no pose {k}: the mesh has {len(poses)} resting poses (0-{len(poses) - 1})"
         )
+    said = (com_pose_note(s, poses, k),) if options.com is not None else ()
     ring, com2d, transform = pose_outline(s, poses[k], options.com)
     outline = make_outline(name, ring, (), com2d, "mm")
     pose = MeshPose(
@@ -422,5 +595,5 @@ def read_mesh(
         kind="mesh",
         source_units=unit_name,
         pose=pose,
-        warnings=tuple(notes) + s.warnings,
+        warnings=tuple(notes) + s.warnings + said,
     )

@@ -181,6 +181,11 @@ def import_parts(
 ) -> tuple[ImportResult, list[ImportedPart]]:
     """Read a source file and build its part(s) (several only with ``options.all_parts``)."""
     result = read_source(path, options, name)
+    if options.com is not None and len(result.parts) > 1:
+        raise InputError(
+            f"{path}: --com X Y is one part's center of mass, and the file holds "
+            f"{len(result.parts)} parts: import each alone (leave out --all-parts) to give it"
+        )
     shared = result.warnings + tuple(f"left out: {o}" for o in result.others)
     try:
         built = [build_part(imp, options, shared) for imp in result.parts]

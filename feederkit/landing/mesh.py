@@ -37,8 +37,10 @@ def landings_of_mesh(
 
     ``hull_tolerance`` simplifies each pose's hull as the import does (default: exact; less
     on a pose whose chords would hold it where it rolls, ``kept_part``). With
-    ``options.com`` (a COM given for one pose) the other poses' COMs are unknown: the only
-    landing is then the imported pose (``options.pose``, default 0).
+    ``options.com`` (a COM given in one pose's plane) the other poses' outlines and COMs
+    need the solid's 3-D center of mass: the only landing is then the imported pose
+    (``options.pose``, default 0), and the import warns which poses, and what share of
+    drops, are left out (:func:`feederkit.importers.mesh.com_pose_note`).
     """
     p = Path(path)
     label = name or p.stem
