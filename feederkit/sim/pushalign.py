@@ -65,6 +65,23 @@ class SettleRule:
         first, second = recent[:half], recent[half:]
         return abs(sum(second) / len(second) - sum(first) / len(first)) < self.drift_tol_deg
 
+    def reading(self, thetas: Sequence[float], widths: Sequence[float]) -> tuple[float, float]:
+        """Where the part rests (unwrapped, deg) and the width across the belt there (mm), from
+        one still window's looks (``thetas`` and ``widths``, one per look).
+
+        Under the range rule every look lies within ``still_tol_deg`` of the others: their
+        means. Under the drift rule the window may still hold the end of the part's turn onto
+        its rest: a part slams flush at tens of degrees per second, and a few looks several
+        degrees off pass the halves' means (a 60 mm part read 0.2 degree off flush and 0.25 mm
+        too wide, outside a ±0.2 mm branch). The part at rest is then the window's second half,
+        where the drift rule found it still: the medians of its looks, which a jitter about
+        the rest (a gentle arc) leaves where the mean would be and a stray look does not move.
+        """
+        if self.drift_tol_deg is None:
+            return sum(thetas) / len(thetas), float(np.mean(widths))
+        half = len(thetas) // 2
+        return float(np.median(thetas[half:])), float(np.median(widths[half:]))
+
     def window_s(self, size_m: float, belt_speed: float) -> float:
         """Length (s) of the still window for a part of ``size_m`` metres."""
         return max(self.min_window_s, self.window_sizes * size_m / belt_speed)
@@ -307,31 +324,33 @@ class PushAligner:
             recent = thetas[-window:]
             if not rule.still(recent):
                 continue
-            mean = norm360(sum(recent) / window)
-            edge, off = self._nearest_edge(mean)
+            rest, width = rule.reading(recent, widths[-window:])
+            rest = norm360(rest)
+            edge, off = self._nearest_edge(rest)
             if self._lowest is not None:
-                ok = _range_distance(mean, self._lowest) <= rule.align_tol_deg
+                ok = _range_distance(rest, self._lowest) <= rule.align_tol_deg
             else:
                 ok = off <= rule.align_tol_deg and bool(self._restable[edge])
             if ok:
                 return PushOutcome(
                     theta_start_deg=norm360(theta_deg),
                     settled=True,
-                    theta_end_deg=mean,
+                    theta_end_deg=rest,
                     edge=edge,
-                    width_mm=float(np.mean(widths[-window:])),
+                    width_mm=width,
                     sim_time_s=float(d.time),
                     steps=steps,
                 )
         if self._rests is not None and len(thetas) >= window:  # the end of the fence
-            mean = norm360(sum(thetas[-window:]) / window)
-            if _range_distance(mean, self._rests) <= rule.align_tol_deg:
+            rest, width = rule.reading(thetas[-window:], widths[-window:])
+            rest = norm360(rest)
+            if _range_distance(rest, self._rests) <= rule.align_tol_deg:
                 return PushOutcome(
                     theta_start_deg=norm360(theta_deg),
                     settled=True,
-                    theta_end_deg=mean,
-                    edge=self._nearest_edge(mean)[0],
-                    width_mm=float(np.mean(widths[-window:])),
+                    theta_end_deg=rest,
+                    edge=self._nearest_edge(rest)[0],
+                    width_mm=width,
                     sim_time_s=float(d.time),
                     steps=steps,
                 )

@@ -42,6 +42,7 @@ from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
 from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.part import Part, make_part
 from feederkit.plans.model import Plan, PlanPart
+from feederkit.sim.likeness import refusal_words
 from feederkit.sim.pushalign import SettleRule
 from feederkit.sources import load_part
 from feederkit.uncertainty import IDEAL
@@ -66,7 +67,8 @@ REAL_SETTLE_RULE = SettleRule(window_sizes=1.0, drift_tol_deg=0.5, max_travel_si
 ``rests``): still (its mean orientation drifting less than 0.5 degree over a part size of belt
 travel: on a gentle arc it jitters by a degree or two) within 1 degree of where it lies lowest,
 or anywhere in a resting range after 60 part sizes of belt travel (it creeps down a gentle arc
-for tens of part sizes). Measured in docs/simulation.md."""
+for tens of part sizes); read where it rests, the window's second half (``SettleRule.reading``:
+the window may begin with the end of its turn onto the rest). Measured in docs/simulation.md."""
 
 
 @dataclass(frozen=True)
@@ -349,7 +351,7 @@ def check_match(
             f"{source}: not the part the plan was made for: its outline's hull lies {d:.4g} mm "
             f"from the plan's hull of {pp.label} (allowed {allowed:.4g} mm: shape tolerance "
             f"{unc.shape_tolerance_mm:g} + hull tolerance {h.mm:g} ({h.words()}) + slack "
-            f"{slack:.3g}; same part frame){_refusal_hint(h, exact)}"
+            f"{slack:.3g}; same part frame){_refusal_hint(h, exact, pp, source, allowed)}"
         )
     allowed_com = unc.com_tolerance_mm + slack
     dc = math.dist(pp.com, exact.com)
@@ -379,10 +381,23 @@ def check_match(
     )
 
 
-def _refusal_hint(h: HullAllowance, exact: Part) -> str:
-    """What a refused SOURCE may still need: the hull tolerance the plan's part was imported
-    with, when it is not known (no catalog revision, no --hull-tolerance); else how far the
-    part lies from the revision's drawing."""
+def _refusal_hint(h: HullAllowance, exact: Part, pp: PlanPart, source: str, allowed: float) -> str:
+    """What a refused SOURCE may still need: its units or its part frame, when its hull is
+    the plan's scaled or moved (:func:`feederkit.sim.likeness.refusal_words`); else the hull
+    tolerance the plan's part was imported with, when it is not known (no catalog revision,
+    no --hull-tolerance); else how far the part lies from the revision's drawing."""
+    other = refusal_words(
+        pp.hull,
+        pp.com,
+        exact.hull,
+        exact.com,
+        allowed,
+        source=source,
+        name=pp.name,
+        is_file=Path(source).exists(),
+    )
+    if other is not None:
+        return other
     if h.drawing is not None:
         far = hull_distance(h.drawing.part.hull, exact.hull)
         return f"; it lies {far:.4g} mm from the drawing of {h.drawing.where}"
