@@ -72,6 +72,47 @@ ORIENT_HEADER = "orient*"
 columns for names up to 24 characters, so the header stays 7 wide)."""
 
 
+HULL_AREA_MARK = "+"
+"""``catalog list`` marks a mesh's area with this, for its footnote (:data:`HULL_AREA_NOTE`)."""
+
+HULL_AREA_NOTE = (
+    "mm2 of a mesh: its convex hull seen from above, which is all the catalog keeps of a "
+    "mesh's outline (what the fence feels), not its footprint; its holes are not known"
+)
+"""Why a mesh's area is its hull's: the mesh import keeps the convex hull of each resting
+pose seen from above as the outline, so area and holes of its footprint are not stored."""
+
+
+def area_fields(kind: str, area: float, holes: int) -> dict[str, object]:
+    """The JSON fields of a part's area: ``area`` (mm2), ``area_of`` (``outline``, or
+    ``convex hull`` for a mesh, whose stored outline is its hull) and ``holes`` (null for a
+    mesh: not known)."""
+    mesh = kind == "mesh"
+    return {
+        "area": area,
+        "area_of": "convex hull" if mesh else "outline",
+        "holes": None if mesh else holes,
+    }
+
+
+def _area_cells(kind: str, area: float, holes: int) -> tuple[str, str]:
+    """``catalog list``'s mm2 and holes cells: a mesh's area marked as its hull's, its holes
+    not known."""
+    if kind == "mesh":
+        return f"{area:.1f}{HULL_AREA_MARK}", "-"
+    return f"{area:.1f}", str(holes)
+
+
+def _area_words(kind: str, area: float, holes: int) -> str:
+    """``catalog show``'s area row."""
+    if kind == "mesh":
+        return (
+            f"{area:.3f} mm2 of its convex hull seen from above (a mesh: the catalog keeps "
+            "that hull as its outline, not its footprint; holes not known)"
+        )
+    return f"{area:.3f} mm2, {plural(holes, 'hole')}"
+
+
 def orientable_fields(orientable: bool) -> dict[str, bool]:
     """The JSON fields of a part's orientability: ``orientable_ideal``, and ``orientable``,
     the same value under its older name."""
@@ -472,8 +513,7 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
                     "revisions": p.revisions,
                     "kind": p.source_kind,
                     "source_units": p.source_units,
-                    "area": p.area,
-                    "holes": p.n_holes,
+                    **area_fields(p.source_kind, p.area, p.n_holes),
                     "hull_vertices": p.n_hull,
                     **orientable_fields(p.orientable),
                     "updated_at": p.updated_at,
@@ -489,8 +529,7 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
             p.name,
             str(p.revision),
             p.source_kind,
-            f"{p.area:.1f}",
-            str(p.n_holes),
+            *_area_cells(p.source_kind, p.area, p.n_holes),
             str(p.n_hull),
             "yes" if p.orientable else "no",
             _date(p.updated_at),
@@ -500,6 +539,9 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
     sys.stdout.write(plain_table(headers, rows, right=(1, 3, 4, 5)))
     if parts:
         sys.stdout.write(orientable_footnote())
+    if any(p.source_kind == "mesh" for p in parts):
+        note = f"{HULL_AREA_MARK} {HULL_AREA_NOTE}"
+        sys.stdout.write(textwrap.fill(note, width=80, subsequent_indent="  ") + "\n")
     sys.stdout.write(f"{plural(len(parts), 'part')}\n")
     sys.stdout.flush()
 
@@ -545,8 +587,7 @@ def revision_dict(
         },
         "options": dict(rev.options),
         "outline": outline_to_dict(rev.outline),
-        "area": rev.area,
-        "holes": len(rev.outline.holes),
+        **area_fields(rev.source_kind, rev.area, len(rev.outline.holes)),
         "com": list(rev.com),
         "hull": [list(p) for p in rev.hull],
         "hull_tolerance": rev.hull_tolerance,
@@ -619,8 +660,12 @@ def cmd_show(
     rows = [
         ("source", f"{rev.source_path} ({rev.source_kind}, {rev.source_units})"),
         ("sha256", rev.source_sha256),
-        ("area", f"{rev.area:.3f} mm2, {plural(len(rev.outline.holes), 'hole')}"),
-        ("outline", plural(len(rev.outline.vertices), "vertex", "vertices")),
+        ("area", _area_words(rev.source_kind, rev.area, len(rev.outline.holes))),
+        (
+            "outline",
+            plural(len(rev.outline.vertices), "vertex", "vertices")
+            + (" (the convex hull seen from above)" if rev.source_kind == "mesh" else ""),
+        ),
         (
             "hull",
             f"{plural(len(rev.hull), 'vertex', 'vertices')} (tolerance {_tol(rev.hull_tolerance)})",

@@ -26,16 +26,25 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+import shapely
+
 from feederkit.angles import norm360
 from feederkit.errors import InputError, PlanningError
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import Offsets, widen_widths
-from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
+from feederkit.mechanics.modelerror import (
+    exact_push_function,
+    keeping_tolerance,
+    largest_offset,
+    part_offsets,
+)
 from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
 from feederkit.mechanics.uncertain import PUSH_BAND_DEG
+from feederkit.part import make_part
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
@@ -395,32 +404,76 @@ SHORT_CHORD_TILT_DEG = 5.0
 """A hull edge the shape tolerance may tilt by at least this much (``asin(2 t / length)``) is
 named when no strong plan exists: finely drawn arcs make them."""
 
+COARSE_HULL_PROBE_REL = 0.01
+"""The coarsest hull tolerance, as a share of the part's size, :func:`coarser_kept_hull` tries
+(then its halves, as import does)."""
+
+
+def _chord_tilt(hull: Sequence[tuple[float, float]], t: float) -> tuple[float, float]:
+    """The shortest edge of ``hull`` (mm) and how far the shape tolerance ``t`` may tilt it
+    (degrees)."""
+    shortest = min(math.dist(hull[i], hull[(i + 1) % len(hull)]) for i in range(len(hull)))
+    return shortest, math.degrees(math.asin(min(1.0, 2.0 * t / shortest)))
+
+
+def _hull_gap(exact: Sequence[tuple[float, float]], hull: Sequence[tuple[float, float]]) -> float:
+    """How far the outline's exact hull strays outside a contact hull simplified inside it."""
+    ring = shapely.LinearRing(hull)
+    return float(np.max(shapely.distance(ring, shapely.points(np.asarray(exact, dtype=float)))))
+
+
+def coarser_kept_hull(pf: PushFunction, t: float) -> float | None:
+    """A hull tolerance coarser than the one ``pf``'s contact hull was simplified at that an
+    import keeps (the simplified hull rests where the outline does: ``keeping_tolerance``,
+    which lowers any coarser request, on a mesh or a drawing alike) and at which no hull edge
+    is short enough for the shape tolerance ``t`` to tilt it by :data:`SHORT_CHORD_TILT_DEG`;
+    None when there is none, and a coarser ``--hull-tolerance`` cannot help."""
+    part = pf.part
+    exact = make_part(part.outline, part.com, name=part.name)
+    own = _hull_gap(exact.hull, part.hull)
+    kept = keeping_tolerance(exact, COARSE_HULL_PROBE_REL * part.size)
+    if kept.tolerance <= 1.01 * own + 1e-9:
+        return None
+    coarser = make_part(part.outline, part.com, hull_tolerance=kept.tolerance, name=part.name)
+    if _chord_tilt(coarser.hull, t)[1] >= SHORT_CHORD_TILT_DEG:
+        return None
+    return kept.tolerance
+
 
 def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
     """ "; ..." naming the part whose contact hull has the shortest edge the shape tolerance
     ``t`` may tilt by ``SHORT_CHORD_TILT_DEG`` or more (an arc drawn as many short chords,
-    each a possible resting edge near a corner under the vertex model, docs/uncertainty.md);
-    "" when none has one."""
+    each a possible resting edge near a corner under the vertex model, docs/uncertainty.md),
+    and what may help: a coarser ``--hull-tolerance`` only when import would keep one that
+    lengthens those edges (:func:`coarser_kept_hull`; a mesh's or a near-round part's is
+    lowered back to what keeps its resting states); "" when none has such an edge."""
     if t <= 0.0:
         return ""
-    worst: tuple[float, str] | None = None
-    for pf in pfs:
-        hull = pf.part.hull
-        edges = [math.dist(hull[i], hull[(i + 1) % len(hull)]) for i in range(len(hull))]
-        shortest = min(edges)
-        if worst is None or shortest < worst[0]:
-            worst = (shortest, pf.part.name)
-    assert worst is not None
-    length, name = worst
-    tilt = math.degrees(math.asin(min(1.0, 2.0 * t / length)))
+    (length, tilt), pf = min(((_chord_tilt(pf.part.hull, t), pf) for pf in pfs), key=_first)
     if tilt < SHORT_CHORD_TILT_DEG:
         return ""
-    return (
+    name = pf.part.name
+    head = (
         f"; {name}'s contact hull has edges as short as {length:.3g} mm (an arc drawn as many "
         f"chords?), which the shape tolerance may tilt by {tilt:.3g} degrees, each then a "
-        "possible resting edge near a corner: an outline with fewer arc points, or a drawing "
-        "imported with a coarser --hull-tolerance, may have a plan (docs/uncertainty.md)"
+        "possible resting edge near a corner: a smaller --shape-tolerance, or an outline with "
+        "fewer arc points (a coarser tessellation in a mesh's CAD export)"
     )
+    coarser = coarser_kept_hull(pf, t)
+    if coarser is not None:
+        return (
+            f"{head}, or the part imported with --hull-tolerance {coarser:.3g} (its resting "
+            "states kept, no edge that short), may have a plan (docs/uncertainty.md)"
+        )
+    return (
+        f"{head}, may have a plan; a coarser --hull-tolerance cannot help: import lowers it "
+        f"to what keeps {name}'s resting states (chords across its arcs would hold the part "
+        "where it rolls) (docs/uncertainty.md)"
+    )
+
+
+def _first(item: tuple[tuple[float, float], PushFunction]) -> float:
+    return item[0][0]
 
 
 def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
