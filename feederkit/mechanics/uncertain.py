@@ -62,6 +62,25 @@ Measured (docs/uncertainty.md, "Push bands"): on the gear, whose tooth tips are 
 vibrations deep, starts up to 3.6 degrees (0.86-0.99 vibrations) below a hilltop beside a tip
 were carried over it onto the tip; the factor 2 is the margin.
 """
+OVERSHOOT_DEG_MM = 175.0
+"""A push ending in a state may carry on over a hilltop less than ``OVERSHOOT_DEG_MM / size``
+degrees from the state's normal (``size`` in mm, at least :data:`OVERSHOOT_MIN_SIZE_MM`),
+into the state beyond, when it comes down a basin at least twice that wide.
+
+Measured, not derived (docs/uncertainty.md, "Overshoot"): in the physics check at the belt's
+0.1 m/s a part coming down a long basin turns at 150-230 degrees per second and carries on
+past the normal: a 20 mm 12-gon whose state has its hilltop 5.7 degrees from its normal on
+one side and 51 on the other was overshot into the neighbour in 4-15 of 100 pushes from its
+basin, the same shape at 30 mm in 1 of 105 and at 40 mm in none; other 20 mm polygons with
+hilltops 4.4 and 6.1 degrees away too; the catalog's 60 mm l-bracket, 2.98 degrees, in none
+of 100. The turn the belt gives (about v / size) against the fence's friction carries the
+part about ``v^2 / (g mu size)`` past the normal: inversely as the size. The quasi-static
+model has no such term, and a vibration (a share of the size) cannot stand for it.
+"""
+OVERSHOOT_MIN_SIZE_MM = 20.0
+"""Parts smaller than this are taken at this size for :data:`OVERSHOOT_DEG_MM`, as the physics
+check simulates them (docs/simulation.md, "Scale"); a small part's own dynamics are not
+modelled."""
 SHALLOW_WELL_FACTOR = 5.0
 """A state whose well beside a hilltop (the hilltop's radius minus the radius at the state's
 normal) is less than this many vibrations deep is shallow: that hilltop gets the depth rule.
@@ -750,6 +769,17 @@ def uncertain_mechanics(
                 )
             ):
                 (wander if w else carry)[i].add(j)
+    if vibration_mm > 0.0:
+        # Overshoot (OVERSHOOT_DEG_MM): a push ending in a state whose hilltop lies close to
+        # its normal, coming down a basin at least twice as wide, may carry on over it.
+        reach = OVERSHOOT_DEG_MM / max(part.size, OVERSHOOT_MIN_SIZE_MM)
+        normal = np.asarray([s.normal_deg for s in pf.states])
+        for k in range(m):
+            for i, j, far in ((left[k], right[k], k - 1), (right[k], left[k], k + 1)):
+                near_deg = abs(norm360(div[k] - normal[i] + 180.0) - 180.0)
+                far_deg = abs(norm360(div[far % m] - normal[i] + 180.0) - 180.0)
+                if i != j and near_deg < reach and far_deg >= 2.0 * near_deg:
+                    carry[i].add(int(j))
     comp = _strong_components(wander)
     first_member: dict[int, int] = {}
     for i in range(pf.n):
