@@ -106,6 +106,8 @@ def test_what_the_plan_holds_comes_from_its_certificate_else_declared_plus_margi
     assert certified_bounds(one, 2.15, None) == Certified(3.15, 0.0, False)
     assert certified_bounds(IDEAL, 4.68, None) == Certified(4.68, 0.0, False)  # margin alone
     assert certified_bounds(one, None, None).rotation_error_deg is None  # no rotation
+    # ... with a certificate too (its 90 degrees for a plan with no rotation is no figure).
+    assert certified_bounds(one, None, Certificate(90.0, 0.02, 1)).rotation_error_deg is None
     assert "its certificate" in Certified(3.15, 0.02, True).words()
 
 
@@ -290,3 +292,15 @@ def test_no_branch_failures_under_a_fine_sensor_are_put_down_to_the_simulators_w
         out = " ".join(capsys.readouterr().out.split())
         assert "reading in no branch" in out
         assert ("(the simulator's widths: see the warning)" in out) is shown
+
+
+def test_a_plan_with_no_rotation_certifies_any_rotation_error_in_words(tmp_path, capsys):
+    # A scalene triangle's three states read apart: one operation, no rotation. Its
+    # certificate stores 90 degrees (docs/plans.md); the table says what that means.
+    path = tmp_path / "tri.json"
+    path.write_text(json.dumps({"name": "tri", "vertices": [[0, 0], [40, 0], [10, 30]]}))
+    rc = main(["plan", str(path), "--tolerance", "0.01", "--landings", "up"])
+    out = capsys.readouterr().out
+    assert rc == 0 and "at most 1 push-align operation" in out
+    assert "any (the plan makes no rotation)" in " ".join(out.split())
+    assert "±90°" not in out

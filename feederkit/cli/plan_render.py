@@ -197,7 +197,10 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
     t.add_row("declared uncertainty", plan.uncertainty_words())
     cert = s.certificate
     if cert is not None:
-        t.add_row("certified rotation error (largest)", f"±{cert.max_rotation_error_deg:.4g}°")
+        rot = f"±{cert.max_rotation_error_deg:.4g}°"
+        if margin is None:
+            rot = "any (the plan makes no rotation)"
+        t.add_row("certified rotation error (largest)", rot)
         shape = f"{cert.max_shape_tolerance_mm:.4g} mm"
         if plan.sensor.informative and cert.max_shape_tolerance_mm <= (
             plan.uncertainty.shape_tolerance_mm

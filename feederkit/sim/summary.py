@@ -145,9 +145,9 @@ def certified_bounds(
     """What the plan holds (see :class:`Certified`): its certificate when it has one, else its
     declared uncertainty plus its smallest margin (the ideal model's smallest margin alone)."""
     if certificate is not None:
-        return Certified(
-            certificate.max_rotation_error_deg, certificate.max_shape_tolerance_mm, True
-        )
+        # A plan with no rotation holds any error: its certificate's 90 is no figure to read.
+        rot = None if min_margin_deg is None else certificate.max_rotation_error_deg
+        return Certified(rot, certificate.max_shape_tolerance_mm, True)
     rot = None if min_margin_deg is None else declared.rotation_error_deg + min_margin_deg
     return Certified(rot, declared.shape_tolerance_mm, False)
 
