@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.errors import InputError
-from feederkit.mechanics.analysis import fragile_member_warnings
+from feederkit.mechanics.analysis import fragile_member_warnings, tipping_warnings
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -116,7 +116,8 @@ def member_fragile_warnings(
     parts: dict[str, list[tuple[str, PushFunction]]] = {}
     for name, landing, pf in members:
         parts.setdefault(name, []).append((member_label(name, landing), pf))
-    return fragile_member_warnings(list(parts.values()))
+    tipping = [line for ms in parts.values() for line in tipping_warnings(ms)]
+    return fragile_member_warnings(list(parts.values())) + tipping
 
 
 @dataclass(frozen=True)

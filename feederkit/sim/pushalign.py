@@ -98,7 +98,9 @@ class PushOutcome:
     ``theta_start_deg`` is the fence orientation (part frame) the part was dropped at;
     ``theta_end_deg`` the one it came to rest at (averaged over the still window);
     ``edge`` the hull edge flush with the fence (None when the run never settled);
-    ``width_mm`` the width across the belt the LED array reads, in the part's millimetres.
+    ``width_mm`` the width across the belt the LED array reads, in the part's millimetres;
+    ``tilt_deg`` how far the part's plane leans from the belt's at the end (a part above
+    :data:`TILT_MAX_DEG` stands on an edge or turned over: it never settles).
     """
 
     theta_start_deg: float
@@ -108,6 +110,13 @@ class PushOutcome:
     width_mm: float
     sim_time_s: float
     steps: int
+    tilt_deg: float = 0.0
+
+
+TILT_MAX_DEG = 10.0
+"""A part whose plane leans more than this from the belt's is not lying flat (it leans on the
+fence, stands on an edge or turns over, e.g. a COM close to the hull's boundary): it does not
+count as settled, whatever its yaw does. Parts lying flat lean a degree or less."""
 
 
 def _signed_delta(a: float, b: float) -> float:
@@ -245,6 +254,11 @@ class PushAligner:
         yaw = math.degrees(math.atan2(xm[3], xm[0]))
         return norm360(-90.0 - yaw)
 
+    def _tilt(self) -> float:
+        """How far (deg) the part's plane leans from the belt's: the angle of its z axis."""
+        zz = float(self.data.xmat[self._body][8])
+        return math.degrees(math.acos(max(-1.0, min(1.0, zz))))
+
     def _extent_y(self) -> tuple[float, float]:
         """Lowest and highest world y of the part (metres)."""
         rot_y = self.data.xmat[self._body][3:6]
@@ -313,8 +327,8 @@ class PushAligner:
             unwrapped += _signed_delta(prev, theta)
             prev = theta
             lo, hi = self._extent_y()
-            if lo > touch_tol:
-                thetas.clear()
+            if lo > touch_tol or self._tilt() > TILT_MAX_DEG:
+                thetas.clear()  # off the fence, or not lying flat: no still window yet
                 widths.clear()
                 continue
             thetas.append(unwrapped)
@@ -340,6 +354,7 @@ class PushAligner:
                     width_mm=width,
                     sim_time_s=float(d.time),
                     steps=steps,
+                    tilt_deg=self._tilt(),
                 )
         if self._rests is not None and len(thetas) >= window:  # the end of the fence
             rest, width = rule.reading(thetas[-window:], widths[-window:])
@@ -353,6 +368,7 @@ class PushAligner:
                     width_mm=width,
                     sim_time_s=float(d.time),
                     steps=steps,
+                    tilt_deg=self._tilt(),
                 )
         lo, hi = self._extent_y()
         return PushOutcome(
@@ -363,4 +379,5 @@ class PushAligner:
             width_mm=(hi - lo) / to_mm,
             sim_time_s=float(d.time),
             steps=steps,
+            tilt_deg=self._tilt(),
         )

@@ -23,7 +23,7 @@ from feederkit.mechanics.push import PushFunction, push
 from feederkit.mechanics.uncertain import UncertainMechanics, outcome_set
 from feederkit.plans.model import Leaf, Plan, PlanPart, Step, push_function_of
 from feederkit.sensors import Sensor
-from feederkit.sim.pushalign import PushAligner, range_distance
+from feederkit.sim.pushalign import TILT_MAX_DEG, PushAligner, range_distance
 from feederkit.sim.summary import PushRecord, TrialResult
 
 CAUSES = ("never settled", "unstable edge", "reading in no branch", "wrong result")
@@ -275,7 +275,13 @@ def run_trial(
                 "unsettled",
                 step,
                 "never settled",
-                f"the part never settled within {aligner.max_time_s:.3g} s",
+                f"the part never settled within {aligner.max_time_s:.3g} s"
+                + (
+                    f": it ended {out.tilt_deg:.0f} deg out of the belt's plane (it tipped "
+                    "onto an edge or over: the planar model does not hold for it)"
+                    if out.tilt_deg > TILT_MAX_DEG
+                    else ""
+                ),
             )
         if unpredicted is None and off_rest is not None and off_rest > pose.limit_deg:
             unpredicted = (
