@@ -281,7 +281,9 @@ def _outline_gaps(
     outline's boundary in the two poses: the Hausdorff distance ``H`` of the two sample sets
     (:func:`_placed_samples`, nearest neighbours by k-d tree) plus half their spacing ``s``
     (every boundary point lies that close to a sample; the true distance also lies above
-    ``H - s / 2``). With ``tol`` a pair is decided on coarser samples first
+    ``H - s / 2``). With ``tol``, a pair whose samples lie farther than ``tol + s`` apart gets
+    an infinite bound (it is not close; the k-d tree stops looking there), and a pair is
+    decided on coarser samples first
     (:data:`COARSE_SPACINGS`) when their bounds lie both on one side of it: a bound at
     most ``tol``, or one above it with the true distance above it too. Holes and notches a
     hull does not show set poses apart for the next station (a plate's off-centre hole 24 mm
@@ -296,9 +298,15 @@ def _outline_gaps(
         trees = {i: cKDTree(samples[i]) for i in used}
         last = level == len(levels) - 1
         undecided = []
+        # Deciding against tol, a sample farther than tol + spacing / 2 from the other set
+        # decides alone (the true distance then exceeds tol): the search stops there.
+        cap = np.inf if tol is None else tol + spacing
         for k in todo:
             a, b = pairs[k]
-            h = max(trees[b].query(samples[a])[0].max(), trees[a].query(samples[b])[0].max())
+            h = max(
+                trees[b].query(samples[a], distance_upper_bound=cap)[0].max(),
+                trees[a].query(samples[b], distance_upper_bound=cap)[0].max(),
+            )
             out[k] = float(h) + spacing / 2.0
             if not last and tol is not None and out[k] > tol >= float(h) - spacing / 2.0:
                 undecided.append(k)  # the bounds straddle tol: finer samples decide
