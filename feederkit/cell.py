@@ -237,6 +237,11 @@ def load_cell(path: str | Path | None = None, *, directory: str | Path = ".") ->
     return CellProfile()
 
 
+MODEL_BELT_SPEED_M_S = 0.1
+"""The belt speed (m/s) the physics check measured the model's push bands and overshoot at
+(docs/uncertainty.md, "Overshoot")."""
+
+
 @dataclass(frozen=True)
 class CellSettings:
     """What a planning command uses: the profile with the command line's overrides applied.
@@ -259,6 +264,21 @@ class CellSettings:
         if self.overrides:
             text += f" (overridden: {', '.join(self.overrides)})"
         return text
+
+    def belt_warning(self) -> str | None:
+        """A warning when the profile's belt runs faster than the physics check measured the
+        model at (``mechanics.uncertain.OVERSHOOT_DEG_MM``: a part turns into a state at
+        about the belt's speed over its size and may overshoot it, farther as the square of
+        the speed); None otherwise."""
+        v = self.profile.belt.speed_m_s
+        if v is None or v <= MODEL_BELT_SPEED_M_S:
+            return None
+        return (
+            f"the belt runs at {v:g} m/s ({self.profile.source}); the model's overshoot of "
+            f"shallow states was measured at {MODEL_BELT_SPEED_M_S:g} m/s and grows as the "
+            f"square of the speed ({(v / MODEL_BELT_SPEED_M_S) ** 2:.3g} times here): check "
+            f"the plan with feederkit simulate --belt-speed {v:g}"
+        )
 
     def costs(self) -> ActionCosts | None:
         """The profile's action costs, or None when it gives no timing."""

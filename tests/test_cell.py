@@ -21,6 +21,7 @@ from feederkit.cell import (
     resolve_settings,
     rotation_deg,
 )
+from feederkit.cli.app import main
 from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
 from feederkit.plans.make import make_plan
@@ -328,3 +329,19 @@ def test_the_worked_example_prints_what_the_docs_say(tmp_path, monkeypatch, caps
             assert all(math.isclose(gd[k], wd[k], abs_tol=1.5e-3) for k in gd), (g, w)
         else:
             assert g == w
+
+
+def test_a_belt_faster_than_the_model_was_measured_at_is_named(tmp_path, capsys):
+    # The overshoot of shallow states was measured at 0.1 m/s (docs/uncertainty.md).
+    root = Path(__file__).resolve().parents[1]
+    fast = tmp_path / "fast.toml"
+    fast.write_text('[sensor]\nmodel = "tolerance"\ntolerance_mm = 0.5\n[belt]\nspeed_m_s = 0.3\n')
+    part = str(root / "catalog" / "t-clip.json")
+    assert main(["plan", part, "--cell", str(fast), "-o", str(tmp_path / "p.json")]) == 0
+    err = capsys.readouterr().err
+    assert "the belt runs at 0.3 m/s" in err and "9 times here" in err
+    assert "simulate --belt-speed 0.3" in err
+    slow = tmp_path / "slow.toml"
+    slow.write_text('[sensor]\nmodel = "tolerance"\ntolerance_mm = 0.5\n[belt]\nspeed_m_s = 0.1\n')
+    assert main(["plan", part, "--cell", str(slow), "-o", str(tmp_path / "q.json")]) == 0
+    assert "the belt runs at" not in capsys.readouterr().err

@@ -101,6 +101,10 @@ def test_another_part_keeps_the_old_refusal() -> None:
     line = _refusal(plate)
     assert "units" not in line and "frame differs" not in line
     assert "give --hull-tolerance MM with the value it was imported with" in line
+    # A part of another shape a unit's factor smaller is not told its units either.
+    bolt = make_part(make_outline("bolt", [(0, 0), (6, 0), (0, 3.5)]))
+    small = _refusal(bolt)
+    assert "units" not in small and "frame differs" not in small
 
 
 def test_the_likeness_is_exact_for_the_same_hull() -> None:

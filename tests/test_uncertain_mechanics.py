@@ -411,8 +411,9 @@ def _best_seconds(part, runs: int = 3) -> float:
 
 def test_a_thousand_vertex_outline_costs_about_linear_time() -> None:
     # Growth, not speed (docs/performance.md keeps the seconds): four times the vertices
-    # cost about four times as long (n log n); a quadratic step would cost 16 times. The
-    # ratio of two runs in the same process absorbs a loaded machine.
+    # cost at most about four times as long (n log n; measured: twice, fixed costs included);
+    # a quadratic step would cost 16 times. The ratio of two runs in the same process
+    # absorbs a loaded machine.
     small, big = _wavy_outline(250), _wavy_outline(1000)
     uncertain_mechanics(small, Uncertainty())  # warm up
     ratio = _best_seconds(big) / max(_best_seconds(small), 1e-4)

@@ -81,7 +81,15 @@ def test_a_small_part_whose_wells_all_wander_is_not_oriented():
     assert m.states[0].unlike_members
     with pytest.raises(NoStrongPlan, match="wanders between unlike poses"):
         plan(m)
+    with pytest.raises(NoStrongPlan, match="no result may hold a state where the part at rest"):
+        plan(m, PlanningOptions(lumping=Lumping.NONE))
     assert not strong_plan_exists(m)
+    # The catalog screen and the sensor design answer as plan does.
+    from feederkit.design.strong import StrongLengthOracle, StrongMix
+    from feederkit.mix.strongpairs import check_alone
+
+    assert not check_alone(pf, NoSensor(), unc).orients
+    assert StrongLengthOracle(StrongMix([pf], unc)).length(0.05) is None
     lumped = plan(m, PlanningOptions(lumping=Lumping.ANY))
     assert lumped.length == 1
     assert strong_plan_exists(m, PlanningOptions(lumping=Lumping.ANY))
@@ -196,3 +204,38 @@ def test_no_plan_under_a_shape_tolerance_names_a_finely_drawn_arc():
         make_plan([pf], ToleranceSensor(0.1), uncertainty=Uncertainty(1.0, 0.03, 0.0))
     assert short_chords_words([pf], 0.0) == ""
     assert short_chords_words([pf], 0.0005) == ""  # 0.3 degrees: not named
+
+
+def test_the_goal_relation_stays_the_machines_own_when_a_state_gets_a_twin():
+    # X and Y look alike; both may be pushed into the wandering state w, which merges them
+    # there, and from w on into Z1 or Z2. On the machine X and Y are not inseparable; a twin
+    # of w (a copy nature could keep apart from w) must not make them so: a result listing
+    # X and Y would claim no plan tells them apart.
+    from feederkit.machine import MachineState, OutcomeRange, PushAlignMachine, search_space
+    from feederkit.planning.tree import leaf_masks
+
+    def state(s, d, alike, **kw):
+        return MachineState(0, s, d, 0.2, members=(s,), look_alike=alike, **kw)
+
+    states = (
+        state(0, 10.0, (1,)),
+        state(1, 10.0, (0,)),
+        MachineState(0, 2, 20.0, 0.2, members=(2, 5), look_alike=(), unlike_members=True),
+        state(3, 20.0, (4,)),
+        state(4, 20.0, (3,)),
+    )
+    maps = (
+        (OutcomeRange(0.0, 180.0, 0b00100), OutcomeRange(180.0, 360.0, 0b01000)),
+        (OutcomeRange(0.0, 180.0, 0b00100), OutcomeRange(180.0, 360.0, 0b10000)),
+        (OutcomeRange(0.0, 360.0, 0b11000),),
+        (OutcomeRange(0.0, 360.0, 0b01000),),
+        (OutcomeRange(0.0, 360.0, 0b10000),),
+    )
+    m = PushAlignMachine(("toy",), states, maps, ToleranceSensor(0.5), Uncertainty(1.0))
+    goal = search_space(m).inseparable
+    result = plan(m)
+    for mask in leaf_masks(result.root):
+        idx = members(mask)
+        assert 2 not in idx
+        assert all(goal[i] >> j & 1 for i in idx for j in idx if i != j), idx
+    assert strong_plan_exists(m)

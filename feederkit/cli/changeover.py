@@ -424,7 +424,7 @@ def compile_command(
     plan, witnesses, pfs = compiled.plan, list(compiled.witnesses), list(compiled.parts)
     lands = landings_text(plan, compiled.rejected)
     cycle = plan["stats"].get("cycle_time")
-    warnings = list(compiled.warnings)
+    warnings = [*compiled.warnings, *filter(None, [settings.belt_warning()])]
     note = time_limit_note(plan["stats"], options.time_limit_s)
     if note is not None:
         warnings.append(note)

@@ -249,7 +249,7 @@ def plan_command(
     files, view = plan_outputs(plan, pfs, witnesses, output, report)
     write_files(files)
     note_written((output, "plan"), (report, "report"))
-    notes = [*made.warnings]
+    notes = [*made.warnings, *filter(None, [settings.belt_warning()])]
     note = time_limit_note(plan["stats"], options.time_limit_s)
     if note is not None:
         notes.append(note)

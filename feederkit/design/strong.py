@@ -84,6 +84,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.solvable import unsolvable
+from feederkit.planning.wandering import split_wandering, twin_masks
 from feederkit.plans.make import make_plan
 from feederkit.plans.model import PlanMember
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor, span
@@ -375,7 +376,10 @@ class StrongLengthOracle:
         self.mix = mix
         self.deadline = deadline or Deadline()
         self.machine = mix.planned
-        self._sorted, _old = by_diameter(self.machine)
+        # The planner's machine: numbered by diameter, then a twin for each state where a part
+        # at rest wanders over unlike poses (no result may hold it: planning.wandering).
+        self._plain, _old = by_diameter(self.machine)
+        self._sorted, self._twin_of = split_wandering(self._plain)
         self._bisimilar: dict[float, tuple[int, ...]] = {}
         self._goals: dict[float, Goal] = {}
         self._searches: OrderedDict[
@@ -389,7 +393,13 @@ class StrongLengthOracle:
     def bisimilar(self, tolerance: float) -> tuple[int, ...]:
         """The bisimilar relation (masks, sorted numbering) at ``tolerance`` mm."""
         if tolerance not in self._bisimilar:
-            self._bisimilar[tolerance] = goal_relation(self.at(tolerance), self.deadline)
+            plain = replace(self._plain, sensor=ToleranceSensor(tolerance))
+            goal = goal_relation(plain, self.deadline)
+            if self._sorted is not self._plain:
+                # The machine's own relation, over the twins and keeping each apart from
+                # its state (planning.wandering.twinned).
+                goal = twin_masks(goal, self._twin_of, apart=True)
+            self._bisimilar[tolerance] = goal
         return self._bisimilar[tolerance]
 
     def _problem(self, tolerance: float, goal: tuple[int, ...]):

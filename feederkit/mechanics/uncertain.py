@@ -775,9 +775,13 @@ def uncertain_mechanics(
         reach = OVERSHOOT_DEG_MM / max(part.size, OVERSHOOT_MIN_SIZE_MM)
         normal = np.asarray([s.normal_deg for s in pf.states])
         for k in range(m):
-            for i, j, far in ((left[k], right[k], k - 1), (right[k], left[k], k + 1)):
-                near_deg = abs(norm360(div[k] - normal[i] + 180.0) - 180.0)
-                far_deg = abs(norm360(div[far % m] - normal[i] + 180.0) - 180.0)
+            # Directed arcs along the state's resting range (its far side may pass 180).
+            n_l, n_r = normal[left[k]], normal[right[k]]
+            arcs = (
+                (left[k], right[k], norm360(div[k] - n_l), norm360(n_l - div[(k - 1) % m])),
+                (right[k], left[k], norm360(n_r - div[k]), norm360(div[(k + 1) % m] - n_r)),
+            )
+            for i, j, near_deg, far_deg in arcs:
                 if i != j and near_deg < reach and far_deg >= 2.0 * near_deg:
                     carry[i].add(int(j))
     comp = _strong_components(wander)

@@ -35,6 +35,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.solvable import solve
+from feederkit.planning.wandering import twinned
 from feederkit.sensors import Diameter, Sensor, span
 from feederkit.uncertainty import Uncertainty
 
@@ -273,6 +274,8 @@ def check_alone(
         None if mechanics is None else [mechanics],
         None if offsets is None else [offsets],
     )
+    # As plan: no result may hold a state a part at rest wanders over unlike poses in.
+    machine = twinned(machine, None if deadline is None else deadline.check)[0]
     problem = Problem(machine, "exact", 0.0)
     roots = sorted(maximal_sets(b.mask for b in problem.readings.branches(problem.full)))
     value = solve(problem, roots, deadline, ALONE_SETS)

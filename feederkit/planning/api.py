@@ -62,7 +62,7 @@ from feederkit.planning.tree import (
     build_dag,
     root_step,
 )
-from feederkit.planning.wandering import split_wandering
+from feederkit.planning.wandering import is_twin_pair, twinned, wandering_words
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -174,8 +174,12 @@ def strong_plan_exists(
         return False
     budget = Deadline() if deadline is None else deadline
     if options.lumping is not Lumping.ANY:
-        # No result may hold a state a part at rest wanders over unlike poses in.
-        machine = split_wandering(machine)[0]
+        # No result may hold a state a part at rest wanders over unlike poses in; the goal
+        # relation stays the machine's own (as in plan).
+        try:
+            machine = twinned(machine, budget.check)[0]
+        except Timeout:
+            return True
     if machine.deterministic:
         return True  # the ideal push machine: a part is always oriented up to inseparable states
     sorted_machine, _old = by_diameter(machine)
@@ -322,7 +326,16 @@ def _plan_machine(
     """:func:`plan` with its options checked and its budget made."""
     # A result may not hold a state where a part at rest wanders between unlike poses
     # (feederkit.planning.wandering), unless lumping 'any' lists anything together.
-    split, twin_of = (machine, None) if options.lumping is Lumping.ANY else split_wandering(machine)
+    split, twin_of = machine, None
+    if options.lumping is not Lumping.ANY:
+        # The goal relation stays the machine's own (planning.wandering.twinned).
+        try:
+            split, twin_of = twinned(machine, budget.check)
+        except Timeout as exc:
+            raise PlanningError(
+                f"no plan found within {_out_of_budget(options, exc.reason)}: it ran out while "
+                f"finding which of the {machine.n} states are inseparable"
+            ) from None
     if split is machine:
         twin_of = None
     # Plan with the states numbered by diameter (readings then pick runs of bits).
@@ -333,7 +346,12 @@ def _plan_machine(
         root, optimal, length, lower, ties, cut = _plan(sorted_machine, options, budget)
     except NoStrongPlan as exc:
         if options.lumping is Lumping.NONE:
-            raise
+            if twin_of is None:
+                raise
+            # No pairs are looked at: say which states no result may hold.
+            pairs = [(i, j) for i in range(split.n) for j in range(i + 1, split.n)]
+            twins = [p for p in pairs if is_twin_pair(split, *p)]
+            raise NoStrongPlan(exc.reason, wandering_words(split, twins, False)) from None
         # Near-symmetric states (docs/planning.md): lump the pairs no strong plan resolves
         # that the rule allows (by default: poses that look alike).
         tried = try_lumping(sorted_machine, options.grouping, budget, rule=options.lumping)

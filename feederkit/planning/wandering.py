@@ -15,9 +15,11 @@ exists.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
-from feederkit.machine import OutcomeRange, PushAlignMachine, members
+from feederkit.machine import OutcomeRange, PushAlignMachine, members, search_space
+from feederkit.machine.inseparable import inseparable_masks
 
 
 def split_wandering(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[int]]:
@@ -72,6 +74,45 @@ def split_wandering(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[i
     return split, list(range(n)) + wandering
 
 
+def twin_masks(masks: tuple[int, ...], old: list[int], apart: bool = False) -> tuple[int, ...]:
+    """Per-state masks of the machine (its bisimilar states, say) over the machine from
+    :func:`split_wandering` (``old[index]``: each state's original): each state's original's
+    mask, every original bit standing for the state and its twin; ``apart``: a state's mask
+    never holds its own twin (a goal relation, where they must stay apart).
+
+    >>> twin_masks((0b01, 0b11), [0, 1, 0]), twin_masks((0b01, 0b11), [0, 1, 0], apart=True)
+    ((5, 7, 5), (1, 7, 4))
+    """
+    copies: dict[int, int] = {}
+    for k, o in enumerate(old):
+        copies[o] = copies.get(o, 0) | 1 << k
+    out = []
+    for k, o in enumerate(old):
+        mask = 0
+        for j in members(masks[o]):
+            mask |= copies[j]
+        if apart:
+            mask &= ~(copies[o] & ~(1 << k))
+        out.append(mask)
+    return tuple(out)
+
+
+def twinned(
+    machine: PushAlignMachine, check: Callable[[], None] | None = None
+) -> tuple[PushAlignMachine, list[int]]:
+    """:func:`split_wandering` with the machine's own goal relation: the split machine's
+    bisimilar states are the machine's (:func:`twin_masks`), computed once (``check`` polls
+    a deadline), not its own, where a twin would be an outcome nature keeps apart from its
+    state (two states pushed into one wandering state are merged there)."""
+    split, old = split_wandering(machine)
+    if split is not machine:
+        space = search_space(machine)
+        if "bisimilar" not in vars(space):
+            vars(space)["bisimilar"] = inseparable_masks(machine, check)
+        vars(search_space(split))["bisimilar"] = twin_masks(space.bisimilar, old)
+    return split, old
+
+
 def is_twin_pair(machine: PushAlignMachine, i: int, j: int) -> bool:
     """Whether states ``i`` and ``j`` of a machine from :func:`split_wandering` are a wandering
     state and its twin (equal records: a pair no plan resolves because a part resting there
@@ -79,29 +120,37 @@ def is_twin_pair(machine: PushAlignMachine, i: int, j: int) -> bool:
     return i != j and machine.states[i] == machine.states[j] and machine.states[i].unlike_members
 
 
-def wandering_words(machine: PushAlignMachine, pairs: list[tuple[int, int]]) -> str:
-    """The clause of a "no strong plan" message for twin pairs (:func:`is_twin_pair`) no
-    strong plan resolves: the part may rest in those states, unoriented, whatever the plan."""
+def wandering_words(
+    machine: PushAlignMachine, pairs: list[tuple[int, int]], unresolved: bool = True
+) -> str:
+    """The clause of a "no strong plan" message for twin pairs (:func:`is_twin_pair`): no
+    strong plan resolves them (the part may rest in those states, unoriented, whatever the
+    plan), or, ``unresolved`` False, only that no result may hold them (not looked at)."""
     named = []
     for i, _j in pairs:
         s = machine.states[i]
         poses = ", ".join(str(m) for m in s.ideal_states)
         named.append(f"{machine.part_names[s.part]} states {poses}")
     u = machine.uncertainty
-    toleranced = u.shape_tolerance_mm > 0.0 or u.com_tolerance_mm > 0.0
+    toleranced = u is not None and (u.shape_tolerance_mm > 0.0 or u.com_tolerance_mm > 0.0)
     barriers = (
         "twice the shape and COM tolerances plus a breath of vibration"
         if toleranced
         else "a breath of vibration"
     )
+    lead = (
+        "every plan may leave the part resting where it wanders between unlike poses"
+        if unresolved
+        else "no result may hold a state where the part at rest wanders between unlike poses"
+    )
     words = (
-        f"every plan may leave the part resting where it wanders between unlike poses "
-        f"({'; '.join(named)}: their barriers lie below {barriers}, docs/uncertainty.md); "
-        "a plan that ends there, leaving the part unoriented, is given with lumping 'any'"
+        f"{lead} ({'; '.join(named)}: their barriers lie below {barriers}, "
+        "docs/uncertainty.md); a plan that ends there, leaving the part unoriented, is given "
+        "with lumping 'any'"
     )
     if toleranced:
         words += "; a smaller --shape-tolerance or --com-tolerance may keep them apart"
     return words
 
 
-__all__ = ["is_twin_pair", "split_wandering", "wandering_words"]
+__all__ = ["is_twin_pair", "split_wandering", "twin_masks", "twinned", "wandering_words"]

@@ -171,7 +171,13 @@ def _make_plan(
         blame = blocking_members(
             pfs, sensor, unc, opts, offsets, named, None if left is None else left / 2.0
         )
-        largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started))
+
+        def planned_on(u: Uncertainty) -> PushAlignMachine:
+            return widen_widths(
+                weigh_members(build_machine(pfs, sensor, u), shares, rejected), offsets
+            )
+
+        largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started), planned_on)
         hint = f"; {exc.hint}" if exc.hint else ""
         culprits = [pfs[k] for k in blame.members] or pfs
         simplified = [pf.part.name for pf in culprits if exact_push_function(pf) is not None]
@@ -791,8 +797,13 @@ def largest_uncertainty(
     uncertainty: Uncertainty,
     options: PlanningOptions,
     seconds: float | None = None,
+    build: Callable[[Uncertainty], PushAlignMachine] | None = None,
 ) -> str:
     """In words: the largest rotation error (and shape tolerance) with a strong plan.
+
+    ``build`` makes the machine at an uncertainty (by default the parts' plain machine; a
+    plan's own caller passes the one it planned on: members' shares and rejected landings,
+    the parts' own widths), so the figure is the plan's.
 
     Bisection over machine builds (a strong plan existing at an uncertainty exists at every
     smaller one: outcome sets and reading intervals shrink), ``BISECT_STEPS`` steps, or
@@ -806,7 +817,8 @@ def largest_uncertainty(
     def exists(unc: Uncertainty) -> bool | None:
         """Whether a strong plan exists at ``unc``; None when not decided in time."""
         left = None if stop is None else max(stop - time.monotonic(), 0.0)
-        return _decided_exists(build_machine(push_functions, sensor, unc), options, left)
+        machine = build_machine(push_functions, sensor, unc) if build is None else build(unc)
+        return _decided_exists(machine, options, left)
 
     at_zero_is_ideal = Uncertainty(0.0, u.shape_tolerance_mm, u.com_tolerance_mm).is_ideal
     words = []
@@ -1028,14 +1040,19 @@ def blocking_members(
 
 
 def _landing_pairs(named: Sequence[PlanMember] | None) -> list[tuple[int, int]]:
-    """The pairs of members that are two landings of one part."""
+    """The pairs of accepted members that are two landings of one part (a rejected landing
+    is checked with the mix, not alone or in a pair)."""
     if named is None:
         return []
     return [
         (a, b)
         for a, m in enumerate(named)
         for b in range(a + 1, len(named))
-        if m.landing is not None and named[b].landing is not None and named[b].name == m.name
+        if m.landing is not None
+        and named[b].landing is not None
+        and named[b].name == m.name
+        and m.accept
+        and named[b].accept
     ]
 
 

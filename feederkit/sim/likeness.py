@@ -191,18 +191,18 @@ def refusal_words(
     is_file: bool,
 ) -> str | None:
     """Why a SOURCE whose hull the match check refused may still be the plan's part: in other
-    units (its size a unit's factor from the plan's, or beyond :data:`FAR_SCALE` while its
+    units (its size a unit's factor from the plan's, or beyond :data:`FAR_SCALE`, and its
     shape fits once scaled), or in another frame (a turn, mirror or shift brings it within
     ``allowed_mm``); None when neither explains it. One clause, starting ``; ``."""
     scale = scale_of(plan_hull, hull)
     size = float(np.ptp(np.asarray(plan_hull, dtype=float), axis=0).max())
-    if likely_units(scale) is not None:
-        return _units_words(scale, source, name, is_file)
-    far = not 1.0 / FAR_SCALE <= scale <= FAR_SCALE
-    found = likeness(plan_hull, plan_com, hull, com, scale if far else 1.0)
+    units = likely_units(scale) is not None or not 1.0 / FAR_SCALE <= scale <= FAR_SCALE
+    # Other units only when the shape fits once scaled: a size a unit's factor off alone is
+    # another part as often as not.
+    found = likeness(plan_hull, plan_com, hull, com, scale if units else 1.0)
     if found.distance_mm > allowed_mm:
         return None
-    if far:
+    if units:
         return _units_words(scale, source, name, is_file)
     return _frame_words(found, size) if found.motion_words(size) else None
 
