@@ -712,8 +712,10 @@ def uncertain_mechanics(
     where it is 0 and every physical state is one ideal state. Bands: with the vibration on, a
     push starting within ``PUSH_BAND_DEG`` of a hilltop (wherever F2 puts it) may end on either
     side; at a hilltop beside a shallow state, within ``PUSH_BAND_FACTOR`` vibrations of its
-    height (:func:`_bands`). Raises InputError for a shape tolerance of half the smallest hull
-    edge or more.
+    height (:func:`_bands`). Overshoot: with the vibration on, a push ending in a state may also
+    end beyond a hilltop close to its normal (:data:`OVERSHOOT_DEG_MM`; an outcome, as a
+    carry crossing). Raises InputError for a shape tolerance of half the smallest hull edge or
+    more.
     """
     check_for_part(uncertainty, part)
     pf = push_function(part)
