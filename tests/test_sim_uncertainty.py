@@ -370,6 +370,8 @@ def test_simulate_cli_reads_friction_ranges_and_ideal(tmp_path, capsys):
     assert main(["simulate", str(path), "--trials", "2", "--ideal", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["settings"]["ideal"] is True and d["uncertainty"]["rotation_error_deg"] == 1.0
+    (entry,) = d["per_part"]
+    assert entry["name"] == entry["part"] and entry["landing"] is None
     assert main(["simulate", str(path), "--friction-belt", "0:0.5"]) == 2
     err = capsys.readouterr().err
     assert "frictionless belt" in err and "Traceback" not in err
@@ -427,3 +429,8 @@ def test_a_plan_over_landings_draws_members_by_share_and_counts_rejects():
     assert s.rejects == down
     d = s.to_dict()
     assert (d["rejects"], d["wrong_accepts"]) == (down, 0)
+    # Each member by its name and landing too, not only by its label.
+    assert [(e["name"], e["landing"]) for e in d["per_part"]] == [
+        ("l-bracket", "up"),
+        ("l-bracket", "down"),
+    ]

@@ -360,6 +360,7 @@ def simulate_plan(
             contact=contact_words(base),
         ),
         parts=tuple(labels),
+        members=tuple((pp.name, x) for pp, x in zip(members, landings, strict=True)),
         part_trials=tuple(member_of_trial.count(k) for k in range(len(members))),
         part_successes=tuple(
             sum(

@@ -490,6 +490,10 @@ class SimulationSummary:
     on the plan's hull, and the JSON is as before."""
     pose_rule: PoseRuleWords | None = None
     """How those members' trials are judged (None without ``--part``)."""
+    members: tuple[tuple[str, str | None], ...] = ()
+    """Each member's part name and landing (None: a plan not over landings), as the plan file
+    names them, beside its label in ``parts``: the JSON's ``per_part`` gives both, so that a
+    reader need not split a label (part names are free text)."""
 
     def geometry_warnings(self) -> list[str]:
         """The members simulated on a part beyond the plan's declared shape tolerance, one
@@ -594,8 +598,10 @@ class SimulationSummary:
             "push_misses": [m.to_dict() for m in self.push_misses],
             "parts": list(self.parts),
             "per_part": [
-                {"part": p, "trials": t, "successes": k}
-                for p, t, k in zip(self.parts, self.part_trials, self.part_successes, strict=True)
+                {"part": p, "trials": t, "successes": k, **self._member_keys(i)}
+                for i, (p, t, k) in enumerate(
+                    zip(self.parts, self.part_trials, self.part_successes, strict=True)
+                )
             ],
             "scale": [_r(s, 6) for s in self.scales],
             "min_margin_deg": _r(self.min_margin_deg),
@@ -607,6 +613,14 @@ class SimulationSummary:
             "sim_time_s": _r(self.sim_time_s, 3),
             **self._geometry_dict(),
         }
+
+    def _member_keys(self, i: int) -> dict[str, object]:
+        """``name`` and ``landing`` of member ``i`` for its ``per_part`` entry (none when
+        the summary does not know them)."""
+        if i >= len(self.members):
+            return {}
+        name, landing = self.members[i]
+        return {"name": name, "landing": landing}
 
     def _geometry_dict(self) -> dict[str, object]:
         """``geometry`` and ``success_rule`` for a run with ``--part``; nothing otherwise."""
