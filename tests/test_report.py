@@ -67,7 +67,13 @@ def rectangle_plan(name="rect"):
     States by edge: s0 (e0, normal 270), s1 (e1, 0), s2 (e2, 90), s3 (e3, 180); rotating by 45
     sends every one of them onto a long edge, s0 or s2, which no plan tells apart.
     """
-    rect = part_entry(name, RECT, com=(1, 0.5))
+    return long_sides_plan(name, RECT, (1, 0.5))
+
+
+def long_sides_plan(name, hull, com):
+    """A rectangle ``hull`` (edges from the bottom one, counter-clockwise) sensorless: rotate
+    45 deg onto a long side, s0 or s2, which the result lists together; length 2."""
+    rect = part_entry(name, hull, com=com)
     root = op(None, None, (None, op(45.0, 18.43, (None, result((rect, 0), (rect, 2))))))
     stats = {
         "length": 2,

@@ -21,7 +21,7 @@ import re
 from pathlib import Path
 
 import pytest
-from test_report import op, parse, part_entry, plan_file, result
+from test_report import long_sides_plan, op, parse, part_entry, plan_file, result
 
 from feederkit.outline import make_outline
 from feederkit.plans import plan_from_dict
@@ -46,16 +46,7 @@ def circle(cx, cy, r, n=32):
 def plate_plan():
     """The plate, sensorless: rotating 45 degrees sends every state onto a long side, s0 or
     s2, which no push or reading tells apart (the hull is symmetric under 180 degrees)."""
-    plate = part_entry("plate", PLATE, com=(20, 10))
-    root = op(None, None, (None, op(45.0, 18.43, (None, result((plate, 0), (plate, 2))))))
-    stats = {
-        "length": 2,
-        "expected_length": 2.0,
-        "min_margin_deg": 18.43,
-        "optimal": True,
-        "lower_bound": 2,
-    }
-    return plan_file([plate], {"model": "none"}, root, stats)
+    return long_sides_plan("plate", PLATE, (20, 10))
 
 
 def outline_with_hole(x):
