@@ -62,7 +62,7 @@ from feederkit.planning.tree import (
     build_dag,
     root_step,
 )
-from feederkit.planning.wandering import is_twin_pair, twinned, wandering_words
+from feederkit.planning.wandering import twinned, wandering_words
 from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
@@ -349,8 +349,7 @@ def _plan_machine(
             if twin_of is None:
                 raise
             # No pairs are looked at: say which states no result may hold.
-            pairs = [(i, j) for i in range(split.n) for j in range(i + 1, split.n)]
-            twins = [p for p in pairs if is_twin_pair(split, *p)]
+            twins = [(twin_of[k], k) for k in range(machine.n, split.n)]  # appended twins
             raise NoStrongPlan(exc.reason, wandering_words(split, twins, False)) from None
         # Near-symmetric states (docs/planning.md): lump the pairs no strong plan resolves
         # that the rule allows (by default: poses that look alike).
