@@ -160,7 +160,12 @@ def _make_plan(
     # reads each state over them too (machine.widths), so no branch parts what the part
     # itself cannot be told apart by.
     offsets = part_offsets(pfs)
-    unwidened = weigh_members(build_machine(pfs, sensor, unc), shares, rejected)
+
+    def weighed(u: Uncertainty) -> PushAlignMachine:
+        """The mix's machine at ``u``: members' shares, rejected landings marked."""
+        return weigh_members(build_machine(pfs, sensor, u), shares, rejected)
+
+    unwidened = weighed(unc)
     machine = widen_widths(unwidened, offsets)
     if rejected:
         _check_rejects_separable(machine, named, lambda: _finest_machine(pfs, unc))
@@ -171,13 +176,14 @@ def _make_plan(
         blame = blocking_members(
             pfs, sensor, unc, opts, offsets, named, None if left is None else left / 2.0
         )
-
-        def planned_on(u: Uncertainty) -> PushAlignMachine:
-            return widen_widths(
-                weigh_members(build_machine(pfs, sensor, u), shares, rejected), offsets
-            )
-
-        largest = largest_uncertainty(pfs, sensor, unc, opts, _left(opts, started), planned_on)
+        largest = largest_uncertainty(
+            pfs,
+            sensor,
+            unc,
+            opts,
+            _left(opts, started),
+            lambda u: widen_widths(weighed(u), offsets),
+        )
         hint = f"; {exc.hint}" if exc.hint else ""
         culprits = [pfs[k] for k in blame.members] or pfs
         simplified = [pf.part.name for pf in culprits if exact_push_function(pf) is not None]
