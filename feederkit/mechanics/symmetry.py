@@ -271,7 +271,7 @@ def _placed_samples(pf: PushFunction, state: int, spacing: float) -> np.ndarray:
 COARSE_SPACINGS = (8.0, 3.0)
 """:func:`_outline_gaps` deciding against a bound first samples the boundary this many
 times :data:`OUTLINE_SPACING_REL` apart (then at that spacing): most pairs are decided
-with a tenth of the points."""
+with an eighth of the points or fewer."""
 
 
 def _outline_gaps(

@@ -70,12 +70,12 @@ into the state beyond, when it comes down a basin at least twice that wide.
 Measured, not derived (docs/uncertainty.md, "Overshoot"): in the physics check at the belt's
 0.1 m/s a part coming down a long basin turns at 150-230 degrees per second and carries on
 past the normal: a 20 mm 12-gon whose state has its hilltop 5.7 degrees from its normal on
-one side and 51 on the other was overshot into the neighbour in 4-15 of 100 pushes from its
-basin, the same shape at 30 mm in 1 of 105 and at 40 mm in none; other 20 mm polygons with
-hilltops 4.4 and 6.1 degrees away too; the catalog's 60 mm l-bracket, 2.98 degrees, in none
-of 100. The turn the belt gives (about v / size) against the fence's friction carries the
-part about ``v^2 / (g mu size)`` past the normal: inversely as the size. The quasi-static
-model has no such term, and a vibration (a share of the size) cannot stand for it.
+one side and 51 on the other was overshot into the neighbour in 4 of 100 and 15 of 105 pushes
+from its basin (two sweeps), the same shape at 30 mm in 1 of 105 and at 40 mm in none; other
+20 mm polygons with hilltops 4.4 and 6.1 degrees away too; the catalog's 60 mm l-bracket,
+2.98 degrees, in none of 100. The turn the belt gives (about v / size) against the fence's
+friction carries the part about ``v^2 / (g mu size)`` past the normal: inversely as the size.
+The quasi-static model has no such term, and a vibration (a share of the size) cannot stand for it.
 """
 OVERSHOOT_MIN_SIZE_MM = 20.0
 """Parts smaller than this are taken at this size for :data:`OVERSHOOT_DEG_MM`, as the physics
