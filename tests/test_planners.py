@@ -14,7 +14,7 @@ from itertools import product
 
 import pytest
 import shapely
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from feederkit.errors import InputError, PlanningError
@@ -23,7 +23,9 @@ from feederkit.machine import (
     PushAlignMachine,
     build_machine,
     inseparable,
+    is_goal,
     members,
+    overlap_ranges,
     search_space,
     successor,
 )
@@ -36,6 +38,7 @@ from feederkit.planning.api import _result, _sensorless_plan, plan
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import Grouping, Method, Objective, PlanningOptions
 from feederkit.planning.problem import Problem
+from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.stats import expected_operations
 from feederkit.planning.tree import Leaf
 from feederkit.sensors import (
@@ -378,6 +381,54 @@ def test_backchaining_fallback_is_a_valid_plan_of_the_sensorless_length():
     assert blind.length == 32  # the sensorless optimum (nothing to read)
     with pytest.raises(Timeout):
         _sensorless_plan(problem, problem.readings.branches(problem.full), Deadline(1e-9))
+
+
+def test_the_plan_that_follows_the_readings_is_a_valid_plan_shorter_than_the_chain():
+    # The hull of 200 random points, 19 stable states at 0.6 mm: the backchaining chain
+    # needs 12 operations; rotations chosen by the sensorless lengths the readings leave,
+    # each reading set going on as the largest reading set holding it, need 7.
+    import random
+
+    rng = random.Random(4)
+    angles = sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(200))
+    pts = [(30 * rng.uniform(0.7, 1.0), t) for t in angles]
+    outline = [(r * math.cos(t), r * math.sin(t)) for r, t in pts]
+    pf = part("rand-200", outline)
+    m = _goal_known(build_machine([pf], ToleranceSensor(0.01 * pf.part.size), IDEAL))
+    problem = Problem(m)
+    branches = problem.readings.branches(problem.full)
+    chain = _result(m, _sensorless_plan(problem, branches, Deadline(), by_image=True),
+                    False, None, 2, "worst", "exact")  # fmt: skip
+    read = _result(m, _sensorless_plan(problem, branches, Deadline()), False, None, 2, "worst",
+                   "exact")  # fmt: skip
+    assert check_plan(chain) == chain.length == 12
+    assert check_plan(read) == read.length == 7
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.sampled_from([("random", 9), ("random", 16), ("regular", 10), ("regular", 11)]),
+    st.integers(0, 10**6),
+    st.integers(1, 2**20 - 1),
+)
+def test_backchaining_length_of_any_set_is_the_breadth_first_length(kind, seed, bits):
+    # Goldberg's table against a breadth-first search over the machine's own images, on
+    # random parts (4-8 states) and off-centre regular polygons (10 and 11: more than a
+    # byte of states).
+    name, n = kind
+    offset = (0.01 + seed % 7 / 100, 0.004 + seed % 5 / 200)
+    pf = random_convex(seed, n) if name == "random" else regular(n, offset)
+    m = build_machine([pf], NoSensor(), uncertainty=IDEAL)
+    insep = inseparable(m)
+    circle = push_circle(m, insep)
+    assume(circle is not None and bits & m.all_states)
+    start = bits & m.all_states
+    depth, frontier, seen = 0, {start}, {start}
+    while not any(is_goal(insep, s) for s in frontier):
+        frontier = {r.image for s in frontier for r in overlap_ranges(m, s)} - seen
+        seen |= frontier
+        depth += 1
+    assert Backchain(circle).length(start) == depth
 
 
 @pytest.mark.slow

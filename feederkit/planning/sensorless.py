@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.angles import ANGLE_EPS, norm360
-from feederkit.machine import PushAlignMachine, members
+from feederkit.machine import PushAlignMachine
 from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.problem import Problem
 
@@ -164,6 +164,20 @@ class Backchain:
         # The states in the order of their positions, for the vectorised hull of big sets.
         self._order = np.argsort(np.asarray(self._state_pos), kind="stable")
         self._sorted_pos = np.asarray(self._state_pos)[self._order]
+        self._pos_list: list[float] = self._sorted_pos.tolist()
+        # A set's bits renumbered by position, a byte at a time: bit r of the result is the
+        # state of rank r (one table of 256 masks per byte of state numbers).
+        rank = [0] * len(self._state_pos)
+        for r, i in enumerate(self._order.tolist()):
+            rank[i] = r
+        self._rank_bytes: list[list[int]] = []
+        for base in range(0, len(rank), 8):
+            table = [0] * 256
+            for byte in range(1, 256):
+                low = byte & -byte
+                state = base + low.bit_length() - 1
+                table[byte] = table[byte ^ low] | (1 << rank[state] if state < len(rank) else 0)
+            self._rank_bytes.append(table)
         self._lengths: dict[int, float] = {}
 
     def hull(self, mask: int) -> float:
@@ -178,13 +192,31 @@ class Backchain:
                 return 0.0
             gap = max(float(np.max(np.diff(at))), float(at[0] + t - at[-1]))
             return t - gap
-        pos = self._state_pos
-        pts = sorted({pos[i] for i in members(mask)})
-        if len(pts) <= 1:
+        if not mask:
             return 0.0
-        gap = max(b - a for a, b in zip(pts, pts[1:], strict=False))
-        gap = max(gap, pts[0] + t - pts[-1])
-        return t - gap
+        # The members in the order of their positions (bits renumbered by rank), then the
+        # largest gap between neighbours on the circle.
+        ranked = 0
+        for table in self._rank_bytes:
+            if not mask:
+                break
+            ranked |= table[mask & 255]
+            mask >>= 8
+        pos = self._pos_list
+        low = ranked & -ranked
+        first = prev = pos[low.bit_length() - 1]
+        ranked ^= low
+        gap = 0.0
+        while ranked:
+            low = ranked & -ranked
+            at = pos[low.bit_length() - 1]
+            ranked ^= low
+            if at - prev > gap:
+                gap = at - prev
+            prev = at
+        if prev == first:
+            return 0.0
+        return t - max(gap, first + t - prev)
 
     def length(self, mask: int) -> float:
         """Minimum number of operations collapsing the set (inf: never; memoised: plans
