@@ -741,3 +741,23 @@ def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, c
     assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)
     # The plan's own size counts too, certified or not: every plan is verified.
     assert budget.per_pair_s == POST_S_PER_PAIR
+
+
+def test_a_deadline_keeps_time_in_hand_to_let_go_of_what_the_process_grew_by(monkeypatch):
+    # Freeing a search's tables takes time after its last poll: a process that grew by
+    # 10 GB keeps 10 s in hand, so a 5 s deadline has already passed, and one of 60 s has
+    # about 50 s left.
+    import feederkit.planning.budget as budget
+
+    base = rss_mb()
+    short, long = Deadline(5.0), Deadline(60.0)
+    monkeypatch.setattr(budget, "rss_mb", lambda: base + 10_000.0)
+    with pytest.raises(Timeout, match="time"):
+        short.check()
+    long.check()
+    assert 45.0 < long.remaining() < 50.5
+    # Without growth nothing is kept.
+    monkeypatch.setattr(budget, "rss_mb", lambda: base)
+    fresh = Deadline(5.0)
+    fresh.check()
+    assert fresh.remaining() > 4.0

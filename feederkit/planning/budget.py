@@ -25,6 +25,14 @@ from contextlib import contextmanager
 MEMORY_POLL_S = 0.02
 """``check`` reads the resident set size at most this often (seconds)."""
 
+RELEASE_S_PER_MB = 0.001
+"""Seconds a deadline keeps in hand per MB the process grew under it: letting go of a
+search's tables (millions of small objects, freed one by one by reference counting once
+the search stops) takes time after the last poll. The 50-part mix at 5 % under 1 degree
+with a 60 s limit grew by about 2 GB, and 2.4 s passed between the searches' Timeout and
+the answer (0.9 s of it in the lumping stage's return, 1.5 s unwinding the planner); a
+dictionary of 6 million tuples (1.9 GB) takes 0.4 CPU s to free."""
+
 _PAGE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
 
 
@@ -80,6 +88,9 @@ class Deadline:
         self.memory_base = memory_base
         if memory_base is None and memory_mb is not None:
             self.memory_base = min(rss_mb(), memory_mb)
+        elif memory_base is None and self.end is not None:
+            self.memory_base = rss_mb()
+        self._release_s = 0.0  # RELEASE_S_PER_MB of the growth at the last memory read
         self._next_memory = now
         self._limited = self.end is not None or memory_mb is not None
         self.polls = 0  # how often check() was called: the work done under this budget
@@ -90,17 +101,20 @@ class Deadline:
         return self._limited
 
     def check(self) -> None:
-        """Raise Timeout once the deadline or the memory limit has passed."""
+        """Raise Timeout once the deadline (less the time to let go of what the process
+        grew by, :data:`RELEASE_S_PER_MB`) or the memory limit has passed."""
         self.polls += 1
         if not self._limited:
             return
         now = time.perf_counter()
-        if self.end is not None and now > self.end:
-            raise Timeout("time")
-        if self.memory_mb is not None and now >= self._next_memory:
+        if now >= self._next_memory and self.memory_base is not None:
             self._next_memory = now + MEMORY_POLL_S
-            if rss_mb() > self.memory_mb:
+            rss = rss_mb()
+            self._release_s = RELEASE_S_PER_MB * max(0.0, rss - self.memory_base)
+            if self.memory_mb is not None and rss > self.memory_mb:
                 raise Timeout("memory")
+        if self.end is not None and now > self.end - self._release_s:
+            raise Timeout("time")
 
     def expired(self) -> bool:
         """Whether a limit has passed (reads the clock and the memory now)."""
@@ -125,7 +139,7 @@ class Deadline:
                 self.grace_s -= free
                 cost -= free
             self.end -= cost
-            if stop and pairs > 0 and time.perf_counter() > self.end:
+            if stop and pairs > 0 and time.perf_counter() > self.end - self._release_s:
                 raise Timeout("time")
 
     def with_grace(self, seconds: float) -> Deadline:
@@ -139,7 +153,7 @@ class Deadline:
         """Seconds left (never negative; None: no deadline)."""
         if self.end is None:
             return None
-        return max(0.0, self.end - time.perf_counter())
+        return max(0.0, self.end - self._release_s - time.perf_counter())
 
     def until(self, time_share: float, memory_share: float = 1.0) -> Deadline:
         """A budget for one stage: ending ``time_share`` of the way from this budget's start
