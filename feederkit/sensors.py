@@ -474,6 +474,11 @@ class ToleranceSensor:
 LED_EDGE_REL = 1e-6
 """A width within this fraction of the pitch of a beam's height may block that beam or not."""
 
+LED_MAX_NOISE_PITCHES = 1000
+"""The largest alignment noise an LED array may declare, in beam pitches: the reading
+branches are made one beam count at a time, so a noise of 10^5 pitches took 13 s and one of
+10^7 exhausted the memory; no array is misaligned by a thousand beams (a unit mistake)."""
+
 READING_EPS = 1e-9
 """Readings within this fraction of the pitch of a beam count are taken as that count."""
 
@@ -737,13 +742,15 @@ def _interval_branches(
     return [ReadingBranch(a, b, m) for a, b, m in _merge_cells(cells, gap=0.0)]
 
 
-def _components(diameters: Sequence[float], extent, closed: bool) -> list[tuple[int, ...]]:
-    """Connected components of overlapping reading intervals, in diameter order."""
-    order = sorted(range(len(diameters)), key=lambda i: diameters[i])
+def _components(diameters: Sequence, extent, closed: bool) -> list[tuple[int, ...]]:
+    """Connected components of overlapping reading intervals, in the order of their lower
+    ends (a diameter may be an interval, under a shape tolerance)."""
+    spans = [extent(d) for d in diameters]
+    order = sorted(range(len(diameters)), key=lambda i: spans[i])
     groups: list[list[int]] = []
     reach = -math.inf
     for i in order:
-        lo, hi = extent(diameters[i])
+        lo, hi = spans[i]
         if groups and (lo <= reach if closed else lo < reach):
             groups[-1].append(i)
             reach = max(reach, hi)
@@ -793,6 +800,11 @@ def make_sensor(
         e = 0.0 if noise is None else noise
         if not math.isfinite(e) or e < 0.0:
             raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
+        if e > LED_MAX_NOISE_PITCHES * led_pitch:
+            raise InputError(
+                f"--noise {e:g} mm is more than {LED_MAX_NOISE_PITCHES} beam pitches of "
+                f"{led_pitch:g} mm: no LED array is that far off (check the units)"
+            )
         return LedSensor(float(led_pitch), float(e))
     return NoSensor()
 

@@ -25,6 +25,7 @@ CASES = [
     ["plan", "no-such-part.json"],
     ["plan", PART, "--led-pitch", "-1"],
     ["plan", PART, "--noise", "0.1"],
+    ["plan", PART, "--led-pitch", "0.5", "--noise", "1e7"],
     ["plan", PART, "--rotation-error", "200"],
     ["plan", PART, "--shape-tolerance", "-1"],
     ["plan", PART, "--shape-tolerance", "1e9"],

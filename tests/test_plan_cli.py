@@ -155,6 +155,16 @@ def test_report_is_written(tmp_path, capsys):
     assert html.read_text().startswith("<!DOCTYPE html>")
 
 
+@pytest.mark.parametrize("sensor", [["--tolerance", "0.3"], ["--led-pitch", "0.5"]])
+def test_component_branching_takes_diameter_intervals(tmp_path, capsys, sensor):
+    # The d-washer's arc states have diameter intervals (its model error): the paper's
+    # component branching sorts them with the plain diameters (it raised TypeError).
+    src = str(CATALOG / "d-washer.json")
+    plan, _ = plan_file(tmp_path, capsys, [src, *sensor, "--grouping", "components"])
+    assert plan["stats"]["grouping"] == "components"
+    run_all(tmp_path / "plan.json", [src], capsys)
+
+
 def test_options_reach_the_plan(tmp_path, capsys):
     src = outline(tmp_path, "tri", TRI)
     plan, _ = plan_file(
