@@ -801,12 +801,34 @@ def make_sensor(
         if not math.isfinite(e) or e < 0.0:
             raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
         if e > LED_MAX_NOISE_PITCHES * led_pitch:
-            raise InputError(
-                f"--noise {e:g} mm is more than {LED_MAX_NOISE_PITCHES} beam pitches of "
-                f"{led_pitch:g} mm: no LED array is that far off (check the units)"
-            )
+            raise InputError(f"--noise {_noise_words(e, led_pitch)}")
         return LedSensor(float(led_pitch), float(e))
     return NoSensor()
+
+
+def _too_noisy(noise: float, pitch: float) -> bool:
+    """Whether an LED array's alignment noise is more than :data:`LED_MAX_NOISE_PITCHES`
+    pitches (but still a count of beams: wider ones are refused where counts are made, as
+    more than 2**53 beams)."""
+    return LED_MAX_NOISE_PITCHES * pitch < noise < 2.0**53 * pitch
+
+
+def _noise_words(noise: float, pitch: float) -> str:
+    """Why an LED array's alignment noise is refused (:func:`_too_noisy`)."""
+    return (
+        f"{noise:g} mm is more than {LED_MAX_NOISE_PITCHES} beam pitches of {pitch:g} mm: "
+        "no LED array is that far off (check the units)"
+    )
+
+
+def _led_from_dict(data: dict) -> SensorModel:
+    """The plan file's LED array, its noise bounded as on the command line."""
+    pitch, noise = float(data["pitch_mm"]), float(data.get("noise_mm", 0.0))
+    if not (math.isfinite(pitch) and pitch > 0.0 and math.isfinite(noise) and noise >= 0.0):
+        return make_sensor(led_pitch=pitch, noise=noise)  # refused there, in its words
+    if _too_noisy(noise, pitch):
+        raise InputError(f"the plan's sensor noise_mm {_noise_words(noise, pitch)}")
+    return LedSensor(pitch, noise)
 
 
 def sensor_from_dict(data: object) -> SensorModel:
@@ -826,9 +848,7 @@ def sensor_from_dict(data: object) -> SensorModel:
 _FROM_DICT: dict[str, Any] = {
     "none": lambda data: NoSensor(),
     "tolerance": lambda data: make_sensor(tolerance=float(data["tolerance_mm"])),
-    "led": lambda data: make_sensor(
-        led_pitch=float(data["pitch_mm"]), noise=float(data.get("noise_mm", 0.0))
-    ),
+    "led": _led_from_dict,
 }
 """Per model name, how its ``to_dict`` object is read back: a new model adds its line."""
 

@@ -202,3 +202,63 @@ def test_a_sensed_certificate_at_the_declared_shape_tolerance_says_why(capsys):
     assert "0.05 mm (the declared: reading" in out
     assert main([*args[:-3], "--sensorless", "--shape-tolerance", "0.05"]) in (0, 1)
     assert "(the declared: reading" not in " ".join(capsys.readouterr().out.split())
+
+
+def _leaves(plan: dict) -> list[dict]:
+    """The plan's distinct result nodes (shared subplans once)."""
+    out, seen, stack = [], set(), [plan["root"]]
+    while stack:
+        node = stack.pop()
+        node = plan.get("nodes", {}).get(node["ref"], node) if "ref" in node else node
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if "result" in node:
+            out.append(node)
+        else:
+            stack.extend(b["next"] for b in node["branches"])
+    return out
+
+
+@pytest.mark.parametrize("rotation_error", ["1", "0"])
+def test_a_result_naming_a_state_no_path_ends_in_is_refused(tmp_path, capsys, rotation_error):
+    # A controller may take any entry of a result as the answer (design.md): an entry for a
+    # state that never ends there (and reads otherwise) would send the part to a wrong pose.
+    path = tmp_path / "irt.plan.json"
+    src = str(CATALOG / "isosceles-right-triangle.json")
+    args = [src, "--tolerance", "0.01", "--rotation-error", rotation_error]
+    assert main(["plan", *args, "-o", str(path)]) == 0
+    plan = json.loads(path.read_text())
+    assert verify_declared(plan).ok
+    leaf = next(leaf for leaf in _leaves(plan) if len(leaf["result"]) == 1)
+    arrived = leaf["result"][0]["state"]
+    states = plan["parts"][0]["stable_states"]
+    other = next(s for s in states if s["id"] != arrived)
+    leaf["result"].append(
+        {"part": leaf["result"][0]["part"], "landing": leaf["result"][0].get("landing"),
+         "state": other["id"], "pose_deg": other["pose_deg"]}
+    )  # fmt: skip
+    if leaf["result"][0].get("landing") is None:
+        del leaf["result"][-1]["landing"]
+    report = verify_declared(plan)
+    assert not report.ok
+    assert f"state {other['id']}" in report.first_problem()
+    assert "ends there" in report.first_problem()
+    bad = tmp_path / "bad.plan.json"
+    bad.write_text(json.dumps(plan))
+    capsys.readouterr()
+    assert main(["run", str(bad), "--all"]) == 1
+    assert "ends there" in capsys.readouterr().err
+
+
+def test_a_state_unlike_its_geometry_says_how(bracket):
+    # A COM moved 3 mm keeps edge, normal and diameter: the resting range tells them apart,
+    # and the message must show it (it printed two equal sides).
+    bad = tampered(
+        bracket, lambda p: p["parts"][0]["com"].__setitem__(0, p["parts"][0]["com"][0] + 3.0)
+    )
+    report = verify_declared(bad)
+    assert not report.ok
+    problem = report.first_problem()
+    said, given = problem.split(", but its hull and COM give ")
+    assert "resting range" in said and said.split(" says ")[1] != given

@@ -310,6 +310,13 @@ def test_an_led_width_of_more_than_2_53_beams_is_refused(written, edit: Edit, wo
     assert words in message and "more than 2**53 beams" in message
 
 
+@pytest.mark.parametrize("noise", [1e7, 1e15])
+def test_an_led_noise_of_more_than_a_thousand_pitches_is_refused(written, noise: float) -> None:
+    """Reading branches are made one beam count at a time: 10^7 exhausted the memory."""
+    message = refused(written, lambda d: d["sensor"].update(noise_mm=noise))
+    assert f"sensor noise_mm {noise:g}" in message and "1000 beam pitches" in message
+
+
 # ---------------------------------------------------------------- the grammar (design.md)
 
 

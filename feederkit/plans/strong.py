@@ -200,6 +200,7 @@ class _Run:
         self._paths: dict[tuple[int, State], int] = {}
         self.rejected: dict[tuple[int, State], int] = {}
         self._handles: dict[tuple[int, State], bool] = {}
+        self.arrivals: dict[int, set[tuple[int, int]]] = {}  # leaf id: (part, ideal state)
         self._outcomes: dict[tuple[int, State], list[State]] = {}
         self._follow: dict[tuple[int, State], list[Mapping[str, Any]] | float] = {}
         self._index: dict[int, _BranchIndex] = {}
@@ -355,6 +356,10 @@ class _Run:
                 )
             self._worst[key], self._paths[key] = 0, 1
             self.rejected[key] = 1 if node.get("reject") is True else 0
+            p, s = x
+            self.arrivals.setdefault(id(node), set()).update(
+                (p, m) for m in self.model.mechanics[p].states[s].members
+            )
             return 0
         longest, paths, rejected = 0, 0, 0
         if self.margins:
@@ -369,6 +374,32 @@ class _Run:
         self._worst[key], self._paths[key] = 1 + longest, paths
         self.rejected[key] = rejected
         return 1 + longest
+
+    def unreached(self, root: Mapping[str, Any]) -> str | None:
+        """The first result entry, in a result some path ends in, that names a state no path
+        ends in there (None: none): a controller may take any entry of a result as the
+        answer (design.md), so such an entry would send the part to a wrong pose."""
+        seen: set[int] = set()
+        stack = [root]
+        while stack:
+            node = self.node(stack.pop())
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
+            if "result" not in node:
+                stack.extend(b["next"] for b in node["branches"])
+                continue
+            arrived = self.arrivals.get(id(node))
+            if not arrived:
+                continue  # a result no path of this model ends in names nothing here
+            for e in node["result"]:
+                p = self.by_name.get((e["part"], e.get("landing")))
+                if p is not None and (p, e["state"]) not in arrived:
+                    return (
+                        f"a result lists {member_label(e['part'], e.get('landing'))} state "
+                        f"{e['state']}, but no start, outcome or reading of it ends there"
+                    )
+        return None
 
     def handles(self, node: Mapping[str, Any], x: State) -> bool:
         """Whether every path of ``x`` from ``node`` on ends in a leaf naming its state."""
@@ -459,6 +490,9 @@ def verify_strong(
             rejected += run.rejected[(id(run.node(root)), x)]
         overall = max(overall, worst)
         checks.append(PartCheck(name, len(states), paths, worst, 0, landing, rejected))
+    spurious = run.unreached(root) if uncertainty is None else None
+    if spurious is not None:
+        raise CheckFailed(spurious)
     stated = plan["stats"]["length"]
     if overall != stated:
         raise CheckFailed(

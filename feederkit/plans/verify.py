@@ -221,6 +221,7 @@ class _PartSearch:
         self.diameter = {s.id: s.diameter for s in self.pf.states}
         self.arcs = resting_arcs(self.pf)
         self.memo: dict[tuple[int, int], _Outcome] = {}
+        self.arrivals: set[tuple[int, int]] = set()  # (id of a leaf, a state that ends there)
 
     def after_push(self, node: Step, number: int, state: StableState) -> _Outcome:
         """Outcome of every continuation once operation ``number`` of ``node`` left ``state``
@@ -248,6 +249,7 @@ class _PartSearch:
                 if isinstance(nxt, Leaf):
                     paths += 1
                     rejects += nxt.reject
+                    self.arrivals.add((id(nxt), state.id))
                     if not nxt.accepts(self.name, state.id, self.landing) and failure is None:
                         failure = _Failure(reading, b, branch.reading, (), state, nxt)
                     continue
@@ -277,6 +279,24 @@ class _PartSearch:
                         )
         self.memo[key] = _Outcome(paths, worst - number, failure, rejects)
         return _Outcome(paths, worst, failure, rejects)
+
+    def unreached(self) -> list[str]:
+        """Result entries of this part that no path of it ends in: a controller may take any
+        entry of a result as the answer (design.md), so one naming a state the part cannot be
+        in there would send it to a wrong pose."""
+        out = []
+        for leaf in self.plan.leaves():
+            for e in leaf.results:
+                if (e.part, e.landing) == (self.name, self.landing) and (
+                    id(leaf),
+                    e.state,
+                ) not in self.arrivals:
+                    out.append(
+                        f"a result lists {member_label(e.part, e.landing)} state {e.state} "
+                        f"(pose {e.pose_deg:.6g} deg), but no start, rotation or reading of it "
+                        "ends there"
+                    )
+        return out
 
     def run(self) -> tuple[PartCheck, list[Trace]]:
         paths, worst, failed, rejects = 0, 0, [], 0
@@ -345,11 +365,19 @@ def _state_problems(plan: Plan, p: int, eps_d: float) -> list[str]:
         )
         if not same:
             out.append(
-                f"part {part.label!r} state {s.id}: the plan says edge {f.edge}, normal "
-                f"{f.normal_deg:.6g} deg, diameter {f.diameter:.10g}, but its hull and COM "
-                f"give edge {s.edge}, normal {s.normal_deg:.6g} deg, diameter {s.diameter:.10g}"
+                f"part {part.label!r} state {s.id}: the plan says {_state_words(f)}, but its "
+                f"hull and COM give {_state_words(s)}"
             )
     return out
+
+
+def _state_words(s: StableState) -> str:
+    """A stable state's listed figures, to the digits the comparison above tells apart."""
+    lo, hi = s.resting_range_deg
+    return (
+        f"edge {s.edge}, normal {s.normal_deg:.9g} deg, resting range {lo:.9g}..{hi:.9g} deg, "
+        f"diameter {s.diameter:.10g}, pose {s.pose_deg:.9g} deg"
+    )
 
 
 def _pose_problems(plan: Plan) -> list[str]:
@@ -486,7 +514,10 @@ def verify_plan(
     try:
         for p in indices:
             problems += _state_problems(plan, p, eps_d)
-            check, failed = _PartSearch(plan, p).run()
+            search = _PartSearch(plan, p)
+            check, failed = search.run()
+            if not failed:
+                problems += search.unreached()
             if check.worst_operations > length:
                 problems.append(
                     f"part {check.part!r}: a run takes "
