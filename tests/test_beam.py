@@ -223,6 +223,10 @@ def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(mo
         raise Timeout("time")
 
     monkeypatch.setattr(api, "longest_root", out_of_time)
+    # Without the backchaining plans and the pairs told apart one at a time (the plan that
+    # follows the readings is often as short as the beams can find), the beams give the plan.
+    for maker in ("_sensorless_plan", "pairwise_plan"):
+        monkeypatch.setattr(api, maker, lambda *_args, **_kwargs: None)
     calls = []
     real = api.beam_plan
 

@@ -162,11 +162,12 @@ def test_an_accepted_landing_no_sensor_tells_from_a_rejected_one(line, capsys):
     compiled = ["changeover", "compile", "edge", "--mix", "pent-plate", "--tolerance", "0.1"]
     _, out = cli(capsys, [*compiled, *args, "--catalog", str(line)], 1)
     # No strong plan, said as such: an accepted and a rejected pose are never listed
-    # together (the verifier refused such a plan before), and lumping cannot help them.
+    # together (the verifier refused such a plan before), and lumping cannot help them; it
+    # is offered only for the edge pose's own states end for end, whose COM sets them apart.
     last = out.err.strip().splitlines()[-1]
     assert "no strong plan tells accepted states from rejected ones" in last
     assert "listed in a reject result and in an accept result" not in last
-    assert "lumping 'any'" not in last
+    assert "lumping 'any'" not in last or "do not look alike" in last
 
 
 @pytest.mark.parametrize(

@@ -17,6 +17,7 @@ import pytest
 from test_strong_plans import strong_search
 
 import feederkit.planning.api as api
+from feederkit.errors import PlanningError
 from feederkit.machine import (
     MachineState,
     OutcomeRange,
@@ -428,10 +429,11 @@ BRACKET_POSES = {
 
 def test_parts_are_listed_together_only_when_lumping_their_own_states_is_not_enough():
     """With a 0.05 mm sensor at 1 degree, pairs across the two poses are unresolvable on
-    the inseparable goal only because each pose's near-symmetric states must be told apart;
-    with those lumped, a strong plan tells the poses apart. The plan did list them together
-    (1 operation, "cannot tell these landings apart"), and the catalog screen named them;
-    now the plan recognizes both (3 operations, verified) and the screen agrees."""
+    the inseparable goal only because each pose's end-for-end states must be told apart;
+    with those lumped (lumping 'any'), a strong plan tells the poses apart. The plan did
+    list them together (1 operation, "cannot tell these landings apart"), and the catalog
+    screen named them; now the plan with lumping 'any' recognizes both (3 operations,
+    verified), and with the default rule neither plan nor screen does."""
     from feederkit.mix.strongpairs import check_strong_pair
     from feederkit.planning.lumping import within_first
 
@@ -446,8 +448,16 @@ def test_parts_are_listed_together_only_when_lumping_their_own_states_is_not_eno
     assert any(states[i].part != states[j].part for i, j in found)  # across, at first
     fewer = within_first(Problem(machine, "exact", 0.0), found)
     assert fewer is not None and all(states[i].part == states[j].part for i, j in fewer)
-    made = make_plan(pfs, sensor, uncertainty=unc, certify=False)  # verified on the model
+    # Each pose's states end for end have congruent hulls but the leg's COM at one end
+    # (6.6 mm off centre on the 40 mm side): they do not look alike, so only lumping 'any'
+    # lists them together (verified on the model).
+    with pytest.raises(PlanningError, match="do not look alike"):
+        make_plan(pfs, sensor, uncertainty=unc, certify=False)
+    made = make_plan(
+        pfs, sensor, uncertainty=unc, certify=False, options=PlanningOptions(lumping="any")
+    )
     assert made.result.length == 3
     for mask in leaf_masks(made.result.root):
         assert len({made.result.machine.states[i].part for i in members(mask)}) == 1
-    assert check_strong_pair(pfs[0], pfs[1], sensor, unc).witness is None
+    # The screen follows the default rule, as the plan does: it names the pair.
+    assert check_strong_pair(pfs[0], pfs[1], sensor, unc).witness is not None

@@ -26,8 +26,10 @@ def _shared_chain(depth: int) -> tuple[PlanResult, object]:
     narrow = sum(1 << i for i, s in enumerate(m.states) if s.diameter < 1.5)
     short = ReadingBranch(0.99, 1.01, narrow)
     long = ReadingBranch(1.99, 2.01, m.all_states ^ narrow)
-    node: Step | Leaf = Leaf(m.all_states)
-    for _ in range(depth):  # two branches to one shared child: 2**depth leaves when expanded
+    # The last step's reading tells the sides apart; the symmetric poses of a side listed
+    # together (paths may end in only one of them).
+    node: Step | Leaf = Step(action, ((short, Leaf(short.mask)), (long, Leaf(long.mask))))
+    for _ in range(depth - 1):  # two branches to one shared child: 2**depth leaves expanded
         node = Step(action, ((short, node), (long, node)))
     root = Step(None, ((short, node), (long, node)))
     result = PlanResult(m, root, depth + 1, float(depth + 1), action.margin, False, 2)

@@ -49,12 +49,16 @@ MARGIN = 10.0  # every multiple of 90 degrees keeps the rectangle's states withi
 def layered(layers: int, width: int = 10, uncertainty: Uncertainty | None = None) -> Plan:
     """A plan of ``layers`` layers of ``width`` distinct steps (rotations by multiples of 90
     degrees), each branching on the reading to two steps of the next layer; every path takes
-    every layer and ends in the one leaf listing every state (right, if useless)."""
+    every layer and ends in one of two leaves, the states of each diameter (right, if
+    useless: paths end there in each state it lists)."""
     base = read_plan(GOLDEN / BASE)
     part = base.parts[0]
-    leaf = Leaf(tuple(ResultEntry(part.name, s.id, s.pose_deg) for s in part.states))
+    leaves = [
+        Leaf(tuple(ResultEntry(part.name, s.id, s.pose_deg) for s in part.states if k == s.id % 2))
+        for k in range(2)
+    ]  # diameters 1, 2, 1, 2: the short states, the long ones
     short, long = (0.98, 1.02), (1.98, 2.02)
-    below: list[Step | Leaf] = [leaf] * width
+    below: list[Step | Leaf] = [leaves[j % 2] for j in range(width)]
     for _ in range(layers):
         below = [
             Step(
@@ -262,8 +266,11 @@ def _uneven(uncertainty: Uncertainty | None = None) -> Plan:
     base = read_plan(GOLDEN / BASE)
     part = base.parts[0]
     short, long = (0.98, 1.02), (1.98, 2.02)
-    leaf = Leaf(tuple(ResultEntry(part.name, s.id, s.pose_deg) for s in part.states))
-    shared = Step(0.0, MARGIN, (Branch(short, leaf), Branch(long, leaf)))
+    narrow, wide = (
+        Leaf(tuple(ResultEntry(part.name, s.id, s.pose_deg) for s in part.states if k == s.id % 2))
+        for k in range(2)
+    )  # diameters 1, 2, 1, 2
+    shared = Step(0.0, MARGIN, (Branch(short, narrow), Branch(long, wide)))
     turn = Step(90.0, MARGIN, (Branch(short, shared), Branch(long, shared)))
     root = Step(None, None, (Branch(short, shared), Branch(long, turn)))
     widths = {s.id: s.resting_range_deg[1] - s.resting_range_deg[0] for s in part.states}

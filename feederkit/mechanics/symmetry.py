@@ -172,6 +172,20 @@ def _placed(pf: PushFunction, state: int) -> np.ndarray:
     return np.asarray(pf.part.hull, dtype=float) @ rot.T - shift
 
 
+def _com_gaps(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
+    """Per pair of stable states, how far apart (mm) the COM lies in the two poses placed as
+    :func:`_placed` places the hull: a hull the poses share hides nothing of the part's mass,
+    so a COM off the hull's symmetry (a solid's leg standing up at one end of the side it
+    lies on, a hidden insert) sets the poses apart as a hole does."""
+    com = np.asarray(pf.part.com, dtype=float)
+    used = sorted({i for p in pairs for i in p})
+    placed = {}
+    for i in used:
+        rot, shift = _pose_frame(pf, i)
+        placed[i] = rot @ com - shift
+    return np.array([float(np.hypot(*(placed[a] - placed[b]))) for a, b in pairs])
+
+
 def _normals(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A convex polygon's outward edge normals (counter-clockwise vertices ``p``), sorted in
     [0, 2 pi), and the support vertex just past each (edge ``i``'s normal: vertex ``i + 1``)."""
@@ -327,7 +341,7 @@ def pose_differences(pf: PushFunction, pairs: Sequence[tuple[int, int]]) -> np.n
     parts = [
         _support_gaps(polys, local[k : k + EXACT_CHUNK]) for k in range(0, len(local), EXACT_CHUNK)
     ]
-    gaps = np.concatenate(parts)
+    gaps = np.maximum(np.concatenate(parts), _com_gaps(pf, pairs))
     if _has_more_than_hull(pf):
         gaps = np.maximum(gaps, _outline_gaps(pf, pairs))
     return gaps
@@ -338,8 +352,9 @@ def pose_difference(pf: PushFunction, a: int, b: int) -> float:
     Hausdorff distance of its hull in the two poses on the fence, each resting on the fence
     line and centred along it (the position along the fence is not observed), exact (the
     largest difference of the two support functions, :func:`_support_gaps`); for an outline
-    with holes or notches, at least the bound :func:`_outline_gaps` on its boundary's. 0 for states
-    that a symmetry of the hull maps onto each other (definitions 3, 6); small for the
+    with holes or notches, at least the bound :func:`_outline_gaps` on its boundary's; at
+    least the distance the COM moves between the poses (:func:`_com_gaps`). 0 for states
+    that a symmetry of the part maps onto each other (definitions 3, 6); small for the
     near-symmetric states a plan under uncertainty may list together. It is at least the
     difference of the two diameters (the poses' heights above the fence).
 
@@ -411,6 +426,11 @@ def look_alike(
         ]
     )
     close = {p for p, d in zip(todo, gaps, strict=True) if d <= tol}
+    if close:
+        # The COM the hull does not show (:func:`_com_gaps`).
+        hull_close = sorted(close)
+        com = _com_gaps(pf, [(ideal[i], ideal[j]) for i, j in hull_close])
+        close = {p for p, d in zip(hull_close, com, strict=True) if d <= tol}
     if close and _has_more_than_hull(pf):
         # Holes and notches the hulls do not show: the outline's own distance decides.
         hull_close = sorted(close)

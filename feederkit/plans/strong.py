@@ -51,7 +51,7 @@ from feederkit.planning.tree import PlanResult, Step
 from feederkit.plans.execute import rounding_inset
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.model import PlanPart, member_label, push_function_of
-from feederkit.plans.verify import PartCheck, VerificationReport
+from feederkit.plans.verify import PartCheck, VerificationReport, unlike_unreached
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
@@ -376,9 +376,8 @@ class _Run:
         return 1 + longest
 
     def unreached(self, root: Mapping[str, Any]) -> str | None:
-        """The first result entry, in a result some path ends in, that names a state no path
-        ends in there (None: none): a controller may take any entry of a result as the
-        answer (design.md), so such an entry would send the part to a wrong pose."""
+        """The first result entry that names a state no path ends in there and that looks
+        like none that does (:func:`~feederkit.plans.verify.unlike_unreached`; None: none)."""
         seen: set[int] = set()
         stack = [root]
         while stack:
@@ -389,15 +388,19 @@ class _Run:
             if "result" not in node:
                 stack.extend(b["next"] for b in node["branches"])
                 continue
-            arrived = self.arrivals.get(id(node))
-            if not arrived:
-                continue  # a result no path of this model ends in names nothing here
+            arrived = self.arrivals.get(id(node), set())
+            listed: dict[int, list[int]] = {}
             for e in node["result"]:
                 p = self.by_name.get((e["part"], e.get("landing")))
-                if p is not None and (p, e["state"]) not in arrived:
+                if p is not None:
+                    listed.setdefault(p, []).append(e["state"])
+            for p, states in listed.items():
+                mine = {s for q, s in arrived if q == p}
+                bad = unlike_unreached(self.model.mechanics[p].push, states, mine)
+                if bad:
                     return (
-                        f"a result lists {member_label(e['part'], e.get('landing'))} state "
-                        f"{e['state']}, but no start, outcome or reading of it ends there"
+                        f"a result lists {self.model.label(p)} state {bad[0]}, but no start, "
+                        "outcome or reading of it ends there, and it looks like none that does"
                     )
         return None
 

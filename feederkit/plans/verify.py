@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -36,7 +36,7 @@ import numpy as np
 from feederkit.angles import angle_close, norm360
 from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
-from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
+from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, NEAR_SYMMETRIC_REL, pose_differences
 from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, Step, member_label, push_function_of
@@ -281,21 +281,19 @@ class _PartSearch:
         return _Outcome(paths, worst, failure, rejects)
 
     def unreached(self) -> list[str]:
-        """Result entries of this part that no path of it ends in: a controller may take any
-        entry of a result as the answer (design.md), so one naming a state the part cannot be
-        in there would send it to a wrong pose."""
+        """Result entries of this part that no path of it ends in and that look like no
+        state that does (:func:`unlike_unreached`)."""
         out = []
         for leaf in self.plan.leaves():
-            for e in leaf.results:
-                if (e.part, e.landing) == (self.name, self.landing) and (
-                    id(leaf),
-                    e.state,
-                ) not in self.arrivals:
-                    out.append(
-                        f"a result lists {member_label(e.part, e.landing)} state {e.state} "
-                        f"(pose {e.pose_deg:.6g} deg), but no start, rotation or reading of it "
-                        "ends there"
-                    )
+            mine = (e for e in leaf.results if (e.part, e.landing) == (self.name, self.landing))
+            listed = {e.state: e.pose_deg for e in mine}
+            arrived = {s for s in listed if (id(leaf), s) in self.arrivals}
+            for s in unlike_unreached(self.pf, listed, arrived):
+                out.append(
+                    f"a result lists {member_label(self.name, self.landing)} state {s} (pose "
+                    f"{listed[s]:.6g} deg), but no start, rotation or reading of it ends there, "
+                    "and it looks like none that does"
+                )
         return out
 
     def run(self) -> tuple[PartCheck, list[Trace]]:
@@ -317,6 +315,25 @@ class _PartSearch:
                 failed.append(finish(self.name, theta, steps, f.final, f.leaf, self.landing))
         check = PartCheck(self.name, len(starts), paths, worst, len(failed), self.landing, rejects)
         return check, failed
+
+
+def unlike_unreached(pf: PushFunction, listed: Iterable[int], arrived: set[int]) -> list[int]:
+    """The states of ``listed`` (one part's entries of a result) that no path ends in there
+    and whose pose looks like that of none of the ``arrived`` (within ``NEAR_SYMMETRIC_REL``
+    of the part's size, :func:`~feederkit.mechanics.symmetry.pose_difference`).
+
+    A controller may take any entry of a result as the answer (design.md), so such an entry
+    would send the part to a wrong pose. Entries that look like an arriving one are harmless
+    (a symmetric pose, or a near-symmetric one listed with it), and plans whose reading sets
+    follow a larger set's subplan list them. A result no state of the part ends in is not
+    judged here (it names what another part's paths bring, or nothing reaches it)."""
+    missing = [s for s in listed if s not in arrived]
+    if not missing or not arrived:
+        return []
+    tol = NEAR_SYMMETRIC_REL * pf.part.size
+    near = pose_differences(pf, [(s, a) for s in missing for a in sorted(arrived)])
+    width = len(arrived)
+    return [s for k, s in enumerate(missing) if near[k * width : (k + 1) * width].min() > tol]
 
 
 def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
