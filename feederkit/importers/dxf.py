@@ -234,17 +234,61 @@ def _count_expanded(doc: DxfDocument, layouts: list[object], budget: Budget) -> 
     return total
 
 
+Unseen = tuple[str, str]
+"""Why CAD does not show an entity: ``("frozen", layer)``, ``("off", layer)`` or
+``("invisible", "")``."""
+
+
 @dataclass(frozen=True)
 class Placed:
     """A curve entity of the drawing as CAD draws it: the entity as stored (in its block's
     coordinates), its effective layer and linetype, the block-to-world ``matrix`` (None for
-    an entity of the layout itself) and the layout's block reference it comes from."""
+    an entity of the layout itself), the layout's block reference it comes from, and why
+    CAD does not show it (:func:`unseen_by`; None when it does)."""
 
     entity: DXFGraphic
     layer: str
     linetype: str = CONTINUOUS
     matrix: Matrix44 | None = None
     ref: DXFGraphic | None = None
+    unseen: Unseen | None = None
+
+
+def hidden_layers(doc: DxfDocument, shown: Sequence[str] = ()) -> dict[str, str]:
+    """The layers CAD does not show, by lower-case name: ``"frozen"`` or ``"off"``.
+
+    Layers named in ``shown`` (``--layer``) are read whatever their state: the user asked
+    for them.
+    """
+    keep = {name.lower() for name in shown}
+    states = {}
+    for layer in doc.layers:
+        name = str(layer.dxf.name).lower()
+        if name in keep:
+            continue
+        if layer.is_frozen():
+            states[name] = "frozen"
+        elif layer.is_off():
+            states[name] = "off"
+    return states
+
+
+def unseen_by(
+    entity: DXFGraphic, layer: str, states: dict[str, str], reference: bool = False
+) -> Unseen | None:
+    """Why CAD does not show ``entity`` drawn on its effective ``layer``: the layer is
+    frozen or off, or the entity carries the invisible flag (group 60); None if it shows.
+
+    For a block ``reference`` only a frozen layer counts: an off one hides the block's
+    entities that take the reference's layer (on layer "0"), and those are told apart
+    when they are read.
+    """
+    state = states.get(layer.lower())
+    if state == "frozen" or (state == "off" and not reference):
+        return state, layer
+    if entity.dxf.is_supported("invisible") and entity.dxf.get("invisible", 0):
+        return "invisible", ""
+    return None
 
 
 def effective_linetype(entity: DXFGraphic, layer: str, block_linetype: str) -> str:
@@ -298,8 +342,11 @@ def explode(
     matrix: Matrix44 | None = None,
     linetype: str = CONTINUOUS,
     ref: DXFGraphic | None = None,
+    states: dict[str, str] | None = None,
+    unseen: Unseen | None = None,
 ) -> Iterator[Placed]:
-    """Curve entities with their effective layer, linetype and block-to-world matrix.
+    """Curve entities with their effective layer, linetype, block-to-world matrix and
+    whether CAD shows them (the layers' ``states``, :func:`hidden_layers`).
 
     A block reference's matrix (``Insert.matrix44``) is composed with its parents', and each
     curve is later transformed as a curve (:func:`curve_path`): ezdxf's ``virtual_entities``
@@ -307,8 +354,10 @@ def explode(
     non-uniform scale into the wrong shape, and re-interpolates a fit-point spline through
     transformed fit points. Annotation inside blocks (dimensions, leaders, text) is
     skipped. Entities of a block on layer "0" take the layer of the reference, as CAD
-    programs draw them.
+    programs draw them: so a reference on an off layer hides them, and one on a frozen
+    layer, or with the invisible flag, hides its whole block (``unseen``).
     """
+    states = {} if states is None else states
     for entity in entities:  # type: ignore[attr-defined]
         kind = entity.dxftype()
         if kind != "INSERT" and kind not in CURVES:
@@ -317,9 +366,10 @@ def explode(
         own = entity.dxf.get("layer", "0") if entity.dxf.is_supported("layer") else "0"
         eff = layer if (own == "0" and layer) else own
         drawn = effective_linetype(entity, eff, linetype)
+        hidden = unseen or unseen_by(entity, eff, states, reference=kind == "INSERT")
         if kind != "INSERT":
             budget.entities()
-            yield Placed(entity, eff, drawn, matrix, ref)
+            yield Placed(entity, eff, drawn, matrix, ref, hidden)
             continue
         if depth >= MAX_BLOCK_DEPTH:
             raise InputError(
@@ -334,7 +384,9 @@ def explode(
         for cell in _block_references(entity, budget.label):
             own = _reference_matrix(cell, budget.label)
             placed = own if matrix is None else own @ matrix
-            yield from explode(block, eff, depth + 1, skipped, budget, placed, drawn, ref or entity)
+            yield from explode(
+                block, eff, depth + 1, skipped, budget, placed, drawn, ref or entity, states, hidden
+            )
 
 
 def _point_count(entity: DXFGraphic) -> int:
@@ -515,20 +567,143 @@ class DrawnLines:
         )
 
 
+def top_view_loss(points: Sequence[np.ndarray], end_on: float) -> tuple[float, float]:
+    """How much the top view (the projection onto XY) shortens the drawing: the largest
+    length a segment of the entities' control polygons (``points``, one array per entity)
+    loses, over all segments and over those not seen end-on (a top view no longer than
+    ``end_on``: a wireframe's vertical edge draws nothing there, so it loses nothing)."""
+    pts = np.concatenate(points)
+    seg = np.diff(pts, axis=0)
+    inside = np.ones(len(seg), dtype=bool)
+    inside[np.cumsum([len(cv) for cv in points])[:-1] - 1] = False  # one entity to the next
+    seg = seg[inside]
+    if not len(seg):
+        return 0.0, 0.0
+    flat = np.hypot(seg[:, 0], seg[:, 1])
+    loss = np.linalg.norm(seg, axis=1) - flat
+    shown = loss[flat > end_on]
+    return float(loss.max()), float(shown.max()) if len(shown) else 0.0
+
+
+def best_plane(pts: np.ndarray) -> tuple[np.ndarray | None, np.ndarray, np.ndarray, float]:
+    """The plane that fits points (n, 3) best: its unit normal (None when the points lie
+    on a line, which no plane fixes), a point of it (their mean), each point's distance
+    from it, and the largest distance of a point from the line that fits them best."""
+    mean = pts.mean(axis=0)
+    centred = pts - mean
+    axes = np.linalg.svd(centred, full_matrices=False)[2]
+    along = centred @ axes[0]
+    off_line = float(np.linalg.norm(centred - along[:, None] * axes[0], axis=1).max())
+    if len(axes) < 3:  # two points
+        return None, mean, np.zeros(len(pts)), off_line
+    return axes[2], mean, centred @ axes[2], off_line
+
+
+def upward(normal: np.ndarray) -> np.ndarray:
+    """The plane's normal seen from above: z up; in a vertical plane, toward -y (CAD's
+    front view), in the YZ plane toward +x (its right view)."""
+    nx, ny, nz = normal
+    key = nz if abs(nz) > 1e-9 else (-ny if abs(ny) > 1e-9 else nx)
+    return normal if key > 0 else -normal
+
+
+def plane_words(normal: np.ndarray, point: np.ndarray, scale: float) -> str:
+    """A plane by name (``the XZ plane (y = 0 mm)``) or by tilt, normal and a point."""
+    for k, (axis, name) in enumerate((("x", "YZ"), ("y", "XZ"))):
+        if abs(abs(normal[k]) - 1.0) < 1e-9:
+            return f"the {name} plane ({axis} = {point[k] * scale:.4g} mm)"
+    tilt = math.degrees(math.acos(min(1.0, abs(float(normal[2])))))
+    n = ", ".join(f"{v:.3g}" for v in normal + 0.0)
+    at = ", ".join(f"{v * scale:.4g}" for v in point + 0.0)
+    return f"a plane tilted {tilt:.3g} degrees to the XY plane (normal ({n}), through ({at}) mm)"
+
+
+def plane_turn(normal: np.ndarray) -> Matrix44:
+    """The smallest rotation that turns a plane's (upward) ``normal`` onto +z."""
+    axis = np.cross(normal, (0.0, 0.0, 1.0))
+    angle = math.acos(max(-1.0, min(1.0, float(normal[2]))))
+    return Matrix44.axis_rotate(Vec3(*(axis / np.linalg.norm(axis))), angle)
+
+
+def turned(points: np.ndarray, matrix: Matrix44) -> np.ndarray:
+    """Points (n, 3) transformed by an ezdxf matrix (row vectors, as ``Matrix44``)."""
+    m = np.array([matrix.get_row(k) for k in range(4)], dtype=float)
+    return points @ m[:3, :3] + m[3, :3]
+
+
+def drawing_plane(
+    points: Sequence[np.ndarray],
+    names: Sequence[str],
+    scale: float,
+    tolerance: float,
+    label: str,
+) -> tuple[Matrix44 | None, str]:
+    """The rotation that lays a drawing drawn in a plane not parallel to XY flat, true to
+    shape, and the warning saying so; (None, "") for a drawing read in its top view.
+
+    ``points`` are the entities' control points (drawing units), ``names`` the entities.
+    The top view is read when it shortens no segment of the entities' control polygons by
+    more than ``tolerance`` (mm, at least :data:`REL_FLATTEN` of the drawing's size): the
+    drawing lies in XY, or in planes parallel to it (a wireframe's edges seen end-on
+    aside). Otherwise geometry in one plane (within the tolerance; an entity drawn in a
+    UCS, LINEs whose z varies with y) is turned onto XY, by the smallest rotation that
+    keeps it seen from above: read as its top view it came in foreshortened, and in the XZ
+    plane as a line. Geometry in no one plane is refused, naming the entity farthest off.
+    """
+    pts = np.concatenate(points)
+    size = float((pts.max(axis=0) - pts.min(axis=0)).max())
+    tol = max(tolerance / scale, REL_FLATTEN * size)
+    loss, loss_seen = top_view_loss(points, tol)
+    if loss <= tol:
+        return None, ""
+    normal, mean, dist, off_line = best_plane(pts)
+    if normal is None or off_line <= tol:
+        return None, ""  # on a line: refused later as having no area
+    normal = upward(normal)
+    if float(np.abs(dist).max()) <= tol:
+        tilt = math.degrees(math.acos(min(1.0, float(normal[2]))))
+        turn = plane_turn(normal)
+        axis = np.cross(normal, (0.0, 0.0, 1.0))
+        axis = ", ".join(f"{v:.3g}" for v in axis / np.linalg.norm(axis) + 0.0)
+        short = 1.0 - float(normal[2])
+        top = "a line" if short > 0.999 else f"{short:.0%} short across the tilt"
+        return turn, (
+            f"the drawing lies in {plane_words(normal, mean, scale)}: imported true to shape, "
+            f"turned {tilt:.3g} degrees onto the XY plane about the axis ({axis}), so the "
+            f"part's coordinates are the turned plane's, not the drawing's (its top view is "
+            f"{top}); draw it in the XY plane to keep the drawing's coordinates"
+        )
+    if loss_seen <= tol:
+        return None, ""  # in planes parallel to XY: a wireframe's top view
+    owner = np.repeat(np.arange(len(points)), [len(cv) for cv in points])
+    worst = int(np.argmax(np.abs(dist)))
+    raise InputError(
+        f"{label}: the geometry lies in no one plane: {names[owner[worst]]} lies "
+        f"{abs(float(dist[worst])) * scale:.3g} mm off the plane that fits the drawing best "
+        f"({plane_words(normal, mean, scale)}), and the top view would shorten lines by up "
+        f"to {loss_seen * scale:.3g} mm; draw the part's outline in one plane, or leave the "
+        "other geometry out with --layer"
+    )
+
+
 def dxf_lines(
     doc: DxfDocument,
     options: ImportOptions,
     scale: float,
     label: str,
     budget: Budget,
-) -> tuple[DrawnLines, Counter[str], list[str], float]:
+) -> tuple[DrawnLines, Counter[str], list[str], float, str]:
     """Outline polylines of the chosen space (mm) with their entities, layers and linetypes,
-    skipped types, warnings, flatten tolerance.
+    skipped types, warnings, flatten tolerance, and what was left out as not shown in CAD
+    (:func:`unseen_note`; "" for nothing).
 
     With ``options.layers``, only entities on those layers (case-insensitive; block contents
-    on layer "0" count on their reference's layer) are read. Every coordinate is checked as
-    it is read: NaN, infinity or a magnitude beyond :data:`MAX_COORD_MM` is refused before
-    any geometry runs. The flatten tolerance is at least :data:`REL_FLATTEN` of the
+    on layer "0" count on their reference's layer) are read. Entities CAD does not show (on
+    a frozen or off layer not named with ``--layer``, or invisible) are left out, with a
+    warning; when nothing else is left the drawing is refused. Every coordinate is checked
+    as it is read: NaN, infinity or a magnitude beyond :data:`MAX_COORD_MM` is refused
+    before any geometry runs. A drawing in one plane not parallel to XY is turned onto it
+    (:func:`drawing_plane`). The flatten tolerance is at least :data:`REL_FLATTEN` of the
     drawing's size, so a huge circle cannot ask for millions of segments.
     """
     layers = options.layers
@@ -537,19 +712,23 @@ def dxf_lines(
     seen: set[str] = set()
     layouts = space_layouts(doc, options.space)
     _count_expanded(doc, layouts, budget)
+    states = hidden_layers(doc, layers)
+    unseen: list[tuple[Unseen, str]] = []
     paths: list[tuple[str, dxfpath.Path]] = []
+    points: list[np.ndarray] = []
     owners: list[str] = []
     owner_layers: list[str] = []
     owner_linetypes: list[str] = []
-    lo = np.full(2, np.inf)
-    hi = np.full(2, -np.inf)
     for layout in layouts:
-        for placed in explode(layout, "", 0, skipped, budget):
+        for placed in explode(layout, "", 0, skipped, budget, states=states):
             entity, layer = placed.entity, placed.layer
             seen.add(layer)
             if wanted and layer.lower() not in wanted:
                 continue
             name = _label(entity, placed.ref)
+            if placed.unseen is not None:
+                unseen.append((placed.unseen, f"{name} on layer {layer!r}"))
+                continue
             budget.need("vertices", _point_count(entity), "points in one entity")
             budget.check_time()
             check_finite(entity, label, placed.ref)
@@ -573,21 +752,37 @@ def dxf_lines(
                     f"{label}: {name} has a coordinate of {far:.3g} mm, beyond any "
                     f"part a feeder can hold ({MAX_COORD_MM:g} mm; check the units)"
                 )
-            xy = cv[:, :2]
-            lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
             paths.append((name, path))
+            points.append(cv)
             owners.append(f"{name} on layer {layer!r}")
             owner_layers.append(layer)
             owner_linetypes.append(placed.linetype)
     notes: list[str] = []
+    left_out = unseen_note(unseen)
+    if unseen and not paths:
+        raise InputError(
+            f"{label}: the drawing shows no outline geometry: every line, arc and curve is "
+            f"hidden in CAD ({left_out}){_unseen_hint(unseen)}"
+        )
+    if unseen:
+        notes.append(
+            f"left out {plural(len(unseen), 'entity', 'entities')} CAD does not show: "
+            f"{left_out}{_unseen_hint(unseen)}"
+        )
     if wanted and not paths and seen:
         names = ", ".join(sorted(seen))
         raise InputError(
             f"{label}: no geometry on layer {', '.join(sorted(layers))} (layers: {names})"
         )
     if not paths:
-        return DrawnLines([], [], [], []), skipped, notes, options.flatten_tolerance
-    size_mm = float((hi - lo).max()) * scale
+        return DrawnLines([], [], [], []), skipped, notes, options.flatten_tolerance, left_out
+    turn, plane_note = drawing_plane(points, owners, scale, options.flatten_tolerance, label)
+    if turn is not None:
+        paths = [(name, path.transform(turn)) for name, path in paths]
+        points = [turned(cv, turn) for cv in points]
+        notes.append(plane_note)
+    xy = np.concatenate(points)[:, :2]
+    size_mm = float((xy.max(axis=0) - xy.min(axis=0)).max()) * scale
     flatten_mm = options.flatten_tolerance
     if REL_FLATTEN * size_mm > flatten_mm:
         flatten_mm = REL_FLATTEN * size_mm
@@ -609,7 +804,33 @@ def dxf_lines(
         [value for value, pieces in zip(values, flat, strict=True) for _ in pieces]
         for values in (owners, owner_layers, owner_linetypes)
     ]
-    return DrawnLines(lines, *per_line), skipped, notes, flatten_mm
+    return DrawnLines(lines, *per_line), skipped, notes, flatten_mm, left_out
+
+
+def unseen_note(unseen: Sequence[tuple[Unseen, str]]) -> str:
+    """What was left out as not shown in CAD: how many entities on each frozen or off
+    layer, and the invisible entities by name (``2 on frozen layer 'C'; CIRCLE 2F on layer
+    '0', invisible``); "" for nothing."""
+    by_layer = Counter((state, layer) for (state, layer), _ in unseen if state != "invisible")
+    parts = [f"{n} on {state} layer {layer!r}" for (state, layer), n in by_layer.items()]
+    invisible = [name for (state, _), name in unseen if state == "invisible"]
+    if invisible:
+        more = f" and {len(invisible) - MAX_LISTED} more" if len(invisible) > MAX_LISTED else ""
+        parts.append(f"{', '.join(invisible[:MAX_LISTED])}{more}, invisible")
+    return "; ".join(parts)
+
+
+def _unseen_hint(unseen: Sequence[tuple[Unseen, str]]) -> str:
+    """How to read entities left out as not shown in CAD: thaw or turn on their layer,
+    or name it with ``--layer`` (invisible entities only in CAD)."""
+    layers = sorted({layer for (state, layer), _ in unseen if state != "invisible"})
+    options = " ".join(f"--layer {layer}" for layer in layers)
+    if not layers:
+        return "; if they are outline, make them visible in CAD"
+    return (
+        f"; if they are outline, thaw or turn on their layer in CAD, or name it with {options} "
+        "(and the part's other layers)"
+    )
 
 
 def is_hidden_linetype(name: str, kept: tuple[str, ...] = ()) -> bool:
@@ -835,7 +1056,7 @@ def _read_doc(
     damage: str | None = None,
 ) -> tuple[list[ImportedOutline], list[str], list[str]]:
     unit_name, scale, warnings_ = drawing_units(doc, options.units, str(path))
-    drawn, skipped, notes, flatten_mm = dxf_lines(doc, options, scale, str(path), budget)
+    drawn, skipped, notes, flatten_mm, unseen = dxf_lines(doc, options, scale, str(path), budget)
     warnings_ += notes
     if not drawn.lines:
         what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
@@ -848,7 +1069,12 @@ def _read_doc(
             f"{path}: no outline geometry (lines, arcs, curves) in the "
             f"{options.space} space: {what}{_paper_space_hint(doc, options)}"
         )
-    drawing, drawn = _drawing(drawn, flatten_mm, str(path), options, budget, warnings_)
+    try:
+        drawing, drawn = _drawing(drawn, flatten_mm, str(path), options, budget, warnings_)
+    except InputError as exc:
+        if not unseen:
+            raise
+        raise InputError(f"{exc}; left out as not shown in CAD: {unseen}") from None
     drawing, bores = counterbores(drawing, flatten_mm)
     if damage is not None:
         warnings_.append(
