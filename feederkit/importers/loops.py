@@ -3,9 +3,10 @@
 Pure functions on polylines in millimetres (numpy arrays of shape (n, 2)). Loops are built
 with ``shapely.polygonize`` per connected group of lines, so lines that cross a part (centre
 lines, bend lines) do not split it; a loop inside a part is a hole, a loop inside a hole is
-a separate part. A closed entity (polyline, circle) that crosses itself or another loop is
-refused rather than merged: polygonizing would split a bow-tie into two parts and weld a
-crossing circle onto the outline.
+a separate part. A closed entity (polyline, circle) or a loop of lines joined end to end
+that crosses itself, or a closed entity crossing another loop, is refused rather than
+merged: polygonizing would split a bow-tie into two parts and weld a crossing circle onto
+the outline.
 """
 
 from __future__ import annotations
@@ -47,6 +48,19 @@ FRAME_HOLE_SHARE = 0.1
 """A rectangle holding one hole whose box is at most this share of its own may be a bare
 single-line drawing frame around one part: imported as a plate, with a warning."""
 
+FRAME_SHEET_MM = 250.0
+"""A rectangle at least this long is the size of a drawing sheet's frame (A4 is 297 x 210
+mm, its frame a few mm in), far larger than a part for a parts feeder."""
+
+FRAME_SHEET_HOLE_SHARE = 0.25
+"""A sheet-sized rectangle holding one hole whose box is at most this share of its own may
+be a bare single-line drawing frame around one part (an A3 frame around a 150 x 100 mm
+bracket holds 14 %)."""
+
+TITLE_BLOCK_CORNER = 0.05
+"""A title block standing free of its frame lies within this share of the frame's size from
+two adjacent sides of it."""
+
 TANGENT_SPREAD = 1.25
 """A closed line that comes within ``t`` (twice the flatten tolerance) of other lines is
 tangent to them when its length within ``4 t`` of them is at least this many times its
@@ -71,6 +85,9 @@ class Region:
     loop_area: float
     enclosed: int = 0
     """Faces merged into the outer loop that share no stretch of its outline (:class:`Loop`)."""
+    outside: tuple[tuple[float, float, float, float], ...] = ()
+    """Bounds of the regions merged into the outer loop that open lines close against a closed
+    line's edge from outside (:class:`Loop`)."""
 
 
 @dataclass(frozen=True)
@@ -239,6 +256,14 @@ class Loop:
     """Faces merged into the loop that touch its outline nowhere or at points only: what lines
     inside the part enclose (a hole drawn with lines that touch the outline or are crossed by
     a centre line): merged, so the part may have lost a hole (a warning says so)."""
+    outside: tuple[tuple[float, float, float, float], ...] = ()
+    """Bounds of the regions merged into the loop that lie outside every closed line of its
+    group and that open lines close only against a closed line's edge (extension and
+    dimension lines drawn against the outline): merged, with a warning."""
+    split: bool = False
+    """Whether the loop is one of several closed lines lying side by side (sharing edges)
+    that tiled a group's merged loop and were read apart (parts nested for common-line
+    cutting, a view drawn against its part)."""
 
 
 def _near(lines: np.ndarray, others: np.ndarray, tol: float) -> bool:
@@ -366,6 +391,66 @@ def _enclosed_faces(poly: Polygon, faces: Sequence[Polygon], eps: float, gap: fl
     return int(((shapely.length(common) <= eps) & ~_thin(polys, gap)).sum())
 
 
+def _open_cover(group: np.ndarray, on_line: csr_matrix, lines: np.ndarray) -> shapely.Geometry:
+    """The area the group's open lines enclose among themselves, without the closed lines:
+    row ``i`` of ``on_line`` marks the drawing's ``lines`` that piece ``i`` of ``group`` lies
+    on. A plate drawn with LINEs encloses itself; extension lines drawn against a closed
+    outline enclose nothing without it."""
+    closed = shapely.is_closed(lines) & (shapely.get_num_coordinates(lines) >= 4)
+    on_open = np.asarray(on_line[:, np.flatnonzero(~closed)].sum(axis=1)).ravel() > 0
+    if not on_open.any():
+        return shapely.GeometryCollection()
+    return shapely.union_all(shapely.get_parts(shapely.polygonize(group[on_open])))
+
+
+def _closed_against(
+    faces: Sequence[Polygon], rings: Sequence[Polygon], cover: shapely.Geometry, gap: float
+) -> tuple[tuple[float, float, float, float], ...]:
+    """Bounds of the regions that ``faces`` (of one merged loop) make outside every closed
+    line ``rings`` and that the open lines alone (their area ``cover``, :func:`_open_cover`)
+    do not enclose: open lines closing a region against a closed outline's edge, as
+    extension and dimension lines drawn from the part's corners do. Slivers (:func:`_thin`)
+    are none."""
+    if len(faces) < 2 or not rings:
+        return ()
+    polys = np.asarray(faces, dtype=object)
+    points = shapely.point_on_surface(polys)
+    k, _ = shapely.STRtree(list(rings)).query(points, predicate="within")
+    in_ring = np.zeros(len(polys), dtype=bool)
+    in_ring[k] = True
+    if not in_ring.any():
+        return ()
+    out = ~in_ring & ~shapely.contains(cover, points) & ~_thin(polys, gap)
+    if not out.any():
+        return ()
+    regions = shapely.get_parts(shapely.union_all(polys[out]))
+    return tuple(tuple(float(v) for v in shapely.bounds(r)) for r in regions)
+
+
+def _side_by_side(faces: Sequence[Polygon], rings: Sequence[Polygon]) -> list[list[Polygon]]:
+    """The faces of each closed line when two or more of ``rings`` lie side by side in one
+    merged loop and tile it (every face inside exactly one of them, none inside another:
+    parts nested for common-line cutting, a view drawn against its part), else [].
+
+    Each is a part of its own: merging them made one part of two. A closed line inside
+    another (a title-block cell in its frame, a notch drawn closed) is no such line.
+    """
+    if len(rings) < 2 or len(faces) < 2:
+        return []
+    points = shapely.point_on_surface(np.asarray(faces, dtype=object))
+    ring, point = shapely.STRtree(points).query(np.asarray(rings), predicate="contains")
+    inside: dict[int, set[int]] = {}
+    for r, f in zip(ring.tolist(), point.tolist(), strict=True):
+        inside.setdefault(r, set()).add(f)
+    sets = {frozenset(fs) for fs in inside.values()}
+    tops = sorted((s for s in sets if not any(s < t for t in sets)), key=min)
+    if len(tops) < 2 or sum(len(s) for s in tops) != len(faces):
+        return []
+    if len(frozenset().union(*tops)) != len(faces):
+        return []  # two of them overlap: a crossing, refused later
+    return [[faces[i] for i in sorted(s)] for s in tops]
+
+
 def closed_loops(
     lines: Sequence[np.ndarray],
     budget: Budget | None = None,
@@ -380,8 +465,11 @@ def closed_loops(
     (:func:`_inner_closed`): each is a loop of its own (a hole tangent to the outline, or
     one a centre line crosses), not merged away; one whose flattened chords cross a curved
     outline's by no more than twice the flatten tolerance ``gap`` is tangent too, and its
-    hole is clipped to the loop. ``Loop.enclosed`` counts the faces still merged that touch
-    the loop's outline at points only (:func:`_enclosed_faces`).
+    hole is clipped to the loop. Closed lines lying side by side that tile a merged loop are
+    loops of their own (:func:`_side_by_side`). ``Loop.enclosed`` counts the faces still
+    merged that touch the loop's outline at points only (:func:`_enclosed_faces`),
+    ``Loop.outside`` those open lines close against a closed line's edge from outside
+    (:func:`_closed_against`).
     """
     lines = [ln for ln in lines if len(ln) >= 2]
     if not lines:
@@ -433,12 +521,14 @@ def closed_loops(
             budget.loops(len(parts))
         merged = shapely.union_all(parts)
         candidates = ring_group.get(int(lab), []) if len(parts) > 1 else []
+        cover: shapely.Geometry | None = None
         if candidates:
             mids = shapely.line_interpolate_point(group, 0.5, normalized=True)
             piece, line = lines_tree.query(mids, predicate="dwithin", distance=eps)
             on_line = csr_matrix(
                 (np.ones(len(piece), dtype=bool), (piece, line)), shape=(len(mids), len(geoms))
             )
+            cover = _open_cover(group, on_line, geoms)
         for poly in shapely.get_parts(merged):
             if budget is not None:
                 budget.check_time()
@@ -451,8 +541,23 @@ def closed_loops(
                 else []
             )
             rings_in = [ring for ring, _ in inner]
-            shapes = [(outline, rings_in), *((h, []) for _, hs in inner for h in hs)]
-            for shape, cut in shapes:
+            apart = (
+                _side_by_side(
+                    [f for f in parts if outline.contains(f.representative_point())],
+                    [r for r in candidates if not any(r is h for h in rings_in)],
+                )
+                if len(candidates) >= 2
+                else []
+            )
+            tiles = [shapely.union_all(fs) for fs in apart]
+            if not all(isinstance(p, Polygon) for p in tiles):
+                apart, tiles = [], []  # a closed line's faces in two: leave them merged
+            outlines = [Polygon(p.exterior) for p in tiles] or [outline]
+            shapes = [
+                *((o, rings_in, True) for o in outlines),
+                *((h, [], False) for _, hs in inner for h in hs),
+            ]
+            for shape, cut, outer in shapes:
                 own = [
                     f
                     for f in parts
@@ -465,6 +570,12 @@ def closed_loops(
                         faces=len(own),
                         largest_face=max((f.area for f in own), default=shape.area),
                         enclosed=_enclosed_faces(shape, own, 1e3 * eps, gap),
+                        outside=(
+                            _closed_against(own, candidates, cover, gap)
+                            if outer and cover is not None
+                            else ()
+                        ),
+                        split=outer and bool(apart),
                     )
                 )
     return loops, dangles
@@ -516,7 +627,9 @@ def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
 
     A frame is a thin border, not a part: either a double line whose border (outer minus the
     inner rectangle) is a small share of its box (2 loops), or a single rectangle whose
-    title-block lines touch it (1 loop: its sheet is one large face beside small cells).
+    title-block lines touch it (1 loop: its sheet is one large face beside small cells,
+    inside the frame when the frame is one closed line; lines closing a face against a
+    closed outline from outside are a view or dimension drawn against a part).
     A rectangle whose holes hold parts but which has neither mark is a plate: a cut sheet
     keeps its material.
     """
@@ -527,7 +640,11 @@ def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
         top.polygon.area
     ):
         return 2
-    if top.faces >= 2 and top.largest_face >= TITLE_BLOCK_SHARE * top.polygon.area:
+    if (
+        top.faces >= 2
+        and not top.outside
+        and top.largest_face >= TITLE_BLOCK_SHARE * top.polygon.area
+    ):
         return 1
     return 0
 
@@ -575,6 +692,7 @@ def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = 
             area=float(area),
             loop_area=float(loop.area),
             enclosed=loops[i].enclosed,
+            outside=loops[i].outside,
         )
         regions.append((i, region))
     regions.sort(key=lambda r: -r[1].loop_area)
@@ -852,12 +970,15 @@ def frame_doubt(
 ) -> str:
     """A warning when the imported part may be a bare single-line drawing frame, else "".
 
-    A rectangle with holes and without a title block cannot be told from a plate
-    (:func:`frame_kind`): it is imported as a plate, but said to be a likely frame when it is
-    drawn on a layer none of its holes is on, or when it holds a single hole whose box is
-    at most :data:`FRAME_HOLE_SHARE` of its own, is not round (a circle or an axis-aligned
-    ellipse: a plate's usual hole) and lies at least its own size away from the rectangle
-    (one part drawn in a sheet's frame).
+    A rectangle with holes and without a title block touching it cannot be told from a
+    plate (:func:`frame_kind`): it is imported as a plate, but said to be a likely frame
+    when it is drawn on a layer none of its holes is on; when it holds a single hole that
+    is not round (a circle or an axis-aligned ellipse: a plate's usual hole) and whose box
+    is at most :data:`FRAME_HOLE_SHARE` of its own and lies at least its own size away from
+    the rectangle, or, for a rectangle the size of a drawing sheet (:data:`FRAME_SHEET_MM`),
+    at most :data:`FRAME_SHEET_HOLE_SHARE` and half its size away (one part drawn in a
+    sheet's frame); or when one of its holes is a title block standing free of the frame
+    (:func:`_title_block`).
     """
     shell = Polygon(region.shell)
     if not region.holes or not _is_rectangle(shell):
@@ -867,16 +988,25 @@ def frame_doubt(
     holes = [Polygon(h) for h in region.holes]
     hx0, hy0, hx1, hy1 = shapely.total_bounds(holes)
     hole_box = (hx1 - hx0) * (hy1 - hy0)
+    size = max(hx1 - hx0, hy1 - hy0)
+    sheet = max(x1 - x0, y1 - y0) >= FRAME_SHEET_MM
     small = (
         len(holes) == 1
-        and hole_box <= FRAME_HOLE_SHARE * box
         and not _round(holes[0])
-        and holes[0].distance(shell.exterior) >= max(hx1 - hx0, hy1 - hy0)
+        and (
+            (hole_box <= FRAME_HOLE_SHARE * box and holes[0].distance(shell.exterior) >= size)
+            or (
+                sheet
+                and hole_box <= FRAME_SHEET_HOLE_SHARE * box
+                and holes[0].distance(shell.exterior) >= 0.5 * size
+            )
+        )
     )
+    tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
+    block = _title_block(shell, holes, lines, tol)
     own: set[str] = set()
     inner: set[str] = set()
     if layers is not None and len(layers) >= len(lines):
-        tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
         rings = [shell.exterior, *(h.exterior for h in holes)]
         for k, ln in enumerate(lines):
             pts = shapely.points(np.asarray(ln, dtype=float))
@@ -885,15 +1015,49 @@ def frame_doubt(
                     (own if j == 0 else inner).add(layers[k])
                     break
     apart = bool(own) and bool(inner) and not own & inner
-    if not (small or apart):
+    if not (small or apart or block is not None):
         return ""
     frame_layers = f" on layer {', '.join(sorted(own))}" if own else ""
-    keep = f" (--layer {' --layer '.join(sorted(inner))})" if apart else ""
+    why = f", one of them divided like a title block ({_box(block.bounds)})" if block else ""
+    remedy = (
+        f"leave the frame's layer out with --layer (--layer {' --layer '.join(sorted(inner))})"
+        if apart
+        else "delete the frame, or move it to a layer of its own and leave that out with --layer"
+    )
     return (
         f"the part is a {x1 - x0:.4g} x {y1 - y0:.4g} mm rectangle{frame_layers} around "
-        f"{plural(len(holes), 'hole')}: if the rectangle is a drawing frame, the part is what "
-        f"it holds: leave the frame's layer out with --layer{keep}"
+        f"{plural(len(holes), 'hole')}{why}: if the rectangle is a drawing frame, the part is "
+        f"what it holds: {remedy}"
     )
+
+
+def _title_block(
+    shell: Polygon, holes: Sequence[Polygon], lines: Sequence[np.ndarray], tol: float
+) -> Polygon | None:
+    """A hole of a rectangle that looks like a title block standing free of its frame, else
+    None: a rectangle within :data:`TITLE_BLOCK_CORNER` of the frame's size from two of its
+    adjacent sides, divided by lines running inside it from its sides (its cells)."""
+    x0, y0, x1, y1 = shell.bounds
+    reach = TITLE_BLOCK_CORNER * max(x1 - x0, y1 - y0)
+    corner = [
+        h
+        for h in holes
+        if _is_rectangle(h)
+        and min(h.bounds[0] - x0, x1 - h.bounds[2]) <= reach
+        and min(h.bounds[1] - y0, y1 - h.bounds[3]) <= reach
+    ]
+    if not corner or not lines:
+        return None
+    geoms = np.array(
+        [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
+    )
+    for hole in corner:
+        within = shapely.covers(hole.buffer(tol), geoms)
+        cells = within & shapely.dwithin(geoms, hole.exterior, tol)
+        cells &= ~_along(geoms, hole.exterior, tol)
+        if cells.any():
+            return hole
+    return None
 
 
 CONCENTRIC_CENTRE = 0.02
@@ -983,6 +1147,202 @@ def _picked(values: Sequence[str] | None, keep: Sequence[int], n: int) -> list[s
     return None if values is None or len(values) != n else [values[k] for k in keep]
 
 
+NEARLY_CLOSED = 0.25
+"""Open lines nearly close a loop when their two free ends lie at most this share of their
+size apart (an ARC of 330 degrees or more, four LINEs of a window one of which stops
+short); a centre line, a centre mark or a bend line does not."""
+
+
+def _box(bounds: Sequence[float]) -> str:
+    """A box in words: ``80 x 10 mm at x 0..80, y -10..0``."""
+    x0, y0, x1, y1 = bounds
+    return f"{x1 - x0:.4g} x {y1 - y0:.4g} mm at x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g}"
+
+
+def _boxes(bounds: Sequence[Sequence[float]]) -> str:
+    """At most three boxes in words (:func:`_box`), "; ..." when there are more."""
+    return "; ".join(_box(b) for b in bounds[:3]) + ("; ..." if len(bounds) > 3 else "")
+
+
+def outside_note(bounds: Sequence[Sequence[float]]) -> str:
+    """The warning for regions that open lines close against the outline's edge from
+    outside (:attr:`Loop.outside`), merged into the part."""
+    return (
+        f"lines close {plural(len(bounds), 'region')} against the outline's edge from outside "
+        f"({_boxes(bounds)}): merged into the part, so its area and COM are off if they are "
+        "extension or dimension lines or a view drawn against it; delete them or leave their "
+        "layer out with --layer"
+    )
+
+
+def side_by_side_note(bounds: Sequence[Sequence[float]]) -> str:
+    """The warning for closed outlines lying side by side, read as separate parts
+    (:attr:`Loop.split`)."""
+    return (
+        f"{plural(len(bounds), 'closed outline')} share edges side by side ({_boxes(bounds)}): "
+        "read as separate parts, not merged into one (parts nested for common-line cutting, or "
+        "a view drawn against its part?); if they are one part, draw its outline as one closed "
+        "line"
+    )
+
+
+def _free_ends(chain: shapely.Geometry) -> np.ndarray:
+    """The ends of a group of noded open lines that no other of its lines meets."""
+    parts = shapely.get_parts(chain)
+    ends = np.concatenate([shapely.get_coordinates(shapely.get_point(parts, k)) for k in (0, -1)])
+    _, first, counts = np.unique(ends, axis=0, return_index=True, return_counts=True)
+    return ends[np.sort(first[counts == 1])]
+
+
+def open_line_notes(
+    dangles: Sequence[LineString], regions: Sequence[Region], gap: float
+) -> list[str]:
+    """Warnings for open lines (``dangles``, the lines no loop uses) that may be an outline
+    left open: a connected group of them around the first part (its real outline open, so
+    the part may be one of its holes), or one nearly closing a loop (:data:`NEARLY_CLOSED`)
+    inside a part's material (a hole whose outline is open, left out).
+
+    Each group is joined over its noded pieces, so an outline of six LINEs one of which
+    stops short counts as one, as an open polyline does.
+    """
+    if not dangles or not regions:
+        return []
+    pieces = np.asarray(dangles, dtype=object)
+    labels = _components(pieces)
+    groups = [shapely.multilinestrings(pieces[labels == lab]) for lab in np.unique(labels)]
+    part = Polygon(regions[0].shell)
+    notes: list[str] = []
+    around = [g for g in groups if _around(g, part)]
+    if around:
+        ends = _free_ends(around[0])
+        notes.append(
+            f"an open outline ({_ends(ends)}, too far apart to close) surrounds the imported "
+            "part: the drawing's real outer outline may be open and the part one of its holes; "
+            "close the outline in the drawing"
+        )
+    nearly: list[tuple[shapely.Geometry, np.ndarray]] = []
+    for g in groups:
+        ends = _free_ends(g)
+        if _nearly_closed(g, ends, gap):
+            nearly.append((g, ends))
+    inside: list[tuple[shapely.Geometry, np.ndarray]] = []
+    if nearly:
+        solids = [Polygon(r.shell, r.holes) for r in regions]
+        tree = shapely.STRtree(solids)
+        for g, ends in nearly:
+            hits = tree.query(g, predicate="intersects")
+            if any(solids[int(j)].buffer(2.0 * gap).covers(g) for j in hits):
+                inside.append((g, ends))
+    if inside:
+        g, ends = inside[0]
+        more = f" and {len(inside) - 1} more" if len(inside) > 1 else ""
+        notes.append(
+            f"open lines inside the part nearly close {plural(len(inside), 'loop')} "
+            f"({_box(g.bounds)}, {_ends(ends)}{more}), left out: if they are a hole whose "
+            "outline is open, the part's area and COM are off; close the gap in the drawing"
+        )
+    return notes
+
+
+def _around(group: shapely.Geometry, part: Polygon) -> bool:
+    """Whether a connected group of open lines goes around ``part``: one of its lines holds
+    the part's box strictly inside its own (an open polyline around it), or it is one chain
+    that, closed between its two ends, holds the whole part (an outline of LINEs one of
+    which stops short). Extension and dimension lines around a part branch: no chain."""
+    x0, y0, x1, y1 = part.bounds
+    for line in shapely.get_parts(group):
+        lx0, ly0, lx1, ly1 = line.bounds
+        if lx0 < x0 and ly0 < y0 and lx1 > x1 and ly1 > y1:
+            return True
+    chain = shapely.line_merge(group)
+    if not isinstance(chain, LineString) or chain.is_closed or len(chain.coords) < 3:
+        return False
+    ring = shapely.node(shapely.linearrings(np.asarray(chain.coords)))
+    inside = shapely.union_all(shapely.get_parts(shapely.polygonize(shapely.get_parts(ring))))
+    return bool(inside.covers(part))
+
+
+def _ends(ends: np.ndarray) -> str:
+    """Open ends in words: ``its ends 0.5 mm apart at (79.5, 0) and (80, 0)``."""
+    if len(ends) == 2:
+        (ax, ay), (bx, by) = ends
+        return (
+            f"its ends {float(np.hypot(ax - bx, ay - by)):.3g} mm apart at "
+            f"({ax:.4g}, {ay:.4g}) and ({bx:.4g}, {by:.4g})"
+        )
+    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends[:3])
+    return f"{plural(len(ends), 'open end')} at {where}{', ...' if len(ends) > 3 else ''}"
+
+
+def _nearly_closed(group: shapely.Geometry, ends: np.ndarray, gap: float) -> bool:
+    """Whether a connected group of open lines is one chain whose two ends lie at most
+    :data:`NEARLY_CLOSED` of its size apart and which, closed there, encloses an area (not a
+    line drawn there and back): a loop left open."""
+    if len(ends) != 2:
+        return False
+    chain = shapely.line_merge(group)
+    if not isinstance(chain, LineString) or len(chain.coords) < 3:
+        return False
+    x0, y0, x1, y1 = chain.bounds
+    apart = float(np.hypot(*(ends[0] - ends[1])))
+    if apart > NEARLY_CLOSED * max(x1 - x0, y1 - y0):
+        return False
+    return abs(float(shapely.area(Polygon(chain.coords)))) > gap * chain.length
+
+
+def line_cycles(lines: Sequence[np.ndarray], skip: set[int]) -> list[list[int]]:
+    """Loops of open lines joined end to end (each end shared by exactly two lines), in
+    order along the loop: an outline drawn with LINEs and ARCs. ``skip`` holds the closed
+    lines; ends are joined when their snapped coordinates are equal."""
+    at: dict[bytes, list[int]] = {}
+    ends: dict[int, tuple[bytes, bytes]] = {}
+    for k, ln in enumerate(lines):
+        if k in skip or len(ln) < 2:
+            continue
+        a = (np.asarray(ln[0], dtype=float) + 0.0).tobytes()  # + 0.0: -0.0 is 0.0
+        b = (np.asarray(ln[-1], dtype=float) + 0.0).tobytes()
+        if a == b:
+            continue
+        ends[k] = (a, b)
+        at.setdefault(a, []).append(k)
+        at.setdefault(b, []).append(k)
+    seen: set[int] = set()
+    cycles: list[list[int]] = []
+    for start in ends:
+        if start in seen:
+            continue
+        cycle, k, node = [start], start, ends[start][1]
+        seen.add(start)
+        while True:
+            if len(at[node]) != 2:
+                break
+            k = at[node][0] if at[node][1] == k else at[node][1]
+            if k == start:
+                if len(at[ends[start][0]]) == 2:
+                    cycles.append(cycle)
+                break
+            if k in seen:
+                break
+            seen.add(k)
+            cycle.append(k)
+            node = ends[k][1] if ends[k][0] == node else ends[k][0]
+    return cycles
+
+
+def _joined(lines: Sequence[np.ndarray], cycle: Sequence[int]) -> np.ndarray:
+    """The closed polyline of a loop of lines (:func:`line_cycles`), each turned to follow
+    the one before."""
+    out = [np.asarray(lines[cycle[0]], dtype=float)]
+    if len(cycle) > 1:
+        nxt = np.asarray(lines[cycle[1]], dtype=float)
+        if not any(np.array_equal(out[0][-1], p) for p in (nxt[0], nxt[-1])):
+            out[0] = out[0][::-1]
+    for k in cycle[1:]:
+        ln = np.asarray(lines[k], dtype=float)
+        out.append((ln if np.array_equal(ln[0], out[-1][-1]) else ln[::-1])[1:])
+    return np.concatenate(out)
+
+
 def drawing_from_lines(
     lines: Sequence[np.ndarray],
     gap: float,
@@ -1024,6 +1384,15 @@ def drawing_from_lines(
             raise InputError(
                 f"{label}: the outline is self-intersecting ({name(k)} {invalid_words(reason)})"
             )
+    for cycle in line_cycles(snapped, set(closed)):
+        if budget is not None:
+            budget.check_time()
+        reason = self_crossing(_joined(snapped, cycle))
+        if reason is not None:
+            raise InputError(
+                f"{label}: the outline is self-intersecting (the loop of {name(cycle[0])} and "
+                f"{plural(len(cycle) - 1, 'other line')} {invalid_words(reason)})"
+            )
     healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
     if budget is not None:
         budget.check_time()
@@ -1063,19 +1432,15 @@ def drawing_from_lines(
                 f"flatten tolerance, {gap:.3g} mm)"
             )
         notes.append(slivers)
+    split = [lp.polygon.bounds for lp in loops if lp.split]
+    if split:
+        notes.append(side_by_side_note(split))
     drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
+    notes += [outside_note(r.outside) for r in drawing.regions if r.outside]
     doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)
     if doubt:
         notes.append(doubt)
-    x0, y0, x1, y1 = Polygon(drawing.regions[0].shell).bounds
-    for d in dangles:
-        dx0, dy0, dx1, dy1 = d.bounds
-        if dx0 < x0 and dy0 < y0 and dx1 > x1 and dy1 > y1:
-            notes.append(
-                "an open outline (its gap too large to close) surrounds the imported part: "
-                "the drawing's real outer outline may be open"
-            )
-            break
+    notes += open_line_notes(dangles, drawing.regions, gap)
     return Drawing(drawing.regions, drawing.frames, drawing.nested, tuple(notes))
