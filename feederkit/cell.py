@@ -153,6 +153,33 @@ def _unit(key: str) -> str:
     return ""
 
 
+MAX_OPERATION_S = 1e9
+"""The most seconds a profile's pick and place, half turn or drift may take (about 32
+years): beyond any cell, and far enough below the largest float that the seconds of a plan,
+summed over its operations, stay finite."""
+
+
+def _timing_problems(robot: RobotSection, belt: BeltSection) -> list[str]:
+    """One line per time that the profile's fields, each valid, make longer than
+    :data:`MAX_OPERATION_S` (or beyond a float): the pick and place, a half turn, the drift."""
+    problems = []
+    limit = f"must be at most {MAX_OPERATION_S:g} seconds"
+    pick, speed = robot.pick_place_s, robot.rotation_speed_deg_s
+    if pick is not None and pick > MAX_OPERATION_S:
+        problems.append(f"robot.pick_place_s {limit}, got {pick:g}")
+    if speed is not None and 180.0 / speed > MAX_OPERATION_S:
+        turn = 180.0 / speed
+        problems.append(f"180 / robot.rotation_speed_deg_s (a half turn) {limit}, got {turn:.3g}")
+    if belt.speed_m_s is not None and belt.drop_to_fence_mm is not None:
+        drift = belt.drop_to_fence_mm / (1000.0 * belt.speed_m_s)
+        if drift > MAX_OPERATION_S:
+            problems.append(
+                f"belt.drop_to_fence_mm / (1000 * belt.speed_m_s) (the drift to the fence) "
+                f"{limit}, got {drift:.3g}"
+            )
+    return problems
+
+
 def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
     """A profile from the parsed TOML tables; CellProfileError names every bad field."""
     problems: list[str] = []
@@ -202,19 +229,18 @@ def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
     for key, owner in (("tolerance_mm", "tolerance"), ("pitch_mm", "led"), ("noise_mm", "led")):
         if key in given and model != owner and not bad_model:
             problems.append(f"sensor.{key} goes with model = {owner!r}, but the model is {model!r}")
+    robot, belt = RobotSection(**values["robot"]), BeltSection(**values["belt"])
+    problems += _timing_problems(robot, belt)
     if problems:
         raise CellProfileError(source, problems)
-    return CellProfile(
-        sensor=SensorSection(**sensor),
-        robot=RobotSection(**values["robot"]),
-        belt=BeltSection(**values["belt"]),
-        source=source,
-    )
+    return CellProfile(sensor=SensorSection(**sensor), robot=robot, belt=belt, source=source)
 
 
 def read_cell(path: str | Path) -> CellProfile:
-    """Read and validate a profile file; InputError when it is missing or not TOML."""
+    """Read and validate a profile file; InputError when it is missing, a folder or not TOML."""
     p = Path(path)
+    if p.is_dir():
+        raise InputError(f"{p}: a folder, not a cell profile file")
     if not p.is_file():
         raise InputError(f"{p}: no such cell profile")
     try:
@@ -273,10 +299,11 @@ class CellSettings:
         v = self.profile.belt.speed_m_s
         if v is None or v <= MODEL_BELT_SPEED_M_S:
             return None
+        ratio = v / MODEL_BELT_SPEED_M_S  # squared by a product: inf, not OverflowError
         return (
             f"the belt runs at {v:g} m/s ({self.profile.source}); the model's overshoot of "
             f"shallow states was measured at {MODEL_BELT_SPEED_M_S:g} m/s and grows as the "
-            f"square of the speed ({(v / MODEL_BELT_SPEED_M_S) ** 2:.3g} times here): check "
+            f"square of the speed ({ratio * ratio:.3g} times here): check "
             f"the plan with feederkit simulate --belt-speed {v:g}"
         )
 
@@ -416,12 +443,16 @@ def rotation_deg(action_deg: float) -> float:
 def action_costs(profile: CellProfile) -> ActionCosts:
     """The seconds of an operation in the cell, as the planners take them
     (:class:`~feederkit.planning.options.ActionCosts`); InputError naming the timing fields
-    the profile does not give."""
+    the profile does not give, CellProfileError those that make a time too long to compute
+    with (a profile not read by :func:`parse_cell`)."""
     missing = profile.missing_timing()
     if missing:
         raise InputError(
             f"{profile.source}: a cycle time needs {', '.join(missing)} in the cell profile"
         )
+    problems = _timing_problems(profile.robot, profile.belt)
+    if problems:
+        raise CellProfileError(profile.source, problems)
     drift = profile.belt.drop_to_fence_mm / (profile.belt.speed_m_s * 1000.0)  # type: ignore[operator]
     return ActionCosts(
         pick_place_s=profile.robot.pick_place_s,  # type: ignore[arg-type]

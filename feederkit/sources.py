@@ -20,6 +20,7 @@ from feederkit.catalog import (
     landings_for,
     part_from_revision,
 )
+from feederkit.catalog.store import NoSuchPartError
 from feederkit.errors import InputError
 from feederkit.importers import (
     NOT_ORIENTABLE,
@@ -54,7 +55,7 @@ def _from_catalog(source: str, com: Point | None, catalog: str | None) -> Loaded
     name, rev = (m["name"], int(m["rev"])) if m else (source, None)
     try:
         revision = get_revision(db, name, rev)
-    except InputError as exc:
+    except NoSuchPartError as exc:  # a damaged row or catalog says so in its own line
         raise InputError(f"{source}: no such file or catalog part ({exc})") from None
     part = part_from_revision(revision)
     if com is not None:

@@ -216,6 +216,12 @@ def _write_landings(
         )
 
 
+class NoSuchPartError(InputError):
+    """The catalog holds no part of the name, or not the revision asked for: kept apart from
+    a damaged row or catalog, which a SOURCE looked up in the catalog reports in the catalog's
+    own words (the part is there)."""
+
+
 class DuplicateNameError(InputError):
     """A part name the catalog already has from another source file (``name``, ``old_path``),
     kept apart so a folder import can skip and name the clash in its own words."""
@@ -705,10 +711,10 @@ def _revision_from_row(row: Sequence[Any], landing_rows: Sequence[Sequence[Any]]
         raise _damaged(row[0], row[1], str(exc)) from None
 
 
-def _unknown(conn: sqlite3.Connection, name: str) -> InputError:
+def _unknown(conn: sqlite3.Connection, name: str) -> NoSuchPartError:
     names = [r[0] for r in conn.execute("SELECT name FROM parts")]
     valid = [n for n in names if isinstance(n, str) and is_valid_name(n)]
-    return InputError(
+    return NoSuchPartError(
         f"no part named {shown_name(name)!s} in the catalog{did_you_mean(_similar(valid, name))}"
         if not is_valid_name(name)
         else f"no part named {name!r} in the catalog{did_you_mean(_similar(valid, name))}"
@@ -729,7 +735,7 @@ def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -
             ).fetchone()
         if row is None:
             if revision is not None and _part_id(conn, name) is not None:
-                raise InputError(f"part {name!r} has no revision {revision}")
+                raise NoSuchPartError(f"part {name!r} has no revision {revision}")
             raise _unknown(conn, name)
         landing_rows = conn.execute(_LANDINGS_SQL, (row[19],)).fetchall()
     return _revision_from_row(row, landing_rows)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 import time
 from collections.abc import Sequence
 from datetime import UTC, datetime
@@ -154,7 +155,14 @@ def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
         given.append(value)
     if all(g is None for g in given):
         return names, None
-    total = math.fsum(g for g in given if g is not None)
+    try:
+        total = math.fsum(g for g in given if g is not None)
+    except OverflowError:
+        listed = ", ".join(f"{n}:{g:g}" for n, g in zip(names, given, strict=True) if g is not None)
+        raise InputError(
+            f"--mix: the shares {listed} add up to more than a number can hold; give smaller "
+            "shares (only their ratios count)"
+        ) from None
     missing = given.count(None)
     if missing:
         if total >= 1.0:
@@ -166,7 +174,14 @@ def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
         rest = (1.0 - total) / missing
         given = [rest if g is None else g for g in given]
         total = 1.0
-    return names, tuple(float(g) / total for g in given)  # type: ignore[arg-type]
+    shares = tuple(float(g) / total for g in given)  # type: ignore[arg-type]
+    for name, g, share in zip(names, given, shares, strict=True):
+        if share < sys.float_info.min:  # underflow beside the others, or near it
+            raise InputError(
+                f"--mix: the share of {name} ({g:g}) is too small beside the others (together "
+                f"{total:g}) to compute with; give shares of nearer sizes"
+            )
+    return names, shares
 
 
 def shares_text(revisions: Sequence[tuple[str, int]], plan: dict[str, Any]) -> str:

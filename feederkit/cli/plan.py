@@ -11,6 +11,7 @@ and the warnings (a margin below 1 degree, a time limit reached).
 
 from __future__ import annotations
 
+import sys
 from typing import Annotated, Any
 
 import typer
@@ -20,6 +21,7 @@ from feederkit.cell import annotate_cycle_time
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
     FLAG_TERMS,
+    JSON_ANSWER,
     LANDING_TERMS,
     AcceptOpt,
     CatalogOpt,
@@ -50,7 +52,6 @@ from feederkit.cli.common import (
     json_option,
     note_written,
     plan_outputs,
-    print_json,
     print_warnings,
     print_written,
     searching,
@@ -67,6 +68,7 @@ from feederkit.landing.plan import LandingPlan, landing_names, load_landings, pl
 from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
+from feederkit.plans.fileformat import plan_json
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label
 from feederkit.uncertainty import check_for_part
@@ -171,6 +173,14 @@ def _accepted_names(text: str | None, planned_names: set[str]) -> tuple[str, ...
     return names
 
 
+def print_plan_file(plan: dict[str, Any]) -> None:
+    """``--json``: the plan file's text on stdout, byte for byte what ``-o`` writes
+    (:func:`~feederkit.plans.fileformat.plan_json`), so a plan saved from stdout is the file."""
+    JSON_ANSWER.printed = True
+    sys.stdout.write(plan_json(plan))
+    sys.stdout.flush()
+
+
 @takes_import_options
 def plan_command(
     sources: Annotated[
@@ -255,7 +265,7 @@ def plan_command(
         notes.append(note)
     print_warnings(notes)
     if json_out:
-        print_json(plan)
+        print_plan_file(plan)
     else:
         sensor_given = sensorless or sensor.informative
         words = None if planned is None else _landings_text(planned)

@@ -15,6 +15,7 @@ the sources a command names. docs/landings.md has the details.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -42,6 +43,9 @@ from feederkit.plans.make import MadePlan
 from feederkit.plans.model import member_fragile_warnings
 from feederkit.sensors import Sensor
 from feederkit.uncertainty import Uncertainty
+
+_POSE_INDEX_RE = re.compile(r"0|[1-9][0-9]*")
+"""The short form ``K`` of ``pose-K`` (design.md's landing names: no leading zeros)."""
 
 
 @dataclass(frozen=True)
@@ -219,7 +223,7 @@ def landing_names(text: str, what: str = "--landings") -> tuple[str, ...]:
         item = item.strip()
         if not item:
             raise InputError(f"{what}: an empty landing name in {text!r}")
-        name = f"pose-{int(item)}" if item.isdigit() else item
+        name = f"pose-{item}" if _POSE_INDEX_RE.fullmatch(item) else item
         try:
             check_landing_name(name)
         except InputError as exc:
