@@ -199,3 +199,15 @@ def test_a_short_landing_with_a_leading_zero_or_a_wide_digit_is_refused(text) ->
 
 def test_a_short_landing_is_pose_k() -> None:
     assert landing_names("0, 1,12,up") == ("pose-0", "pose-1", "pose-12", "up")
+
+
+def test_a_damaged_part_leaves_the_changeover_listing_whole(db, capsys) -> None:
+    # One changeover's part damaged: the listing still shows every changeover and says which
+    # part the catalog cannot read (it stopped at the first with that part's line).
+    args = ["--tolerance", "0.2", "--catalog", str(db)]
+    assert main(["changeover", "compile", "one", "--mix", "l-bracket", *args]) == 0
+    _edit(db, "UPDATE revisions SET hull_json = '[[0, 0], [10, 0]]'")
+    capsys.readouterr()
+    assert main(["changeover", "list", "--catalog", str(db)]) == 0
+    out = capsys.readouterr()
+    assert "one" in out.out and "l-bracket: catalog part l-bracket@1" in out.err

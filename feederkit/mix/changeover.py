@@ -376,10 +376,16 @@ def changeover_exists(catalog: str | os.PathLike[str], name: str) -> bool:
 def stale_revisions(
     catalog: str | os.PathLike[str], revisions: Iterable[tuple[str, int]]
 ) -> list[str]:
-    """One line per part whose pinned revision is older than the catalog's latest."""
+    """One line per part whose pinned revision is older than the catalog's latest, or whose
+    latest revision the catalog cannot read (the catalog's own words: a damaged row must not
+    hide the other changeovers of a listing)."""
     out = []
     for name, rev in revisions:
-        latest = get_revision(catalog, name, None).revision
+        try:
+            latest = get_revision(catalog, name, None).revision
+        except InputError as exc:
+            out.append(f"{name}: {exc}")
+            continue
         if latest > rev:
             out.append(
                 f"{name}: the changeover is made for revision {rev}, the catalog's latest is "
