@@ -211,3 +211,13 @@ def test_a_damaged_part_leaves_the_changeover_listing_whole(db, capsys) -> None:
     assert main(["changeover", "list", "--catalog", str(db)]) == 0
     out = capsys.readouterr()
     assert "one" in out.out and "l-bracket: catalog part l-bracket@1" in out.err
+
+
+def test_an_led_noise_of_a_thousand_pitches_in_a_profile_names_the_profile(tmp_path, capsys):
+    # It was refused as "--noise ... (--led-pitch)", flags the user never gave; a message the
+    # flags' words were added to also built a CellProfileError wrongly (exit 70).
+    cell = tmp_path / "noisy.toml"
+    cell.write_text('[sensor]\nmodel = "led"\npitch_mm = 0.05\nnoise_mm = 100\n', encoding="utf-8")
+    err = one_line_error(capsys, ["plan", str(CATALOG / "t-clip.json"), "--cell", str(cell)])
+    assert err.startswith(f"error: {cell}: sensor.noise_mm must be at most 1000 times")
+    assert "--noise" not in err and "--led-pitch" not in err

@@ -115,6 +115,21 @@ def test_a_part_in_a_vertical_plane_is_imported_not_refused_as_a_line(tmp_path, 
     assert plane in note and "turned 90 degrees" in note and "top view is a line" in note
 
 
+def test_a_flat_drawing_with_short_steps_out_of_its_plane_is_read_as_drawn(tmp_path):
+    # A 100 x 60 plate of LINEs in XY with 0.013 mm vertical LINEs at its corners: the top
+    # view shortens those by more than the flatten tolerance, but the plane that fits is
+    # horizontal; it was "turned" about a zero axis (every coordinate NaN, exit 70).
+    doc, msp = _new()
+    corners = [(0, 0), (100, 0), (100, 60), (0, 60)]
+    for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+        msp.add_line((*a, 0), (*b, 0))
+    for x, y in corners:
+        msp.add_line((x, y, 0), (x, y, 0.013))
+    result, (ip,) = import_parts(_save(doc, tmp_path / "steps.dxf"), ImportOptions())
+    assert ip.part.outline.polygon().area == pytest.approx(6000.0, rel=1e-9)
+    assert not any("plane" in w for w in result.warnings)
+
+
 def test_geometry_in_no_one_plane_is_refused_naming_the_entity_off_it(tmp_path):
     doc, msp = _new()
     _plate(msp)

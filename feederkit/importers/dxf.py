@@ -660,6 +660,10 @@ def drawing_plane(
     if normal is None or off_line <= tol:
         return None, ""  # on a line: refused later as having no area
     normal = upward(normal)
+    if size * math.hypot(float(normal[0]), float(normal[1])) <= tol:
+        # The plane is horizontal within the tolerance across the drawing: what the top view
+        # shortens are short steps out of it (or edges seen end-on), nothing to turn.
+        return None, ""
     if float(np.abs(dist).max()) <= tol:
         tilt = math.degrees(math.acos(min(1.0, float(normal[2]))))
         turn = plane_turn(normal)

@@ -194,6 +194,8 @@ class Backchain:
             return t - gap
         if not mask:
             return 0.0
+        if mask >> len(self._state_pos):
+            raise ValueError(f"the set {mask:#x} holds states the machine does not have")
         # The members in the order of their positions (bits renumbered by rank), then the
         # largest gap between neighbours on the circle.
         ranked = 0
