@@ -35,7 +35,7 @@ from typing import Any
 from feederkit.errors import InputError
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.stats import expected_seconds, worst_seconds
-from feederkit.sensors import LED_MAX_NOISE_PITCHES, SensorModel, make_sensor
+from feederkit.sensors import LED_MAX_NOISE_PITCHES, SensorModel, make_sensor, too_noisy
 from feederkit.uncertainty import Uncertainty
 
 DEFAULT_CELL_FILE = "feederkit.toml"
@@ -230,7 +230,7 @@ def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
         if key in given and model != owner and not bad_model:
             problems.append(f"sensor.{key} goes with model = {owner!r}, but the model is {model!r}")
     pitch, noise = sensor.get("pitch_mm"), sensor.get("noise_mm", 0.0)
-    if model == "led" and pitch is not None and noise > LED_MAX_NOISE_PITCHES * pitch:
+    if model == "led" and pitch is not None and too_noisy(noise, pitch):
         problems.append(
             f"sensor.noise_mm must be at most {LED_MAX_NOISE_PITCHES} times sensor.pitch_mm "
             f"({LED_MAX_NOISE_PITCHES * pitch:g} mm), got {noise:g}: no LED array is that far off"

@@ -800,21 +800,24 @@ def make_sensor(
         e = 0.0 if noise is None else noise
         if not math.isfinite(e) or e < 0.0:
             raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")
-        if e > LED_MAX_NOISE_PITCHES * led_pitch:
+        if too_noisy(e, led_pitch):
             raise InputError(f"--noise {_noise_words(e, led_pitch)}")
         return LedSensor(float(led_pitch), float(e))
     return NoSensor()
 
 
-def _too_noisy(noise: float, pitch: float) -> bool:
+def too_noisy(noise: float, pitch: float) -> bool:
     """Whether an LED array's alignment noise is more than :data:`LED_MAX_NOISE_PITCHES`
-    pitches (but still a count of beams: wider ones are refused where counts are made, as
-    more than 2**53 beams)."""
-    return LED_MAX_NOISE_PITCHES * pitch < noise < 2.0**53 * pitch
+    pitches (the one bound, on the command line, in cell profiles and in plan files).
+
+    >>> too_noisy(0.1, 0.5), too_noisy(600.0, 0.5)
+    (False, True)
+    """
+    return noise > LED_MAX_NOISE_PITCHES * pitch
 
 
 def _noise_words(noise: float, pitch: float) -> str:
-    """Why an LED array's alignment noise is refused (:func:`_too_noisy`)."""
+    """Why an LED array's alignment noise is refused (:func:`too_noisy`)."""
     return (
         f"{noise:g} mm is more than {LED_MAX_NOISE_PITCHES} beam pitches of {pitch:g} mm: "
         "no LED array is that far off (check the units)"
@@ -826,7 +829,8 @@ def _led_from_dict(data: dict) -> SensorModel:
     pitch, noise = float(data["pitch_mm"]), float(data.get("noise_mm", 0.0))
     if not (math.isfinite(pitch) and pitch > 0.0 and math.isfinite(noise) and noise >= 0.0):
         return make_sensor(led_pitch=pitch, noise=noise)  # refused there, in its words
-    if _too_noisy(noise, pitch):
+    # Past 2**53 pitches the widths are no beam counts: refused where counts are made.
+    if too_noisy(noise, pitch) and noise < 2.0**53 * pitch:
         raise InputError(f"the plan's sensor noise_mm {_noise_words(noise, pitch)}")
     return LedSensor(pitch, noise)
 

@@ -217,13 +217,18 @@ def _block_of_holes(doc) -> None:
     block.add_circle((8, 6), 2, dxfattribs={"layer": "OWN"})
 
 
-def test_a_block_reference_on_a_frozen_layer_hides_its_whole_block(tmp_path):
-    doc, msp = _with_layer("frozen", "REF")
+def _referenced_on(state: str, tmp_path: Path):
+    """The plate with block ``HOLES`` referenced on a layer ``REF`` in ``state``, imported."""
+    doc, msp = _with_layer(state, "REF")
     doc.layers.add("OWN")
     _block_of_holes(doc)
     _plate(msp)
     msp.add_blockref("HOLES", (0, 0), dxfattribs={"layer": "REF"})
-    ip = _one(_save(doc, tmp_path / "frozen_ref.dxf"))
+    return _one(_save(doc, tmp_path / f"{state}_ref.dxf"))
+
+
+def test_a_block_reference_on_a_frozen_layer_hides_its_whole_block(tmp_path):
+    ip = _referenced_on("frozen", tmp_path)
     _is_the_plate(ip)
     assert any(
         "left out 2 entities CAD does not show: 2 on frozen layer 'REF'" in w for w in ip.warnings
@@ -231,12 +236,7 @@ def test_a_block_reference_on_a_frozen_layer_hides_its_whole_block(tmp_path):
 
 
 def test_a_block_reference_on_an_off_layer_hides_only_its_layer_0_entities(tmp_path):
-    doc, msp = _with_layer("off", "REF")
-    doc.layers.add("OWN")
-    _block_of_holes(doc)
-    _plate(msp)
-    msp.add_blockref("HOLES", (0, 0), dxfattribs={"layer": "REF"})
-    ip = _one(_save(doc, tmp_path / "off_ref.dxf"))
+    ip = _referenced_on("off", tmp_path)
     want = TRUTH.difference(Point(8, 6).buffer(2, quad_segs=1024))
     assert len(ip.part.outline.holes) == 2
     assert ip.part.outline.polygon().area == pytest.approx(want.area, rel=2e-4)

@@ -15,6 +15,7 @@ from test_strong_plans import _usable, perturbed, random_pf, run_plan
 
 from feederkit.cli.app import main
 from feederkit.errors import CheckFailed, PlanningError
+from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import action_nodes, certificate_problems, verify_strong
 from feederkit.plans.verify import verify_declared
@@ -204,22 +205,6 @@ def test_a_sensed_certificate_at_the_declared_shape_tolerance_says_why(capsys):
     assert "(the declared: reading" not in " ".join(capsys.readouterr().out.split())
 
 
-def _leaves(plan: dict) -> list[dict]:
-    """The plan's distinct result nodes (shared subplans once)."""
-    out, seen, stack = [], set(), [plan["root"]]
-    while stack:
-        node = stack.pop()
-        node = plan.get("nodes", {}).get(node["ref"], node) if "ref" in node else node
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if "result" in node:
-            out.append(node)
-        else:
-            stack.extend(b["next"] for b in node["branches"])
-    return out
-
-
 @pytest.mark.parametrize("rotation_error", ["1", "0"])
 def test_a_result_naming_a_state_no_path_ends_in_is_refused(tmp_path, capsys, rotation_error):
     # A controller may take any entry of a result as the answer (design.md): an entry for a
@@ -230,7 +215,7 @@ def test_a_result_naming_a_state_no_path_ends_in_is_refused(tmp_path, capsys, ro
     assert main(["plan", *args, "-o", str(path)]) == 0
     plan = json.loads(path.read_text())
     assert verify_declared(plan).ok
-    leaf = next(leaf for leaf in _leaves(plan) if len(leaf["result"]) == 1)
+    leaf = next(leaf for leaf in result_nodes(plan) if len(leaf["result"]) == 1)
     arrived = leaf["result"][0]["state"]
     states = plan["parts"][0]["stable_states"]
     other = next(s for s in states if s["id"] != arrived)

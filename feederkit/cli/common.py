@@ -319,12 +319,8 @@ def flag_words(terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> Iterator[None]:
         text = with_flags(str(exc), terms)
         if text == str(exc):
             raise
-        try:
-            err = type(exc)(text)
-        except TypeError:  # an error that carries more than its line (a cell profile's)
-            err = InputError(text) if isinstance(exc, InputError) else FeederkitError(text)
-        err.exit_code = exc.exit_code
-        raise err from None
+        exc.args = (text,)  # the same error (its type, fields and exit code), a new line
+        raise
 
 
 def uncertainty_option(
