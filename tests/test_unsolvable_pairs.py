@@ -70,10 +70,30 @@ def test_the_planner_says_no_strong_plan_when_its_search_cannot_finish(monkeypat
 
     monkeypatch.setattr(api, "longest_root", out_of_time)
     monkeypatch.setattr(api, "beam_plan", lambda *args, **kwargs: None)
+    monkeypatch.setattr(api, "kept_roots", lambda *args, **kwargs: [])  # the test below
     options = PlanningOptions(time_limit_s=30.0, lumping="none")
     with pytest.raises(NoStrongPlan, match="no strong plan exists"):
         plan(machine, options)
     assert not strong_plan_exists(machine, options)
+
+
+def test_the_planner_says_no_strong_plan_before_searching_when_nature_keeps_a_pair(monkeypatch):
+    # Seed 18 keeps a pair apart: the planner answers before its length search (which on a
+    # 50-part mix at 5 % ran 30 s before it gave up).
+    machine = _two_parts(18, 1.0, 0.1)
+    monkeypatch.setattr(api, "longest_root", lambda *a, **k: pytest.fail("a search was run"))
+    with pytest.raises(NoStrongPlan, match="no strong plan exists"):
+        plan(machine, PlanningOptions(time_limit_s=30.0, lumping="none"))
+
+
+@pytest.mark.parametrize("seed", range(0, 40, 2))
+def test_the_roots_kept_pairs_name_have_no_strong_plan(seed):
+    problem = Problem(_two_parts(seed, 1.0, 0.1))
+    roots = _roots(problem)
+    kept = kept_apart(problem.machine, solvable.candidate_pairs(problem))
+    got = solvable.kept_roots(problem, roots)
+    assert got == solvable.holding_kept_pairs(roots, kept)
+    assert set(got) <= set(unsolvable(problem, roots))
 
 
 def _every_pair_refused(problem: Problem, roots: list[int]) -> bool:

@@ -177,13 +177,16 @@ class LumpingTry:
     None); ``unlike``: the unresolvable pairs the rule left out (poses that do not look
     alike), sorted; ``decided``: False when the search ran out of time or sets (``goal`` is
     then None, and no strong plan may yet exist); ``cut_by``: then what it ran out of (the
-    Timeout's reason, ``"time"`` or ``"memory"``, or ``"sets"``), else None.
+    Timeout's reason, ``"time"`` or ``"memory"``, or ``"sets"``), else None; ``undecided``:
+    with ``"sets"``, the lumped goal whose roots had too many sets to decide (its pairs are
+    decided: a planner's search may still find a strong plan to it).
     """
 
     goal: LumpedGoal | None
     unlike: tuple[Pair, ...] = ()
     decided: bool = True
     cut_by: str | None = None
+    undecided: LumpedGoal | None = None
 
 
 def try_lumping(
@@ -221,7 +224,8 @@ def try_lumping(
             if value is not None and all(value[r] < math.inf for r in roots):
                 return LumpingTry(LumpedGoal(goal, lumps, exact), unlike)
             if value is None and k == len(tries) - 1:
-                return LumpingTry(None, unlike, decided=False, cut_by="sets")
+                undecided = LumpedGoal(goal, lumps, exact)
+                return LumpingTry(None, unlike, False, "sets", undecided)
     except Timeout as exc:
         return LumpingTry(None, decided=False, cut_by=exc.reason)
     return LumpingTry(None, unlike)

@@ -167,6 +167,21 @@ def holding_kept_pairs(roots: list[int], kept: set[tuple[int, int]]) -> list[int
     return [r for r in roots if any(partner.get(i, 0) & r for i in members(r))]
 
 
+def kept_roots(problem: Problem, roots: list[int], deadline: Deadline | None = None) -> list[int]:
+    """The roots holding a pair nature keeps apart whatever the plan does
+    (:func:`~feederkit.machine.inseparable.kept_apart` over :func:`candidate_pairs`, one
+    fixpoint over all pairs, polled by ``deadline``): no strong plan orients them.
+
+    Sound, not complete (empty proves nothing), and cheap beside a search: the 50-part mix at
+    5 % under 1 degree names 30 of its 96 roots in 0.2 s, where the length search ran 30 s
+    before it gave up; 0.01-0.13 s on the mixes of 20-50 parts at 1-3 %, which have plans.
+    """
+    deadline = deadline or Deadline(None)
+    return holding_kept_pairs(
+        roots, kept_apart(problem.machine, candidate_pairs(problem), deadline.check)
+    )
+
+
 def unsolvable_by_pairs(
     problem: Problem,
     roots: list[int],
@@ -192,8 +207,7 @@ def unsolvable_by_pairs(
     under 1 degree: the same 30 roots in 0.3 s, where the pairs' searches take 5.8 s.
     """
     deadline = deadline or Deadline(None)
-    kept = kept_apart(problem.machine, candidate_pairs(problem), deadline.check)
-    held = holding_kept_pairs(roots, kept)
+    held = kept_roots(problem, roots, deadline)
     if held:
         return held
     bad = _bad_pairs(problem, _pairs_within(problem, roots, NEIGHBOUR_PAIRS), deadline, max_sets)
