@@ -1,7 +1,8 @@
 """Messy drawings (docs/import.md, "Loops", "Parts and holes", "Drawing frames"): dimension
-and extension lines drawn against the outline, an outline or a hole left open, a drawing
-frame around a part on the part's own layer or holding a free-standing title block, parts
-sharing a cut line, a view drawn against its part, and a self-crossing outline of LINEs.
+and extension lines drawn against the outline (a closed one or one of lines), an outline or
+a hole left open, a drawing frame around a part on the part's own layer or holding a
+free-standing title block, parts sharing a cut line, a view drawn against its part, and a
+self-crossing outline of LINEs.
 
 Each drawing is built here with ezdxf; each must import the drawn part or say what is doubtful.
 """
@@ -127,6 +128,74 @@ def test_a_closed_cell_in_a_plate_of_lines_says_nothing(tmp_path):
     (ip,) = parts(drawing(tmp_path / "cell.dxf", build))
     assert area(ip) == pytest.approx(3200.0)
     assert not ip.warnings
+
+
+# ---- the same against an outline drawn with lines -------------------------------------------
+
+
+def _l_plate_of_lines(msp) -> None:
+    _lines(msp, L_PLATE)
+    msp.add_circle((60, 20), 6)
+
+
+def test_dimension_lines_against_an_outline_of_lines_are_named(tmp_path):
+    def build(msp):
+        _l_plate_of_lines(msp)
+        msp.add_line((0, 0), (0, -12))  # extension lines from the part's corners
+        msp.add_line((80, 0), (80, -12))
+        msp.add_line((0, -10), (80, -10))  # the dimension line
+
+    (ip,) = parts(drawing(tmp_path / "hand.dxf", build))
+    (note,) = noted(ip, "ends on it at both ends and cuts off 1 region")
+    assert "80 x 10 mm at x 0..80, y -10..0" in note and "dimension lines" in note
+    assert area(ip) == pytest.approx(Polygon(L_PLATE).area + 800 - 113.0, abs=0.2)  # merged
+
+
+def test_exploded_dimensions_against_an_outline_of_lines_are_named(tmp_path):
+    def build(msp):
+        _l_plate_of_lines(msp)
+        for base, p1, p2, angle in (
+            ((0, -10), (0, 0), (80, 0), 0),
+            ((90, 0), (80, 0), (80, 40), 90),
+        ):
+            dim = msp.add_linear_dim(base=base, p1=p1, p2=p2, angle=angle, override={"dimexo": 0})
+            dim.render()
+        for entity in list(msp.query("DIMENSION")):
+            entity.explode()
+        for entity in list(msp.query("INSERT")):
+            entity.explode()
+
+    (ip,) = parts(drawing(tmp_path / "dims.dxf", build, True))
+    (note,) = noted(ip, "cuts off 2 regions")
+    assert "80 x 10 mm at x 0..80, y -10..0" in note and "10 x 40 mm at x 80..90, y 0..40" in note
+
+
+@pytest.mark.parametrize("closed", [False, True], ids=["lines", "polyline"])
+def test_centre_lines_running_on_past_the_outline_say_nothing(tmp_path, closed):
+    def build(msp):
+        if closed:
+            _l_plate_with_hole(msp)
+        else:
+            _l_plate_of_lines(msp)
+        msp.add_line((60, -5), (60, 45))
+        msp.add_line((45, 20), (85, 20))
+        msp.add_line((-3, 12), (83, 12))  # across the whole part
+
+    (ip,) = parts(drawing(tmp_path / "centre.dxf", build))
+    truth = Polygon(L_PLATE).difference(Point(60, 20).buffer(6, 2048))
+    assert area(ip) == pytest.approx(truth.area, rel=1e-3)
+    assert not ip.warnings
+
+
+def test_two_parts_of_lines_drawn_against_each_other_are_named(tmp_path):
+    def build(msp):
+        _lines(msp, [(0, 0), (50, 0), (50, 40), (0, 40)])
+        _lines(msp, [(50, 0), (90, 0), (90, 40), (50, 40)], close=False)
+
+    (ip,) = parts(drawing(tmp_path / "nest.dxf", build))
+    (note,) = noted(ip, "cuts off 1 region", "another part drawn against it")
+    assert "40 x 40 mm at x 50..90, y 0..40" in note
+    assert area(ip) == pytest.approx(90 * 40)
 
 
 # ---- an outline or a hole left open ---------------------------------------------------------

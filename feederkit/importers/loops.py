@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import shapely
 import shapely.affinity
+import shapely.ops
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -88,6 +89,9 @@ class Region:
     outside: tuple[tuple[float, float, float, float], ...] = ()
     """Bounds of the regions merged into the outer loop that open lines close against a closed
     line's edge from outside (:class:`Loop`)."""
+    cut_off: tuple[tuple[float, float, float, float], ...] = ()
+    """Bounds of the regions merged into the outer loop that an open line inside it cuts off,
+    stopping on its outline at both ends (:class:`Loop`)."""
 
 
 @dataclass(frozen=True)
@@ -260,6 +264,10 @@ class Loop:
     """Bounds of the regions merged into the loop that lie outside every closed line of its
     group and that open lines close only against a closed line's edge (extension and
     dimension lines drawn against the outline): merged, with a warning."""
+    cut_off: tuple[tuple[float, float, float, float], ...] = ()
+    """Bounds of the regions merged into the loop that an open line inside it cuts off,
+    stopping on its outline at both ends (:func:`_cut_off`: dimension lines drawn against an
+    outline of lines, a part drawn against another): merged, with a warning."""
     split: bool = False
     """Whether the loop is one of several closed lines lying side by side (sharing edges)
     that tiled a group's merged loop and were read apart (parts nested for common-line
@@ -427,6 +435,50 @@ def _closed_against(
     return tuple(tuple(float(v) for v in shapely.bounds(r)) for r in regions)
 
 
+def _cut_off(
+    shape: Polygon, group: np.ndarray, rings: Sequence[Polygon], tol: float, gap: float
+) -> tuple[tuple[float, float, float, float], ...]:
+    """Bounds of the regions of the merged loop ``shape`` that an open line inside it cuts
+    off while stopping on its outline at both ends (no line of ``group`` runs on outside it
+    there): the part's own edge between it and extension or dimension lines drawn from its
+    corners, when the part is drawn with lines, or a second part drawn against it. A centre
+    line runs on beyond the outline; lines along a closed line (``rings``) are that line's
+    (:func:`_closed_against` judges those). The largest region is the part; slivers
+    (:func:`_thin`) are none."""
+    group = group[shapely.intersects(shape, group)]
+    mids = shapely.line_interpolate_point(group, 0.5, normalized=True)
+    edge = shapely.distance(mids, shape.exterior) <= tol
+    inner = shapely.contains(shape, mids) & ~edge
+    for ring in rings:
+        inner &= shapely.distance(mids, ring.exterior) > tol
+    if not inner.any():
+        return ()
+    out = group[~inner & ~edge]
+    chains = shapely.get_parts(shapely.line_merge(shapely.union_all(group[inner])))
+    starts = shapely.get_point(chains, 0)
+    ends = shapely.get_point(chains, -1)
+    on_edge = (shapely.distance(starts, shape.exterior) <= tol) & (
+        shapely.distance(ends, shape.exterior) <= tol
+    )
+    if len(out):
+        tree = shapely.STRtree(out)
+        for pts in (starts, ends):
+            on_edge[np.unique(tree.query(pts, predicate="dwithin", distance=tol)[0])] = False
+    if not on_edge.any():
+        return ()
+    pieces = shapely.get_parts(shapely.ops.split(shape, shapely.union_all(chains[on_edge])))
+    pieces = np.asarray([p for p in pieces if isinstance(p, Polygon)], dtype=object)
+    if len(pieces) < 2:
+        return ()
+    rest = np.ones(len(pieces), dtype=bool)
+    rest[int(np.argmax(shapely.area(pieces)))] = False
+    rest &= ~_thin(pieces, gap)
+    if not rest.any():
+        return ()
+    regions = shapely.get_parts(shapely.union_all(pieces[rest]))
+    return tuple(tuple(float(v) for v in shapely.bounds(r)) for r in regions)
+
+
 def _side_by_side(faces: Sequence[Polygon], rings: Sequence[Polygon]) -> list[list[Polygon]]:
     """The faces of each closed line when two or more of ``rings`` lie side by side in one
     merged loop and tile it (every face inside exactly one of them, none inside another:
@@ -575,6 +627,11 @@ def closed_loops(
                             if outer and cover is not None
                             else ()
                         ),
+                        cut_off=(
+                            _cut_off(shape, group, ring_group.get(int(lab), []), 1e3 * eps, gap)
+                            if outer and len(own) >= 2
+                            else ()
+                        ),
                         split=outer and bool(apart),
                     )
                 )
@@ -693,6 +750,7 @@ def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = 
             loop_area=float(loop.area),
             enclosed=loops[i].enclosed,
             outside=loops[i].outside,
+            cut_off=loops[i].cut_off,
         )
         regions.append((i, region))
     regions.sort(key=lambda r: -r[1].loop_area)
@@ -1175,6 +1233,17 @@ def outside_note(bounds: Sequence[Sequence[float]]) -> str:
     )
 
 
+def cut_off_note(bounds: Sequence[Sequence[float]]) -> str:
+    """The warning for regions an open line inside the part cuts off (:attr:`Loop.cut_off`),
+    merged into the part."""
+    return (
+        f"a line inside the outline ends on it at both ends and cuts off "
+        f"{plural(len(bounds), 'region')} ({_boxes(bounds)}): merged into the part, so its "
+        "area and COM are off if the region is closed by extension or dimension lines or is "
+        "another part drawn against it; delete such lines or leave their layer out with --layer"
+    )
+
+
 def side_by_side_note(bounds: Sequence[Sequence[float]]) -> str:
     """The warning for closed outlines lying side by side, read as separate parts
     (:attr:`Loop.split`)."""
@@ -1439,6 +1508,7 @@ def drawing_from_lines(
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
     notes += [outside_note(r.outside) for r in drawing.regions if r.outside]
+    notes += [cut_off_note(r.cut_off) for r in drawing.regions if r.cut_off]
     doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)
     if doubt:
         notes.append(doubt)
