@@ -50,7 +50,9 @@ from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
-from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
+from feederkit.planning.tree import Certificate, PlanResult, PlanTree, leaf_masks
+from feederkit.planning.tree import Leaf as TreeLeaf
+from feederkit.planning.tree import Step as TreeStep
 from feederkit.plans.fileformat import as_plan, plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.strong import (
@@ -204,17 +206,19 @@ def _make_plan(
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
         if widened:
             data["stats"]["expected_length"] = file_expected(as_plan(data))
-        report = check_plan(data)
+        report = check_plan(data, prune=True)
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         ideal = widen_widths(ideal, offsets)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
-        report = verify_strong(data, tighten_margins=True, restate_expected=widened)
+        report = verify_strong(data, tighten_margins=True, restate_expected=widened, prune=True)
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
+    # The file's results were pruned to what ends there: the warnings below read the same.
+    result = replace(result, root=listed_tree(result, data))
     if widened:
         result = replace(result, expected_length=data["stats"]["expected_length"])
     notes: list[str] = []
@@ -271,6 +275,65 @@ def _make_plan(
     if held is not None:
         warnings.append(held)
     return MadePlan(data, result, report, tuple(warnings + notes), unoriented)
+
+
+def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
+    """The planner's tree with each leaf's mask cut to the states its results in the plan
+    file's object ``data`` (written from that tree, then pruned) still list: a state stays
+    when one of its ideal members is listed at one of the leaf's places."""
+    machine = result.machine
+    parts = [(part["name"], part.get("landing")) for part in data["parts"]]
+    shared = data.get("nodes") or {}
+    listed: dict[int, set[tuple[int, int]]] = {}  # tree leaf id: (part, ideal state) listed
+    index = {key: p for p, key in enumerate(parts)}
+    seen: set[tuple[int, int]] = set()
+    stack: list[tuple[PlanTree, Any]] = [(result.root, data["root"])]
+    while stack:
+        node, raw = stack.pop()
+        while "ref" in raw:
+            raw = shared[raw["ref"]]
+        if (id(node), id(raw)) in seen:
+            continue
+        seen.add((id(node), id(raw)))
+        if isinstance(node, TreeLeaf):
+            names = listed.setdefault(id(node), set())
+            names.update((index[(e["part"], e.get("landing"))], e["state"]) for e in raw["result"])
+            continue
+        pairs = zip(node.branches, raw["branches"], strict=True)
+        stack.extend((child, b["next"]) for (_b, child), b in pairs)
+
+    def cut(leaf: TreeLeaf) -> TreeLeaf:
+        names = listed[id(leaf)]
+        mask = 0
+        for i in members(leaf.mask):
+            ms = machine.states[i]
+            if any((ms.part, m) in names for m in ms.ideal_states):
+                mask |= 1 << i
+        return leaf if mask == leaf.mask else TreeLeaf(mask)
+
+    return _map_leaves(result.root, cut)
+
+
+def _map_leaves(root: PlanTree, leaf: Callable[[TreeLeaf], TreeLeaf]) -> PlanTree:
+    """The tree with every leaf replaced by ``leaf`` of it, each distinct node once, children
+    first, without recursion (sharing kept; a step none of whose leaves changes is kept)."""
+    nodes: dict[int, PlanTree] = {}
+    stack: list[tuple[PlanTree, bool]] = [(root, False)]
+    while stack:
+        n, ready = stack.pop()
+        if id(n) in nodes:
+            continue
+        if isinstance(n, TreeLeaf):
+            nodes[id(n)] = leaf(n)
+            continue
+        if not ready:
+            stack.append((n, True))
+            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
+            continue
+        subs = tuple((b, nodes[id(sub)]) for b, sub in n.branches)
+        same = all(new is old for (_b, new), (_c, old) in zip(subs, n.branches, strict=True))
+        nodes[id(n)] = n if same else TreeStep(n.action, subs)
+    return nodes[id(root)]
 
 
 def ideal_plan_words(

@@ -51,7 +51,12 @@ from feederkit.planning.tree import PlanResult, Step
 from feederkit.plans.execute import rounding_inset
 from feederkit.plans.fileformat import result_nodes
 from feederkit.plans.model import PlanPart, member_label, push_function_of
-from feederkit.plans.verify import PartCheck, VerificationReport, unlike_unreached
+from feederkit.plans.verify import (
+    PartCheck,
+    VerificationReport,
+    unsupported,
+    unsupported_words,
+)
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
@@ -375,33 +380,49 @@ class _Run:
         self.rejected[key] = rejected
         return 1 + longest
 
-    def unreached(self, root: Mapping[str, Any]) -> str | None:
-        """The first result entry that names a state no path ends in there and that looks
-        like none that does (:func:`~feederkit.plans.verify.unlike_unreached`; None: none)."""
-        seen: set[int] = set()
-        stack = [root]
+    def results(self, root: Mapping[str, Any]) -> list[Mapping[str, Any]]:
+        """Every distinct result node, references resolved."""
+        out, seen, stack = [], set(), [root]
         while stack:
             node = self.node(stack.pop())
             if id(node) in seen:
                 continue
             seen.add(id(node))
-            if "result" not in node:
+            if "result" in node:
+                out.append(node)
+            else:
                 stack.extend(b["next"] for b in node["branches"])
-                continue
-            arrived = self.arrivals.get(id(node), set())
-            listed: dict[int, list[int]] = {}
-            for e in node["result"]:
-                p = self.by_name.get((e["part"], e.get("landing")))
-                if p is not None:
-                    listed.setdefault(p, []).append(e["state"])
-            for p, states in listed.items():
-                mine = {s for q, s in arrived if q == p}
-                bad = unlike_unreached(self.model.mechanics[p].push, states, mine)
-                if bad:
-                    return (
-                        f"a result lists {self.model.label(p)} state {bad[0]}, but no start, "
-                        "outcome or reading of it ends there, and it looks like none that does"
-                    )
+        return out
+
+    def listed(self, node: Mapping[str, Any]) -> list[tuple[int, int]]:
+        """A result's entries as (part, ideal state) pairs."""
+        return [(self.by_name[(e["part"], e.get("landing"))], e["state"]) for e in node["result"]]
+
+    def prune(self, root: Mapping[str, Any]) -> None:
+        """Each result node pruned in place to the entries that end there (a plan being
+        made: a controller may take any entry as the answer, so a result names only what
+        ends there); a result nothing ends in keeps its entries
+        (:func:`~feederkit.plans.verify.unsupported`)."""
+        for node in self.results(root):
+            ends = self.arrivals.get(id(node))
+            if ends:
+                keep = [x in ends for x in self.listed(node)]
+                entries = node["result"]
+                node["result"] = [e for e, k in zip(entries, keep, strict=True) if k]  # type: ignore[index]
+
+    def unreached(self, root: Mapping[str, Any]) -> str | None:
+        """The first result entry nothing supports there (None: none): a state that no
+        start, outcome or reading ends in there and that looks like none of its member's
+        that does, or of a part or landing none of whose states ends there
+        (:func:`~feederkit.plans.verify.unsupported`)."""
+        pfs = [m.push for m in self.model.mechanics]
+        for node in self.results(root):
+            ends = self.arrivals.get(id(node), set())
+            bad = unsupported(pfs, self.listed(node), ends)
+            if bad:
+                p, s = bad[0]
+                there = any(q == p for q, _s in ends)
+                return unsupported_words(self.model.label(p), s, there)
         return None
 
     def handles(self, node: Mapping[str, Any], x: State) -> bool:
@@ -459,6 +480,7 @@ def verify_strong(
     parts: Sequence[PushFunction] | None = None,
     tighten_margins: bool = False,
     restate_expected: bool = False,
+    prune: bool = False,
 ) -> VerificationReport:
     """Execute every start, outcome and reading branch of ``plan`` on rebuilt mechanics.
 
@@ -475,7 +497,8 @@ def verify_strong(
     touching end at a critical tolerance, probability ~1e-16), where nothing is claimed.
     ``restate_expected`` (a plan made on wider reading sets than its file's model, the parts'
     own widths: ``machine.widths``): ``stats.expected_length`` is set to the file model's
-    figure rather than checked against it.
+    figure rather than checked against it. ``prune`` (a plan being made): each result is
+    pruned in place to what ends there (:meth:`_Run.prune`) before its entries are judged.
     """
     model = strong_model(plan, uncertainty, vibration_mm=vibration_mm, parts=parts)
     # The margins are claims at the declared uncertainty (the ideal verifier follows them).
@@ -493,6 +516,8 @@ def verify_strong(
             rejected += run.rejected[(id(run.node(root)), x)]
         overall = max(overall, worst)
         checks.append(PartCheck(name, len(states), paths, worst, 0, landing, rejected))
+    if prune:
+        run.prune(root)
     spurious = run.unreached(root) if uncertainty is None else None
     if spurious is not None:
         raise CheckFailed(spurious)

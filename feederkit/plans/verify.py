@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Container, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -39,7 +39,7 @@ from feederkit.mechanics.push import PushFunction, StableState, push, rotation_a
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, NEAR_SYMMETRIC_REL, pose_differences
 from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan, Step, member_label, push_function_of
+from feederkit.plans.model import Leaf, Node, Plan, Step, member_label, push_function_of
 from feederkit.sensors import Sensor
 from feederkit.words import plural
 
@@ -280,22 +280,6 @@ class _PartSearch:
         self.memo[key] = _Outcome(paths, worst - number, failure, rejects)
         return _Outcome(paths, worst, failure, rejects)
 
-    def unreached(self) -> list[str]:
-        """Result entries of this part that no path of it ends in and that look like no
-        state that does (:func:`unlike_unreached`)."""
-        out = []
-        for leaf in self.plan.leaves():
-            mine = (e for e in leaf.results if (e.part, e.landing) == (self.name, self.landing))
-            listed = {e.state: e.pose_deg for e in mine}
-            arrived = {s for s in listed if (id(leaf), s) in self.arrivals}
-            for s in unlike_unreached(self.pf, listed, arrived):
-                out.append(
-                    f"a result lists {member_label(self.name, self.landing)} state {s} (pose "
-                    f"{listed[s]:.6g} deg), but no start, rotation or reading of it ends there, "
-                    "and it looks like none that does"
-                )
-        return out
-
     def run(self) -> tuple[PartCheck, list[Trace]]:
         paths, worst, failed, rejects = 0, 0, [], 0
         starts = self.pf.states
@@ -318,22 +302,139 @@ class _PartSearch:
 
 
 def unlike_unreached(pf: PushFunction, listed: Iterable[int], arrived: set[int]) -> list[int]:
-    """The states of ``listed`` (one part's entries of a result) that no path ends in there
-    and whose pose looks like that of none of the ``arrived`` (within ``NEAR_SYMMETRIC_REL``
-    of the part's size, :func:`~feederkit.mechanics.symmetry.pose_difference`).
+    """The states of ``listed`` (one member's entries of a result) that are not ``arrived``
+    (the member's states that end there) and whose pose looks like that of none of them
+    (within ``NEAR_SYMMETRIC_REL`` of the part's size,
+    :func:`~feederkit.mechanics.symmetry.pose_difference`); every missing one when none of
+    the member's states ends there.
 
     A controller may take any entry of a result as the answer (design.md), so such an entry
-    would send the part to a wrong pose. Entries that look like an arriving one are harmless
-    (a symmetric pose, or a near-symmetric one listed with it), and plans whose reading sets
-    follow a larger set's subplan list them. A result no state of the part ends in is not
-    judged here (it names what another part's paths bring, or nothing reaches it)."""
+    would send the part to a wrong pose, or name a part or landing that never comes there.
+    Entries that look like an arriving one are harmless (a symmetric pose, or a
+    near-symmetric one listed with it)."""
     missing = [s for s in listed if s not in arrived]
     if not missing or not arrived:
-        return []
+        return missing
     tol = NEAR_SYMMETRIC_REL * pf.part.size
     near = pose_differences(pf, [(s, a) for s in missing for a in sorted(arrived)])
     width = len(arrived)
     return [s for k, s in enumerate(missing) if near[k * width : (k + 1) * width].min() > tol]
+
+
+Listed = tuple[int, int]
+"""A result entry as the verifiers judge it: (member index, state id)."""
+
+
+def unsupported(
+    pfs: Sequence[PushFunction], listed: Iterable[Listed], arrived: set[Listed]
+) -> list[Listed]:
+    """The entries of ``listed`` (one result's) that are not ``arrived`` (the pairs that
+    end there, from every start, outcome and reading) and that look like none of their
+    member's arrived states (:func:`unlike_unreached`: every entry of a member none of whose
+    states ends there), in the order listed. A result nothing ends in is not judged: only
+    readings beyond the plan's model lead there (a part's own widths beyond a contact hull
+    simplified inside its arcs, ``machine.widths``), which the file does not hold."""
+    if not arrived:
+        return []
+    by_member: dict[int, list[int]] = {}
+    for p, s in listed:
+        by_member.setdefault(p, []).append(s)
+    bad: set[Listed] = set()
+    for p, states in by_member.items():
+        mine = {s for q, s in arrived if q == p}
+        bad.update((p, s) for s in unlike_unreached(pfs[p], states, mine))
+    return [x for x in listed if x in bad]
+
+
+def unsupported_words(label: str, state: int, member_there: bool, pose: float | None = None) -> str:
+    """A result entry :func:`unsupported` refuses, in words: ``member_there`` whether some
+    state of its member (``label``) ends there."""
+    shown = "" if pose is None else f" (pose {pose:.6g} deg)"
+    head = f"a result lists {label} state {state}{shown}, but no start, outcome or reading of "
+    if not member_there:
+        return head + f"{label} ends there"
+    return head + "it ends there, and it looks like none that does"
+
+
+def _arrivals(plan: Plan, searches: Mapping[int, _PartSearch]) -> dict[int, set[Listed]]:
+    """Per result (its id): the (member, state) pairs of the searched members that end
+    there."""
+    out: dict[int, set[Listed]] = {id(leaf): set() for leaf in plan.leaves()}
+    for p, search in searches.items():
+        for leaf, state in search.arrivals:
+            out[leaf].add((p, state))
+    return out
+
+
+def _listed(
+    index: Mapping[tuple[str, str | None], int], leaf: Leaf, searched: Container[int]
+) -> list[Listed]:
+    """A result's entries of the searched members as (member, state) pairs (``index``: each
+    member's index by its key)."""
+    return [(k, e.state) for e in leaf.results if (k := index[e.key]) in searched]
+
+
+def _member_index(plan: Plan) -> dict[tuple[str, str | None], int]:
+    """Each member's index by its key ``(name, landing)``."""
+    return {part.key: p for p, part in enumerate(plan.parts)}
+
+
+def entry_problems(
+    plan: Plan, searches: Mapping[int, _PartSearch], arrived: Mapping[int, set[Listed]]
+) -> list[str]:
+    """Result entries of the searched members that nothing ends in there and that look like
+    none that does (:func:`unsupported`), ``arrived`` per result (:func:`_arrivals`); with
+    some members searched only, a result none of theirs ends in is not judged."""
+    pfs = plan.push_functions()
+    poses = {(p, s.id): s.pose_deg for p, part in enumerate(plan.parts) for s in part.states}
+    index = _member_index(plan)
+    out = []
+    for leaf in plan.leaves():
+        ends = arrived[id(leaf)]
+        for p, s in unsupported(pfs, _listed(index, leaf, searches), ends):
+            there = any(q == p for q, _s in ends)
+            out.append(unsupported_words(plan.parts[p].label, s, there, poses[(p, s)]))
+    return out
+
+
+def file_results(data: Mapping[str, Any], plan: Plan) -> dict[int, list[dict[str, Any]]]:
+    """Per result of ``plan`` (its id): the result objects of ``data``, the file's object
+    ``plan`` was read from, that it stands for (the two walked side by side)."""
+    shared = data.get("nodes") or {}
+    out: dict[int, list[dict[str, Any]]] = {}
+    seen: set[int] = set()
+    stack: list[tuple[Any, Node]] = [(data["root"], plan.root)]
+    while stack:
+        raw, node = stack.pop()
+        while "ref" in raw:
+            raw = shared[raw["ref"]]
+        if id(raw) in seen:
+            continue
+        seen.add(id(raw))
+        if isinstance(node, Leaf):
+            out.setdefault(id(node), []).append(raw)
+        else:
+            stack.extend(
+                (b["next"], n.next) for b, n in zip(raw["branches"], node.branches, strict=True)
+            )
+    return out
+
+
+def prune_results(data: Mapping[str, Any], plan: Plan, arrived: Mapping[int, set[Listed]]) -> None:
+    """Each result object of ``data`` (the file's object of ``plan``, being made, every
+    member searched) pruned in place to the entries that end there, ``arrived`` per result
+    (:func:`_arrivals`): a controller may take any entry as the answer, so a result names
+    only what ends there. A result nothing ends in keeps its entries (:func:`unsupported`)."""
+    everyone = range(len(plan.parts))
+    index = _member_index(plan)
+    by_id = {id(leaf): leaf for leaf in plan.leaves()}
+    for leaf, raws in file_results(data, plan).items():
+        ends = arrived[leaf]
+        if not ends:
+            continue
+        keep = [x in ends for x in _listed(index, by_id[leaf], everyone)]
+        for raw in raws:
+            raw["result"] = [e for e, k in zip(raw["result"], keep, strict=True) if k]
 
 
 def _theta_into(normal_deg: float, step: Step, target: StableState) -> float:
@@ -511,15 +612,22 @@ def expected_problems(plan: Plan, expected: float) -> list[str]:
 
 
 def verify_plan(
-    plan: Plan | Mapping[str, Any], part_indices: Sequence[int] | None = None
+    plan: Plan | Mapping[str, Any],
+    part_indices: Sequence[int] | None = None,
+    *,
+    prune: bool = False,
 ) -> VerificationReport:
     """Follow the plan on the kinematic model: every start, reading and rotation (see the
     module).
 
     ``part_indices`` restricts the check to some of the plan's parts (default: all); the
     plan's stated length is checked against its tree when it is made (plan_from_dict), so
-    it holds either way. Raises InputError when the plan is structurally broken.
+    it holds either way. ``prune`` (a plan being made, given as its file's object, every
+    part checked): each result of the object is pruned to what ends there
+    (:func:`prune_results`) before its entries are judged. Raises InputError when the plan
+    is structurally broken.
     """
+    data = plan if prune and part_indices is None and not isinstance(plan, Plan) else None
     plan = as_plan(plan)
     indices = range(len(plan.parts)) if part_indices is None else part_indices
     problems = _pose_problems(plan) + reject_problems(plan)
@@ -528,16 +636,12 @@ def verify_plan(
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 4 * length + 200))  # the search recurses once per operation
     eps_d = _diameter_eps(plan)
+    searches: dict[int, _PartSearch] = {}
     try:
         for p in indices:
             problems += _state_problems(plan, p, eps_d)
-            search = _PartSearch(plan, p)
+            search = searches[p] = _PartSearch(plan, p)
             check, failed = search.run()
-            if not failed and plan.uncertainty.is_ideal:
-                # A strong plan's results name physical resting states, each with all its
-                # ideal members, some of which no kinematic path reaches: its own verifier
-                # checks its entries (plans/strong.py).
-                problems += search.unreached()
             if check.worst_operations > length:
                 problems.append(
                     f"part {check.part!r}: a run takes "
@@ -548,6 +652,16 @@ def verify_plan(
             failures += failed
     finally:
         sys.setrecursionlimit(old)
+    if not failures and plan.uncertainty.is_ideal:
+        # A strong plan's results name physical resting states, each with all its ideal
+        # members, some of which no kinematic path reaches: its own verifier checks its
+        # entries (plans/strong.py).
+        arrived = _arrivals(plan, searches)
+        if data is None:
+            problems += entry_problems(plan, searches, arrived)
+        else:
+            # Pruned to exactly what ends there, the file's results hold no entry to refuse.
+            prune_results(data, plan, arrived)
     longest = max(c.worst_operations for c in checks)
     if part_indices is None and not failures and longest < length:
         # every node is reachable (its states are images of every start), so some path is as
@@ -560,9 +674,10 @@ def verify_plan(
     return VerificationReport(tuple(checks), tuple(failures), tuple(problems))
 
 
-def check_plan(plan: Plan | Mapping[str, Any]) -> VerificationReport:
-    """Verify a plan; a failure raises CheckFailed with the first counterexample in one line."""
-    report = verify_plan(plan)
+def check_plan(plan: Plan | Mapping[str, Any], *, prune: bool = False) -> VerificationReport:
+    """Verify a plan (``prune``: as :func:`verify_plan`); a failure raises CheckFailed with
+    the first counterexample in one line."""
+    report = verify_plan(plan, prune=prune)
     if not report.ok:
         raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
     return report
