@@ -110,8 +110,14 @@ def test_the_near_symmetric_rectangle_plans_with_the_defaults_and_verifies(wired
     _sorted, old = by_diameter(machine)
     pairs = lump.renumbered(old).pairs
     assert pairs == ((0, 2), (1, 3))  # each pose with its near-symmetric twin, 180 deg on
-    for leaf in file_leaves(made.plan["root"], made.plan.get("nodes")):
+    leaves = file_leaves(made.plan["root"], made.plan.get("nodes"))
+    for leaf in leaves:
         assert leaf in ([0, 2], [1, 3])
+    # The warning names the pairs the file's results list together, no more (results are
+    # pruned to what ends there: sensorless, the plan ends in one pose pair).
+    assert made.result.lumped_pairs
+    for i, j in made.result.lumped_pairs:
+        assert any(i in leaf and j in leaf for leaf in leaves)
     assert made.result.length == (2 if sensor == NoSensor() else 1)
     words = lumped_words(machine, pairs)
     assert "rect state 0 with rect state 2" in words and "rotation error 1 deg" in words

@@ -218,7 +218,8 @@ def _make_plan(
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
     # The file's results were pruned to what ends there: the warnings below read the same.
-    result = replace(result, root=listed_tree(result, data))
+    root = listed_tree(result, data)
+    result = replace(result, root=root, lumped_pairs=listed_together(result.lumped_pairs, root))
     if widened:
         result = replace(result, expected_length=data["stats"]["expected_length"])
     notes: list[str] = []
@@ -312,6 +313,20 @@ def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
         return leaf if mask == leaf.mask else TreeLeaf(mask)
 
     return _map_leaves(result.root, cut)
+
+
+def listed_together(
+    pairs: Sequence[tuple[int, int]], root: PlanTree
+) -> tuple[tuple[int, int], ...]:
+    """The ``pairs`` of states some leaf of ``root`` lists together (the lumped pairs a
+    warning may name once results are pruned to what ends there).
+
+    >>> from feederkit.planning.tree import Leaf, Step
+    >>> listed_together([(0, 2), (1, 3)], Step(0.0, ((None, Leaf(0b0101)),)))
+    ((0, 2),)
+    """
+    masks = leaf_masks(root)
+    return tuple((i, j) for i, j in pairs if any(m >> i & 1 and m >> j & 1 for m in masks))
 
 
 def _map_leaves(root: PlanTree, leaf: Callable[[TreeLeaf], TreeLeaf]) -> PlanTree:
