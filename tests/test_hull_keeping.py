@@ -46,12 +46,14 @@ def _rests(part) -> list[float]:
 def test_chords_across_an_ellipse_make_resting_states_it_does_not_have():
     exact = _ellipse()
     chorded = make_part(exact.outline, exact.com, hull_tolerance=0.05)
-    assert _resting(exact).n == 4  # both ends of each axis (the major ones shallow)
+    # The ends of the minor axis; at the ends of the major axis the radius function has its
+    # maxima, where the chords' shallow states are the facets of a hill the part rolls off.
+    assert _resting(exact).n == 2
     assert _resting(chorded).n == 16
     assert splits(_resting(chorded), _resting(exact))
     assert not splits(_resting(exact), _resting(exact))
     kept = keeping_tolerance(exact, 0.05)
-    assert kept.lowered and (kept.model, kept.outline) == (16, 4)
+    assert kept.lowered and (kept.model, kept.outline) == (16, 2)
     assert kept.tolerance == pytest.approx(0.025)
     part, same = kept_part(exact, 0.05)
     assert same == kept and len(part.hull) <= len(exact.hull)
@@ -61,7 +63,7 @@ def test_chords_across_an_ellipse_make_resting_states_it_does_not_have():
 def test_a_tolerance_that_splits_at_every_halving_gives_the_exact_hull():
     exact = _ellipse(30.0, 29.5, 512)
     kept = keeping_tolerance(exact, 0.05 * 2**7)  # 6.4 mm: still above 0.05 after 4 halvings
-    assert (kept.tolerance, kept.model, kept.outline) == (0.0, 7, 4)
+    assert (kept.tolerance, kept.model, kept.outline) == (0.0, 7, 2)
     assert KEEP_STEPS == 4
     assert kept_part(exact, kept.asked)[0].hull == exact.hull
 

@@ -148,14 +148,16 @@ class KeptTolerance:
 
 def _resting(part: Part) -> UncertainMechanics:
     """The part's physical resting states with a breath of vibration and nothing else
-    uncertain (section 3's stable states, those vibration carries across merged)."""
+    uncertain (section 3's stable states, those vibration carries across merged, the facets of
+    a hill left out)."""
     return uncertain_mechanics(part, IDEAL, vibration_mm=FRAGILE_BARRIER_REL * part.size)
 
 
 def splits(model: UncertainMechanics, outline: UncertainMechanics) -> bool:
     """Whether ``model`` rests in two states where ``outline`` rests in one: two of its
     physical states' resting normals in one of the outline's capture ranges (a chord across
-    an arc makes a stable edge the arc does not have; the part rolls over it).
+    an arc makes a stable edge the arc does not have; the part rolls over it), or one in no
+    capture range (where the outline's facets are a hill the part rolls off).
 
     >>> import math
     >>> pts = [(30 * math.cos(k * math.pi / 64), 27 * math.sin(k * math.pi / 64))
@@ -175,6 +177,8 @@ def splits(model: UncertainMechanics, outline: UncertainMechanics) -> bool:
                     return True
                 owner.add(o.id)
                 break
+        else:
+            return True
     return False
 
 
@@ -206,7 +210,7 @@ def keeping_tolerance(part: Part, tolerance: float) -> KeptTolerance:
     ``part`` is the part on its outline's exact hull. Simplifying a hull (``clean_hull``)
     replaces an arc's facets by chords; on a near-round part a chord's stable edge holds
     the part where the arc lets it roll (a 60 x 54 mm ellipse: 16 resting states at 0.05 mm
-    where it has 4), and a plan made on them fails on the belt.
+    where it has 2), and a plan made on them fails on the belt.
     """
     if tolerance <= 0.0:
         return KeptTolerance(0.0, tolerance)

@@ -176,9 +176,9 @@ class FenceCell:
 class UncertainMechanics:
     """The mechanics of one part under one declared uncertainty (what a machine is built from).
 
-    ``state_of[i]`` is the physical state holding ideal stable state ``i`` (the type admits
-    None, but every state is kept: see :func:`uncertain_mechanics`); ``destinations[i]`` are
-    the physical states a part coming to
+    ``state_of[i]`` is the physical state holding ideal stable state ``i``, None for the
+    facets of a hill (no resting state: see :func:`uncertain_mechanics`); ``destinations[i]``
+    are the physical states a part coming to
     rest in ideal state ``i`` may end in (its own, and those vibration may carry it to over a
     barrier below ``merge_threshold_mm``, vibration plus ``2 (t + c)``).
     ``cells`` tile the circle of fence orientations, starting at the first band.
@@ -693,6 +693,39 @@ def _cell_targets(
     return frozenset(out)
 
 
+def _run(ks: Sequence[int], m: int) -> list[int]:
+    """The resting ranges ``ks`` of a strong component of the crossing graph in CCW order: a
+    component of this ring graph is a run of ranges, so it starts after its gap (all ``m`` from
+    0)."""
+    if len(ks) == m:
+        return list(range(m))
+    inside = set(ks)
+    start = next(k for k in ks if (k - 1) % m not in inside)
+    return [(start + i) % m for i in range(len(ks))]
+
+
+def _on_hill(peaks: np.ndarray, wells: np.ndarray, eps: float, vibration: float) -> bool:
+    """Whether a run of stable states (``wells``, the drawn radius at their normals, CCW;
+    ``peaks`` at the hilltops around and between them, both ends included) is the facets of a
+    hill, not a resting state: a part dropped there rolls off to a real minimum.
+
+    That is a flattened arc's chords where its smooth radius function (through the chords'
+    ends, the hilltops) has a maximum: every state's barrier (``noise``, the largest) is below
+    the vibration for every shape (plus ``2 eps``, F1); a hilltop between them stands higher
+    than ``noise`` above both hilltops where the run is left; and no well sinks more than
+    ``noise`` below the lower of those (a well that deep is a real minimum). A single stable
+    state never is one (no hilltop lies between its two), nor a run down a slope.
+    """
+    noise = float((np.minimum(peaks[:-1], peaks[1:]) - wells).max())
+    top = float(peaks[1:-1].max(initial=-math.inf))
+    low = float(min(peaks[0], peaks[-1]))
+    return (
+        noise + 2.0 * eps < vibration
+        and top - max(peaks[0], peaks[-1]) > noise
+        and low - float(wells.min()) <= noise
+    )
+
+
 def uncertain_mechanics(
     part: Part, uncertainty: Uncertainty, *, vibration_mm: float | None = None
 ) -> UncertainMechanics:
@@ -707,6 +740,9 @@ def uncertain_mechanics(
     crossings from near-top candidates only (a fillet's short chords) reach. A state the part
     *should* leave (its barrier below the vibration) is kept as one it may stay in: the
     feeder's vibration is not known, and the physics check shows parts resting on such edges.
+    Except the facets of a hill (:func:`_on_hill`: a flattened arc's chords where its radius
+    function has a maximum): they are no resting state (``state_of`` None), and a part coming
+    to rest there ends where the crossings take it.
     ``vibration_mm`` defaults to the fragile threshold (1e-3 of the part's size, a breath of
     vibration) unless the uncertainty is ideal,
     where it is 0 and every physical state is one ideal state. Bands: with the vibration on, a
@@ -790,11 +826,29 @@ def uncertain_mechanics(
     first_member: dict[int, int] = {}
     for i in range(pf.n):
         first_member.setdefault(comp[i], i)
-    # No state is transient: one the part *should* leave (its barrier below the vibration) is
-    # kept as a state it may stay in, since how hard a feeder vibrates is not known and the
-    # physics check shows parts resting on such edges; a push ending there may end in it or in
-    # any state it can cross to (``destinations``).
-    kept = sorted(set(comp), key=first_member.__getitem__)
+    ranges_of: dict[int, list[int]] = {}
+    for k in range(m):
+        ranges_of.setdefault(comp[rs[k]], []).append(k)
+    runs = {cc: _run(ks, m) for cc, ks in ranges_of.items()}
+    # No state is transient for the vibration alone: one the part *should* leave (its barrier
+    # below the vibration) is kept as a state it may stay in, since how hard a feeder vibrates
+    # is not known and the physics check shows parts resting on such edges; a push ending there
+    # may end in it or in any state it can cross to (``destinations``). Only the facets of a
+    # hill go (:func:`_on_hill`): there the part rolls off to a real minimum.
+    leaves = {comp[i] for i in range(pf.n) for j in wander[i] if comp[j] != comp[i]}
+    hills = {
+        cc
+        for cc, order in runs.items()
+        if cc in leaves
+        and len(order) < m
+        and _on_hill(
+            peaks[np.asarray([*order, (order[-1] + 1) % m])],
+            heights[np.asarray([rs[k] for k in order])],
+            eps,
+            vibration_mm,
+        )
+    }
+    kept = sorted(set(comp) - hills, key=first_member.__getitem__)
     pid_of = {cc: p for p, cc in enumerate(kept)}
     state_of = [pid_of.get(comp[i]) for i in range(pf.n)]
     destinations = _destinations([w | x for w, x in zip(wander, carry, strict=True)], comp, pid_of)
@@ -803,18 +857,9 @@ def uncertain_mechanics(
     by_basin: dict[int, list[RestCandidate]] = {}
     for x in cands:
         by_basin.setdefault(x.basin, []).append(x)
-    ranges_of: dict[int, list[int]] = {}
-    for k in range(m):
-        ranges_of.setdefault(comp[rs[k]], []).append(k)
     for pid, cc in enumerate(kept):
         ks = ranges_of[cc]
-        if len(ks) == m:
-            order = list(range(m))
-        else:
-            # A strong component of this ring graph is a run of ranges: start after its gap.
-            inside = set(ks)
-            start = next(k for k in ks if (k - 1) % m not in inside)
-            order = [(start + i) % m for i in range(len(ks))]
+        order = runs[cc]
         members = tuple(rs[k] for k in order)
         cap_lo = float(div[order[0]])
         if len(ks) == m:
