@@ -206,7 +206,9 @@ def simulate_plan(
     overrides it, to stress a plan beyond its claim; with ``ideal``, which rotates exactly,
     it is bad input). Trial ``i`` draws from generators
     seeded with ``(seed, i)``, so a trial's outcome does not depend on the others. Every
-    operation is judged by the plan's model.
+    operation is judged by the plan's model, and the feeder breathes on a resting part with
+    the vibration that model assumes (``PushAligner``'s ``vibration_mm``: a part stays only
+    where a barrier above it holds it).
 
     The plan is verified at its declared uncertainty first (CheckFailed when it fails);
     ``check=False`` skips that, to watch how a plan known to be wrong fails physically.
@@ -252,13 +254,14 @@ def simulate_plan(
     if len(own) != len(real) or any(not 0 <= k < len(members) for k in own):
         raise InputError("each real part must name a different member of the plan")
     real_rule = real_rule or REAL_SETTLE_RULE
+    models = _models(sim_plan)
+    breath = [x.mechanics.vibration_mm for x in models]
     aligners = [
-        PushAligner(own[k].part, base, real_rule, rests=own[k].rests)
+        PushAligner(own[k].part, base, real_rule, rests=own[k].rests, vibration_mm=breath[k])
         if k in own
-        else PushAligner(push_function_of(pp).part, base, rule)
+        else PushAligner(push_function_of(pp).part, base, rule, vibration_mm=breath[k])
         for k, pp in enumerate(members)
     ]
-    models = _models(sim_plan)
     limit = sim_plan.uncertainty.rotation_error_deg + real_rule.align_tol_deg
     poses = {k: PoseRule.of(members[k], models[k], limit) for k in own}
     shares = _member_shares(sim_plan)
@@ -295,7 +298,9 @@ def simulate_plan(
                 )
             elif shapes:
                 perturbed = perturbed_part(pp, push_function_of(pp), draw)
-                aligner = PushAligner(perturbed.part, base, rule, scale=aligners[k].scale)
+                aligner = PushAligner(
+                    perturbed.part, base, rule, scale=aligners[k].scale, vibration_mm=breath[k]
+                )
                 edges = perturbed.basin_of_edge
             aligner.set_friction(draw.friction_belt, draw.friction_fence)
 

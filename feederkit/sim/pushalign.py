@@ -28,6 +28,22 @@ from feederkit.sim.scene import MM, SceneConfig, scene_geometry, scene_xml
 CHUNK_STEPS = 5
 """Physics steps between two looks at the part (10 ms at the 2 ms step)."""
 
+BREATH_MOVES = 5
+"""How many times a breath of vibration (:meth:`PushAligner.align`) may move a resting part on
+before it is judged where it lies (each move ends lower; MuJoCo may hold a part set down on a
+slope for a window)."""
+
+BREATH_MAX_DEG = 90.0
+"""How far (deg) either way a breath of vibration follows the part rolling on the fence."""
+
+BREATH_STEP_DEG = 0.05
+"""Angular step (deg) of that search (a finely flattened arc's facets span 0.3 degree or
+more)."""
+
+BREATH_DROP_REL = 1e-3
+"""A breath moves a part only to a point lower than where it lies by this share of the
+vibration (the wells of one arc's facets differ by rounding)."""
+
 
 @dataclass(frozen=True)
 class SettleRule:
@@ -154,6 +170,41 @@ def size_scale(part: Part, lo_mm: float = 20.0, hi_mm: float = 200.0) -> float:
     return 1.0
 
 
+def fence_heights(rel: np.ndarray, turns: np.ndarray) -> np.ndarray:
+    """The COM's height over the fence (world -y) of a part whose hull about its COM is
+    ``rel`` (world axes) after each yaw turn in ``turns`` (rad), touching the fence."""
+    return -(np.sin(turns)[:, None] * rel[:, 0] + np.cos(turns)[:, None] * rel[:, 1]).min(axis=1)
+
+
+def breath_turn(rel: np.ndarray, lift: float) -> float | None:
+    """Where a breath of vibration that can lift the COM by ``lift`` takes a resting part whose
+    hull about its COM is ``rel`` (world axes, the fence below): the yaw turn (rad) to the
+    lowest point it can roll to on the fence without its COM rising more than ``lift`` above
+    the bottom of its well, when that lies past a hilltop; None when a barrier higher than
+    ``lift`` holds it on both sides.
+
+    The bottom of its own well, not where it lies: MuJoCo's soft contacts hold a part a little
+    off it (one held up a slope may go anywhere lower, and one held just past a hilltop, on a
+    slope that falls all the way, rolls down it). The lowest point, not any: a part shaken
+    among wells drifts down, never up (a row of breaths would climb an arc's facets).
+    """
+    steps = np.radians(np.arange(0.0, BREATH_MAX_DEG, BREATH_STEP_DEG))
+    turns = [steps, -steps]
+    heights = [fence_heights(rel, t) for t in turns]
+    rises = [np.flatnonzero(np.diff(h) > 0.0) for h in heights]
+    own = [int(r[0]) if r.size else 0 for r in rises]  # its well's bottom (none: a slope)
+    floor = min(float(h[k]) for h, k in zip(heights, own, strict=True))
+    ceiling = max(floor + lift, float(heights[0][0]))
+    best, to = BREATH_DROP_REL * lift, None
+    for turn, height, bottom in zip(turns, heights, own, strict=True):
+        out = np.flatnonzero(height > ceiling)
+        reach = height[: int(out[0]) if out.size else len(height)]
+        k = int(np.argmin(reach))
+        if k > bottom and floor - float(reach[k]) > best:
+            best, to = floor - float(reach[k]), float(turn[k])
+    return to
+
+
 class PushAligner:
     """A MuJoCo model of the feeder with one part, reused across push-align operations.
 
@@ -178,6 +229,7 @@ class PushAligner:
         scale: float | None = None,
         *,
         rests: Sequence[tuple[float, float, float]] | None = None,
+        vibration_mm: float = 0.0,
     ) -> None:
         mujoco = require_mujoco()
         self._mj = mujoco
@@ -210,6 +262,7 @@ class PushAligner:
         self._body = m.body("part").id
         self._size = float(np.max(np.linalg.norm(hull, axis=1)))
         self._wrap = 0.5  # metres of belt travel before the slab is moved back
+        self.vibration_mm = float(vibration_mm)
 
     def set_friction(self, belt: float, fence: float) -> None:
         """Set the belt's and the fence's friction coefficients for the next operations (the
@@ -299,11 +352,43 @@ class PushAligner:
         d.qvel[self._bv] = -self.config.belt_speed
         mj.mj_forward(self.model, d)
 
+    def _breathe(self) -> bool:
+        """A breath of vibration on the resting part (:func:`breath_turn`, the vibration
+        :attr:`vibration_mm`): it is set down at rest where the breath takes it, touching the
+        fence as before. Whether it moved."""
+        d = self.data
+        rot = d.xmat[self._body].reshape(3, 3)[:2, :2]
+        rel = self._hull @ rot.T  # the hull about the COM, world axes
+        turn = breath_turn(rel, self.vibration_mm * self.scale * MM)
+        if turn is None:
+            return False
+        before, after = fence_heights(rel, np.array([0.0, turn]))
+        yaw = math.atan2(rot[1, 0], rot[0, 0]) + turn
+        q = self._pq
+        d.qpos[q + 1] += float(after - before)
+        d.qpos[q + 3 : q + 7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+        d.qvel[self._pv : self._pv + 6] = 0.0
+        self._mj.mj_forward(self.model, d)
+        return True
+
     def align(self, theta_deg: float) -> PushOutcome:
-        """Drop the part at fence orientation ``theta_deg`` and run until it settles."""
+        """Drop the part at fence orientation ``theta_deg`` and run until it settles.
+
+        With :attr:`vibration_mm` set (the vibration the plan's model assumes) the feeder
+        breathes on the part each time it comes to rest, settled or not, wherever it lies: a
+        part that can roll lower on the fence without its COM rising more than the vibration
+        is set down there (:meth:`_breathe`) and let come to rest again (at most
+        :data:`BREATH_MOVES` times). So it stays only where a barrier above the vibration holds
+        it on both sides, as the model assumes; a flattened arc's facets at a hilltop do not
+        (the model has no state there, docs/simulation.md, "A breath of vibration").
+        """
+        self._drop(theta_deg)
+        return self._settle(theta_deg)
+
+    def _settle(self, theta_deg: float) -> PushOutcome:
+        """Run the dropped part until it settles (:meth:`align`)."""
         mj, m, d = self._mj, self.model, self.data
         rule = self.rule
-        self._drop(theta_deg)
         v = -self.config.belt_speed
         bv, bq = self._bv, self._bq
         dt = m.opt.timestep * CHUNK_STEPS
@@ -316,7 +401,12 @@ class PushAligner:
         steps = 0
         prev = theta_deg
         unwrapped = theta_deg
-        for _ in range(max_checks):
+        moves = 0 if self.vibration_mm > 0.0 else BREATH_MOVES
+        breathed: float | None = None  # unwrapped rest a breath last found
+        tol = rule.align_tol_deg
+        checks = 0
+        while checks < max_checks:
+            checks += 1
             for _ in range(CHUNK_STEPS):
                 d.qvel[bv] = v
                 mj.mj_step(m, d)
@@ -339,6 +429,14 @@ class PushAligner:
             if not rule.still(recent):
                 continue
             rest, width = rule.reading(recent, widths[-window:])
+            if moves < BREATH_MOVES and (breathed is None or abs(rest - breathed) > tol):
+                breathed = rest
+                if self._breathe():
+                    moves += 1
+                    thetas.clear()
+                    widths.clear()
+                    checks = 0  # the whole travel to come to rest again
+                    continue
             rest = norm360(rest)
             edge, off = self._nearest_edge(rest)
             if self._lowest is not None:
