@@ -10,8 +10,6 @@ import heapq
 import math
 from collections.abc import Iterable, Sequence
 
-import numpy as np
-
 Point = tuple[float, float]
 
 REL_LENGTH_TOL = 1e-9
@@ -79,77 +77,8 @@ def _chord_deviation(ring: Sequence[Point], i: int, k: int) -> float:
     return worst
 
 
-SYMMETRY_REL = 1e-7
-"""A ring's vertex lies on another's image under a symmetry when they are this close, relative
-to the ring's size (a drawing's symmetric arcs flatten to the same points up to rounding)."""
-
-
-def _area_centroid(pts: np.ndarray) -> np.ndarray:
-    """The area centroid of the polygon ``pts`` (the centre of any symmetry it has)."""
-    x, y = pts[:, 0], pts[:, 1]
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    cross = x * yn - xn * y
-    area = cross.sum() / 2.0
-    return np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
-
-
-SYMMETRY_MAX = 32
-"""The largest symmetry group a simplification keeps (the gear's 15 teeth: 30). A finely
-flattened circle has one as large as its vertex count; no fewer vertices keep it all."""
-
-
-def _symmetries(ring: Sequence[Point], tol: float) -> list[np.ndarray] | None:
-    """The ring's symmetries other than the identity, each as the index of every vertex's
-    image: rotations and reflections about its centroid that map every vertex within ``tol``
-    of a vertex; None when there are more than :data:`SYMMETRY_MAX`. A rotation keeps the
-    ring's order (``i -> i + s``), a reflection reverses it (``i -> s - i``), so each is one
-    shift ``s`` to try (a few vertices' radii first: most shifts fail there)."""
-    pts = np.asarray(ring, dtype=float)
-    n = len(pts)
-    rel = pts - _area_centroid(pts)
-    radius = np.hypot(rel[:, 0], rel[:, 1])
-    angle = np.arctan2(rel[:, 1], rel[:, 0])
-    r = radius.tolist()
-    probe = range(min(n, 4))
-    idx = np.arange(n)
-    out: list[np.ndarray] = []
-    for s in range(n):
-        for sign in (1, -1):
-            if (s == 0 and sign == 1) or any(
-                abs(r[(s + sign * i) % n] - r[i]) > tol for i in probe
-            ):
-                continue
-            image = (s + sign * idx) % n
-            if np.abs(radius[image] - radius).max() > tol:
-                continue
-            if sign < 0:  # the reflection across the axis halfway between vertex 0 and s
-                c, t = math.cos(angle[0] + angle[s]), math.sin(angle[0] + angle[s])
-                x, y = c * rel[:, 0] + t * rel[:, 1], t * rel[:, 0] - c * rel[:, 1]
-            else:
-                c, t = math.cos(angle[s] - angle[0]), math.sin(angle[s] - angle[0])
-                x, y = c * rel[:, 0] - t * rel[:, 1], t * rel[:, 0] + c * rel[:, 1]
-            if np.hypot(x - rel[image, 0], y - rel[image, 1]).max() <= tol:
-                out.append(image)
-                if len(out) >= SYMMETRY_MAX:
-                    return None
-    return out
-
-
-def _orbits(ring: Sequence[Point], tol: float) -> list[list[int]] | None:
-    """Each vertex's orbit under the ring's symmetries (:func:`_symmetries`), None when it has
-    none but the identity or too many to keep."""
-    maps = _symmetries(ring, tol)
-    if not maps:
-        return None
-    return [sorted({i, *(int(m[i]) for m in maps)}) for i in range(len(ring))]
-
-
-def _simplify(
-    ring: Sequence[Point], length_tol: float, orbits: Sequence[Sequence[int]] | None = None
-) -> list[int]:
-    """Indices of the vertices :func:`clean_hull` keeps (see there), in ring order. With
-    ``orbits`` a vertex goes only with its whole orbit (all of them or none), so a symmetric
-    ring stays symmetric."""
+def _simplify(ring: Sequence[Point], length_tol: float) -> list[int]:
+    """Indices of the vertices :func:`clean_hull` keeps (see there), in ring order."""
     n = len(ring)
     if n <= 3:
         return list(range(n))
@@ -169,27 +98,15 @@ def _simplify(
         _, _, i, version = heapq.heappop(heap)
         if not alive[i] or version != stamp[i]:
             continue  # stale entry
-        group = [i] if orbits is None else [j for j in orbits[i] if alive[j]]
-        if count - len(group) < 3:
-            continue
-        gone: list[int] = []
-        for j in group:
-            if _chord_deviation(ring, prev[j], nxt[j]) > length_tol:
-                break  # kept unless a neighbour goes (then it is queued again)
-            nxt[prev[j]], prev[nxt[j]] = nxt[j], prev[j]
-            alive[j] = False
-            gone.append(j)
-        else:
-            count -= len(gone)
-            for j in gone:
-                for k in (prev[j], nxt[j]):
-                    if alive[k]:
-                        stamp[k] += 1
-                        heapq.heappush(heap, (priority(k), ring[k], k, stamp[k]))
-            continue
-        for j in reversed(gone):  # not the whole orbit: none of it
-            nxt[prev[j]], prev[nxt[j]] = j, j
-            alive[j] = True
+        if _chord_deviation(ring, prev[i], nxt[i]) > length_tol:
+            continue  # kept unless a neighbour goes (then it is queued again)
+        alive[i] = False
+        count -= 1
+        a, b = prev[i], nxt[i]
+        nxt[a], prev[b] = b, a
+        for j in (a, b):
+            stamp[j] += 1
+            heapq.heappush(heap, (priority(j), ring[j], j, stamp[j]))
     return [i for i in range(n) if alive[i]]
 
 
@@ -295,17 +212,12 @@ def clean_hull(hull: Sequence[Point], length_tol: float) -> list[Point]:
     starts): runs of tiny chords merge among themselves before a long straight edge is
     touched. A merged edge that is mostly one flat side is then laid on that side's fence
     line (its direction, touching the outermost point it replaces), so flat sides keep their
-    exact direction and distance; other vertices are unchanged original points. A symmetric
-    ring (:func:`_orbits`) loses a vertex only with every vertex of its orbit, so it keeps its
-    symmetries (one at a time, a square's corners were cut unevenly).
+    exact direction and distance; other vertices are unchanged original points.
     """
     ring = list(hull)
     kept = _simplify(ring, length_tol)
     if len(kept) == len(ring):
         return ring
-    orbits = _orbits(ring, SYMMETRY_REL * size_of(ring))
-    if orbits is not None:
-        kept = _simplify(ring, length_tol, orbits)
     refit = _refit(ring, kept, length_tol) if len(kept) >= 3 else None
     return refit if refit is not None else [ring[i] for i in kept]
 

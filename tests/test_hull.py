@@ -84,38 +84,3 @@ def test_a_vertex_off_an_edge_by_rounding_is_collinear_at_tolerance_zero(off) ->
     part = make_part(make_outline("hair", [list(p) for p in ring]), hull_tolerance=0.0)
     assert push_function(part).n == 4
     assert len(contact_hull([(0, 0), (5, -1e-8), (10, 0), (10, 6), (0, 6)], 0.0)) == 5
-
-
-def _rounded_square(corner_points: int) -> list[tuple[float, float]]:
-    """A 20 x 20 square with corners of radius 1.5 flattened into ``corner_points`` points."""
-    pts = []
-    for cx, cy, a0 in ((8.5, 8.5, 0), (-8.5, 8.5, 90), (-8.5, -8.5, 180), (8.5, -8.5, 270)):
-        for k in range(corner_points):
-            a = math.radians(a0 + 90.0 * k / (corner_points - 1))
-            pts.append((cx + 1.5 * math.cos(a), cy + 1.5 * math.sin(a)))
-    return pts
-
-
-def _key(p: tuple[float, float]) -> tuple[float, float]:
-    return (round(p[0], 6) + 0.0, round(p[1], 6) + 0.0)
-
-
-@pytest.mark.parametrize("corner_points", [7, 9, 13])
-@pytest.mark.parametrize("tol", [0.02, 0.03, 0.05, 0.1])
-def test_simplification_keeps_the_hulls_symmetries(corner_points, tol):
-    # Removed one at a time, in the order of their coordinates, vertices of one corner went
-    # where their images at another stayed (9 of these 12 cases lost a symmetry). Where only
-    # one end of a side can go (its two would cut the side deeper than the tolerance), neither
-    # does: the exact hull is kept.
-    hull = contact_hull(_rounded_square(corner_points), tol)
-    kept = {_key(p) for p in hull}
-    assert {_key((-y, x)) for x, y in hull} == kept  # a quarter turn
-    assert {_key((x, -y)) for x, y in hull} == kept  # the mirror
-
-
-def test_a_finely_flattened_circle_is_simplified_though_no_fewer_vertices_keep_its_symmetry():
-    pts = [
-        (50 * math.cos(2 * math.pi * k / 2000), 50 * math.sin(2 * math.pi * k / 2000))
-        for k in range(2000)
-    ]
-    assert 71 <= len(contact_hull(pts, 0.05)) <= 142

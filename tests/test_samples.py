@@ -11,7 +11,6 @@ import pytest
 
 from feederkit.importers import ImportOptions, import_parts
 from feederkit.mechanics import push_function
-from feederkit.mechanics.symmetry import push_periods
 
 SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "samples"
 
@@ -78,17 +77,3 @@ def test_plate_holes_two_likely_poses():
         for k in range(ip.source.pose.count)
     ]
     assert sum(probs[:2]) > 0.95 and probs[2] < 0.05
-
-
-def test_the_vslot_keeps_its_four_fold_symmetry():
-    """Simplified one vertex at a time its four corners were cut unevenly (sides 9.9 and 9.934
-    mm from the centre): the push function read asymmetric (class 7, not 8). A symmetric chord
-    across a corner is a hilltop state the outline does not have, so the import keeps 0.005 mm:
-    the exact hull."""
-    _, (ip,) = import_parts(SAMPLES / "cadquery__vslot-2020_1.dxf", ImportOptions())
-    assert ip.hull_tolerance == pytest.approx(0.005)
-    pf = push_function(ip.part)
-    assert [round(s.normal_deg, 9) % 360.0 for s in pf.states] == [270.0, 0.0, 90.0, 180.0]
-    ranges = [s.resting_range_deg[1] - s.resting_range_deg[0] for s in pf.states]
-    assert ranges == pytest.approx([90.0] * 4, abs=1e-9)
-    assert push_periods(pf) == 4

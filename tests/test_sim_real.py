@@ -351,8 +351,8 @@ def test_a_plan_on_a_simplified_hull_fails_on_the_washers_true_outline(
     that hold the part where its arc rolls), the plan passes ``simulate`` and names the wrong
     pose on the true outline; the plan the import now makes passes on both.
 
-    Measured (30 trials, seed 0): 2 of 30 on the true outline (95 % Wilson 1.8-21.3 %; 26
-    named the flat for a washer on its arc, 2 read a width in no branch), 30 of 30 on the
+    Measured (30 trials, seed 0): 12 of 30 on the true outline (95 % Wilson 24.5-57.7 %; 3
+    named the flat for a washer on its arc, 15 a pose 2.9-3.6 degrees off), 30 of 30 on the
     plan's hull; the import's plan 30 of 30 on the true outline (docs/simulation.md).
     """
     trials = 30
@@ -365,9 +365,8 @@ def test_a_plan_on_a_simplified_hull_fails_on_the_washers_true_outline(
     k = on_outline["successes"]
     lo, hi = wilson(k, trials)
     assert k <= 0.8 * trials and hi < 0.9, (k, lo, hi)  # a meaningful share fails
-    wrong = [r for r in on_outline["failures"] if r["cause"] == "wrong result"]
-    assert {r["cause"] for r in on_outline["failures"]} <= {"wrong result", "reading in no branch"}
-    assert len(wrong) >= 0.5 * trials
+    wrong = on_outline["failures"]
+    assert {r["cause"] for r in wrong} == {"wrong result"}
     assert all(r["pose_error_deg"] > 2.0 for r in wrong)
     assert any(r["pose_error_deg"] > 170.0 for r in wrong)  # the flat named for the arc
     fixed = _run(["simulate", str(new), *common, "--part", str(washer)], capsys)
