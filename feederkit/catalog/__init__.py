@@ -20,7 +20,9 @@ from feederkit.catalog.model import (
     PartSummary,
     Revision,
     check_name,
+    check_part_name,
     could_be_part_name,
+    is_mix_name,
     is_valid_name,
 )
 from feederkit.catalog.schema import (
@@ -74,6 +76,7 @@ __all__ = [
     "add_file",
     "add_outline",
     "check_name",
+    "check_part_name",
     "connect",
     "could_be_part_name",
     "declared_uncertainties",
@@ -84,6 +87,7 @@ __all__ = [
     "get_part",
     "get_revision",
     "import_directory",
+    "is_mix_name",
     "is_valid_name",
     "landings_for",
     "list_changeovers",

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from feederkit.catalog.model import AddOutcome, check_name
+from feederkit.catalog.model import AddOutcome, check_part_name
 from feederkit.catalog.schema import transaction
 from feederkit.catalog.store import (
     CatalogLike,
@@ -126,6 +126,13 @@ FOLDER_NAME_ADVICE = (
 file's stem)."""
 
 
+FOLDER_RENAME_ADVICE = (
+    "rename the file, or change an outline file's \"name\", to a name without ',' or ':'"
+)
+"""How a folder import (no ``--name``) gives a part another name: its name is the outline's
+"name", else the file's stem."""
+
+
 def _bad_line(path: Path, exc: InputError) -> str:
     """One skipped file: ``path: reason``, a name clash with advice that works for a folder
     import (it has no ``--name``)."""
@@ -186,7 +193,7 @@ def import_directory(
             progress("read", k, len(files), str(path))
         try:
             result, parts = import_parts(path, options)
-            names = [check_name(p.part.name) for p in parts]
+            names = [check_part_name(p.part.name, FOLDER_RENAME_ADVICE) for p in parts]
             landings = [landings_for(p, options, path, side_probability) for p in parts]
         except InputError as exc:
             bad.append(_bad_line(path, exc))

@@ -66,6 +66,45 @@ def check_name(name: str, what: str = "part") -> str:
     return name
 
 
+MIX_SEPARATORS = {
+    ",": "separates the parts of --mix (A,B)",
+    ":": "separates a part's share in --mix (NAME:SHARE)",
+}
+"""The characters ``--mix`` reads as syntax: a part name holding one could not be put in a mix
+(``t-clip:0.5`` would be the part ``t-clip`` at 50 %)."""
+
+PART_NAME_ADVICE = "give the part a name without ',' or ':' (catalog add FILE --name NAME)"
+"""How to name a part whose name holds a mix separator, when the name came from a file."""
+
+
+def mix_separator(name: str) -> str | None:
+    """The first character of ``name`` that ``--mix`` reads as syntax, or None."""
+    return next((ch for ch in name if ch in MIX_SEPARATORS), None)
+
+
+def check_part_name(name: str, advice: str = PART_NAME_ADVICE) -> str:
+    """Return ``name`` when it may name a new part, else raise InputError (one line).
+
+    A catalog name (:func:`check_name`) without ',' or ':', which ``--mix`` reads as syntax.
+    Parts stored before this rule keep their names (they list, show and plan by name);
+    ``advice`` says how to give the part another name where it was made.
+    """
+    check_name(name)
+    ch = mix_separator(name)
+    if ch is not None:
+        raise InputError(
+            f"invalid part name {_clip(name)!r}: {ch!r} {MIX_SEPARATORS[ch]}, so no mix could "
+            f"name this part; {advice}"
+        )
+    return name
+
+
+def is_mix_name(name: str) -> bool:
+    """Whether ``name`` can be typed in ``--mix`` (holds no ',' or ':'): only such names are
+    suggested ("did you mean ...?")."""
+    return mix_separator(name) is None
+
+
 def is_valid_name(name: object) -> bool:
     """Whether ``name`` could name a catalog part or changeover (see :func:`check_name`)."""
     return _name_problem(name) is None

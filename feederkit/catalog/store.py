@@ -24,7 +24,8 @@ from feederkit.catalog.model import (
     AddOutcome,
     PartSummary,
     Revision,
-    check_name,
+    check_part_name,
+    is_mix_name,
     is_valid_name,
     shown_name,
 )
@@ -256,7 +257,7 @@ def write_revision(
     if landings is None:
         landings = landings_for(imported)
     part = imported.part
-    name = check_name(part.name)
+    name = check_part_name(part.name)
     who = created_by or current_user()
     when = now_utc()
     options_json = _dumps(options_key)
@@ -380,9 +381,11 @@ def add_file(
     """Import one file and store its part(s) with their landings in one transaction (several
     parts with ``all_parts``); ``side_probability`` is a flat part's probability of ``up``."""
     if name is not None:
-        check_name(name)
+        check_part_name(name, "give --name a name without ',' or ':'")
     check_side_probability(side_probability)
     result, parts = import_parts(path, options, name)
+    for p in parts:
+        check_part_name(p.part.name)  # a name from the file, before anything is written
     landings = [landings_for(p, options, path, side_probability) for p in parts]
     source = str(Path(path).resolve())
     with _conn(catalog, create=True) as conn, transaction(conn):
@@ -415,7 +418,7 @@ def add_outline(
     """Store an outline made in Python with its landings (``up`` with ``side_probability``);
     its SHA-256 is that of its outline-file JSON."""
     if name is not None:
-        outline = dataclasses.replace(outline, name=check_name(name))
+        outline = dataclasses.replace(outline, name=check_part_name(name))
     text = _dumps(outline_to_dict(outline))
     sha = hashlib.sha256(text.encode()).hexdigest()
     options = ImportOptions(hull_tolerance=hull_tolerance)
@@ -569,7 +572,13 @@ def part_names(catalog: CatalogLike) -> list[str]:
 
 def similar_names(catalog: CatalogLike, name: str, n: int = 3) -> list[str]:
     """Up to ``n`` catalog part names closest to ``name`` (for "did you mean ...?")."""
-    return _similar(part_names(catalog), name, n)
+    return _similar(_suggestable(part_names(catalog)), name, n)
+
+
+def _suggestable(names: Sequence[object]) -> list[str]:
+    """The part names a hint may suggest: valid, and typeable in ``--mix`` (no ',' or ':',
+    :func:`~feederkit.catalog.model.is_mix_name`; older parts may hold them)."""
+    return [n for n in names if isinstance(n, str) and is_valid_name(n) and is_mix_name(n)]
 
 
 def _similar(names: list[str], name: str, n: int = 3) -> list[str]:
@@ -712,8 +721,7 @@ def _revision_from_row(row: Sequence[Any], landing_rows: Sequence[Sequence[Any]]
 
 
 def _unknown(conn: sqlite3.Connection, name: str) -> NoSuchPartError:
-    names = [r[0] for r in conn.execute("SELECT name FROM parts")]
-    valid = [n for n in names if isinstance(n, str) and is_valid_name(n)]
+    valid = _suggestable([r[0] for r in conn.execute("SELECT name FROM parts")])
     return NoSuchPartError(
         f"no part named {shown_name(name)!s} in the catalog{did_you_mean(_similar(valid, name))}"
         if not is_valid_name(name)

@@ -18,7 +18,7 @@ import math
 import re
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Any
@@ -32,6 +32,7 @@ from feederkit.catalog import (
     UNREADABLE,
     declared_uncertainties,
     list_changeovers,
+    part_names,
     remove_changeover,
     resolve_catalog_path,
 )
@@ -63,6 +64,7 @@ from feederkit.cli.common import (
     add_name_column,
     cell_planning_options,
     cell_settings,
+    check_mix_revision,
     check_output_folders,
     check_outputs,
     check_report_name,
@@ -134,6 +136,7 @@ def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
         name = name.strip()
         if not name:
             raise InputError(f"--mix: {item!r} names no part (write NAME or NAME:SHARE)")
+        check_mix_revision(name)
         if name in names:
             raise InputError(f"--mix: {name} is listed twice; give each part once")
         names.append(name)
@@ -182,6 +185,22 @@ def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
                 f"{total:g}) to compute with; give shares of nearer sizes"
             )
     return names, shares
+
+
+def check_mix_names(text: str, names: Collection[str]) -> None:
+    """Refuse a ``--mix`` item that is, whole, the name of a catalog part holding ':' (stored
+    before such names were refused): ``--mix`` reads it as ``NAME:SHARE``, another part at a
+    share, so it would silently compile the wrong part."""
+    for item in (m.strip() for m in text.split(",")):
+        whole = re.sub(r"@[0-9]+$", "", item)
+        if ":" in whole and whole in names:
+            part, _, share = item.partition(":")
+            raise InputError(
+                f"--mix {item} is ambiguous: it names the catalog part {whole!r} and reads as "
+                f"part {part.strip()!r} at share {share.strip()}; a part whose name holds ':' "
+                "cannot be put in a mix: add its file again under a name without ',' or ':' "
+                "(catalog add FILE --name NAME)"
+            )
 
 
 def shares_text(revisions: Sequence[tuple[str, int]], plan: dict[str, Any]) -> str:
@@ -400,8 +419,16 @@ def compile_command(
         settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
     uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    over: dict[str, Any] = {}
+    with flag_words((*FLAG_TERMS, *LANDING_TERMS)):
+        if landings is not None:
+            over["landings"] = "all" if landings == "all" else landing_names(landings)
+        if accept is not None:
+            over["accept"] = landing_names(accept, "--accept")
     json_found(name=name, mix=members, cell=settings.to_dict())
     path = resolve_catalog_path(catalog)
+    if ":" in mix:  # every input is checked before the catalog's changeovers
+        check_mix_names(mix, part_names(path))
     if not replace and changeover_exists(path, name):
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
 
@@ -415,11 +442,6 @@ def compile_command(
             files.append(OutputFile(report, html, "report"))
         return files
 
-    over: dict[str, Any] = {}
-    if landings is not None:
-        over["landings"] = "all" if landings == "all" else landing_names(landings)
-    if accept is not None:
-        over["accept"] = landing_names(accept, "--accept")
     terms = (*FLAG_TERMS, *LANDING_TERMS)
     with searching(f"compiling changeover {name}", options.time_limit_s), flag_words(terms):
         compiled = compile_changeover(

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
@@ -284,6 +285,16 @@ FLAG_TERMS = (
 )
 """The library's words for what a command-line flag sets: a library message that names one
 is shown with the flag."""
+
+
+def check_mix_revision(item: str) -> None:
+    """Refuse a ``--mix`` item ``NAME@REV`` whose revision is not a number, in the catalog's
+    words for a revision it does not have (not as a missing file)."""
+    name, at, rev = item.rpartition("@")
+    if at and name and not re.fullmatch(r"[0-9]+", rev):
+        raise InputError(
+            f"--mix {item}: part {name!r} has no revision {rev!r} (revisions are numbers: {name}@2)"
+        )
 
 
 def add_name_column(table: Table, header: str, **kwargs: Any) -> None:

@@ -33,6 +33,7 @@ from feederkit.cli.common import (
     JsonOpt,
     LandingsOpt,
     ShapeToleranceOpt,
+    check_mix_revision,
     check_outputs,
     console,
     default_memory_limit,
@@ -85,6 +86,7 @@ def parse_mix(text: str) -> list[str]:
     if not names or any(not n for n in names):
         raise InputError(f"--mix must list part names separated by commas, got {text!r}")
     for n in names:
+        check_mix_revision(n)
         if ":" in n:
             raise InputError(
                 f"--mix {n}: design sensor takes part names only; mix shares weigh expected "

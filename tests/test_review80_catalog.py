@@ -1,0 +1,135 @@
+"""A new user's review of mixes and catalogs: part names ``--mix`` cannot name, the catalog
+screen under a shape tolerance, the pairs a stored changeover cannot tell apart, the pairs'
+``kind``, honest advice, and the wording and layout of the tables."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+
+import pytest
+from shared import no_stray_profile, one_line_error  # noqa: F401 (autouse)
+
+from feederkit.catalog import list_parts, similar_names
+from feederkit.cli.app import main
+
+CATALOG = Path(__file__).resolve().parents[1] / "catalog"
+
+
+def run(capsys, *args: str) -> tuple[int, str, str]:
+    rc = main(list(args))
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+def outline(name: str) -> dict:
+    """The chamfered plate's outline file under another name."""
+    return {**json.loads((CATALOG / "chamfered-plate.json").read_text()), "name": name}
+
+
+def rename_part(db: str, old: str, new: str) -> None:
+    """A part stored before names with ',' or ':' were refused (an old catalog's row)."""
+    with sqlite3.connect(db) as conn:
+        conn.execute("UPDATE parts SET name = ? WHERE name = ?", (new, old))
+
+
+@pytest.fixture()
+def db(tmp_path, capsys) -> str:
+    """The L bracket and the T clip."""
+    path = str(tmp_path / "c.db")
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    for part in ("l-bracket", "t-clip"):
+        source = str(CATALOG / f"{part}.json")
+        assert run(capsys, "catalog", "add", source, "--catalog", path)[0] == 0
+    return path
+
+
+# Finding 1: a name with ',' or ':' cannot be put in a mix.
+
+
+@pytest.mark.parametrize(("name", "char"), [("t-clip:0.5", "':'"), ("clip,a", "','")])
+def test_add_refuses_a_name_from_the_file_that_mix_cannot_name(db, tmp_path, capsys, name, char):
+    source = tmp_path / "odd.json"
+    source.write_text(json.dumps(outline(name)))
+    err = one_line_error(capsys, ["catalog", "add", str(source), "--catalog", db])
+    assert f"invalid part name {name!r}: {char}" in err and "--name NAME" in err
+    assert [p.name for p in list_parts(db)] == ["l-bracket", "t-clip"]
+
+
+def test_add_refuses_such_a_name_given_with_name(db, tmp_path, capsys):
+    source = tmp_path / "plate.json"
+    source.write_text(json.dumps(outline("plate")))
+    args = ["catalog", "add", str(source), "--name", "plate:2", "--catalog", db]
+    err = one_line_error(capsys, args)
+    assert "invalid part name 'plate:2': ':'" in err and "give --name a name without" in err
+    assert "plate:2" not in {p.name for p in list_parts(db)}
+
+
+def test_import_refuses_such_a_name_and_imports_nothing(db, tmp_path, capsys):
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    (folder / "good.json").write_text(json.dumps(outline("plate")))
+    (folder / "odd.json").write_text(json.dumps(outline("clip,a")))
+    err = one_line_error(capsys, ["catalog", "import", str(folder), "--catalog", db])
+    assert "odd.json: invalid part name 'clip,a': ','" in err
+    assert "rename the file, or change an outline file's" in err
+    assert [p.name for p in list_parts(db)] == ["l-bracket", "t-clip"]
+
+
+def test_an_old_part_with_a_colon_still_lists_and_shows(db, tmp_path, capsys):
+    source = tmp_path / "plate.json"
+    source.write_text(json.dumps(outline("plate")))
+    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    rename_part(db, "plate", "t-clip:0.5")
+    rc, out, _ = run(capsys, "catalog", "list", "--json", "--catalog", db)
+    assert rc == 0 and "t-clip:0.5" in {p["name"] for p in json.loads(out)}
+    rc, out, _ = run(capsys, "catalog", "show", "t-clip:0.5", "--catalog", db)
+    assert rc == 0 and "t-clip:0.5" in out
+
+
+def test_a_mix_item_that_is_a_part_name_and_name_share_is_refused(db, tmp_path, capsys):
+    source = tmp_path / "plate.json"
+    source.write_text(json.dumps(outline("plate")))
+    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    rename_part(db, "plate", "t-clip:0.5")
+    args = ["changeover", "compile", "odd", "--mix", "t-clip:0.5,l-bracket", "--catalog", db]
+    err = one_line_error(capsys, [*args, "--tolerance", "0.2", "--landings", "up"])
+    assert "--mix t-clip:0.5 is ambiguous" in err and "part 't-clip' at share 0.5" in err
+    rc, out, _ = run(capsys, "changeover", "list", "--json", "--catalog", db)
+    assert rc == 0 and json.loads(out) == []
+
+
+def test_a_hint_never_suggests_a_name_mix_cannot_take(db, tmp_path, capsys):
+    source = tmp_path / "plate.json"
+    source.write_text(json.dumps(outline("clip-a")))
+    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    assert "clip-a" in similar_names(db, "clip")
+    rename_part(db, "clip-a", "clip,a")
+    assert "clip,a" not in similar_names(db, "clip")
+    err = one_line_error(capsys, ["catalog", "show", "clip,", "--catalog", db])
+    assert "clip,a" not in err and "no part named 'clip,'" in err
+
+
+# Finding 11: a revision that is not a number; inputs checked before the changeover's name.
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["changeover", "compile", "x", "--mix", "l-bracket@abc,t-clip"],
+        ["design", "sensor", "--mix", "l-bracket@abc,t-clip"],
+    ],
+)
+def test_a_revision_that_is_not_a_number_is_named_as_such(db, capsys, args):
+    err = one_line_error(capsys, [*args, "--catalog", db])
+    assert "part 'l-bracket' has no revision 'abc'" in err and "no such file" not in err
+
+
+def test_compile_checks_its_inputs_before_the_name_is_taken(db, capsys):
+    args = ["changeover", "compile", "lt", "--mix", "l-bracket,t-clip", "--catalog", db]
+    assert run(capsys, *args, "--tolerance", "0.5", "--landings", "up")[0] in (0, 1)
+    err = one_line_error(capsys, [*args, "--tolerance", "0.5", "--landings", "sideways"])
+    assert "already exists" not in err and "sideways" in err
+    err = one_line_error(capsys, [*args, "--tolerance", "0.5", "--accept", "pose-x"])
+    assert "already exists" not in err
