@@ -133,3 +133,38 @@ def test_compile_checks_its_inputs_before_the_name_is_taken(db, capsys):
     assert "already exists" not in err and "sideways" in err
     err = one_line_error(capsys, [*args, "--tolerance", "0.5", "--accept", "pose-x"])
     assert "already exists" not in err
+
+
+# Finding 5: a member that cannot take the shape tolerance is left out of the screen.
+
+
+def nicked_square(tmp_path: Path) -> Path:
+    """A 20 mm square with one corner cut by 0.2 mm: half its smallest hull edge is 0.14 mm."""
+    path = tmp_path / "nicked.json"
+    square = [[0, 0], [20, 0], [20, 19.8], [19.8, 20], [0, 20]]
+    path.write_text(json.dumps({"name": "nicked", "units": "mm", "vertices": square}))
+    return path
+
+
+def test_analyze_leaves_out_a_member_too_small_for_the_shape_tolerance(db, tmp_path, capsys):
+    assert run(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", db)[0] == 0
+    args = ("catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.5")
+    rc, out, _ = run(capsys, *args, "--json", "--catalog", db)
+    data = json.loads(out)
+    assert rc in (0, 1) and data["uncertainty"]["shape_tolerance_mm"] == 0.5
+    assert data["counts"]["parts"] == 3  # the L bracket up and down, the T clip (symmetric)
+    left_out = [line for line in data["skipped"] if "nicked" in line]
+    assert len(left_out) == 1 and "smallest hull edge" in left_out[0]
+    assert "left out (--shape-tolerance)" in left_out[0]
+    rc, _, err = run(capsys, *args, "--catalog", db)
+    warned = [line for line in err.splitlines() if line.startswith("warning: nicked")]
+    assert rc in (0, 1) and len(warned) == 1
+
+
+def test_analyze_refuses_a_shape_tolerance_no_member_takes(tmp_path, capsys):
+    path = str(tmp_path / "c.db")
+    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    assert run(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", path)[0] == 0
+    args = ["catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.5"]
+    err = one_line_error(capsys, [*args, "--catalog", path])
+    assert "no member takes the declared tolerances" in err and "--shape-tolerance" in err

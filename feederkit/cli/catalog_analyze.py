@@ -38,6 +38,7 @@ from feederkit.cli.common import (
     print_json,
     progress_bar,
     uncertainty_option,
+    with_flags,
 )
 from feederkit.cli.plan_render import sensor_text
 from feederkit.errors import CheckFailed, InputError
@@ -53,7 +54,12 @@ from feederkit.mix.changeover import plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.part import Part
 from feederkit.sensors import NoSensor, Sensor, make_sensor
-from feederkit.uncertainty import DEFAULT_ROTATION_ERROR_DEG, IDEAL, Uncertainty
+from feederkit.uncertainty import (
+    DEFAULT_ROTATION_ERROR_DEG,
+    IDEAL,
+    Uncertainty,
+    check_for_part,
+)
 
 
 def catalog_file(option: Path | None) -> Path:
@@ -110,6 +116,35 @@ def load_catalog_parts(
             pfs.append(push_function(x.part))
             owners.append(part.name)
     return pfs, skipped, tuple(owners)
+
+
+def members_taking(
+    pfs: list[PushFunction], owners: tuple[str, ...] | None, unc: Uncertainty
+) -> tuple[list[PushFunction], tuple[str, ...] | None, list[str]]:
+    """The members whose hull takes the declared shape and COM tolerances
+    (:func:`~feederkit.uncertainty.check_for_part`), their owners, and a line per member
+    left out: one part with a short hull edge must not stop the whole catalog's screen.
+    InputError (the first member's, naming the flag) when no member takes them."""
+    if unc.is_ideal:
+        return pfs, owners, []
+    kept: list[int] = []
+    left_out: list[str] = []
+    first: InputError | None = None
+    for k, pf in enumerate(pfs):
+        try:
+            check_for_part(unc, pf.part)
+        except InputError as exc:
+            first = first or exc
+            left_out.append(with_flags(f"{exc}, left out"))
+            continue
+        kept.append(k)
+    if first is not None and not kept:
+        raise InputError(with_flags(f"no member takes the declared tolerances: {first}"))
+    return (
+        [pfs[k] for k in kept],
+        None if owners is None else tuple(owners[k] for k in kept),
+        left_out,
+    )
 
 
 AnalyzeRotationErrorOpt = Annotated[
@@ -178,6 +213,8 @@ def analyze_command(
     )
     unc = analysis_uncertainty(rotation_error, shape_tolerance, com_tolerance)
     pfs, skipped, owners = load_catalog_parts(catalog_file(catalog))
+    pfs, owners, too_small = members_taking(pfs, owners, unc)
+    skipped += too_small
     over_landings = owners is not None
     # A tolerance too large for a member is refused first: one line naming it and the flag.
     with flag_words(), err_console.status("analyzing ..."):
