@@ -233,13 +233,13 @@ def test_the_summary_and_the_result_name_the_tolerances(rects, capsys):
         (("--com-tolerance", "nan"), "COM tolerance must be a finite nonnegative"),
         (("--com-tolerance", "x"), "Invalid value for '--com-tolerance'"),
         (("--rotation-error", "90", "--shape-tolerance", "0.1"), "(--rotation-error)"),
-        (("--shape-tolerance", "5"), "r10: shape tolerance 5 mm must be below half the"),
-        (("--com-tolerance", "5"), "r10: COM tolerance 5 mm must be below"),
+        (("--shape-tolerance", "6"), "r10: shape tolerance 6 mm must be below half the"),
+        (("--com-tolerance", "6"), "r10: COM tolerance 6 mm must be below"),
     ],
 )
 def test_bad_uncertainty_flags_are_one_line(rects, capsys, flags, words):
-    """The words ``plan`` and ``changeover compile`` say, a tolerance too large for a part
-    naming the part and the flag; exit 2."""
+    """The words ``plan`` and ``changeover compile`` say, a tolerance too large for every
+    part naming the first and the flag; exit 2."""
     args = ["catalog", "analyze", "--tolerance", "0.5", *flags, "--catalog", rects]
     err = one_line_error(capsys, args)
     assert words in err

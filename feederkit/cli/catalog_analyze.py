@@ -36,6 +36,7 @@ from feederkit.cli.common import (
     flag_words,
     plural,
     print_json,
+    print_warnings,
     progress_bar,
     uncertainty_option,
     with_flags,
@@ -225,8 +226,7 @@ def analyze_command(
         data["members"] = "landings" if over_landings else "parts"
         print_json(data)
     else:
-        for line in skipped:
-            err_console.print(f"warning: {line}", highlight=False, markup=False)
+        print_warnings(skipped)
         _print_report(result, pfs, over_landings)
     what = "landings" if over_landings else "parts"
     problems = []
