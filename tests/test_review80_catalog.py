@@ -168,3 +168,63 @@ def test_analyze_refuses_a_shape_tolerance_no_member_takes(tmp_path, capsys):
     args = ["catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.5"]
     err = one_line_error(capsys, [*args, "--catalog", path])
     assert "no member takes the declared tolerances" in err and "--shape-tolerance" in err
+
+
+# Finding 6: a stored changeover shows the pairs its plan cannot tell apart, as compile did.
+
+
+def add_variant(db: str, tmp_path: Path, capsys, name: str, change) -> None:
+    """The L bracket changed by ``change`` (its outline file's dict), added as ``name``."""
+    data = {**json.loads((CATALOG / "l-bracket.json").read_text()), "name": name}
+    change(data)
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(data))
+    assert run(capsys, "catalog", "add", str(path), "--catalog", db)[0] == 0
+
+
+def mirror(data: dict) -> None:
+    data["vertices"] = [[-x, y] for x, y in data["vertices"]]
+    data["holes"] = [[[-x, y] for x, y in h] for h in data["holes"]]
+
+
+def move_hole(data: dict) -> None:
+    data["holes"][0] = [[x - 3, y] for x, y in data["holes"][0]]
+
+
+@pytest.mark.parametrize(
+    ("variant", "change", "landings"),
+    [
+        ("l-bracket-mirror", mirror, "all"),  # Lemma 8: decided again exactly
+        ("l-bracket-hole-moved", move_hole, "up"),  # only under uncertainty: read off the plan
+    ],
+)
+def test_show_and_list_name_the_pairs_compile_named(
+    db, tmp_path, capsys, variant, change, landings
+):
+    add_variant(db, tmp_path, capsys, variant, change)
+    mix = f"l-bracket,{variant}"
+    args = ["changeover", "compile", "co", "--mix", mix, "--tolerance", "0.2"]
+    rc, out, _ = run(capsys, *args, "--landings", landings, "--json", "--catalog", db)
+    compiled = json.loads(out)["unrecognizable_pairs"]
+    assert rc == 1 and compiled
+    rc, out, _ = run(capsys, "changeover", "show", "co", "--json", "--catalog", db)
+    assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == compiled
+    rc, out, _ = run(capsys, "changeover", "list", "--json", "--catalog", db)
+    assert rc == 0 and json.loads(out)[0]["unrecognizable_pairs"] == compiled
+    rc, out, _ = run(capsys, "changeover", "show", "co", "--catalog", db)
+    text = " ".join(out.split())
+    assert rc == 0 and "parts this plan orients but cannot tell apart" in text
+    assert all(w["reason"].split()[0] in text for w in compiled)
+    rc, out, _ = run(capsys, "changeover", "list", "--catalog", db)
+    pair = f"{compiled[0]['part_a']} & {compiled[0]['part_b']}"
+    assert rc == 0 and "changeover co: its plan cannot tell apart" in out and pair in out
+
+
+def test_show_of_a_mix_told_apart_names_no_pairs(db, capsys):
+    args = ["changeover", "compile", "lt", "--mix", "l-bracket,t-clip", "--tolerance", "0.5"]
+    assert run(capsys, *args, "--landings", "up", "--catalog", db)[0] == 0
+    rc, out, _ = run(capsys, "changeover", "show", "lt", "--json", "--catalog", db)
+    assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == []
+    for command in (("show", "lt"), ("list",)):
+        rc, out, _ = run(capsys, "changeover", *command, "--catalog", db)
+        assert rc == 0 and "lt" in out and "cannot tell apart" not in out

@@ -331,7 +331,9 @@ def changeover_report(
     )
 
 
-def _pairs_table(witnesses: list[PairWitness], pfs: list[PushFunction]) -> Table:
+def _pairs_table(witnesses: Sequence[PairWitness]) -> Table:
+    """The pairs a changeover's plan cannot tell apart, as ``compile`` and ``show`` print
+    them."""
     t = Table(title="parts this plan orients but cannot tell apart (section 8.4, Corollary 7)")
     add_name_column(t, "part A")
     add_name_column(t, "part B")
@@ -458,7 +460,7 @@ def compile_command(
         )
     DONE_WORK.note(f"stored changeover {name!r} in {path}")
     note_written((output, "plan"), (report, "report"))
-    plan, witnesses, pfs = compiled.plan, list(compiled.witnesses), list(compiled.parts)
+    plan, witnesses = compiled.plan, list(compiled.witnesses)
     lands = landings_text(plan, compiled.rejected)
     cycle = plan["stats"].get("cycle_time")
     warnings = [*compiled.warnings, *filter(None, [settings.belt_warning()])]
@@ -497,7 +499,7 @@ def compile_command(
         console.print(stats_table(view, compiled.made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)
         if witnesses:
-            console.print(_pairs_table(witnesses, pfs))
+            console.print(_pairs_table(witnesses))
         console.print(f"stored changeover {name!r} in {path}", highlight=False, markup=False)
         print_written(output, report)
     lumped = compiled.lumped
@@ -590,9 +592,10 @@ def list_command(json_out: JsonOpt = False, catalog: CatalogOpt = None) -> None:
     stored = declared_uncertainties(path) if infos else {}
     declared = {i.name: listed_uncertainty(stored.get(i.name, UNREADABLE)) for i in infos}
     stale = {i.name: stale_revisions(path, i.parts) for i in infos}
+    pairs = {i.name: listed_pairs(path, i.name) for i in infos}
     print_warnings(f"changeover {i.name}: {w}" for i in infos for w in stale[i.name])
     if json_out:
-        print_json([_listed_dict(i, declared[i.name], stale[i.name]) for i in infos])
+        print_json([_listed_dict(i, declared[i.name], stale[i.name], pairs[i.name]) for i in infos])
         return
     if not infos:
         console.print("no changeovers in the catalog")
@@ -616,6 +619,33 @@ def list_command(json_out: JsonOpt = False, catalog: CatalogOpt = None) -> None:
             escape(i.created_by),
         )
     console.print(t)
+    for i in infos:
+        line = pairs_line(i.name, pairs[i.name])
+        if line is not None:
+            console.print(line, highlight=False, markup=False, soft_wrap=True)
+
+
+def listed_pairs(catalog: Path, name: str) -> list[PairWitness] | None:
+    """The pairs a stored changeover's plan cannot tell apart (as ``show`` gives them), or
+    None when it cannot be read (``show NAME`` says why): a damaged changeover must not hide
+    the others of a listing."""
+    try:
+        return load_changeover(catalog, name).witnesses()
+    except InputError:
+        return None
+
+
+def pairs_line(name: str, pairs: Sequence[PairWitness] | None) -> str | None:
+    """The line under ``list``'s table for a changeover whose plan cannot tell some parts
+    apart (``show`` names them in a table), or None."""
+    if not pairs:
+        return None
+    named = "; ".join(f"{w.part_a} & {w.part_b}" for w in pairs[:3])
+    more = f" and {len(pairs) - 3} more" if len(pairs) > 3 else ""
+    return (
+        f"changeover {name}: its plan cannot tell apart {plural(len(pairs), 'pair')}: "
+        f"{named}{more} (changeover show {name})"
+    )
 
 
 LIST_PARTS_WIDTH = 40
@@ -635,16 +665,21 @@ def _when(created_at: str) -> str:
 
 
 def _listed_dict(
-    info, declared: tuple[Uncertainty | None, bool | None], warnings: list[str]
+    info,
+    declared: tuple[Uncertainty | None, bool | None],
+    warnings: list[str],
+    pairs: Sequence[PairWitness] | None,
 ) -> dict[str, Any]:
     """One changeover of ``list --json``: its record, its declared uncertainty (the plan
     file's names; the ideal model's when it declares none, null when unreadable) and
-    whether the plan declares one, and its warnings."""
+    whether the plan declares one, the pairs its plan cannot tell apart (null when it
+    cannot be read), and its warnings."""
     unc, is_declared = declared
     return {
         **_info_dict(info),
         "uncertainty": None if unc is None else unc.to_dict(),
         "uncertainty_declared": is_declared,
+        "unrecognizable_pairs": None if pairs is None else [w.to_dict() for w in pairs],
         "warnings": warnings,
     }
 
@@ -654,12 +689,14 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
     """A stored changeover: its parts (exact revisions), sensor and plan."""
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
+    witnesses = co.witnesses()
     if json_out:
         print_json(
             {
                 **_info_dict(co.info, co.plan),
                 "landings": landing_rows(co.plan, co.rejected),
                 "cycle_time": co.plan["stats"].get("cycle_time"),
+                "unrecognizable_pairs": [w.to_dict() for w in witnesses],
                 "warnings": list(co.warnings),
                 "plan": co.plan,
             }
@@ -680,6 +717,8 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
     console.print(stats_table(view))
     cycle = co.plan["stats"].get("cycle_time")
     console.print(escape(cycle_time_text(cycle, "as compiled")), highlight=False)
+    if witnesses:
+        console.print(_pairs_table(witnesses))
 
 
 @changeover_app.command("remove")

@@ -100,11 +100,67 @@ class StoredChangeover:
         return rejected_members(self.plan)
 
     def witnesses(self) -> list[PairWitness]:
-        """The pairs of its parts (or landings) no plan can tell apart (section 8.4), decided
-        again exactly, as :func:`reported_pairs` reports them."""
+        """The pairs of its parts (or landings) the stored plan cannot tell apart, as
+        ``changeover compile`` reported them (:func:`stored_witnesses`): what ``show``,
+        ``list`` and ``report`` say."""
         if len(self.parts) < 2:
             return []
-        return reported_pairs(unrecognizable_pairs(list(self.parts), self.sensor), self.rejected)
+        return stored_witnesses(self.plan, list(self.parts), self.sensor)
+
+
+def stored_witnesses(
+    plan: Mapping[str, Any], parts: Sequence[PushFunction], sensor: Sensor
+) -> list[PairWitness]:
+    """The pairs of members a stored plan cannot tell apart, with their witnesses.
+
+    On the ideal model (no uncertainty declared, or all zero) they are decided again exactly
+    (section 8.4, :func:`reported_pairs`), as compile decided them. Under a declared
+    uncertainty compile's pairs are those of the strong machine's search, which a stored plan
+    does not keep; they are the pairs its accepting results list together
+    (:func:`accepted_lumps`), each with the ideal witness where there is one (it explains the
+    pair better), else the states the results list together and compile's reason
+    (:func:`uncertainty_reason`)."""
+    ideal = reported_pairs(unrecognizable_pairs(list(parts), sensor), rejected_members(plan))
+    declared = plan.get("uncertainty")
+    unc = Uncertainty.from_dict(declared) if declared else None
+    if unc is None or unc.is_ideal:
+        return ideal
+    known = {(w.part_a, w.part_b): w for w in ideal}
+    lumped = accepted_lumps(plan)
+    index = {pf.part.name: k for k, pf in enumerate(parts)}
+    out = [known.get(ab) or _lumped_witness(plan, ab, unc, index) for ab in lumped]
+    return out + [w for w in ideal if (w.part_a, w.part_b) not in set(lumped)]
+
+
+def _lumped_witness(
+    plan: Mapping[str, Any], pair: tuple[str, str], unc: Uncertainty, index: Mapping[str, int]
+) -> PairWitness:
+    """The witness of two members an accepting result of ``plan`` lists together: each pair
+    of their states some such result lists, with compile's reason under ``unc``."""
+    a, b = pair
+    found: set[tuple[int, int]] = set()
+    for leaf in as_plan(plan).leaves():
+        if leaf.reject:
+            continue
+        named = [(member_name(e.part, e.landing), e.state) for e in leaf.results]
+        for m, i in named:
+            for n, j in named:
+                if m == a and n == b:
+                    found.add((i, j))
+    states_a = tuple(i for i, _ in sorted(found))
+    states_b = tuple(j for _, j in sorted(found))
+    return PairWitness(
+        a, b, states_a, states_b, uncertainty_reason(unc), "uncertainty", index[a], index[b]
+    )
+
+
+def uncertainty_reason(unc: Uncertainty) -> str:
+    """Why no strong plan tells two members apart under ``unc``, in compile's words."""
+    return (
+        f"no strong plan tells their resting states apart under rotation error "
+        f"{unc.rotation_error_deg:g} deg (shape {unc.shape_tolerance_mm:g} mm, COM "
+        f"{unc.com_tolerance_mm:g} mm)"
+    )
 
 
 def _source(member: Member) -> str:
@@ -355,12 +411,7 @@ def strong_witnesses(
                 sa, sb = found.setdefault((a.part, b.part), ([], []))
                 sa.append(a.state)
                 sb.append(b.state)
-    u = machine.uncertainty
-    reason = (
-        f"no strong plan tells their resting states apart under rotation error "
-        f"{u.rotation_error_deg:g} deg (shape {u.shape_tolerance_mm:g} mm, COM "
-        f"{u.com_tolerance_mm:g} mm)"
-    )
+    reason = uncertainty_reason(machine.uncertainty)
     names = machine.part_names
     return [
         PairWitness(names[i], names[j], tuple(sa), tuple(sb), reason, "uncertainty")
