@@ -68,7 +68,8 @@ def test_analyze_reports_classes_and_the_lookalike_pair(db, capsys, tmp_path):
         frozenset(("quadrilateral/down", "quad-twin/down")),
     }
     assert all("Lemma 8" in p["reason"] for p in pairs)
-    assert set(pairs[0]) == {"part_a", "part_b", "states_a", "states_b", "reason"}
+    assert set(pairs[0]) == {"part_a", "part_b", "states_a", "states_b", "reason", "kind"}
+    assert {p["kind"] for p in pairs} == {"same-push-diameter"}
     # The analysis is the ideal model's, and says so (design.md: never assume it silently).
     assert data["uncertainty"] == {
         "rotation_error_deg": 0.0,

@@ -141,7 +141,8 @@ def test_witness_to_dict_has_exactly_the_agreed_keys():
     w = distinguishable(push_function(pa), push_function(pc), ToleranceSensor(0.1))
     assert isinstance(w, PairWitness)
     d = w.to_dict()
-    assert set(d) == {"part_a", "part_b", "states_a", "states_b", "reason"}
+    assert set(d) == {"part_a", "part_b", "states_a", "states_b", "reason", "kind"}
+    assert d["kind"] == w.kind
     assert d["part_a"] == "A" and d["part_b"] == pc.name
     assert len(d["states_a"]) == len(d["states_b"]) == push_function(pa).n
     assert all(isinstance(x, int) for x in d["states_a"] + d["states_b"])

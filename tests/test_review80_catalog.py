@@ -192,21 +192,21 @@ def move_hole(data: dict) -> None:
 
 
 @pytest.mark.parametrize(
-    ("variant", "change", "landings"),
+    ("variant", "change", "landings", "kind"),
     [
-        ("l-bracket-mirror", mirror, "all"),  # Lemma 8: decided again exactly
-        ("l-bracket-hole-moved", move_hole, "up"),  # only under uncertainty: read off the plan
+        ("l-bracket-mirror", mirror, "all", "same-push-diameter"),  # decided again exactly
+        ("l-bracket-hole-moved", move_hole, "up", "uncertainty"),  # read off the plan
     ],
 )
 def test_show_and_list_name_the_pairs_compile_named(
-    db, tmp_path, capsys, variant, change, landings
+    db, tmp_path, capsys, variant, change, landings, kind
 ):
     add_variant(db, tmp_path, capsys, variant, change)
     mix = f"l-bracket,{variant}"
     args = ["changeover", "compile", "co", "--mix", mix, "--tolerance", "0.2"]
     rc, out, _ = run(capsys, *args, "--landings", landings, "--json", "--catalog", db)
     compiled = json.loads(out)["unrecognizable_pairs"]
-    assert rc == 1 and compiled
+    assert rc == 1 and compiled and {w["kind"] for w in compiled} == {kind}  # finding 10
     rc, out, _ = run(capsys, "changeover", "show", "co", "--json", "--catalog", db)
     assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == compiled
     rc, out, _ = run(capsys, "changeover", "list", "--json", "--catalog", db)
@@ -228,3 +228,17 @@ def test_show_of_a_mix_told_apart_names_no_pairs(db, capsys):
     for command in (("show", "lt"), ("list",)):
         rc, out, _ = run(capsys, "changeover", *command, "--catalog", db)
         assert rc == 0 and "lt" in out and "cannot tell apart" not in out
+
+
+# Finding 10: every JSON pair carries its kind.
+
+
+def test_analyze_json_pairs_carry_their_kind(db, tmp_path, capsys):
+    add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
+    add_variant(db, tmp_path, capsys, "l-bracket-hole-moved", move_hole)
+    args = ("catalog", "analyze", "--tolerance", "0.2", "--rotation-error", "1", "--json")
+    rc, out, _ = run(capsys, *args, "--catalog", db)
+    data = json.loads(out)
+    assert rc == 1
+    assert {w["kind"] for w in data["unrecognizable_pairs"]} == {"same-push-diameter"}
+    assert {w["kind"] for w in data["apart_only_on_the_ideal_model"]} == {"uncertainty"}

@@ -61,8 +61,9 @@ class PairWitness:
     ``states_a[k]`` (a stable state id of ``part_a``) and ``states_b[k]`` (of ``part_b``) are
     the k-th inseparable pair: if the part is in one of them no action sequence ever makes
     its readings differ from those of the other. ``kind`` names the reason in one word:
-    ``same-push-diameter``, ``sensorless``, ``single-diameter``, ``same-diameters`` or
-    ``tolerance``. Slotted: a catalog's analysis holds a million of them.
+    ``same-push-diameter``, ``sensorless``, ``single-diameter``, ``same-diameters``,
+    ``tolerance`` or ``uncertainty`` (no strong plan under the declared uncertainty).
+    Slotted: a catalog's analysis holds a million of them.
     """
 
     part_a: str
@@ -80,13 +81,16 @@ class PairWitness:
         return tuple(zip(self.states_a, self.states_b, strict=True))
 
     def to_dict(self) -> dict[str, object]:
-        """``{"part_a", "part_b", "states_a", "states_b", "reason"}`` for reports and plans."""
+        """``{"part_a", "part_b", "states_a", "states_b", "reason", "kind"}`` for reports and
+        ``--json``: ``kind`` lets a script tell a pair no sensor separates from one a finer
+        sensor may, without parsing ``reason``."""
         return {
             "part_a": self.part_a,
             "part_b": self.part_b,
             "states_a": list(self.states_a),
             "states_b": list(self.states_b),
             "reason": self.reason,
+            "kind": self.kind,
         }
 
 
