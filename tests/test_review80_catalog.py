@@ -242,3 +242,16 @@ def test_analyze_json_pairs_carry_their_kind(db, tmp_path, capsys):
     assert rc == 1
     assert {w["kind"] for w in data["unrecognizable_pairs"]} == {"same-push-diameter"}
     assert {w["kind"] for w in data["apart_only_on_the_ideal_model"]} == {"uncertainty"}
+
+
+# Finding 3: no promise that a smaller rotation error helps.
+
+
+def test_analyze_does_not_promise_that_a_smaller_rotation_error_helps(db, tmp_path, capsys):
+    add_variant(db, tmp_path, capsys, "l-bracket-hole-moved", move_hole)
+    args = ("catalog", "analyze", "--tolerance", "0.2", "--rotation-error", "0.001")
+    rc, _, err = run(capsys, *args, "--catalog", db)
+    assert rc == 1 and "l-bracket/up & l-bracket-hole-moved/up" in err
+    assert "need a smaller rotation error" not in err
+    assert "may or may not be told apart with a smaller rotation error" in err
+    assert "vibration" in err

@@ -295,9 +295,11 @@ def _under(unc: Uncertainty, article: str = "the") -> str:
 
 def _advice(kinds: set[str], unc: Uncertainty | None = None) -> str:
     """What helps, by the witnesses' kinds: no sensor separates parts with the same
-    push-diameter function (Lemma 8), a finer one may separate the others; a pair told apart
-    only on the ideal model needs a smaller rotation error or tighter shape and COM
-    tolerances (those ``unc`` declares; None: the rotation error)."""
+    push-diameter function (Lemma 8), a finer one may separate the others. A pair told apart
+    only on the ideal model may or may not be told apart at a smaller rotation error or
+    tighter shape and COM tolerances (those ``unc`` declares; None: the rotation error): any
+    declared uncertainty switches the feeder's vibration on, which no smaller value removes
+    (``feederkit.plans.make.VIBRATION_OBSTACLE``), so no smaller value is promised to help."""
     if "uncertainty" in kinds:
         rest = _advice(kinds - {"uncertainty"}) if kinds - {"uncertainty"} else None
         less = []
@@ -305,7 +307,13 @@ def _advice(kinds: set[str], unc: Uncertainty | None = None) -> str:
             less.append("a smaller rotation error")
         if unc is not None and unc.radius_error_mm > 0.0:
             less.append("tighter shape and COM tolerances")
-        told = f"the pairs told apart only on the ideal model need {' or '.join(less)}"
+        told = (
+            "the pairs told apart only on the ideal model (no error and no vibration) may or "
+            f"may not be told apart with {' or '.join(less)}: any declared uncertainty "
+            "switches on the feeder's vibration (push bands, merged fragile states: "
+            "docs/uncertainty.md), which no smaller value removes; screen again at the "
+            "smaller values to know"
+        )
         return told if rest is None else f"{rest}; {told}"
     if kinds == {"same-push-diameter"}:
         return "keep them out of one mix: no sensor tells them apart (same push-diameter function)"
