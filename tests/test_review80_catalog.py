@@ -5,7 +5,10 @@ screen under a shape tolerance, the pairs a stored changeover cannot tell apart,
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -255,3 +258,50 @@ def test_analyze_does_not_promise_that_a_smaller_rotation_error_helps(db, tmp_pa
     assert "need a smaller rotation error" not in err
     assert "may or may not be told apart with a smaller rotation error" in err
     assert "vibration" in err
+
+
+# Finding 11: tolerances without float noise, no "none mm", names whole at 80 columns.
+
+
+def test_a_tolerance_is_shown_without_float_noise_and_never_above_itself():
+    from feederkit.design.sensor import shown_tolerance
+
+    assert shown_tolerance(0.3 - 1e-12) == "0.3"
+    assert shown_tolerance(0.3) == "0.3"
+    assert float(shown_tolerance(6.0274085)) <= 6.0274085
+
+
+def test_design_pitches_say_no_tolerance_rather_than_none_mm(db, tmp_path, capsys):
+    add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
+    args = ("design", "sensor", "--mix", "l-bracket,l-bracket-mirror", "--pitches", "0.5")
+    rc, out, _ = run(capsys, *args, "--catalog", db)
+    assert rc == 1 and "none mm" not in out
+    assert "an exact diameter sensor: no tolerance tells every pair apart" in out
+
+
+def at_80_columns(*args: str) -> list[str]:
+    """``feederkit ARGS``'s stdout lines in a process whose terminal is 80 columns wide."""
+    code = "import sys; from feederkit.cli.app import main; sys.exit(main(sys.argv[1:]))"
+    root = str(Path(__file__).resolve().parents[1])  # this tree's feederkit
+    env = {**os.environ, "COLUMNS": "80", "PYTHONPATH": root}
+    done = subprocess.run(
+        [sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, check=False
+    )
+    return done.stdout.splitlines()
+
+
+def test_pair_tables_keep_names_whole_at_80_columns(db, tmp_path, capsys):
+    add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
+    mix = ["--mix", "l-bracket,l-bracket-mirror", "--tolerance", "0.2", "--catalog", db]
+    assert run(capsys, "changeover", "compile", "lr", *mix)[0] == 1
+    for args in (
+        ("changeover", "show", "lr", "--catalog", db),
+        ("catalog", "analyze", "--tolerance", "0.2", "--catalog", db),
+        ("design", "sensor", "--mix", "l-bracket,l-bracket-mirror", "--catalog", db),
+    ):
+        lines = at_80_columns(*args)
+        table = [line for line in lines if line.startswith(("│", "┃", "┏", "└"))]
+        assert table and max(len(line) for line in table) <= 80, args
+        assert any("l-bracket-mirror/down" in line for line in table), args
+        assert any("l-bracket-mirror/up" in line for line in table), args
+        assert not any("…" in line for line in table), args

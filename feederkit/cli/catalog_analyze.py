@@ -6,6 +6,7 @@ The lead registers :func:`analyze_command` as ``analyze`` in the ``catalog`` gro
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Annotated
 
@@ -490,6 +491,30 @@ class _Readings:
         return f"{state} ({self.edge(member, state)})"
 
 
+WHOLE_NAME_WIDTH = 26
+"""A pair table keeps a member name up to this long on one line (a longer one folds)."""
+
+
+def name_width(names: Iterable[str]) -> int:
+    """The width of a pair table's name column that keeps each name whole: at 80 columns the
+    words of the other columns wrap first, so ``l-bracket-mirror/down`` never breaks before
+    its landing (up to :data:`WHOLE_NAME_WIDTH`)."""
+    return min(max((len(n) for n in names), default=1), WHOLE_NAME_WIDTH)
+
+
+def add_pair_column(table: Table, pairs: Iterable[PairWitness]) -> None:
+    """The column of a pair table naming both members, one a line (:func:`pair_cell`), as
+    wide as the longest name (:func:`name_width`): two name columns side by side leave the
+    other columns too little room at 80 columns."""
+    widths = [name_width([w.part_a + " &", w.part_b]) for w in pairs]
+    add_name_column(table, "parts (A & B)", width=max(widths, default=1))
+
+
+def pair_cell(w: PairWitness) -> str:
+    """Both members of a pair, one a line (escaped for rich)."""
+    return f"{escape(w.part_a)} &\n{escape(w.part_b)}"
+
+
 def _pairs_table(
     pairs: tuple[PairWitness, ...],
     pfs: list[PushFunction],
@@ -500,8 +525,7 @@ def _pairs_table(
     diameters), else the reading intervals under the declared uncertainty."""
     how = "edge, diameter mm" if reads is None else READS_HEADING
     t = Table(title=title)
-    add_name_column(t, "part A")
-    add_name_column(t, "part B")
+    add_pair_column(t, pairs)
     t.add_column(f"inseparable states (A ~ B: {how})")
     t.add_column("why")
     exact = reads or _Readings(pfs, NoSensor(), IDEAL)
@@ -509,5 +533,5 @@ def _pairs_table(
         states = ", ".join(
             f"{i}~{j} ({exact.edge(w.index_a, i)} / {exact.edge(w.index_b, j)})" for i, j in w.pairs
         )
-        t.add_row(escape(w.part_a), escape(w.part_b), states, escape(w.reason))
+        t.add_row(pair_cell(w), states, escape(w.reason))
     return t

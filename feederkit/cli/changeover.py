@@ -37,6 +37,7 @@ from feederkit.catalog import (
     resolve_catalog_path,
 )
 from feederkit.cell import annotate_cycle_time, cycle_time_text
+from feederkit.cli.catalog_analyze import add_pair_column, pair_cell
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
     DONE_WORK,
@@ -335,14 +336,12 @@ def _pairs_table(witnesses: Sequence[PairWitness]) -> Table:
     """The pairs a changeover's plan cannot tell apart, as ``compile`` and ``show`` print
     them."""
     t = Table(title="parts this plan orients but cannot tell apart (section 8.4, Corollary 7)")
-    add_name_column(t, "part A")
-    add_name_column(t, "part B")
+    add_pair_column(t, witnesses)
     t.add_column("inseparable states (A ~ B)")
     t.add_column("why")
     for w in witnesses:
         t.add_row(
-            escape(w.part_a),
-            escape(w.part_b),
+            pair_cell(w),
             ", ".join(f"{i}~{j}" for i, j in w.pairs),
             escape(w.reason),
         )

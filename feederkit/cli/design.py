@@ -17,6 +17,7 @@ length table).
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -24,6 +25,7 @@ import typer
 from rich.table import Table
 
 from feederkit.cell import load_cell
+from feederkit.cli.catalog_analyze import name_width
 from feederkit.cli.common import (
     FLAG_TERMS,
     LANDING_TERMS,
@@ -33,6 +35,7 @@ from feederkit.cli.common import (
     JsonOpt,
     LandingsOpt,
     ShapeToleranceOpt,
+    add_name_column,
     check_mix_revision,
     check_outputs,
     console,
@@ -55,12 +58,12 @@ from feederkit.design.sensor import (
     design_tolerance,
     landing_design_members,
     member_landing_rows,
+    shown_tolerance,
 )
 from feederkit.errors import InputError
 from feederkit.landing.plan import landing_names, load_landings
 from feederkit.mechanics import push_function
 from feederkit.mix.changeover import plans_over_landings
-from feederkit.words import at_most
 
 design_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -307,8 +310,14 @@ def sensor_command(
 
 
 def _mm(x: float | None) -> str:
-    """A critical tolerance (a largest value that works), rounded down (``at_most``)."""
-    return "none" if x is None else at_most(x)
+    """A critical tolerance (a largest value that works) for display (``shown_tolerance``)."""
+    return "none" if x is None else shown_tolerance(x)
+
+
+def names(pairs: Iterable[Any]) -> Iterator[str]:
+    """The member names of a design's pairs (``a`` and ``b`` of each)."""
+    for p in pairs:
+        yield from (p.a + " &", p.b)
 
 
 def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
@@ -324,13 +333,13 @@ def _pairs_table(design: ToleranceDesign | PitchDesign) -> Table:
     if design.rejected:
         title += "; none of two rejected ones"
     table = Table(title=title)
-    table.add_column("part a")
-    table.add_column("part b")
+    # One column, a name a line: each name whole (its landing shown) at 80 columns.
+    add_name_column(table, "parts (a & b)", width=name_width([*names(shown)]))
     table.add_column("critical tolerance (mm)", justify="right")
     table.add_column("why not", overflow="fold")
     for p in shown:
         why = p.witness.reason if p.witness is not None else ""
-        table.add_row(p.a, p.b, _mm(p.critical_tolerance), why)
+        table.add_row(f"{p.a} &\n{p.b}", _mm(p.critical_tolerance), why)
     return table
 
 
@@ -342,23 +351,24 @@ def _print_tolerance(design: ToleranceDesign, members: str) -> None:
     table.add_column("length", justify="right")
     table.add_column(f"expected (at hi; {members} equally likely)", justify="right")
     for s in design.steps:
-        hi = "..." if s.hi is None else at_most(s.hi)  # the step holds up to hi
+        hi = "..." if s.hi is None else shown_tolerance(s.hi)  # the step holds up to hi
         length = "no strong plan" if s.length is None else str(s.length)
         expected = "-" if s.expected is None else f"{s.expected:.4f}"
-        table.add_row(f"({at_most(s.lo)}, {hi}]", length, expected)  # both ends alike
+        table.add_row(f"({shown_tolerance(s.lo)}, {hi}]", length, expected)  # both ends alike
     if design.steps:
         console.print(table)
 
 
 def _print_pitches(design: PitchDesign, members: str) -> None:
     table = Table(title=f"LED pitches, each on its own (noise {design.noise:g} mm)")
-    table.add_column("pitch (mm)", justify="right")
+    table.add_column("pitch (mm)", justify="right", max_width=7)
     table.add_column("recognizable")
     table.add_column("length", justify="right")
-    table.add_column(f"expected ({members} equally likely)", justify="right")
-    table.add_column("pairs it cannot tell apart", overflow="fold")
+    table.add_column(f"expected ({members} equally likely)", justify="right", max_width=10)
+    shown = [n for row in design.rows for pair in row.unrecognizable[:3] for n in pair]
+    table.add_column("pairs it cannot tell apart", overflow="fold", width=name_width(shown) + 2)
     for row in design.rows:
-        bad = ", ".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])
+        bad = ",\n".join(f"{a} & {b}" for a, b in row.unrecognizable[:3])  # a pair a line
         if len(row.unrecognizable) > 3:
             bad += f" and {len(row.unrecognizable) - 3} more"
         if row.no_plan is not None:
@@ -371,9 +381,12 @@ def _print_pitches(design: PitchDesign, members: str) -> None:
             bad,
         )
     console.print(table)
+    x = design.critical.critical_tolerance
+    exact = (
+        "no tolerance tells every pair apart" if x is None else f"critical tolerance {_mm(x)} mm"
+    )
     console.print(
-        f"for comparison, an exact diameter sensor: critical tolerance "
-        f"{_mm(design.critical.critical_tolerance)} mm",
+        f"for comparison, an exact diameter sensor: {exact}",
         highlight=False,
         markup=False,
     )

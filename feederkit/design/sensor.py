@@ -45,6 +45,19 @@ from feederkit.plans.model import PlanMember
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import at_most
 
+FLOAT_NOISE_DIGITS = 9
+"""Significant digits a computed tolerance is snapped to before it is shown: diameters that
+differ by exactly 0.6 mm give a critical tolerance of 0.3 mm minus float noise (1e-12), which
+must show as 0.3, not as 0.299999 beside a step that ends at 0.3."""
+
+
+def shown_tolerance(x: float) -> str:
+    """A critical tolerance or step bound for display: rid of float noise
+    (:data:`FLOAT_NOISE_DIGITS`), then rounded down to 6 significant digits (``at_most``: the
+    printed value works). The values themselves (``--json``) are kept exact."""
+    return at_most(float(f"{x:.{FLOAT_NOISE_DIGITS}g}"))
+
+
 MODEL_NOTE = "ideal model: plans assume no rotation error"
 """The model note of the ideal model (all three bounds zero)."""
 
@@ -223,11 +236,11 @@ class ToleranceDesign:
         pairs_x = self.critical.critical_tolerance
         if self.stopped is not None and pairs_x is not None:
             if x is not None:  # the ideal model: the pairs' tolerance is the mix's
-                text = f"this mix is recognizable with a tolerance up to {at_most(x)} mm"
+                text = f"this mix is recognizable with a tolerance up to {shown_tolerance(x)} mm"
             else:
                 text = (
-                    f"every pair of this mix is told apart up to {at_most(pairs_x)} mm, so no "
-                    "larger tolerance recognizes it; whether one strong plan does up to it "
+                    f"every pair of this mix is told apart up to {shown_tolerance(pairs_x)} mm, "
+                    "so no larger tolerance recognizes it; whether one strong plan does up to it "
                     "was not decided"
                 )
             return f"{text}{self._model_words()}; {self.stopped}"
@@ -242,7 +255,7 @@ class ToleranceDesign:
                 + self._model_words()
             )
         step = self.step_at(x)
-        text = f"this mix is recognizable with a tolerance up to {at_most(x)} mm"
+        text = f"this mix is recognizable with a tolerance up to {shown_tolerance(x)} mm"
         if step is not None and step.length is not None and step.expected is not None:
             text += (
                 f"; with it the plan takes {step.length} operations (expected {step.expected:.4g})"
