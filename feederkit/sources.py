@@ -128,6 +128,12 @@ def load_parts_with_warnings(
     if exists:
         raise InputError(f"{source}: not a file")
     if not could_be_part_name(source):
+        name, at, rev = source.rpartition("@")
+        if at and could_be_part_name(name):  # NAME@REV with a revision that is no number
+            raise InputError(
+                f"{source}: no such file, nor a catalog part: part {name!r} has no revision "
+                f"{rev!r} (NAME@REV takes a revision number)"
+            )
         raise InputError(f"{source}: no such file")
     found = _from_catalog(source, opts.com, catalog)  # a mistyped name says so first
     if opts.units is not None:

@@ -129,6 +129,12 @@ def test_a_revision_that_is_not_a_number_is_named_as_such(db, capsys, args):
     assert "part 'l-bracket' has no revision 'abc'" in err and "no such file" not in err
 
 
+def test_a_source_with_a_revision_that_is_not_a_number_is_named_as_such(db, capsys):
+    # A SOURCE may be a file, so "no such file" stays; the revision is named too.
+    err = one_line_error(capsys, ["plan", "l-bracket@abc", "--tolerance", "0.2", "--catalog", db])
+    assert "no such file" in err and "part 'l-bracket' has no revision 'abc'" in err
+
+
 def test_compile_checks_its_inputs_before_the_name_is_taken(db, capsys):
     args = ["changeover", "compile", "lt", "--mix", "l-bracket,t-clip", "--catalog", db]
     assert run(capsys, *args, "--tolerance", "0.5", "--landings", "up")[0] in (0, 1)
