@@ -262,7 +262,8 @@ def verification_title(plan: Plan) -> str:
 
 
 def verification_table(report: VerificationReport, plan: Plan | None = None) -> Table:
-    """Per part: starts, paths, the most operations a path took, failed starts."""
+    """Per part: starts, paths, the most operations a path took, the paths ending in an
+    unrecognized result (when some do), failed starts."""
     title = "verification"
     if plan is not None:
         title += " " + verification_title(plan).removeprefix("verified ")
@@ -273,11 +274,15 @@ def verification_table(report: VerificationReport, plan: Plan | None = None) -> 
         t.add_column("landing")
     for col in ("starts", "paths", *(["rejects"] if landings else []), "worst operations"):
         add_count_column(t, col)
+    unrecognized = report.unrecognized > 0
+    if unrecognized:
+        add_count_column(t, "unrecognized")
     add_count_column(t, "failed starts")
     for p in report.parts:
         failed = Text(str(p.failed_starts), style="bold red" if p.failed_starts else "green")
         head = [p.part, str(p.landing), str(p.starts), str(p.paths), str(p.rejects)]
         if not landings:
             head = [p.part, str(p.starts), str(p.paths)]
-        t.add_row(*head, str(p.worst_operations), failed)
+        more = [str(p.unrecognized)] if unrecognized else []
+        t.add_row(*head, str(p.worst_operations), *more, failed)
     return t

@@ -7,7 +7,9 @@ plan's (same hull and COM: the plan is checked against the current part). One ru
 uncertainty (a strong plan: every outcome and reading; the ideal model: the kinematic model).
 In a plan over landings every member is a part in one landing: the tables and messages name
 it as ``PART (LANDING)``, and a run that ends in a reject result says "reject" (the next
-station cannot take that landing: recirculate or re-drop). Exit 1 when anything fails,
+station cannot take that landing: recirculate or re-drop). A run that ends in a result
+listing several parts or landings says so, naming them (the plan cannot tell them apart),
+and ``--all`` counts such paths apart. Exit 1 when anything fails,
 including a plan that fails verification.
 """
 
@@ -31,8 +33,8 @@ from feederkit.errors import CheckFailed, InputError
 from feederkit.landing.plan import load_landings
 from feederkit.plans.execute import execute
 from feederkit.plans.match import match_part, same_geometry
-from feederkit.plans.model import Plan
-from feederkit.plans.verify import verify_declared
+from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan
+from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.sources import load_part
 
 
@@ -98,15 +100,8 @@ def run_command(
             if report.parts:  # a failed strong check has no counts, only its first problem
                 console.print(verification_table(report, plan))
             if report.ok:
-                rejects = sum(p.rejects for p in report.parts)
-                tail = ""
-                if rejects:
-                    tail = (
-                        f", {rejects} of them in a reject result (a landing the next station "
-                        "cannot take: recirculate or re-drop)"
-                    )
                 console.print(
-                    f"{_every_path(report.paths)} in their result{tail}",
+                    f"{_every_path(report.paths)} in their result{_of_them(report)}",
                     highlight=False,
                     markup=False,
                     soft_wrap=True,
@@ -122,7 +117,7 @@ def run_command(
     else:
         for t in traces:
             console.print(trace_table(t))
-            style = "green" if t.success else "bold red"
+            style = "yellow" if t.unrecognized else "green" if t.success else "bold red"
             console.print(t.message, style=style, highlight=False, markup=False, soft_wrap=True)
     failed = [t for t in traces if not t.success]
     if failed:
@@ -159,6 +154,21 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
                 )
             out.append(j)
     return sorted(out) or [match_part(plan, part, source)]
+
+
+def _of_them(report: VerificationReport) -> str:
+    """What the right paths end in besides a known part and pose: a reject result, an
+    unrecognized one (:data:`UNRECOGNIZED_WORDS`); empty when neither."""
+    rejects = sum(p.rejects for p in report.parts)
+    tail = ""
+    if rejects:
+        tail += (
+            f", {rejects} of them in a reject result (a landing the next station cannot take: "
+            "recirculate or re-drop)"
+        )
+    if report.unrecognized:
+        tail += f", {report.unrecognized} of them {UNRECOGNIZED_WORDS}"
+    return tail
 
 
 def _every_path(n: int) -> str:

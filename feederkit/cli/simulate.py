@@ -40,7 +40,7 @@ from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_pl
 from feederkit.errors import CheckFailed, InputError
 from feederkit.importers import ImportOptions
 from feederkit.part import Part
-from feederkit.plans.model import REJECTED_WORDS
+from feederkit.plans.model import REJECTED_WORDS, UNRECOGNIZED_WORDS
 from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
     DEFAULT_FRICTION_BELT_RANGE,
@@ -83,6 +83,8 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
             table.add_row(f"  {escape(name)}", f"{k} of {t}")
     if s.rejects:
         table.add_row("  of them", f"{s.rejects} {REJECTED_WORDS}")
+    if s.unrecognized:
+        table.add_row("  of them", f"{s.unrecognized} {UNRECOGNIZED_WORDS}")
     table.add_row("failures", str(len(s.failures)))
     if s.wrong_accepts:
         table.add_row("  wrong accepts", f"{s.wrong_accepts} (accepted, landing or state wrong)")

@@ -105,7 +105,8 @@ class Trace:
     ``result`` is the leaf's entries (empty when the run stopped on a reading no branch
     holds); ``success``: the part's final (part, landing, state) is among them. ``landing``
     is the member's landing (None: a plan not made over landings); ``reject``: the run ended
-    in a reject leaf, the part is to be recirculated or re-dropped.
+    in a reject leaf, the part is to be recirculated or re-dropped; ``unrecognized``: it
+    ended, rightly, in an accept leaf naming several members (:attr:`Leaf.unrecognized`).
     """
 
     part: str
@@ -118,6 +119,7 @@ class Trace:
     message: str
     landing: str | None = None
     reject: bool = False
+    unrecognized: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The trace as JSON."""
@@ -130,6 +132,7 @@ class Trace:
             "final_pose_deg": self.final_pose_deg,
             "result": [entry_dict(e) for e in self.result],
             "reject": self.reject,
+            "unrecognized": self.unrecognized,
             "operations": len(self.steps),
             "success": self.success,
             "message": self.message,
@@ -181,7 +184,9 @@ def finish(
     (None: on an unheld reading).
 
     A failure's message gives the whole run in one line (:func:`path_text`); a run that
-    ends in a reject leaf listing its state is right, and its message says "reject".
+    ends in a reject leaf listing its state is right, and its message says "reject"; one that
+    ends in an accept leaf naming several members is right too, but its message names them
+    and says the plan cannot tell them apart, never "oriented".
     """
     steps = tuple(steps)
     head = f"{member_label(name, landing)} from theta {start:.10g} deg"
@@ -202,6 +207,13 @@ def finish(
         msg = (
             f"{head}: reject{side} after {ops}, resting in state {state.id} "
             f"(edge {state.edge}): the next station cannot take it; recirculate or re-drop"
+        )
+    elif ok and leaf.unrecognized:
+        msg = (
+            f"{head}: ends after {ops} at a result that lists {_listing(result)}: the plan "
+            f"cannot tell them apart, so the controller knows only that the part is one of "
+            f"them (this run rests in state {state.id} (edge {state.edge}), pose "
+            f"{state.pose_deg:.6g} deg)"
         )
     elif ok:
         msg = (
@@ -226,7 +238,14 @@ def finish(
         msg,
         landing=landing,
         reject=leaf.reject,
+        unrecognized=ok and leaf.unrecognized,
     )
+
+
+def _listing(entries: Sequence[ResultEntry]) -> str:
+    """A result's entries in words: ``A state 0 and B state 0`` (:func:`entry_text`)."""
+    words = [entry_text(e) for e in entries]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _pick_reading(

@@ -120,6 +120,22 @@ def member_fragile_warnings(
     return fragile_member_warnings(list(parts.values())) + tipping
 
 
+def names_several(members: Iterable[tuple[str, str | None]], reject: bool = False) -> bool:
+    """Whether an accept result naming ``members`` (``(part, landing)``, repeats allowed)
+    leaves the part unrecognized: it names more than one part or landing, which the plan
+    cannot tell apart (each entry is still a correct answer, design.md). A reject result
+    never does: every member it names is recirculated alike."""
+    return not reject and len(set(members)) > 1
+
+
+UNRECOGNIZED_WORDS = (
+    "unrecognized (a result listing several parts or landings the plan cannot tell apart: "
+    "the part is one of them, each with its pose, but not known which)"
+)
+"""How ``run --all``, ``simulate`` and the report name the successes that ended in an accept
+result naming several members (:func:`names_several`)."""
+
+
 @dataclass(frozen=True)
 class ResultEntry:
     """One correct answer of a leaf: part ``part``, lying in ``landing`` (None: a plan not
@@ -147,6 +163,17 @@ class Leaf:
 
     results: tuple[ResultEntry, ...]
     reject: bool = False
+
+    @property
+    def candidates(self) -> tuple[tuple[str, str | None], ...]:
+        """The members ``(part, landing)`` the result names, each once, in result order."""
+        return tuple(dict.fromkeys(r.key for r in self.results))
+
+    @property
+    def unrecognized(self) -> bool:
+        """Whether this is an accept result naming several members (:func:`names_several`):
+        the part is one of them, and the controller cannot know which."""
+        return names_several(self.candidates, self.reject)
 
     def accepts(self, part: str, state: int, landing: str | None = None) -> bool:
         """Whether ``part`` lying in ``landing`` and resting in ``state`` is one of the

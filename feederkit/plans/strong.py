@@ -50,7 +50,7 @@ from feederkit.planning.reindex import map_masks
 from feederkit.planning.tree import PlanResult, Step
 from feederkit.plans.execute import rounding_inset
 from feederkit.plans.fileformat import result_nodes
-from feederkit.plans.model import PlanPart, member_label, push_function_of
+from feederkit.plans.model import PlanPart, member_label, names_several, push_function_of
 from feederkit.plans.verify import (
     PartCheck,
     VerificationReport,
@@ -204,6 +204,7 @@ class _Run:
         self._worst: dict[tuple[int, State], int] = {}
         self._paths: dict[tuple[int, State], int] = {}
         self.rejected: dict[tuple[int, State], int] = {}
+        self.unrecognized: dict[tuple[int, State], int] = {}  # paths to an unrecognized result
         self._handles: dict[tuple[int, State], bool] = {}
         self.arrivals: dict[int, set[tuple[int, int]]] = {}  # leaf id: (part, ideal state)
         self._outcomes: dict[tuple[int, State], list[State]] = {}
@@ -360,13 +361,16 @@ class _Run:
                     f"physical state {s} (ideal states {ideal})"
                 )
             self._worst[key], self._paths[key] = 0, 1
-            self.rejected[key] = 1 if node.get("reject") is True else 0
+            reject = node.get("reject") is True
+            self.rejected[key] = 1 if reject else 0
+            members = ((e["part"], e.get("landing")) for e in node["result"])
+            self.unrecognized[key] = 1 if names_several(members, reject) else 0
             p, s = x
             self.arrivals.setdefault(id(node), set()).update(
                 (p, m) for m in self.model.mechanics[p].states[s].members
             )
             return 0
-        longest, paths, rejected = 0, 0, 0
+        longest, paths, rejected, unrecognized = 0, 0, 0, 0
         if self.margins:
             # On the verified paths only: the expected walk also follows branches a reading
             # meets within rounding (probability ~1e-16), where no margin is claimed.
@@ -376,8 +380,10 @@ class _Run:
                 longest = max(longest, self.worst(nxt, y))
                 paths += self._paths[(id(self.node(nxt)), y)]
                 rejected += self.rejected[(id(self.node(nxt)), y)]
+                unrecognized += self.unrecognized[(id(self.node(nxt)), y)]
         self._worst[key], self._paths[key] = 1 + longest, paths
         self.rejected[key] = rejected
+        self.unrecognized[key] = unrecognized
         return 1 + longest
 
     def results(self, root: Mapping[str, Any]) -> list[Mapping[str, Any]]:
@@ -508,14 +514,17 @@ def verify_strong(
     checks = []
     overall = 0
     for p, (name, landing) in enumerate(model.members):
-        worst, paths, rejected = 0, 0, 0
+        worst, paths, rejected, unrecognized = 0, 0, 0, 0
         states = [x for x in model.states() if x[0] == p]
         for x in states:
             worst = max(worst, run.worst(root, x))
             paths += run._paths[(id(run.node(root)), x)]
             rejected += run.rejected[(id(run.node(root)), x)]
+            unrecognized += run.unrecognized[(id(run.node(root)), x)]
         overall = max(overall, worst)
-        checks.append(PartCheck(name, len(states), paths, worst, 0, landing, rejected))
+        checks.append(
+            PartCheck(name, len(states), paths, worst, 0, landing, rejected, unrecognized)
+        )
     if prune:
         run.prune(root)
     spurious = run.unreached(root) if uncertainty is None else None

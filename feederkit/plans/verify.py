@@ -51,8 +51,9 @@ on resting-range boundaries, which rebuilding the push function reproduces to ab
 @dataclass(frozen=True)
 class PartCheck:
     """What was tried for one member: starts, complete paths, the most operations any run
-    took; ``landing`` the member's landing (None: not a plan over landings) and
-    ``rejects`` the paths that end in a reject leaf."""
+    took; ``landing`` the member's landing (None: not a plan over landings),
+    ``rejects`` the paths that end in a reject leaf and ``unrecognized`` those that end in an
+    accept leaf naming several members (:attr:`~feederkit.plans.model.Leaf.unrecognized`)."""
 
     part: str
     starts: int
@@ -61,6 +62,7 @@ class PartCheck:
     failed_starts: int
     landing: str | None = None
     rejects: int = 0
+    unrecognized: int = 0
 
     @property
     def label(self) -> str:
@@ -75,6 +77,7 @@ class PartCheck:
             "starts": self.starts,
             "paths": self.paths,
             "rejects": self.rejects,
+            "unrecognized": self.unrecognized,
             "worst_operations": self.worst_operations,
             "failed_starts": self.failed_starts,
         }
@@ -98,6 +101,11 @@ class VerificationReport:
         """Number of complete paths tried."""
         return sum(p.paths for p in self.parts)
 
+    @property
+    def unrecognized(self) -> int:
+        """Paths that end, rightly, in an accept result naming several members."""
+        return sum(p.unrecognized for p in self.parts)
+
     def first_problem(self) -> str | None:
         """The first counterexample or inconsistency, in one line (None when the plan passed)."""
         if self.problems:
@@ -109,6 +117,7 @@ class VerificationReport:
         return {
             "ok": self.ok,
             "paths": self.paths,
+            "unrecognized": self.unrecognized,
             "parts": [p.to_dict() for p in self.parts],
             "problems": list(self.problems),
             "failures": [t.to_dict() for t in self.failures],
@@ -133,6 +142,7 @@ class _Outcome:
     worst: int
     failure: _Failure | None
     rejects: int = 0
+    unrecognized: int = 0
 
 
 def _discrete(sensor: Sensor, diameter: float) -> bool:
@@ -233,8 +243,10 @@ class _PartSearch:
         key = (id(node), state.id)
         hit = self.memo.get(key)
         if hit is not None:
-            return _Outcome(hit.paths, number + hit.worst, hit.failure, hit.rejects)
-        paths, worst, failure, rejects = 0, number, None, 0
+            return _Outcome(
+                hit.paths, number + hit.worst, hit.failure, hit.rejects, hit.unrecognized
+            )
+        paths, worst, failure, rejects, unrecognized = 0, number, None, 0, 0
         explored: set[int] = set()
         for reading in candidate_readings(self.sensor, node, self.diameter[state.id]):
             held = node.held_by(reading)
@@ -249,6 +261,7 @@ class _PartSearch:
                 if isinstance(nxt, Leaf):
                     paths += 1
                     rejects += nxt.reject
+                    unrecognized += nxt.unrecognized
                     self.arrivals.add((id(nxt), state.id))
                     if not nxt.accepts(self.name, state.id, self.landing) and failure is None:
                         failure = _Failure(reading, b, branch.reading, (), state, nxt)
@@ -258,6 +271,7 @@ class _PartSearch:
                     sub = self.after_push(nxt, number + 1, s2)
                     paths += sub.paths
                     rejects += sub.rejects
+                    unrecognized += sub.unrecognized
                     worst = max(worst, sub.worst)
                     if sub.failure is not None and failure is None:
                         f = sub.failure
@@ -277,16 +291,17 @@ class _PartSearch:
                         failure = _Failure(
                             reading, b, branch.reading, (step, *f.rest), f.final, f.leaf
                         )
-        self.memo[key] = _Outcome(paths, worst - number, failure, rejects)
-        return _Outcome(paths, worst, failure, rejects)
+        self.memo[key] = _Outcome(paths, worst - number, failure, rejects, unrecognized)
+        return _Outcome(paths, worst, failure, rejects, unrecognized)
 
     def run(self) -> tuple[PartCheck, list[Trace]]:
-        paths, worst, failed, rejects = 0, 0, [], 0
+        paths, worst, failed, rejects, unrecognized = 0, 0, [], 0, 0
         starts = self.pf.states
         for s0 in starts:
             o = self.after_push(self.plan.root, 1, s0)
             paths += o.paths
             rejects += o.rejects
+            unrecognized += o.unrecognized
             worst = max(worst, o.worst)
             if o.failure is not None:
                 f = o.failure
@@ -297,7 +312,9 @@ class _PartSearch:
                 # a path's k-th step is operation k, wherever a shared subplan was first met
                 steps = [replace(t, number=k) for k, t in enumerate((first, *f.rest), 1)]
                 failed.append(finish(self.name, theta, steps, f.final, f.leaf, self.landing))
-        check = PartCheck(self.name, len(starts), paths, worst, len(failed), self.landing, rejects)
+        check = PartCheck(
+            self.name, len(starts), paths, worst, len(failed), self.landing, rejects, unrecognized
+        )
         return check, failed
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 from feederkit.cell import expectation_words
 from feederkit.errors import InputError
-from feederkit.plans.model import REJECTED_WORDS, Plan
+from feederkit.plans.model import REJECTED_WORDS, UNRECOGNIZED_WORDS, Plan
 from feederkit.reports.svgkit import esc, num
 from feederkit.reports.trace import Confusion
 from feederkit.reports.tree_html import Drawing, path_text
@@ -154,7 +154,8 @@ def _int(value: object) -> int | None:
 def simulation_text(simulation: Mapping[str, Any]) -> str:
     """The simulator's result in words, from the summary ``feederkit simulate --json`` prints
     (``SimulationSummary.to_dict``, docs/simulation.md), in the command line's words: the
-    successes with their 95 % Wilson interval (the rightly rejected counted apart), what
+    successes with their 95 % Wilson interval (the rightly rejected and the unrecognized
+    counted apart), what
     was sampled and the seed, the failures by cause, the model errors, per part, the push
     agreement, and the notes on what the plan certifies, the simulator's width accuracy and a
     part simulated beyond the plan's declared shape tolerance."""
@@ -165,11 +166,12 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     shown = simulation.get("success_words")
     success = shown if isinstance(shown, str) else f"{successes} of {trials}{rate}"
     rejects = _int(simulation.get("rejects")) or 0
-    if rejects:
-        words = [
-            f"successes: {success}, {successes - rejects} oriented correctly and {rejects} "
-            f"{REJECTED_WORDS}"
-        ]
+    unrecognized = _int(simulation.get("unrecognized")) or 0
+    if rejects or unrecognized:
+        kinds = [f"{successes - rejects - unrecognized} oriented correctly"]
+        kinds += [f"{rejects} {REJECTED_WORDS}"] if rejects else []
+        kinds += [f"{unrecognized} {UNRECOGNIZED_WORDS}"] if unrecognized else []
+        words = [f"successes: {success}, " + " and ".join(kinds)]
     else:
         words = [f"successes (oriented correctly): {success}"]
     settings = simulation.get("settings")

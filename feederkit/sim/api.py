@@ -384,6 +384,7 @@ def simulate_plan(
         ),
         successes=sum(r.outcome == "success" for r in results),
         rejects=sum(r.outcome == "success" and r.rejected for r in results),
+        unrecognized=sum(r.outcome == "success" and r.unrecognized for r in results),
         failures=wrong("failure"),
         unsettled=wrong("unsettled"),
         pushes=len(pushes),

@@ -326,6 +326,9 @@ class TrialResult:
     landing: str | None = None
     rejected: bool = False
     final_deg: float | None = None
+    unrecognized: bool = False
+    """A success that ended in an accept leaf naming several members (the plan cannot tell
+    them apart, :attr:`~feederkit.plans.model.Leaf.unrecognized`)."""
     pose_error_deg: float | None = None
 
     @property
@@ -341,6 +344,7 @@ class TrialResult:
             "part": self.part,
             "landing": self.landing,
             "rejected": self.rejected,
+            "unrecognized": self.unrecognized,
             "start_deg": _r(self.start_deg),
             "outcome": self.outcome,
             "step": self.step,
@@ -455,8 +459,9 @@ class SimulationSummary:
     ``trials == successes + len(failures) + len(unsettled)``; ``part_trials`` and
     ``part_successes`` split them by the members of the mix (``parts``: ``NAME`` or
     ``NAME (LANDING)``). ``rejects`` of the successes ended in a reject leaf that names the
-    member (design.md, "Landings"); ``wrong_accepts`` of the failures in an accepting leaf that
-    does not. Push agreement counts the
+    member (design.md, "Landings"), ``unrecognized`` in an accept leaf that names it among
+    other members (right, but the part is not known); ``wrong_accepts`` of the failures in an
+    accepting leaf that does not. Push agreement counts the
     settled pushes that ended where the push function predicts from the actual drop
     orientation (physics against the kinematic model, whatever the rotation error).
     """
@@ -478,6 +483,9 @@ class SimulationSummary:
     sim_time_s: float
     rejects: int = 0
     """Successes that ended in a reject leaf naming the member's landing (correct rejects)."""
+    unrecognized: int = 0
+    """Successes that ended in an accept leaf naming several members (:attr:`TrialResult.
+    unrecognized`): right by the plan's contract, yet the part is not known."""
     physical_agreements: int | None = None
     """Settled pushes that ended where the push function says or in the same physical state
     of the plan's model (:attr:`PushRecord.agrees_physically`); None without the model."""
@@ -583,6 +591,7 @@ class SimulationSummary:
             "interval_method": INTERVAL_METHOD,
             "success_words": self.success_words(),
             "rejects": self.rejects,
+            "unrecognized": self.unrecognized,
             "wrong_accepts": self.wrong_accepts,
             "model_errors": self.model_errors,
             "by_cause": self.by_cause(),

@@ -195,7 +195,12 @@ def run_trial(
     state: int | None = None
 
     def finish(
-        outcome: str, step: int | None, cause: str | None, why: str | None, rejected: bool = False
+        outcome: str,
+        step: int | None,
+        cause: str | None,
+        why: str | None,
+        rejected: bool = False,
+        unrecognized: bool = False,
     ) -> TrialResult:
         predicted = None
         if outcome != "success":
@@ -215,6 +220,7 @@ def run_trial(
             predicted=predicted,
             landing=landing,
             rejected=rejected,
+            unrecognized=unrecognized,
             final_deg=final_theta,
             pose_error_deg=pose_error,
         )
@@ -313,10 +319,11 @@ def run_trial(
         node = node.branches[branch].next
     assert isinstance(node, Leaf)
     reject = bool(getattr(node, "reject", False))
+    several = node.unrecognized  # right, but the part is not known
     if pose is not None and final_theta is not None:
         pose_error = pose.leaf_error(node, part_name, landing, final_theta)
         if pose_error <= pose.limit_deg:
-            return finish("success", None, None, None, rejected=reject)
+            return finish("success", None, None, None, rejected=reject, unrecognized=several)
         leaf = "reject result" if reject else "result"
         far = (
             f"{pose_error:.2f} deg from the resting range of the nearest state the plan's {leaf} "
@@ -332,7 +339,7 @@ def run_trial(
             rejected=reject,
         )
     if state is not None and leaf_holds(node, part_name, state, landing):
-        return finish("success", None, None, None, rejected=reject)
+        return finish("success", None, None, None, rejected=reject, unrecognized=several)
     what = f"state {state}" if landing is None else f"landing {landing}, state {state}"
     leaf = "reject result" if reject else "result"
     return finish(

@@ -1,0 +1,106 @@
+"""What a plan says about parts it cannot tell apart: runs, simulation, the pair words, the
+report's section and the rotation-error hint (a new user's review of product mixes)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from shared import run_cli
+
+from feederkit.plans.execute import execute
+from feederkit.plans.fileformat import read_plan
+from feederkit.plans.model import Leaf, ResultEntry, names_several
+from feederkit.plans.verify import verify_declared
+from feederkit.reports.sections import simulation_text
+
+TRI = [[0, 0], [1, 0], [0, 1]]
+
+
+def _outline(tmp_path: Path, name: str, vertices: list[list[float]]) -> str:
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps({"name": name, "vertices": vertices}))
+    return str(path)
+
+
+@pytest.fixture(params=["1", "0"], ids=["strong", "ideal"])
+def twin_plan(request, tmp_path: Path, capsys) -> Path:
+    """A plan for the triangle and a copy of it under another name: every result lists both."""
+    a, b = _outline(tmp_path, "tri", TRI), _outline(tmp_path, "tri-copy", TRI)
+    out = tmp_path / "twins.plan.json"
+    args = ["plan", a, b, "--tolerance", "0.01", "--rotation-error", request.param]
+    code, _, err = run_cli(capsys, *args, "-o", str(out))
+    assert code == 1, err  # the pair is reported, the plan written
+    return out
+
+
+def test_a_result_naming_several_members_is_unrecognized_but_one_member_is_not() -> None:
+    both = Leaf((ResultEntry("a", 0, 0.0), ResultEntry("b", 0, 0.0)))
+    sides = Leaf((ResultEntry("a", 0, 0.0, "up"), ResultEntry("a", 1, 90.0, "down")))
+    poses = Leaf((ResultEntry("a", 0, 0.0, "up"), ResultEntry("a", 2, 180.0, "up")))
+    rejected = Leaf(both.results, reject=True)
+    assert both.unrecognized and sides.unrecognized
+    assert not poses.unrecognized and not rejected.unrecognized
+    assert names_several([("a", "up"), ("a", "up")]) is False
+
+
+def test_a_run_ending_unrecognized_names_the_candidates_never_oriented(twin_plan, capsys):
+    code, out, _ = run_cli(capsys, "run", str(twin_plan), "--start-deg", "200")
+    assert code == 0  # a correct answer by the plan's contract
+    lines = [ln for ln in out.splitlines() if "from theta 200 deg" in ln]
+    assert len(lines) == 2
+    for line in lines:
+        assert "oriented" not in line
+        assert "ends after" in line and "at a result that lists tri state" in line
+        assert "and tri-copy state" in line and "the plan cannot tell them apart" in line
+    trace = execute(read_plan(twin_plan), 0, 200.0)
+    assert trace.success and trace.unrecognized and trace.to_dict()["unrecognized"] is True
+
+
+def test_run_all_counts_the_unrecognized_paths(twin_plan, capsys):
+    code, out, _ = run_cli(capsys, "run", str(twin_plan), "--all")
+    assert code == 0
+    report = verify_declared(read_plan(twin_plan))
+    assert report.ok and report.unrecognized == report.paths > 0
+    assert f"{report.paths} of them unrecognized (a result listing several parts" in out
+    assert "unrecognized" in out.split("verification")[1]  # the table's column
+    code, out, _ = run_cli(capsys, "run", str(twin_plan), "--all", "--json")
+    data = json.loads(out)
+    assert data["unrecognized"] == data["paths"]
+    assert all(p["unrecognized"] == p["paths"] for p in data["parts"])
+
+
+def test_a_plan_that_recognizes_every_part_counts_none(tmp_path: Path, capsys):
+    out = tmp_path / "tri.plan.json"
+    src = _outline(tmp_path, "tri", TRI)
+    assert run_cli(capsys, "plan", src, "--tolerance", "0.01", "-o", str(out))[0] == 0
+    code, text, _ = run_cli(capsys, "run", str(out), "--all")
+    assert code == 0 and "unrecognized" not in text
+    assert verify_declared(read_plan(out)).unrecognized == 0
+    code, text, _ = run_cli(capsys, "run", str(out), "--start-deg", "200")
+    assert "oriented in" in text and "cannot tell" not in text
+
+
+def test_the_report_counts_unrecognized_successes_apart() -> None:
+    text = simulation_text({"trials": 10, "successes": 10, "rejects": 2, "unrecognized": 3})
+    assert "5 oriented correctly" in text and "3 unrecognized (a result listing" in text
+    alone = simulation_text({"trials": 4, "successes": 4, "unrecognized": 4})
+    assert "oriented correctly" not in alone.replace("0 oriented correctly", "")
+
+
+needs_mujoco = pytest.mark.skipif(
+    not __import__("feederkit.sim", fromlist=["mujoco_available"]).mujoco_available(),
+    reason="needs MuJoCo (feederkit[sim])",
+)
+
+
+@needs_mujoco
+def test_simulate_counts_the_unrecognized_successes(twin_plan, capsys):
+    code, out, _ = run_cli(capsys, "simulate", str(twin_plan), "--trials", "3", "--json")
+    data = json.loads(out)
+    assert data["unrecognized"] == data["successes"] > 0  # every result lists both parts
+    assert data["success_rate"] == data["successes"] / data["trials"]
+    assert all(t["unrecognized"] is False for t in data["went_wrong"])
+    code, out, _ = run_cli(capsys, "simulate", str(twin_plan), "--trials", "3")
+    assert f"{data['unrecognized']} unrecognized (a result listing" in " ".join(out.split())
