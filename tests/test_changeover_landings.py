@@ -141,8 +141,8 @@ def test_sides_no_plan_tells_apart_exit_1_named_part_slash_landing(db, tmp_path,
     out = tmp_path / "blind.json"
     args = ["changeover", "compile", "blind", "--mix", "ell", "--sensorless"]
     cap = cli(capsys, [*args, "--rotation-error", "0", "-o", str(out), "--catalog", str(db)], 1)
-    assert "cannot tell these apart: ell/up & ell/down" in cap.err
-    assert "(ell: known, but not which side is up, so not its pose)" in cap.err
+    assert "recognizes ell but not which side is up: ell/up & ell/down" in cap.err
+    assert "ell is not oriented" in cap.err and "orients" not in cap.err
     assert "ell/up" in cap.out and "ell/down" in cap.out  # the pairs table
     # The plan is still written and stored; a result lists both sides, each with its pose.
     plan = json.loads(out.read_text())

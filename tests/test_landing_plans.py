@@ -302,7 +302,7 @@ def test_landings_option_picks_one_side(tmp_path, capsys):
 def test_sides_no_plan_tells_apart_exit_1_and_the_plan_is_still_written(tmp_path, capsys):
     src = write_outline(tmp_path, "ell", ELL_RING, [ELL_HOLE])
     plan, cap = plan_cli(tmp_path, capsys, [src, "--rotation-error", "0"], code=1)
-    assert "cannot tell these landings apart: ell (up) & ell (down)" in cap.err
+    assert "recognizes ell but not which side is up: ell/up & ell/down" in cap.err
     assert any({e.landing for e in leaf.results} == {"up", "down"} for leaf in leaves(plan))
 
 

@@ -242,4 +242,6 @@ def test_analyze_finds_a_part_and_its_mirror_image(tmp_path, capsys):
     }
     assert main(["plan", "l-bracket", "l-bracket-mirror", "--tolerance", "0.2",
                  "--catalog", str(path), "--time-limit", "20"]) == 1  # fmt: skip
-    assert "cannot tell these landings apart" in capsys.readouterr().err
+    assert (
+        "cannot tell these apart: l-bracket/up & l-bracket-mirror/down" in capsys.readouterr().err
+    )

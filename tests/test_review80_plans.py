@@ -104,3 +104,49 @@ def test_simulate_counts_the_unrecognized_successes(twin_plan, capsys):
     assert all(t["unrecognized"] is False for t in data["went_wrong"])
     code, out, _ = run_cli(capsys, "simulate", str(twin_plan), "--trials", "3")
     assert f"{data['unrecognized']} unrecognized (a result listing" in " ".join(out.split())
+
+
+ELL_RING = [(0, 0), (40, 0), (40, 10), (10, 10), (10, 25), (0, 25)]
+
+
+def test_two_sides_no_plan_tells_apart_are_never_called_oriented(tmp_path: Path, capsys):
+    """``plan`` and ``changeover compile`` say it in one wording: the part is recognized,
+    not its side, so it is not oriented."""
+    src = _outline(tmp_path, "ell", [list(p) for p in ELL_RING])
+    blind = ("--sensorless", "--rotation-error", "0")
+    code, _, planned = run_cli(capsys, "plan", src, *blind)
+    assert code == 1
+    db = str(tmp_path / "parts.db")
+    assert run_cli(capsys, "catalog", "init", "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", src, "--catalog", db)[0] == 0
+    code, _, compiled = run_cli(
+        capsys, "changeover", "compile", "blind", "--mix", "ell", *blind, "--catalog", db
+    )
+    assert code == 1
+    words = "recognizes ell but not which side is up: ell/up & ell/down ("
+    for err in (planned, compiled):
+        line = " ".join(err.split())
+        assert words in line and "ell is not oriented" in line
+        assert "orients" not in line
+    tail = planned.split("recognizes ell", 1)[1]
+    assert " ".join(tail.split()) == " ".join(compiled.split("recognizes ell", 1)[1].split())
+
+
+def test_pairs_words_name_pairs_of_parts_and_sides_apart() -> None:
+    from feederkit.plans.model import pairs_words
+
+    parts = pairs_words("the plan", [(("a", None), ("b", None), "same")])
+    assert parts == (
+        "the plan cannot tell these apart: a & b (same); its results list each candidate with "
+        "its pose"
+    )
+    both = pairs_words(
+        "the plan",
+        [(("a", "up"), ("a", "down"), "w0"), (("a", "up"), ("b", "up"), "w1")],
+    )
+    # a's side pairs with b too: a is not even recognized, so the words do not say it is
+    assert "cannot tell these apart: a/up & b/up (w1)" in both
+    assert "cannot tell which side of a is up: a/up & a/down (w0): a is not oriented" in both
+    assert "recognizes a" not in both
+    mesh = pairs_words("the plan", [(("m", "pose-0"), ("m", "pose-2"), "w")])
+    assert "recognizes m but not which pose it lies in: m/pose-0 & m/pose-2 (w)" in mesh

@@ -99,6 +99,7 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import as_plan, plan_file_text
+from feederkit.plans.model import pairs_words
 from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -335,7 +336,7 @@ def changeover_report(
 def _pairs_table(witnesses: Sequence[PairWitness]) -> Table:
     """The pairs a changeover's plan cannot tell apart, as ``compile`` and ``show`` print
     them."""
-    t = Table(title="parts this plan orients but cannot tell apart (section 8.4, Corollary 7)")
+    t = Table(title="parts (or landings) this plan cannot tell apart (section 8.4, Corollary 7)")
     add_pair_column(t, witnesses)
     t.add_column("inseparable states (A ~ B)")
     t.add_column("why")
@@ -503,28 +504,22 @@ def compile_command(
         print_written(output, report)
     lumped = compiled.lumped
     if witnesses or lumped:
-        named = "; ".join(f"{w.part_a} & {w.part_b} ({w.reason})" for w in witnesses)
         if not witnesses:
             named = ", ".join(f"{a} & {b}" for a, b in lumped)
-        sides = [w for w in witnesses if _part_of(w.part_a) == _part_of(w.part_b)]
-        side_note = ""
-        if sides:
-            side_note = (
-                f" ({', '.join(dict.fromkeys(_part_of(w.part_a) for w in sides))}: known, but "
-                "not which side is up, so not its pose)"
+            raise CheckFailed(
+                f"changeover {name!r} cannot tell these apart: {named}; the plan's results "
+                "list each candidate with its pose"
             )
+        view = compiled.view or as_plan(plan)
+        member = {member_name(p.name, p.landing): p.key for p in view.parts}
         raise CheckFailed(
-            f"changeover {name!r} orients every part but cannot tell these apart: {named}; "
-            f"the plan's results list each candidate with its pose{side_note}"
+            pairs_words(
+                f"changeover {name!r}",
+                [(member[w.part_a], member[w.part_b], w.reason) for w in witnesses],
+            )
         )
     if compiled.made.unoriented is not None:
         raise CheckFailed(f"changeover {name!r}: {compiled.made.unoriented}")
-
-
-def _part_of(member: str) -> str:
-    """The part of a member named ``PART`` or ``PART/LANDING``."""
-    head, _, tail = member.rpartition("/")
-    return head if head and re.fullmatch(r"up|down|pose-[0-9]+", tail) else member
 
 
 def _shares(plan: dict[str, Any]) -> dict[str, float]:

@@ -70,23 +70,21 @@ from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.fileformat import plan_json
 from feederkit.plans.match import leaf_part_pairs
-from feederkit.plans.model import member_label
+from feederkit.plans.model import member_label, pairs_words
 from feederkit.uncertainty import check_for_part
 
 
 def pairs_message(witnesses: list[PairWitness], lumped: list[tuple[str, str]]) -> str:
-    """One line naming the pairs no plan can tell apart (section 8.4), and any disagreement."""
+    """One line naming the pairs no plan can tell apart (section 8.4, :func:`pairs_words`),
+    and any disagreement."""
     lumped_text = ", ".join(f"{a} & {b}" for a, b in lumped) or "none"
     if not witnesses:
         return (
             f"the plan's results lump {lumped_text}, which the mix analysis can tell apart: "
             "please report this as a bug"
         )
-    named = "; ".join(f"{w.part_a} & {w.part_b} ({w.reason})" for w in witnesses)
-    msg = (
-        f"the plan orients every part but cannot tell these parts apart: {named}; "
-        "its results list each candidate with its pose"
-    )
+    pairs = [((w.part_a, None), (w.part_b, None), w.reason) for w in witnesses]
+    msg = pairs_words("the plan", pairs)
     if {(w.part_a, w.part_b) for w in witnesses} != set(lumped):
         msg += f" (but the plan's results lump {lumped_text}: please report this as a bug)"
     return msg
@@ -108,8 +106,9 @@ def landing_lumps(planned: LandingPlan) -> set[tuple[str, str]]:
 
 
 def landing_pairs_message(planned: LandingPlan, lumped: set[tuple[str, str]]) -> str:
-    """One line naming the landings no plan can tell apart (section 8.4), and any
-    disagreement with the plan's accepting results (``lumped``, :func:`landing_lumps`)."""
+    """One line naming the landings no plan can tell apart (section 8.4, :func:`pairs_words`:
+    two sides of one part are not oriented), and any disagreement with the plan's accepting
+    results (``lumped``, :func:`landing_lumps`)."""
     pairs = {
         (member_label(p.a.part_name, p.a.name), member_label(p.b.part_name, p.b.name))
         for p in planned.indistinguishable
@@ -120,14 +119,12 @@ def landing_pairs_message(planned: LandingPlan, lumped: set[tuple[str, str]]) ->
             f"the plan's results lump {shown}, which the mix analysis can tell apart: "
             "please report this as a bug"
         )
-    named = "; ".join(
-        f"{member_label(p.a.part_name, p.a.name)} & {member_label(p.b.part_name, p.b.name)} "
-        f"({p.witness.reason})"
-        for p in planned.indistinguishable
-    )
-    msg = (
-        f"the plan orients every landing but cannot tell these landings apart: {named}; "
-        "its results list each candidate with its pose"
+    msg = pairs_words(
+        "the plan",
+        [
+            ((p.a.part_name, p.a.name), (p.b.part_name, p.b.name), p.witness.reason)
+            for p in planned.indistinguishable
+        ],
     )
     if pairs != lumped:
         shown = ", ".join(f"{a} & {b}" for a, b in sorted(lumped)) or "none"

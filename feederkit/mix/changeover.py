@@ -41,6 +41,7 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import as_plan, parse_plan_text, read_back, validate_plan
 from feederkit.plans.make import MadePlan, make_plan
 from feederkit.plans.model import Plan, PlanMember, member_fragile_warnings
+from feederkit.plans.model import member_name as member_name  # its home: plans.model
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
 
@@ -248,12 +249,6 @@ def landing_members(
         )
         for x in landings
     )
-
-
-def member_name(part: str, landing: str | None) -> str:
-    """A plan member as its push function is named: ``PART``, or ``PART/LANDING`` in a plan
-    over landings (:attr:`feederkit.landing.model.Landing.label`)."""
-    return part if landing is None else f"{part}/{landing}"
 
 
 def reported_pairs(

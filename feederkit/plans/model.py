@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,6 +100,52 @@ def push_function_of(part: PlanPart) -> PushFunction:
 def member_label(name: str, landing: str | None) -> str:
     """A member of a plan in words: ``NAME``, or ``NAME (LANDING)`` in a plan over landings."""
     return name if landing is None else f"{name} ({landing})"
+
+
+def member_name(part: str, landing: str | None) -> str:
+    """A plan member as its push function is named: ``PART``, or ``PART/LANDING`` in a plan
+    over landings (:attr:`feederkit.landing.model.Landing.label`): how the mix analysis and
+    its pairs name it (docs/landings.md)."""
+    return part if landing is None else f"{part}/{landing}"
+
+
+Member = tuple[str, str | None]
+"""A plan member as ``(part, landing)`` (landing None: a plan not over landings)."""
+
+
+def pairs_words(subject: str, pairs: Sequence[tuple[Member, Member, str]]) -> str:
+    """One line naming the pairs of members no plan tells apart (section 8.4), each
+    ``(member_a, member_b, reason)``, for ``plan`` and ``changeover compile`` alike.
+
+    Pairs of two parts: ``SUBJECT cannot tell these apart: A & B (reason); ...``. Two landings
+    of one part: the plan knows the part (unless one of its landings pairs with another
+    part) but neither its side nor its pose, so the part is not oriented and the words never
+    say it is: ``SUBJECT recognizes X but not which side is up: X/up & X/down (reason): X is
+    not oriented``. Members are named :func:`member_name`-wise, as the mix analysis names
+    them.
+    """
+
+    def named(group: Sequence[tuple[Member, Member, str]]) -> str:
+        return "; ".join(f"{member_name(*a)} & {member_name(*b)} ({why})" for a, b, why in group)
+
+    across = [p for p in pairs if p[0][0] != p[1][0]]
+    clauses = [f"cannot tell these apart: {named(across)}"] if across else []
+    mixed_up = {m[0] for a, b, _ in across for m in (a, b)}
+    sides: dict[str, list[tuple[Member, Member, str]]] = {}
+    for pair in pairs:
+        if pair[0][0] == pair[1][0]:
+            sides.setdefault(pair[0][0], []).append(pair)
+    for part, group in sides.items():
+        flat = {m[1] for a, b, _ in group for m in (a, b)} <= {"up", "down"}
+        if part in mixed_up:
+            how = f"which side of {part} is up" if flat else f"which pose {part} lies in"
+            lead = f"cannot tell {how}"
+        else:
+            how = "which side is up" if flat else "which pose it lies in"
+            lead = f"recognizes {part} but not {how}"
+        clauses.append(f"{lead}: {named(group)}: {part} is not oriented")
+    listed = "; its results list each candidate with its pose"
+    return f"{subject} " + "; and it ".join(clauses) + listed
 
 
 def member_fragile_warnings(
