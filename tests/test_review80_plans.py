@@ -150,3 +150,68 @@ def test_pairs_words_name_pairs_of_parts_and_sides_apart() -> None:
     assert "recognizes a" not in both
     mesh = pairs_words("the plan", [(("m", "pose-0"), ("m", "pose-2"), "w")])
     assert "recognizes m but not which pose it lies in: m/pose-0 & m/pose-2 (w)" in mesh
+
+
+def _section(html: str, ident: str) -> str:
+    """The text of the element with ``id=ident`` up to the next section (tags dropped)."""
+    import re
+    from html import unescape
+
+    start = html.index(f'id="{ident}"')
+    end = html.find("<section", start + 1)
+    bare = re.sub(r"<[^>]+>", " ", html[start : end if end > 0 else None])
+    return " ".join(unescape(bare).split())
+
+
+def test_report_of_a_plan_file_gives_each_pairs_reason_as_compile_does(tmp_path, capsys):
+    """``feederkit report PLAN.json`` decides the pairs as ``changeover report`` does: the
+    reason, the full witness, a banner in the words of ``plan``."""
+    a, b = _outline(tmp_path, "tri", TRI), _outline(tmp_path, "tri-copy", TRI)
+    plan, made = tmp_path / "p.json", tmp_path / "made.html"
+    args = ["plan", a, b, "--tolerance", "0.01", "-o", str(plan), "--report", str(made)]
+    assert run_cli(capsys, *args)[0] == 1
+    page = tmp_path / "page.html"
+    assert run_cli(capsys, "report", str(plan), "-o", str(page))[0] == 0
+    html, compiled = page.read_text(), made.read_text()
+    text = _section(html, "lookalikes")
+    assert text == _section(compiled, "lookalikes")
+    assert "same push-diameter function (Lemma 8)" in text
+    assert "tri s0 ~ tri-copy s0, tri s1 ~ tri-copy s1, tri s2 ~ tri-copy s2" in text
+    assert "behave alike under every push-align operation" not in text
+    banner = _section(html, "unrecognized")
+    assert "this plan cannot tell these apart: tri & tri-copy (same push-diameter" in banner
+
+
+def test_report_names_a_pair_only_a_strong_plan_lists_together() -> None:
+    from feederkit.reports.sections import PairRow
+
+    row = PairRow(("a", None), ("b", None), "plan", listed=["a s0 ~ b s0"])
+    plan = read_plan_of_triangle()
+    assert row.reason(plan).startswith("told apart on the ideal model, but this plan, strong")
+    assert row.states == "listed together: a s0 ~ b s0"
+    row.why.append("same push-diameter function")
+    assert row.reason(plan) == "same push-diameter function"
+
+
+def read_plan_of_triangle():
+    from feederkit.mechanics.push import push_function
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+    from feederkit.plans.fileformat import plan_from_dict
+    from feederkit.plans.make import make_plan
+    from feederkit.sensors import ToleranceSensor
+
+    pf = push_function(make_part(make_outline("tri", TRI)))
+    return plan_from_dict(make_plan([pf], ToleranceSensor(0.01)).plan)
+
+
+def test_the_tree_says_two_sides_of_one_part_are_recognized_not_oriented(tmp_path, capsys):
+    src = _outline(tmp_path, "ell", [list(p) for p in ELL_RING])
+    page = tmp_path / "ell.html"
+    args = ["plan", src, "--sensorless", "--rotation-error", "0", "--report", str(page)]
+    assert run_cli(capsys, *args)[0] == 1
+    html = page.read_text()
+    assert "not oriented: ell recognized, but not which side is up (2 landings)" in html
+    assert "not recognized" not in html
+    assert "recognizes ell but not which side is up" in _section(html, "unrecognized")
+    assert "Two landings of one part: the part is known" in _section(html, "lookalikes")

@@ -113,6 +113,15 @@ Member = tuple[str, str | None]
 """A plan member as ``(part, landing)`` (landing None: a plan not over landings)."""
 
 
+def side_words(landings: Iterable[str | None], part: str | None = None) -> str:
+    """What the plan does not know of a part whose ``landings`` a result lists together:
+    ``which side is up`` (a flat part's ``up`` and ``down``) or ``which pose it lies in`` (a
+    mesh's poses); ``part`` named in it when given."""
+    if set(landings) <= {"up", "down"}:
+        return "which side is up" if part is None else f"which side of {part} is up"
+    return "which pose it lies in" if part is None else f"which pose {part} lies in"
+
+
 def pairs_words(subject: str, pairs: Sequence[tuple[Member, Member, str]]) -> str:
     """One line naming the pairs of members no plan tells apart (section 8.4), each
     ``(member_a, member_b, reason)``, for ``plan`` and ``changeover compile`` alike.
@@ -136,13 +145,11 @@ def pairs_words(subject: str, pairs: Sequence[tuple[Member, Member, str]]) -> st
         if pair[0][0] == pair[1][0]:
             sides.setdefault(pair[0][0], []).append(pair)
     for part, group in sides.items():
-        flat = {m[1] for a, b, _ in group for m in (a, b)} <= {"up", "down"}
+        landings = [m[1] for a, b, _ in group for m in (a, b)]
         if part in mixed_up:
-            how = f"which side of {part} is up" if flat else f"which pose {part} lies in"
-            lead = f"cannot tell {how}"
+            lead = f"cannot tell {side_words(landings, part)}"
         else:
-            how = "which side is up" if flat else "which pose it lies in"
-            lead = f"recognizes {part} but not {how}"
+            lead = f"recognizes {part} but not {side_words(landings)}"
         clauses.append(f"{lead}: {named(group)}: {part} is not oriented")
     listed = "; its results list each candidate with its pose"
     return f"{subject} " + "; and it ".join(clauses) + listed

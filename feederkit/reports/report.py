@@ -6,8 +6,9 @@ and plots, the pairs the plan cannot tell apart, and the conventions. The plan i
 its declared uncertainty (:func:`feederkit.plans.verify.verify_declared`: a strong plan for
 every outcome and reading, an ideal one on the kinematic model) as it is drawn: a plan that
 fails gets a red banner at the top naming the first problem; a plan whose smallest margin is
-below 1 degree a warning, and so a plan whose members have fragile states, or a result that
-lists poses of one part that do not look alike (the part is not oriented; docs/reports.md).
+below 1 degree a warning, and so a plan whose members have fragile states, a result that
+lists poses of one part that do not look alike (the part is not oriented), or pairs of
+members no plan tells apart (docs/reports.md).
 """
 
 from __future__ import annotations
@@ -17,17 +18,24 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from feederkit.errors import InputError
+from feederkit.landing.model import renamed
+from feederkit.mechanics.push import push_function
+from feederkit.mix.changeover import rejected_members, reported_pairs
+from feederkit.mix.pairs import unrecognizable_pairs
 from feederkit.outline import Outline
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan, PlanPart, Step
+from feederkit.plans.model import Leaf, Plan, PlanPart, Step, member_name, push_function_of
 from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.reports.design_html import design_section
 from feederkit.reports.parts_html import part_section
 from feederkit.reports.sections import (
+    PairRow,
     conventions_section,
     lookalike_section,
     mix_section,
+    pair_rows,
     stats_section,
+    unrecognized_words,
 )
 from feederkit.reports.style import CSS
 from feederkit.reports.svgkit import Ring, esc
@@ -93,10 +101,31 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
     )
 
 
-def _banners(plan: Plan, report: VerificationReport, twins: Sequence[TwinLeaf] = ()) -> str:
+def plan_pairs(plan: Plan) -> list[dict[str, Any]]:
+    """The pairs of the plan's members no plan tells apart, with the mix analysis's witness
+    and reason (``PairWitness.to_dict``), decided from the plan file alone as ``changeover
+    report`` decides a stored changeover's: :func:`~feederkit.mix.pairs.unrecognizable_pairs`
+    on the members' hulls and COMs (named ``PART/LANDING``), kept by
+    :func:`~feederkit.mix.changeover.reported_pairs` (two rejected landings left out)."""
+    if len(plan.parts) < 2:
+        return []
+    pfs = [
+        push_function(renamed(push_function_of(p).part, member_name(*p.key))) for p in plan.parts
+    ]
+    found = unrecognizable_pairs(pfs, plan.sensor)
+    return [w.to_dict() for w in reported_pairs(found, rejected_members(plan))]
+
+
+def _banners(
+    plan: Plan,
+    report: VerificationReport,
+    twins: Sequence[TwinLeaf] = (),
+    pairs: Sequence[PairRow] = (),
+) -> str:
     """The verification verdict when it failed, the low-margin warning, the fragile
-    states of the plan's members (:meth:`Plan.fragile_warnings`), and the poses of one part
-    a result lists that do not look alike (:func:`unoriented_words`: not oriented)."""
+    states of the plan's members (:meth:`Plan.fragile_warnings`), the poses of one part
+    a result lists that do not look alike (:func:`unoriented_words`: not oriented), and the
+    pairs of members no plan tells apart (:func:`unrecognized_words`)."""
     out = ""
     where = (
         "on the kinematic model"
@@ -119,6 +148,12 @@ def _banners(plan: Plan, report: VerificationReport, twins: Sequence[TwinLeaf] =
     unoriented = unoriented_words(plan, twins)
     if unoriented:
         out += f'<div class="banner caution" id="unoriented">Warning: {esc(unoriented)}.</div>'
+    unrecognized = unrecognized_words(plan, pairs)
+    if unrecognized:
+        out += (
+            f'<div class="banner caution" id="unrecognized">Warning: {esc(unrecognized)} '
+            '(<a href="#lookalikes">the pairs and their witnesses</a>).</div>'
+        )
     return out
 
 
@@ -163,7 +198,8 @@ def render_report(
     ``cycle_time`` (default: the plan file's ``stats.cycle_time``, docs/cell.md) gives the
     seconds per part in a named cell profile; ``seconds_per_op`` a flat cycle time instead;
     ``simulation`` (``trials``, ``successes``, ...) the simulator's result; ``unrecognizable``
-    pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis;
+    pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis (None:
+    decided here from the plan, :func:`plan_pairs`);
     ``outlines`` (part name, or ``PART/LANDING`` for a member of a plan over landings, ->
     Outline) draws holes around the plan's hulls; ``design`` (the
     JSON of ``feederkit design sensor``) adds the sensor design table and plot;
@@ -184,10 +220,12 @@ def render_report(
     names = ", ".join(dict.fromkeys(p.name for p in plan.parts))
     twins = plan_twins(plan, numbered, outlines)
     tree = tree_html(plan, numbered, trace, draw, twins={t.node_id: t for t in twins})
+    given = plan_pairs(plan) if unrecognizable is None else list(unrecognizable)
+    found = confusions(plan, numbered, trace)
     body = "".join(
         [
             f"<h1>{'Changeover' if len(plan.parts) > 1 else 'Plan'} report: {esc(names)}</h1>",
-            _banners(plan, report, twins),
+            _banners(plan, report, twins, pair_rows(plan, found, given)),
             mix_section(plan, draw),
             tree_section(numbered, tree),
             stats_section(plan, seconds_per_op, simulation, cycle_time),
@@ -198,9 +236,7 @@ def render_report(
                 for i, (p, share) in enumerate(zip(plan.parts, _shares(plan), strict=True))
             ),
             "</section>",
-            lookalike_section(
-                plan, confusions(plan, numbered, trace), list(unrecognizable or []), twins
-            ),
+            lookalike_section(plan, found, given, twins),
             conventions_section(plan),
         ]
     )

@@ -6,11 +6,20 @@ Each function returns an HTML fragment; every value that comes from outside is e
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 from feederkit.cell import expectation_words
 from feederkit.errors import InputError
-from feederkit.plans.model import REJECTED_WORDS, UNRECOGNIZED_WORDS, Plan
+from feederkit.plans.model import (
+    REJECTED_WORDS,
+    UNRECOGNIZED_WORDS,
+    Member,
+    Plan,
+    member_label,
+    member_name,
+    pairs_words,
+)
 from feederkit.reports.svgkit import esc, num
 from feederkit.reports.trace import Confusion
 from feederkit.reports.tree_html import Drawing, path_text
@@ -234,60 +243,102 @@ def _unique(items: Sequence[str]) -> list[str]:
     return list(dict.fromkeys(items))
 
 
-def _member_words(plan: Plan, name: str) -> str:
-    """A name from the mix analysis as the report names members: ``PART/LANDING`` (the
-    landing's part, docs/landings.md) becomes the member's label ``PART (LANDING)``."""
-    for p in plan.parts:
-        if p.landing is not None and name == f"{p.name}/{p.landing}":
-            return p.label
-    return name
+@dataclass
+class PairRow:
+    """A pair of members no plan tells apart, as the report shows it: the members (``a``,
+    ``b``: ``(part, landing)``), where the row comes from (``plan``: a leaf holds both;
+    ``mix``: the mix analysis alone), the inseparable state pairings (the mix analysis's
+    witness when it has one, as the terminal and ``--json`` give it; else the states a leaf
+    lists together), the leaves that hold both (each a witness) and the reasons."""
+
+    a: Member
+    b: Member
+    source: str
+    listed: list[str] = field(default_factory=list)
+    witness: list[str] = field(default_factory=list)
+    paths: list[str] = field(default_factory=list)
+    why: list[str] = field(default_factory=list)
+
+    @property
+    def states(self) -> str:
+        """The inseparable states in words (the witness's, else the leaves')."""
+        if self.witness:
+            return "; ".join(_unique(self.witness))
+        return "listed together: " + "; ".join(_unique(self.listed)) if self.listed else ""
+
+    def reason(self, plan: Plan) -> str:
+        """The mix analysis's reason; for a pair only a strong plan's results list together
+        (the ideal model tells it apart), what holds of it."""
+        if self.why:
+            return "; ".join(_unique(self.why))
+        if plan.uncertainty.is_ideal:
+            return ""
+        return (
+            "told apart on the ideal model, but this plan, strong for its declared uncertainty "
+            f"({plan.uncertainty_words()}), lists them together: no strong plan tells them apart"
+        )
 
 
-def _rows(
+def pair_rows(
     plan: Plan, confusions: Sequence[Confusion], given: Sequence[Mapping[str, Any]]
-) -> list[str]:
-    """One row per pair of members, whichever order they are named in: the plan's leaves that
-    hold both (each a witness) and the mix analysis's reason; no pairing listed twice."""
-    rows: dict[frozenset[str], dict[str, Any]] = {}
+) -> list[PairRow]:
+    """One row per pair of members, whichever order they are named in: the plan's leaves
+    that hold both (:func:`~feederkit.reports.trace.confusions`) and the mix analysis's
+    pairs ``given`` (``PART/LANDING`` names, :func:`member_name`), no pairing listed twice."""
+    by_label = {p.label: p.key for p in plan.parts}
+    by_name = {member_name(*p.key): p.key for p in plan.parts}
+    rows: dict[frozenset[Member], PairRow] = {}
 
-    def row(a: str, b: str, source: str) -> dict[str, Any]:
+    def row(a: Member, b: Member, source: str) -> PairRow:
         key = frozenset((a, b))
         if key not in rows:
-            rows[key] = {"a": a, "b": b, "source": source, "states": [], "paths": [], "why": []}
+            rows[key] = PairRow(a, b, source)
         return rows[key]
 
     for c in confusions:
-        r = row(c.part_a, c.part_b, "plan")
-        r["states"].append(_pairing(c.part_a, c.part_b, c.states_a, c.states_b))
-        r["paths"].append(f"leaf {c.node_id}: {path_text(c.path)}")
+        r = row(by_label[c.part_a], by_label[c.part_b], "plan")
+        r.listed.append(_pairing(c.part_a, c.part_b, c.states_a, c.states_b))
+        r.paths.append(f"leaf {c.node_id}: {path_text(c.path)}")
     for i, pair in enumerate(given):
         if not isinstance(pair, Mapping):
             raise InputError(f"unrecognizable pair {i} must be a mapping")
-        a = _member_words(plan, str(pair.get("part_a", "?")))
-        b = _member_words(plan, str(pair.get("part_b", "?")))
+        names = (str(pair.get("part_a", "?")), str(pair.get("part_b", "?")))
+        a, b = (by_name.get(n, (n, None)) for n in names)
         r = row(a, b, "mix")
-        if r["a"] != a:  # named the other way round: keep the row's order
-            a, b = b, a
-            sa, sb = pair.get("states_b"), pair.get("states_a")
-        else:
-            sa, sb = pair.get("states_a"), pair.get("states_b")
-        if r["source"] == "mix":
-            r["states"].append(_pairing(a, b, list(sa or []), list(sb or [])))
+        sa, sb = list(pair.get("states_a") or []), list(pair.get("states_b") or [])
+        if r.a != a:  # named the other way round: keep the row's order
+            a, b, sa, sb = b, a, sb, sa
+        r.witness.append(_pairing(member_label(*a), member_label(*b), sa, sb))
         if pair.get("reason"):
-            r["why"].append(str(pair["reason"]))
-    out = []
-    for r in rows.values():
-        witness = ""
-        if r["paths"]:
-            items = "".join(f"<li>{esc(p)}</li>" for p in _unique(r["paths"]))
-            witness = f"the plan ends with both at<ul>{items}</ul>"
-        why = "; ".join(_unique(r["why"]))
-        out.append(
-            f'<tr class="pair" data-source="{r["source"]}"><td>{esc(r["a"])}</td>'
-            f"<td>{esc(r['b'])}</td><td>{esc('; '.join(_unique(r['states'])))}</td>"
-            f"<td>{esc(why)}{' ' if why and witness else ''}{witness}</td></tr>"
-        )
-    return out
+            r.why.append(str(pair["reason"]))
+    return list(rows.values())
+
+
+def unrecognized_words(plan: Plan, rows: Sequence[PairRow]) -> str | None:
+    """The pairs no plan tells apart in the words of ``plan`` and ``changeover compile``
+    (:func:`~feederkit.plans.model.pairs_words`); None when there are none."""
+    if not rows:
+        return None
+    return pairs_words("this plan", [(r.a, r.b, r.reason(plan) or "no reason given") for r in rows])
+
+
+def _row_html(plan: Plan, r: PairRow) -> str:
+    witness = ""
+    if r.paths:
+        items = "".join(f"<li>{esc(p)}</li>" for p in _unique(r.paths))
+        witness = f"the plan ends with both at<ul>{items}</ul>"
+    why = r.reason(plan)
+    return (
+        f'<tr class="pair" data-source="{r.source}"><td>{esc(member_label(*r.a))}</td>'
+        f"<td>{esc(member_label(*r.b))}</td><td>{esc(r.states)}</td>"
+        f"<td>{esc(why)}{' ' if why and witness else ''}{witness}</td></tr>"
+    )
+
+
+_SIDES = (
+    " Two landings of one part: the part is known, but not which side is up (or which pose it "
+    "lies in), so it is not oriented."
+)
 
 
 def lookalike_section(
@@ -299,13 +350,19 @@ def lookalike_section(
     """Pairs of parts that cannot be told apart, with their witnesses, then the leaves that
     list several poses of one part (``twins``): those that look alike, each a correct answer,
     apart from those that do not, between which the part is not oriented."""
-    rows = _rows(plan, confusions, given)
+    found = pair_rows(plan, confusions, given)
+    rows = [_row_html(plan, r) for r in found]
+    sides = any(r.a[0] == r.b[0] for r in found)
     if rows:
         body = (
-            "<p>These parts behave alike under every push-align operation the sensor can "
-            "tell apart; a plan can orient them but not say which part it holds.</p>"
+            "<p>No plan tells these apart with this sensor"
+            f"{'' if plan.uncertainty.is_ideal else ' at the declared uncertainty'}: whatever "
+            "push-align operations follow, their readings may agree (they behave alike, or "
+            "differ by less than the sensor resolves), so a result lists both, each with its "
+            "state and pose, and the controller does not know which it holds."
+            f"{_SIDES if sides else ''}</p>"
             '<table class="grid"><tr><th>part</th><th>look-alike</th>'
-            f"<th>inseparable states</th><th>witness</th></tr>{''.join(rows)}</table>"
+            f"<th>inseparable states</th><th>why, and witness</th></tr>{''.join(rows)}</table>"
         )
     elif len(plan.parts) > 1:
         what = "member (part and landing)" if plan.over_landings else "part"

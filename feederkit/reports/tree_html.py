@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from feederkit.plans.model import Branch, Leaf, Plan, Step
+from feederkit.plans.model import Branch, Leaf, Plan, Step, side_words
 from feederkit.reports.svgkit import Ring, esc, num, part_colour, pose_svg, reach
 from feederkit.reports.trace import Place, StateKey, Trace, TraceStep, leaf_members
 from feederkit.reports.twins import TwinLeaf
@@ -207,6 +207,11 @@ def _result_node(
         label = plan.parts[next(iter(members))].label
         head = f"done: {label}, one of {len(node.results)} poses that no plan tells apart"
         kind = "symmetric"
+    elif len({plan.parts[m].name for m in members}) == 1:
+        part = plan.parts[next(iter(members))].name
+        how = side_words(plan.parts[m].landing for m in members)
+        head = f"not oriented: {part} recognized, but not {how} ({len(members)} landings)"
+        kind = "confused"
     else:
         what = "landings" if plan.over_landings else "parts"
         head = f"not recognized: {len(members)} {what} end here together"
