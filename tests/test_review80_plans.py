@@ -215,3 +215,49 @@ def test_the_tree_says_two_sides_of_one_part_are_recognized_not_oriented(tmp_pat
     assert "not recognized" not in html
     assert "recognizes ell but not which side is up" in _section(html, "unrecognized")
     assert "Two landings of one part: the part is known" in _section(html, "lookalikes")
+
+
+CATALOG = Path(__file__).resolve().parent.parent / "catalog"
+
+
+def _lumping_warning(err: str) -> str:
+    (line,) = [ln for ln in err.splitlines() if "results list states together" in ln]
+    return line
+
+
+def test_the_lumping_warning_says_no_smaller_rotation_error_helps_when_none_does(
+    tmp_path: Path, capsys
+):
+    """The near-symmetric rectangle's poses stay together at a thousandth of the rotation
+    error: the feeder's vibration keeps them, so the warning points to the ideal model and
+    never to a smaller --rotation-error."""
+    near = tmp_path / "near.json"
+    rect = [[0, 0], [5, 0], [5, 2.5], [0, 2.5]]
+    near.write_text(json.dumps({"name": "near", "vertices": rect, "com": [2.508, 1.25]}))
+    for error in ("1", "0.001"):
+        code, _, err = run_cli(
+            capsys, "plan", str(near), "--sensorless", "--landings", "up", "--rotation-error", error
+        )
+        assert code == 0
+        line = _lumping_warning(err)
+        assert "no smaller rotation error helps: at ±" in line
+        assert "the feeder's vibration" in line and "0 plans on the ideal model" in line
+        assert "--rotation-error" not in line
+
+
+def test_the_lumping_warning_points_to_a_smaller_rotation_error_when_it_helps(capsys):
+    src = str(CATALOG / "quadrilateral.json")
+    args = ["--sensorless", "--landings", "up", "--rotation-error", "30", "--lumping", "any"]
+    code, _, err = run_cli(capsys, "plan", src, *args)
+    assert code == 0
+    line = _lumping_warning(err)
+    assert "a smaller rotation error helps: at ±0.03 deg a strong plan tells each pair" in line
+    assert "--rotation-error" in line and "vibration" not in line
+
+
+def test_a_flag_is_not_named_for_a_term_the_message_says_does_not_help() -> None:
+    from feederkit.cli.common import with_flags
+
+    assert with_flags("no smaller rotation error helps") == "no smaller rotation error helps"
+    assert with_flags("no rotation error helps, not even 0").endswith("even 0")
+    assert with_flags("a smaller rotation error helps").endswith("(--rotation-error)")

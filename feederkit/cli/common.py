@@ -313,12 +313,20 @@ def add_count_column(table: Table, header: str) -> None:
 def with_flags(message: str, terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> str:
     """``message`` followed by the flags of the library terms it names, e.g. ``(--min-margin)``.
 
-    A flag the message already names is not repeated.
+    A flag the message already names is not repeated, nor one whose term it says does not
+    help ("no smaller rotation error helps").
     """
     lower = message.lower()
-    flags = [f for term, f in terms if term in lower and f not in message]
+    flags = [
+        f for term, f in terms if term in lower and f not in message and not _no_help(lower, term)
+    ]
     flags = list(dict.fromkeys(flags))
     return f"{message} ({', '.join(flags)})" if flags else message
+
+
+def _no_help(lower: str, term: str) -> bool:
+    """Whether a (lower-case) message says that changing ``term`` does not help."""
+    return f"no smaller {term} helps" in lower or f"no {term} helps" in lower
 
 
 @contextmanager

@@ -48,8 +48,9 @@ from feederkit.part import make_part
 from feederkit.planning.api import NoStrongPlan, shortest_length, strong_plan_exists
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import Deadline, Timeout, collector_paused
-from feederkit.planning.lumping import lumped_words
+from feederkit.planning.lumping import lumped_words, unresolvable_pairs
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem
 from feederkit.planning.tree import Certificate, PlanResult, PlanTree, leaf_masks
 from feederkit.planning.tree import Leaf as TreeLeaf
 from feederkit.planning.tree import Step as TreeStep
@@ -259,7 +260,15 @@ def _make_plan(
     warnings = sensor_warnings(sensor, diameters)
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
-        warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs))
+        left = _left(opts, started)
+        smaller = smaller_error_words(
+            lambda u: widen_widths(weighed(u), offsets),
+            unc,
+            result.machine,
+            result.lumped_pairs,
+            SMALLER_ERROR_S if left is None else min(SMALLER_ERROR_S, max(left, 0.0)),
+        )
+        warnings.append(lumped + _lump_shapes(result.machine, pfs, result.lumped_pairs) + smaller)
     spread = _spread_words(result, pfs)
     if spread is not None:
         warnings.append(spread)
@@ -636,6 +645,93 @@ def _spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None
         f"some results name a resting state made of several stable states, shallow wells a "
         f"breath of vibration crosses (docs/uncertainty.md): {named}; there the part rests "
         "anywhere over those poses, oriented only that far"
+    )
+
+
+SMALLER_ERROR_FACTOR = 1e-3
+"""A rotation error this fraction of the declared one stands for "a smaller rotation error":
+:func:`smaller_error_words` asks whether the lumped pairs are still unresolvable there."""
+
+SMALLER_ERROR_S = 5.0
+"""The most seconds :func:`smaller_error_words` spends deciding (less when the time limit
+leaves less); undecided, it says a smaller rotation error may or may not help."""
+
+
+def smaller_error_words(
+    machine_at: Callable[[Uncertainty], PushAlignMachine],
+    uncertainty: Uncertainty,
+    machine: PushAlignMachine,
+    pairs: Sequence[tuple[int, int]],
+    seconds: float,
+) -> str:
+    """Whether a smaller rotation error lets a strong plan tell the lumped ``pairs`` (states
+    of ``machine``) apart, in words, decided exactly where it is affordable: the pairs
+    still unresolvable (:func:`~feederkit.planning.lumping.unresolvable_pairs`) on the
+    machine ``machine_at`` builds at :data:`SMALLER_ERROR_FACTOR` of the declared rotation
+    error, the tolerances and the feeder's vibration unchanged. A pair unresolvable even
+    there is kept together by that vibration (push bands, merged fragile states), which any
+    declared uncertainty switches on, not by the rotation error (:data:`VIBRATION_OBSTACLE`);
+    the words then say "no smaller rotation error helps" and point to the ideal model (a
+    rotation error of 0), and the command line names no flag for them (``with_flags``).
+    """
+    tiny = replace(
+        uncertainty, rotation_error_deg=uncertainty.rotation_error_deg * SMALLER_ERROR_FACTOR
+    )
+    vibration = (
+        "the feeder's vibration, which any declared uncertainty switches on (push bands and "
+        "merged fragile states: docs/uncertainty.md)"
+    )
+    try:
+        if seconds <= 0.0:
+            raise Timeout("time limit")
+        small = machine_at(tiny)
+        found = unresolvable_pairs(Problem(small, "exact", 0.0), Deadline(seconds))
+    except Timeout:
+        found = None
+    if found is None:
+        return (
+            f"; whether a smaller rotation error helps was not decided: it may or may not, "
+            f"since {vibration} may keep them together at any rotation error"
+        )
+    kept = set(found)
+
+    def alike(i: int, table: PushAlignMachine) -> list[int]:
+        """The states of ``table`` that hold some ideal state of ``machine``'s state ``i``."""
+        s = machine.states[i]
+        ideal = set(s.ideal_states)
+        return [
+            k
+            for k, t in enumerate(table.states)
+            if t.part == s.part and ideal & set(t.ideal_states)
+        ]
+
+    def still(i: int, j: int) -> bool:
+        return any((min(x, y), max(x, y)) in kept for x in alike(i, small) for y in alike(j, small))
+
+    left = [(i, j) for i, j in pairs if still(i, j)]
+    at = f"±{tiny.rotation_error_deg:.3g} deg"
+    if not left:
+        return f"; a smaller rotation error helps: at {at} a strong plan tells each pair apart"
+    ideal = machine_at(IDEAL)
+    insep = search_space(ideal).inseparable
+    if all(
+        any(insep[x] >> y & 1 for x in alike(i, ideal) for y in alike(j, ideal)) for i, j in left
+    ):
+        # the ideal model does not tell them apart either: no uncertainty is the cause
+        which = "them" if len(left) == len(pairs) else "those left"
+        return (
+            "; no rotation error helps, not even 0: the ideal model does not "
+            f"tell {which} apart either (the mix's pairs say why)"
+        )
+    cause = (
+        f"{vibration} keeps them together, not the rotation error; a rotation error of 0 plans "
+        "on the ideal model, with no margin for that vibration"
+    )
+    if len(left) == len(pairs):
+        return f"; no smaller rotation error helps: at {at} they are still not told apart: {cause}"
+    return (
+        f"; a smaller rotation error helps {plural(len(pairs) - len(left), 'pair')} only: at "
+        f"{at} {len(left)} of the {len(pairs)} are still not told apart: {cause}"
     )
 
 
