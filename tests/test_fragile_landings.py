@@ -62,7 +62,7 @@ def _cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[str, str]
 
 
 def _fragile_lines(err: str) -> list[str]:
-    return [ln.removeprefix("warning: ") for ln in err.splitlines() if "fragile" in ln]
+    return [ln.removeprefix("warning: ") for ln in err.splitlines() if ": fragile states " in ln]
 
 
 def _analysis(path: Path, capsys: pytest.CaptureFixture[str]) -> dict:

@@ -107,7 +107,7 @@ def test_two_part_mix(tmp_path, capsys):
     # plan lists both and exits 1.
     args = [a, b, "--tolerance", "0.01", "--rotation-error", "0"]
     plan, cap = plan_file(tmp_path, capsys, args, code=1)
-    assert "octagon (up) & octagon (down)" in cap.err
+    assert "recognizes octagon but not which side is up: octagon/up & octagon/down" in cap.err
     # The right triangle is mirror-symmetric (one landing), the off-centre octagon is not.
     assert [(p["name"], p["landing"]) for p in plan["parts"]] == [
         ("tri", "up"),
