@@ -428,7 +428,7 @@ def test_a_skipped_part_plot_names_the_members_catalog_revision():
 def test_symmetric_leaves_and_twins_are_reported():
     text = "".join(parse(render_report(rectangle_plan())).text)
     assert "Poses no plan tells apart" in text and "rect: states s0, s2" in text
-    doc = parse(render_report(twin_plan(), unrecognizable=[]))  # the plan's leaves alone
+    doc = parse(render_report(twin_plan()))
     pairs = doc.with_class("pair")
     assert len(pairs) == 1 and pairs[0]["data-source"] == "plan"  # one row, three witnesses
     assert len(doc.with_class("confused")) == 3

@@ -24,7 +24,11 @@ from feederkit.cli.common import (
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import read_json, write_text_atomic
-from feederkit.plans.model import Plan
+from feederkit.landing.model import renamed
+from feederkit.mechanics.push import push_function
+from feederkit.mix.changeover import rejected_members, reported_pairs
+from feederkit.mix.pairs import unrecognizable_pairs
+from feederkit.plans.model import Plan, member_name, push_function_of
 from feederkit.plans.verify import verify_declared
 from feederkit.reports import render_report
 
@@ -41,6 +45,21 @@ def _simulate(plan: Plan, trials: int, seed: int) -> dict[str, Any]:
             bar.update(task, completed=done, total=total)
 
         return simulate_plan(plan, trials, seed, progress=progress).to_dict()
+
+
+def plan_pairs(plan: Plan) -> list[dict[str, Any]]:
+    """The pairs of the plan's members no plan tells apart, with the mix analysis's witness
+    and reason (``PairWitness.to_dict``), decided from the plan file alone as ``changeover
+    report`` decides a stored changeover's: :func:`~feederkit.mix.pairs.unrecognizable_pairs`
+    on the members' hulls and COMs (named ``PART/LANDING``), kept by
+    :func:`~feederkit.mix.changeover.reported_pairs` (two rejected landings left out)."""
+    if len(plan.parts) < 2:
+        return []
+    pfs = [
+        push_function(renamed(push_function_of(p).part, member_name(*p.key))) for p in plan.parts
+    ]
+    found = unrecognizable_pairs(pfs, plan.sensor)
+    return [w.to_dict() for w in reported_pairs(found, rejected_members(plan))]
 
 
 def _cycle_time(path: Path) -> dict[str, Any] | None:
@@ -107,6 +126,7 @@ def report_command(
         seconds_per_op=seconds_per_op,
         simulation=simulation,
         cycle_time=None if seconds_per_op is not None else _cycle_time(plan),
+        unrecognizable=plan_pairs(data),
         verification=verdict,
     )
     write_text_atomic(output, html, what="report")  # its name checked above

@@ -18,13 +18,9 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from feederkit.errors import InputError
-from feederkit.landing.model import renamed
-from feederkit.mechanics.push import push_function
-from feederkit.mix.changeover import rejected_members, reported_pairs
-from feederkit.mix.pairs import unrecognizable_pairs
 from feederkit.outline import Outline
 from feederkit.plans.fileformat import as_plan
-from feederkit.plans.model import Leaf, Plan, PlanPart, Step, member_name, push_function_of
+from feederkit.plans.model import Leaf, Plan, PlanPart, Step
 from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.reports.design_html import design_section
 from feederkit.reports.parts_html import part_section
@@ -99,21 +95,6 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
         f'<p class="counts">{esc(counts)}.</p>'
         f"{tree}</section>"
     )
-
-
-def plan_pairs(plan: Plan) -> list[dict[str, Any]]:
-    """The pairs of the plan's members no plan tells apart, with the mix analysis's witness
-    and reason (``PairWitness.to_dict``), decided from the plan file alone as ``changeover
-    report`` decides a stored changeover's: :func:`~feederkit.mix.pairs.unrecognizable_pairs`
-    on the members' hulls and COMs (named ``PART/LANDING``), kept by
-    :func:`~feederkit.mix.changeover.reported_pairs` (two rejected landings left out)."""
-    if len(plan.parts) < 2:
-        return []
-    pfs = [
-        push_function(renamed(push_function_of(p).part, member_name(*p.key))) for p in plan.parts
-    ]
-    found = unrecognizable_pairs(pfs, plan.sensor)
-    return [w.to_dict() for w in reported_pairs(found, rejected_members(plan))]
 
 
 def _banners(
@@ -198,8 +179,8 @@ def render_report(
     ``cycle_time`` (default: the plan file's ``stats.cycle_time``, docs/cell.md) gives the
     seconds per part in a named cell profile; ``seconds_per_op`` a flat cycle time instead;
     ``simulation`` (``trials``, ``successes``, ...) the simulator's result; ``unrecognizable``
-    pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis (None:
-    decided here from the plan, :func:`plan_pairs`);
+    pairs ``{part_a, part_b, states_a, states_b, reason}`` from the mix analysis (``feederkit
+    report`` decides them from the plan file: ``cli.report.plan_pairs``);
     ``outlines`` (part name, or ``PART/LANDING`` for a member of a plan over landings, ->
     Outline) draws holes around the plan's hulls; ``design`` (the
     JSON of ``feederkit design sensor``) adds the sensor design table and plot;
@@ -220,7 +201,7 @@ def render_report(
     names = ", ".join(dict.fromkeys(p.name for p in plan.parts))
     twins = plan_twins(plan, numbered, outlines)
     tree = tree_html(plan, numbered, trace, draw, twins={t.node_id: t for t in twins})
-    given = plan_pairs(plan) if unrecognizable is None else list(unrecognizable)
+    given = list(unrecognizable or [])
     found = confusions(plan, numbered, trace)
     body = "".join(
         [
