@@ -222,7 +222,7 @@ def test_show_and_list_name_the_pairs_compile_named(
     assert rc == 0 and json.loads(out)[0]["unrecognizable_pairs"] == compiled
     rc, out, _ = run(capsys, "changeover", "show", "co", "--catalog", db)
     text = " ".join(out.split())
-    assert rc == 0 and "parts this plan orients but cannot tell apart" in text
+    assert rc == 0 and "parts (or landings) this plan cannot tell apart" in text
     assert all(w["reason"].split()[0] in text for w in compiled)
     rc, out, _ = run(capsys, "changeover", "list", "--catalog", db)
     pair = f"{compiled[0]['part_a']} & {compiled[0]['part_b']}"
