@@ -365,7 +365,7 @@ def test_a_lumped_goal_too_large_to_decide_is_planned_to(monkeypatch, wired):
     assert len(wired) == 1
     tried = try_lumping(by_diameter(machine)[0], max_sets=0)
     assert tried.goal is None and tried.cut_by == "sets"
-    assert tried.undecided is not None and tried.undecided.pairs == wired[0].pairs
+    assert tried.undecided and tried.undecided[-1].pairs == wired[0].pairs
     monkeypatch.setattr(api, "LUMPED_ROOT_SETS", 0)
     planned = make_plan([pf], sensor, certify=False)
     verify_strong(planned.plan)
@@ -495,3 +495,31 @@ def test_parts_are_listed_together_only_when_lumping_their_own_states_is_not_eno
         assert len({made.result.machine.states[i].part for i in members(mask)}) == 1
     # The screen follows the default rule, as the plan does: it names the pair.
     assert check_strong_pair(pfs[0], pfs[1], sensor, unc).witness is not None
+
+
+def test_an_undecided_goal_of_one_part_s_own_pairs_is_tried_before_listing_parts_together(
+    monkeypatch,
+):
+    """The L-bracket poses above: the goal lumping each pose's own states needs 7 sets to
+    decide, the one lumping every pair 3. With a cap between them the first went undecided
+    and the second, decided, listed the poses together (4 pairs across parts) where a plan
+    tells them apart: an undecided goal is for the search to try, fewer pairs across first."""
+    pfs = [
+        push_function(make_part(make_outline(name, hull, com=com)))
+        for name, (hull, com) in BRACKET_POSES.items()
+    ]
+    sensor, unc = ToleranceSensor(0.05), Uncertainty(1.0)
+    machine = build_machine(pfs, sensor, unc)
+    sorted_machine = by_diameter(machine)[0]
+    states = sorted_machine.states
+    tried = try_lumping(sorted_machine, "exact", None, 2, rule="any")
+    assert tried.goal is None and len(tried.undecided) == 2
+    first, last = tried.undecided
+    assert all(states[i].part == states[j].part for i, j in first.pairs)
+    assert any(states[i].part != states[j].part for i, j in last.pairs)
+    monkeypatch.setattr(api, "LUMPED_ROOT_SETS", 2)
+    options = PlanningOptions(lumping="any")
+    made = make_plan(pfs, sensor, uncertainty=unc, certify=False, options=options)
+    assert made.result.length == 3
+    names = made.result.machine.states
+    assert all(names[i].part == names[j].part for i, j in made.result.lumped_pairs)

@@ -12,9 +12,10 @@ written here and against the exact answer.
 from __future__ import annotations
 
 import math
+import random
 
 import pytest
-from shared import outcome_mask, rotation_mids
+from shared import outcome_mask, rotation_mids, small_mix
 from test_strong_plans import random_pf
 
 from feederkit.machine import build_machine
@@ -24,7 +25,7 @@ from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import unsolvable, unsolvable_by_pairs
+from feederkit.planning.solvable import solve, unsolvable, unsolvable_by_pairs
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
@@ -208,3 +209,23 @@ def test_with_single_outcomes_no_pair_is_kept_apart():
     )
     problem = Problem(machine)
     assert kept_apart(machine, solvable.candidate_pairs(problem)) == set()
+
+
+@pytest.mark.parametrize("seed", [19, 29, 36, 3, 7, 11, 23, 31])
+@pytest.mark.parametrize("grouping", ["exact", "components"])
+def test_kept_roots_are_sound_under_either_grouping(seed, grouping):
+    """Under the components rule every pair not inseparable is a candidate, also pairs that
+    never read alike; nature keeping such a pair apart proves nothing (a reading separates
+    it once no third state bridges them). Seeds 19, 29, 36 gave roots called hopeless that
+    have plans (36: a 3-operation plan orienting both parts on both sides, refused)."""
+    rng = random.Random(seed)
+    pfs = small_mix(rng.randint(1, 3), 300 + 7 * seed)
+    tol = rng.choice([0.3, 1.0, 2.0, 4.0, 8.0])
+    machine = build_machine(pfs, ToleranceSensor(tol), Uncertainty(rng.choice([1.0, 3.0, 6.0])))
+    if machine.deterministic:
+        pytest.skip("no outcome sets at this seed")
+    problem = Problem(machine, grouping, 0.0)
+    roots = _roots(problem)
+    value = solve(problem, roots, None, 200_000)
+    assert value is not None
+    assert all(value[r] == math.inf for r in solvable.kept_roots(problem, roots))

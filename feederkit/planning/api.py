@@ -368,24 +368,26 @@ def _plan_machine(
         tried = try_lumping(
             sorted_machine, options.grouping, budget, LUMPED_ROOT_SETS, rule=options.lumping
         )
-        lumping = tried.goal or tried.undecided
-        if lumping is None and tried.cut_by in ("time", "memory"):
+        goals = (tried.goal,) if tried.goal is not None else tried.undecided
+        if not goals and tried.cut_by in ("time", "memory"):
             # Unproven: listing near-symmetric states together may still give a plan.
             raise PlanningError(
                 f"no plan found within {_out_of_budget(options, tried.cut_by)}: no strong "
                 "plan tells every pair of states apart, and it ran out while deciding which "
                 "near-symmetric states a plan may list together"
             ) from None
-        if lumping is None:
-            hint = unlike_words(sorted_machine, tried.unlike)
+        hint = unlike_words(sorted_machine, tried.unlike)
+        if not goals:
             raise NoStrongPlan(exc.reason, hint) from None
-        try:
-            root, optimal, length, lower, ties, cut = _plan(
-                sorted_machine, options, budget, lumping.insep
-            )
-        except NoStrongPlan as again:  # the roots were undecided: the search decided
-            hint = unlike_words(sorted_machine, tried.unlike)
-            raise NoStrongPlan(again.reason, hint) from None
+        for k, lumping in enumerate(goals):
+            try:
+                root, optimal, length, lower, ties, cut = _plan(
+                    sorted_machine, options, budget, lumping.insep
+                )
+                break
+            except NoStrongPlan as again:  # its roots were undecided: the search decided
+                if k == len(goals) - 1:
+                    raise NoStrongPlan(again.reason, hint) from None
     share_bisimilar(split, sorted_machine, old)
     if twin_of is not None:
         old = [twin_of[i] for i in old]  # each twin is its wandering state again

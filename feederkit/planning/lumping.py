@@ -53,7 +53,7 @@ from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import MAX_SETS, candidate_pairs, solve
+from feederkit.planning.solvable import MAX_SETS, alike_pairs, candidate_pairs, solve
 from feederkit.planning.tree import PlanTree, leaf_masks
 from feederkit.planning.wandering import is_twin_pair, wandering_words
 
@@ -117,7 +117,7 @@ def unresolvable_pairs(
     together, those sets pruned.
     """
     pairs = candidate_pairs(problem)
-    kept = kept_apart(problem.machine, pairs)
+    kept = kept_apart(problem.machine, alike_pairs(problem))
     rest = [p for p in pairs if p not in kept]
     found = set(kept)
     if rest:
@@ -178,15 +178,16 @@ class LumpingTry:
     alike), sorted; ``decided``: False when the search ran out of time or sets (``goal`` is
     then None, and no strong plan may yet exist); ``cut_by``: then what it ran out of (the
     Timeout's reason, ``"time"`` or ``"memory"``, or ``"sets"``), else None; ``undecided``:
-    with ``"sets"``, the lumped goal whose roots had too many sets to decide (its pairs are
-    decided: a planner's search may still find a strong plan to it).
+    with ``"sets"``, the lumped goals whose roots had too many sets to decide, fewest pairs
+    across parts first (their pairs are decided: a planner's search may still find a strong
+    plan to one).
     """
 
     goal: LumpedGoal | None
     unlike: tuple[Pair, ...] = ()
     decided: bool = True
     cut_by: str | None = None
-    undecided: LumpedGoal | None = None
+    undecided: tuple[LumpedGoal, ...] = ()
 
 
 def try_lumping(
@@ -207,7 +208,7 @@ def try_lumping(
         pairs = unresolvable_pairs(problem, deadline, pair_sets)
         exact = pairs is not None
         if pairs is None:
-            pairs = tuple(sorted(kept_apart(problem.machine, candidate_pairs(problem))))
+            pairs = tuple(sorted(kept_apart(problem.machine, alike_pairs(problem))))
         unlike = tuple(p for p in pairs if not may_lump(machine, *p, rule))
         pairs = tuple(p for p in pairs if may_lump(machine, *p, rule))
         if not pairs:
@@ -223,9 +224,11 @@ def try_lumping(
             value = solve(wide, roots, deadline, max_sets)
             if value is not None and all(value[r] < math.inf for r in roots):
                 return LumpingTry(LumpedGoal(goal, lumps, exact), unlike)
-            if value is None and k == len(tries) - 1:
-                undecided = LumpedGoal(goal, lumps, exact)
-                return LumpingTry(None, unlike, False, "sets", undecided)
+            if value is None:
+                # Undecided: this goal and every wider one are for a search to try, in order
+                # (fewer pairs across parts first, as when decided).
+                left = tuple(LumpedGoal(lumped(problem.insep, x), x, exact) for x in tries[k:])
+                return LumpingTry(None, unlike, False, "sets", left)
     except Timeout as exc:
         return LumpingTry(None, decided=False, cut_by=exc.reason)
     return LumpingTry(None, unlike)

@@ -156,6 +156,21 @@ def candidate_pairs(problem: Problem) -> list[tuple[int, int]]:
     ]
 
 
+def alike_pairs(problem: Problem) -> list[tuple[int, int]]:
+    """The :func:`candidate_pairs` that can read alike, whatever the grouping: the pairs
+    :func:`~feederkit.machine.inseparable.kept_apart` is sound over (nature answers each
+    reading with one both states can give). Under the components rule a pair that never
+    reads alike is a candidate, yet a reading separates it once no third state bridges the
+    two: keeping it apart proves nothing."""
+    if problem.grouping is Grouping.EXACT:
+        return candidate_pairs(problem)
+    sensor = problem.machine.sensor
+    sensed = [s.sensed for s in problem.machine.states]
+    return [
+        (i, j) for i, j in candidate_pairs(problem) if sensor.can_read_alike(sensed[i], sensed[j])
+    ]
+
+
 def holding_kept_pairs(roots: list[int], kept: set[tuple[int, int]]) -> list[int]:
     """The roots holding a pair of ``kept`` (pairs nature keeps apart,
     :func:`~feederkit.machine.inseparable.kept_apart`): no strong plan orients them."""
@@ -169,7 +184,7 @@ def holding_kept_pairs(roots: list[int], kept: set[tuple[int, int]]) -> list[int
 
 def kept_roots(problem: Problem, roots: list[int], deadline: Deadline | None = None) -> list[int]:
     """The roots holding a pair nature keeps apart whatever the plan does
-    (:func:`~feederkit.machine.inseparable.kept_apart` over :func:`candidate_pairs`, one
+    (:func:`~feederkit.machine.inseparable.kept_apart` over :func:`alike_pairs`, one
     fixpoint over all pairs, polled by ``deadline``): no strong plan orients them.
 
     Sound, not complete (empty proves nothing), and cheap beside a search: the 50-part mix at
@@ -178,7 +193,7 @@ def kept_roots(problem: Problem, roots: list[int], deadline: Deadline | None = N
     """
     deadline = deadline or Deadline(None)
     return holding_kept_pairs(
-        roots, kept_apart(problem.machine, candidate_pairs(problem), deadline.check)
+        roots, kept_apart(problem.machine, alike_pairs(problem), deadline.check)
     )
 
 
