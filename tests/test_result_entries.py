@@ -100,6 +100,7 @@ def test_an_entry_of_a_member_that_never_ends_there_is_refused(kind, request):
     assert problem is not None
     assert f"a result lists {label} state {entry['state']}" in problem
     assert f"no start, outcome or reading of {label} ends there" in problem
+    assert "a plan written by an earlier feederkit may list it: make the plan again" in problem
 
 
 def test_every_loader_refuses_a_hand_added_entry(mix_plan, tmp_path, capsys):
@@ -243,3 +244,16 @@ def test_pruning_keeps_every_state_a_brute_force_follow_ends_in(seed):
         for leaf, state in _follow(data, p, pf, tolerance):
             assert (name, None, state) in _entries(nodes[leaf]), (name, state)
     assert verify_declared(data).ok
+
+
+@pytest.mark.parametrize("unc", [IDEAL, Uncertainty()], ids=["ideal", "strong"])
+def test_the_report_made_with_a_plan_counts_what_its_file_ends_in(unc):
+    """The verifiers count the runs that end at a result naming several members before they
+    prune; the report returned with the plan is the written file's (it said 73 where the
+    file's own check says 71: pruning leaves some results naming one member)."""
+    pfs = _d_and_rect()
+    x = mix_critical_tolerance(pfs).pairs[0].critical_tolerance
+    made = make_plan(pfs, ToleranceSensor(x * (1 + 1e-6)), uncertainty=unc, certify=False)
+    again = verify_declared(made.plan)
+    assert made.report.unrecognized == again.unrecognized > 0
+    assert [c.unrecognized for c in made.report.parts] == [c.unrecognized for c in again.parts]

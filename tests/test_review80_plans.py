@@ -241,8 +241,26 @@ def test_the_lumping_warning_says_no_smaller_rotation_error_helps_when_none_does
         assert code == 0
         line = _lumping_warning(err)
         assert "no smaller rotation error helps: at ±" in line
-        assert "the feeder's vibration" in line and "0 plans on the ideal model" in line
+        assert "the feeder's vibration" in line and "the ideal model (no uncertainty" in line
         assert "--rotation-error" not in line
+
+
+def test_the_lumping_warning_names_the_shape_tolerance_when_it_keeps_pairs_together(capsys):
+    """The chamfered plate at 2 mm with a 0.2 mm shape tolerance: its sides stay together at
+    a thousandth of the rotation error but not without the tolerance (at 0.01 mm a plan
+    orients both sides): the tolerance is named, not the vibration, nor a rotation error of
+    0 as the ideal model (with a shape tolerance declared it is none)."""
+    src = str(CATALOG / "chamfered-plate.json")
+    for error in ("1", "0"):
+        args = ["--tolerance", "2", "--shape-tolerance", "0.2", "--rotation-error", error]
+        code, _, err = run_cli(capsys, "plan", src, *args)
+        assert code == 1
+        line = _lumping_warning(err)
+        assert "the declared shape and COM tolerances keep them together" in line
+        assert "--shape-tolerance" in line and "vibration" not in line
+        assert ("no smaller rotation error helps: at ±0.001 deg" in line) == (error == "1")
+    code, _, _ = run_cli(capsys, "plan", src, "--tolerance", "2", "--shape-tolerance", "0.01")
+    assert code == 0
 
 
 def test_the_lumping_warning_points_to_a_smaller_rotation_error_when_it_helps(capsys):

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -207,14 +207,20 @@ def _make_plan(
         data = with_uncertainty(_plan_dict(result, pfs, named, shares), unc)
         if widened:
             data["stats"]["expected_length"] = file_expected(as_plan(data))
+        listed = _entries(data)
         report = check_plan(data, prune=True)
+        if _entries(data) != listed and _time_left(opts, started):
+            report = check_plan(data)  # its counts (runs ending unrecognized) are the file's
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
         ideal = widen_widths(ideal, offsets)
         data = with_uncertainty(_plan_dict(ideal_view(result, ideal), pfs, named, shares), unc)
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
+        listed = _entries(data)
         report = verify_strong(data, tighten_margins=True, restate_expected=widened, prune=True)
+        if _entries(data) != listed and _time_left(opts, started):
+            report = verify_strong(data, restate_expected=widened)  # the file's counts
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
             result = replace(result, min_margin=written)
@@ -285,6 +291,17 @@ def _make_plan(
     if held is not None:
         warnings.append(held)
     return MadePlan(data, result, report, tuple(warnings + notes), unoriented)
+
+
+def _time_left(opts: PlanningOptions, started: float) -> bool:
+    """Whether the time limit (if any) leaves time for one more walk of the plan."""
+    left = _left(opts, started)
+    return left is None or left > 0.0
+
+
+def _entries(data: Mapping[str, Any]) -> int:
+    """How many entries the results of the plan file's object ``data`` list."""
+    return sum(len(node["result"]) for node in result_nodes(data))
 
 
 def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
@@ -664,75 +681,114 @@ def smaller_error_words(
     pairs: Sequence[tuple[int, int]],
     seconds: float,
 ) -> str:
-    """Whether a smaller rotation error lets a strong plan tell the lumped ``pairs`` (states
-    of ``machine``) apart, in words, decided exactly where it is affordable: the pairs
-    still unresolvable (:func:`~feederkit.planning.lumping.unresolvable_pairs`) on the
-    machine ``machine_at`` builds at :data:`SMALLER_ERROR_FACTOR` of the declared rotation
-    error, the tolerances and the feeder's vibration unchanged. A pair unresolvable even
-    there is kept together by that vibration (push bands, merged fragile states), which any
-    declared uncertainty switches on, not by the rotation error (:data:`VIBRATION_OBSTACLE`);
-    the words then say "no smaller rotation error helps" and point to the ideal model (a
-    rotation error of 0), and the command line names no flag for them (``with_flags``).
+    """What keeps the lumped ``pairs`` (states of ``machine``) together, in words, decided
+    exactly where it is affordable (within ``seconds``): the pairs still unresolvable
+    (:func:`~feederkit.planning.lumping.unresolvable_pairs`) on the machines ``machine_at``
+    builds at :data:`SMALLER_ERROR_FACTOR` of the declared rotation error, then with the
+    declared shape and COM tolerances at 0 too, the feeder's vibration on in both (any
+    declared uncertainty switches it on). Told apart at the smaller rotation error: "a
+    smaller rotation error helps"; else, told apart without the tolerances: a smaller
+    --shape-tolerance / --com-tolerance helps; else the vibration keeps them together, or
+    not even the ideal model tells them apart. The command line names a flag only where the
+    words say it helps (``with_flags``).
     """
-    tiny = replace(
-        uncertainty, rotation_error_deg=uncertainty.rotation_error_deg * SMALLER_ERROR_FACTOR
-    )
+    r = uncertainty.rotation_error_deg
+    tiny = replace(uncertainty, rotation_error_deg=r * SMALLER_ERROR_FACTOR)
+    loose = uncertainty.shape_tolerance_mm > 0.0 or uncertainty.com_tolerance_mm > 0.0
+    exact = replace(tiny, shape_tolerance_mm=0.0, com_tolerance_mm=0.0)
+    if exact.is_ideal:  # nothing declared but the rotation error, and that is 0
+        exact = replace(exact, rotation_error_deg=SMALLER_ERROR_FACTOR)
     vibration = (
         "the feeder's vibration, which any declared uncertainty switches on (push bands and "
         "merged fragile states: docs/uncertainty.md)"
     )
-    try:
-        if seconds <= 0.0:
-            raise Timeout("time limit")
-        small = machine_at(tiny)
-        found = unresolvable_pairs(Problem(small, "exact", 0.0), Deadline(seconds))
-    except Timeout:
-        found = None
-    if found is None:
-        return (
-            f"; whether a smaller rotation error helps was not decided: it may or may not, "
-            f"since {vibration} may keep them together at any rotation error"
-        )
-    kept = set(found)
+    stop = time.monotonic() + max(seconds, 0.0)
 
-    def alike(i: int, table: PushAlignMachine) -> list[int]:
-        """The states of ``table`` that hold some ideal state of ``machine``'s state ``i``."""
-        s = machine.states[i]
-        ideal = set(s.ideal_states)
+    def left_at(u: Uncertainty) -> list[tuple[int, int]] | None:
+        """The pairs still unresolvable at ``u`` (None: undecided in time)."""
+        rest = stop - time.monotonic()
+        if rest <= 0.0:
+            return None
+        try:
+            at = machine_at(u)
+            found = unresolvable_pairs(Problem(at, "exact", 0.0), Deadline(rest))
+        except Timeout:
+            return None
+        if found is None:
+            return None
+        kept = set(found)
         return [
-            k
-            for k, t in enumerate(table.states)
-            if t.part == s.part and ideal & set(t.ideal_states)
+            (i, j)
+            for i, j in pairs
+            if any(
+                (min(x, y), max(x, y)) in kept
+                for x in _alike(machine, i, at)
+                for y in _alike(machine, j, at)
+            )
         ]
 
-    def still(i: int, j: int) -> bool:
-        return any((min(x, y), max(x, y)) in kept for x in alike(i, small) for y in alike(j, small))
-
-    left = [(i, j) for i, j in pairs if still(i, j)]
+    left = left_at(tiny) if r > 0.0 else list(pairs)
     at = f"±{tiny.rotation_error_deg:.3g} deg"
+    if left is None:
+        return (
+            "; whether a smaller rotation error or tighter tolerances help was not decided: "
+            f"they may or may not, since {vibration} may keep them together whatever they are"
+        )
     if not left:
         return f"; a smaller rotation error helps: at {at} a strong plan tells each pair apart"
+    helped = len(pairs) - len(left)
+    head = (
+        f"; a smaller rotation error helps {plural(helped, 'pair')} only: at {at} "
+        f"{len(left)} of the {len(pairs)} are still not told apart"
+        if helped
+        else (
+            f"; no smaller rotation error helps: at {at} they are still not told apart"
+            if r > 0.0
+            else ""
+        )
+    )
+    if loose:
+        still = left_at(exact)
+        if still is not None and len(still) < len(left):
+            fixed = len(left) - len(still)
+            which = "them" if not still else plural(fixed, "pair")
+            return (
+                f"{head}{': ' if head else '; '}the declared shape and COM tolerances keep "
+                f"{which} together: with none a strong plan tells {which} apart (a smaller "
+                "shape tolerance or COM tolerance helps)"
+            )
+        if still is None:
+            return (
+                f"{head}{': ' if head else '; '}the declared shape and COM tolerances or "
+                f"{vibration} keep them together (not decided which)"
+            )
+        left = still
     ideal = machine_at(IDEAL)
     insep = search_space(ideal).inseparable
     if all(
-        any(insep[x] >> y & 1 for x in alike(i, ideal) for y in alike(j, ideal)) for i, j in left
+        any(insep[x] >> y & 1 for x in _alike(machine, i, ideal) for y in _alike(machine, j, ideal))
+        for i, j in left
     ):
         # the ideal model does not tell them apart either: no uncertainty is the cause
         which = "them" if len(left) == len(pairs) else "those left"
         return (
-            "; no rotation error helps, not even 0: the ideal model does not "
-            f"tell {which} apart either (the mix's pairs say why)"
+            f"{head}{': ' if head else '; '}no rotation error helps, not even 0: the ideal "
+            f"model does not tell {which} apart either (the mix's pairs say why)"
         )
     cause = (
-        f"{vibration} keeps them together, not the rotation error; a rotation error of 0 plans "
-        "on the ideal model, with no margin for that vibration"
+        f"{vibration} keeps them together, whatever else is declared; the ideal model (no "
+        "uncertainty declared) plans with no margin for that vibration"
     )
-    if len(left) == len(pairs):
-        return f"; no smaller rotation error helps: at {at} they are still not told apart: {cause}"
-    return (
-        f"; a smaller rotation error helps {plural(len(pairs) - len(left), 'pair')} only: at "
-        f"{at} {len(left)} of the {len(pairs)} are still not told apart: {cause}"
-    )
+    return f"{head}{': ' if head else '; '}{cause}"
+
+
+def _alike(machine: PushAlignMachine, i: int, table: PushAlignMachine) -> list[int]:
+    """The states of ``table`` that hold some ideal state of ``machine``'s state ``i``."""
+    s = machine.states[i]
+    ideal = set(s.ideal_states)
+    return [
+        k for k, t in enumerate(table.states) if t.part == s.part and ideal & set(t.ideal_states)
+    ]
 
 
 def _lump_shapes(

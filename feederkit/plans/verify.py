@@ -368,9 +368,12 @@ def unsupported_words(label: str, state: int, member_there: bool, pose: float | 
     state of its member (``label``) ends there."""
     shown = "" if pose is None else f" (pose {pose:.6g} deg)"
     head = f"a result lists {label} state {state}{shown}, but no start, outcome or reading of "
+    # Results before 2026-12-06 listed such entries (a controller may take any entry): the
+    # fix is a plan made again, which names only what ends there.
+    again = " (a plan written by an earlier feederkit may list it: make the plan again)"
     if not member_there:
-        return head + f"{label} ends there"
-    return head + "it ends there, and it looks like none that does"
+        return head + f"{label} ends there" + again
+    return head + "it ends there, and it looks like none that does" + again
 
 
 def _arrivals(plan: Plan, searches: Mapping[int, _PartSearch]) -> dict[int, set[Listed]]:
