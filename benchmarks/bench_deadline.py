@@ -23,7 +23,7 @@ Two tables (docs/performance.md, "Deadline and memory"):
   360-facet circle with a flat cut, random 50-1000-point outlines at 1-3 %, mixes of 20-200
   parts of one size at 0.5-5 %.
 
-A tolerance in % is of the largest part's size (the larger side of its bounding box: 60 mm
+A tolerance in % is of the largest part's size (its hull's diameter, `Part.size`: about 60 mm
 for the outlines and mixes, 20 mm for the near-round parts). The model is the default
 uncertainty (rotation error 1 deg) unless the case says "ideal". The tables print as
 markdown at the end. Exit code 1 when some case overshoots by more than

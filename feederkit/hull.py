@@ -58,6 +58,33 @@ def size_of(points: Sequence[Point]) -> float:
     return max(max(xs) - min(xs), max(ys) - min(ys))
 
 
+def diameter_of(hull: Sequence[Point]) -> float:
+    """The largest distance between two vertices of the convex polygon ``hull`` (mm): its
+    diameter, the part's largest dimension, which turning the drawing does not change (the
+    bounding box's larger side does, by up to a factor of sqrt 2). Rotating calipers over
+    the antipodal pairs (Shamos), linear in the vertices.
+
+    >>> diameter_of([(0.0, 0.0), (3.0, 0.0), (3.0, 4.0)])
+    5.0
+    """
+    n = len(hull)
+    if n < 3:
+        return math.dist(hull[0], hull[-1]) if n else 0.0
+
+    def twice_area(a: Point, b: Point, c: Point) -> float:
+        return abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+    best, j = 0.0, 1
+    for i in range(n):
+        a, b = hull[i], hull[(i + 1) % n]
+        for _ in range(n):  # the vertex farthest from edge i-(i+1), moving one way only
+            if twice_area(a, b, hull[(j + 1) % n]) <= twice_area(a, b, hull[j]):
+                break
+            j = (j + 1) % n
+        best = max(best, math.dist(a, hull[j]), math.dist(b, hull[j]))
+    return best
+
+
 def _chord_deviation(ring: Sequence[Point], i: int, k: int) -> float:
     """Largest distance from chord i-k of the ring points strictly between ``i`` and ``k``."""
     n = len(ring)

@@ -4,9 +4,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 from feederkit.errors import InputError
-from feederkit.hull import REL_LENGTH_TOL, Point, contact_hull, point_in_convex, size_of
+from feederkit.hull import (
+    REL_LENGTH_TOL,
+    Point,
+    contact_hull,
+    diameter_of,
+    point_in_convex,
+    size_of,
+)
 from feederkit.outline import Outline
 
 
@@ -25,10 +33,12 @@ class Part:
     hull: tuple[Point, ...]
     revision: str | None = None
 
-    @property
+    @cached_property
     def size(self) -> float:
-        """The larger side of the hull's bounding box (mm): the length scale of tolerances."""
-        return size_of(self.hull)
+        """The hull's diameter, the part's largest dimension (mm): the length scale of
+        tolerances (the vibration, near-symmetry, rounding), the same however the drawing
+        turns the part (a bounding box's larger side is not)."""
+        return diameter_of(self.hull)
 
 
 def make_part(

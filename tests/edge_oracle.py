@@ -204,8 +204,8 @@ def check_plan(
     for part in plan["parts"]:
         name = part["name"]
         mech = mechanics(part["hull"], part["com"])
-        xs, ys = zip(*part["hull"], strict=True)
-        size = max(max(xs) - min(xs), max(ys) - min(ys))
+        # The part's size: its diameter, the largest distance between two hull vertices.
+        size = max(math.dist(p, q) for p in part["hull"] for q in part["hull"])
         inset = reading_slack * size
         bands = mech.bands(push_depth_rel * size)
         state_of = {s["edge"]: s["id"] for s in part["stable_states"]}

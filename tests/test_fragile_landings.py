@@ -36,7 +36,7 @@ from feederkit.plans.model import member_fragile_warnings
 
 # An L bracket (legs 60 and 40 mm, 15 mm wide) with two 6.6 mm holes: its short end (edge
 # normal 0 deg) is a stable state 0.05 mm from tipping, below the fragile threshold of
-# 0.06 mm (1e-3 of its 60 mm size); its other states are robust.
+# 0.0721 mm (1e-3 of its 72.1 mm size, its diameter); its other states are robust.
 L_RING = [(0, 0), (60, 0), (60, 15), (15, 15), (15, 40), (0, 40)]
 L_HOLES = [((47.0, 7.5), 3.3), ((7.5, 30.0), 3.3)]
 
@@ -113,7 +113,7 @@ def test_the_down_landing_is_warned_about_with_its_own_fragile_state(bracket):
     (line,) = bracket["warnings"]
     assert line.startswith(
         f"bracket-a (up): fragile states {up_id}; bracket-a (down): fragile states {down_id} "
-        "(barrier below 0.06 mm): the part may settle on a neighbour"
+        "(barrier below 0.0721 mm): the part may settle on a neighbour"
     )
     assert "bracket-a: " not in line  # never the bare part name, with the up side's numbers
     # The down landing's state 1 is robust: a result names it, and no warning does.
@@ -190,9 +190,9 @@ def test_members_of_different_sizes_give_each_its_barrier_and_a_large_mix_counts
     small, large = bar("s", 1.0), bar("l", 2.0)
     (line,) = fragile_member_warnings([[("box (pose-0)", small), ("box (pose-1)", large)]])
     assert line.startswith("box (pose-0): fragile states ")
-    assert "(barrier below 0.04 mm); box (pose-1): fragile states " in line
+    assert "(barrier below 0.0412 mm); box (pose-1): fragile states " in line
     assert line.endswith(
-        "(barrier below 0.08 mm): the part may settle on a neighbour; check the plan with "
+        "(barrier below 0.0825 mm): the part may settle on a neighbour; check the plan with "
         "feederkit simulate"
     )
     many = [[(f"p{k} (up)", small), (f"p{k} (down)", small)] for k in range(FRAGILE_LINES + 1)]

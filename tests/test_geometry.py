@@ -173,6 +173,10 @@ def test_com_outside_in_the_file(tmp_path) -> None:
 
 def test_part_size_and_frame() -> None:
     part = make_part(make_outline("r", [(10, 10), (30, 10), (30, 20), (10, 20)]))
-    assert part.size == 20.0
+    assert part.size == pytest.approx(math.hypot(20.0, 10.0))  # its diameter, not its box
+    c, s = math.cos(math.radians(37.0)), math.sin(math.radians(37.0))
+    box = [(0, 0), (20, 0), (20, 10), (0, 10)]
+    turned = make_part(make_outline("t", [(c * x - s * y, s * x + c * y) for x, y in box]))
+    assert turned.size == pytest.approx(part.size)  # the drawing turned: the same size
     assert part.hull[0] == (10.0, 10.0)
     assert part.com == pytest.approx((20.0, 15.0))

@@ -101,8 +101,9 @@ def test_the_tolerance_is_a_few_micrometres_and_a_share_of_a_small_part():
     nut = plate("nut", nut_ring())
     assert congruence_tolerance(nut, mirror_part(nut)) == TOL == 0.005
     small = plate("small", [(0, 0), (2, 0), (2, 1), (0, 1)])
-    assert congruence_tolerance(small, small) == pytest.approx(CONGRUENCE_REL_TOL * 2.0)
-    assert congruence_tolerance(small, small) == pytest.approx(0.002)
+    across = 5.0**0.5  # the 2 x 1 plate's diameter
+    assert congruence_tolerance(small, small) == pytest.approx(CONGRUENCE_REL_TOL * across)
+    assert congruence_tolerance(small, small) == pytest.approx(0.002236, rel=1e-3)
 
 
 # --- the drawing's precision: one landing ----------------------------------------------------

@@ -154,8 +154,6 @@ def test_a_margin_at_a_critical_tolerance_is_checked_on_the_paths_only(monkeypat
     verify_strong(made.plan)  # every margin holds for every state its paths bring to its node
     margins = [a["margin_deg"] for a in actions(made.plan)]
     assert made.plan["stats"]["min_margin_deg"] == min(margins) == made.result.min_margin
-    assert any(abs(m - 51.0617) < 1e-3 for m in margins)
-    assert not any(abs(m - 32.5835) < 1e-3 for m in margins)
     # The same plan, its margins checked without lowering: nothing fails.
     seen: list[int] = []
     real = make.verify_strong
@@ -167,8 +165,11 @@ def test_a_margin_at_a_critical_tolerance_is_checked_on_the_paths_only(monkeypat
         return report
 
     monkeypatch.setattr(make, "verify_strong", strict)
-    make_plan(pfs, ToleranceSensor(pair.critical_tolerance), certify=False)
+    again = make_plan(pfs, ToleranceSensor(pair.critical_tolerance), certify=False)
     assert seen
+    # Nothing was lowered: the file's margins are the planner's (once 51.06 degrees went to
+    # 32.58 for a state only the expected walk put at its node).
+    assert [a["margin_deg"] for a in actions(again.plan)] == margins
 
 
 def test_a_margin_lowered_below_the_floor_is_said(monkeypatch):

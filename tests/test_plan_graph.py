@@ -39,10 +39,11 @@ from feederkit.plans import (
 )
 from feederkit.plans.fileformat import file_nodes
 from feederkit.plans.verify import verify_declared
+from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
-BASE = "rectangle-2x1.tolerance.json"  # tolerance 0.02 mm; diameters 1, 2, 1, 2
+BASE = "rectangle-2x1.tolerance.json"  # diameters 1, 2, 1, 2; read at 0.02 mm below
 MARGIN = 10.0  # every multiple of 90 degrees keeps the rectangle's states within ±10
 
 
@@ -72,7 +73,8 @@ def layered(layers: int, width: int = 10, uncertainty: Uncertainty | None = None
     n = layers + 1
     stats = PlanStats(n, float(n), MARGIN, False, 1)
     unc = base.uncertainty if uncertainty is None else uncertainty
-    return dataclasses.replace(base, root=root, stats=stats, uncertainty=unc)
+    sensor = ToleranceSensor(0.02)  # the branches' reading intervals are 1 and 2 mm +- 0.02
+    return dataclasses.replace(base, root=root, stats=stats, uncertainty=unc, sensor=sensor)
 
 
 def _table_refs(node: dict) -> list[str]:
@@ -277,7 +279,8 @@ def _uneven(uncertainty: Uncertainty | None = None) -> Plan:
     narrow = sum(w for sid, w in widths.items() if part.state(sid).diameter < 1.5) / 360.0
     stats = PlanStats(3, 2.0 * narrow + 3.0 * (1.0 - narrow), MARGIN, False, 1)
     unc = base.uncertainty if uncertainty is None else uncertainty
-    return dataclasses.replace(base, root=root, stats=stats, uncertainty=unc)
+    sensor = ToleranceSensor(0.02)  # the branches' reading intervals are 1 and 2 mm +- 0.02
+    return dataclasses.replace(base, root=root, stats=stats, uncertainty=unc, sensor=sensor)
 
 
 @pytest.mark.parametrize("uncertainty", [None, Uncertainty(1.0, 0.0, 0.0)])

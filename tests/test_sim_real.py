@@ -365,8 +365,11 @@ def test_a_plan_on_a_simplified_hull_fails_on_the_washers_true_outline(
     k = on_outline["successes"]
     lo, hi = wilson(k, trials)
     assert k <= 0.8 * trials and hi < 0.9, (k, lo, hi)  # a meaningful share fails
-    wrong = on_outline["failures"]
-    assert {r["cause"] for r in wrong} == {"wrong result"}
+    # The true outline reads a little wider than the simplified hull: some runs end at a
+    # reading the plan has no branch for, the others at a wrong pose.
+    failures = on_outline["failures"]
+    assert {r["cause"] for r in failures} <= {"wrong result", "reading in no branch"}
+    wrong = [r for r in failures if r["cause"] == "wrong result"]
     assert all(r["pose_error_deg"] > 2.0 for r in wrong)
     assert any(r["pose_error_deg"] > 170.0 for r in wrong)  # the flat named for the arc
     fixed = _run(["simulate", str(new), *common, "--part", str(washer)], capsys)

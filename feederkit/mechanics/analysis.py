@@ -146,7 +146,7 @@ def tipping_warnings(members: Sequence[tuple[str, PushFunction]]) -> list[str]:
     >>> from feederkit.part import make_part
     >>> q = make_part(make_outline("q", [(0, 0), (40, 0), (40, 20), (0, 8)], com=(0.3, 4)))
     >>> tipping_warnings([("q", push_function(q))])  # doctest: +ELLIPSIS
-    ['q: its COM lies 0.3 mm from hull edge 3 (0.8% of its size): pushed against the fence ...']
+    ['q: its COM lies 0.3 mm from hull edge 3 (0.7% of its size): pushed against the fence ...']
     """
     out, seen = [], set()
     for label, pf in members:

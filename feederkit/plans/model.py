@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.errors import InputError
+from feederkit.hull import diameter_of
 from feederkit.mechanics.analysis import fragile_member_warnings, tipping_warnings
 from feederkit.mechanics.push import PushFunction, StableState, push_function
 from feederkit.outline import make_outline
@@ -75,12 +76,11 @@ class PlanPart:
                 return s
         raise InputError(f"plan: part {self.name!r} lists no stable state {sid}")
 
-    @property
+    @functools.cached_property
     def size(self) -> float:
-        """The hull's largest extent (mm): the scale of geometric tolerances."""
-        xs = [p[0] for p in self.hull]
-        ys = [p[1] for p in self.hull]
-        return max(max(xs) - min(xs), max(ys) - min(ys))
+        """The hull's diameter (mm), as :attr:`feederkit.part.Part.size`: the scale of
+        geometric tolerances, the same however the drawing turns the part."""
+        return diameter_of(self.hull)
 
 
 @functools.lru_cache(maxsize=256)
