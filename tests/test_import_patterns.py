@@ -83,7 +83,8 @@ def test_metre_header_on_an_inch_drawing_is_pointed_out(tmp_path):
     (ip,) = parts(path)
     size = [w for w in ip.warnings if "across" in w]
     assert len(size) == 1
-    assert "8000 mm" in size[0] and "203.2 mm in in" in size[0] and "--units" in size[0]
+    # 8 x 5 m read in metres: 9434 mm across its diagonal (its size is its diameter)
+    assert "9434 mm" in size[0] and "239.6 mm in in" in size[0] and "--units" in size[0]
     assert any("contradicts" in w and "$MEASUREMENT 0" in w for w in ip.warnings)
     (right,) = parts(path, units="in")
     assert area(right) == pytest.approx(fx.WRONG_HEADER_AREA_IN2 * 25.4**2, rel=2e-4)
@@ -99,7 +100,7 @@ def test_mesh_modelled_in_metres_is_imported_with_a_warning(tmp_path):
     box = trimesh.creation.box((0.04, 0.03, 0.02))  # a 40 mm housing modelled in metres
     (ip,) = parts(fx.write_mesh(box, tmp_path / "housing.stl"))
     assert any("0.04 mm across" in w and "40 mm in m" in w for w in ip.warnings)
-    assert ip.hull_tolerance == pytest.approx(0.002 * 0.04)
+    assert ip.hull_tolerance == pytest.approx(0.002 * 0.05)  # of its 0.05 mm diameter
     (right,) = parts(fx.write_mesh(box, tmp_path / "housing.stl"), units="m")
     assert sorted(fx_extents(right.part.hull)) == pytest.approx([30.0, 40.0], rel=1e-6)
     assert not any("across" in w for w in right.warnings)
@@ -120,7 +121,9 @@ def test_hull_tolerance_scales_with_a_small_part(tmp_path):
         )  # fmt: skip
 
     (ip,) = parts(fx.write_entities(tmp_path / "small.dxf", build))
-    assert ip.hull_tolerance == pytest.approx(0.006)  # 0.2 % of 3 mm, below the 0.05 cap
+    # 0.2 % of its 3.23 mm diameter, below the 0.05 cap
+    assert ip.hull_tolerance == pytest.approx(0.002 * ip.part.size, rel=1e-6)
+    assert ip.hull_tolerance == pytest.approx(0.00647, rel=1e-3)
     assert fx_extents(ip.part.hull) == pytest.approx((3.0, 2.0), abs=1e-6)
     (big,) = parts(fx.write_plate(tmp_path / "plate.dxf"))
     assert big.hull_tolerance == pytest.approx(0.05)

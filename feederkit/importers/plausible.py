@@ -8,6 +8,7 @@ is told what the part would measure in the other likely units, and how to choose
 
 from __future__ import annotations
 
+from feederkit.hull import convex_hull, diameter_of
 from feederkit.outline import Outline, unit_scale
 
 MIN_PLAUSIBLE_MM = 1.0
@@ -24,10 +25,9 @@ IMPERIAL = frozenset({"in", "ft", "mi", "yd", "mil", "microinch"})
 
 
 def outline_size(outline: Outline) -> float:
-    """The larger side of the outline's bounding box (mm)."""
-    xs = [p[0] for p in outline.vertices]
-    ys = [p[1] for p in outline.vertices]
-    return max(max(xs) - min(xs), max(ys) - min(ys))
+    """The outline's largest dimension (mm): its convex hull's diameter, the part's size as
+    ``Part.size`` takes it, the same however the drawing turns the part."""
+    return diameter_of(convex_hull(outline.vertices))
 
 
 def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
