@@ -18,7 +18,7 @@ from feederkit.machine import (
     members,
     search_space,
 )
-from feederkit.planning.tree import Leaf, PlanTree, Step
+from feederkit.planning.tree import Leaf, PlanTree, Step, map_tree
 
 
 def by_diameter(machine: PushAlignMachine) -> tuple[PushAlignMachine, list[int]]:
@@ -94,26 +94,14 @@ def remap_tree(node: PlanTree, old: list[int]) -> PlanTree:
 
 def map_masks(node: PlanTree, mask: Callable[[int], int]) -> PlanTree:
     """The plan with every mask (leaves, action images, reading branches) replaced by
-    ``mask`` of it: each distinct node converted once, children first, without recursion
-    (a plan's DAG can have far more paths than nodes, and more levels than Python's stack)."""
-    nodes: dict[int, PlanTree] = {}
-    stack: list[tuple[PlanTree, bool]] = [(node, False)]
-    while stack:
-        n, ready = stack.pop()
-        if id(n) in nodes:
-            continue
-        if isinstance(n, Leaf):
-            nodes[id(n)] = Leaf(mask(n.mask))
-            continue
-        if not ready:
-            stack.append((n, True))
-            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
-            continue
+    ``mask`` of it (:func:`~feederkit.planning.tree.map_tree`: each distinct node once)."""
+
+    def step(n: Step, subs: tuple) -> Step:
         action = n.action
         if action is not None:
             action = OverlapRange(action.lo, action.hi, mask(action.image))
-        subs = tuple(
-            (ReadingBranch(b.lo, b.hi, mask(b.mask)), nodes[id(sub)]) for b, sub in n.branches
+        return Step(
+            action, tuple((ReadingBranch(b.lo, b.hi, mask(b.mask)), sub) for b, sub in subs)
         )
-        nodes[id(n)] = Step(action, subs)
-    return nodes[id(node)]
+
+    return map_tree(node, lambda x: Leaf(mask(x.mask)), step)

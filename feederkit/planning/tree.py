@@ -63,6 +63,37 @@ def leaf_masks(root: Step | Leaf) -> list[int]:
     return out
 
 
+def map_tree(
+    root: Step | Leaf,
+    leaf: Callable[[Leaf], Leaf],
+    step: Callable[[Step, tuple[tuple[ReadingBranch, Step | Leaf], ...]], Step],
+) -> Step | Leaf:
+    """The plan with every leaf replaced by ``leaf(it)`` and every step by ``step(it, its
+    branches with their subtrees mapped)``: each distinct node once, children first, without
+    recursion (a plan's DAG can have far more paths than nodes, and more levels than Python's
+    stack), so shared subplans stay shared.
+
+    >>> t = Step(None, ((ReadingBranch(1.0, 2.0, 0b11), Leaf(0b11)),))
+    >>> map_tree(t, lambda x: Leaf(x.mask & 1), lambda n, subs: Step(n.action, subs)).branches[0][1]
+    Leaf(mask=1)
+    """
+    nodes: dict[int, Step | Leaf] = {}
+    stack: list[tuple[Step | Leaf, bool]] = [(root, False)]
+    while stack:
+        n, ready = stack.pop()
+        if id(n) in nodes:
+            continue
+        if isinstance(n, Leaf):
+            nodes[id(n)] = leaf(n)
+            continue
+        if not ready:
+            stack.append((n, True))
+            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
+            continue
+        nodes[id(n)] = step(n, tuple((b, nodes[id(sub)]) for b, sub in n.branches))
+    return nodes[id(root)]
+
+
 def branch_pairs(branches: Iterable[tuple[ReadingBranch, object]]) -> int:
     """The (node, state) pairs a step's branches add to a plan: the states of each branch,
     those that can reach the node below it (what verifying the plan walks, and what a

@@ -51,7 +51,7 @@ from feederkit.planning.budget import Deadline, Timeout, collector_paused
 from feederkit.planning.lumping import lumped_words, unresolvable_pairs
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
-from feederkit.planning.tree import Certificate, PlanResult, PlanTree, leaf_masks
+from feederkit.planning.tree import Certificate, PlanResult, PlanTree, leaf_masks, map_tree
 from feederkit.planning.tree import Leaf as TreeLeaf
 from feederkit.planning.tree import Step as TreeStep
 from feederkit.plans.fileformat import as_plan, plan_to_dict, result_nodes
@@ -356,25 +356,14 @@ def listed_together(
 
 
 def _map_leaves(root: PlanTree, leaf: Callable[[TreeLeaf], TreeLeaf]) -> PlanTree:
-    """The tree with every leaf replaced by ``leaf`` of it, each distinct node once, children
-    first, without recursion (sharing kept; a step none of whose leaves changes is kept)."""
-    nodes: dict[int, PlanTree] = {}
-    stack: list[tuple[PlanTree, bool]] = [(root, False)]
-    while stack:
-        n, ready = stack.pop()
-        if id(n) in nodes:
-            continue
-        if isinstance(n, TreeLeaf):
-            nodes[id(n)] = leaf(n)
-            continue
-        if not ready:
-            stack.append((n, True))
-            stack.extend((sub, False) for _b, sub in n.branches if id(sub) not in nodes)
-            continue
-        subs = tuple((b, nodes[id(sub)]) for b, sub in n.branches)
+    """The tree with every leaf replaced by ``leaf`` of it (shared subplans kept shared; a
+    step none of whose leaves changes is kept, :func:`~feederkit.planning.tree.map_tree`)."""
+
+    def step(n: TreeStep, subs: tuple) -> TreeStep:
         same = all(new is old for (_b, new), (_c, old) in zip(subs, n.branches, strict=True))
-        nodes[id(n)] = n if same else TreeStep(n.action, subs)
-    return nodes[id(root)]
+        return n if same else TreeStep(n.action, subs)
+
+    return map_tree(root, leaf, step)
 
 
 def ideal_plan_words(
