@@ -1222,25 +1222,36 @@ def _boxes(bounds: Sequence[Sequence[float]]) -> str:
     return "; ".join(_box(b) for b in bounds[:3]) + ("; ..." if len(bounds) > 3 else "")
 
 
+def _merged_note(what: str, where: str, bounds: Sequence[Sequence[float]], cause: str) -> str:
+    """A warning for regions merged into the part that lines drawn against it may have
+    closed: ``what`` did it to the regions ``where`` (their ``bounds``), ``cause`` what
+    they may be."""
+    return (
+        f"{what} {plural(len(bounds), 'region')}{where} ({_boxes(bounds)}): merged into the "
+        f"part, so its area and COM are off if {cause}; delete such lines or leave their "
+        "layer out with --layer"
+    )
+
+
 def outside_note(bounds: Sequence[Sequence[float]]) -> str:
     """The warning for regions that open lines close against the outline's edge from
     outside (:attr:`Loop.outside`), merged into the part."""
-    return (
-        f"lines close {plural(len(bounds), 'region')} against the outline's edge from outside "
-        f"({_boxes(bounds)}): merged into the part, so its area and COM are off if they are "
-        "extension or dimension lines or a view drawn against it; delete them or leave their "
-        "layer out with --layer"
+    return _merged_note(
+        "lines close",
+        " against the outline's edge from outside",
+        bounds,
+        "they are extension or dimension lines or a view drawn against it",
     )
 
 
 def cut_off_note(bounds: Sequence[Sequence[float]]) -> str:
     """The warning for regions an open line inside the part cuts off (:attr:`Loop.cut_off`),
     merged into the part."""
-    return (
-        f"a line inside the outline ends on it at both ends and cuts off "
-        f"{plural(len(bounds), 'region')} ({_boxes(bounds)}): merged into the part, so its "
-        "area and COM are off if the region is closed by extension or dimension lines or is "
-        "another part drawn against it; delete such lines or leave their layer out with --layer"
+    return _merged_note(
+        "a line inside the outline ends on it at both ends and cuts off",
+        "",
+        bounds,
+        "the region is closed by extension or dimension lines or is another part drawn against it",
     )
 
 
