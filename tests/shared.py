@@ -8,6 +8,7 @@ import functools
 import math
 import random
 import sqlite3
+from collections.abc import Sequence
 from pathlib import Path
 
 import pytest
@@ -161,3 +162,15 @@ def catalog_snapshot(db: Path) -> list[str]:
         return list(conn.iterdump())
     finally:
         conn.close()
+
+
+def catalog_with(tmp_path: Path, capsys, names: Sequence[str]) -> str:
+    """A fresh catalog file holding the bundled ``catalog/`` parts ``names``, its path."""
+    root = Path(__file__).resolve().parents[1] / "catalog"
+    path = str(tmp_path / "c.db")
+    assert run_cli(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    for name in names:
+        assert (
+            run_cli(capsys, "catalog", "add", str(root / f"{name}.json"), "--catalog", path)[0] == 0
+        )
+    return path

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from shared import no_stray_profile, run_cli  # noqa: F401 (autouse)
+from shared import catalog_with, no_stray_profile, run_cli  # noqa: F401 (autouse)
 
 from feederkit.cli.catalog_analyze import IDEAL_ONLY_NOTE, _Readings
 from feederkit.errors import PlanningError
@@ -159,12 +159,7 @@ def test_the_command_line_points_a_chiral_parts_two_sides_to_landings(tmp_path, 
 
 @pytest.fixture()
 def catalog(tmp_path, capsys) -> str:
-    path = str(tmp_path / "c.db")
-    assert run_cli(capsys, "catalog", "init", "--catalog", path)[0] == 0
-    for name in ("rectangle-2x1", "isosceles-right-triangle"):
-        source = str(CATALOG / f"{name}.json")
-        assert run_cli(capsys, "catalog", "add", source, "--catalog", path)[0] == 0
-    return path
+    return catalog_with(tmp_path, capsys, ("rectangle-2x1", "isosceles-right-triangle"))
 
 
 def test_analyze_offers_only_landings_for_one_parts_two_sides(catalog, capsys):

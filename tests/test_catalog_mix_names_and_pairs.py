@@ -12,18 +12,11 @@ import sys
 from pathlib import Path
 
 import pytest
-from shared import no_stray_profile, one_line_error  # noqa: F401 (autouse)
+from shared import catalog_with, no_stray_profile, one_line_error, run_cli  # noqa: F401
 
 from feederkit.catalog import list_parts, similar_names
-from feederkit.cli.app import main
 
 CATALOG = Path(__file__).resolve().parents[1] / "catalog"
-
-
-def run(capsys, *args: str) -> tuple[int, str, str]:
-    rc = main(list(args))
-    cap = capsys.readouterr()
-    return rc, cap.out, cap.err
 
 
 def outline(name: str) -> dict:
@@ -40,12 +33,7 @@ def rename_part(db: str, old: str, new: str) -> None:
 @pytest.fixture()
 def db(tmp_path, capsys) -> str:
     """The L bracket and the T clip."""
-    path = str(tmp_path / "c.db")
-    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
-    for part in ("l-bracket", "t-clip"):
-        source = str(CATALOG / f"{part}.json")
-        assert run(capsys, "catalog", "add", source, "--catalog", path)[0] == 0
-    return path
+    return catalog_with(tmp_path, capsys, ("l-bracket", "t-clip"))
 
 
 # Finding 1: a name with ',' or ':' cannot be put in a mix.
@@ -83,30 +71,30 @@ def test_import_refuses_such_a_name_and_imports_nothing(db, tmp_path, capsys):
 def test_an_old_part_with_a_colon_still_lists_and_shows(db, tmp_path, capsys):
     source = tmp_path / "plate.json"
     source.write_text(json.dumps(outline("plate")))
-    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
     rename_part(db, "plate", "t-clip:0.5")
-    rc, out, _ = run(capsys, "catalog", "list", "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "catalog", "list", "--json", "--catalog", db)
     assert rc == 0 and "t-clip:0.5" in {p["name"] for p in json.loads(out)}
-    rc, out, _ = run(capsys, "catalog", "show", "t-clip:0.5", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "catalog", "show", "t-clip:0.5", "--catalog", db)
     assert rc == 0 and "t-clip:0.5" in out
 
 
 def test_a_mix_item_that_is_a_part_name_and_name_share_is_refused(db, tmp_path, capsys):
     source = tmp_path / "plate.json"
     source.write_text(json.dumps(outline("plate")))
-    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
     rename_part(db, "plate", "t-clip:0.5")
     args = ["changeover", "compile", "odd", "--mix", "t-clip:0.5,l-bracket", "--catalog", db]
     err = one_line_error(capsys, [*args, "--tolerance", "0.2", "--landings", "up"])
     assert "--mix t-clip:0.5 is ambiguous" in err and "part 't-clip' at share 0.5" in err
-    rc, out, _ = run(capsys, "changeover", "list", "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "changeover", "list", "--json", "--catalog", db)
     assert rc == 0 and json.loads(out) == []
 
 
 def test_a_hint_never_suggests_a_name_mix_cannot_take(db, tmp_path, capsys):
     source = tmp_path / "plate.json"
     source.write_text(json.dumps(outline("clip-a")))
-    assert run(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", str(source), "--catalog", db)[0] == 0
     assert "clip-a" in similar_names(db, "clip")
     rename_part(db, "clip-a", "clip,a")
     assert "clip,a" not in similar_names(db, "clip")
@@ -137,7 +125,7 @@ def test_a_source_with_a_revision_that_is_not_a_number_is_named_as_such(db, caps
 
 def test_compile_checks_its_inputs_before_the_name_is_taken(db, capsys):
     args = ["changeover", "compile", "lt", "--mix", "l-bracket,t-clip", "--catalog", db]
-    assert run(capsys, *args, "--tolerance", "0.5", "--landings", "up")[0] in (0, 1)
+    assert run_cli(capsys, *args, "--tolerance", "0.5", "--landings", "up")[0] in (0, 1)
     err = one_line_error(capsys, [*args, "--tolerance", "0.5", "--landings", "sideways"])
     assert "already exists" not in err and "sideways" in err
     err = one_line_error(capsys, [*args, "--tolerance", "0.5", "--accept", "pose-x"])
@@ -156,24 +144,26 @@ def nicked_square(tmp_path: Path) -> Path:
 
 
 def test_analyze_leaves_out_a_member_too_small_for_the_shape_tolerance(db, tmp_path, capsys):
-    assert run(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", db)[0] == 0
     args = ("catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.5")
-    rc, out, _ = run(capsys, *args, "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, *args, "--json", "--catalog", db)
     data = json.loads(out)
     assert rc in (0, 1) and data["uncertainty"]["shape_tolerance_mm"] == 0.5
     assert data["counts"]["parts"] == 3  # the L bracket up and down, the T clip (symmetric)
     left_out = [line for line in data["skipped"] if "nicked" in line]
     assert len(left_out) == 1 and "smallest hull edge" in left_out[0]
     assert "left out (--shape-tolerance)" in left_out[0]
-    rc, _, err = run(capsys, *args, "--catalog", db)
+    rc, _, err = run_cli(capsys, *args, "--catalog", db)
     warned = [line for line in err.splitlines() if line.startswith("warning: nicked")]
     assert rc in (0, 1) and len(warned) == 1 and warned[0].endswith("(--shape-tolerance)")
 
 
 def test_analyze_refuses_a_shape_tolerance_no_member_takes(tmp_path, capsys):
     path = str(tmp_path / "c.db")
-    assert run(capsys, "catalog", "init", "--catalog", path)[0] == 0
-    assert run(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", path)[0] == 0
+    assert run_cli(capsys, "catalog", "init", "--catalog", path)[0] == 0
+    assert (
+        run_cli(capsys, "catalog", "add", str(nicked_square(tmp_path)), "--catalog", path)[0] == 0
+    )
     args = ["catalog", "analyze", "--tolerance", "0.5", "--shape-tolerance", "0.5"]
     err = one_line_error(capsys, [*args, "--catalog", path])
     assert "no member takes the declared tolerances" in err and "--shape-tolerance" in err
@@ -188,7 +178,7 @@ def add_variant(db: str, tmp_path: Path, capsys, name: str, change) -> None:
     change(data)
     path = tmp_path / f"{name}.json"
     path.write_text(json.dumps(data))
-    assert run(capsys, "catalog", "add", str(path), "--catalog", db)[0] == 0
+    assert run_cli(capsys, "catalog", "add", str(path), "--catalog", db)[0] == 0
 
 
 def mirror(data: dict) -> None:
@@ -213,29 +203,29 @@ def test_show_and_list_name_the_pairs_compile_named(
     add_variant(db, tmp_path, capsys, variant, change)
     mix = f"l-bracket,{variant}"
     args = ["changeover", "compile", "co", "--mix", mix, "--tolerance", "0.2"]
-    rc, out, _ = run(capsys, *args, "--landings", landings, "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, *args, "--landings", landings, "--json", "--catalog", db)
     compiled = json.loads(out)["unrecognizable_pairs"]
     assert rc == 1 and compiled and {w["kind"] for w in compiled} == {kind}  # finding 10
-    rc, out, _ = run(capsys, "changeover", "show", "co", "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "changeover", "show", "co", "--json", "--catalog", db)
     assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == compiled
-    rc, out, _ = run(capsys, "changeover", "list", "--json", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "changeover", "list", "--json", "--catalog", db)
     assert rc == 0 and json.loads(out)[0]["unrecognizable_pairs"] == compiled
-    rc, out, _ = run(capsys, "changeover", "show", "co", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "changeover", "show", "co", "--catalog", db)
     text = " ".join(out.split())
     assert rc == 0 and "parts (or landings) this plan cannot tell apart" in text
     assert all(w["reason"].split()[0] in text for w in compiled)
-    rc, out, _ = run(capsys, "changeover", "list", "--catalog", db)
+    rc, out, _ = run_cli(capsys, "changeover", "list", "--catalog", db)
     pair = f"{compiled[0]['part_a']} & {compiled[0]['part_b']}"
     assert rc == 0 and "changeover co: its plan cannot tell apart" in out and pair in out
 
 
 def test_show_of_a_mix_told_apart_names_no_pairs(db, capsys):
     args = ["changeover", "compile", "lt", "--mix", "l-bracket,t-clip", "--tolerance", "0.5"]
-    assert run(capsys, *args, "--landings", "up", "--catalog", db)[0] == 0
-    rc, out, _ = run(capsys, "changeover", "show", "lt", "--json", "--catalog", db)
+    assert run_cli(capsys, *args, "--landings", "up", "--catalog", db)[0] == 0
+    rc, out, _ = run_cli(capsys, "changeover", "show", "lt", "--json", "--catalog", db)
     assert rc == 0 and json.loads(out)["unrecognizable_pairs"] == []
     for command in (("show", "lt"), ("list",)):
-        rc, out, _ = run(capsys, "changeover", *command, "--catalog", db)
+        rc, out, _ = run_cli(capsys, "changeover", *command, "--catalog", db)
         assert rc == 0 and "lt" in out and "cannot tell apart" not in out
 
 
@@ -246,7 +236,7 @@ def test_analyze_json_pairs_carry_their_kind(db, tmp_path, capsys):
     add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
     add_variant(db, tmp_path, capsys, "l-bracket-hole-moved", move_hole)
     args = ("catalog", "analyze", "--tolerance", "0.2", "--rotation-error", "1", "--json")
-    rc, out, _ = run(capsys, *args, "--catalog", db)
+    rc, out, _ = run_cli(capsys, *args, "--catalog", db)
     data = json.loads(out)
     assert rc == 1
     assert {w["kind"] for w in data["unrecognizable_pairs"]} == {"same-push-diameter"}
@@ -259,7 +249,7 @@ def test_analyze_json_pairs_carry_their_kind(db, tmp_path, capsys):
 def test_analyze_does_not_promise_that_a_smaller_rotation_error_helps(db, tmp_path, capsys):
     add_variant(db, tmp_path, capsys, "l-bracket-hole-moved", move_hole)
     args = ("catalog", "analyze", "--tolerance", "0.2", "--rotation-error", "0.001")
-    rc, _, err = run(capsys, *args, "--catalog", db)
+    rc, _, err = run_cli(capsys, *args, "--catalog", db)
     assert rc == 1 and "l-bracket/up & l-bracket-hole-moved/up" in err
     assert "need a smaller rotation error" not in err
     assert "may or may not be told apart with a smaller rotation error" in err
@@ -280,7 +270,7 @@ def test_a_tolerance_is_shown_without_float_noise_and_never_above_itself():
 def test_design_pitches_say_no_tolerance_rather_than_none_mm(db, tmp_path, capsys):
     add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
     args = ("design", "sensor", "--mix", "l-bracket,l-bracket-mirror", "--pitches", "0.5")
-    rc, out, _ = run(capsys, *args, "--catalog", db)
+    rc, out, _ = run_cli(capsys, *args, "--catalog", db)
     assert rc == 1 and "none mm" not in out
     assert "an exact diameter sensor: no tolerance tells every pair apart" in out
 
@@ -299,7 +289,7 @@ def at_80_columns(*args: str) -> list[str]:
 def test_pair_tables_keep_names_whole_at_80_columns(db, tmp_path, capsys):
     add_variant(db, tmp_path, capsys, "l-bracket-mirror", mirror)
     mix = ["--mix", "l-bracket,l-bracket-mirror", "--tolerance", "0.2", "--catalog", db]
-    assert run(capsys, "changeover", "compile", "lr", *mix)[0] == 1
+    assert run_cli(capsys, "changeover", "compile", "lr", *mix)[0] == 1
     for args in (
         ("changeover", "show", "lr", "--catalog", db),
         ("catalog", "analyze", "--tolerance", "0.2", "--catalog", db),
