@@ -3,7 +3,7 @@
 Block references are exploded recursively in world coordinates (rotated, scaled, mirrored
 and nested inserts alike). Curves are flattened within a tolerance by :mod:`.flatten` (a
 bounded version of ezdxf's subdivision); text, dimensions, hatches and other annotation are
-skipped. The loops are built in :mod:`.loops`.
+skipped. The lines become loops in :mod:`.loops` and parts in :mod:`.drawing`.
 """
 
 from __future__ import annotations
@@ -32,16 +32,10 @@ from shapely.geometry import Polygon
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
+from feederkit.importers.drawing import Counterbore, Drawing, counterbores, drawing_from_lines
+from feederkit.importers.drawingnotes import merged_note
 from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
-from feederkit.importers.loops import (
-    Counterbore,
-    Drawing,
-    Region,
-    closing_lines,
-    counterbores,
-    drawing_from_lines,
-    merged_note,
-)
+from feederkit.importers.loops import Region, closing_lines
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
 from feederkit.outline import make_outline, unit_scale

@@ -1,66 +1,33 @@
-"""From loose drawing lines to parts: closed loops, their nesting, holes, and drawing frames.
+"""The closed loops of a drawing's lines: found, healed, and refused when they cross.
 
 Pure functions on polylines in millimetres (numpy arrays of shape (n, 2)). Loops are built
 with ``shapely.polygonize`` per connected group of lines, so lines that cross a part (centre
-lines, bend lines) do not split it; a loop inside a part is a hole, a loop inside a hole is
-a separate part. A closed entity (polyline, circle) or a loop of lines joined end to end
-that crosses itself, or a closed entity crossing another loop, is refused rather than
-merged: polygonizing would split a bow-tie into two parts and weld a crossing circle onto
-the outline.
+lines, bend lines) do not split it. A closed entity (polyline, circle) or a loop of lines
+joined end to end that crosses itself, or a closed entity crossing another loop, is refused
+rather than merged: polygonizing would split a bow-tie into two parts and weld a crossing
+circle onto the outline. A :class:`Region` is a part the loops make (its outer loop and its
+holes); :mod:`.drawing` nests the loops into regions.
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import shapely
-import shapely.affinity
 import shapely.ops
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from shapely.geometry import LineString, Polygon
 
-from feederkit.errors import InputError
 from feederkit.importers.budget import Budget
-from feederkit.outline import invalid_words
 from feederkit.words import plural
 
 Point = tuple[float, float]
 
-FRAME_FILL = 0.9
-"""A drawing frame fills at least this share of its bounding box (it is a rectangle)."""
-
-FRAME_STRAIGHT_REL = 1e-3
-"""A frame's sides are straight: its loop simplified to this share of its size has four
-corners (rounded corners keep their arcs' points)."""
-
-FRAME_MATERIAL = 0.2
-"""A double-line frame border (outer minus inner rectangle) is at most this share of its box."""
-
-TITLE_BLOCK_SHARE = 0.7
-"""In a single-line frame the empty sheet is at least this share of the loop; the rest are
-title-block cells (faces made by lines touching the border)."""
-
-FRAME_HOLE_SHARE = 0.1
-"""A rectangle holding one hole whose box is at most this share of its own may be a bare
-single-line drawing frame around one part: imported as a plate, with a warning."""
-
-FRAME_SHEET_MM = 250.0
-"""A rectangle at least this long is the size of a drawing sheet's frame (A4 is 297 x 210
-mm, its frame a few mm in), far larger than a part for a parts feeder."""
-
-FRAME_SHEET_HOLE_SHARE = 0.25
-"""A sheet-sized rectangle holding one hole whose box is at most this share of its own may
-be a bare single-line drawing frame around one part (an A3 frame around a 150 x 100 mm
-bracket holds 14 %)."""
-
-TITLE_BLOCK_CORNER = 0.05
-"""A title block standing free of its frame lies within this share of the frame's size from
-two adjacent sides of it."""
 
 TANGENT_SPREAD = 1.25
 """A closed line that comes within ``t`` (twice the flatten tolerance) of other lines is
@@ -69,11 +36,9 @@ length within ``t`` (:func:`_tangent`): a curve leaves a tangent curve or line g
 (twice the length within four times the distance), a side drawn along another line stays
 on it and then turns away."""
 
+
 NEAR_COPY_SHARE = 0.01
 """Two closed lines within this share of their size of each other are one loop drawn twice."""
-
-HEAL_GAP_REL = 0.002
-"""Gaps between open line ends up to this share of the drawing's size are closed (0.2 %)."""
 
 
 @dataclass(frozen=True)
@@ -92,31 +57,6 @@ class Region:
     cut_off: tuple[tuple[float, float, float, float], ...] = ()
     """Bounds of the regions merged into the outer loop that an open line inside it cuts off,
     stopping on its outline at both ends (:class:`Loop`)."""
-
-
-@dataclass(frozen=True)
-class Drawing:
-    """The parts of a drawing, largest loop first, what was skipped, and notes for the user.
-
-    ``frames`` counts the drawing frames skipped; ``nested`` counts the parts lying in the
-    first region's holes (a cut sheet); ``warnings`` say what was healed or guessed.
-    """
-
-    regions: tuple[Region, ...]
-    frames: int
-    nested: int = 0
-    warnings: tuple[str, ...] = ()
-
-
-def merged_note(enclosed: int) -> str:
-    """The warning for a part whose outline holds faces enclosed by lines inside it."""
-    return (
-        f"lines inside the part enclose {plural(enclosed, 'region')} touching its outline at "
-        "a point or joined to it by other lines (a hole drawn with lines and touching the "
-        "outline, or crossed by a centre line?): merged into the part, so its area and COM "
-        "may be off if they are holes; check the drawing or leave construction lines out "
-        "with --layer"
-    )
 
 
 def snap_endpoints(lines: Sequence[np.ndarray], gap: float) -> list[np.ndarray]:
@@ -150,7 +90,7 @@ def snap_endpoints(lines: Sequence[np.ndarray], gap: float) -> list[np.ndarray]:
     return out
 
 
-def _along(lines: np.ndarray | shapely.Geometry, other: shapely.Geometry, tol: float) -> np.ndarray:
+def along(lines: np.ndarray | shapely.Geometry, other: shapely.Geometry, tol: float) -> np.ndarray:
     """Which ``lines`` lie wholly within ``tol`` of ``other``: inside its buffer, so a chord's
     middle counts as well as its ends."""
     return shapely.covers(shapely.buffer(other, tol), lines)
@@ -222,10 +162,10 @@ def _bounds(lines: Sequence[np.ndarray]) -> np.ndarray:
 
 def _same(a: shapely.Geometry, b: shapely.Geometry, tol: float) -> bool:
     """Whether two lines are equal within ``tol``: each lies within ``tol`` of the other."""
-    return bool(_along(a, b, tol)) and bool(_along(b, a, tol))
+    return bool(along(a, b, tol)) and bool(along(b, a, tol))
 
 
-def _components(pieces: np.ndarray) -> np.ndarray:
+def components(pieces: np.ndarray) -> np.ndarray:
     """Label of the connected group of each noded line piece."""
     tree = shapely.STRtree(pieces)
     left, right = tree.query(pieces, predicate="intersects")
@@ -312,7 +252,7 @@ def _on_other_lines(
     the ring, or part of it, drawn again (ARCs under a CIRCLE): no stretch it shares with
     another line, as a title-block cell's side on the frame is."""
     cols = np.unique(on_line.indices)
-    other = ~_along(lines[cols], ring.exterior, tol)
+    other = ~along(lines[cols], ring.exterior, tol)
     return np.asarray(on_line[:, cols[other]].sum(axis=1)).ravel() > 0
 
 
@@ -543,7 +483,7 @@ def closed_loops(
         return [], []
     if budget is not None:
         budget.segments(int(shapely.get_num_coordinates(pieces).sum()) - len(pieces))
-    labels = _components(pieces)
+    labels = components(pieces)
     if budget is not None:
         budget.need("loops", face_count(pieces, labels), "closed loops (parts and holes)")
     x0, y0, x1, y1 = shapely.total_bounds(pieces)
@@ -638,133 +578,6 @@ def closed_loops(
     return loops, dangles
 
 
-def _is_rectangle(loop: Polygon) -> bool:
-    """Whether a loop is close to its bounding box and has four corners (a drawing frame, or
-    a plate that could be one; a plate with rounded corners is no frame)."""
-    x0, y0, x1, y1 = loop.bounds
-    box = (x1 - x0) * (y1 - y0)
-    if not (box > 0.0 and loop.area >= FRAME_FILL * box):
-        return False
-    sides = shapely.simplify(loop, FRAME_STRAIGHT_REL * max(x1 - x0, y1 - y0))
-    return len(sides.exterior.coords) - 1 <= 4
-
-
-def nest(loops: Sequence[Polygon]) -> list[int]:
-    """For loops sorted by decreasing area: each one's smallest enclosing loop (-1: none)."""
-    parent = [-1] * len(loops)
-    if not loops:
-        return parent
-    tree = shapely.STRtree(list(loops))
-    shapely.prepare(list(loops))
-    for i, loop in enumerate(loops):
-        point = loop.representative_point()
-        best = -1
-        for j in tree.query(point, predicate="within"):
-            j = int(j)
-            if j < i and loops[j].contains(loop) and (best < 0 or j > best):
-                best = j
-        parent[i] = best
-    return parent
-
-
-def _ring(poly: Polygon) -> tuple[Point, ...]:
-    coords = np.asarray(poly.exterior.coords)[:-1]
-    return tuple((float(x), float(y)) for x, y in coords)
-
-
-def _children(loops: Sequence[Polygon]) -> dict[int, list[int]]:
-    children: dict[int, list[int]] = {}
-    for i, p in enumerate(nest(loops)):
-        children.setdefault(p, []).append(i)
-    return children
-
-
-def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
-    """How many loops (from the largest) a drawing frame takes: 0 (not a frame), 1 or 2.
-
-    A frame is a thin border, not a part: either a double line whose border (outer minus the
-    inner rectangle) is a small share of its box (2 loops), or a single rectangle whose
-    title-block lines touch it (1 loop: its sheet is one large face beside small cells,
-    inside the frame when the frame is one closed line; lines closing a face against a
-    closed outline from outside are a view or dimension drawn against a part).
-    A rectangle whose holes hold parts but which has neither mark is a plate: a cut sheet
-    keeps its material.
-    """
-    if not kids or not _is_rectangle(top.polygon):
-        return 0
-    inner = loops[kids[0]]
-    if _is_rectangle(inner.polygon) and inner.polygon.area >= (1.0 - FRAME_MATERIAL) * (
-        top.polygon.area
-    ):
-        return 2
-    if (
-        top.faces >= 2
-        and not top.outside
-        and top.largest_face >= TITLE_BLOCK_SHARE * top.polygon.area
-    ):
-        return 1
-    return 0
-
-
-def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = None) -> Drawing:
-    """Parts (largest loop first) from closed loops; skips drawing frames.
-
-    A loop at even nesting depth is a part, the loops directly inside it are its holes; parts
-    inside a part's holes (a cut sheet: pieces cut from a plate's window) are separate parts.
-    Drawing frames (:func:`frame_kind`) around the parts are dropped; each one costs a
-    nesting of all loops, so the deadline of ``budget`` is checked between them.
-    """
-    loops = sorted(
-        (lp if isinstance(lp, Loop) else Loop(lp, 1, lp.area) for lp in found),
-        key=lambda p: -p.polygon.area,
-    )
-    frames = 0
-    while loops:
-        if budget is not None:
-            budget.check_time()
-        kids = _children([lp.polygon for lp in loops]).get(0, [])
-        drop = frame_kind(loops[0], loops, kids)
-        if not drop:
-            break
-        loops = [lp for k, lp in enumerate(loops) if k != 0 and (drop == 1 or k != kids[0])]
-        frames += 1
-    polys = [lp.polygon for lp in loops]
-    parent = nest(polys)
-    depth = [0] * len(polys)
-    for i, p in enumerate(parent):
-        depth[i] = 0 if p < 0 else depth[p] + 1
-    holes: dict[int, list[int]] = {}
-    for i, p in enumerate(parent):
-        if depth[i] % 2 == 1:
-            holes.setdefault(p, []).append(i)
-    regions: list[tuple[int, Region]] = []
-    for i, loop in enumerate(polys):
-        if depth[i] % 2:
-            continue
-        hole_loops = [polys[h] for h in holes.get(i, [])]
-        area = loop.area - sum(h.area for h in hole_loops)
-        region = Region(
-            shell=_ring(loop),
-            holes=tuple(_ring(h) for h in hole_loops),
-            area=float(area),
-            loop_area=float(loop.area),
-            enclosed=loops[i].enclosed,
-            outside=loops[i].outside,
-            cut_off=loops[i].cut_off,
-        )
-        regions.append((i, region))
-    regions.sort(key=lambda r: -r[1].loop_area)
-    nested = 0
-    if regions:
-        first = regions[0][0]
-        for i, _ in regions[1:]:
-            k = parent[i]
-            while k >= 0 and k != first:
-                k = parent[k]
-            nested += k == first
-    return Drawing(regions=tuple(r for _, r in regions), frames=frames, nested=nested)
-
-
 def open_ends(lines: Sequence[np.ndarray], tol: float) -> np.ndarray:
     """Indices (into the 2n polyline ends) of ends that meet no other end nor any line."""
     n = len(lines)
@@ -829,13 +642,13 @@ def closing_lines(lines: Sequence[np.ndarray], gap: float) -> list[int]:
     geoms = np.array([shapely.linestrings(np.asarray(ln, dtype=float)) for ln in snapped])
     faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(shapely.union_all(geoms))))
     if len(faces) == 0:
-        return [k for k, ln in enumerate(snapped) if _is_closed(ln, gap)]
+        return [k for k, ln in enumerate(snapped) if is_closed(ln, gap)]
     rims = shapely.union_all(shapely.boundary(faces))
-    on_rim = _along(geoms, rims, max(gap, 1e-9))
-    return [k for k, ln in enumerate(snapped) if on_rim[k] or _is_closed(ln, gap)]
+    on_rim = along(geoms, rims, max(gap, 1e-9))
+    return [k for k, ln in enumerate(snapped) if on_rim[k] or is_closed(ln, gap)]
 
 
-def _is_closed(line: np.ndarray, gap: float) -> bool:
+def is_closed(line: np.ndarray, gap: float) -> bool:
     """Whether a polyline is a closed ring (its ends within ``gap``) with room for an area."""
     return len(line) >= 4 and float(np.hypot(*(line[0] - line[-1]))) <= gap
 
@@ -877,6 +690,7 @@ def _beyond(a: Polygon, b: Polygon, reach: float) -> bool:
 
 CONSTRUCTION_LAYER = re.compile(r"CENT(ER|RE)|CONSTR|HIDDEN|PHANTOM|DASH|AUX", re.IGNORECASE)
 """Layer names of construction geometry (bolt circles, centre lines, helper lines)."""
+
 
 MAX_CROSSING_CANDIDATES = 50
 """Closed lines tried at most, once one is found crossing, to name the likeliest one."""
@@ -983,7 +797,7 @@ def near_copy(
     return None
 
 
-def _without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple[list[Loop], str]:
+def without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple[list[Loop], str]:
     """The loops that have an area, and a warning naming those left out (or "").
 
     A loop is a sliver when it is on average no thicker than twice the flatten tolerance
@@ -1012,362 +826,6 @@ def _without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple
         f"no wider than the flatten tolerance ({gap:.3g} mm) or the gaps closed "
         f"({bridged:.3g} mm); not a part"
     )
-
-
-def _round(poly: Polygon) -> bool:
-    """Whether a loop is a circle or an axis-aligned ellipse (within 5 % of its area)."""
-    x0, y0, x1, y1 = poly.bounds
-    disk = shapely.affinity.scale(
-        shapely.Point((x0 + x1) / 2, (y0 + y1) / 2).buffer(0.5, 64), x1 - x0, y1 - y0
-    )
-    return float(poly.symmetric_difference(disk).area) <= 0.05 * poly.area
-
-
-def frame_doubt(
-    region: Region, lines: Sequence[np.ndarray], gap: float, layers: Sequence[str] | None
-) -> str:
-    """A warning when the imported part may be a bare single-line drawing frame, else "".
-
-    A rectangle with holes and without a title block touching it cannot be told from a
-    plate (:func:`frame_kind`): it is imported as a plate, but said to be a likely frame
-    when it is drawn on a layer none of its holes is on; when it holds a single hole that
-    is not round (a circle or an axis-aligned ellipse: a plate's usual hole) and whose box
-    is at most :data:`FRAME_HOLE_SHARE` of its own and lies at least its own size away from
-    the rectangle, or, for a rectangle the size of a drawing sheet (:data:`FRAME_SHEET_MM`),
-    at most :data:`FRAME_SHEET_HOLE_SHARE` and half its size away (one part drawn in a
-    sheet's frame); or when one of its holes is a title block standing free of the frame
-    (:func:`_title_block`).
-    """
-    shell = Polygon(region.shell)
-    if not region.holes or not _is_rectangle(shell):
-        return ""
-    x0, y0, x1, y1 = shell.bounds
-    box = (x1 - x0) * (y1 - y0)
-    holes = [Polygon(h) for h in region.holes]
-    hx0, hy0, hx1, hy1 = shapely.total_bounds(holes)
-    hole_box = (hx1 - hx0) * (hy1 - hy0)
-    size = max(hx1 - hx0, hy1 - hy0)
-    sheet = max(x1 - x0, y1 - y0) >= FRAME_SHEET_MM
-    small = (
-        len(holes) == 1
-        and not _round(holes[0])
-        and (
-            (hole_box <= FRAME_HOLE_SHARE * box and holes[0].distance(shell.exterior) >= size)
-            or (
-                sheet
-                and hole_box <= FRAME_SHEET_HOLE_SHARE * box
-                and holes[0].distance(shell.exterior) >= 0.5 * size
-            )
-        )
-    )
-    tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
-    block = _title_block(shell, holes, lines, tol)
-    own: set[str] = set()
-    inner: set[str] = set()
-    if layers is not None and len(layers) >= len(lines):
-        rings = [shell.exterior, *(h.exterior for h in holes)]
-        for k, ln in enumerate(lines):
-            pts = shapely.points(np.asarray(ln, dtype=float))
-            for j, ring in enumerate(rings):
-                if shapely.dwithin(pts, ring, tol).all():
-                    (own if j == 0 else inner).add(layers[k])
-                    break
-    apart = bool(own) and bool(inner) and not own & inner
-    if not (small or apart or block is not None):
-        return ""
-    frame_layers = f" on layer {', '.join(sorted(own))}" if own else ""
-    why = f", one of them divided like a title block ({_box(block.bounds)})" if block else ""
-    remedy = (
-        f"leave the frame's layer out with --layer (--layer {' --layer '.join(sorted(inner))})"
-        if apart
-        else "delete the frame, or move it to a layer of its own and leave that out with --layer"
-    )
-    return (
-        f"the part is a {x1 - x0:.4g} x {y1 - y0:.4g} mm rectangle{frame_layers} around "
-        f"{plural(len(holes), 'hole')}{why}: if the rectangle is a drawing frame, the part is "
-        f"what it holds: {remedy}"
-    )
-
-
-def _title_block(
-    shell: Polygon, holes: Sequence[Polygon], lines: Sequence[np.ndarray], tol: float
-) -> Polygon | None:
-    """A hole of a rectangle that looks like a title block standing free of its frame, else
-    None: a rectangle within :data:`TITLE_BLOCK_CORNER` of the frame's size from two of its
-    adjacent sides, divided by lines running inside it from its sides (its cells)."""
-    x0, y0, x1, y1 = shell.bounds
-    reach = TITLE_BLOCK_CORNER * max(x1 - x0, y1 - y0)
-    corner = [
-        h
-        for h in holes
-        if _is_rectangle(h)
-        and min(h.bounds[0] - x0, x1 - h.bounds[2]) <= reach
-        and min(h.bounds[1] - y0, y1 - h.bounds[3]) <= reach
-    ]
-    if not corner or not lines:
-        return None
-    geoms = np.array(
-        [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
-    )
-    for hole in corner:
-        within = shapely.covers(hole.buffer(tol), geoms)
-        cells = within & shapely.dwithin(geoms, hole.exterior, tol)
-        cells &= ~_along(geoms, hole.exterior, tol)
-        if cells.any():
-            return hole
-    return None
-
-
-CONCENTRIC_CENTRE = 0.02
-"""Loops are concentric when their centroids lie within this share of the outer one's
-equivalent diameter (plus twice the flatten tolerance)."""
-
-CONCENTRIC_SPREAD = 1.1
-"""Concentric loops are parallel (a counterbore, not a square in a round hole) when the
-farthest point of one from the other is at most this many times their nearest distance."""
-
-
-@dataclass(frozen=True)
-class Counterbore:
-    """A hole drawn as concentric loops: the ``outer`` loop the part's hole was, the
-    ``inner`` loop taken as the through hole, and the loops of the stack (largest first)."""
-
-    outer: tuple[Point, ...]
-    inner: tuple[Point, ...]
-    rings: tuple[tuple[Point, ...], ...]
-    crosses: bool = False
-    """Whether the outer loop crosses other holes of the part (a bolt circle)."""
-
-
-def concentric(outer: Polygon, inner: Polygon, gap: float) -> bool:
-    """Whether ``inner`` (inside ``outer``) is concentric with it and parallel to it: their
-    centroids close (:data:`CONCENTRIC_CENTRE`), the band between them of even width
-    (:data:`CONCENTRIC_SPREAD`), as a counterbore, countersink or chamfer is drawn."""
-    size = 2.0 * np.sqrt(outer.area / np.pi)
-    if outer.centroid.distance(inner.centroid) > CONCENTRIC_CENTRE * size + 2.0 * gap:
-        return False
-    near = outer.exterior.distance(inner.exterior)
-    far = outer.exterior.hausdorff_distance(inner.exterior)
-    return near > 0.0 and far <= CONCENTRIC_SPREAD * near + 2.0 * gap
-
-
-def counterbores(drawing: Drawing, gap: float) -> tuple[Drawing, list[Counterbore]]:
-    """The drawing with each hole that holds only loops concentric with it and parallel to it
-    (:func:`concentric`) replaced by the smallest of them, those loops' parts dropped.
-
-    A disc in a hole, concentric with it, is a counterbore (or countersink, chamfer,
-    construction circle) drawn in a top view, not a part cut from a sheet: the through hole
-    is the innermost loop and the part keeps the material under the counterbore.
-    """
-    regions = list(drawing.regions)
-    dropped: set[int] = set()
-    found: list[Counterbore] = []
-    for i, region in enumerate(regions):
-        if i in dropped:
-            continue
-        holes = list(region.holes)
-        for h, hole in enumerate(holes):
-            outer = Polygon(hole)
-            inside = [
-                j
-                for j, other in enumerate(regions)
-                if j != i and j not in dropped and outer.contains(Polygon(other.shell))
-            ]
-            rings = [ring for j in inside for ring in (regions[j].shell, *regions[j].holes)]
-            if not rings or not all(concentric(outer, Polygon(r), gap) for r in rings):
-                continue
-            stack = sorted(rings, key=lambda r: -Polygon(r).area)
-            holes[h] = stack[-1]
-            dropped.update(inside)
-            rim = outer.exterior
-            crosses = any(rim.crosses(Polygon(o)) for k, o in enumerate(holes) if k != h)
-            found.append(Counterbore(hole, stack[-1], (hole, *stack), crosses))
-        if holes != list(region.holes):
-            polys = [Polygon(r) for r in holes]
-            area = Polygon(region.shell).area - sum(p.area for p in polys)
-            regions[i] = replace(region, holes=tuple(holes), area=float(area))
-    if not found:
-        return drawing, []
-    first = drawing.regions[0]
-    nested = drawing.nested - sum(1 for j in dropped if _inside(first, regions[j]))
-    kept = tuple(r for j, r in enumerate(regions) if j not in dropped)
-    return replace(drawing, regions=kept, nested=max(0, nested)), found
-
-
-def _inside(region: Region, other: Region) -> bool:
-    """Whether ``other`` lies in one of ``region``'s holes."""
-    shell = Polygon(other.shell)
-    return any(Polygon(h).contains(shell) for h in region.holes)
-
-
-def _picked(values: Sequence[str] | None, keep: Sequence[int], n: int) -> list[str] | None:
-    """``values[k]`` for each ``k`` in ``keep``; None unless there is one value per line."""
-    return None if values is None or len(values) != n else [values[k] for k in keep]
-
-
-NEARLY_CLOSED = 0.25
-"""Open lines nearly close a loop when their two free ends lie at most this share of their
-size apart (an ARC of 330 degrees or more, four LINEs of a window one of which stops
-short); a centre line, a centre mark or a bend line does not."""
-
-
-def _box(bounds: Sequence[float]) -> str:
-    """A box in words: ``80 x 10 mm at x 0..80, y -10..0``."""
-    x0, y0, x1, y1 = bounds
-    return f"{x1 - x0:.4g} x {y1 - y0:.4g} mm at x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g}"
-
-
-def _boxes(bounds: Sequence[Sequence[float]]) -> str:
-    """At most three boxes in words (:func:`_box`), "; ..." when there are more."""
-    return "; ".join(_box(b) for b in bounds[:3]) + ("; ..." if len(bounds) > 3 else "")
-
-
-def _merged_note(what: str, where: str, bounds: Sequence[Sequence[float]], cause: str) -> str:
-    """A warning for regions merged into the part that lines drawn against it may have
-    closed: ``what`` did it to the regions ``where`` (their ``bounds``), ``cause`` what
-    they may be."""
-    return (
-        f"{what} {plural(len(bounds), 'region')}{where} ({_boxes(bounds)}): merged into the "
-        f"part, so its area and COM are off if {cause}; delete such lines or leave their "
-        "layer out with --layer"
-    )
-
-
-def outside_note(bounds: Sequence[Sequence[float]]) -> str:
-    """The warning for regions that open lines close against the outline's edge from
-    outside (:attr:`Loop.outside`), merged into the part."""
-    return _merged_note(
-        "lines close",
-        " against the outline's edge from outside",
-        bounds,
-        "they are extension or dimension lines or a view drawn against it",
-    )
-
-
-def cut_off_note(bounds: Sequence[Sequence[float]]) -> str:
-    """The warning for regions an open line inside the part cuts off (:attr:`Loop.cut_off`),
-    merged into the part."""
-    return _merged_note(
-        "a line inside the outline ends on it at both ends and cuts off",
-        "",
-        bounds,
-        "the region is closed by extension or dimension lines or is another part drawn against it",
-    )
-
-
-def side_by_side_note(bounds: Sequence[Sequence[float]]) -> str:
-    """The warning for closed outlines lying side by side, read as separate parts
-    (:attr:`Loop.split`)."""
-    return (
-        f"{plural(len(bounds), 'closed outline')} share edges side by side ({_boxes(bounds)}): "
-        "read as separate parts, not merged into one (parts nested for common-line cutting, or "
-        "a view drawn against its part?); if they are one part, draw its outline as one closed "
-        "line"
-    )
-
-
-def _free_ends(chain: shapely.Geometry) -> np.ndarray:
-    """The ends of a group of noded open lines that no other of its lines meets."""
-    parts = shapely.get_parts(chain)
-    ends = np.concatenate([shapely.get_coordinates(shapely.get_point(parts, k)) for k in (0, -1)])
-    _, first, counts = np.unique(ends, axis=0, return_index=True, return_counts=True)
-    return ends[np.sort(first[counts == 1])]
-
-
-def open_line_notes(
-    dangles: Sequence[LineString], regions: Sequence[Region], gap: float
-) -> list[str]:
-    """Warnings for open lines (``dangles``, the lines no loop uses) that may be an outline
-    left open: a connected group of them around the first part (its real outline open, so
-    the part may be one of its holes), or one nearly closing a loop (:data:`NEARLY_CLOSED`)
-    inside a part's material (a hole whose outline is open, left out).
-
-    Each group is joined over its noded pieces, so an outline of six LINEs one of which
-    stops short counts as one, as an open polyline does.
-    """
-    if not dangles or not regions:
-        return []
-    pieces = np.asarray(dangles, dtype=object)
-    labels = _components(pieces)
-    groups = [shapely.multilinestrings(pieces[labels == lab]) for lab in np.unique(labels)]
-    part = Polygon(regions[0].shell)
-    notes: list[str] = []
-    around = [g for g in groups if _around(g, part)]
-    if around:
-        ends = _free_ends(around[0])
-        notes.append(
-            f"an open outline ({_ends(ends)}, too far apart to close) surrounds the imported "
-            "part: the drawing's real outer outline may be open and the part one of its holes; "
-            "close the outline in the drawing"
-        )
-    nearly: list[tuple[shapely.Geometry, np.ndarray]] = []
-    for g in groups:
-        ends = _free_ends(g)
-        if _nearly_closed(g, ends, gap):
-            nearly.append((g, ends))
-    inside: list[tuple[shapely.Geometry, np.ndarray]] = []
-    if nearly:
-        solids = [Polygon(r.shell, r.holes) for r in regions]
-        tree = shapely.STRtree(solids)
-        for g, ends in nearly:
-            hits = tree.query(g, predicate="intersects")
-            if any(solids[int(j)].buffer(2.0 * gap).covers(g) for j in hits):
-                inside.append((g, ends))
-    if inside:
-        g, ends = inside[0]
-        more = f" and {len(inside) - 1} more" if len(inside) > 1 else ""
-        notes.append(
-            f"open lines inside the part nearly close {plural(len(inside), 'loop')} "
-            f"({_box(g.bounds)}, {_ends(ends)}{more}), left out: if they are a hole whose "
-            "outline is open, the part's area and COM are off; close the gap in the drawing"
-        )
-    return notes
-
-
-def _around(group: shapely.Geometry, part: Polygon) -> bool:
-    """Whether a connected group of open lines goes around ``part``: one of its lines holds
-    the part's box strictly inside its own (an open polyline around it), or it is one chain
-    that, closed between its two ends, holds the whole part (an outline of LINEs one of
-    which stops short). Extension and dimension lines around a part branch: no chain."""
-    x0, y0, x1, y1 = part.bounds
-    for line in shapely.get_parts(group):
-        lx0, ly0, lx1, ly1 = line.bounds
-        if lx0 < x0 and ly0 < y0 and lx1 > x1 and ly1 > y1:
-            return True
-    chain = shapely.line_merge(group)
-    if not isinstance(chain, LineString) or chain.is_closed or len(chain.coords) < 3:
-        return False
-    ring = shapely.node(shapely.linearrings(np.asarray(chain.coords)))
-    inside = shapely.union_all(shapely.get_parts(shapely.polygonize(shapely.get_parts(ring))))
-    return bool(inside.covers(part))
-
-
-def _ends(ends: np.ndarray) -> str:
-    """Open ends in words: ``its ends 0.5 mm apart at (79.5, 0) and (80, 0)``."""
-    if len(ends) == 2:
-        (ax, ay), (bx, by) = ends
-        return (
-            f"its ends {float(np.hypot(ax - bx, ay - by)):.3g} mm apart at "
-            f"({ax:.4g}, {ay:.4g}) and ({bx:.4g}, {by:.4g})"
-        )
-    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends[:3])
-    return f"{plural(len(ends), 'open end')} at {where}{', ...' if len(ends) > 3 else ''}"
-
-
-def _nearly_closed(group: shapely.Geometry, ends: np.ndarray, gap: float) -> bool:
-    """Whether a connected group of open lines is one chain whose two ends lie at most
-    :data:`NEARLY_CLOSED` of its size apart and which, closed there, encloses an area (not a
-    line drawn there and back): a loop left open."""
-    if len(ends) != 2:
-        return False
-    chain = shapely.line_merge(group)
-    if not isinstance(chain, LineString) or len(chain.coords) < 3:
-        return False
-    x0, y0, x1, y1 = chain.bounds
-    apart = float(np.hypot(*(ends[0] - ends[1])))
-    if apart > NEARLY_CLOSED * max(x1 - x0, y1 - y0):
-        return False
-    return abs(float(shapely.area(Polygon(chain.coords)))) > gap * chain.length
 
 
 def line_cycles(lines: Sequence[np.ndarray], skip: set[int]) -> list[list[int]]:
@@ -1409,7 +867,7 @@ def line_cycles(lines: Sequence[np.ndarray], skip: set[int]) -> list[list[int]]:
     return cycles
 
 
-def _joined(lines: Sequence[np.ndarray], cycle: Sequence[int]) -> np.ndarray:
+def joined(lines: Sequence[np.ndarray], cycle: Sequence[int]) -> np.ndarray:
     """The closed polyline of a loop of lines (:func:`line_cycles`), each turned to follow
     the one before."""
     out = [np.asarray(lines[cycle[0]], dtype=float)]
@@ -1421,107 +879,3 @@ def _joined(lines: Sequence[np.ndarray], cycle: Sequence[int]) -> np.ndarray:
         ln = np.asarray(lines[k], dtype=float)
         out.append((ln if np.array_equal(ln[0], out[-1][-1]) else ln[::-1])[1:])
     return np.concatenate(out)
-
-
-def drawing_from_lines(
-    lines: Sequence[np.ndarray],
-    gap: float,
-    label: str,
-    budget: Budget | None = None,
-    names: Sequence[str] | None = None,
-    layers: Sequence[str] | None = None,
-) -> Drawing:
-    """Parts of a drawing from its flattened lines (mm); InputError without a closed loop.
-
-    Line ends closer than ``gap`` (the flatten tolerance) are joined and a line repeating
-    another within ``gap`` is left out (:func:`repeated_lines`); open ends up to
-    :data:`HEAL_GAP_REL` of the drawing's size apart are bridged, with a warning, before the
-    loops and holes are chosen. A closed line that crosses itself, or crosses another loop
-    (a hole across the outline), is refused, as an outline file with those faults is;
-    ``names[k]`` names line ``k`` in that error (an entity and its layer), ``layers[k]`` is
-    its layer (:func:`frame_doubt`). A loop with no area to speak of (:func:`_without_slivers`)
-    is left out with a warning.
-    """
-    if not lines:
-        raise InputError(f"{label}: the drawing has no lines, arcs or curves")
-    pts = np.concatenate([np.asarray(ln, dtype=float) for ln in lines])
-    extent = pts.max(axis=0) - pts.min(axis=0)
-    if float(extent.max()) == 0.0 or float(extent.min()) <= 1e-12 * float(extent.max()):
-        raise InputError(f"{label}: the outline has zero area (all geometry lies on a line)")
-    snapped = snap_endpoints(lines, gap)
-    repeats = set(repeated_lines(snapped, gap, budget))
-    keep = [k for k in range(len(snapped)) if k not in repeats]
-    snapped = [snapped[k] for k in keep]
-    names, layers = _picked(names, keep, len(lines)), _picked(layers, keep, len(lines))
-
-    def name(k: int) -> str:
-        return names[k] if names is not None and k < len(names) else f"closed line {k + 1}"
-
-    closed = [k for k, ln in enumerate(snapped) if _is_closed(ln, gap)]
-    for k in closed:
-        reason = self_crossing(snapped[k])
-        if reason is not None:
-            raise InputError(
-                f"{label}: the outline is self-intersecting ({name(k)} {invalid_words(reason)})"
-            )
-    for cycle in line_cycles(snapped, set(closed)):
-        if budget is not None:
-            budget.check_time()
-        reason = self_crossing(_joined(snapped, cycle))
-        if reason is not None:
-            raise InputError(
-                f"{label}: the outline is self-intersecting (the loop of {name(cycle[0])} and "
-                f"{plural(len(cycle) - 1, 'other line')} {invalid_words(reason)})"
-            )
-    healed, notes = heal_gaps(snapped, gap, HEAL_GAP_REL * float(extent.max()))
-    if budget is not None:
-        budget.check_time()
-    loops, dangles = closed_loops(healed, budget, [healed[k] for k in closed], gap)
-    if not loops:
-        ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
-        detail = f" ({plural(ends, 'open end')})" if ends else ""
-        raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
-    shells = [lp.polygon for lp in loops]
-    found = crossing_loop(healed, closed, shells, gap, budget, layers)
-    if found is not None:
-        crossing, crossed = found
-        copy = near_copy(healed, closed, crossing, gap)
-        if copy is not None:
-            largest = max(p.area for p in shells)
-            what = "the outline" if Polygon(healed[crossing]).area >= 0.9 * largest else "a loop"
-            raise InputError(
-                f"{label}: {what} seems drawn twice, {copy[1]:.2g} mm apart ({name(copy[0])} "
-                f"and {name(crossing)}): delete one copy"
-            )
-        if crosses_the_outline(healed, closed, shells, crossing):
-            raise InputError(
-                f"{label}: a hole crosses the outline ({name(crossing)} crosses "
-                f"{plural(crossed, 'other loop')}; leave construction geometry out with --layer)"
-            )
-        raise InputError(
-            f"{label}: loops cross inside the outline ({name(crossing)} crosses "
-            f"{plural(crossed, 'other loop')}: a bolt circle or other construction geometry? "
-            "leave it out with --layer, or draw it in a centre linetype)"
-        )
-    bridged = max((float(np.hypot(*(b[-1] - b[0]))) for b in healed[len(snapped) :]), default=0.0)
-    loops, slivers = _without_slivers(loops, gap, bridged)
-    if slivers:
-        if not loops:
-            raise InputError(
-                f"{label}: the outline has zero area (its closed loops are no wider than the "
-                f"flatten tolerance, {gap:.3g} mm)"
-            )
-        notes.append(slivers)
-    split = [lp.polygon.bounds for lp in loops if lp.split]
-    if split:
-        notes.append(side_by_side_note(split))
-    drawing = regions_from_loops(loops, budget)
-    if not drawing.regions:
-        raise InputError(f"{label}: no closed outline outside a drawing frame")
-    notes += [outside_note(r.outside) for r in drawing.regions if r.outside]
-    notes += [cut_off_note(r.cut_off) for r in drawing.regions if r.cut_off]
-    doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)
-    if doubt:
-        notes.append(doubt)
-    notes += open_line_notes(dangles, drawing.regions, gap)
-    return Drawing(drawing.regions, drawing.frames, drawing.nested, tuple(notes))
