@@ -28,7 +28,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from feederkit.plans.fileformat import read_plan
+from feederkit.plans.readplan import read_plan
 
 MAX_OVERSHOOT_S = 2.5
 """The command may end this many seconds past its limit, beyond Python's own start."""

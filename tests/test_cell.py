@@ -281,7 +281,7 @@ def test_the_statistics_table_says_the_mix_shares_weigh_the_expectation(mix_plan
     from rich.console import Console
 
     from feederkit.cli.plan_render import stats_table
-    from feederkit.plans.fileformat import as_plan
+    from feederkit.plans.readplan import as_plan
 
     pfs = [
         push_function(load_part(str(CATALOG / f"{n}.json")))

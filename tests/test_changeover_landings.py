@@ -27,7 +27,8 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.outline import make_outline
-from feederkit.plans.fileformat import plan_from_dict, plan_json
+from feederkit.plans.fileformat import plan_json
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL
 

@@ -199,7 +199,7 @@ def test_a_bug_without_ctrl_c_is_still_a_bug(capsys, monkeypatch):
 
 
 # 4. ``run``'s wording. The lines come from the library (feederkit/plans/match.py, strong.py,
-# fileformat.py); the command line passes them through.
+# readplan.py); the command line passes them through.
 
 
 def test_a_part_not_in_the_plan_names_the_plans_parts_plainly(good_plan, capsys):

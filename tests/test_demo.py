@@ -14,7 +14,7 @@ import pytest
 from feederkit.cli.app import main
 from feederkit.demo import DemoResult, run_demo
 from feederkit.errors import InputError
-from feederkit.plans.fileformat import read_plan
+from feederkit.plans.readplan import read_plan
 from feederkit.plans.verify import check_plan
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -31,8 +31,8 @@ from feederkit.mechanics.analysis import (
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.plans.fileformat import plan_from_dict
 from feederkit.plans.model import member_fragile_warnings
+from feederkit.plans.readplan import plan_from_dict
 
 # An L bracket (legs 60 and 40 mm, 15 mm wide) with two 6.6 mm holes: its short end (edge
 # normal 0 deg) is a stable state 0.05 mm from tipping, below the fragile threshold of

@@ -28,9 +28,9 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.stats import expected_operations
 from feederkit.planning.tree import Leaf as TreeLeaf
-from feederkit.plans.fileformat import plan_from_dict
 from feederkit.plans.make import make_plan
 from feederkit.plans.model import PlanMember
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL
 

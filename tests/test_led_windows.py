@@ -26,8 +26,9 @@ from feederkit.mechanics import push_function
 from feederkit.outline import load_outline_json
 from feederkit.part import make_part
 from feederkit.plans.execute import execute
-from feederkit.plans.fileformat import LED_WINDOWS, plan_from_dict, plan_json
+from feederkit.plans.fileformat import LED_WINDOWS, plan_json
 from feederkit.plans.model import Plan, Step
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.plans.verify import verify_declared
 from feederkit.sensors import LED_WINDOW_REL, LedSensor
 from feederkit.uncertainty import IDEAL, Uncertainty

@@ -69,7 +69,7 @@ def test_the_sensorless_plan_no_longer_ends_where_a_push_overshoots():
 def test_the_plan_succeeds_in_the_physics_check():
     # The 6-operation plan succeeded in 87 of 100 and 164 of 200 trials; P(100 of 100) at
     # that rate is below 1e-5.
-    from feederkit.plans.fileformat import plan_from_dict
+    from feederkit.plans.readplan import plan_from_dict
     from feederkit.sim import simulate_plan
 
     made = make_plan([push_function(polygon())], NoSensor())

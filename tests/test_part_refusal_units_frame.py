@@ -22,8 +22,9 @@ from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline, save_outline_json
 from feederkit.part import Part, make_part
-from feederkit.plans.fileformat import as_plan, plan_json
+from feederkit.plans.fileformat import plan_json
 from feederkit.plans.make import make_plan
+from feederkit.plans.readplan import as_plan
 from feederkit.sensors import NoSensor
 from feederkit.sim.likeness import likely_units, likeness, scale_of
 from feederkit.sim.real import check_match

@@ -21,7 +21,7 @@ from shared import no_stray_profile, one_line_error  # noqa: F401 (an autouse fi
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError
-from feederkit.plans.fileformat import plan_from_dict, read_plan
+from feederkit.plans.readplan import plan_from_dict, read_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 CATALOG = ROOT / "catalog"
@@ -359,7 +359,7 @@ def test_an_unknown_objective_is_refused(written) -> None:
 def test_class_and_objective_may_be_null_or_any_of_design_mds(written) -> None:
     """Null: a mix's plan has no class; the objectives are the planner's (``--objective``)."""
     from feederkit.planning.options import Objective
-    from feederkit.plans.fileformat import OBJECTIVES
+    from feederkit.plans.readplan import OBJECTIVES
 
     assert set(OBJECTIVES) == {o.value for o in Objective}
     for objective in (None, *OBJECTIVES):
@@ -391,7 +391,7 @@ def test_a_sensor_key_of_another_model_is_refused(written, sensor: dict, words: 
 
 
 def test_the_sensor_parameters_are_the_ones_the_models_write() -> None:
-    from feederkit.plans.fileformat import SENSOR_PARAMETERS
+    from feederkit.plans.readplan import SENSOR_PARAMETERS
     from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 
     for sensor in (NoSensor(), ToleranceSensor(0.1), LedSensor(0.5, 0.1)):
@@ -412,7 +412,7 @@ def test_a_plan_its_own_loader_refuses_is_never_written(written, tmp_path, monke
     """Every written plan is read back as a reader will before anything is written: a file
     the loader refuses is a bug (exit 70) and no file, not a written plan that ``run`` then
     refuses."""
-    from feederkit.plans.fileformat import plan_file_text, plan_from_text
+    from feederkit.plans.readplan import plan_file_text, plan_from_text
 
     assert plan_from_text(plan_file_text(written)).parts[0].name == "l-bracket"
     with pytest.raises(AssertionError, match="its own loader refuses: .*revision"):
@@ -439,7 +439,7 @@ def test_a_plan_as_deep_as_the_loader_takes_parses() -> None:
     """A stored changeover's plan is parsed as deep as a plan file may be (three JSON levels
     per operation), not to the JSON files' general limit."""
     from feederkit.jsonio import MAX_JSON_DEPTH, parse_json
-    from feederkit.plans.fileformat import parse_plan_text
+    from feederkit.plans.readplan import parse_plan_text
 
     text = "[" * (MAX_JSON_DEPTH + 50) + "]" * (MAX_JSON_DEPTH + 50)
     with pytest.raises(InputError):

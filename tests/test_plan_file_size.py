@@ -14,7 +14,8 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.tree import Leaf, PlanResult, Step
-from feederkit.plans.fileformat import file_nodes, plan_from_dict, plan_from_result, plan_to_dict
+from feederkit.plans.fileformat import file_nodes, plan_from_result, plan_to_dict
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.plans.verify import verify_plan
 from feederkit.sensors import ToleranceSensor
 

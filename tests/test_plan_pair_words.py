@@ -10,8 +10,8 @@ import pytest
 from shared import run_cli
 
 from feederkit.plans.execute import execute
-from feederkit.plans.fileformat import read_plan
 from feederkit.plans.model import Leaf, ResultEntry, names_several
+from feederkit.plans.readplan import read_plan
 from feederkit.plans.verify import verify_declared
 from feederkit.reports.sections import simulation_text
 
@@ -197,8 +197,8 @@ def read_plan_of_triangle():
     from feederkit.mechanics.push import push_function
     from feederkit.outline import make_outline
     from feederkit.part import make_part
-    from feederkit.plans.fileformat import plan_from_dict
     from feederkit.plans.make import make_plan
+    from feederkit.plans.readplan import plan_from_dict
     from feederkit.sensors import ToleranceSensor
 
     pf = push_function(make_part(make_outline("tri", TRI)))

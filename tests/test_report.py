@@ -414,7 +414,7 @@ def test_only_the_first_members_get_a_part_plot(monkeypatch):
 def test_a_skipped_part_plot_names_the_members_catalog_revision():
     from dataclasses import replace
 
-    from feederkit.plans.fileformat import plan_from_dict
+    from feederkit.plans.readplan import plan_from_dict
     from feederkit.reports.parts_html import _no_plot
 
     plan = plan_from_dict(twin_plan())

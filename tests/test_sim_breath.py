@@ -133,7 +133,7 @@ def test_simulate_breathes_with_the_vibration_of_the_plans_model(monkeypatch):
 @pytest.mark.parametrize("own", [False, True], ids=["hull", "own-outline"])
 def test_the_idler_risers_plan_succeeds_in_every_trial(own):
     from feederkit.loading import load_parts
-    from feederkit.plans.fileformat import as_plan
+    from feederkit.plans.readplan import as_plan
     from feederkit.sim.real import real_parts
 
     source = str(SAMPLES / "trimesh__idler_riser.STL")

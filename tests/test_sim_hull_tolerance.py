@@ -15,7 +15,7 @@ import pytest
 from shared import cli_ok, one_line_error
 
 from feederkit.errors import InputError
-from feederkit.plans.fileformat import as_plan
+from feederkit.plans.readplan import as_plan
 from feederkit.sim.real import plan_drawing, real_parts
 
 needs_mujoco = pytest.mark.skipif(

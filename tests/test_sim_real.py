@@ -24,9 +24,10 @@ from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline, save_outline_json
 from feederkit.part import Part, make_part
-from feederkit.plans.fileformat import as_plan, plan_json
+from feederkit.plans.fileformat import plan_json
 from feederkit.plans.make import make_plan
 from feederkit.plans.model import Leaf, ResultEntry
+from feederkit.plans.readplan import as_plan
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.sim.pushalign import SettleRule, range_distance
 from feederkit.sim.real import (

@@ -24,8 +24,9 @@ from hypothesis import strategies as st
 from feederkit.cli.app import main
 from feederkit.errors import InputError
 from feederkit.mechanics.push import push_function
-from feederkit.plans.fileformat import plan_from_dict, plan_json, plan_to_dict
+from feederkit.plans.fileformat import plan_json, plan_to_dict
 from feederkit.plans.make import make_plan
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.plans.verify import verify_declared
 from feederkit.sensors import ToleranceSensor
 from feederkit.sim.sampling import (

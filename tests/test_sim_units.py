@@ -11,8 +11,8 @@ import pytest
 from test_sim_plans import build_plan, pentagon, rectangle
 
 from feederkit.errors import CheckFailed, InputError
-from feederkit.plans.fileformat import plan_from_dict
 from feederkit.plans.model import Leaf, Step, push_function_of
+from feederkit.plans.readplan import plan_from_dict
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 from feederkit.sim.massprops import plate_inertia, region_moments
 from feederkit.sim.scene import SceneConfig, scene_xml

@@ -98,8 +98,8 @@ from feederkit.mix.changeover import (
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.fileformat import as_plan, plan_file_text
 from feederkit.plans.model import pairs_words
+from feederkit.plans.readplan import as_plan, plan_file_text
 from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 

@@ -22,8 +22,8 @@ from feederkit.cli.common import add_count_column, add_name_column, plural
 from feederkit.errors import InputError
 from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
-from feederkit.plans.fileformat import MAX_PLAN_BYTES, as_plan, read_plan
 from feederkit.plans.model import Leaf, Plan, Step, member_label
+from feederkit.plans.readplan import MAX_PLAN_BYTES, as_plan, read_plan
 from feederkit.plans.verify import VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
 

@@ -2,10 +2,11 @@
 verification on geometry; plans over landings (reject results) and shared subplans.
 
 - :mod:`~feederkit.plans.model`: the one immutable :class:`Plan` (parts, sensor, tree, stats).
-- :mod:`~feederkit.plans.fileformat`: the only maker and writer of a Plan:
-  ``plan_from_result``, ``plan_from_dict``, ``read_plan`` (size and depth limits),
-  ``plan_to_dict``, ``plan_json``, ``plan_file_text`` and ``read_back`` (checked before
-  anything is written), ``write_plan`` (atomic).
+- :mod:`~feederkit.plans.fileformat`: the format's constants, the maker of a Plan from a
+  planner's result (``plan_from_result``) and its writer: ``plan_to_dict``, ``plan_json``.
+- :mod:`~feederkit.plans.readplan`: the reader and checker of a plan file:
+  ``plan_from_dict``, ``read_plan`` (size and depth limits), ``plan_file_text`` and
+  ``read_back`` (checked before anything is written), ``write_plan`` (atomic).
 - :mod:`~feederkit.plans.stats`: the ``stats`` object (length, margins, Fig. 14 class bound).
 - :mod:`~feederkit.plans.execute`: ``execute`` a plan on the kinematic model rebuilt from
   the plan's hulls and COMs, giving a ``Trace``.
@@ -18,19 +19,10 @@ from feederkit.plans.execute import Trace, TraceStep, execute
 from feederkit.plans.fileformat import (
     CONVENTIONS,
     FORMAT,
-    MAX_PLAN_BYTES,
-    MAX_PLAN_DEPTH,
     VERSION,
-    as_plan,
-    plan_file_text,
-    plan_from_dict,
     plan_from_result,
     plan_json,
     plan_to_dict,
-    read_back,
-    read_plan,
-    validate_plan,
-    write_plan,
 )
 from feederkit.plans.match import leaf_part_pairs, match_part
 from feederkit.plans.model import (
@@ -43,6 +35,17 @@ from feederkit.plans.model import (
     ResultEntry,
     Step,
     push_function_of,
+)
+from feederkit.plans.readplan import (
+    MAX_PLAN_BYTES,
+    MAX_PLAN_DEPTH,
+    as_plan,
+    plan_file_text,
+    plan_from_dict,
+    read_back,
+    read_plan,
+    validate_plan,
+    write_plan,
 )
 from feederkit.plans.stats import plan_stats
 from feederkit.plans.verify import PartCheck, VerificationReport, check_plan, verify_plan

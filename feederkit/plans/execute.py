@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from feederkit.mechanics.push import StableState, push, rotation_after
-from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, ResultEntry, Step, member_label, push_function_of
+from feederkit.plans.readplan import as_plan
 from feederkit.sensors import Sensor
 from feederkit.words import plural
 

@@ -54,8 +54,9 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.tree import Certificate, PlanResult, PlanTree, leaf_masks, map_tree
 from feederkit.planning.tree import Leaf as TreeLeaf
 from feederkit.planning.tree import Step as TreeStep
-from feederkit.plans.fileformat import as_plan, plan_to_dict, result_nodes
+from feederkit.plans.fileformat import plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
+from feederkit.plans.readplan import as_plan
 from feederkit.plans.strong import (
     ideal_view,
     max_rotation_error_deg,

@@ -8,8 +8,8 @@ from typing import Any
 
 from feederkit.errors import InputError
 from feederkit.part import Part
-from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Plan, PlanPart
+from feederkit.plans.readplan import as_plan
 
 MATCH_REL_TOL = 1e-6
 """Hull vertices and COM must agree within this fraction of the part's size."""

@@ -11,8 +11,9 @@ correct answer, and a reject leaf (``reject``) lists landings the next station c
 every walk here visits each distinct node once, so a plan with astronomically many paths
 costs its number of distinct nodes.
 
-Only :mod:`feederkit.plans.fileformat` makes a :class:`Plan` (from a file, a dict or a
-planner's result) and writes one; everything else reads it. Every value here is a frozen
+Only :mod:`feederkit.plans.fileformat` (from a planner's result) and
+:mod:`feederkit.plans.readplan` (from a file, its text or a dict) make a :class:`Plan`, and
+only they write one; everything else reads it. Every value here is a frozen
 dataclass; a part's push function (section 3.1) is rebuilt from the hull and COM the plan
 records, by :func:`push_function_of`, an explicit cache keyed by the part.
 """

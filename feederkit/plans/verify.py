@@ -38,8 +38,8 @@ from feederkit.errors import CheckFailed
 from feederkit.mechanics.push import PushFunction, StableState, push, rotation_after
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, NEAR_SYMMETRIC_REL, pose_differences
 from feederkit.plans.execute import Trace, TraceStep, finish, rounding_inset
-from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Node, Plan, Step, member_label, push_function_of
+from feederkit.plans.readplan import as_plan
 from feederkit.sensors import Sensor
 from feederkit.words import plural
 

@@ -19,8 +19,8 @@ from typing import Any
 
 from feederkit.errors import InputError
 from feederkit.outline import Outline
-from feederkit.plans.fileformat import as_plan
 from feederkit.plans.model import Leaf, Plan, PlanPart, Step
+from feederkit.plans.readplan import as_plan
 from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.reports.design_html import design_section
 from feederkit.reports.parts_html import part_section

@@ -25,8 +25,9 @@ import numpy as np
 from feederkit.errors import InputError
 from feederkit.mechanics.push import StableState, push, push_function
 from feederkit.part import Part
-from feederkit.plans.fileformat import as_plan, plan_to_dict
+from feederkit.plans.fileformat import plan_to_dict
 from feederkit.plans.model import Plan, push_function_of
+from feederkit.plans.readplan import as_plan
 from feederkit.plans.verify import check_declared
 from feederkit.sim.pushalign import PushAligner, PushOutcome, SettleRule
 from feederkit.sim.real import REAL_SETTLE_RULE, RealPart
