@@ -32,7 +32,7 @@ from feederkit.mechanics.analysis import analyze_part
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import CompiledChangeover, compile_changeover, landing_rows
 from feederkit.mix.lookalike import build_lookalike
-from feederkit.plans.readplan import plan_file_text
+from feederkit.plans.writeplan import plan_file_text
 from feederkit.sensors import NoSensor, Sensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 

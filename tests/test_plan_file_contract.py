@@ -412,7 +412,8 @@ def test_a_plan_its_own_loader_refuses_is_never_written(written, tmp_path, monke
     """Every written plan is read back as a reader will before anything is written: a file
     the loader refuses is a bug (exit 70) and no file, not a written plan that ``run`` then
     refuses."""
-    from feederkit.plans.readplan import plan_file_text, plan_from_text
+    from feederkit.plans.readplan import plan_from_text
+    from feederkit.plans.writeplan import plan_file_text
 
     assert plan_from_text(plan_file_text(written)).parts[0].name == "l-bracket"
     with pytest.raises(AssertionError, match="its own loader refuses: .*revision"):

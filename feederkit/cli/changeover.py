@@ -99,7 +99,8 @@ from feederkit.mix.changeover import (
 )
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.model import pairs_words
-from feederkit.plans.readplan import as_plan, plan_file_text
+from feederkit.plans.readplan import as_plan
+from feederkit.plans.writeplan import plan_file_text
 from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty
 

@@ -38,7 +38,7 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
 from feederkit.plans.model import Plan
-from feederkit.plans.readplan import read_back
+from feederkit.plans.writeplan import read_back
 from feederkit.sensors import Sensor, make_sensor
 from feederkit.uncertainty import Uncertainty
 from feederkit.words import plural
@@ -447,7 +447,7 @@ def plan_outputs(
     report: Path | None,
 ) -> tuple[list[OutputFile], Plan]:
     """The files ``-o`` and ``--report`` ask for (rendered here, before any write) and the
-    plan as its file reads back (:func:`~feederkit.plans.readplan.read_back`: what the
+    plan as its file reads back (:func:`~feederkit.plans.writeplan.read_back`: what the
     file holds is what the command shows)."""
     text, view = read_back(plan)
     files = []

@@ -79,7 +79,8 @@ _POLISH_STEPS = 40
 _MAX_SAMPLES = 20000
 """At most this many points sample an outline's boundary for the search's bounds."""
 
-_LANDING_RE = re.compile(r"^(up|down|pose-(0|[1-9][0-9]*))$")
+LANDING_RE = re.compile(r"^(up|down|pose-(0|[1-9][0-9]*))$")
+"""A landing's name (design.md, "Landings"): ``up``, ``down`` or ``pose-K``."""
 
 
 @dataclass(frozen=True)
@@ -106,7 +107,7 @@ class Landing:
 
 def check_landing_name(name: str) -> str:
     """``name`` when it is ``up``, ``down`` or ``pose-K``, else InputError."""
-    if not isinstance(name, str) or not _LANDING_RE.match(name):
+    if not isinstance(name, str) or not LANDING_RE.match(name):
         raise InputError(
             f"invalid landing {name!r}: a landing is up, down or pose-K (K = 0, 1, ...)"
         )

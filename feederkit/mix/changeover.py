@@ -41,7 +41,8 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.plans.make import MadePlan, make_plan
 from feederkit.plans.model import Plan, PlanMember, member_fragile_warnings
 from feederkit.plans.model import member_name as member_name  # its home: plans.model
-from feederkit.plans.readplan import as_plan, parse_plan_text, read_back, validate_plan
+from feederkit.plans.readplan import as_plan, parse_plan_text, validate_plan
+from feederkit.plans.writeplan import read_back
 from feederkit.sensors import Sensor, sensor_from_dict
 from feederkit.uncertainty import Uncertainty
 

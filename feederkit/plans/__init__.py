@@ -5,8 +5,9 @@ verification on geometry; plans over landings (reject results) and shared subpla
 - :mod:`~feederkit.plans.fileformat`: the format's constants, the maker of a Plan from a
   planner's result (``plan_from_result``) and its writer: ``plan_to_dict``, ``plan_json``.
 - :mod:`~feederkit.plans.readplan`: the reader and checker of a plan file:
-  ``plan_from_dict``, ``read_plan`` (size and depth limits), ``plan_file_text`` and
-  ``read_back`` (checked before anything is written), ``write_plan`` (atomic).
+  ``plan_from_dict``, ``read_plan`` (size and depth limits).
+- :mod:`~feederkit.plans.writeplan`: ``plan_file_text`` and ``read_back`` (checked as the
+  reader will before anything is written), ``write_plan`` (atomic).
 - :mod:`~feederkit.plans.stats`: the ``stats`` object (length, margins, Fig. 14 class bound).
 - :mod:`~feederkit.plans.execute`: ``execute`` a plan on the kinematic model rebuilt from
   the plan's hulls and COMs, giving a ``Trace``.
@@ -40,15 +41,13 @@ from feederkit.plans.readplan import (
     MAX_PLAN_BYTES,
     MAX_PLAN_DEPTH,
     as_plan,
-    plan_file_text,
     plan_from_dict,
-    read_back,
     read_plan,
     validate_plan,
-    write_plan,
 )
 from feederkit.plans.stats import plan_stats
 from feederkit.plans.verify import PartCheck, VerificationReport, check_plan, verify_plan
+from feederkit.plans.writeplan import plan_file_text, read_back, write_plan
 
 __all__ = [
     "CONVENTIONS",

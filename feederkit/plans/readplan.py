@@ -11,9 +11,7 @@ stable state, node or field), an InputError (exit 2). Nothing recurses over the 
 the JSON parser is given the room a plan of the limit's depth needs, so a plan as deep as
 the limit loads. Whether the plan is right for its parts is the verifier's question.
 
-What feederkit writes is read back first: :func:`read_back` checks the object the text is
-written from as this reader will, and :func:`plan_file_text` and :func:`write_plan` (atomic)
-write only such text, so a file the reader refuses is a bug, never a file. The format's
+What feederkit writes is read back first (:mod:`feederkit.plans.writeplan`). The format's
 constants and the text itself are :mod:`feederkit.plans.fileformat`'s.
 """
 
@@ -21,7 +19,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import sys
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -31,14 +28,13 @@ from typing import Any
 
 from feederkit.errors import InputError
 from feederkit.hull import Point
-from feederkit.jsonio import parse_json, write_text_atomic
+from feederkit.jsonio import parse_json
+from feederkit.landing.model import LANDING_RE
 from feederkit.mechanics.push import StableState
 from feederkit.plans.fileformat import (
     FORMAT,
     READABLE_VERSIONS,
     check_shares,
-    plan_json,
-    plan_to_dict,
     shown,
 )
 from feederkit.plans.model import (
@@ -199,10 +195,6 @@ def _check_certificate(c: _Checker, raw: object, unc: Uncertainty) -> Certificat
     if ideal is not None and c.int_(ideal, "certificate ideal_length") < 1:
         raise c.fail(f"certificate ideal_length {ideal} must be at least 1")
     return Certificate(r, t, ideal)
-
-
-LANDING_RE = re.compile(r"^(up|down|pose-(0|[1-9][0-9]*))$")
-"""A landing's name (design.md, "Landings"): ``up``, ``down`` or ``pose-K``."""
 
 
 def _check_landing(c: _Checker, value: object, where: str) -> str | None:
@@ -799,43 +791,6 @@ def plan_from_text(text: str, source: str = "plan", max_depth: int = MAX_PLAN_DE
 
 
 # ---------------------------------------------------------------- the checked write
-
-
-def plan_file_text(plan: Plan | Mapping[str, Any]) -> str:
-    """The text every plan feederkit writes (:func:`~feederkit.plans.fileformat.plan_json`),
-    checked as a reader will check it (:func:`read_back`) before anything is written."""
-    return read_back(plan)[0]
-
-
-def read_back(plan: Plan | Mapping[str, Any]) -> tuple[str, Plan]:
-    """A plan's file text and the :class:`Plan` a reader gets from it: the object the text
-    is written from, checked by the loader's validator (:func:`plan_from_dict`; the writer
-    writes exactly it, and parsing an 11 MB plan again would cost a command its deadline). A
-    file the loader refuses is a bug in feederkit, never a written file (AssertionError)."""
-    value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
-    text = plan_json(value)  # ValueError for a NaN or an infinity, which JSON cannot hold
-    try:
-        return text, plan_from_dict(value, "the plan to write")
-    except InputError as exc:
-        raise AssertionError(f"feederkit made a plan file its own loader refuses: {exc}") from None
-
-
-def write_plan(
-    plan: Plan | str | os.PathLike[str], path: str | os.PathLike[str] | Plan | Mapping[str, Any]
-) -> None:
-    """Write a plan file atomically (a temporary file beside it, then a rename), its text
-    checked first (:func:`plan_file_text`: ValueError for a NaN or an infinity,
-    AssertionError for a plan the loader would refuse; no file either way).
-
-    ``write_plan(plan, path)``; the older order ``write_plan(path, plan_dict)`` is accepted
-    while callers move to the :class:`Plan`.
-    """
-    if isinstance(plan, Plan | Mapping):
-        target, value = path, plan
-    else:
-        target, value = plan, path
-    assert isinstance(target, str | os.PathLike)
-    write_text_atomic(target, plan_file_text(value), what="plan file")  # type: ignore[arg-type]
 
 
 def _too_deep(source: str, max_depth: int) -> str:
