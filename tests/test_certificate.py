@@ -27,7 +27,7 @@ from feederkit.planning.api import plan
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
-from feederkit.plans import make as make_module
+from feederkit.plans import certify, timelimit
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import (
     declared_uncertainty,
@@ -163,7 +163,7 @@ def test_a_certificate_out_of_time_states_the_declared_values_and_says_so(monkey
         return cut
 
     for name in ("max_rotation_error_deg", "max_shape_tolerance_mm"):
-        monkeypatch.setattr(make_module, name, out_of_time(getattr(make_module, name)))
+        monkeypatch.setattr(certify, name, out_of_time(getattr(certify, name)))
     made = make_plan([random_pf(7000)], ToleranceSensor(0.2), options, uncertainty=unc)
     cert = made.plan["stats"]["certificate"]
     assert cert["max_rotation_error_deg"] == 1.0 and cert["max_shape_tolerance_mm"] == 0.01
@@ -178,7 +178,7 @@ def test_the_certificate_leaves_the_time_its_plan_needs_to_be_written(monkeypatc
     # would take the whole limit gets no certificate search at all (declared values).
     unc = Uncertainty(1.0, 0.01)
     options = PlanningOptions(time_limit_s=30.0)
-    monkeypatch.setattr(make_module, "OUTPUT_S_PER_NODE", 30.0)
+    monkeypatch.setattr(timelimit, "OUTPUT_S_PER_NODE", 30.0)
     made = make_plan([random_pf(7000)], ToleranceSensor(0.2), options, uncertainty=unc)
     cert = made.plan["stats"]["certificate"]
     assert cert["max_rotation_error_deg"] == 1.0 and cert["max_shape_tolerance_mm"] == 0.01

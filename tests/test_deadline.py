@@ -30,7 +30,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.stats import node_states
-from feederkit.plans.make import POST_S_PER_PAIR, _planner_budget
+from feederkit.plans.timelimit import POST_S_PER_PAIR, planner_budget
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -736,7 +736,7 @@ def test_the_goal_fixpoint_of_a_plan_serves_the_machine_it_was_asked_of():
 )
 def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, certify, planner_s):
     # 15 % of the limit, or 1.5 s where that is more, up to a quarter of the limit.
-    budget = _planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify)
+    budget = planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify)
     assert budget.end is not None
     assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)
     # The plan's own size counts too, certified or not: every plan is verified.

@@ -18,7 +18,9 @@ from feederkit.mechanics.push import push_function
 from feederkit.outline import load_outline_json, make_outline
 from feederkit.part import make_part
 from feederkit.planning.options import PlanningOptions
-from feederkit.plans.make import blocking_members, largest_uncertainty, make_plan
+from feederkit.plans.advice import blocking_members
+from feederkit.plans.certify import largest_uncertainty
+from feederkit.plans.make import make_plan
 from feederkit.plans.model import PlanMember
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty

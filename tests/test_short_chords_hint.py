@@ -6,7 +6,7 @@ coarser --hull-tolerance" for every part, but import lowers any hull tolerance a
 simplified hull rests in two states where the outline rests in one (a near-round part, most
 meshes of arcs: ``mechanics.modelerror.keeping_tolerance``), so following it changed
 nothing. Now the hint names a coarser tolerance only when import keeps one that lengthens
-those edges (``plans.make.coarser_kept_hull``), and otherwise says what can help.
+those edges (``plans.advice.coarser_kept_hull``), and otherwise says what can help.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from shared import cli_ok
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.plans.make import coarser_kept_hull, short_chords_words
+from feederkit.plans.advice import coarser_kept_hull, short_chords_words
 
 
 def _ellipse_points() -> list[tuple[float, float]]:

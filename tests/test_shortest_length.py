@@ -16,6 +16,7 @@ from feederkit.machine import build_machine
 from feederkit.planning.api import plan, shortest_length
 from feederkit.planning.budget import Deadline
 from feederkit.planning.options import PlanningOptions
+from feederkit.plans import certify
 from feederkit.plans import make as make_module
 from feederkit.plans.make import make_plan
 from feederkit.sensors import NoSensor, ToleranceSensor
@@ -78,6 +79,6 @@ def test_the_certificate_states_the_proven_ideal_length_not_a_cut_plans(monkeypa
     proven = make_plan([random_pf(7000)], ToleranceSensor(0.2), options, uncertainty=unc)
     assert planned == [False]  # the strong plan only: the ideal length is searched alone
     assert proven.plan["stats"]["certificate"]["ideal_length"] == plan(ideal).length
-    monkeypatch.setattr(make_module, "shortest_length", lambda machine, opts: None)
+    monkeypatch.setattr(certify, "shortest_length", lambda machine, opts: None)
     unproven = make_plan([random_pf(7000)], ToleranceSensor(0.2), options, uncertainty=unc)
     assert unproven.plan["stats"]["certificate"]["ideal_length"] is None

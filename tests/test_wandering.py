@@ -195,7 +195,8 @@ def test_a_result_on_a_merged_arc_names_the_spread_it_leaves():
 
 def test_no_plan_under_a_shape_tolerance_names_a_finely_drawn_arc():
     from feederkit.errors import PlanningError
-    from feederkit.plans.make import make_plan, short_chords_words
+    from feederkit.plans.advice import short_chords_words
+    from feederkit.plans.make import make_plan
 
     box = Polygon([(0, 0), (40, 0), (40, 25), (0, 25)])
     rounded = box.buffer(-2, quad_segs=16).buffer(2, quad_segs=16)

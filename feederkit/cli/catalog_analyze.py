@@ -300,7 +300,7 @@ def _advice(kinds: set[str], unc: Uncertainty | None = None) -> str:
     only on the ideal model may or may not be told apart at a smaller rotation error or
     tighter shape and COM tolerances (those ``unc`` declares; None: the rotation error): any
     declared uncertainty switches the feeder's vibration on, which no smaller value removes
-    (``feederkit.plans.make.VIBRATION_OBSTACLE``), so no smaller value is promised to help."""
+    (``feederkit.plans.certify.VIBRATION_OBSTACLE``), so no smaller value is promised to help."""
     if "uncertainty" in kinds:
         rest = _advice(kinds - {"uncertainty"}) if kinds - {"uncertainty"} else None
         less = []

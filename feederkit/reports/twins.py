@@ -83,7 +83,7 @@ def twin_leaves(
 
 def unoriented_words(plan: Plan, twins: Sequence[TwinLeaf]) -> str | None:
     """One line naming every pair of poses of one member that a result lists together and
-    that do not look alike, in the words ``plan`` uses (``plans.make.unlike_twins_words``);
+    that do not look alike, in the words ``plan`` uses (``plans.advice.unlike_twins_words``);
     None when there are none."""
     named: dict[tuple[int, int, int], None] = {}
     for t in twins:

@@ -1,0 +1,522 @@
+"""The words that say why a result is as it is and what would change it.
+
+On a made plan: warnings that it holds less than its margins say on a feeder that vibrates,
+that the choice among shortest plans was cut short, that results lump poses (and whether a
+smaller rotation error or tighter tolerances would tell them apart), that results list
+unlike poses no plan can tell apart (the paper's indistinguishable poses) or spread over
+shallow wells. When no strong plan exists: the members that leave a mix none (section 8.5)
+and the short hull edges a shape tolerance tilts.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import shapely
+
+from feederkit.angles import norm360
+from feederkit.machine import PushAlignMachine, members, search_space
+from feederkit.machine.build import build_machine
+from feederkit.machine.widths import Offsets, widen_widths
+from feederkit.mechanics.modelerror import keeping_tolerance
+from feederkit.mechanics.push import PushFunction
+from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
+from feederkit.part import make_part
+from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.lumping import unresolvable_pairs
+from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem
+from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
+from feederkit.plans.certify import decided_exists
+from feederkit.plans.model import PlanMember
+from feederkit.sensors import Sensor
+from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.words import plural
+
+
+def ideal_plan_words(
+    unc: Uncertainty, min_margin: float, certificate: Certificate | None
+) -> str | None:
+    """One line when a plan made on the ideal model holds less on a feeder that vibrates
+    than its margins say: the certificate is computed with the vibration the planner's
+    model has under any rotation error (fragile states merged, a push band at each hilltop,
+    ``strong.strong_model``), where an ideal plan may hold no rotation error at all.
+
+    >>> print(ideal_plan_words(IDEAL, 5.0, Certificate(3.0, 0.0, 2)))
+    the plan is the ideal model's: on a feeder that vibrates it holds rotation errors up to ±3° ...
+    """
+    if not unc.is_ideal or certificate is None or not math.isfinite(min_margin):
+        return None
+    held = certificate.max_rotation_error_deg
+    if held >= min_margin - 1e-9:
+        return None
+    what = "no rotation error at all" if held <= 0.0 else f"rotation errors up to ±{held:.4g}°"
+    return (
+        f"the plan is the ideal model's: on a feeder that vibrates it holds {what} (its "
+        f"margins say ±{min_margin:.4g}°: drops near a hilltop may go either way, fragile "
+        "states merge); plan with --rotation-error DEG for one that holds it"
+    )
+
+
+def ties_cut_words(result: PlanResult, options: PlanningOptions) -> str | None:
+    """One line when a plan of proven length stopped choosing among the shortest plans
+    (``PlanResult.tie_breaks``; the time limit or the tie-breaking budget ended it): the
+    largest smallest margin, or the fewest expected operations, was not found."""
+    if not result.optimal or options.objective.value != "worst":
+        return None
+    words = f"a plan of {plural(result.length, 'operation')}"
+    more = _MORE.get(result.ties_cut_by or "", _MORE["time"])
+    if result.tie_breaks == "margin":
+        return (
+            f"the choice among shortest plans stopped at {words} with the largest margin, "
+            f"not the fewest expected operations ({more})"
+        )
+    if result.tie_breaks == "none" and math.isfinite(result.min_margin):
+        return (
+            f"the choice among shortest plans stopped at {words} whose smallest margin, "
+            f"±{result.min_margin:.4g}° of slack beyond the declared uncertainty, is not "
+            f"proven the largest; another may keep more slack ({more})"
+        )
+    return None
+
+
+_MORE = {
+    "time": "allow more time with --time-limit S",
+    "memory": "allow more memory with --memory-limit MB",
+    "work": "the tie-breaking budget, a multiple of the length proof's work, ran out; "
+    "more time does not change it",
+}
+"""What a user can do when the choice among shortest plans was cut short, by its cause
+(``PlanResult.ties_cut_by``)."""
+
+
+SHORT_CHORD_TILT_DEG = 5.0
+"""A hull edge the shape tolerance may tilt by at least this much (``asin(2 t / length)``) is
+named when no strong plan exists: finely drawn arcs make them."""
+
+COARSE_HULL_PROBE_REL = 0.01
+"""The coarsest hull tolerance, as a share of the part's size, :func:`coarser_kept_hull` tries
+(then its halves, as import does)."""
+
+
+def _chord_tilt(hull: Sequence[tuple[float, float]], t: float) -> tuple[float, float]:
+    """The shortest edge of ``hull`` (mm) and how far the shape tolerance ``t`` may tilt it
+    (degrees)."""
+    shortest = min(math.dist(hull[i], hull[(i + 1) % len(hull)]) for i in range(len(hull)))
+    return shortest, math.degrees(math.asin(min(1.0, 2.0 * t / shortest)))
+
+
+def _hull_gap(exact: Sequence[tuple[float, float]], hull: Sequence[tuple[float, float]]) -> float:
+    """How far the outline's exact hull strays outside a contact hull simplified inside it."""
+    ring = shapely.LinearRing(hull)
+    return float(np.max(shapely.distance(ring, shapely.points(np.asarray(exact, dtype=float)))))
+
+
+def coarser_kept_hull(pf: PushFunction, t: float) -> float | None:
+    """A hull tolerance coarser than the one ``pf``'s contact hull was simplified at that an
+    import keeps (the simplified hull rests where the outline does: ``keeping_tolerance``,
+    which lowers any coarser request, on a mesh or a drawing alike) and at which no hull edge
+    is short enough for the shape tolerance ``t`` to tilt it by :data:`SHORT_CHORD_TILT_DEG`;
+    None when there is none, and a coarser ``--hull-tolerance`` cannot help."""
+    part = pf.part
+    exact = make_part(part.outline, part.com, name=part.name)
+    own = _hull_gap(exact.hull, part.hull)
+    kept = keeping_tolerance(exact, COARSE_HULL_PROBE_REL * part.size)
+    if kept.tolerance <= 1.01 * own + 1e-9:
+        return None
+    coarser = make_part(part.outline, part.com, hull_tolerance=kept.tolerance, name=part.name)
+    if _chord_tilt(coarser.hull, t)[1] >= SHORT_CHORD_TILT_DEG:
+        return None
+    return kept.tolerance
+
+
+def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
+    """ "; ..." naming the part whose contact hull has the shortest edge the shape tolerance
+    ``t`` may tilt by ``SHORT_CHORD_TILT_DEG`` or more (an arc drawn as many short chords,
+    each a possible resting edge near a corner under the vertex model, docs/uncertainty.md),
+    and what may help: a coarser ``--hull-tolerance`` only when import would keep one that
+    lengthens those edges (:func:`coarser_kept_hull`; a mesh's or a near-round part's is
+    lowered back to what keeps its resting states); "" when none has such an edge."""
+    if t <= 0.0:
+        return ""
+    (length, tilt), pf = min(((_chord_tilt(pf.part.hull, t), pf) for pf in pfs), key=_first)
+    if tilt < SHORT_CHORD_TILT_DEG:
+        return ""
+    name = pf.part.name
+    head = (
+        f"; {name}'s contact hull has edges as short as {length:.3g} mm (an arc drawn as many "
+        f"chords?), which the shape tolerance may tilt by {tilt:.3g} degrees, each then a "
+        "possible resting edge near a corner: a smaller --shape-tolerance, or an outline with "
+        "fewer arc points (a coarser tessellation in a mesh's CAD export)"
+    )
+    coarser = coarser_kept_hull(pf, t)
+    if coarser is not None:
+        return (
+            f"{head}, or the part imported with --hull-tolerance {coarser:.3g} (its resting "
+            "states kept, no edge that short), may have a plan (docs/uncertainty.md)"
+        )
+    return (
+        f"{head}, may have a plan; a coarser --hull-tolerance cannot help: import lowers it "
+        f"to what keeps {name}'s resting states (chords across its arcs would hold the part "
+        "where it rolls) (docs/uncertainty.md)"
+    )
+
+
+def _first(item: tuple[tuple[float, float], PushFunction]) -> float:
+    return item[0][0]
+
+
+def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
+    """Words naming the poses of one part that some result lists together though they do not
+    look alike (holes, slots or notches placed differently: ``look_alike`` compares the
+    outline) while no plan tells them apart (the contact hull, all the fence and the sensor
+    feel, is symmetric: the paper's indistinguishable poses); None when there are none.
+    Pairs the lumping already named (``lumped_pairs``) are left to its warning."""
+    machine = result.machine
+    lumped = set(result.lumped_pairs)
+    found: dict[tuple[int, int], None] = {}
+    for mask in leaf_masks(result.root):
+        by_part: dict[int, list[int]] = {}
+        for i in members(mask):
+            if not machine.states[i].reject:  # a reject result needs no telling apart
+                by_part.setdefault(machine.states[i].part, []).append(i)
+        for part, idx in by_part.items():
+            if len(idx) < 2:
+                continue
+            groups = [machine.states[i].ideal_states for i in idx]
+            for a, b in unlike_pairs(pfs[part], groups):
+                if (idx[a], idx[b]) not in lumped:
+                    found[(idx[a], idx[b])] = None
+    if not found:
+        return None
+    named = []
+    for i, j in found:
+        a, b = machine.states[i], machine.states[j]
+        pf = pfs[a.part]
+        poses = [norm360(-90.0 - pf.states[x.state].normal_deg) for x in (a, b)]
+        named.append(
+            f"{machine.part_names[a.part]} states {a.state} and {b.state} (poses "
+            f"{poses[0]:.4g} and {poses[1]:.4g} degrees)"
+        )
+    return (
+        "no plan can tell apart poses that do not look alike: "
+        + "; ".join(named)
+        + ": pushing and reading cannot tell them apart (the paper's indistinguishable poses: "
+        "a symmetric contact hull with holes, slots or notches placed otherwise, or a push "
+        "function that repeats), so a result lists them and the part is not oriented between "
+        "them: check its pose by other means, or take it either way"
+    )
+
+
+def spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
+    """A warning naming the results that end in a physical state of several unlike stable
+    states (shallow wells a breath of vibration crosses: a part resting anywhere over their
+    poses, docs/uncertainty.md), with the angle their normals span; None when there are
+    none. Congruent ones (a regular polygon's) orient the part and are not named."""
+    machine = result.machine
+    found: dict[int, float] = {}
+    for mask in leaf_masks(result.root):
+        for i in members(mask):
+            s = machine.states[i]
+            if len(s.members) < 2 or i in found:
+                continue
+            pf = pfs[s.part]
+            if not unlike_pairs(pf, [(m,) for m in s.members]):
+                continue
+            normals = [pf.states[m].normal_deg for m in s.members]
+            found[i] = norm360(normals[-1] - normals[0])
+    if not found:
+        return None
+    named = "; ".join(
+        f"{machine.part_names[machine.states[i].part]} states "
+        f"{', '.join(str(m) for m in machine.states[i].members)} over {spread:.3g} degrees"
+        for i, spread in sorted(found.items(), key=lambda kv: -kv[1])
+    )
+    return (
+        f"some results name a resting state made of several stable states, shallow wells a "
+        f"breath of vibration crosses (docs/uncertainty.md): {named}; there the part rests "
+        "anywhere over those poses, oriented only that far"
+    )
+
+
+SMALLER_ERROR_FACTOR = 1e-3
+"""A rotation error this fraction of the declared one stands for "a smaller rotation error":
+:func:`smaller_error_words` asks whether the lumped pairs are still unresolvable there."""
+
+SMALLER_ERROR_S = 5.0
+"""The most seconds :func:`smaller_error_words` spends deciding (less when the time limit
+leaves less); undecided, it says a smaller rotation error may or may not help."""
+
+
+def smaller_error_words(
+    machine_at: Callable[[Uncertainty], PushAlignMachine],
+    uncertainty: Uncertainty,
+    machine: PushAlignMachine,
+    pairs: Sequence[tuple[int, int]],
+    seconds: float,
+) -> str:
+    """What keeps the lumped ``pairs`` (states of ``machine``) together, in words, decided
+    exactly where it is affordable (within ``seconds``): the pairs still unresolvable
+    (:func:`~feederkit.planning.lumping.unresolvable_pairs`) on the machines ``machine_at``
+    builds at :data:`SMALLER_ERROR_FACTOR` of the declared rotation error, then with the
+    declared shape and COM tolerances at 0 too, the feeder's vibration on in both (any
+    declared uncertainty switches it on). Told apart at the smaller rotation error: "a
+    smaller rotation error helps"; else, told apart without the tolerances: a smaller
+    --shape-tolerance / --com-tolerance helps; else the vibration keeps them together, or
+    not even the ideal model tells them apart. The command line names a flag only where the
+    words say it helps (``with_flags``).
+    """
+    r = uncertainty.rotation_error_deg
+    tiny = replace(uncertainty, rotation_error_deg=r * SMALLER_ERROR_FACTOR)
+    loose = uncertainty.shape_tolerance_mm > 0.0 or uncertainty.com_tolerance_mm > 0.0
+    exact = replace(tiny, shape_tolerance_mm=0.0, com_tolerance_mm=0.0)
+    if exact.is_ideal:  # nothing declared but the rotation error, and that is 0
+        exact = replace(exact, rotation_error_deg=SMALLER_ERROR_FACTOR)
+    vibration = (
+        "the feeder's vibration, which any declared uncertainty switches on (push bands and "
+        "merged fragile states: docs/uncertainty.md)"
+    )
+    stop = time.monotonic() + max(seconds, 0.0)
+
+    def left_at(u: Uncertainty) -> list[tuple[int, int]] | None:
+        """The pairs still unresolvable at ``u`` (None: undecided in time)."""
+        rest = stop - time.monotonic()
+        if rest <= 0.0:
+            return None
+        try:
+            at = machine_at(u)
+            found = unresolvable_pairs(Problem(at, "exact", 0.0), Deadline(rest))
+        except Timeout:
+            return None
+        if found is None:
+            return None
+        kept = set(found)
+        return [
+            (i, j)
+            for i, j in pairs
+            if any(
+                (min(x, y), max(x, y)) in kept
+                for x in _alike(machine, i, at)
+                for y in _alike(machine, j, at)
+            )
+        ]
+
+    left = left_at(tiny) if r > 0.0 else list(pairs)
+    at = f"±{tiny.rotation_error_deg:.3g} deg"
+    if left is None:
+        return (
+            "; whether a smaller rotation error or tighter tolerances help was not decided: "
+            f"they may or may not, since {vibration} may keep them together whatever they are"
+        )
+    if not left:
+        return f"; a smaller rotation error helps: at {at} a strong plan tells each pair apart"
+    helped = len(pairs) - len(left)
+    head = (
+        f"; a smaller rotation error helps {plural(helped, 'pair')} only: at {at} "
+        f"{len(left)} of the {len(pairs)} are still not told apart"
+        if helped
+        else (
+            f"; no smaller rotation error helps: at {at} they are still not told apart"
+            if r > 0.0
+            else ""
+        )
+    )
+    if loose:
+        still = left_at(exact)
+        if still is not None and len(still) < len(left):
+            fixed = len(left) - len(still)
+            which = "them" if not still else plural(fixed, "pair")
+            return (
+                f"{head}{': ' if head else '; '}the declared shape and COM tolerances keep "
+                f"{which} together: with none a strong plan tells {which} apart (a smaller "
+                "shape tolerance or COM tolerance helps)"
+            )
+        if still is None:
+            return (
+                f"{head}{': ' if head else '; '}the declared shape and COM tolerances or "
+                f"{vibration} keep them together (not decided which)"
+            )
+        left = still
+    ideal = machine_at(IDEAL)
+    insep = search_space(ideal).inseparable
+    if all(
+        any(insep[x] >> y & 1 for x in _alike(machine, i, ideal) for y in _alike(machine, j, ideal))
+        for i, j in left
+    ):
+        # the ideal model does not tell them apart either: no uncertainty is the cause
+        which = "them" if len(left) == len(pairs) else "those left"
+        return (
+            f"{head}{': ' if head else '; '}no rotation error helps, not even 0: the ideal "
+            f"model does not tell {which} apart either (the mix's pairs say why)"
+        )
+    cause = (
+        f"{vibration} keeps them together, whatever else is declared; the ideal model (no "
+        "uncertainty declared) plans with no margin for that vibration"
+    )
+    return f"{head}{': ' if head else '; '}{cause}"
+
+
+def _alike(machine: PushAlignMachine, i: int, table: PushAlignMachine) -> list[int]:
+    """The states of ``table`` that hold some ideal state of ``machine``'s state ``i``."""
+    s = machine.states[i]
+    ideal = set(s.ideal_states)
+    return [
+        k for k, t in enumerate(table.states) if t.part == s.part and ideal & set(t.ideal_states)
+    ]
+
+
+def lump_shapes(
+    machine: PushAlignMachine, pfs: Sequence[PushFunction], pairs: Sequence[tuple[int, int]]
+) -> str:
+    """How alike the lumped poses of one part look (:func:`poses_difference`, the measure
+    the default lumping rule bounds by ``NEAR_SYMMETRIC_REL``), in words: near symmetry the
+    user can accept, or (lumping ``any``) a warning that the plan leaves them unoriented."""
+    worst, size = 0.0, 1.0
+    for i, j in pairs:
+        a, b = machine.states[i], machine.states[j]
+        if a.part != b.part:
+            continue  # parts that behave alike: reported as pairs of the mix
+        pf = pfs[a.part]
+        d = poses_difference(pf, a.ideal_states, b.ideal_states)
+        if d / pf.part.size >= worst / size:
+            worst, size = d, pf.part.size
+    if worst == 0.0:
+        return ""
+    share = 100.0 * worst / size
+    # Pairs of different members (parts, landings, mesh poses) are the mix's pairs, named
+    # apart: the figure speaks of the states of one member only.
+    across = any(machine.states[i].part != machine.states[j].part for i, j in pairs)
+    whose = "the states of one part among them" if across else "their outlines"
+    words = f"; {whose} differ by at most {worst:.3g} mm ({share:.2g} % of the part)"
+    if worst > NEAR_SYMMETRIC_REL * size:
+        words += (
+            ": not near-symmetric, so the plan does not orient them apart (the default "
+            "lumping says which rotation error, if any, has a plan that does)"
+        )
+    return words
+
+
+NAMED_MEMBERS = 6
+""":func:`blocking_members` names at most this many members, then counts the rest."""
+
+
+@dataclass(frozen=True)
+class Blame:
+    """Why a mix has no strong plan, member by member (:func:`blocking_members`): ``words``
+    for the message ("" when there is nothing to say) and ``members``, the indices of the
+    members blamed (none: the pairs between members, or nothing decided)."""
+
+    words: str = ""
+    members: tuple[int, ...] = ()
+
+
+def blocking_members(
+    pfs: Sequence[PushFunction],
+    sensor: Sensor,
+    unc: Uncertainty,
+    options: PlanningOptions,
+    offsets: Offsets,
+    named: Sequence[PlanMember] | None,
+    seconds: float | None = None,
+) -> Blame:
+    """The members of a mix with no strong plan that leave it none (section 8.5: the mix's
+    plan orients every member, so one no strong plan orients alone leaves the mix none,
+    whatever the others): the accepted members no strong plan orients even alone, then
+    the landings of one part that each have a plan alone but none together, both accepted
+    (only planning one side helps there: an accepted and a rejected landing no plan tells
+    apart leave no plan either, docs/changeovers.md). Each check is a machine of one or two
+    members, each read over its ``offsets`` as the mix's is; they stop when ``seconds`` run
+    out (an undecided member is not blamed). With everything decided and none to blame, the words
+    say that the pairs between members leave no plan."""
+    if len(pfs) < 2:
+        return Blame()
+    stop = None if seconds is None else time.monotonic() + max(seconds, 0.0)
+    rejected = set() if named is None else {k for k, m in enumerate(named) if not m.accept}
+
+    def exists(ks: tuple[int, ...]) -> bool | None:
+        left = None if stop is None else stop - time.monotonic()
+        if left is not None and left <= 0.0:
+            return None
+        machine = build_machine([pfs[k] for k in ks], sensor, unc)
+        machine = widen_widths(machine, [offsets[k] for k in ks])
+        return decided_exists(machine, options, left)
+
+    verdicts = {k: exists((k,)) for k in range(len(pfs)) if k not in rejected}
+    alone = [k for k, found in verdicts.items() if found is False]
+    pairs = [p for p in _landing_pairs(named) if not set(p) & set(alone)]
+    together = {p: exists(p) for p in pairs}
+    sides = [p for p, found in together.items() if found is False]
+    decided = None not in verdicts.values() and None not in together.values()
+    words = []
+    if alone:
+        # A failing landing whose part has another landing in the mix: plan that one.
+        others = named is not None and any(
+            named[k].landing is not None and any(b in verdicts and b not in alone for b in p)
+            for k in alone
+            for p in _landing_pairs(named)
+            if k in p
+        )
+        words.append(_alone_words([pfs[k].part.name for k in alone], others))
+    if sides:
+        words.append(_sides_words(pfs, named, sides))
+    if not words and decided:
+        words.append(
+            "every member has a strong plan alone: what leaves none is states of different "
+            "members that must be told apart (the pairs between members)"
+        )
+    blamed = dict.fromkeys([*alone, *(k for p in sides for k in p)])
+    return Blame("; ".join(words), tuple(blamed))
+
+
+def _landing_pairs(named: Sequence[PlanMember] | None) -> list[tuple[int, int]]:
+    """The pairs of accepted members that are two landings of one part (a rejected landing
+    is checked with the mix, not alone or in a pair)."""
+    if named is None:
+        return []
+    return [
+        (a, b)
+        for a, m in enumerate(named)
+        for b in range(a + 1, len(named))
+        if m.landing is not None
+        and named[b].landing is not None
+        and named[b].name == m.name
+        and m.accept
+        and named[b].accept
+    ]
+
+
+def _alone_words(names: Sequence[str], landings: bool) -> str:
+    """The members no strong plan orients even alone, and what to do, in words
+    (``landings``: some is a landing whose part has another that may be planned)."""
+    shown = list(names[:NAMED_MEMBERS])
+    if len(names) > NAMED_MEMBERS:
+        shown.append(f"{len(names) - NAMED_MEMBERS} more")
+    one = len(names) == 1
+    listed = shown[0] if len(shown) == 1 else f"{', '.join(shown[:-1])} and {shown[-1]}"
+    out = "leave it out of the mix" if one else "leave them out of the mix"
+    if landings:
+        out += " (a landing: plan the others, --landings)"
+    return (
+        f"{listed} {'has' if one else 'have'} no strong plan even alone at the declared "
+        f"uncertainty: {out}, or loosen the declared uncertainty"
+    )
+
+
+def _sides_words(
+    pfs: Sequence[PushFunction],
+    named: Sequence[PlanMember] | None,
+    sides: Sequence[tuple[int, int]],
+) -> str:
+    """The landings of one part that each have a strong plan alone but none together, and
+    the one remedy: plan only one side (``--landings``)."""
+    assert named is not None
+    listed = "; ".join(f"{pfs[a].part.name} and {pfs[b].part.name}" for a, b in sides)
+    side = named[sides[0][0]].landing
+    return (
+        f"two landings of one part each have a strong plan alone but none together "
+        f"({listed}): plan only one side (--landings {side})"
+    )
