@@ -41,7 +41,8 @@ from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import NoStrongPlan, plan
+from feederkit.planning.api import plan
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 

@@ -14,10 +14,11 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import api
-from feederkit.planning.api import _choice_plan, _result, goal_relation, plan
+from feederkit.planning import api, fallback
+from feederkit.planning.api import _result, goal_relation, plan
 from feederkit.planning.beam import BeamSearch, _depth, _lengths, beam_plan, branch_key
 from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.fallback import _choice_plan
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
@@ -225,17 +226,17 @@ def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(mo
     monkeypatch.setattr(api, "longest_root", out_of_time)
     # Without the backchaining plans and the pairs told apart one at a time (the plan that
     # follows the readings is often as short as the beams can find), the beams give the plan.
-    for maker in ("_sensorless_plan", "pairwise_plan"):
-        monkeypatch.setattr(api, maker, lambda *_args, **_kwargs: None)
+    for maker in ("sensorless_plan", "pairwise_plan"):
+        monkeypatch.setattr(fallback, maker, lambda *_args, **_kwargs: None)
     calls = []
-    real = api.beam_plan
+    real = fallback.beam_plan
 
     def spy(*args, **kwargs):
         out = real(*args, **kwargs)
         calls.append(out)
         return out
 
-    monkeypatch.setattr(api, "beam_plan", spy)
+    monkeypatch.setattr(fallback, "beam_plan", spy)
     result = plan(machine, PlanningOptions(time_limit_s=60.0))
     assert calls and calls[0] is not None
     assert check_plan(result) == result.length >= exact.length

@@ -21,7 +21,7 @@ from feederkit.machine.inseparable import inseparable_masks
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import api
+from feederkit.planning import api, fallback
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Checkpoint, Deadline, Timeout, WorkBudget, rss_mb
@@ -29,6 +29,7 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.stats import node_states
 from feederkit.plans.timelimit import POST_S_PER_PAIR, planner_budget
 from feederkit.sensors import NoSensor, ToleranceSensor
@@ -187,13 +188,13 @@ def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(
 
     monkeypatch.setattr(api, "longest_root", endless)
     left = []
-    real = api._fallback
+    real = api.fallback
 
     def spy(problem, worst, roots, root_branches, budget, *args):
         left.append(budget.remaining())
         return real(problem, worst, roots, root_branches, budget, *args)
 
-    monkeypatch.setattr(api, "_fallback", spy)
+    monkeypatch.setattr(api, "fallback", spy)
     result = plan(machine, PlanningOptions(time_limit_s=60.0))
     assert len(budgets) == 1 and budgets[0].handed_over
     assert left and left[0] > 0.9 * 60.0 > api.FALLBACK_SHARE * 60.0
@@ -355,7 +356,7 @@ def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
     full = plan(machine, PlanningOptions())
     budget = Deadline(3600.0, per_pair_s=0.01)
     end = budget.end
-    held = api._Held(budget)
+    held = fallback._Held(budget)
     held.hold(full.root)
     assert end - budget.end == pytest.approx(0.01 * node_states(full.root), abs=1e-9)
     one = full.root.branches[0][1]
@@ -366,7 +367,7 @@ def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
     assert budget.end == pytest.approx(end, abs=1e-9)
     # A plan made is kept whatever it costs: holding it never raises, even past the end.
     late = Deadline(0.0, per_pair_s=1.0)
-    api._Held(late).hold(full.root)
+    fallback._Held(late).hold(full.root)
     assert late.expired()
 
 
@@ -386,7 +387,7 @@ def _answered(result) -> None:
     """Either a plan that says it is not proven optimal, with a bound it keeps, or one line:
     the limit, or (decided in time) that no strong plan exists."""
     if isinstance(result, PlanningError):
-        decided = isinstance(result, api.NoStrongPlan)
+        decided = isinstance(result, NoStrongPlan)
         assert (decided or "limit" in str(result)) and "\n" not in str(result)
         return
     assert result.lower_bound <= result.length
@@ -611,7 +612,8 @@ def _hull_of_random_points(n: int, seed: int):
 
 
 def test_the_backchaining_plan_has_one_step_per_operation_and_is_correct():
-    from feederkit.planning.api import _result, _sensorless_plan, goal_relation, tree_length
+    from feederkit.planning.api import _result, goal_relation, tree_length
+    from feederkit.planning.fallback import sensorless_plan
     from feederkit.planning.problem import Problem
     from feederkit.planning.reindex import by_diameter
     from feederkit.planning.tree import Step
@@ -620,7 +622,7 @@ def test_the_backchaining_plan_has_one_step_per_operation_and_is_correct():
     machine, _old = by_diameter(build_machine([pf], ToleranceSensor(0.03 * pf.part.size), IDEAL))
     problem = Problem(machine, PlanningOptions().grouping, 0.0, goal_relation(machine, Deadline()))
     root_branches = problem.readings.branches(problem.full)
-    root = _sensorless_plan(problem, root_branches, Deadline(), by_image=True)
+    root = sensorless_plan(problem, root_branches, Deadline(), by_image=True)
     steps, stack, seen = 0, [root], set()
     while stack:
         node = stack.pop()

@@ -424,7 +424,7 @@ def test_a_plan_whose_ties_are_undecided_counts_only_before_the_fallback_may_ans
     from types import SimpleNamespace
 
     from feederkit.design import limit as limit_module
-    from feederkit.planning.api import TIES_NONE
+    from feederkit.planning.tree import TIES_NONE
 
     limit_s = 1.0
     assert wait_s == 0.0 or wait_s > (

@@ -45,10 +45,10 @@ from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import strong_witnesses
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import NoStrongPlan, plan
+from feederkit.planning.api import plan
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
-from feederkit.planning.solvable import unsolvable
+from feederkit.planning.solvable import NoStrongPlan, unsolvable
 from feederkit.plans.make import make_plan
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor, span
 from feederkit.uncertainty import IDEAL, Uncertainty

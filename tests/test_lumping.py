@@ -30,7 +30,6 @@ from feederkit.machine.inseparable import kept_apart
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import NoStrongPlan
 from feederkit.planning.lumping import (
     LumpedGoal,
     LumpingTry,
@@ -42,7 +41,7 @@ from feederkit.planning.lumping import (
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.reindex import by_diameter
-from feederkit.planning.solvable import candidate_pairs
+from feederkit.planning.solvable import NoStrongPlan, candidate_pairs
 from feederkit.planning.tree import Leaf
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import verify_strong

@@ -35,9 +35,10 @@ from feederkit.mechanics.symmetry import (
 )
 from feederkit.outline import load_outline_json, make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
+from feederkit.planning.api import plan, strong_plan_exists
 from feederkit.planning.lumping import may_lump, try_lumping
 from feederkit.planning.options import Lumping, PlanningOptions
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.tree import Leaf
 from feederkit.plans.make import make_plan
 from feederkit.plans.strong import verify_strong

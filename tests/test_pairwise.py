@@ -22,7 +22,7 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import api
+from feederkit.planning import api, fallback
 from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
@@ -121,23 +121,23 @@ def test_the_fallback_answers_with_it_when_nothing_else_finds_a_plan(monkeypatch
     # The exact search runs out at once and the beams find nothing: the pairwise plan is
     # the plan in hand, and the depth-first search only looks for something shorter.
     monkeypatch.setattr(api, "longest_root", out_of_time)
-    monkeypatch.setattr(api, "beam_plan", lambda *_args, **_kwargs: None)
-    monkeypatch.setattr(api, "sequential_plan", lambda *_args: None)
+    monkeypatch.setattr(fallback, "beam_plan", lambda *_args, **_kwargs: None)
+    monkeypatch.setattr(fallback, "sequential_plan", lambda *_args: None)
     made = []
-    real = api.pairwise_plan
+    real = fallback.pairwise_plan
 
     def spy(*args):
         made.append(real(*args))
         return made[-1]
 
-    monkeypatch.setattr(api, "pairwise_plan", spy)
+    monkeypatch.setattr(fallback, "pairwise_plan", spy)
     result = plan(machine, PlanningOptions(time_limit_s=30.0))
     assert made and made[0] is not None
     assert not result.optimal
     assert check_plan(result) == result.length
     assert optimum <= result.length <= tree_length(made[0])
     # Without it, and with a depth-first search that finds nothing, no plan at all.
-    monkeypatch.setattr(api, "pairwise_plan", lambda *_args: None)
+    monkeypatch.setattr(fallback, "pairwise_plan", lambda *_args: None)
     monkeypatch.setattr(api.WorstCase, "within", lambda *_args: False)
     with pytest.raises(PlanningError, match="no plan found"):
         plan(machine, PlanningOptions(time_limit_s=5.0))

@@ -34,8 +34,9 @@ from feederkit.mechanics.actions import ActionRange
 from feederkit.mechanics.polygon_classes import polygon_class
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import _result, _sensorless_plan, plan
+from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.fallback import sensorless_plan
 from feederkit.planning.options import Grouping, Method, Objective, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.sensorless import Backchain, push_circle
@@ -375,12 +376,12 @@ def test_time_limit_returns_a_valid_plan_with_a_lower_bound():
 def test_backchaining_fallback_is_a_valid_plan_of_the_sensorless_length():
     m = _goal_known(build_machine([regular(32, (0.02, 0.008))], uncertainty=IDEAL))
     problem = Problem(m)
-    root = _sensorless_plan(problem, problem.readings.branches(problem.full), Deadline())
+    root = sensorless_plan(problem, problem.readings.branches(problem.full), Deadline())
     blind = _result(m, root, False, None, 2, "worst", "exact")
     check_plan(blind)
     assert blind.length == 32  # the sensorless optimum (nothing to read)
     with pytest.raises(Timeout):
-        _sensorless_plan(problem, problem.readings.branches(problem.full), Deadline(1e-9))
+        sensorless_plan(problem, problem.readings.branches(problem.full), Deadline(1e-9))
 
 
 def test_the_plan_that_follows_the_readings_is_a_valid_plan_shorter_than_the_chain():
@@ -397,9 +398,9 @@ def test_the_plan_that_follows_the_readings_is_a_valid_plan_shorter_than_the_cha
     m = _goal_known(build_machine([pf], ToleranceSensor(0.01 * pf.part.size), IDEAL))
     problem = Problem(m)
     branches = problem.readings.branches(problem.full)
-    chain = _result(m, _sensorless_plan(problem, branches, Deadline(), by_image=True),
+    chain = _result(m, sensorless_plan(problem, branches, Deadline(), by_image=True),
                     False, None, 2, "worst", "exact")  # fmt: skip
-    read = _result(m, _sensorless_plan(problem, branches, Deadline()), False, None, 2, "worst",
+    read = _result(m, sensorless_plan(problem, branches, Deadline()), False, None, 2, "worst",
                    "exact")  # fmt: skip
     assert check_plan(chain) == chain.length == 12
     assert check_plan(read) == read.length == 7

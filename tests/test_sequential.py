@@ -14,7 +14,7 @@ from test_strong_plans import random_pf
 from feederkit.landing.model import landings_of_outline
 from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
-from feederkit.planning import api
+from feederkit.planning import api, fallback
 from feederkit.planning.andor import part_chains
 from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout
@@ -98,8 +98,8 @@ def test_the_fallback_answers_with_it_before_the_pairwise_plan(monkeypatch):
         pytest.fail("the pairwise plan was built with a plan in hand")
 
     monkeypatch.setattr(api, "longest_root", out_of_time)
-    monkeypatch.setattr(api, "beam_plan", lambda *_args, **_kwargs: None)
-    monkeypatch.setattr(api, "pairwise_plan", never)
+    monkeypatch.setattr(fallback, "beam_plan", lambda *_args, **_kwargs: None)
+    monkeypatch.setattr(fallback, "pairwise_plan", never)
     result = plan(machine, PlanningOptions(time_limit_s=30.0))
     assert check_plan(result) == result.length
     assert optimum <= result.length <= tree_length(chained)

@@ -29,7 +29,7 @@ from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses
 from feederkit.planning.reindex import by_diameter
-from feederkit.planning.tree import Leaf
+from feederkit.planning.tree import TIES_CHAIN, TIES_EXACT, TIES_MARGIN, TIES_NONE, Leaf
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -122,8 +122,8 @@ def test_with_no_time_for_ties_the_plan_keeps_the_proven_length(monkeypatch):
     check_plan(quick)
     assert quick.optimal and quick.length == exact.length
     assert quick.min_margin < exact.min_margin  # the first plan, not the widest
-    assert quick.tie_breaks == api.TIES_NONE
-    assert exact.tie_breaks == api.TIES_EXACT
+    assert quick.tie_breaks == TIES_NONE
+    assert exact.tie_breaks == TIES_EXACT
 
 
 def test_out_of_time_in_the_expected_stage_the_margin_stays_exact(monkeypatch):
@@ -138,7 +138,7 @@ def test_out_of_time_in_the_expected_stage_the_margin_stays_exact(monkeypatch):
     assert partial.optimal and partial.length == exact.length
     assert partial.min_margin == exact.min_margin
     assert partial.expected_length > exact.expected_length + 1e-6
-    assert partial.tie_breaks == api.TIES_MARGIN
+    assert partial.tie_breaks == TIES_MARGIN
 
 
 def test_the_tie_budget_counts_polls_not_seconds():
@@ -194,7 +194,7 @@ def test_a_plan_cut_short_in_its_tie_breaks_is_the_same_on_a_slow_computer(monke
 
     monkeypatch.setattr(WorkBudget, "check", slow_check)
     slow = api.plan(build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL))
-    assert fast.tie_breaks != api.TIES_EXACT
+    assert fast.tie_breaks != TIES_EXACT
     assert (slow.tie_breaks, slow.min_margin, slow.expected_length) == (
         fast.tie_breaks,
         fast.min_margin,
@@ -345,7 +345,7 @@ def test_a_command_says_when_the_choice_among_shortest_plans_was_cut(monkeypatch
     monkeypatch.setattr(api, "TIE_GRACE_POLLS", -1)
     monkeypatch.setattr(api, "TIE_SHARE", 0.0)
     quick = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
-    assert quick.result.tie_breaks == api.TIES_NONE
+    assert quick.result.tie_breaks == TIES_NONE
     (line,) = [w for w in quick.warnings if "choice among shortest plans" in w]
     assert "not proven the largest" in line and "\n" not in line
     # The tie-breaking budget cut it, not the clock: more time would not help.
@@ -358,7 +358,7 @@ def test_a_command_says_when_the_choice_among_shortest_plans_was_cut(monkeypatch
 
     monkeypatch.setattr(Refiner, "expected", out_of_time)
     partial = make_plan(pfs, ToleranceSensor(2.0), options, uncertainty=IDEAL)
-    assert partial.result.tie_breaks == api.TIES_MARGIN
+    assert partial.result.tie_breaks == TIES_MARGIN
     assert partial.result.ties_cut_by == "time"
     (line,) = [w for w in partial.warnings if "choice among shortest plans" in w]
     assert "not the fewest expected operations" in line
@@ -372,7 +372,7 @@ def test_the_backchaining_plan_is_no_tie_break_cut_short():
 
     pf = near_round(64, 0.01)  # 35 states, all reading alike at 3 %
     made = make_plan([pf], ToleranceSensor(0.03 * pf.part.size), uncertainty=IDEAL)
-    assert made.result.tie_breaks == api.TIES_CHAIN
+    assert made.result.tie_breaks == TIES_CHAIN
     assert not any("choice among shortest plans" in w for w in made.warnings)
 
 
@@ -417,7 +417,7 @@ def test_ties_cut_after_the_margin_follow_the_probes_plans_without_a_search(
     monkeypatch.setattr(Refiner, "expected", cut)
     fresh = build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL)
     got = api.plan(fresh)
-    assert got.tie_breaks == api.TIES_MARGIN and got.optimal
+    assert got.tie_breaks == TIES_MARGIN and got.optimal
     assert got.length == exact.length
     assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
     assert any(searches) is False and len(searches) > 0
@@ -442,7 +442,7 @@ def test_ties_cut_before_any_margin_follow_the_length_proofs_plans_without_a_sea
     searched = _calls_while_following(monkeypatch, "choose_worst")
     monkeypatch.setattr(Refiner, "keeps", cut)
     got = api.plan(build_machine(small_mix(count), ToleranceSensor(tolerance), IDEAL))
-    assert got.tie_breaks == api.TIES_NONE and got.optimal
+    assert got.tie_breaks == TIES_NONE and got.optimal
     assert got.length == exact.length
     assert searched == []
     assert check_plan(got) <= got.length
@@ -465,7 +465,7 @@ def test_ties_cut_after_the_margin_under_uncertainty_give_a_verified_strong_plan
     monkeypatch.setattr(Refiner, "expected", cut)
     made = make_plan(pfs, ToleranceSensor(tolerance), uncertainty=Uncertainty())
     got = made.result
-    assert got.tie_breaks == api.TIES_MARGIN and made.report.ok
+    assert got.tie_breaks == TIES_MARGIN and made.report.ok
     assert got.length == exact.length
     assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
 
@@ -488,7 +488,7 @@ def test_the_expected_stage_gets_its_own_share_of_the_tie_budget(monkeypatch):
     (proof, whole), (_, share) = seen
     assert whole == 1e6 * proof + 5
     assert share == 0.5 * proof + 5
-    assert got.tie_breaks == api.TIES_MARGIN  # 5 polls do not finish it
+    assert got.tie_breaks == TIES_MARGIN  # 5 polls do not finish it
     assert got.ties_cut_by == "work"
     assert check_plan(got) <= got.length
 
@@ -514,7 +514,7 @@ def test_the_expected_stages_budget_counts_the_bounds_it_computes(monkeypatch):
     monkeypatch.setattr(Refiner, "_open_mass", counted)
     monkeypatch.setattr(refine, "BOUNDS_PER_POLL", 1)
     got = api.plan(build_machine(small_mix(8), ToleranceSensor(2.0), IDEAL))
-    assert got.tie_breaks == api.TIES_EXACT
+    assert got.tie_breaks == TIES_EXACT
     expected_stage = budgets[-1]
     made = sum(1 for d in bounds if d is expected_stage)
     assert made > 100
@@ -537,7 +537,7 @@ def test_root_branches_chosen_before_the_expected_stage_ran_out_keep_their_subtr
     )
     partial = _cut_after(monkeypatch, first + 1)
     for got in (followed, partial):
-        assert got.tie_breaks == api.TIES_MARGIN and got.optimal
+        assert got.tie_breaks == TIES_MARGIN and got.optimal
         assert got.length == exact.length
         assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)
         assert check_plan(got) <= got.length
@@ -588,7 +588,7 @@ def test_the_expected_objective_cut_short_is_not_optimal(monkeypatch):
         build_machine(small_mix(5), ToleranceSensor(2.0), IDEAL),
         PlanningOptions(objective="expected"),
     )
-    assert not got.optimal and got.tie_breaks == api.TIES_NONE
+    assert not got.optimal and got.tie_breaks == TIES_NONE
     assert check_plan(got) <= got.length
 
 
@@ -602,6 +602,6 @@ def test_root_branches_kept_under_uncertainty_give_a_verified_strong_plan(monkey
     _run_out_after(monkeypatch, 2)
     made = make_plan(pfs, ToleranceSensor(3.0), uncertainty=Uncertainty())
     got = made.result
-    assert got.tie_breaks == api.TIES_MARGIN and made.report.ok
+    assert got.tie_breaks == TIES_MARGIN and made.report.ok
     assert got.length == exact.length
     assert math.isclose(got.min_margin, exact.min_margin, rel_tol=0.0, abs_tol=1e-9)

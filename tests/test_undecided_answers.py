@@ -18,12 +18,14 @@ from feederkit.cli.common import time_limit_note
 from feederkit.errors import PlanningError
 from feederkit.machine import build_machine
 from feederkit.planning.andor import WorstCase
-from feederkit.planning.api import NoStrongPlan, goal_relation
+from feederkit.planning.api import goal_relation
 from feederkit.planning.budget import Deadline
+from feederkit.planning.fallback import fallback
 from feederkit.planning.lumping import LumpingTry, try_lumping
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
@@ -77,9 +79,7 @@ def _fallback_of(machine, apart: bool) -> str:
         worst.lb[r] = 3  # as if the search had proven it
     options = PlanningOptions(time_limit_s=1.0)
     with pytest.raises(PlanningError) as info:
-        api._fallback(
-            problem, worst, roots, root_branches, Deadline(end=0.0), options, "time", apart
-        )
+        fallback(problem, worst, roots, root_branches, Deadline(end=0.0), options, "time", apart)
     return str(info.value)
 
 

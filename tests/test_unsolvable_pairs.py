@@ -20,12 +20,12 @@ from test_strong_plans import random_pf
 
 from feederkit.machine import build_machine
 from feederkit.machine.inseparable import kept_apart
-from feederkit.planning import api, solvable
-from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
+from feederkit.planning import api, fallback, solvable
+from feederkit.planning.api import plan, strong_plan_exists
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import solve, unsolvable, unsolvable_by_pairs
+from feederkit.planning.solvable import NoStrongPlan, solve, unsolvable, unsolvable_by_pairs
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 
@@ -70,7 +70,7 @@ def test_the_planner_says_no_strong_plan_when_its_search_cannot_finish(monkeypat
         raise api.Timeout("time")
 
     monkeypatch.setattr(api, "longest_root", out_of_time)
-    monkeypatch.setattr(api, "beam_plan", lambda *args, **kwargs: None)
+    monkeypatch.setattr(fallback, "beam_plan", lambda *args, **kwargs: None)
     monkeypatch.setattr(api, "kept_roots", lambda *args, **kwargs: [])  # the test below
     options = PlanningOptions(time_limit_s=30.0, lumping="none")
     with pytest.raises(NoStrongPlan, match="no strong plan exists"):

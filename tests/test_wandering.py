@@ -13,8 +13,9 @@ from feederkit.mechanics import push_function
 from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.api import NoStrongPlan, plan, strong_plan_exists
+from feederkit.planning.api import plan, strong_plan_exists
 from feederkit.planning.options import Lumping, PlanningOptions
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import Uncertainty
 

@@ -22,9 +22,10 @@ import time
 from collections.abc import Callable
 
 from feederkit.errors import PlanningError
-from feederkit.planning.api import EXACT_CHECK_SHARE, FALLBACK_SHARE, TIES_EXACT
+from feederkit.planning.api import EXACT_CHECK_SHARE, FALLBACK_SHARE
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.tree import TIES_EXACT
 from feederkit.plans.make import MadePlan
 
 Progress = Callable[[str, int, int], None]

@@ -4,6 +4,7 @@ The root is the first alignment from an unknown orientation (``Step(action=None)
 branches are the readings of the full set of states. Each branch is then oriented by a
 minimum worst-case plan (sections 4 and 6), ties broken by the order of docs/planning.md
 (see :mod:`feederkit.planning.refine`). ``length`` counts the first alignment (design.md).
+When the exact search runs out of its budget, :mod:`feederkit.planning.fallback` answers.
 
 References
 ----------
@@ -11,22 +12,20 @@ Akella, S. and Mason, M. T. (1999). Using partial sensor information to orient p
 The International Journal of Robotics Research 18(10), sections 4 (sensorless plans), 6
 (AND/OR search 6.1, bottom-up 6.4) and 8.5 (mixes).
 Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 10
-(backchaining, the sensorless fallback here).
+(backchaining: the plan where the readings carry nothing).
 """
 
 from __future__ import annotations
 
-import gc
 import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
 
 from feederkit.errors import InputError, PlanningError
-from feederkit.machine import OverlapRange, PushAlignMachine, search_space
+from feederkit.machine import PushAlignMachine, search_space
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.planning.andor import WorstCase
-from feederkit.planning.beam import beam_plan
 from feederkit.planning.budget import (
     Checkpoint,
     Deadline,
@@ -34,36 +33,36 @@ from feederkit.planning.budget import (
     WorkBudget,
     collector_paused,
 )
+from feederkit.planning.fallback import fallback, sensorless_plan
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
-from feederkit.planning.options import Lumping, PlanningOptions
-from feederkit.planning.pairwise import applies as pairwise_applies
-from feederkit.planning.pairwise import pairwise_plan
+from feederkit.planning.options import Lumping, PlanningOptions, out_of_budget
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
-from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
-from feederkit.planning.sequential import sequential_plan
-from feederkit.planning.solvable import decide, kept_roots, unsolvable, unsolvable_by_pairs
-from feederkit.planning.stats import (
-    expected_operations,
-    node_states,
-    tree_length,
-    tree_min_margin,
+from feederkit.planning.sensorless import BackchainWorst
+from feederkit.planning.solvable import (
+    NoStrongPlan,
+    decide,
+    kept_roots,
+    length_cap,
+    no_strong_plan,
+    unsolvable,
 )
-from feederkit.planning.subsets import subset_lower_bound
+from feederkit.planning.stats import expected_operations, tree_length, tree_min_margin
 from feederkit.planning.tree import (
-    Leaf,
+    TIES_CHAIN,
+    TIES_EXACT,
+    TIES_MARGIN,
+    TIES_NONE,
     PlanResult,
     Step,
     branch_pairs,
-    build_dag,
     root_step,
 )
 from feederkit.planning.wandering import twinned, wandering_words
-from feederkit.words import plural
 
 FALLBACK_SHARE = 0.3
 """With a time limit, the share of it kept for finding some plan when the exact search fails."""
@@ -73,10 +72,6 @@ EXACT_CHECK_SHARE = 0.4
 ``1 - FALLBACK_SHARE`` of the limit) after which it goes on only when at least this share
 of the root branches' lengths is proven (:func:`_on_course`); else the fallback gets the
 rest of the limit (:class:`~feederkit.planning.budget.Checkpoint`)."""
-
-FALLBACK_MAX_OPERATIONS = 100
-"""The depth-first fallback looks for plans of at most this many operations: longer ones are
-of no use on a feeder, and every consumer of a plan walks it level by level."""
 
 EXACT_MEMORY_SHARE = 0.8
 """With a memory limit, the share of it the exact search may hold; the rest is headroom for
@@ -109,49 +104,6 @@ TIE_GRACE_POLLS = 10_000
 """Polls the tie-breaking stages get on top of ``TIE_SHARE`` of the length proof's (a second
 of expected-operations polls on the benchmark machine, up to four of margin probes): the
 small cases, whose proof polls a few hundred times, break their ties exactly."""
-
-TIES_EXACT = "exact"
-"""``tie_breaks``: every tie-break of the objective was decided exactly."""
-TIES_MARGIN = "margin"
-"""``tie_breaks``: the largest margin is exact, the expected operations are not minimised."""
-TIES_NONE = "none"
-"""``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
-TIES_CHAIN = "backchain"
-"""``tie_breaks``: the backchaining plan of a set whose readings carry nothing (its
-rotations the widest that shorten the set; no tie-break searched, none cut short)."""
-
-
-class NoStrongPlan(PlanningError):
-    """No strong plan exists under the machine's declared uncertainty (design.md).
-
-    ``reason`` is the message without ``hint``, the clause (maybe empty) naming the
-    unresolvable pairs the lumping rule would not list together (docs/planning.md,
-    "Near-symmetric states under uncertainty"); callers that add to the message put the
-    hint last.
-    """
-
-    def __init__(self, reason: str, hint: str = "") -> None:
-        super().__init__(f"{reason}; {hint}" if hint else reason)
-        self.reason = reason
-        self.hint = hint
-
-
-def _uncertainty_words(machine: PushAlignMachine) -> str:
-    u = machine.uncertainty
-    return (
-        f"rotation error {u.rotation_error_deg:g} deg, shape tolerance "
-        f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
-    )
-
-
-def _no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
-    what = _uncertainty_words(machine)
-    if undecided:
-        return NoStrongPlan(f"no strong plan found within {_limit(machine)} operations ({what})")
-    return NoStrongPlan(
-        f"no strong plan exists under the declared uncertainty ({what}): for every action "
-        "some outcome leaves states that must be told apart reading alike"
-    )
 
 
 def strong_plan_exists(
@@ -271,7 +223,7 @@ def _decide(problem: Problem, roots, deadline: Deadline, machine: PushAlignMachi
     except Timeout:
         return None
     if bad:
-        raise _no_strong_plan(machine)
+        raise no_strong_plan(machine)
     return known
 
 
@@ -285,11 +237,6 @@ LUMPED_ROOT_SETS = 5_000
 """The most sets :func:`plan` lets lumping explore to decide the lumped goal's roots; past it
 the search to that goal decides (the 50-part mix at 5 % under 1 degree: 200,000 sets in 91 s
 left them undecided, where the search found a plan in 33 s)."""
-
-
-def _limit(machine: PushAlignMachine) -> int:
-    """A cap on a strong plan's length when solvability is undecided (sets too many)."""
-    return 4 * machine.n + 4
 
 
 def plan(
@@ -345,7 +292,7 @@ def _plan_machine(
             split, twin_of = twinned(machine, budget.check)
         except Timeout as exc:
             raise PlanningError(
-                f"no plan found within {_out_of_budget(options, exc.reason)}: it ran out while "
+                f"no plan found within {out_of_budget(options, exc.reason)}: it ran out while "
                 f"finding which of the {machine.n} states are inseparable"
             ) from None
     if split is machine:
@@ -372,7 +319,7 @@ def _plan_machine(
         if not goals and tried.cut_by in ("time", "memory"):
             # Unproven: listing near-symmetric states together may still give a plan.
             raise PlanningError(
-                f"no plan found within {_out_of_budget(options, tried.cut_by)}: no strong "
+                f"no plan found within {out_of_budget(options, tried.cut_by)}: no strong "
                 "plan tells every pair of states apart, and it ran out while deciding which "
                 "near-symmetric states a plan may list together"
             ) from None
@@ -400,13 +347,6 @@ def _plan_machine(
     if lumping is None:
         return result
     return replace(result, lumped_pairs=lumping.renumbered(old).in_leaves(root))
-
-
-def _out_of_budget(options: PlanningOptions, reason: str) -> str:
-    """The limit that stopped a search, in words."""
-    if reason == "memory" and options.memory_limit_mb is not None:
-        return f"the memory limit of {options.memory_limit_mb:g} MB"
-    return f"the time limit of {options.time_limit_s:g} s"
 
 
 def goal_relation(machine: PushAlignMachine, budget: Deadline) -> tuple[int, ...]:
@@ -450,7 +390,7 @@ def _plan(
         insep = goal_relation(machine, budget) if goal is None else goal
     except Timeout as exc:
         raise PlanningError(
-            f"no plan found within {_out_of_budget(options, exc.reason)}: it ran out while "
+            f"no plan found within {out_of_budget(options, exc.reason)}: it ran out while "
             f"finding which of the {machine.n} states are inseparable"
         ) from None
     problem = Problem(machine, grouping, min_margin, insep)
@@ -478,7 +418,7 @@ def _plan(
         # FIRST_LIMIT operations, and decide only when that fails (below).
         if problem.sensorless:
             known = _decide(problem, roots, exact_deadline, machine)
-            limit = None if known is not None else _limit(machine)
+            limit = None if known is not None else length_cap(machine)
         else:
             limit = FIRST_LIMIT
             # A pair nature keeps apart in a root settles it before any search (cheap,
@@ -486,7 +426,7 @@ def _plan(
             # first KEPT_SHARE of the limit, so that solvable machines lose little.
             try:
                 if kept_roots(problem.with_margin(0.0), roots, budget.until(KEPT_SHARE)):
-                    raise _no_strong_plan(machine)
+                    raise no_strong_plan(machine)
             except Timeout:
                 pass  # the search and its fallback decide
     worst = make_oracle(problem, method, exact_deadline)
@@ -494,7 +434,7 @@ def _plan(
         try:
             _check_margin(problem, roots, min_margin, exact_deadline)
         except Timeout as exc:
-            return _fallback(
+            return fallback(
                 problem, worst, roots, root_branches, budget, options, exc.reason, apart
             )
     if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
@@ -515,19 +455,19 @@ def _plan(
             known = _decide(problem, roots, exact_deadline, machine)
             if known is not None and min_margin == 0.0:
                 worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
-            longest = longest_root(problem, worst, roots, method, _limit(machine))
+            longest = longest_root(problem, worst, roots, method, length_cap(machine))
     except Timeout as exc:
         stopped = exc.reason
     except ValueError:
         exact = method in ("bfs", "bottom-up") or known is not None
-        raise _no_strong_plan(machine, undecided=not exact) from None
+        raise no_strong_plan(machine, undecided=not exact) from None
     finally:
         if checkpoint is not None:
             # The question is asked while the lengths are searched only; its closure holds
             # the search, which holds the checkpoint: a cycle only the collector would free.
             checkpoint.on_course = None
     if stopped is not None:
-        return _fallback(problem, worst, roots, root_branches, budget, options, stopped, apart)
+        return fallback(problem, worst, roots, root_branches, budget, options, stopped, apart)
     if checkpoint is not None:
         checkpoint.go_on()  # every root's length is proven: the rest of the share is ours
     length = 1 + longest
@@ -537,9 +477,9 @@ def _plan(
         # of the whole set is a shortest plan (its rotations the widest that shorten the
         # set), and any plan that follows the readings grows a tree of every reading set.
         try:  # under a copy: a chain too large to verify leaves its commits behind
-            chain = _sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
+            chain = sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
         except Timeout as exc:
-            return _fallback(
+            return fallback(
                 problem, worst, roots, root_branches, budget, options, exc.reason, apart
             )
         if chain is not None and tree_length(chain) == length:
@@ -581,7 +521,7 @@ def _plan(
         try:
             root, _cut = _build(refiner, children, roots, budget_ops, "first")
         except Timeout as exc:
-            return _fallback(
+            return fallback(
                 problem, worst, roots, root_branches, budget, options, exc.reason, apart
             )
         complete = objective == "worst"
@@ -672,7 +612,7 @@ def _check_margin(
         return
     best = largest_margin(problem.with_margin(0.0), roots, deadline)
     if best == -math.inf:
-        raise _no_strong_plan(problem.machine)
+        raise no_strong_plan(problem.machine)
     raise PlanningError(
         f"no plan keeps a margin of {min_margin:g} deg; the largest margin any plan keeps is "
         f"{best:.6g} deg"
@@ -682,393 +622,6 @@ def _check_margin(
 def _root_children(problem: Problem, root_branches, start_mass):
     """The root's branches with their probabilities and normalised masses."""
     return child_masses(problem, problem.full, tuple(start_mass), None, tuple(root_branches))
-
-
-BEAM_SHARE = 0.2
-"""The share of the fallback's time (after the backchaining plan) the widening beams may take,
-never into the tree's reserve; the hardest subsets' lower bound and the AND/OR search for a
-plan at the bound get the rest."""
-
-READ_SHARE = 0.5
-"""With a time limit, the share of what is left after the backchaining plan that the plan
-following the readings may take (a node per maximal reading set it meets: 2.4 CPU s on the
-random 1000-point outline at 1 % on the ideal model, whose fallback gets about 7 s of a
-10 s limit; a quarter of that ran out)."""
-
-TREE_RESERVE = 0.15
-"""The share of the time limit the fallback's last search leaves for building its tree."""
-
-WALK_SHARE = 1.0
-"""With the beams' plan in hand, the searches after it stop this many times its tree's
-building time before the limit (when more than half the tree reserve): the result's
-statistics and renumbering walk that tree once more after them (the 50-part mix at 3 %
-under 1 degree: the answer 2.6-4.5 s past a 60 s limit without this; 1.5 left the 20-part
-mix at 5 % under 10 s no time for the subsets' bound)."""
-
-PAIRWISE_SHARE = 0.7
-"""With a time limit and no plan in hand, the share of what is left that the plan telling
-the states apart one pair at a time may take (the ideal model only)."""
-
-FIRST_PLAN_RESERVE = 2.0
-"""With no plan in hand, the widening beams look for a first one until this many tree
-reserves (``TREE_RESERVE``) before the limit, past their ``BEAM_SHARE``; shorter ones only
-within it."""
-
-FIRST_PLAN_GRACE_S = 1.5
-"""With no plan in hand, the first this many seconds of the first plan's verification are
-not committed to the budget (:meth:`~feederkit.planning.budget.Deadline.with_grace`): a plan
-a little late beats none (the command then answers at most this much past its limit); one
-later still is dropped like one too slow to find."""
-
-
-def _fallback(
-    problem: Problem,
-    worst: WorstCase,
-    roots: list[int],
-    root_branches,
-    budget: Deadline,
-    options: PlanningOptions,
-    stop: str,
-    apart: bool = False,
-):
-    """Some plan when the exact search ran out of its budget (``stop``: the Timeout's reason),
-    with the lower bound proven; ``apart``: the goal tells every pair of states apart and a
-    lumped one may follow, so with no plan found the bound is stated for this goal only.
-
-    Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
-    part, no margin floor: one chain of the whole set; the plan that follows the readings
-    within ``READ_SHARE`` of what is left, when it is shorter); else, on the ideal model, the
-    parts' chains in turn (:func:`~feederkit.planning.sequential.sequential_plan`, when the
-    readings after them leave goals), else the plan that tells the states apart one pair at
-    a time (within ``PAIRWISE_SHARE``); the
-    widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
-    shorter; with a plan in hand, the hardest subsets' bound
-    (:func:`~feederkit.planning.subsets.subset_lower_bound`); then a depth-first search (the
-    greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
-    shorter still. A tree follows the actions that proved it; a reading set the searches
-    never met lies inside one they did (its "witness"), and follows the witness's
-    rotations. PlanningError when none finds a plan in time.
-
-    No Timeout is kept past its ``except`` block: its traceback holds the frames of the
-    search, and a frame holding it would make the searches' tables cyclic garbage that only
-    the collector (paused while planning) could free.
-    """
-    lower = 1 + max((_proven(worst, r) for r in roots), default=0)
-    if stop == "memory":
-        # Let the exact search's tables go: the fallback starts from a fresh problem.
-        problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
-        del worst
-        gc.collect()
-    # Each plan below is built under a copy of the budget (its nodes' verification
-    # committed there while it is built) and held, once made, by ``held`` on the budget.
-    try:  # the backchaining plan itself first: one chain, one step per operation
-        blind = _sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
-    except Timeout:
-        blind = None
-    rest = budget.remaining()
-    share = budget.ending(None)
-    if rest is not None and not problem.sensorless:
-        # With readings its tree can be large: keep the rest for the searches.
-        share = budget.ending(budget.end - rest * (1.0 - READ_SHARE))
-    if blind is not None:
-        try:  # the readings may shorten it
-            read = _sensorless_plan(problem, root_branches, share)
-        except Timeout:
-            read = None
-        if read is not None and tree_length(read) < tree_length(blind):
-            blind = read
-    if blind is None:
-        try:  # several parts on the ideal model: each part's backchaining chain in turn
-            blind = sequential_plan(problem, root_branches, budget.ending(None))
-        except Timeout:
-            blind = None
-        if blind is not None and tree_length(blind) > FALLBACK_MAX_OPERATIONS:
-            blind = None
-    held = _Held(budget)  # the plan in hand's verification comes out of the time left
-    held.hold(blind)
-    if blind is None and pairwise_applies(problem):
-        # On the ideal model a plan always exists: the pairs told apart one at a time
-        # (feederkit.planning.pairwise), within PAIRWISE_SHARE of what is left; the searches
-        # below then look for something shorter.
-        rest = budget.remaining()
-        share = budget
-        if rest is not None:
-            share = _graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)), None)
-        try:
-            told = pairwise_plan(problem, root_branches, share)
-        except Timeout:
-            told = None
-        if told is not None and tree_length(told) <= FALLBACK_MAX_OPERATIONS:
-            blind = told
-            held.hold(blind)
-    anytime = WorstCase(problem, budget)
-    if stop != "memory" and type(worst) is WorstCase:
-        # What the exact search proved stays true (its exact lengths are left out: they
-        # may come without the action that proves them).
-        anytime.lb.update(worst.lb)
-        anytime.ub.update(worst.ub)
-        anytime.choice.update(worst.choice)
-    cap = min(2 * problem.n + 1, FALLBACK_MAX_OPERATIONS)
-    if blind is not None:
-        cap = tree_length(blind) - 2  # look only for something shorter
-    # A plan in hand needs time for its tree and statistics: the searches below stop a
-    # reserve of the limit before it.
-    reserve = 0.0 if budget.end is None else TREE_RESERVE * (budget.end - budget.start)
-    gap = reserve / 2.0  # the tree of a plan found must be built by this long before the end
-    rest = budget.remaining()
-    # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
-    # BEAM_SHARE of what is left; what they find is where the search below starts.
-    beam_end = None if rest is None else budget.end - max(rest * (1.0 - BEAM_SHARE), reserve)
-    seed = worst if stop != "memory" and type(worst) is WorstCase else None
-    # With no plan in hand a first one may take until FIRST_PLAN_RESERVE before the limit
-    # (what is left then builds its tree).
-    first = None
-    if blind is None and budget.end is not None:
-        first = budget.ending(max(beam_end, budget.end - FIRST_PLAN_RESERVE * reserve))
-    beamed = beam_plan(
-        problem,
-        roots,
-        seed,
-        budget.ending(beam_end),
-        cap,
-        lower - 1,
-        first,
-    )
-    if beamed is not None:
-        search, best = beamed
-        # Its tree now, under the whole budget: a plan in hand (shorter than blind) beats none,
-        # though its statistics may then run past the limit by one walk of the tree.
-        built = time.perf_counter()
-        held.hold(None)  # the plan in hand gives way to it: only its own pairs count
-        try:
-            blind = _choice_plan(
-                problem, search.choice, roots, root_branches, _graced(budget, blind)
-            )
-            # Its statistics and renumbering after the searches below cost up to about as
-            # much as building it: they stop WALK_SHARE of that before the limit, when more
-            # than the reserve's half.
-            gap = max(gap, WALK_SHARE * (time.perf_counter() - built))
-        except Timeout:
-            pass  # the plan in hand, if any, stays
-        held.hold(blind)
-        anytime.ub.update(search.ub)
-        anytime.choice.update(search.choice)
-        cap = best - 1  # the search below looks only for something shorter
-    if blind is None and not problem.machine.deterministic:
-        # No plan in hand under uncertainty: perhaps none exists. A root holding a pair no
-        # strong plan orients has none (solvable.unsolvable_by_pairs: quick where the roots'
-        # own sets are too many); half of what is left decides it, when it can.
-        rest = budget.remaining()
-        share = budget if rest is None else budget.ending(budget.end - rest / 2.0)
-        try:
-            bad = unsolvable_by_pairs(problem.with_margin(0.0), roots, share)
-        except Timeout:
-            bad = None
-        if bad:
-            raise _no_strong_plan(problem.machine)
-    # Where a tree must be built by once a plan is in hand; read after the plan in hand's
-    # pairs are committed (``held``), which brought the budget's end forward.
-    tree_budget = budget if budget.end is None else budget.ending(budget.end - gap)
-    if blind is not None and budget.end is not None:
-        # The bound, from the hardest subsets of the roots (feederkit.planning.subsets), up to
-        # half the reserve (no tree to build, only the statistics of the plan in hand): a
-        # closer bound tells how good that plan is, and ends the search below when met.
-        goal = tree_length(blind) - 1
-        lower = 1 + subset_lower_bound(problem, roots, lower - 1, tree_budget, goal)
-    # With a deadline, lengths at the proven bound and one above it first (each with a third
-    # of the time left), then the generous cap: a plan within one operation of the bound
-    # when the search finds one, some plan else.
-    near = (lower - 1, lower) if budget.end is not None else ()
-    caps = sorted({k for k in near if k < cap}) + [cap]
-    found = None
-    last = stop  # the reason the last search stopped
-    # The last search keeps a reserve of the limit for the tree of what it finds: a plan
-    # found at the deadline with no time left to write it down is no answer. With a plan in
-    # hand every search keeps the whole reserve, and a shorter plan's tree half of it.
-    if blind is None:
-        tree_budget = budget
-    for k in caps if cap >= max(lower - 1, 1) else ():
-        rest = budget.remaining()
-        if rest is None:
-            end = None
-        elif blind is not None:
-            end = min(
-                tree_budget.end, budget.end - max(reserve, rest * 2.0 / 3.0 if k < cap else 0.0)
-            )
-        elif k == cap:
-            end = budget.end - min(reserve, rest / 2.0)
-        else:
-            end = budget.end - rest * 2.0 / 3.0
-        anytime.deadline = budget.ending(end)
-        try:
-            if all(anytime.within(r, k) for r in roots):
-                found = k
-                break
-        except Timeout as exc:
-            last = exc.reason
-            if last == "memory":
-                break
-    root = None
-    if found is not None:
-        # The shorter plan replaces the one in hand: only its own pairs count.
-        held.hold(None)
-        if budget.end is not None and blind is not None:
-            tree_budget = budget.ending(budget.end - gap)
-        anytime.deadline = tree_budget
-        try:
-            root = _choice_plan(
-                problem, anytime.choice, roots, root_branches, _graced(tree_budget, blind)
-            )
-            held.hold(root)
-        except Timeout as exc:
-            last = exc.reason
-    if root is None:
-        if blind is not None:
-            return blind, False, None, lower, TIES_NONE, None
-        reason = last if last == "memory" else stop
-        which = "one that tells every pair of states apart" if apart else "a plan"
-        raise PlanningError(
-            f"no plan found within {_out_of_budget(options, reason)} "
-            f"({which} needs at least {plural(lower, 'operation')})"
-        )
-    return root, False, None, lower, TIES_NONE, None
-
-
-def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
-    """A copy of ``budget`` to build a plan under; with no plan ``in_hand``, the first
-    ``FIRST_PLAN_GRACE_S`` of its verification free (a plan a little late beats none)."""
-    return budget.with_grace(0.0 if in_hand is not None else FIRST_PLAN_GRACE_S)
-
-
-class _Held:
-    """The (node, state) pairs of the plan in hand, committed to the fallback's budget
-    (:meth:`~feederkit.planning.budget.Deadline.commit`): its verification and file come out
-    of the time left, and a plan that replaces it gives its pairs back."""
-
-    def __init__(self, budget: Deadline) -> None:
-        self.budget = budget
-        self.pairs = 0
-
-    def hold(self, root: Step | None) -> None:
-        """``root`` is the plan in hand now (None: none)."""
-        pairs = 0 if root is None else node_states(root)
-        self.budget.commit(pairs - self.pairs, stop=False)  # the plan is made: keep it
-        self.pairs = pairs
-
-
-def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:
-    """The plan that follows a search's ``choice`` table (the action that proved each set).
-
-    A reading set the search did not choose for lies inside one it did (its witness: a
-    searched superset, or the set itself, whichever has the shorter plan) and follows the
-    witness's subplan itself: the witness's rotation sends the set inside the witness's
-    image, each reading then leaves a subset of one of the image's branches, and a subset
-    of a goal is a goal. So the plan has one node per witness, not one per reading set met
-    (the 50-part mix at 3 % under 1 degree: about a tenth of the nodes), and every consumer
-    (verification, certificate, file, drawing) walks that much less.
-    """
-
-    def witness_of(mask: int, supersets) -> int:
-        # The set itself or a searched set containing it, whichever has the shorter plan: a
-        # set's own entry may be a longer plan than the one its parent's bound counted on.
-        if problem.is_goal(mask):
-            return mask
-        own = choice.get(mask)
-        best = mask
-        bound = own[0] if own is not None else None
-        for c in supersets:
-            if mask & c == mask and c in choice and (bound is None or choice[c][0] < bound):
-                best, bound = c, choice[c][0]
-        return best
-
-    def expand(witness: int):
-        if problem.is_goal(witness):
-            return Leaf(witness)
-        _k, act = choice[witness]
-        subs = [
-            (b, witness_of(b.mask, act.children))
-            for b in problem.readings.image_branches(act.action.image)
-        ]
-        return act.action, subs
-
-    top = [(b, witness_of(b.mask, roots)) for b in root_branches]
-    made = build_dag([k for _b, k in top], expand, deadline)
-    return root_step(((b, made[k]) for b, k in top), deadline)
-
-
-def _sensorless_plan(
-    problem: Problem, root_branches, deadline: Deadline, by_image: bool = False
-) -> Step | None:
-    """A plan that takes the readings but chooses rotations by backchaining, or None.
-
-    For one part's push machine (no margin floor), Goldberg's table says how many
-    operations collapse any set with no sensor; each step takes the rotation whose reading
-    sets need the fewest (the largest, then their sum), which is fewer than the set needs,
-    since a rotation that lowers the whole image's number exists and a reading only leaves
-    a subset. Never longer than the sensorless plan; on the random 1000-point outline at
-    1 % on the ideal model 21 operations, where the first rotation that lowers the image's
-    number gave 22. Its size grows with the distinct reading sets, so it is built
-    under ``deadline`` (Timeout). ``by_image``: the backchaining plan of the whole set
-    itself, readings followed but not used, for when the other runs out: every root branch
-    and every reading branch of a step goes on with the subplan of the step's whole image
-    (a reading only leaves a subset of it, and a subset of a goal set is a goal), so the
-    plan is one chain, one step per operation.
-    """
-    if problem.min_margin > 0.0:
-        return None
-    circle = push_circle(problem.machine, problem.insep)
-    if circle is None:
-        return None
-    chain = Backchain(circle)
-
-    def after(cell: tuple[float, float, int]) -> tuple[float, float]:
-        # The sensorless lengths the readings can leave: the largest, then their sum.
-        lengths = [chain.length(b) for b in problem.readings.children(cell[2])]
-        return max(lengths), sum(lengths)
-
-    def expand(mask: int):
-        if problem.is_goal(mask):
-            return Leaf(mask)
-        cells = problem.choices.cells(mask, False)
-        if by_image:
-            k = chain.length(mask)
-            lo, hi, img = next(c for c in cells if chain.length(c[2]) < k)
-            return OverlapRange(lo, hi, img), [
-                (b, img) for b in problem.readings.image_branches(img)
-            ]
-        # The rotation whose readings leave the shortest sets (the first such in the
-        # problem's order): never worse than the first that shortens the whole image, and
-        # better where the readings split it. A reading set goes on as the largest reading
-        # set holding it (its witness: a plan of a set orients its subsets), so the plan
-        # has a node per maximal set, not one per reading set (on the 1000-point outline
-        # above 136 s became about 2).
-        lo, hi, img = min(cells, key=after)
-        wider = problem.readings.children(img)
-
-        def witness(m: int) -> int:
-            return m if problem.is_goal(m) else next((c for c in wider if m & ~c == 0), m)
-
-        return OverlapRange(lo, hi, img), [
-            (b, witness(b.mask)) for b in problem.readings.image_branches(img)
-        ]
-
-    if by_image:
-        # One chain for every reading: the whole set's rotations send each branch (a
-        # subset) inside the same images, so the plan has one step per operation.
-        keys = {b.mask: b.mask if problem.is_goal(b.mask) else problem.full for b in root_branches}
-    else:
-        keys = {b.mask: b.mask for b in root_branches}
-    made = build_dag(list(keys.values()), expand, deadline)
-    return root_step(((b, made[keys[b.mask]]) for b in root_branches), deadline)
-
-
-def _proven(worst: WorstCase, mask: int) -> int:
-    """A proven lower bound on the set's operations (exact for backchaining)."""
-    if worst.p.is_goal(mask):
-        return 0
-    if isinstance(worst, BackchainWorst):
-        return worst.length(mask)
-    return worst.exact.get(mask, worst.lb.get(mask, 1))
 
 
 def _result(

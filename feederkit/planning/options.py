@@ -203,3 +203,10 @@ class PlanningOptions:
                 f"the objective {self.objective.value!r} needs the seconds of an operation "
                 "(action costs: pick-and-place time, rotation speed, drift time)"
             )
+
+
+def out_of_budget(options: PlanningOptions, reason: str) -> str:
+    """The limit that stopped a search, in words."""
+    if reason == "memory" and options.memory_limit_mb is not None:
+        return f"the memory limit of {options.memory_limit_mb:g} MB"
+    return f"the time limit of {options.time_limit_s:g} s"

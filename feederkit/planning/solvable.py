@@ -9,6 +9,8 @@ branches``. :func:`solve` finds both, level by level with a counter per action, 
 linear in the explored graph; the planners then read the lengths instead of searching.
 Subsets of solvable sets are solvable (images and branches shrink with the set), so the
 length view's pruning is sound here too.
+
+When none exists the planners raise :class:`NoStrongPlan`, naming the declared uncertainty.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from feederkit.machine import Grouping, members
+from feederkit.errors import PlanningError
+from feederkit.machine import Grouping, PushAlignMachine, members
 from feederkit.machine.inseparable import kept_apart
 from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.problem import Problem
@@ -261,3 +264,45 @@ NEIGHBOUR_PAIRS = 1
 """:func:`unsolvable_by_pairs` first asks only each state and the next this many of its root
 (in the machine's order: by diameter in the planners), the pairs most alike; the sets they
 reach are a few of all pairs' (the problem keeps their actions for the full check after)."""
+
+
+class NoStrongPlan(PlanningError):
+    """No strong plan exists under the machine's declared uncertainty (design.md).
+
+    ``reason`` is the message without ``hint``, the clause (maybe empty) naming the
+    unresolvable pairs the lumping rule would not list together (docs/planning.md,
+    "Near-symmetric states under uncertainty"); callers that add to the message put the
+    hint last.
+    """
+
+    def __init__(self, reason: str, hint: str = "") -> None:
+        super().__init__(f"{reason}; {hint}" if hint else reason)
+        self.reason = reason
+        self.hint = hint
+
+
+def _uncertainty_words(machine: PushAlignMachine) -> str:
+    u = machine.uncertainty
+    return (
+        f"rotation error {u.rotation_error_deg:g} deg, shape tolerance "
+        f"{u.shape_tolerance_mm:g} mm, COM tolerance {u.com_tolerance_mm:g} mm"
+    )
+
+
+def no_strong_plan(machine: PushAlignMachine, undecided: bool = False) -> NoStrongPlan:
+    """The error naming the declared uncertainty: no strong plan exists, or (``undecided``)
+    none was found within :func:`length_cap` operations."""
+    what = _uncertainty_words(machine)
+    if undecided:
+        return NoStrongPlan(
+            f"no strong plan found within {length_cap(machine)} operations ({what})"
+        )
+    return NoStrongPlan(
+        f"no strong plan exists under the declared uncertainty ({what}): for every action "
+        "some outcome leaves states that must be told apart reading alike"
+    )
+
+
+def length_cap(machine: PushAlignMachine) -> int:
+    """A cap on a strong plan's length when solvability is undecided (sets too many)."""
+    return 4 * machine.n + 4

@@ -173,6 +173,17 @@ class Certificate:
         }
 
 
+TIES_EXACT = "exact"
+"""``tie_breaks``: every tie-break of the objective was decided exactly."""
+TIES_MARGIN = "margin"
+"""``tie_breaks``: the largest margin is exact, the expected operations are not minimised."""
+TIES_NONE = "none"
+"""``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
+TIES_CHAIN = "backchain"
+"""``tie_breaks``: the backchaining plan of a set whose readings carry nothing (its
+rotations the widest that shorten the set; no tie-break searched, none cut short)."""
+
+
 @dataclass(frozen=True)
 class PlanResult:
     """A plan and its statistics.

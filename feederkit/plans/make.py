@@ -36,11 +36,11 @@ from feederkit.machine.weights import normalised_shares, weigh_members
 from feederkit.machine.widths import widen_widths
 from feederkit.mechanics.modelerror import exact_push_function, largest_offset, part_offsets
 from feederkit.mechanics.push import PushFunction
-from feederkit.planning.api import NoStrongPlan
 from feederkit.planning.api import plan as plan_machine
 from feederkit.planning.budget import collector_paused
 from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.tree import Leaf as TreeLeaf
 from feederkit.planning.tree import PlanResult, PlanTree, leaf_masks, map_tree
 from feederkit.planning.tree import Step as TreeStep
