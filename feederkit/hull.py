@@ -28,27 +28,47 @@ or not by the push function (a vertex 1e-11 mm off a 10 mm edge failed it)."""
 
 def convex_hull(points: Iterable[Sequence[float]]) -> list[Point]:
     """Andrew's monotone chain: the hull vertices counter-clockwise, collinear points dropped
-    (within ``COLLINEAR_REL`` of the points' size of their neighbours' line)."""
+    (within ``COLLINEAR_REL`` of the points' size of their neighbours' line).
+
+    The exact chains come first and the collinear vertices are dropped from them: with the
+    tolerance inside the chain, points of one edge whose x differ by rounding alone (a drawing
+    converted from inches) were taken in the wrong order and a real corner was popped.
+
+    >>> convex_hull([(75.0054901286538, 113.869), (75.00549012865379, 116.126),
+    ...              (75.0054901286538, 126.383), (100, 113), (100, 127)])
+    [(75.0054901286538, 113.869), (100.0, 113.0), (100.0, 127.0), (75.0054901286538, 126.383)]
+    """
     pts = sorted({(float(p[0]), float(p[1])) for p in points})
     if len(pts) <= 2:
         return pts
     eps = COLLINEAR_REL * size_of(pts)
 
-    def turns(o: Point, a: Point, b: Point) -> bool:
-        # Left of the line o -> b by more than eps (the cross product over the base length).
-        return _cross(o, a, b) > eps * math.hypot(b[0] - o[0], b[1] - o[1])
+    def turns(o: Point, a: Point, b: Point, tol: float) -> bool:
+        # Left of the line o -> b by more than tol (the cross product over the base length).
+        return _cross(o, a, b) > tol * math.hypot(b[0] - o[0], b[1] - o[1])
 
-    lower: list[Point] = []
-    for p in pts:
-        while len(lower) >= 2 and not turns(lower[-2], lower[-1], p):
-            lower.pop()
-        lower.append(p)
-    upper: list[Point] = []
-    for p in reversed(pts):
-        while len(upper) >= 2 and not turns(upper[-2], upper[-1], p):
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
+    def chain(seq: Iterable[Point], tol: float) -> list[Point]:
+        out: list[Point] = []
+        for p in seq:
+            while len(out) >= 2 and not turns(out[-2], out[-1], p, tol):
+                out.pop()
+            out.append(p)
+        return out
+
+    lower = chain(chain(pts, 0.0), eps)
+    upper = chain(chain(reversed(pts), 0.0), eps)
+    hull = lower[:-1] + upper[:-1]
+    # The chains' ends (the leftmost and rightmost points) were never tested: drop them too
+    # when they lie on their neighbours' line.
+    dropped = True
+    while dropped and len(hull) > 3:
+        dropped = False
+        for i in range(len(hull)):
+            if not turns(hull[i - 1], hull[i], hull[(i + 1) % len(hull)], eps):
+                del hull[i]
+                dropped = True
+                break
+    return hull
 
 
 def size_of(points: Sequence[Point]) -> float:
