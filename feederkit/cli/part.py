@@ -126,7 +126,8 @@ def _print_analysis(a: PartAnalysis) -> None:
         c = a.polygon_class
         console.print(
             f"class {c.number} (Fig. 14): {c.description}; worst-case plan length {c.bound} "
-            f"(m = {c.m}, n = {c.n}, p = {c.p})",
+            f"(m = {c.m}, n = {c.n}, p = {c.p}) for this side alone on the ideal model (a plan "
+            "over both landings, or under a rotation error, may need more)",
             highlight=False,
         )
     console.print()
