@@ -22,7 +22,7 @@ from feederkit.cli.common import add_count_column, add_name_column, plural
 from feederkit.errors import InputError
 from feederkit.mechanics.polygon_classes import CLASS_NAMES
 from feederkit.plans.execute import Trace
-from feederkit.plans.model import Leaf, Plan, Step, member_label
+from feederkit.plans.model import Leaf, Plan, Step, member_label, robust_ideal_words
 from feederkit.plans.readplan import MAX_PLAN_BYTES, as_plan, read_plan
 from feederkit.plans.verify import VerificationReport
 from feederkit.sensors import Sensor, sensor_from_dict
@@ -207,8 +207,7 @@ def stats_table(plan: Plan | Mapping[str, Any], report: VerificationReport | Non
         ):
             shape += " (the declared: reading branches end at the declared widths)"
         t.add_row("certified shape tolerance (largest)", shape)
-        ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
-        t.add_row("length: robust / ideal model", f"{s.length} / {ideal}")
+        t.add_row("length: robust / ideal model", robust_ideal_words(s.length, cert.ideal_length))
     bound = "lower bound" if (s.objective or "worst") == "worst" else "worst-case length at least"
     optimal = "yes" if s.optimal else f"not proven ({bound} {s.lower_bound})"
     t.add_row(f"optimal ({s.objective or 'worst'} objective)", optimal)

@@ -399,6 +399,25 @@ LOW_MARGIN_DEG = 1.0
 """Below this smallest margin no robot holds the plan's rotations: every output warns."""
 
 
+def robust_ideal_words(length: int, ideal_length: int | None) -> str:
+    """The certificate's "length: robust / ideal model" figure, with why a robust plan can be
+    the shorter: a strong plan under uncertainty is a plan on the ideal model too (for the
+    same goal), so a shorter one lists together in its results poses the ideal model's plan
+    tells apart (lumping; docs/uncertainty.md).
+
+    >>> robust_ideal_words(2, 3)
+    '2 / 3 (shorter: its results list together poses the ideal model tells apart)'
+    """
+    if ideal_length is None:
+        return f"{length} / not computed"
+    why = (
+        " (shorter: its results list together poses the ideal model tells apart)"
+        if ideal_length > length
+        else ""
+    )
+    return f"{length} / {ideal_length}{why}"
+
+
 def low_margin_words(min_margin_deg: float | None, rotation_error_deg: float = 0.0) -> str | None:
     """One line when a plan holds rotations off by less than :data:`LOW_MARGIN_DEG`: its
     declared rotation error plus its smallest margin (None: no rotation, or enough).

@@ -19,6 +19,7 @@ from feederkit.plans.model import (
     member_label,
     member_name,
     pairs_words,
+    robust_ideal_words,
 )
 from feederkit.reports.svgkit import esc, num
 from feederkit.reports.trace import Confusion
@@ -97,7 +98,6 @@ def stats_section(
     ]
     cert = stats.certificate
     if cert is not None:
-        ideal = "not computed" if cert.ideal_length is None else str(cert.ideal_length)
         rows += [
             _row(
                 "certified rotation error",
@@ -106,7 +106,7 @@ def stats_section(
             _row("certified shape tolerance", f"up to {num(cert.max_shape_tolerance_mm, 4)} mm"),
             _row(
                 "length: robust / ideal model",
-                f"{stats.length} / {esc(ideal)} push-align operations",
+                esc(robust_ideal_words(stats.length, cert.ideal_length)),
             ),
         ]
     opt = "yes: no shorter plan exists" if stats.optimal else "not proven"
