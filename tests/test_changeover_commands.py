@@ -80,7 +80,7 @@ def test_report_names_the_pair_no_plan_can_tell_apart(db, tmp_path, capsys):
 def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, monkeypatch):
     import feederkit.reports
 
-    def fake_report(plan, *, unrecognizable, outlines, design=None):
+    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=()):
         assert design is not None and design["sensor_model"] == "tolerance"
         pairs = sorted(sorted((u["part_a"], u["part_b"])) for u in unrecognizable)
         return f"<p>{pairs} {sorted(outlines)}</p>"
@@ -125,7 +125,7 @@ def test_a_design_past_its_limit_is_cut_short_in_the_report(db, tmp_path, capsys
 
     got: list = []
 
-    def fake_report(plan, *, unrecognizable, outlines, design=None):
+    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=()):
         got.append(design)
         return "<p>report</p>"
 
@@ -181,6 +181,12 @@ def test_a_newer_part_revision_is_warned_about(db, tmp_path, capsys):
     assert (
         exported["output"] == str(out) and {"name": "octagon", "revision": 1} in (exported["parts"])
     )
+    # So is a stale report: the page says it first, the file still written.
+    page = tmp_path / "r.html"
+    cap = ok(capsys, ["changeover", "report", "fig27", "-o", str(page), "--catalog", str(db)], 1)
+    assert "out of date" in cap.err and page.is_file()
+    html = page.read_text(encoding="utf-8")
+    assert 'id="caution-0"' in html and "latest is 2" in html
     # Compiling against the old revision on purpose says so, too.
     pinned = ["changeover", "compile", "old", "--mix", "octagon@1,rectangle-2x1"]
     cap = ok(capsys, [*pinned, "--tolerance", "0.01", "--json", "--catalog", str(db)])

@@ -314,11 +314,12 @@ def changeover_report(
     pfs: Sequence[PushFunction],
     witnesses: Sequence[PairWitness],
     design_limit_s: float | None = None,
+    cautions: Sequence[str] = (),
 ) -> str:
     """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`changeover_design`; docs/reports.md) within ``design_limit_s`` seconds
-    (None: ``REPORT_DESIGN_LIMIT_S``)."""
+    (None: ``REPORT_DESIGN_LIMIT_S``); ``cautions`` open the page (parts revised since)."""
     from feederkit.design import sensor
     from feederkit.reports import render_report
 
@@ -331,6 +332,7 @@ def changeover_report(
         unrecognizable=[w.to_dict() for w in witnesses],
         outlines={pf.part.name: pf.part.outline for pf in pfs},
         design=design,
+        cautions=cautions,
     )
 
 
@@ -759,12 +761,12 @@ def export_command(
         raise CheckFailed(_stale_result(name, len(co.warnings)))
 
 
-def _stale_result(name: str, stale: int) -> str:
-    """The ``result:`` line of an export of a changeover whose parts have newer revisions
-    (``stale`` of them, each named in a warning line)."""
+def _stale_result(name: str, stale: int, written: str = "plan file") -> str:
+    """The ``result:`` line of an export or report of a changeover whose parts have newer
+    revisions (``stale`` of them, each named in a warning line)."""
     return (
         f"changeover {name!r} is out of date (newer catalog revisions of "
-        f"{plural(stale, 'part')}, warned above); the plan file is written for the revisions "
+        f"{plural(stale, 'part')}, warned above); the {written} is written for the revisions "
         "it names: compile the changeover again to plan for the latest"
     )
 
@@ -800,10 +802,12 @@ def report_command(
     check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    html = changeover_report(co.plan, list(co.parts), co.witnesses(), design_limit)
+    html = changeover_report(co.plan, list(co.parts), co.witnesses(), design_limit, co.warnings)
     write_files([OutputFile(output, html, "report")])
     note_written((output, "report"))
     console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)
+    if co.warnings:
+        raise CheckFailed(_stale_result(name, len(co.warnings), "report"))
 
 
 def _info_dict(info, plan: dict[str, Any] | None = None) -> dict[str, Any]:

@@ -173,6 +173,7 @@ def render_report(
     cycle_time: Mapping[str, Any] | None = None,
     design: Mapping[str, Any] | None = None,
     verification: VerificationReport | None = None,
+    cautions: Sequence[str] = (),
 ) -> str:
     """The HTML report of a plan (or a plan file's JSON object, checked; design.md).
 
@@ -185,7 +186,8 @@ def render_report(
     Outline) draws holes around the plan's hulls; ``design`` (the
     JSON of ``feederkit design sensor``) adds the sensor design table and plot;
     ``verification``, the plan's :func:`~feederkit.plans.verify.verify_declared` when the
-    caller has it (else it is made here), gives the banner. Raises
+    caller has it (else it is made here), gives the banner; ``cautions`` are lines the page
+    must say first (a stored changeover whose parts have newer revisions). Raises
     InputError for a malformed plan or option.
     """
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -206,6 +208,10 @@ def render_report(
     body = "".join(
         [
             f"<h1>{'Changeover' if len(plan.parts) > 1 else 'Plan'} report: {esc(names)}</h1>",
+            "".join(
+                f'<div class="banner caution" id="caution-{i}">Warning: {esc(c)}.</div>'
+                for i, c in enumerate(cautions)
+            ),
             _banners(plan, report, twins, pair_rows(plan, found, given)),
             mix_section(plan, draw),
             tree_section(numbered, tree),
