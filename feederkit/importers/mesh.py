@@ -33,7 +33,12 @@ from feederkit.importers.meshbodies import (
     winding_number,
 )
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
-from feederkit.importers.plausible import size_warnings
+from feederkit.importers.plausible import (
+    MAX_PLAUSIBLE_MM,
+    MIN_PLAUSIBLE_MM,
+    size_warnings,
+    unitless_warnings,
+)
 from feederkit.outline import make_outline, unit_scale
 from feederkit.words import plural
 
@@ -159,8 +164,6 @@ def load_mesh(
     budget = budget or Budget(ImportLimits(), str(path))
     notes: list[str] = []
     unit_name = units or "mm"
-    if units is None:
-        notes.append("mesh files carry no units: read as mm (use --units)")
     scale = unit_scale(unit_name)
     _precount_faces(path, budget)
     try:
@@ -569,7 +572,10 @@ def read_mesh(
     budget.check_time()
     s = solid(mesh, options.com is not None, str(path), budget)
     budget.check_time()
-    notes += size_warnings(float(s.mesh.extents.max()), unit_name, options.units is not None)
+    size = float(s.mesh.extents.max())
+    notes += size_warnings(size, unit_name, options.units is not None)
+    if options.units is None and MIN_PLAUSIBLE_MM <= size <= MAX_PLAUSIBLE_MM:
+        notes += unitless_warnings(size)  # outside, size_warnings names the other units
     try:
         poses = resting_poses(s)
     except InputError as exc:

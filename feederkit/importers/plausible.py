@@ -55,6 +55,29 @@ def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
     ]
 
 
+SMALL_UNITLESS_MM = 10.0
+"""A part read from a file without units (a mesh) smaller than this across gets the size it
+would have in inches too: a part modelled in inches and read as mm is 25.4 times too small,
+yet above :data:`MIN_PLAUSIBLE_MM` (the angle block sample: 1.9 mm read as mm)."""
+
+
+def unitless_warnings(size_mm: float) -> list[str]:
+    """The note of a file that carries no units, read as mm: with the size it then has and,
+    below :data:`SMALL_UNITLESS_MM`, the size drawn in inches would give.
+
+    >>> "48.26 mm" in unitless_warnings(1.9)[0], "inches" in unitless_warnings(60.0)[0]
+    (True, False)
+    """
+    note = f"the file carries no units: read as mm, the part is {size_mm:.4g} mm across"
+    if size_mm < SMALL_UNITLESS_MM:
+        note += (
+            f" (in inches it would be {size_mm * unit_scale('in'):.4g} mm: use --units in if so)"
+        )
+    else:
+        note += " (use --units)"
+    return [note]
+
+
 def measurement_warnings(doc: object, unit_name: str) -> list[str]:
     """A warning when ``$INSUNITS`` contradicts ``$MEASUREMENT`` (0 imperial, 1 metric)."""
     header = doc.header  # type: ignore[attr-defined]
