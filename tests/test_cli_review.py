@@ -76,10 +76,12 @@ def test_export_of_a_stale_changeover_writes_the_file_warns_and_exits_1(
     assert result.startswith("result: changeover 'mx' is out of date") and "compile" in result
 
 
-def test_list_show_and_report_of_a_stale_changeover_warn_and_exit_0(
+def test_list_and_show_of_a_stale_changeover_warn_and_exit_0_its_report_exits_1(
     stale_catalog, tmp_path, capsys
 ):
-    """They describe the stored changeover (informational): the warning, in ``--json`` too."""
+    """List and show describe the stored changeover (informational): the warning, in
+    ``--json`` too; its report goes to the line as the plan does, so it exits 1 as export
+    does (the page written, the warnings on it)."""
     db = ["--catalog", str(stale_catalog)]
     rc, out, err = run(capsys, ["changeover", "show", "mx", "--json", *db])
     assert rc == 0 and "latest is 2" in err
@@ -87,7 +89,7 @@ def test_list_show_and_report_of_a_stale_changeover_warn_and_exit_0(
     rc, out, _ = run(capsys, ["changeover", "list", "--json", *db])
     assert rc == 0 and json.loads(out)[0]["warnings"]
     rc, _, err = run(capsys, ["changeover", "report", "mx", "-o", str(tmp_path / "mx.html"), *db])
-    assert rc == 0 and "latest is 2" in err
+    assert rc == 1 and "latest is 2" in err and (tmp_path / "mx.html").is_file()
 
 
 # 2. ``--json`` prints one JSON object on stdout when a command exits 1 without an answer.
