@@ -145,7 +145,10 @@ def _mini_bracket(path: Path) -> Path:
 
 def test_the_command_line_points_a_chiral_parts_two_sides_to_landings(tmp_path, capsys):
     dxf = _mini_bracket(tmp_path / "mini-bracket.dxf")
+    # Under 1 degree its fillet's hilltop (a near-metastable facet) leaves no plan even face
+    # up; at 0.5 degree one side has one.
     flags = ["--led-pitch", "0.1", "--noise", "0.02", "--shape-tolerance", "0.05"]
+    flags += ["--rotation-error", "0.5"]
     flags += ["--com-tolerance", "0.1", "-o", str(tmp_path / "p.json")]
     rc, _, err = run_cli(capsys, "plan", str(dxf), *flags)
     line = [x for x in err.splitlines() if x.startswith("result:")]

@@ -263,6 +263,8 @@ def changeover_page(tmp_path_factory):
                 "0.1",
                 "--noise",
                 "0.02",
+                "--rotation-error",
+                "0.5",
                 "--shape-tolerance",
                 "0.05",
                 "--com-tolerance",

@@ -18,10 +18,11 @@ from a fence orientation it ends on a rest candidate (F3) between the nearest ce
 either side (F1, F2: a hilltop whose barriers both exceed ``2 eps``, or a run of hilltops whose
 highest stands more than ``2 eps`` above the wells on either side), and never where the drawn
 radius is more than ``2 eps`` above its start (F1); a push starting within ``PUSH_BAND_DEG``
-of a hilltop, or beside a shallow state less than twice the vibration below it, may be carried
-over it (the push bands, measured in the physics check). With ``t = c = 0`` and no
-vibration every set here is the ideal one exactly; otherwise each is a superset of what the
-perturbed parts can do (provably conservative), and the docstrings say which.
+of a hilltop, or beside a shallow state or a near-metastable facet less than twice the
+vibration below it, may be carried over it (the push bands, measured in the physics check).
+With ``t = c = 0`` and no vibration every set here is the ideal one exactly; otherwise each is
+a superset of what the perturbed parts can do (provably conservative), and the docstrings say
+which.
 docs/uncertainty.md gives the derivations and the measured price of conservatism.
 """
 
@@ -122,8 +123,8 @@ class Band:
     no push ends beyond it. ``[lo_deg, hi_deg]`` holds it (``lo <= top_lo``, ``top_hi <= hi``):
     a push starting inside may end on either side, one starting outside never crosses it.
     With the vibration on it is the F2 band widened by the push band (:data:`PUSH_BAND_DEG`,
-    or the depth rule beside a shallow state: :func:`_bands`); at ``t = c = 0`` and vibration 0
-    both are the point.
+    or the depth rule beside a shallow state or a near-metastable facet: :func:`_bands`); at
+    ``t = c = 0`` and vibration 0 both are the point.
     """
 
     divergent_deg: float
@@ -510,8 +511,9 @@ def _push_band(
 ) -> np.ndarray:
     """The push band (deg) of each hilltop on one flank (``d`` its unwrapped orientation,
     ``flank_end`` the neighbouring state's normal): :data:`PUSH_BAND_DEG`, or beside a shallow
-    state as far as the drawn radius stays within :data:`PUSH_BAND_FACTOR` vibrations of the
-    hilltop, if that is wider (docs/uncertainty.md, "Push bands")."""
+    state or a near-metastable facet (:func:`_near_metastable_hills`) as far as the drawn radius
+    stays within :data:`PUSH_BAND_FACTOR` vibrations of the hilltop, if that is wider
+    (docs/uncertainty.md, "Push bands")."""
     m = len(peaks)
     rs = pf.range_state
     width = np.full(len(hilltops), PUSH_BAND_DEG)
@@ -520,7 +522,7 @@ def _push_band(
         peaks[k] - heights[np.asarray([rs[(i - 1) % m] for i in k])],
         peaks[k] - heights[np.asarray([rs[i] for i in k])],
     )
-    near = np.flatnonzero(wells < SHALLOW_WELL_FACTOR * vibration)
+    near = np.flatnonzero((wells < SHALLOW_WELL_FACTOR * vibration) | _near_metastable_hills(pf)[k])
     if len(near):
         h = np.asarray(pf.part.hull, dtype=float)
         com = np.asarray(pf.part.com, dtype=float)
@@ -532,6 +534,24 @@ def _push_band(
             _, p = _level_crossing(h, com, d[near], flank_end[near], level)
             width[near] = np.maximum(width[near], p - d[near])
     return width
+
+
+def _near_metastable_hills(pf: PushFunction) -> np.ndarray:
+    """Per hilltop (``pf.divergent_deg``): whether a hull edge at its vertex is near-metastable
+    (the COM's foot within ``NEAR_METASTABLE_DEG`` of the vertex, section 3's metastable edge
+    nearly), as a flattened arc's facet beside the hilltop: the radius function is nearly flat
+    there, like a shallow state's well, and the physics check carried pushes over such a
+    hilltop from up to 2.45 degrees (docs/uncertainty.md, "Push bands")."""
+    h = np.asarray(pf.part.hull, dtype=float)
+    com = np.asarray(pf.part.com, dtype=float)
+    n = len(h)
+    towards = np.degrees(np.arctan2(h[:, 1] - com[1], h[:, 0] - com[0]))
+    near = set(pf.near_metastable_edges)
+    out = np.zeros(len(pf.divergent_deg), dtype=bool)
+    for i, d in enumerate(pf.divergent_deg):
+        j = int(np.argmin(np.abs(np.mod(towards - d + 180.0, 360.0) - 180.0)))
+        out[i] = (j - 1) % n in near or j in near
+    return out
 
 
 def _band_list(
@@ -747,11 +767,11 @@ def uncertain_mechanics(
     vibration) unless the uncertainty is ideal,
     where it is 0 and every physical state is one ideal state. Bands: with the vibration on, a
     push starting within ``PUSH_BAND_DEG`` of a hilltop (wherever F2 puts it) may end on either
-    side; at a hilltop beside a shallow state, within ``PUSH_BAND_FACTOR`` vibrations of its
-    height (:func:`_bands`). Overshoot: with the vibration on, a push ending in a state may also
-    end beyond a hilltop close to its normal (:data:`OVERSHOOT_DEG_MM`; an outcome, as a
-    carry crossing). Raises InputError for a shape tolerance of half the smallest hull edge or
-    more.
+    side; at a hilltop beside a shallow state or a near-metastable facet, within
+    ``PUSH_BAND_FACTOR`` vibrations of its height (:func:`_bands`). Overshoot: with the
+    vibration on, a push ending in a state may also end beyond a hilltop close to its normal
+    (:data:`OVERSHOOT_DEG_MM`; an outcome, as a carry crossing). Raises InputError for a shape
+    tolerance of half the smallest hull edge or more.
     """
     check_for_part(uncertainty, part)
     pf = push_function(part)
