@@ -23,8 +23,9 @@ from feederkit.importers.drawingnotes import (
     open_line_notes,
     outside_note,
     side_by_side_note,
+    title_block_note,
 )
-from feederkit.importers.frames import frame_doubt, frame_kind
+from feederkit.importers.frames import frame_doubt, frame_kind, free_title_block
 from feederkit.importers.loops import (
     Loop,
     Point,
@@ -336,6 +337,12 @@ def drawing_from_lines(
     drawing = regions_from_loops(loops, budget)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
+    blocks = [free_title_block(r, healed[: len(snapped)], gap) for r in drawing.regions]
+    if any(blocks) and not all(blocks):  # a title block beside the part is no part
+        left = [r for r, b in zip(drawing.regions, blocks, strict=True) if b]
+        notes.append(title_block_note([Polygon(r.shell).bounds for r in left]))
+        kept = tuple(r for r, b in zip(drawing.regions, blocks, strict=True) if not b)
+        drawing = replace(drawing, regions=kept)
     notes += [outside_note(r.outside) for r in drawing.regions if r.outside]
     notes += [cut_off_note(r.cut_off) for r in drawing.regions if r.cut_off]
     doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)

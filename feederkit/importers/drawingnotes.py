@@ -89,6 +89,14 @@ def side_by_side_note(bounds: Sequence[Sequence[float]]) -> str:
     )
 
 
+def title_block_note(bounds: Sequence[Sequence[float]]) -> str:
+    """The note of title blocks drawn beside the part (no frame) and left out."""
+    return (
+        f"left out {plural(len(bounds), 'title block')} beside the part, a rectangle divided "
+        f"into cells ({_boxes(bounds)}); if it is the part, import it alone with --layer"
+    )
+
+
 def _free_ends(chain: shapely.Geometry) -> np.ndarray:
     """The ends of a group of noded open lines that no other of its lines meets."""
     parts = shapely.get_parts(chain)

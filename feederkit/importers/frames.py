@@ -192,9 +192,35 @@ def _title_block(
         [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
     )
     for hole in corner:
-        within = shapely.covers(hole.buffer(tol), geoms)
-        cells = within & shapely.dwithin(geoms, hole.exterior, tol)
-        cells &= ~along(geoms, hole.exterior, tol)
-        if cells.any():
+        if _cell_lines(hole, geoms, tol):
             return hole
     return None
+
+
+def _cell_lines(rect: Polygon, geoms: np.ndarray, tol: float) -> int:
+    """How many of the lines ``geoms`` run inside the rectangle ``rect`` from its sides (a
+    title block's cells)."""
+    within = shapely.covers(rect.buffer(tol), geoms)
+    cells = within & shapely.dwithin(geoms, rect.exterior, tol)
+    cells &= ~along(geoms, rect.exterior, tol)
+    return int(cells.sum())
+
+
+TITLE_BLOCK_CELL_LINES = 2
+"""A rectangle standing alone beside the part is a title block when at least this many lines
+divide it into cells (a table); one line across a plate may be a bend or a cut."""
+
+
+def free_title_block(region: Region, lines: Sequence[np.ndarray], gap: float) -> bool:
+    """Whether a drawing's separate ``region`` is a title block drawn beside the part, with no
+    frame: a rectangle divided into cells by at least :data:`TITLE_BLOCK_CELL_LINES` lines
+    running inside it from its sides."""
+    shell = Polygon(region.shell)
+    if not _is_rectangle(shell):
+        return False
+    x0, y0, x1, y1 = shell.bounds
+    tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
+    geoms = np.array(
+        [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
+    )
+    return len(geoms) > 0 and _cell_lines(shell, geoms, tol) >= TITLE_BLOCK_CELL_LINES

@@ -1,0 +1,57 @@
+"""A title block drawn beside the part with no frame (a rectangle divided into cells) is no
+part: the import takes the part, however much larger the block is, and says what it left out.
+A review's drawing: a 30 x 20 mm clip with a hole and a 180 x 56 mm title block on layer TITLE
+(three rows, one column line, a TEXT); before, the block was imported as the part."""
+
+from __future__ import annotations
+
+import pytest
+from fixtures_cad import write_entities
+from shared import run_cli
+
+from feederkit.sources import load_part_with_warnings
+
+
+def _clip(msp) -> None:
+    pts = [(20, 100, 0), (50, 100, 0), (50, 110, -0.4), (40, 120, 0), (20, 120, 0)]
+    msp.add_lwpolyline(pts, format="xyb", close=True)
+    msp.add_circle((28, 110), 3)
+
+
+def _title_block(msp, rows: tuple[float, ...] = (14, 28, 42)) -> None:
+    x0, y0, title = 100, 0, {"layer": "TITLE"}
+    msp.add_lwpolyline([(x0, y0), (x0 + 180, y0), (x0 + 180, y0 + 56), (x0, y0 + 56)],
+                       close=True, dxfattribs=title)  # fmt: skip
+    for y in rows:
+        msp.add_line((x0, y0 + y), (x0 + 180, y0 + y), dxfattribs=title)
+    msp.add_line((x0 + 60, y0), (x0 + 60, y0 + 56), dxfattribs=title)
+    msp.add_text("TITLE: CLIP", dxfattribs={**title, "height": 5}).set_placement((x0 + 65, 45))
+
+
+@pytest.fixture()
+def drawing(tmp_path):
+    def build(msp):
+        _clip(msp)
+        _title_block(msp)
+
+    return write_entities(tmp_path / "tb_free.dxf", build)
+
+
+def test_the_part_is_imported_and_the_title_block_left_out(drawing, capsys):
+    loaded = load_part_with_warnings(str(drawing))
+    xs = [p[0] for p in loaded.part.hull]
+    ys = [p[1] for p in loaded.part.hull]
+    assert (min(xs), min(ys)) == pytest.approx((20, 100))
+    assert max(xs) <= 50 + 1e-6 and max(ys) <= 120 + 1e-6
+    words = " ".join(loaded.warnings)
+    assert "left out 1 title block beside the part" in words and "180 x 56 mm" in words
+    assert "imported the largest" not in words
+    rc, _, err = run_cli(capsys, "part", "analyze", str(drawing))
+    assert rc == 0 and "title block" in err
+
+
+def test_a_drawing_of_title_blocks_alone_keeps_the_largest(tmp_path):
+    # Nothing else to take: the rectangle is imported as it was (the part may be a table).
+    path = write_entities(tmp_path / "only.dxf", _title_block)
+    loaded = load_part_with_warnings(str(path))
+    assert len(loaded.part.hull) == 4 and "title block" not in " ".join(loaded.warnings)
