@@ -371,11 +371,12 @@ def resolve_settings(
         sensor = profile.sensor.sensor()
     r = profile.robot.rotation_error_deg
     if rotation_error is not None:
-        # The one validation of a rotation error (finite, in [0, 90) degrees).
+        # The one validation of a rotation error (finite, in [0, 90) degrees), its flag named
+        # last as the command line names every term's (cli.common.with_flags).
         try:
             r = Uncertainty(rotation_error_deg=float(rotation_error)).rotation_error_deg
         except InputError as exc:
-            raise InputError(f"--rotation-error: {exc}") from None
+            raise InputError(f"{exc} (--rotation-error)") from None
         overrides.append("--rotation-error")
     return CellSettings(profile, sensor, r, tuple(overrides))
 
