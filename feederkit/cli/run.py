@@ -78,7 +78,8 @@ def run_command(
                 indices.append(k)
     if not sources:
         indices = list(range(len(plan.parts)))
-    warnings = [w for w in (plan.low_margin_warning(),) if w] + plan.fragile_warnings()
+    # The fragile states of the parts run (a SOURCE's member), not of every part of the mix.
+    warnings = [w for w in (plan.low_margin_warning(),) if w] + plan.fragile_warnings(indices)
     if not json_out:
         for w in warnings:
             console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)

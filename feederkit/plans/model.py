@@ -561,12 +561,15 @@ class Plan:
         ]
         return min(margins) if margins else None
 
-    def fragile_warnings(self) -> list[str]:
+    def fragile_warnings(self, members: Sequence[int] | None = None) -> list[str]:
         """The fragile states of the plan's members in words, as ``plan`` warned when it
         made the plan (:func:`member_fragile_warnings`, from the hulls and COMs the plan
         records): in a plan over landings, every landing named as the results name it, with
-        its own state numbers."""
-        return member_fragile_warnings((p.name, p.landing, push_function_of(p)) for p in self.parts)
+        its own state numbers. ``members``: only those (indices into ``parts``)."""
+        chosen = range(len(self.parts)) if members is None else members
+        return member_fragile_warnings(
+            (p.name, p.landing, push_function_of(p)) for p in (self.parts[k] for k in chosen)
+        )
 
     def low_margin_warning(self) -> str | None:
         """A warning when the plan holds rotation errors below LOW_MARGIN_DEG (None otherwise).
