@@ -153,7 +153,7 @@ def test_run_all_shows_the_uncertainty_and_certificate(tmp_path, capsys):
     assert main(["run", str(path), "--all"]) == 0
     out = capsys.readouterr().out
     assert "declared uncertainty: rotation error ±1°" in out
-    assert "certificate: holds up to rotation error" in out and "on the ideal model" in out
+    assert "certificate: holds up to rotation error" in out and "robust / ideal model" in out
     assert "strong plan" in out
 
 

@@ -18,11 +18,12 @@ the cost of every walk is its number of distinct nodes.
 
 Made here: :func:`plan_from_result` (a planner's result). Written here: :func:`plan_to_dict`
 and :func:`plan_json` (the text). The members' shares obey one rule, :func:`check_shares`,
-for the maker and the reader alike. Reading and checking a file, and the checked write
-(``read_back``, ``plan_file_text``, ``write_plan``: the text checked as the reader will read
-it), are :mod:`feederkit.plans.readplan`'s, which imports this module and never the other
-way round. Nothing recurses over the tree, so a plan as deep as the reader's limit writes.
-The planner's types are imported only where a result is turned into a plan, so reading a
+for the maker and the reader alike. Reading and checking a file are
+:mod:`feederkit.plans.readplan`'s, and the checked write (``read_back``, ``plan_file_text``,
+``write_plan``: the text checked as the reader will read it)
+:mod:`feederkit.plans.writeplan`'s; both import this module, never the other way round.
+Nothing recurses over the tree, so a plan as deep as the reader's limit writes. The planner's
+types are imported only where a result is turned into a plan, so reading a
 plan needs no planner.
 """
 

@@ -13,9 +13,10 @@ costs its number of distinct nodes.
 
 Only :mod:`feederkit.plans.fileformat` (from a planner's result) and
 :mod:`feederkit.plans.readplan` (from a file, its text or a dict) make a :class:`Plan`, and
-only they write one; everything else reads it. Every value here is a frozen
-dataclass; a part's push function (section 3.1) is rebuilt from the hull and COM the plan
-records, by :func:`push_function_of`, an explicit cache keyed by the part.
+only fileformat and :mod:`feederkit.plans.writeplan` write one; everything else reads it.
+Every value here is a frozen dataclass; a part's push function (section 3.1) is rebuilt from
+the hull and COM the plan records, by :func:`push_function_of`, an explicit cache keyed by the
+part.
 """
 
 from __future__ import annotations
@@ -477,11 +478,10 @@ class Plan:
         c = self.stats.certificate
         if c is None:
             return None
-        ideal = "not computed" if c.ideal_length is None else str(c.ideal_length)
         return (
             f"holds up to rotation error ±{c.max_rotation_error_deg:.4g}° and shape tolerance "
-            f"{c.max_shape_tolerance_mm:.4g} mm; length {self.stats.length} here, "
-            f"{ideal} on the ideal model"
+            f"{c.max_shape_tolerance_mm:.4g} mm; length robust / ideal model "
+            f"{robust_ideal_words(self.stats.length, c.ideal_length)}"
         )
 
     def part(self, name: str, landing: str | None = None) -> PlanPart:
