@@ -55,3 +55,41 @@ def test_a_drawing_of_title_blocks_alone_keeps_the_largest(tmp_path):
     path = write_entities(tmp_path / "only.dxf", _title_block)
     loaded = load_part_with_warnings(str(path))
     assert len(loaded.part.hull) == 4 and "title block" not in " ".join(loaded.warnings)
+
+
+def _bent_plate(msp) -> None:
+    """A 120 x 60 mm flat pattern with two bend lines across it and a hole."""
+    msp.add_lwpolyline([(0, 0), (120, 0), (120, 60), (0, 60)], close=True)
+    msp.add_line((40, 0), (40, 60))
+    msp.add_line((80, 0), (80, 60))
+    msp.add_circle((20, 30), 4)
+
+
+def _box(loaded) -> tuple[float, float, float, float]:
+    xs = [p[0] for p in loaded.part.hull]
+    ys = [p[1] for p in loaded.part.hull]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+def test_a_plate_with_bend_lines_is_no_title_block(tmp_path):
+    # Beside a washer: the plate stays the part (lines one way, and a hole).
+    def build(msp):
+        _bent_plate(msp)
+        msp.add_circle((160, 30), 8)
+
+    loaded = load_part_with_warnings(str(write_entities(tmp_path / "bent.dxf", build)))
+    assert _box(loaded) == pytest.approx((0, 0, 120, 60))
+    assert "title block" not in " ".join(loaded.warnings)
+
+
+def test_beside_a_larger_title_block_the_bent_plate_is_the_part(tmp_path):
+    def build(msp):
+        _bent_plate(msp)
+        msp.add_lwpolyline([(200, 0), (380, 0), (380, 56), (200, 56)], close=True)
+        for y in (14, 28, 42):
+            msp.add_line((200, y), (380, y))
+        msp.add_line((260, 0), (260, 56))
+
+    loaded = load_part_with_warnings(str(write_entities(tmp_path / "both.dxf", build)))
+    assert _box(loaded) == pytest.approx((0, 0, 120, 60))
+    assert "left out 1 title block beside the part" in " ".join(loaded.warnings)

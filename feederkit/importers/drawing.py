@@ -338,7 +338,7 @@ def drawing_from_lines(
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
     blocks = [free_title_block(r, healed[: len(snapped)], gap) for r in drawing.regions]
-    if any(blocks) and not all(blocks):  # a title block beside the part is no part
+    if blocks[0] and not all(blocks):  # the largest loop a title block beside the part
         left = [r for r, b in zip(drawing.regions, blocks, strict=True) if b]
         notes.append(title_block_note([Polygon(r.shell).bounds for r in left]))
         kept = tuple(r for r, b in zip(drawing.regions, blocks, strict=True) if not b)

@@ -93,7 +93,8 @@ def title_block_note(bounds: Sequence[Sequence[float]]) -> str:
     """The note of title blocks drawn beside the part (no frame) and left out."""
     return (
         f"left out {plural(len(bounds), 'title block')} beside the part, a rectangle divided "
-        f"into cells ({_boxes(bounds)}); if it is the part, import it alone with --layer"
+        f"into cells ({_boxes(bounds)}); if it is a part, draw it on a layer of its own and "
+        "import that with --layer, or from a drawing of its own"
     )
 
 

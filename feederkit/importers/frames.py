@@ -192,35 +192,43 @@ def _title_block(
         [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
     )
     for hole in corner:
-        if _cell_lines(hole, geoms, tol):
+        if _cells(hole, geoms, tol).any():
             return hole
     return None
 
 
-def _cell_lines(rect: Polygon, geoms: np.ndarray, tol: float) -> int:
-    """How many of the lines ``geoms`` run inside the rectangle ``rect`` from its sides (a
-    title block's cells)."""
+def _cells(rect: Polygon, geoms: np.ndarray, tol: float) -> np.ndarray:
+    """Which of the lines ``geoms`` run inside the rectangle ``rect`` from its sides (a title
+    block's cells)."""
     within = shapely.covers(rect.buffer(tol), geoms)
     cells = within & shapely.dwithin(geoms, rect.exterior, tol)
-    cells &= ~along(geoms, rect.exterior, tol)
-    return int(cells.sum())
+    return cells & ~along(geoms, rect.exterior, tol)
 
 
-TITLE_BLOCK_CELL_LINES = 2
-"""A rectangle standing alone beside the part is a title block when at least this many lines
-divide it into cells (a table); one line across a plate may be a bend or a cut."""
+CELL_LINE_TURN_DEG = 30.0
+"""Two cell lines whose directions differ by more than this run across each other (a row and
+a column): a table, not a plate's parallel bend lines or slits."""
 
 
 def free_title_block(region: Region, lines: Sequence[np.ndarray], gap: float) -> bool:
     """Whether a drawing's separate ``region`` is a title block drawn beside the part, with no
-    frame: a rectangle divided into cells by at least :data:`TITLE_BLOCK_CELL_LINES` lines
-    running inside it from its sides."""
+    frame: a rectangle without holes divided into cells by lines running inside it from its
+    sides, rows and columns (two of them at least :data:`CELL_LINE_TURN_DEG` apart). A plate's
+    bend lines or slits run one way, and a plate has holes more often than not."""
     shell = Polygon(region.shell)
-    if not _is_rectangle(shell):
+    if region.holes or not _is_rectangle(shell):
         return False
     x0, y0, x1, y1 = shell.bounds
     tol = max(2.0 * gap, 1e-9 * max(x1 - x0, y1 - y0))
-    geoms = np.array(
-        [shapely.linestrings(np.asarray(ln, dtype=float)) for ln in lines if len(ln) >= 2]
-    )
-    return len(geoms) > 0 and _cell_lines(shell, geoms, tol) >= TITLE_BLOCK_CELL_LINES
+    arrays = [np.asarray(ln, dtype=float) for ln in lines if len(ln) >= 2]
+    if not arrays:
+        return False
+    geoms = np.array([shapely.linestrings(a) for a in arrays])
+    cells = _cells(shell, geoms, tol)
+    turns = {
+        round(float(np.degrees(np.arctan2(*(a[-1] - a[0])[::-1]))) % 180.0 / CELL_LINE_TURN_DEG)
+        % round(180.0 / CELL_LINE_TURN_DEG)
+        for a, c in zip(arrays, cells, strict=True)
+        if c
+    }
+    return len(turns) >= 2
