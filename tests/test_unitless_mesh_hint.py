@@ -22,3 +22,14 @@ def test_a_small_unitless_mesh_names_its_size_in_inches(capsys):
     assert "in inches it would be 34.34 mm: use --units in if so" in line
     rc, _, err = run_cli(capsys, "part", "analyze", str(BLOCK), "--units", "in")
     assert rc == 0 and "carries no units" not in err
+
+
+def test_a_tiny_unitless_mesh_says_it_carries_no_units(tmp_path, capsys):
+    import trimesh
+
+    path = tmp_path / "tiny.stl"
+    trimesh.creation.box((0.5, 0.4, 0.3)).export(path)
+    rc, _, err = run_cli(capsys, "part", "analyze", str(path))
+    line = " ".join(err.split())
+    assert rc == 0 and "read in mm as the file carries no units" in line
+    assert "from the file" not in line and "12.7 mm in in" in line

@@ -573,8 +573,9 @@ def read_mesh(
     s = solid(mesh, options.com is not None, str(path), budget)
     budget.check_time()
     size = float(s.mesh.extents.max())
-    notes += size_warnings(size, unit_name, options.units is not None)
-    if options.units is None and MIN_PLAUSIBLE_MM <= size <= MAX_PLAUSIBLE_MM:
+    unitless = options.units is None
+    notes += size_warnings(size, unit_name, not unitless, unitless)
+    if unitless and MIN_PLAUSIBLE_MM <= size <= MAX_PLAUSIBLE_MM:
         notes += unitless_warnings(size)  # outside, size_warnings names the other units
     try:
         poses = resting_poses(s)

@@ -30,11 +30,12 @@ def outline_size(outline: Outline) -> float:
     return diameter_of(convex_hull(outline.vertices))
 
 
-def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
+def size_warnings(size_mm: float, unit_name: str, given: bool, unitless: bool = False) -> list[str]:
     """A warning when a part of ``size_mm`` (read in ``unit_name``) is implausibly small or large.
 
     It names the size the part would have in the other likely units and the ``--units``
-    option; ``given`` says the user chose the unit (the warning then says so).
+    option; ``given`` says the user chose the unit (the warning then says so), ``unitless``
+    that the file carries none (a mesh: read as mm).
     """
     if MIN_PLAUSIBLE_MM <= size_mm <= MAX_PLAUSIBLE_MM:
         return []
@@ -42,7 +43,13 @@ def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
         scale = unit_scale(unit_name)
     except Exception:  # noqa: BLE001 - units outside the table (miles, ...): the size alone
         scale = None
-    how = "as you chose with --units" if given else "from the file"
+    how = (
+        "as you chose with --units"
+        if given
+        else "as the file carries no units"
+        if unitless
+        else "from the file"
+    )
     what = "smaller than 1 mm" if size_mm < MIN_PLAUSIBLE_MM else "larger than 2 m"
     alt = ""
     if scale is not None:
@@ -58,7 +65,7 @@ def size_warnings(size_mm: float, unit_name: str, given: bool) -> list[str]:
 SMALL_UNITLESS_MM = 10.0
 """A part read from a file without units (a mesh) smaller than this across gets the size it
 would have in inches too: a part modelled in inches and read as mm is 25.4 times too small,
-yet above :data:`MIN_PLAUSIBLE_MM` (the angle block sample: 1.9 mm read as mm)."""
+yet above :data:`MIN_PLAUSIBLE_MM` (the angle block sample: 1.35 mm read as mm)."""
 
 
 def unitless_warnings(size_mm: float) -> list[str]:
