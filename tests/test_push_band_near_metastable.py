@@ -76,3 +76,18 @@ def test_the_plates_default_plan_holds_in_the_physics_check(drawing, tmp_path, c
     )
     got = json.loads(stdout)
     assert got["wrong_accepts"] == 0 and got["successes"] == 200
+
+
+def test_a_stable_near_metastable_edge_leaves_the_far_corners_alone():
+    # A 40 x 20 rectangle whose bottom edge's COM foot lies 0.5 degree inside its right end:
+    # a state, nearly metastable; the corners away from it keep the fixed angle.
+    from feederkit.outline import make_outline
+    from feederkit.part import make_part
+
+    cx = 40.0 - 10.0 * math.tan(math.radians(0.5))
+    part = make_part(make_outline("p", [(0, 0), (40, 0), (40, 20), (0, 20)]), com=(cx, 10.0))
+    assert push_function(part).near_metastable_edges
+    mech = uncertain_mechanics(part, Uncertainty(1.0, 0.0, 0.0))
+    far = [b for b in mech.bands if 150.0 < b.divergent_deg < 210.0]
+    assert len(far) == 2
+    assert all(math.isclose(r, PUSH_BAND_DEG, abs_tol=1e-9) for b in far for r in _reach(b))

@@ -537,20 +537,22 @@ def _push_band(
 
 
 def _near_metastable_hills(pf: PushFunction) -> np.ndarray:
-    """Per hilltop (``pf.divergent_deg``): whether a hull edge at its vertex is near-metastable
-    (the COM's foot within ``NEAR_METASTABLE_DEG`` of the vertex, section 3's metastable edge
-    nearly), as a flattened arc's facet beside the hilltop: the radius function is nearly flat
-    there, like a shallow state's well, and the physics check carried pushes over such a
-    hilltop from up to 2.45 degrees (docs/uncertainty.md, "Push bands")."""
+    """Per hilltop (``pf.divergent_deg``): whether a hull edge at its vertex is an unstable
+    near-metastable facet (its COM's foot outside it by less than ``NEAR_METASTABLE_DEG``,
+    at either end: section 3's metastable edge nearly), as a flattened arc's facet beside the
+    hilltop: the radius function falls along it to almost a minimum, nearly a state, and the
+    physics check carried pushes over such a hilltop from up to 2.45 degrees
+    (docs/uncertainty.md, "Push bands"). A stable edge is a state, judged by its well."""
     h = np.asarray(pf.part.hull, dtype=float)
     com = np.asarray(pf.part.com, dtype=float)
     n = len(h)
     towards = np.degrees(np.arctan2(h[:, 1] - com[1], h[:, 0] - com[0]))
-    near = set(pf.near_metastable_edges)
+    # Unstable edges only: a stable one is a state, whose well the shallow-state rule judges.
+    facets = {e for e in pf.near_metastable_edges if pf.edge_margin_deg[e] < 0.0}
     out = np.zeros(len(pf.divergent_deg), dtype=bool)
     for i, d in enumerate(pf.divergent_deg):
         j = int(np.argmin(np.abs(np.mod(towards - d + 180.0, 360.0) - 180.0)))
-        out[i] = (j - 1) % n in near or j in near
+        out[i] = (j - 1) % n in facets or j in facets
     return out
 
 
