@@ -61,13 +61,19 @@ def convex_hull(points: Iterable[Sequence[float]]) -> list[Point]:
     # The chains' ends (the leftmost and rightmost points) were never tested: drop them too
     # when they lie on their neighbours' line.
     dropped = True
-    while dropped and len(hull) > 3:
+    while dropped and len(hull) > 2:
         dropped = False
         for i in range(len(hull)):
             if not turns(hull[i - 1], hull[i], hull[(i + 1) % len(hull)], eps):
                 del hull[i]
                 dropped = True
                 break
+    if len(hull) < 3:
+        # Collinear within the tolerance: the segment between the two points farthest apart
+        # (the chains may have kept a middle point rounding put off the line as an end).
+        b = max(pts, key=lambda p: math.dist(pts[0], p))
+        c = max(pts, key=lambda p: math.dist(b, p))
+        return sorted([b, c])
     return hull
 
 

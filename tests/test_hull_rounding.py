@@ -61,3 +61,16 @@ def test_points_of_an_edge_a_few_ulps_apart_keep_every_corner(shifts, w, h, insi
     # Every point is inside the hull or on it to rounding, and every vertex is a real turn.
     assert all(poly.distance(Point(p)) <= 1e-9 * max(w, h) for p in pts)
     assert len(hull) == 4
+
+
+def test_points_collinear_to_rounding_give_the_segment_between_the_farthest_two() -> None:
+    # A middle point rounding puts off the line once ended the chain and dropped a real end.
+    assert convex_hull([(math.nextafter(1.0, 0.0), 1.0), (1.0, 0.0), (1.0, 2.0)]) == [
+        (1.0, 0.0),
+        (1.0, 2.0),
+    ]
+    assert convex_hull([(0.0, 0.0), (2.4e-172, 0.0), (0.0, 1.0)]) == [(0.0, 0.0), (0.0, 1.0)]
+    assert convex_hull([(3.0, 3.0), (1.0, 1.0), (0.0, 0.0), (2.0, 2.0)]) == [
+        (0.0, 0.0),
+        (3.0, 3.0),
+    ]
