@@ -93,3 +93,19 @@ def test_beside_a_larger_title_block_the_bent_plate_is_the_part(tmp_path):
     loaded = load_part_with_warnings(str(write_entities(tmp_path / "both.dxf", build)))
     assert _box(loaded) == pytest.approx((0, 0, 120, 60))
     assert "left out 1 title block beside the part" in " ".join(loaded.warnings)
+
+
+def test_a_cut_sheet_beside_a_title_block_still_says_what_its_holes_hold(tmp_path):
+    def build(msp):
+        msp.add_lwpolyline([(0, 0), (120, 0), (120, 60), (0, 60)], close=True)
+        msp.add_lwpolyline([(20, 20), (60, 20), (60, 40), (20, 40)], close=True)  # a window
+        msp.add_lwpolyline([(25, 25), (35, 25), (35, 35), (25, 35)], close=True)  # cut from it
+        msp.add_lwpolyline([(200, 0), (380, 0), (380, 56), (200, 56)], close=True)
+        for y in (14, 28, 42):
+            msp.add_line((200, y), (380, y))
+        msp.add_line((260, 0), (260, 56))
+
+    loaded = load_part_with_warnings(str(write_entities(tmp_path / "sheet.dxf", build)))
+    words = " ".join(loaded.warnings)
+    assert _box(loaded) == pytest.approx((0, 0, 120, 60))
+    assert "title block" in words and "the part's holes hold 1 other part(s)" in words

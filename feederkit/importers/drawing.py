@@ -342,7 +342,11 @@ def drawing_from_lines(
         left = [r for r, b in zip(drawing.regions, blocks, strict=True) if b]
         notes.append(title_block_note([Polygon(r.shell).bounds for r in left]))
         kept = tuple(r for r, b in zip(drawing.regions, blocks, strict=True) if not b)
-        drawing = replace(drawing, regions=kept)
+        # The parts in the new first part's holes (regions never overlap, so inside its
+        # outer ring is inside a hole): counted again, the block had none.
+        outer = Polygon(kept[0].shell)
+        nested = sum(outer.contains(Polygon(r.shell).representative_point()) for r in kept[1:])
+        drawing = replace(drawing, regions=kept, nested=int(nested))
     notes += [outside_note(r.outside) for r in drawing.regions if r.outside]
     notes += [cut_off_note(r.cut_off) for r in drawing.regions if r.cut_off]
     doubt = frame_doubt(drawing.regions[0], healed[: len(snapped)], gap, layers)
