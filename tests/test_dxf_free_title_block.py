@@ -5,6 +5,9 @@ A review's drawing: a 30 x 20 mm clip with a hole and a 180 x 56 mm title block 
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 from fixtures_cad import write_entities
 from shared import run_cli
@@ -109,3 +112,24 @@ def test_a_cut_sheet_beside_a_title_block_still_says_what_its_holes_hold(tmp_pat
     words = " ".join(loaded.warnings)
     assert _box(loaded) == pytest.approx((0, 0, 120, 60))
     assert "title block" in words and "the part's holes hold 1 other part(s)" in words
+
+
+def test_cell_lines_a_few_degrees_apart_are_not_rows_and_columns():
+    # Two slits drawn 14 and 16 degrees off the vertical run one way: no title block, however
+    # the angles fall around any bucket's edge.
+    from feederkit.importers.frames import free_title_block
+    from feederkit.importers.loops import Region
+
+    shell = ((0.0, 0.0), (100.0, 0.0), (100.0, 50.0), (0.0, 50.0))
+    plate = Region(shell=shell, holes=(), area=5000.0, loop_area=5000.0)
+
+    def slit(x: float, deg: float):
+        dx = 20.0 * math.tan(math.radians(deg))
+        return np.array([(x, 0.0), (x + dx, 20.0)])
+
+    assert not free_title_block(plate, [slit(30.0, 14.0), slit(70.0, 16.0)], 1e-3)
+    rows_and_column = [
+        np.array([(0.0, 20.0), (100.0, 20.0)]),
+        np.array([(40.0, 0.0), (40.0, 50.0)]),
+    ]
+    assert free_title_block(plate, rows_and_column, 1e-3)

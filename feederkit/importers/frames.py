@@ -225,10 +225,11 @@ def free_title_block(region: Region, lines: Sequence[np.ndarray], gap: float) ->
         return False
     geoms = np.array([shapely.linestrings(a) for a in arrays])
     cells = _cells(shell, geoms, tol)
-    turns = {
-        round(float(np.degrees(np.arctan2(*(a[-1] - a[0])[::-1]))) % 180.0 / CELL_LINE_TURN_DEG)
-        % round(180.0 / CELL_LINE_TURN_DEG)
-        for a, c in zip(arrays, cells, strict=True)
-        if c
-    }
-    return len(turns) >= 2
+    ways = np.array(
+        [np.arctan2(*(a[-1] - a[0])[::-1]) for a, c in zip(arrays, cells, strict=True) if c]
+    )
+    if len(ways) < 2:
+        return False
+    # The angle between two lines, whatever their directions: 0 (parallel) to 90 degrees.
+    apart = np.abs(np.mod(np.degrees(ways[:, None] - ways[None, :]) + 90.0, 180.0) - 90.0)
+    return bool((apart > CELL_LINE_TURN_DEG).any())
