@@ -33,12 +33,7 @@ from feederkit.importers.meshbodies import (
     winding_number,
 )
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
-from feederkit.importers.plausible import (
-    MAX_PLAUSIBLE_MM,
-    MIN_PLAUSIBLE_MM,
-    size_warnings,
-    unitless_warnings,
-)
+from feederkit.importers.plausible import size_warnings, unitless_warnings
 from feederkit.outline import make_outline, unit_scale
 from feederkit.words import plural
 
@@ -575,8 +570,8 @@ def read_mesh(
     size = float(s.mesh.extents.max())
     unitless = options.units is None
     notes += size_warnings(size, unit_name, not unitless, unitless)
-    if unitless and MIN_PLAUSIBLE_MM <= size <= MAX_PLAUSIBLE_MM:
-        notes += unitless_warnings(size)  # outside, size_warnings names the other units
+    if unitless:
+        notes += unitless_warnings(size)
     try:
         poses = resting_poses(s)
     except InputError as exc:

@@ -70,11 +70,14 @@ yet above :data:`MIN_PLAUSIBLE_MM` (the angle block sample: 1.35 mm read as mm).
 
 def unitless_warnings(size_mm: float) -> list[str]:
     """The note of a file that carries no units, read as mm: with the size it then has and,
-    below :data:`SMALL_UNITLESS_MM`, the size drawn in inches would give.
+    below :data:`SMALL_UNITLESS_MM`, the size drawn in inches would give. None outside the
+    plausible sizes, where :func:`size_warnings` names the other units.
 
     >>> "48.26 mm" in unitless_warnings(1.9)[0], "inches" in unitless_warnings(60.0)[0]
     (True, False)
     """
+    if not MIN_PLAUSIBLE_MM <= size_mm <= MAX_PLAUSIBLE_MM:
+        return []
     note = f"the file carries no units: read as mm, the part is {size_mm:.4g} mm across"
     if size_mm < SMALL_UNITLESS_MM:
         note += (
