@@ -228,8 +228,8 @@ def _decide(problem: Problem, roots, deadline: Deadline, machine: PushAlignMachi
 
 
 KEPT_SHARE = 0.1
-"""The share of the time limit (from the plan's start) within which :func:`plan` asks, before
-its search, whether nature keeps a pair of some root apart (``solvable.kept_roots``): 0.2 s
+"""The share of the time limit (counted from when it is asked) within which :func:`plan` asks,
+before its search, whether nature keeps a pair of some root apart (``solvable.kept_roots``): 0.2 s
 on a 50-part mix at 5 % under 1 degree, whose search ran 30 s before giving up; 0.9 s on a
 200-part mix at 0.5 %, which has a plan."""
 
@@ -411,6 +411,7 @@ def _plan(
     exact_deadline = _exact_budget(budget)
     limit = None
     known: dict[int, float] | None = None
+    kept_known = False  # whether kept_roots found that nature keeps no pair of a root apart
     if not machine.deterministic:
         # Strong plans need not exist. Sensorless, decide first: one pass over the reachable
         # sets gives every set's length (a shortest path, which iterative deepening finds
@@ -422,11 +423,14 @@ def _plan(
         else:
             limit = FIRST_LIMIT
             # A pair nature keeps apart in a root settles it before any search (cheap,
-            # solvable.kept_roots); the search would run until it gave up. Within the
-            # first KEPT_SHARE of the limit, so that solvable machines lose little.
+            # solvable.kept_roots); the search would run until it gave up. Within
+            # KEPT_SHARE of the limit from now, so that solvable machines lose little (from
+            # the plan's start, the goal relation of a 100-part mix at 5 % under 1 degree
+            # took the whole share, and the fallback asked again 30 s later).
             try:
-                if kept_roots(problem.with_margin(0.0), roots, budget.until(KEPT_SHARE)):
+                if kept_roots(problem.with_margin(0.0), roots, budget.share_from_now(KEPT_SHARE)):
                     raise no_strong_plan(machine)
+                kept_known = True  # none: the fallback need not ask again
             except Timeout:
                 pass  # the search and its fallback decide
     worst = make_oracle(problem, method, exact_deadline)
@@ -435,7 +439,7 @@ def _plan(
             _check_margin(problem, roots, min_margin, exact_deadline)
         except Timeout as exc:
             return fallback(
-                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
             )
     if known is not None and min_margin == 0.0 and method in ("auto", "andor"):
         worst.exact.update({m: int(v) for m, v in known.items() if v != math.inf})
@@ -467,7 +471,9 @@ def _plan(
             # the search, which holds the checkpoint: a cycle only the collector would free.
             checkpoint.on_course = None
     if stopped is not None:
-        return fallback(problem, worst, roots, root_branches, budget, options, stopped, apart)
+        return fallback(
+            problem, worst, roots, root_branches, budget, options, stopped, apart, kept_known
+        )
     if checkpoint is not None:
         checkpoint.go_on()  # every root's length is proven: the rest of the share is ours
     length = 1 + longest
@@ -480,7 +486,7 @@ def _plan(
             chain = sensorless_plan(problem, root_branches, budget.ending(None), by_image=True)
         except Timeout as exc:
             return fallback(
-                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
             )
         if chain is not None and tree_length(chain) == length:
             return chain, True, length, length, TIES_CHAIN, None
@@ -522,7 +528,7 @@ def _plan(
             root, _cut = _build(refiner, children, roots, budget_ops, "first")
         except Timeout as exc:
             return fallback(
-                problem, worst, roots, root_branches, budget, options, exc.reason, apart
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
             )
         complete = objective == "worst"
     else:

@@ -172,6 +172,23 @@ class Deadline:
             per_pair_s=self.per_pair_s,
         )
 
+    def share_from_now(self, time_share: float) -> Deadline:
+        """A budget for one stage that starts now: ending ``time_share`` of the whole limit
+        from now (never past this budget's end), this budget's memory limit. A stage that a
+        slow one before it must not starve (:meth:`until` counts from the start).
+
+        >>> b = Deadline(10.0)
+        >>> 0.0 < b.share_from_now(0.1).end - time.perf_counter() <= 1.0
+        True
+        >>> Deadline().share_from_now(0.1).end is None
+        True
+        """
+        if self.end is None:
+            return self.ending(None)
+        return self.ending(
+            min(self.end, time.perf_counter() + time_share * (self.end - self.start))
+        )
+
     def ending(self, end: float | None) -> Deadline:
         """This budget's memory limit with the deadline ``end`` (a :func:`time.perf_counter`
         instant; None keeps this one's): a stage that must stop early."""

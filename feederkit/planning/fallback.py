@@ -86,10 +86,13 @@ def fallback(
     options: PlanningOptions,
     stop: str,
     apart: bool = False,
+    kept_known: bool = False,
 ):
     """Some plan when the exact search ran out of its budget (``stop``: the Timeout's reason),
     with the lower bound proven; ``apart``: the goal tells every pair of states apart and a
-    lumped one may follow, so with no plan found the bound is stated for this goal only.
+    lumped one may follow, so with no plan found the bound is stated for this goal only;
+    ``kept_known``: :func:`~feederkit.planning.solvable.kept_roots` found no root holding a
+    pair nature keeps apart (it is not asked again).
 
     Everything here runs under the rest of the plan's ``budget``: the backchaining plan (one
     part, no margin floor: one chain of the whole set; the plan that follows the readings
@@ -217,7 +220,7 @@ def fallback(
         rest = budget.remaining()
         share = budget if rest is None else budget.ending(budget.end - rest / 2.0)
         try:
-            bad = unsolvable_by_pairs(problem.with_margin(0.0), roots, share)
+            bad = unsolvable_by_pairs(problem.with_margin(0.0), roots, share, kept_known=kept_known)
         except Timeout:
             bad = None
         if bad:

@@ -205,6 +205,8 @@ def unsolvable_by_pairs(
     roots: list[int],
     deadline: Deadline | None = None,
     max_sets: int = MAX_SETS,
+    *,
+    kept_known: bool = False,
 ) -> list[int] | None:
     """Roots holding a pair of states that no strong plan orients: a subset of a solvable
     set is solvable, so these roots are not (empty: every pair is; that proves nothing of the
@@ -223,9 +225,11 @@ def unsolvable_by_pairs(
     (:func:`~feederkit.machine.inseparable.kept_apart` over :func:`candidate_pairs`, one
     fixpoint over all pairs): the roots holding one are the answer. The 50-part mix at 5 %
     under 1 degree: the same 30 roots in 0.3 s, where the pairs' searches take 5.8 s.
+    ``kept_known``: the caller found no such root already (:func:`kept_roots`, 2 s on a
+    100-part mix at 5 %), and it is not asked again.
     """
     deadline = deadline or Deadline(None)
-    held = kept_roots(problem, roots, deadline)
+    held = [] if kept_known else kept_roots(problem, roots, deadline)
     if held:
         return held
     bad = _bad_pairs(problem, _pairs_within(problem, roots, NEIGHBOUR_PAIRS), deadline, max_sets)
