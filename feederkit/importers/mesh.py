@@ -33,7 +33,7 @@ from feederkit.importers.meshbodies import (
     winding_number,
 )
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
-from feederkit.importers.plausible import size_warnings, unitless_warnings
+from feederkit.importers.plausible import outline_size, size_warnings, unitless_warnings
 from feederkit.outline import make_outline, unit_scale
 from feederkit.words import plural
 
@@ -567,11 +567,6 @@ def read_mesh(
     budget.check_time()
     s = solid(mesh, options.com is not None, str(path), budget)
     budget.check_time()
-    size = float(s.mesh.extents.max())
-    unitless = options.units is None
-    notes += size_warnings(size, unit_name, not unitless, unitless)
-    if unitless:
-        notes += unitless_warnings(size)
     try:
         poses = resting_poses(s)
     except InputError as exc:
@@ -586,6 +581,13 @@ def read_mesh(
     said = (com_pose_note(s, poses, k),) if options.com is not None else ()
     ring, com2d, transform = pose_outline(s, poses[k], options.com)
     outline = make_outline(name, ring, (), com2d, "mm")
+    # The part's size as the plan has it (its resting outline's hull diameter, Part.size),
+    # not the solid's largest extent: one size per part in what the import says.
+    size = outline_size(outline)
+    unitless = options.units is None
+    notes += size_warnings(size, unit_name, not unitless, unitless)
+    if unitless:
+        notes += unitless_warnings(size)
     pose = MeshPose(
         index=k,
         probability=poses[k].probability,
