@@ -229,3 +229,31 @@ def test_kept_roots_are_sound_under_either_grouping(seed, grouping):
     value = solve(problem, roots, None, 200_000)
     assert value is not None
     assert all(value[r] == math.inf for r in solvable.kept_roots(problem, roots))
+
+
+def test_the_kept_check_gets_its_share_after_a_slow_goal_relation(monkeypatch):
+    # The goal relation takes longer than a tenth of the limit (as on a 100-part mix at 5 %
+    # under 1 degree): the kept pairs still answer before any search.
+    import time
+
+    machine = _two_parts(18, 1.0, 0.1)
+    slow = api.goal_relation
+
+    def goal_relation(*args, **kwargs):
+        time.sleep(0.4)  # more than KEPT_SHARE of the 2-second limit
+        return slow(*args, **kwargs)
+
+    monkeypatch.setattr(api, "goal_relation", goal_relation)
+    monkeypatch.setattr(api, "longest_root", lambda *a, **k: pytest.fail("a search was run"))
+    with pytest.raises(NoStrongPlan, match="no strong plan exists"):
+        plan(machine, PlanningOptions(time_limit_s=2.0, lumping="none"))
+
+
+def test_the_fallback_does_not_ask_the_kept_pairs_again(monkeypatch):
+    problem = Problem(_two_parts(3, 1.0, 0.1))
+    roots = _roots(problem)
+    expected = unsolvable_by_pairs(problem, roots)
+    if solvable.kept_roots(problem, roots):
+        pytest.skip("this seed keeps a pair apart")
+    monkeypatch.setattr(solvable, "kept_roots", lambda *a, **k: pytest.fail("asked again"))
+    assert unsolvable_by_pairs(problem, roots, kept_known=True) == expected
