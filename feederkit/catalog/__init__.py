@@ -57,6 +57,12 @@ from feederkit.catalog.store import (
     revision_history,
     similar_names,
 )
+from feederkit.catalog.tolerances import (
+    DeclaredTolerances,
+    PartTolerances,
+    RevisionTolerances,
+    declared_tolerances,
+)
 
 __all__ = [
     "CATALOG_ENV",
@@ -69,16 +75,20 @@ __all__ = [
     "CatalogLike",
     "Changeover",
     "ChangeoverInfo",
+    "DeclaredTolerances",
     "DirectoryImport",
     "DuplicateNameError",
     "PartSummary",
+    "PartTolerances",
     "Revision",
+    "RevisionTolerances",
     "add_file",
     "add_outline",
     "check_name",
     "check_part_name",
     "connect",
     "could_be_part_name",
+    "declared_tolerances",
     "declared_uncertainties",
     "default_catalog_path",
     "did_you_mean",

@@ -25,6 +25,7 @@ from feederkit.catalog.store import (
     options_key,
     write_revision,
 )
+from feederkit.catalog.tolerances import PartCheck, PartTolerances
 from feederkit.errors import InputError
 from feederkit.importers import SUPPORTED_SUFFIXES, ImportedPart, ImportOptions, import_parts
 from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
@@ -169,6 +170,8 @@ def import_directory(
     progress: Progress | None = None,
     skip_bad: bool = False,
     side_probability: float = DEFAULT_SIDE_PROBABILITY,
+    tolerances: PartTolerances = PartTolerances(),
+    check_part: PartCheck | None = None,
 ) -> DirectoryImport:
     """Import every source file under ``directory`` in one transaction (all files or none).
 
@@ -177,7 +180,9 @@ def import_directory(
     ``revise``). Every file is read; a bad one raises :class:`BadFilesError` naming every bad
     file with its path and reason, and nothing is written; with ``skip_bad`` the good files
     are written and the bad ones, and the parts whose name is taken, are listed in
-    :attr:`DirectoryImport.bad`.
+    :attr:`DirectoryImport.bad`. Every new revision stores ``tolerances``, checked against
+    its part by ``check_part`` (:func:`~feederkit.catalog.store.write_revision`; a refusal
+    is a bad file).
     """
     check_side_probability(side_probability)
     check_one_file_options(options)
@@ -227,6 +232,8 @@ def import_directory(
                         revise=revise,
                         created_by=created_by,
                         landings=lands,
+                        tolerances=tolerances,
+                        check_part=check_part,
                     )
                 )
             except DuplicateNameError as exc:

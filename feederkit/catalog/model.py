@@ -8,6 +8,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from feederkit.catalog.tolerances import RevisionTolerances
 from feederkit.errors import InputError
 from feederkit.landing.model import Landing
 from feederkit.outline import Outline
@@ -154,6 +155,9 @@ class PartSummary:
     n_hull: int
     orientable: bool
     updated_at: str
+    shape_tolerance_mm: float | None = None
+    com_tolerance_mm: float | None = None
+    """The latest revision's own tolerances (mm; None: not stored)."""
 
 
 @dataclass(frozen=True)
@@ -162,7 +166,9 @@ class Revision:
 
     ``landings`` are the ways the part lands (docs/landings.md), each with its own outline,
     hull and COM; ``landings_note`` says when they were not stored but computed on read (a
-    revision stored before catalog schema 2), and what that means.
+    revision stored before catalog schema 2), and what that means. ``shape_tolerance_mm``
+    and ``com_tolerance_mm`` are the revision's own tolerances (design.md, "Uncertainty"; None:
+    not stored, which plans count as 0).
     """
 
     name: str
@@ -185,6 +191,15 @@ class Revision:
     created_by: str
     landings: tuple[Landing, ...] = ()
     landings_note: str | None = None
+    shape_tolerance_mm: float | None = None
+    com_tolerance_mm: float | None = None
+
+    @property
+    def tolerances(self) -> RevisionTolerances:
+        """What this revision stores, for :func:`~feederkit.catalog.declared_tolerances`."""
+        return RevisionTolerances(
+            self.name, self.revision, self.shape_tolerance_mm, self.com_tolerance_mm
+        )
 
 
 @dataclass(frozen=True)
@@ -198,7 +213,11 @@ class AddOutcome:
     orientable: bool
     warnings: tuple[str, ...]
     changes: tuple[str, ...] = ()
-    """For ``revised``: what changed against the previous latest revision (file, options)."""
+    """For ``revised``: what changed against the previous latest revision (file, options,
+    tolerances)."""
+    shape_tolerance_mm: float | None = None
+    com_tolerance_mm: float | None = None
+    """The tolerances the revision stores (mm; None: not stored)."""
 
 
 @dataclass(frozen=True)

@@ -99,7 +99,24 @@ def _v2(conn: sqlite3.Connection) -> None:
             conn.execute(statement)
 
 
-MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2)
+SCHEMA_V3 = """
+ALTER TABLE revisions ADD COLUMN shape_tolerance_mm REAL
+    CHECK (shape_tolerance_mm IS NULL OR shape_tolerance_mm >= 0);
+ALTER TABLE revisions ADD COLUMN com_tolerance_mm REAL
+    CHECK (com_tolerance_mm IS NULL OR com_tolerance_mm >= 0);
+"""
+
+
+def _v3(conn: sqlite3.Connection) -> None:
+    """A revision's own shape and COM tolerances (mm; design.md, "Uncertainty"): NULL where
+    none is stored, which the plan commands count as 0 (docs/uncertainty.md). Existing
+    revisions keep every field and store none."""
+    for statement in SCHEMA_V3.split(";"):
+        if statement.strip():
+            conn.execute(statement)
+
+
+MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2, _v3)
 """Migration ``k`` brings a catalog from version ``k`` to ``k + 1``."""
 
 SCHEMA_VERSION = len(MIGRATIONS)

@@ -36,6 +36,7 @@ from feederkit.catalog.schema import (
     connect,
     transaction,
 )
+from feederkit.catalog.tolerances import TOLERANCE_WORDS, PartCheck, PartTolerances
 from feederkit.errors import InputError
 from feederkit.importers import (
     ImportedOutline,
@@ -137,10 +138,12 @@ def _part_id(conn: sqlite3.Connection, name: str) -> int | None:
     return None if row is None else int(row[0])
 
 
-def _latest(conn: sqlite3.Connection, part_id: int) -> tuple[int, str, str, str, int]:
+def _latest(
+    conn: sqlite3.Connection, part_id: int
+) -> tuple[int, str, str, str, int, float | None, float | None]:
     return conn.execute(
-        "SELECT revision, source_path, source_sha256, options_json, id FROM revisions "
-        "WHERE part_id = ? ORDER BY revision DESC LIMIT 1",
+        "SELECT revision, source_path, source_sha256, options_json, id, shape_tolerance_mm, "
+        "com_tolerance_mm FROM revisions WHERE part_id = ? ORDER BY revision DESC LIMIT 1",
         (part_id,),
     ).fetchone()
 
@@ -245,14 +248,19 @@ def write_revision(
     revise: bool = False,
     created_by: str | None = None,
     landings: Sequence[Landing] | None = None,
+    tolerances: PartTolerances = PartTolerances(),
+    check_part: PartCheck | None = None,
 ) -> AddOutcome:
     """Store one imported part and its landings inside the caller's transaction.
 
     A new name is added as revision 1. For an existing name, the same source path (or
     ``revise``) with the same SHA-256 and options is a no-op; with a changed file or options
     it becomes the next revision, and so does a mesh whose latest revision was stored before
-    landings (to store all its resting poses). Another source file under an existing name is
-    refused. ``landings`` default to :func:`landings_for` without the source file.
+    landings (to store all its resting poses), and a tolerance given that the latest
+    revision does not store. Another source file under an existing name is refused.
+    ``landings`` default to :func:`landings_for` without the source file. A new revision
+    stores ``tolerances`` where given and keeps the latest revision's where not
+    (:meth:`PartTolerances.over`); ``check_part`` checks them against the part first.
     """
     if landings is None:
         landings = landings_for(imported)
@@ -263,6 +271,7 @@ def write_revision(
     options_json = _dumps(options_key)
     pid = _part_id(conn, name)
     changes: tuple[str, ...] = ()
+    stored, kept, rev = tolerances, {}, 0
     if pid is None:
         cur = conn.execute(
             "INSERT INTO parts (name, created_at, created_by) VALUES (?, ?, ?)", (name, when, who)
@@ -270,13 +279,16 @@ def write_revision(
         pid = int(cur.lastrowid)
         revision, status = 1, "added"
     else:
-        rev, old_path, old_sha, old_options, old_id = _latest(conn, pid)
+        rev, old_path, old_sha, old_options, old_id, old_shape, old_com = _latest(conn, pid)
         if old_path != source_path and not revise:
             raise DuplicateNameError(name, old_path)
         poses_missing = (
             imported.source.kind == "mesh" and len(landings) > 1 and not _has_landings(conn, old_id)
         )
-        if old_sha == sha256 and old_options == options_json and not poses_missing:
+        old = _stored_tolerances(name, int(rev), old_shape, old_com)
+        stored, kept = tolerances.over(old), tolerances.kept(old)
+        same = old_sha == sha256 and old_options == options_json and not poses_missing
+        if same and stored == old:
             return AddOutcome(
                 name,
                 int(rev),
@@ -284,14 +296,19 @@ def write_revision(
                 source_path,
                 imported.orientability.orientable,
                 imported.warnings,
+                shape_tolerance_mm=old.shape_tolerance_mm,
+                com_tolerance_mm=old.com_tolerance_mm,
             )
         revision, status = int(rev) + 1, "revised"
         changes = _changes(int(rev), old_sha, sha256, old_options, options_key)
+        changes += _tolerance_changes(old, stored)
         if poses_missing:
             changes += (
                 f"landings: all {len(landings)} resting poses stored (revision {rev} was "
                 "stored before landings)",
             )
+    if check_part is not None:
+        _check_tolerances(check_part, part, stored, kept, int(rev))
     src = imported.source
     pose = None
     if src.pose is not None:
@@ -306,7 +323,8 @@ def write_revision(
         "INSERT INTO revisions (part_id, revision, source_path, source_sha256, source_kind, "
         "source_units, options_json, outline_json, hull_json, com_x, com_y, hull_tolerance, "
         "mesh_pose_json, orientable, not_orientable_reason, warnings_json, area, n_holes, "
-        "n_hull, created_at, created_by) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
+        "n_hull, created_at, created_by, shape_tolerance_mm, com_tolerance_mm) "
+        "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
         (
             pid,
             revision,
@@ -329,6 +347,8 @@ def write_revision(
             len(part.hull),
             when,
             who,
+            stored.shape_tolerance_mm,
+            stored.com_tolerance_mm,
         ),
     )
     _write_landings(conn, int(cur.lastrowid), landings)
@@ -340,7 +360,54 @@ def write_revision(
         imported.orientability.orientable,
         imported.warnings,
         changes,
+        stored.shape_tolerance_mm,
+        stored.com_tolerance_mm,
     )
+
+
+def _stored_tolerances(
+    name: str, revision: int, shape: float | None, com: float | None
+) -> PartTolerances:
+    """The latest revision's tolerances, read for a write; a damaged value says so."""
+    try:
+        return PartTolerances(shape, com)
+    except InputError as exc:
+        raise _damaged(name, revision, str(exc)) from None
+
+
+def _check_tolerances(
+    check: PartCheck, part: Part, stored: PartTolerances, kept: dict[str, str], previous: int
+) -> None:
+    """``check`` the tolerances to store against the part; the refusal of a tolerance kept
+    from revision ``previous`` says so (the user did not give it this time). The check's
+    error names the tolerance it refuses in ``field`` when it can
+    (``feederkit.uncertainty.ToleranceTooLarge``)."""
+    try:
+        check(part, stored)
+    except InputError as exc:
+        field = getattr(exc, "field", None)
+        what = kept.get(field) if field is not None else " and ".join(kept.values())
+        if what:
+            verb = "are" if " and " in what else "is"
+            exc.args = (
+                f"{exc}; the {what} {verb} revision {previous}'s, kept because not given: give "
+                "a smaller one",
+            )
+        raise
+
+
+def _tolerance_changes(old: PartTolerances, new: PartTolerances) -> tuple[str, ...]:
+    """The tolerances of a new revision that differ from the previous one's, in words."""
+    out = []
+    for key, what in TOLERANCE_WORDS:
+        before, after = getattr(old, key), getattr(new, key)
+        if before != after:
+            out.append(f"{what}: {_tolerance_words(before)} -> {_tolerance_words(after)}")
+    return tuple(out)
+
+
+def _tolerance_words(value: float | None) -> str:
+    return "not stored" if value is None else f"{value:g} mm"
 
 
 def _changes(
@@ -377,9 +444,13 @@ def add_file(
     revise: bool = False,
     created_by: str | None = None,
     side_probability: float = DEFAULT_SIDE_PROBABILITY,
+    tolerances: PartTolerances = PartTolerances(),
+    check_part: PartCheck | None = None,
 ) -> list[AddOutcome]:
     """Import one file and store its part(s) with their landings in one transaction (several
-    parts with ``all_parts``); ``side_probability`` is a flat part's probability of ``up``."""
+    parts with ``all_parts``); ``side_probability`` is a flat part's probability of ``up``,
+    ``tolerances`` the new revisions' own, checked against each part by ``check_part``
+    (:func:`write_revision`; a refusal writes nothing)."""
     if name is not None:
         check_part_name(name, "give --name a name without ',' or ':'")
     check_side_probability(side_probability)
@@ -399,6 +470,8 @@ def add_file(
                 revise=revise,
                 created_by=created_by,
                 landings=lands,
+                tolerances=tolerances,
+                check_part=check_part,
             )
             for p, lands in zip(parts, landings, strict=True)
         ]
@@ -414,9 +487,10 @@ def add_outline(
     revise: bool = False,
     created_by: str | None = None,
     side_probability: float = DEFAULT_SIDE_PROBABILITY,
+    tolerances: PartTolerances = PartTolerances(),
 ) -> AddOutcome:
-    """Store an outline made in Python with its landings (``up`` with ``side_probability``);
-    its SHA-256 is that of its outline-file JSON."""
+    """Store an outline made in Python with its landings (``up`` with ``side_probability``)
+    and its own ``tolerances``; its SHA-256 is that of its outline-file JSON."""
     if name is not None:
         outline = dataclasses.replace(outline, name=check_part_name(name))
     text = _dumps(outline_to_dict(outline))
@@ -437,12 +511,14 @@ def add_outline(
             revise=revise,
             created_by=created_by,
             landings=landings,
+            tolerances=tolerances,
         )
 
 
 _SUMMARY_SQL = """
 SELECT p.name, r.revision, (SELECT count(*) FROM revisions c WHERE c.part_id = p.id),
-       r.source_kind, r.source_units, r.area, r.n_holes, r.n_hull, r.orientable, r.created_at
+       r.source_kind, r.source_units, r.area, r.n_holes, r.n_hull, r.orientable, r.created_at,
+       r.shape_tolerance_mm, r.com_tolerance_mm
 FROM parts p JOIN revisions r ON r.part_id = p.id
 WHERE r.revision = (SELECT max(m.revision) FROM revisions m WHERE m.part_id = p.id)
 """
@@ -489,6 +565,14 @@ def _real(value: Any, what: str, *, optional: bool = False) -> float | None:
     x = float(value)
     if not math.isfinite(x) or abs(x) > MAX_COORD_MM:
         raise _Damaged(f"{what} is {value!r}, not a finite number within 1e9")
+    return x
+
+
+def _tolerance(value: Any, what: str) -> float | None:
+    """A stored tolerance: None (not stored) or a finite number of mm, at least 0."""
+    x = _real(value, what, optional=True)
+    if x is not None and x < 0.0:
+        raise _Damaged(f"{what} is {x}, negative")
     return x
 
 
@@ -551,6 +635,8 @@ def _summary_from_row(r: Sequence[Any]) -> PartSummary:
             n_hull=_int(r[7], "n_hull", 3),
             orientable=bool(_int(r[8], "orientable")),
             updated_at=_text(r[9], "created_at"),  # type: ignore[arg-type]
+            shape_tolerance_mm=_tolerance(r[10], "shape_tolerance_mm"),
+            com_tolerance_mm=_tolerance(r[11], "com_tolerance_mm"),
         )
     except _Damaged as exc:
         raise _damaged(r[0], r[1], str(exc)) from None
@@ -598,7 +684,7 @@ _REVISION_SQL = """
 SELECT p.name, r.revision, r.source_path, r.source_sha256, r.source_kind, r.source_units,
        r.options_json, r.outline_json, r.hull_json, r.com_x, r.com_y, r.hull_tolerance,
        r.mesh_pose_json, r.orientable, r.not_orientable_reason, r.warnings_json, r.area,
-       r.created_at, r.created_by, r.id
+       r.created_at, r.created_by, r.id, r.shape_tolerance_mm, r.com_tolerance_mm
 FROM parts p JOIN revisions r ON r.part_id = p.id WHERE p.name = ?
 """
 
@@ -715,6 +801,8 @@ def _revision_from_row(row: Sequence[Any], landing_rows: Sequence[Sequence[Any]]
             created_by=_text(row[18], "created_by"),  # type: ignore[arg-type]
             landings=landings,
             landings_note=note,
+            shape_tolerance_mm=_tolerance(row[20], "shape_tolerance_mm"),
+            com_tolerance_mm=_tolerance(row[21], "com_tolerance_mm"),
         )
     except _Damaged as exc:
         raise _damaged(row[0], row[1], str(exc)) from None
