@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from feederkit.catalog import RevisionTolerances
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.mechanics.analysis import fragile_warnings
@@ -30,7 +31,9 @@ class LoadedParts:
     (a plan over landings names each landing's own instead, so they are kept apart);
     ``left_out``: one line per part that is not orientable by pushing (only when such parts
     are left out rather than refused); ``origins``: the SOURCE each push function came from
-    (a drawing read with ``all_parts`` gives several).
+    (a drawing read with ``all_parts`` gives several); ``tolerances``: what the catalog
+    revisions among them store (:func:`feederkit.catalog.declared_tolerances` makes them the
+    plan's; parts read from files store none).
     """
 
     push_functions: tuple[PushFunction, ...]
@@ -38,6 +41,7 @@ class LoadedParts:
     fragile_warnings: tuple[str, ...] = ()
     left_out: tuple[str, ...] = ()
     origins: tuple[str, ...] = ()
+    tolerances: tuple[RevisionTolerances, ...] = ()
 
     @property
     def warnings(self) -> tuple[str, ...]:
@@ -86,6 +90,7 @@ def load_parts(
     origins: list[str] = []
     import_warnings: list[str] = []
     left_out: list[str] = []
+    tolerances: list[RevisionTolerances] = []
     for source in sources:
         every = load_parts_with_warnings(source, catalog=db, options=options)
         for loaded in every:
@@ -99,6 +104,8 @@ def load_parts(
             import_warnings += [f"{where}: {w}" for w in loaded.warnings]
             pfs.append(push_function(loaded.part))
             origins.append(source)
+            if loaded.tolerances is not None:
+                tolerances.append(loaded.tolerances)
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:
@@ -109,4 +116,5 @@ def load_parts(
         fragile_warnings=tuple(fragile_warnings(pfs)),
         left_out=tuple(left_out),
         origins=tuple(origins),
+        tolerances=tuple(tolerances),
     )

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from feederkit.catalog import (
+    RevisionTolerances,
     could_be_part_name,
     default_catalog_path,
     get_revision,
@@ -39,12 +40,14 @@ _REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>\d+)$")
 
 @dataclass(frozen=True)
 class LoadedPart:
-    """A part resolved from a SOURCE, with the import's warnings and its orientability."""
+    """A part resolved from a SOURCE, with the import's warnings and its orientability;
+    ``tolerances``: what its catalog revision stores (None: a part read from a file)."""
 
     part: Part
     warnings: tuple[str, ...]
     orientability: Orientability
     origin: str
+    tolerances: RevisionTolerances | None = None
 
 
 def _from_catalog(source: str, com: Point | None, catalog: str | None) -> LoadedPart:
@@ -66,7 +69,7 @@ def _from_catalog(source: str, com: Point | None, catalog: str | None) -> Loaded
     notes = [w for w in revision.warnings if not w.startswith(NOT_ORIENTABLE)]
     if not verdict.orientable:
         notes.append(f"{NOT_ORIENTABLE}: {verdict.reason}")
-    loaded = LoadedPart(part, tuple(notes), verdict, f"catalog {db}")
+    loaded = LoadedPart(part, tuple(notes), verdict, f"catalog {db}", revision.tolerances)
     if not verdict.orientable and revision.source_kind == "mesh":
         lands = [(x.name, x.part) for x in revision.landings]
         return _by_landings(loaded, lands, revision.hull_tolerance)
@@ -89,7 +92,7 @@ def _by_landings(
                 f"the imported pose is {NOT_ORIENTABLE} ({loaded.orientability.reason}); "
                 f"landing {name} is: leave the others out with --landings"
             )
-            return LoadedPart(loaded.part, tuple(notes), verdict, loaded.origin)
+            return dataclasses.replace(loaded, warnings=tuple(notes), orientability=verdict)
     return loaded
 
 

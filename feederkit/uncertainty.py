@@ -132,23 +132,36 @@ def com_clearance(part: Part) -> float:
     return float((cross / np.hypot(d[:, 0], d[:, 1])).min())
 
 
+class ToleranceTooLarge(InputError):
+    """A shape or COM tolerance a part cannot take (:func:`check_for_part`); ``field`` names
+    which, as the plan file's ``"uncertainty"`` does (``shape_tolerance_mm`` or
+    ``com_tolerance_mm``), so a caller can say where the value came from."""
+
+    def __init__(self, message: str, field: str) -> None:
+        super().__init__(message)
+        self.field = field
+
+
 def check_for_part(unc: Uncertainty, part: Part) -> Uncertainty:
     """Return ``unc`` if its shape tolerance is below half ``part``'s smallest hull edge and
     its COM tolerance below the COM's distance to the hull's boundary.
 
-    Raises InputError naming the part and both lengths otherwise.
+    Raises :class:`ToleranceTooLarge` (an InputError) naming the part and both lengths
+    otherwise.
     """
     limit = max_shape_tolerance(part)
     if unc.shape_tolerance_mm >= limit:
-        raise InputError(
+        raise ToleranceTooLarge(
             f"{part.name}: shape tolerance {unc.shape_tolerance_mm:g} mm must be below half the "
-            f"smallest hull edge ({limit:.4g} mm)"
+            f"smallest hull edge ({limit:.4g} mm)",
+            "shape_tolerance_mm",
         )
     clearance = com_clearance(part)
     if unc.com_tolerance_mm >= clearance:
-        raise InputError(
+        raise ToleranceTooLarge(
             f"{part.name}: COM tolerance {unc.com_tolerance_mm:g} mm must be below the COM's "
-            f"distance to the hull's boundary ({clearance:.4g} mm)"
+            f"distance to the hull's boundary ({clearance:.4g} mm)",
+            "com_tolerance_mm",
         )
     return unc
 
@@ -156,6 +169,7 @@ def check_for_part(unc: Uncertainty, part: Part) -> Uncertainty:
 __all__ = [
     "DEFAULT_ROTATION_ERROR_DEG",
     "IDEAL",
+    "ToleranceTooLarge",
     "Uncertainty",
     "check_for_part",
     "com_clearance",

@@ -27,6 +27,7 @@ from feederkit.catalog import (
     DEFAULT_WAIT,
     SCHEMA_VERSION,
     AddOutcome,
+    PartTolerances,
     Revision,
     add_file,
     export_part,
@@ -46,6 +47,7 @@ from feederkit.cli.common import (
     JsonOpt,
     console,
     err_console,
+    flag_words,
     plural,
     print_json,
     progress_bar,
@@ -54,6 +56,8 @@ from feederkit.cli.importopts import takes_import_options, with_com
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
+from feederkit.part import Part
+from feederkit.uncertainty import Uncertainty, check_for_part
 
 RICH_TABLE_ROWS = 200
 """Longer tables are printed as plain columns."""
@@ -151,6 +155,55 @@ SideOpt = Annotated[
         help="Probability (0 < P < 1) that a flat part lands up, as drawn; down gets 1 - P.",
     ),
 ]
+
+StoredShapeToleranceOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--shape-tolerance",
+        metavar="MM",
+        help="Store with the new revision: its hull vertices lie within MM of their drawn "
+        "positions (below half its smallest hull edge); plans declare the largest their parts "
+        "store unless given. Not given, the previous revision's is kept.",
+    ),
+]
+StoredComToleranceOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--com-tolerance",
+        metavar="MM",
+        help="Store with the new revision: its centre of mass lies within MM of its nominal "
+        "position (below its distance to the hull's edges), as --shape-tolerance.",
+    ),
+]
+
+
+def stored_tolerances(shape: float | None, com: float | None) -> PartTolerances:
+    """The tolerances ``add`` and ``import`` store (finite, at least 0; errors name the flags)."""
+    with flag_words():
+        return PartTolerances(shape, com)
+
+
+def check_tolerances(part: Part, tolerances: PartTolerances) -> None:
+    """The part's own bounds on the tolerances its new revision stores (half its smallest
+    hull edge, its COM's distance to the hull: :func:`feederkit.uncertainty.check_for_part`),
+    checked before anything is written; errors name the flags."""
+    shape, com = tolerances.shape_tolerance_mm, tolerances.com_tolerance_mm
+    with flag_words():
+        check_for_part(Uncertainty(0.0, shape or 0.0, com or 0.0), part)
+
+
+def _tolerance_words(o: AddOutcome) -> str:
+    """``; stores shape tolerance 0.05 mm`` for an outcome whose revision stores tolerances."""
+    stored = [
+        f"{what} {value:g} mm"
+        for what, value in (
+            ("shape tolerance", o.shape_tolerance_mm),
+            ("COM tolerance", o.com_tolerance_mm),
+        )
+        if value is not None
+    ]
+    return f"; stores {' and '.join(stored)}" if stored else ""
+
 
 RevisionOpt = Annotated[
     int | None,
@@ -272,6 +325,8 @@ def _outcome_dict(o: AddOutcome) -> dict[str, Any]:
         **orientable_fields(o.orientable),
         "warnings": list(o.warnings),
         "changes": list(o.changes),
+        "shape_tolerance_mm": o.shape_tolerance_mm,
+        "com_tolerance_mm": o.com_tolerance_mm,
     }
 
 
@@ -393,18 +448,29 @@ def cmd_add(
     import_opts: ImportOptions = ImportOptions(),
     com: ComOpt = None,
     side_probability: SideOpt = DEFAULT_SIDE_PROBABILITY,
+    shape_tolerance: StoredShapeToleranceOpt = None,
+    com_tolerance: StoredComToleranceOpt = None,
     catalog: CatalogOpt = None,
     wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
-    """Import one file as a part with its landings; a changed file or changed options make a
-    new revision (and say what changed), an unchanged one nothing."""
+    """Import one file as a part with its landings; a changed file, changed options or a new
+    shape or COM tolerance make a new revision (and say what changed), an unchanged one
+    nothing."""
     opts = with_com(import_opts, com)
     check_side_probability(side_probability)
+    tolerances = stored_tolerances(shape_tolerance, com_tolerance)
     _check_source_file(file)
     with opened_for_import(catalog, wait) as conn:
         outcomes = add_file(
-            conn, file, opts, name=name, revise=revise, side_probability=side_probability
+            conn,
+            file,
+            opts,
+            name=name,
+            revise=revise,
+            side_probability=side_probability,
+            tolerances=tolerances,
+            check_part=check_tolerances,
         )
     DONE_WORK.note(f"stored {_stored_words(outcomes)}")
     _warn(outcomes)
@@ -414,7 +480,7 @@ def cmd_add(
     for o in outcomes:
         changed = f": {'; '.join(o.changes)}" if o.changes else ""
         console.print(
-            f"{o.name}: revision {o.revision} ({o.status}{changed})",
+            f"{o.name}: revision {o.revision} ({o.status}{changed}){_tolerance_words(o)}",
             highlight=False,
             markup=False,
         )
@@ -444,14 +510,18 @@ def cmd_import(
         bool,
         typer.Option("--skip-bad", help="Import the good files and name each bad one."),
     ] = False,
+    shape_tolerance: StoredShapeToleranceOpt = None,
+    com_tolerance: StoredComToleranceOpt = None,
     catalog: CatalogOpt = None,
     wait: WaitOpt = DEFAULT_WAIT,
     json_out: JsonOpt = False,
 ) -> None:
     """Import every source file of a folder, with landings, in one transaction: all files or
-    none (with --skip-bad: every good file, and each bad one named)."""
+    none (with --skip-bad: every good file, and each bad one named). A shape or COM tolerance
+    is stored with every new revision; a part it is too large for is a bad file."""
     opts = with_com(import_opts, com)
     check_side_probability(side_probability)
+    tolerances = stored_tolerances(shape_tolerance, com_tolerance)
     if not directory.is_dir():  # before the catalog is created: bad input leaves no file
         what = "not a directory" if directory.exists() else "no such directory"
         raise InputError(f"{directory}: {what}")
@@ -474,6 +544,8 @@ def cmd_import(
                 progress=progress,
                 skip_bad=skip_bad,
                 side_probability=side_probability,
+                tolerances=tolerances,
+                check_part=check_tolerances,
             )
     DONE_WORK.note(f"stored {_stored_words(result.outcomes)}")
     _warn(result.outcomes)
@@ -517,6 +589,8 @@ def cmd_list(catalog: CatalogOpt = None, json_out: JsonOpt = False) -> None:
                     "hull_vertices": p.n_hull,
                     **orientable_fields(p.orientable),
                     "updated_at": p.updated_at,
+                    "shape_tolerance_mm": p.shape_tolerance_mm,
+                    "com_tolerance_mm": p.com_tolerance_mm,
                 }
                 for p in parts
             ]
@@ -591,6 +665,8 @@ def revision_dict(
         "com": list(rev.com),
         "hull": [list(p) for p in rev.hull],
         "hull_tolerance": rev.hull_tolerance,
+        "shape_tolerance_mm": rev.shape_tolerance_mm,
+        "com_tolerance_mm": rev.com_tolerance_mm,
         "mesh_pose": None if rev.mesh_pose is None else dict(rev.mesh_pose),
         **orientable_fields(rev.orientable),
         "not_orientable_reason": rev.not_orientable_reason,
@@ -628,6 +704,19 @@ def _landing_line(x: Landing) -> str:
         f"{plural(len(x.part.hull), 'hull vertex', 'hull vertices')}, "
         f"com ({x.part.com[0]:.4f}, {x.part.com[1]:.4f}) mm{same}"
     )
+
+
+def _stored_tolerance_rows(rev: Revision) -> list[tuple[str, str]]:
+    """``catalog show``'s rows of the tolerances the revision stores (none when not stored)."""
+    rows = [
+        (what, f"{value:g} mm ({meaning})")
+        for what, value, meaning in (
+            ("shape tolerance", rev.shape_tolerance_mm, "every hull vertex within it"),
+            ("COM tolerance", rev.com_tolerance_mm, "the centre of mass within it"),
+        )
+        if value is not None
+    ]
+    return rows
 
 
 def _tol(value: float | None) -> str:
@@ -671,6 +760,7 @@ def cmd_show(
             f"{plural(len(rev.hull), 'vertex', 'vertices')} (tolerance {_tol(rev.hull_tolerance)})",
         ),
         ("com", f"({rev.com[0]:.4f}, {rev.com[1]:.4f}) mm"),
+        *_stored_tolerance_rows(rev),
         (
             "mesh pose",
             "-"

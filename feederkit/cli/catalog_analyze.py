@@ -15,6 +15,9 @@ from rich.markup import escape
 from rich.table import Table
 
 from feederkit.catalog import (
+    DeclaredTolerances,
+    RevisionTolerances,
+    declared_tolerances,
     get_revision,
     list_parts,
     open_catalog,
@@ -34,11 +37,13 @@ from feederkit.cli.common import (
     add_name_column,
     console,
     err_console,
+    flag_tolerance,
     flag_words,
     plural,
     print_json,
     print_warnings,
     progress_bar,
+    stored_tolerance_words,
     uncertainty_option,
     with_flags,
 )
@@ -77,10 +82,11 @@ def catalog_file(option: Path | None) -> Path:
 
 def load_catalog_parts(
     path: Path,
-) -> tuple[list[PushFunction], list[str], tuple[str, ...] | None]:
+) -> tuple[list[PushFunction], list[str], tuple[str, ...] | None, list[RevisionTolerances]]:
     """Push functions of every landing of every orientable part's latest revision, a
-    warning per part (or mesh pose) left out, and, when the members are the landings, the
-    part each belongs to (None: the members are the parts).
+    warning per part (or mesh pose) left out, when the members are the landings the part
+    each belongs to (None: the members are the parts), and what the revisions read store
+    (:func:`~feederkit.catalog.declared_tolerances`).
 
     design.md, "Landings": plans cover every landing unless told otherwise, so the analysis
     is of the mix ``plan`` would plan: when some part has several landings, each landing is
@@ -91,6 +97,7 @@ def load_catalog_parts(
     try:
         summaries = list_parts(conn)
         per_part: list[tuple[Part, tuple[Landing, ...]]] = []
+        stored: list[RevisionTolerances] = []
         skipped = []
         with progress_bar() as progress:
             task = progress.add_task("reading parts", total=len(summaries))
@@ -102,12 +109,13 @@ def load_catalog_parts(
                 # Rows are validated when read (COM strictly inside a convex hull), so every
                 # stored orientable part has a push function.
                 rev = get_revision(conn, s.name, s.revision)
+                stored.append(rev.tolerances)
                 part = part_from_revision(rev)
                 per_part.append((part, revision_landings(rev, part)))
     finally:
         conn.close()
     if not plans_over_landings([lands for _, lands in per_part], False, False):
-        return [push_function(part) for part, _ in per_part], skipped, None
+        return [push_function(part) for part, _ in per_part], skipped, None, stored
     pfs = []
     owners = []
     for part, lands in per_part:
@@ -117,16 +125,20 @@ def load_catalog_parts(
                 continue
             pfs.append(push_function(x.part))
             owners.append(part.name)
-    return pfs, skipped, tuple(owners)
+    return pfs, skipped, tuple(owners), stored
 
 
 def members_taking(
-    pfs: list[PushFunction], owners: tuple[str, ...] | None, unc: Uncertainty
+    pfs: list[PushFunction],
+    owners: tuple[str, ...] | None,
+    unc: Uncertainty,
+    declared: DeclaredTolerances | None = None,
 ) -> tuple[list[PushFunction], tuple[str, ...] | None, list[str]]:
     """The members whose hull takes the declared shape and COM tolerances
     (:func:`~feederkit.uncertainty.check_for_part`), their owners, and a line per member
     left out: one part with a short hull edge must not stop the whole catalog's screen.
-    InputError (the first member's, naming the flag) when no member takes them."""
+    InputError (the first member's, naming the flag) when no member takes them; a tolerance
+    the catalog gave (``declared``) names the revision storing it."""
     if unc.is_ideal:
         return pfs, owners, []
     kept: list[int] = []
@@ -134,7 +146,8 @@ def members_taking(
     first: InputError | None = None
     for k, pf in enumerate(pfs):
         try:
-            check_for_part(unc, pf.part)
+            with stored_tolerance_words(declared):
+                check_for_part(unc, pf.part)
         except InputError as exc:
             first = first or exc
             left_out.append(with_flags(f"{exc}, left out"))
@@ -166,11 +179,13 @@ def analysis_uncertainty(
 ) -> Uncertainty:
     """The declared uncertainty the analysis checks the pairs under (errors name the flags).
 
-    Without any of the three flags the analysis is the ideal model's (section 8). A shape or
-    COM tolerance without ``--rotation-error`` takes design.md's default rotation error (1
-    degree), as ``plan`` and ``changeover compile`` do without a cell profile: the same flags
-    screen for the pairs compile reports. ``--rotation-error 0`` with a tolerance is that
-    tolerance alone, not the ideal model (``Uncertainty.is_ideal``), as in compile.
+    Without any of the three flags, and no tolerance stored in the catalog, the analysis is
+    the ideal model's (section 8). A shape or COM tolerance (given, or the largest the
+    revisions store: :func:`~feederkit.catalog.declared_tolerances`) without
+    ``--rotation-error`` takes design.md's default rotation error (1 degree), as ``plan``
+    and ``changeover compile`` do without a cell profile: the same flags screen for the pairs
+    compile reports. ``--rotation-error 0`` with a tolerance is that tolerance alone, not the
+    ideal model (``Uncertainty.is_ideal``), as in compile.
     """
     if rotation_error is None:
         tolerant = bool(shape_tolerance) or bool(com_tolerance)
@@ -184,8 +199,8 @@ def analyze_command(
     led_pitch: LedPitchOpt = None,
     noise: NoiseOpt = None,
     rotation_error: AnalyzeRotationErrorOpt = None,
-    shape_tolerance: ShapeToleranceOpt = 0.0,
-    com_tolerance: ComToleranceOpt = 0.0,
+    shape_tolerance: ShapeToleranceOpt = None,
+    com_tolerance: ComToleranceOpt = None,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
 ) -> None:
@@ -202,7 +217,8 @@ def analyze_command(
     of ``plan`` and ``changeover compile``) check the pairs it tells apart whose states may
     read alike under them again, each pair for strong plans (``feederkit.mix.strongpairs``),
     and list those told apart only on the ideal model (a near-duplicate 0.05 mm longer is
-    one at 1 degree).
+    one at 1 degree). Without them, the shape and COM tolerances are the largest the parts'
+    latest revisions store (none stored: the ideal model, as before).
 
     Under a declared uncertainty each member is checked alone first: one no strong plan
     orients even alone is listed once and its pairs are not checked.
@@ -213,9 +229,17 @@ def analyze_command(
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
-    unc = analysis_uncertainty(rotation_error, shape_tolerance, com_tolerance)
-    pfs, skipped, owners = load_catalog_parts(catalog_file(catalog))
-    pfs, owners, too_small = members_taking(pfs, owners, unc)
+    # The flags, checked before the catalog is read.
+    analysis_uncertainty(
+        rotation_error, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
+    )
+    pfs, skipped, owners, stored = load_catalog_parts(catalog_file(catalog))
+    declared = declared_tolerances(stored, shape_tolerance, com_tolerance)
+    unc = analysis_uncertainty(
+        rotation_error, declared.shape_tolerance_mm, declared.com_tolerance_mm
+    )
+    pfs, owners, too_small = members_taking(pfs, owners, unc, declared)
+    print_warnings(declared.warnings)
     skipped += too_small
     over_landings = owners is not None
     # A tolerance too large for a member is refused first: one line naming it and the flag.
@@ -225,10 +249,11 @@ def analyze_command(
         data = result.to_dict()
         data["skipped"] = skipped
         data["members"] = "landings" if over_landings else "parts"
+        data["uncertainty_from"] = declared.sources()
         print_json(data)
     else:
         print_warnings(skipped)
-        _print_report(result, pfs, over_landings)
+        _print_report(result, pfs, over_landings, declared)
     what = "landings" if over_landings else "parts"
     problems = []
     if result.pairs is None and len(pfs) > 1:
@@ -326,7 +351,28 @@ def _advice(kinds: set[str], unc: Uncertainty | None = None) -> str:
     return "keep them out of one mix or use a finer sensor"
 
 
-def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: bool) -> None:
+def _catalog_words(declared: DeclaredTolerances | None) -> str:
+    """The tolerances taken from the catalog, each with the revision storing it (the largest
+    stored), or nothing when none was."""
+    if declared is None:
+        return ""
+    found = [
+        f"{what} {value:g} mm{declared.note(key)}"
+        for key, what, value in (
+            ("shape_tolerance_mm", "shape tolerance", declared.shape_tolerance_mm),
+            ("com_tolerance_mm", "COM tolerance", declared.com_tolerance_mm),
+        )
+        if declared.note(key)
+    ]
+    return "; ".join(found)
+
+
+def _print_report(
+    result: MixAnalysis,
+    pfs: list[PushFunction],
+    over_landings: bool,
+    declared: DeclaredTolerances | None = None,
+) -> None:
     c = result.counts()
     summary = Table(title="catalog analysis (section 8)", show_header=False)
     # Over landings each member is a part face up or face down (or a mesh pose).
@@ -344,6 +390,9 @@ def _print_report(result: MixAnalysis, pfs: list[PushFunction], over_landings: b
         if result.pairs is not None
         else f"{_under(unc, 'a')}: without a sensor no pair is told apart anyway (section 8.6)",
     )
+    stored = _catalog_words(declared)
+    if stored:
+        summary.add_row("from the catalog", stored)
     summary.add_row(
         "tolerances",
         f"{result.angle_tol_deg:g} deg per resting-range side, "

@@ -71,6 +71,8 @@ from feederkit.cli.common import (
     check_report_name,
     console,
     cycle_line,
+    declared_uncertainty,
+    flag_tolerance,
     flag_words,
     json_found,
     note_written,
@@ -80,6 +82,7 @@ from feederkit.cli.common import (
     print_warnings,
     print_written,
     searching,
+    stored_tolerance_words,
     time_limit_note,
     uncertainty_option,
     uncertainty_text,
@@ -88,6 +91,7 @@ from feederkit.cli.plan_render import plan_tree, sensor_text, stats_table
 from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import OutputFile, write_files
 from feederkit.landing.plan import landing_names
+from feederkit.loading import load_parts
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import (
     changeover_exists,
@@ -102,7 +106,7 @@ from feederkit.plans.model import pairs_words
 from feederkit.plans.readplan import as_plan
 from feederkit.plans.writeplan import plan_file_text
 from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
-from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
 
 changeover_app = typer.Typer(
     rich_markup_mode="markdown",
@@ -397,8 +401,8 @@ def compile_command(
     catalog: CatalogOpt = None,
     cell: CellOpt = None,
     rotation_error: ProfileRotationErrorOpt = None,
-    shape_tolerance: ShapeToleranceOpt = 0.0,
-    com_tolerance: ComToleranceOpt = 0.0,
+    shape_tolerance: ShapeToleranceOpt = None,
+    com_tolerance: ComToleranceOpt = None,
     landings: LandingsOpt = None,
     accept: AcceptOpt = None,
 ) -> None:
@@ -410,7 +414,9 @@ def compile_command(
     ``PART/LANDING``; landings not in ``--accept`` end in reject results (docs/landings.md).
 
     The cell profile (``--cell`` or ./feederkit.toml) gives the sensor, the rotation error
-    and the timing; options override it. With timing, the output gives the cycle time.
+    and the timing; options override it. With timing, the output gives the cycle time. The
+    shape and COM tolerances default to the largest the parts' revisions store (one for the
+    mix: its plan declares one uncertainty).
     Exit 1 when some parts or landings cannot be told apart, the two sides of one part too
     (the plan is still written and stored), or when an accepted and a rejected landing
     cannot be.
@@ -423,7 +429,9 @@ def compile_command(
     options = cell_planning_options(
         settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
-    uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    uncertainty = uncertainty_option(  # the flags, checked before the parts are loaded
+        settings.rotation_error_deg, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
+    )
     over: dict[str, Any] = {}
     with flag_words((*FLAG_TERMS, *LANDING_TERMS)):
         if landings is not None:
@@ -436,6 +444,17 @@ def compile_command(
         check_mix_names(mix, part_names(path))
     if not replace and changeover_exists(path, name):
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
+    terms = (*FLAG_TERMS, *LANDING_TERMS)
+    with flag_words(terms):
+        loaded = load_parts(members, catalog=path)
+    uncertainty, declared = declared_uncertainty(
+        settings.rotation_error_deg, loaded.tolerances, shape_tolerance, com_tolerance
+    )
+    json_found(uncertainty=uncertainty.to_dict(), uncertainty_from=declared.sources())
+    with flag_words(terms), stored_tolerance_words(declared):  # one line, before any warning
+        for pf in loaded.push_functions:
+            check_for_part(uncertainty, pf.part)
+    print_warnings(declared.warnings)
 
     def outputs(c) -> list[OutputFile]:
         # Runs before the changeover is stored: its plan file carries the cycle time.
@@ -447,8 +466,11 @@ def compile_command(
             files.append(OutputFile(report, html, "report"))
         return files
 
-    terms = (*FLAG_TERMS, *LANDING_TERMS)
-    with searching(f"compiling changeover {name}", options.time_limit_s), flag_words(terms):
+    with (
+        searching(f"compiling changeover {name}", options.time_limit_s),
+        flag_words(terms),
+        stored_tolerance_words(declared),
+    ):
         compiled = compile_changeover(
             path,
             name,
@@ -459,6 +481,7 @@ def compile_command(
             outputs=outputs,
             uncertainty=uncertainty,
             shares=shares,
+            loaded=loaded,
             **over,
         )
     DONE_WORK.note(f"stored changeover {name!r} in {path}")
@@ -480,6 +503,7 @@ def compile_command(
                     for n, r in compiled.revisions
                 ],
                 "cell": settings.to_dict(),
+                "uncertainty_from": declared.sources(),
                 "landings": landing_rows(plan, compiled.rejected),
                 "cycle_time": cycle,
                 "unrecognizable_pairs": [w.to_dict() for w in witnesses],
@@ -494,7 +518,7 @@ def compile_command(
             + ("" if lands is None else f"{escape(lands)}\n")
             + f"{escape(settings.describe())}\n"
             f"sensor: {sensor_text(sensor.to_dict())}\n"
-            f"uncertainty: {uncertainty_text(plan.get('uncertainty'))}",
+            f"uncertainty: {uncertainty_text(plan.get('uncertainty'), declared)}",
             highlight=False,
         )
         view = compiled.view or as_plan(plan)  # checked once, for the drawing and the table

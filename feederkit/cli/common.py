@@ -30,7 +30,13 @@ from rich.progress import (
 )
 from rich.table import Column, Table
 
-from feederkit.catalog import CATALOG_ENV, DEFAULT_CATALOG
+from feederkit.catalog import (
+    CATALOG_ENV,
+    DEFAULT_CATALOG,
+    DeclaredTolerances,
+    RevisionTolerances,
+    declared_tolerances,
+)
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
 from feederkit.jsonio import OutputFile, check_writable, is_device
@@ -40,7 +46,7 @@ from feederkit.planning.options import PlanningOptions
 from feederkit.plans.model import Plan
 from feederkit.plans.writeplan import read_back
 from feederkit.sensors import Sensor, make_sensor
-from feederkit.uncertainty import Uncertainty
+from feederkit.uncertainty import ToleranceTooLarge, Uncertainty
 from feederkit.words import plural
 
 # No emoji codes: a file name or value such as ``x:100:y`` is printed as typed.
@@ -245,22 +251,24 @@ RotationErrorOpt = Annotated[
     ),
 ]
 ShapeToleranceOpt = Annotated[
-    float,
+    float | None,
     typer.Option(
         "--shape-tolerance",
         metavar="MM",
         help=(
-            "Every hull vertex lies within MM of its drawn position (a profile tolerance of "
-            "+-P moves a corner of angle B by P / sin(B/2): docs/uncertainty.md)."
+            "Every hull vertex lies within MM of its drawn position (default: the largest the "
+            "planned parts' catalog revisions store, else 0; a profile tolerance of +-P moves "
+            "a corner of angle B by P / sin(B/2): docs/uncertainty.md)."
         ),
     ),
 ]
 ComToleranceOpt = Annotated[
-    float,
+    float | None,
     typer.Option(
         "--com-tolerance",
         metavar="MM",
-        help="The centre of mass lies within MM of its nominal position.",
+        help="The centre of mass lies within MM of its nominal position (default: the largest "
+        "the planned parts' catalog revisions store, else 0).",
     ),
 ]
 
@@ -351,12 +359,57 @@ def uncertainty_option(
         return Uncertainty(rotation_error, shape_tolerance, com_tolerance)
 
 
-def uncertainty_text(data: dict[str, Any] | None) -> str:
-    """A plan file's ``uncertainty`` in words (every output says which values it used)."""
+def declared_uncertainty(
+    rotation_error: float,
+    stored: Iterable[RevisionTolerances],
+    shape_tolerance: float | None,
+    com_tolerance: float | None,
+) -> tuple[Uncertainty, DeclaredTolerances]:
+    """The one declared :class:`Uncertainty` of a command that plans parts whose catalog
+    revisions store ``stored``, and where its tolerances came from: the flags when given,
+    else the largest stored (:func:`feederkit.catalog.declared_tolerances`, the one rule)."""
+    declared = declared_tolerances(stored, shape_tolerance, com_tolerance)
+    unc = uncertainty_option(rotation_error, declared.shape_tolerance_mm, declared.com_tolerance_mm)
+    return unc, declared
+
+
+def flag_tolerance(value: float | None) -> float:
+    """A tolerance flag's value to check before the parts are loaded (None: not given, 0)."""
+    return 0.0 if value is None else value
+
+
+TOLERANCE_FLAGS = {"shape_tolerance_mm": "--shape-tolerance", "com_tolerance_mm": "--com-tolerance"}
+"""The flag of each tolerance, keyed as the plan file's ``"uncertainty"``."""
+
+
+@contextmanager
+def stored_tolerance_words(declared: DeclaredTolerances | None) -> Iterator[None]:
+    """A tolerance too large for a part (:class:`~feederkit.uncertainty.ToleranceTooLarge`)
+    that the catalog gave says which revision stores it and how to plan at another."""
+    try:
+        yield
+    except ToleranceTooLarge as exc:
+        note = "" if declared is None else declared.note(exc.field)
+        if note:
+            flag = TOLERANCE_FLAGS[exc.field]
+            exc.args = (
+                f"{exc}; it is the largest the planned parts' catalog revisions store{note}: "
+                f"plan at another with {flag} MM",
+            )
+        raise
+
+
+def uncertainty_text(
+    data: dict[str, Any] | None, declared: DeclaredTolerances | None = None
+) -> str:
+    """A plan file's ``uncertainty`` in words (every output says which values it used), each
+    tolerance taken from the catalog followed by the revision storing it (``declared``)."""
     if data is None:
         return "not declared (a plan made on the ideal model)"
     r, t, c = data["rotation_error_deg"], data["shape_tolerance_mm"], data["com_tolerance_mm"]
-    text = f"rotation error ±{r:g}°, shape tolerance {t:g} mm, COM tolerance {c:g} mm"
+    shape = "" if declared is None else declared.note("shape_tolerance_mm")
+    com = "" if declared is None else declared.note("com_tolerance_mm")
+    text = f"rotation error ±{r:g}°, shape tolerance {t:g} mm{shape}, COM tolerance {c:g} mm{com}"
     return text + (" (the ideal model)" if r == t == c == 0 else "")
 
 

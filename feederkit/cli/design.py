@@ -39,13 +39,16 @@ from feederkit.cli.common import (
     check_mix_revision,
     check_outputs,
     console,
+    declared_uncertainty,
     default_memory_limit,
     fail,
+    flag_tolerance,
     flag_words,
     json_found,
     print_json,
     print_warnings,
     progress_bar,
+    stored_tolerance_words,
     uncertainty_option,
     uncertainty_text,
 )
@@ -136,8 +139,8 @@ def sensor_command(
             "0 with the tolerances 0: the ideal model).",
         ),
     ] = None,
-    shape_tolerance: ShapeToleranceOpt = 0.0,
-    com_tolerance: ComToleranceOpt = 0.0,
+    shape_tolerance: ShapeToleranceOpt = None,
+    com_tolerance: ComToleranceOpt = None,
     cell: Annotated[
         Path | None,
         typer.Option("--cell", metavar="FILE", help="Cell profile (default ./feederkit.toml)."),
@@ -187,7 +190,10 @@ def sensor_command(
         raise InputError("no parts: give SOURCE... or --mix A,B,...")
     profile = load_cell(cell)
     r = profile.robot.rotation_error_deg if rotation_error is None else rotation_error
-    uncertainty = uncertainty_option(r, shape_tolerance, com_tolerance)  # validates r
+    # Validates r and the flags; the tolerances are the parts' when not given (below).
+    uncertainty = uncertainty_option(
+        r, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
+    )
     led = pitches is not None or profile.sensor.model == "led"
     if not led and noise is not None:
         raise InputError("--noise goes with --pitches (or a profile with an LED array)")
@@ -212,6 +218,9 @@ def sensor_command(
         accepted = None if accept is None else landing_names(accept, "--accept")
         found = load_landings(names, catalog=catalog, which=which)
     loaded = found.parts
+    uncertainty, declared = declared_uncertainty(
+        r, loaded.tolerances, shape_tolerance, com_tolerance
+    )
     # design.md: plans cover every landing unless told otherwise, so the design is of the
     # mix whose members are the landings, as ``plan`` and ``changeover compile`` plan it.
     over_landings = plans_over_landings(found.landings, landings is not None, accepted is not None)
@@ -227,11 +236,12 @@ def sensor_command(
         landings=member_landing_rows(members),
         cell_profile=profile.source,
         uncertainty=uncertainty.to_dict(),
+        uncertainty_from=declared.sources(),
     )
     # The design's expected figures weigh its members alike (plan weighs each part's landings).
     kind = "landings" if over_landings else "parts"
     design: ToleranceDesign | PitchDesign
-    with progress_bar() as bar, flag_words(terms):
+    with progress_bar() as bar, flag_words(terms), stored_tolerance_words(declared):
         tasks: dict[str, Any] = {}
 
         def progress(what: str, done: int, total: int) -> None:
@@ -267,7 +277,7 @@ def sensor_command(
             more = hints[exc.reason]
             raise DesignTimeout(f"{exc}; allow more {more}", exc.reason) from None
     # stderr, with --json too; after bad options are refused; fragile states per landing
-    print_warnings(found.warnings(over_landings))
+    print_warnings([*declared.warnings, *found.warnings(over_landings)])
     if plot is not None:
         from feederkit.design.plot import plot_design
 
@@ -276,6 +286,7 @@ def sensor_command(
     if json_out:
         data = design.to_dict()
         data["cell_profile"] = profile.source
+        data["uncertainty_from"] = declared.sources()
         if plot is not None:
             data["plot"] = str(plot)
         print_json(data)
@@ -295,7 +306,7 @@ def sensor_command(
         model = "" if uncertainty.is_ideal else " (the figures are for strong plans)"
         console.print(
             f"cell profile: {profile.source}; uncertainty: "
-            f"{uncertainty_text(uncertainty.to_dict())}{model}",
+            f"{uncertainty_text(uncertainty.to_dict(), declared)}{model}",
             highlight=False,
             markup=False,
             soft_wrap=True,

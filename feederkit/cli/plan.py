@@ -17,6 +17,7 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
+from feederkit.catalog import DeclaredTolerances
 from feederkit.cell import annotate_cycle_time
 from feederkit.cli.common import (
     DEFAULT_TIME_LIMIT_S,
@@ -47,6 +48,8 @@ from feederkit.cli.common import (
     check_output_folders,
     console,
     cycle_line,
+    declared_uncertainty,
+    flag_tolerance,
     flag_words,
     json_found,
     json_option,
@@ -55,6 +58,7 @@ from feederkit.cli.common import (
     print_warnings,
     print_written,
     searching,
+    stored_tolerance_words,
     time_limit_note,
     uncertainty_option,
     uncertainty_text,
@@ -144,7 +148,12 @@ def _landings_text(planned: LandingPlan) -> str:
     return "landings (share): " + ", ".join(rows)
 
 
-def _header(plan: dict[str, Any], sensor_given: bool, landings: str | None = None) -> str:
+def _header(
+    plan: dict[str, Any],
+    sensor_given: bool,
+    landings: str | None = None,
+    declared: DeclaredTolerances | None = None,
+) -> str:
     names = escape(", ".join(dict.fromkeys(p["name"] for p in plan["parts"])))
     sensor = sensor_text(plan["sensor"])
     if not sensor_given:
@@ -153,7 +162,7 @@ def _header(plan: dict[str, Any], sensor_given: bool, landings: str | None = Non
     lines = "" if landings is None else f"{escape(landings)}\n"
     return (
         f"[bold]feederkit plan[/] for {names}\n{lines}"
-        f"sensor: {sensor}\nuncertainty: {uncertainty_text(plan.get('uncertainty'))}\n"
+        f"sensor: {sensor}\nuncertainty: {uncertainty_text(plan.get('uncertainty'), declared)}\n"
         f"objective: {stats['objective']}, reading branching: {stats['grouping']}"
     )
 
@@ -201,8 +210,8 @@ def plan_command(
     report: ReportOpt = None,
     catalog: CatalogOpt = None,
     rotation_error: ProfileRotationErrorOpt = None,
-    shape_tolerance: ShapeToleranceOpt = 0.0,
-    com_tolerance: ComToleranceOpt = 0.0,
+    shape_tolerance: ShapeToleranceOpt = None,
+    com_tolerance: ComToleranceOpt = None,
     landings: LandingsOpt = None,
     accept: AcceptOpt = None,
     cell: CellOpt = None,
@@ -215,8 +224,9 @@ def plan_command(
     state; landings not in ``--accept`` end in reject results. The plan is verified on the
     kinematic model (every start, reading and branch) before it is written or printed; under
     the declared uncertainty (``--rotation-error``, default 1 degree) it is a strong plan,
-    verified for every outcome. Exit 1 when some parts of a mix, or some landings, cannot be
-    told apart (the plan is still written) or an accepted and a rejected landing cannot be.
+    verified for every outcome; the shape and COM tolerances default to the largest the
+    parts' catalog revisions store. Exit 1 when some parts of a mix, or some landings, cannot
+    be told apart (the plan is still written) or an accepted and a rejected landing cannot be.
     """
     terms = (*FLAG_TERMS, *LANDING_TERMS)
     check_output_folders(output, report)
@@ -225,18 +235,25 @@ def plan_command(
     options = cell_planning_options(
         settings, objective, grouping, min_margin, time_limit, memory_limit, lumping
     )
-    uncertainty = uncertainty_option(settings.rotation_error_deg, shape_tolerance, com_tolerance)
+    uncertainty = uncertainty_option(  # the flags, checked before the parts are loaded
+        settings.rotation_error_deg, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
+    )
     json_found(sources=list(sources), sensor=sensor.to_dict(), uncertainty=uncertainty.to_dict())
     with flag_words(terms):
         which = "all" if landings in (None, "all") else landing_names(landings)
         found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
     loaded = found.parts
-    with flag_words(terms):  # bad input: one line, before any warning about the parts
+    uncertainty, declared = declared_uncertainty(
+        settings.rotation_error_deg, loaded.tolerances, shape_tolerance, com_tolerance
+    )
+    json_found(uncertainty=uncertainty.to_dict(), uncertainty_from=declared.sources())
+    # bad input: one line, before any warning about the parts
+    with flag_words(terms), stored_tolerance_words(declared):
         for part in [pf.part for pf in loaded.push_functions] + [x.part for x in found.all]:
             check_for_part(uncertainty, part)
     planned: LandingPlan | None = None
     if not plans_over_landings(found.landings, landings is not None, accept is not None):
-        print_warnings(loaded.warnings)
+        print_warnings([*declared.warnings, *loaded.warnings])
         pfs = list(loaded.push_functions)
         json_found(members=[pf.part.name for pf in pfs])
         with searching("planning and verifying", options.time_limit_s), flag_words():
@@ -246,7 +263,7 @@ def plan_command(
         names = {x.name for x in every} | {m for x in every for m in x.merged}
         taken = _accepted_names(accept, names)  # bad input: one line, before any warning
         pfs = [push_function(x.part) for x in every]
-        print_warnings(found.warnings(over_landings=True))
+        print_warnings([*declared.warnings, *found.warnings(over_landings=True)])
         json_found(members=[x.label for x in every])
         with searching("planning and verifying", options.time_limit_s), flag_words(terms):
             planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
@@ -267,7 +284,7 @@ def plan_command(
         sensor_given = sensorless or sensor.informative
         words = None if planned is None else _landings_text(planned)
         console.print(escape(settings.describe()), highlight=False)
-        console.print(_header(plan, sensor_given, words), highlight=False)
+        console.print(_header(plan, sensor_given, words, declared), highlight=False)
         console.print(plan_tree(view))
         console.print(stats_table(view, made.report))
         console.print(escape(cycle_line(cycle)), highlight=False)

@@ -32,7 +32,7 @@ from feederkit.errors import InputError
 from feederkit.importers.orientable import orientability
 from feederkit.jsonio import OutputFile, StagedFiles
 from feederkit.landing.model import Landing, landings_of_outline, select_landings
-from feederkit.loading import load_parts
+from feederkit.loading import LoadedParts, load_parts
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.weights import normalised_shares
 from feederkit.mechanics.push import PushFunction, push_function
@@ -454,6 +454,7 @@ def compile_changeover(
     shares: Sequence[float] | None = None,
     landings: str | Sequence[str] | None = None,
     accept: Collection[str] | None = None,
+    loaded: LoadedParts | None = None,
 ) -> CompiledChangeover:
     """Plan, verify and store the changeover ``name`` for ``members`` (catalog parts).
 
@@ -469,7 +470,9 @@ def compile_changeover(
     ``outputs`` gives the files to write with the changeover (its plan file, its report):
     they are written in full before the changeover is stored and put in place inside the
     store's transaction, so either the changeover is stored and its files written, or
-    neither. ``uncertainty`` is the declared one (default ``Uncertainty()``). Raises
+    neither. ``uncertainty`` is the declared one (default ``Uncertainty()``); ``loaded``
+    the members as the caller loaded them (:func:`load_parts`), e.g. to declare the
+    tolerances their revisions store (:func:`feederkit.catalog.declared_tolerances`). Raises
     InputError for an existing name (unless ``replace``), bad parts, a landing a part does
     not have or an accepted name no landing has, PlanningError when no plan meets the
     request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
@@ -477,7 +480,8 @@ def compile_changeover(
     """
     if not replace and changeover_exists(catalog, name):
         raise InputError(f"a changeover named {name!r} already exists")
-    loaded = load_parts([_source(m) for m in members], catalog=catalog)
+    if loaded is None:
+        loaded = load_parts([_source(m) for m in members], catalog=catalog)
     pfs = list(loaded.push_functions)
     revisions = loaded.revisions  # InputError for a part given as a file
     per_part = [
