@@ -389,3 +389,20 @@ def test_catalog_analyze_and_design_sensor_take_the_stored_values(capsys, mix):
         "shape_tolerance_mm": "catalog: ra r1",
         "com_tolerance_mm": "default",
     }
+
+
+def test_no_strong_plan_under_a_stored_tolerance_names_its_revision(tmp_path, capsys, mix):
+    # A 40 x 36 mm plate: at a 4 mm shape tolerance its sides may tilt enough that no strong
+    # plan exists; the user gave no tolerance, so the answer says where 4 mm came from.
+    path = tmp_path / "sq.json"
+    save_outline_json(make_outline("sq", [(0, 0), (40, 0), (40, 36), (0, 36)]), path)
+    add(capsys, mix, path, "--shape-tolerance", "4")
+    code, _, err = run(capsys, "plan", "sq", "--tolerance", "0.5", "--catalog", str(mix))
+    line = " ".join(err.split())
+    assert code == 1 and "no strong plan exists" in line
+    assert "the shape tolerance is the largest the planned parts' catalog revisions store" in line
+    assert "(catalog: sq r1)" in line
+    code, _, err = run(
+        capsys, "plan", "sq", "--tolerance", "0.5", "--shape-tolerance", "4", "--catalog", str(mix)
+    )
+    assert code == 1 and "catalog revisions store" not in err  # given: the user knows

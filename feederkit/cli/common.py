@@ -37,12 +37,14 @@ from feederkit.catalog import (
     RevisionTolerances,
     declared_tolerances,
 )
+from feederkit.catalog.tolerances import TOLERANCE_WORDS
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError
 from feederkit.jsonio import OutputFile, check_writable, is_device
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
+from feederkit.planning.solvable import NoStrongPlan
 from feederkit.plans.model import Plan
 from feederkit.plans.writeplan import read_back
 from feederkit.sensors import Sensor, make_sensor
@@ -385,7 +387,9 @@ TOLERANCE_FLAGS = {"shape_tolerance_mm": "--shape-tolerance", "com_tolerance_mm"
 @contextmanager
 def stored_tolerance_words(declared: DeclaredTolerances | None) -> Iterator[None]:
     """A tolerance too large for a part (:class:`~feederkit.uncertainty.ToleranceTooLarge`)
-    that the catalog gave says which revision stores it and how to plan at another."""
+    that the catalog gave says which revision stores it and how to plan at another; so does
+    "no strong plan exists" (:class:`~feederkit.planning.solvable.NoStrongPlan`) under a
+    tolerance the user did not give."""
     try:
         yield
     except ToleranceTooLarge as exc:
@@ -396,6 +400,16 @@ def stored_tolerance_words(declared: DeclaredTolerances | None) -> Iterator[None
                 f"{exc}; it is the largest the planned parts' catalog revisions store{note}: "
                 f"plan at another with {flag} MM",
             )
+        raise
+    except NoStrongPlan as exc:
+        stored = [
+            f"the {what} is the largest the planned parts' catalog revisions store"
+            f"{declared.note(field)}"
+            for field, what in TOLERANCE_WORDS
+            if declared is not None and declared.note(field)
+        ]
+        if stored:
+            exc.args = (f"{exc}; {'; '.join(stored)}",)
         raise
 
 

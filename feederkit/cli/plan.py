@@ -256,7 +256,11 @@ def plan_command(
         print_warnings([*declared.warnings, *loaded.warnings])
         pfs = list(loaded.push_functions)
         json_found(members=[pf.part.name for pf in pfs])
-        with searching("planning and verifying", options.time_limit_s), flag_words():
+        with (
+            searching("planning and verifying", options.time_limit_s),
+            flag_words(),
+            stored_tolerance_words(declared),
+        ):
             made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
     else:
         every = found.all
@@ -265,7 +269,11 @@ def plan_command(
         pfs = [push_function(x.part) for x in every]
         print_warnings([*declared.warnings, *found.warnings(over_landings=True)])
         json_found(members=[x.label for x in every])
-        with searching("planning and verifying", options.time_limit_s), flag_words(terms):
+        with (
+            searching("planning and verifying", options.time_limit_s),
+            flag_words(terms),
+            stored_tolerance_words(declared),
+        ):
             planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
         made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]
     plan = made.plan

@@ -194,7 +194,8 @@ def _make_plan(
                 "simplification only, widths it cuts): a smaller --hull-tolerance may help"
             )
         who = f"; {blame.words}" if blame.words else ""
-        raise PlanningError(f"{exc.reason}{who}; {largest}{hint}") from None
+        # Still "no strong plan exists" (its callers may add to it), with what it blames.
+        raise NoStrongPlan(f"{exc.reason}{who}; {largest}", hint.removeprefix("; ")) from None
     # Planned on the parts' own widths, the plan's expected length is restated on the file's
     # model (its diameters), the one every reader computes.
     widened = machine is not unwidened
