@@ -99,7 +99,8 @@ def test_plausible_header_gives_no_unit_warning(tmp_path):
 def test_mesh_modelled_in_metres_is_imported_with_a_warning(tmp_path):
     box = trimesh.creation.box((0.04, 0.03, 0.02))  # a 40 mm housing modelled in metres
     (ip,) = parts(fx.write_mesh(box, tmp_path / "housing.stl"))
-    assert any("0.04 mm across" in w and "40 mm in m" in w for w in ip.warnings)
+    # Its size is its resting outline's diameter (0.04 x 0.03: 0.05 mm), as the plan's.
+    assert any("0.05 mm across" in w and "50 mm in m" in w for w in ip.warnings)
     assert ip.hull_tolerance == pytest.approx(0.002 * 0.05)  # of its 0.05 mm diameter
     (right,) = parts(fx.write_mesh(box, tmp_path / "housing.stl"), units="m")
     assert sorted(fx_extents(right.part.hull)) == pytest.approx([30.0, 40.0], rel=1e-6)
