@@ -18,8 +18,9 @@ from a fence orientation it ends on a rest candidate (F3) between the nearest ce
 either side (F1, F2: a hilltop whose barriers both exceed ``2 eps``, or a run of hilltops whose
 highest stands more than ``2 eps`` above the wells on either side), and never where the drawn
 radius is more than ``2 eps`` above its start (F1); a push starting within ``PUSH_BAND_DEG``
-of a hilltop, or beside a shallow state or a near-metastable facet less than twice the
-vibration below it, may be carried over it (the push bands, measured in the physics check).
+of a hilltop (``SLENDER_BAND_DEG`` on a slender part checked at 20 mm), or beside a shallow
+state or a near-metastable facet less than twice the vibration below it, may be carried over it
+(the push bands, measured in the physics check).
 With ``t = c = 0`` and no vibration every set here is the ideal one exactly; otherwise each is
 a superset of what the perturbed parts can do (provably conservative), and the docstrings say
 which.
@@ -82,6 +83,36 @@ OVERSHOOT_MIN_SIZE_MM = 20.0
 """Parts smaller than this are taken at this size for :data:`OVERSHOOT_DEG_MM`, as the physics
 check simulates them (docs/simulation.md, "Scale"); a small part's own dynamics are not
 modelled."""
+SLENDER_GYRATION_REL = 0.27
+"""A part whose radius of gyration about its COM (its hull as a plate, as the physics check
+simulates it) is less than this share of its size is slender: its ordinary hilltops get
+:data:`SLENDER_BAND_DEG` instead of :data:`PUSH_BAND_DEG` when it is checked at 20 mm.
+
+Measured (docs/uncertainty.md, "Push bands"): pushes from 0.1-7 degrees either side of every
+hilltop, 12 frictions, the parts simulated at 20 mm. Hulls with the radius of gyration at
+0.215-0.251 of the size were carried over hilltops from 2.9-6.0 degrees (triangles 30-30-120,
+30-60-90, 45-45-90, 75-75-30, the 45-degree triangle with its right angle cut, rhombi of 45
+and 60 degrees), one at 0.264 (a 50-60-70 triangle) from 2.1; those at 0.285-0.306 (the
+catalog's quadrilateral, rectangle-2x1, a square and the equilateral triangle) from 1.9 at
+most. Per hilltop neither the corner's angle, its distance from the COM nor its wells
+separate them (the 45-45-90 triangle's right angle was carried from 4.0 degrees, its
+45-degree corners from 3.4; a 75-75-30 triangle's 30-degree tip from 2.0): the chatter at the
+fence turns a part the farther, the less inertia it has for its size. 0.275 splits them.
+"""
+SLENDER_BAND_DEG = 8.0
+"""The push band (deg) at an ordinary hilltop of a slender part (:data:`SLENDER_GYRATION_REL`)
+checked at 20 mm; narrowed for larger ones (:func:`ordinary_push_band_deg`).
+
+Measured: carried from up to 6.0 degrees (the cut triangle's 135-degree corner), 5.8 (the
+30-30-120 triangle's tips), 4.7, 4.6, 4.3 and 4.0 on the others; 8 is the margin, as 2 is
+over 1.5 for :data:`PUSH_BAND_DEG`. The catalog's isosceles right triangle's sensorless plan,
+made with 2 degrees, failed 3 of 400 trials (drops 3.2-3.4 degrees before a hilltop).
+"""
+SLENDER_MAX_SIZE_MM = 30.0
+"""Slender parts this large or larger get :data:`PUSH_BAND_DEG` (the physics check simulates
+them at their own size, where the chatter is gone): the 45-45-90 triangle, carried from 4.0
+degrees at 20 mm, was carried from 1.8 at most at 24 mm and 0.3 at 30 mm (docs/uncertainty.md,
+"Push bands"); between 20 mm and this the band falls linearly, above what was measured."""
 SHALLOW_WELL_FACTOR = 5.0
 """A state whose well beside a hilltop (the hilltop's radius minus the radius at the state's
 normal) is less than this many vibrations deep is shallow: that hilltop gets the depth rule.
@@ -510,13 +541,14 @@ def _push_band(
     rising: bool,
 ) -> np.ndarray:
     """The push band (deg) of each hilltop on one flank (``d`` its unwrapped orientation,
-    ``flank_end`` the neighbouring state's normal): :data:`PUSH_BAND_DEG`, or beside a shallow
-    state or a near-metastable facet (:func:`_near_metastable_hills`) as far as the drawn radius
-    stays within :data:`PUSH_BAND_FACTOR` vibrations of the hilltop, if that is wider
-    (docs/uncertainty.md, "Push bands")."""
+    ``flank_end`` the neighbouring state's normal): :func:`ordinary_push_band_deg` (the fixed
+    angle, or the slender band), or beside a shallow state or a near-metastable facet
+    (:func:`_near_metastable_hills`) as far as the drawn radius stays within
+    :data:`PUSH_BAND_FACTOR` vibrations of the hilltop, if that is wider (docs/uncertainty.md,
+    "Push bands")."""
     m = len(peaks)
     rs = pf.range_state
-    width = np.full(len(hilltops), PUSH_BAND_DEG)
+    width = np.full(len(hilltops), ordinary_push_band_deg(pf.part))
     k = hilltops % m
     wells = np.minimum(
         peaks[k] - heights[np.asarray([rs[(i - 1) % m] for i in k])],
@@ -534,6 +566,30 @@ def _push_band(
             _, p = _level_crossing(h, com, d[near], flank_end[near], level)
             width[near] = np.maximum(width[near], p - d[near])
     return width
+
+
+def gyration_rel(part: Part) -> float:
+    """The radius of gyration of the part's hull, a uniform plate, about its COM, over its size
+    (the plate the physics check simulates for a plan's part)."""
+    h = np.asarray(part.hull, dtype=float) - np.asarray(part.com, dtype=float)
+    x, y = h[:, 0], h[:, 1]
+    x1, y1 = np.roll(x, -1), np.roll(y, -1)
+    cross = x * y1 - x1 * y
+    area = cross.sum() / 2.0
+    polar = (cross * (x * x + x * x1 + x1 * x1 + y * y + y * y1 + y1 * y1)).sum() / 12.0
+    return math.sqrt(max(polar / area, 0.0)) / part.size
+
+
+def ordinary_push_band_deg(part: Part) -> float:
+    """The push band (deg) at an ordinary hilltop of ``part``: :data:`PUSH_BAND_DEG`, or for a
+    slender part (:data:`SLENDER_GYRATION_REL`) :data:`SLENDER_BAND_DEG` at 20 mm and below
+    (:data:`OVERSHOOT_MIN_SIZE_MM`: smaller parts are checked at 20 mm), falling linearly to
+    :data:`PUSH_BAND_DEG` at :data:`SLENDER_MAX_SIZE_MM`."""
+    if gyration_rel(part) >= SLENDER_GYRATION_REL:
+        return PUSH_BAND_DEG
+    lo, hi = OVERSHOOT_MIN_SIZE_MM, SLENDER_MAX_SIZE_MM
+    share = min(max((hi - part.size) / (hi - lo), 0.0), 1.0)
+    return PUSH_BAND_DEG + (SLENDER_BAND_DEG - PUSH_BAND_DEG) * share
 
 
 def _near_metastable_hills(pf: PushFunction) -> np.ndarray:
@@ -1245,6 +1301,9 @@ __all__ = [
     "PUSH_BAND_DEG",
     "PUSH_BAND_FACTOR",
     "SHALLOW_WELL_FACTOR",
+    "SLENDER_BAND_DEG",
+    "SLENDER_GYRATION_REL",
+    "SLENDER_MAX_SIZE_MM",
     "Band",
     "FenceCell",
     "PhysicalState",
@@ -1252,10 +1311,12 @@ __all__ = [
     "UncertainMechanics",
     "action_map",
     "fence_outcomes",
+    "gyration_rel",
     "max_rotation_error",
     "max_shape_tolerance",
     "mechanics_to_dict",
     "outcome_at",
+    "ordinary_push_band_deg",
     "outcome_set",
     "uncertain_mechanics",
     "width_range",
