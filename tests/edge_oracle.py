@@ -30,6 +30,13 @@ PUSH_BAND_DEG = 2.0
 """The angular push band on each side of a hilltop (docs/uncertainty.md; the value the
 physics measurements gave, restated here so the oracle shares no code)."""
 
+SLENDER_REL = 0.27
+"""A hull whose radius of gyration (a uniform plate, about the COM) is below this share of its
+diameter is slender: its ordinary bands are ``SLENDER_BAND_DEG`` up to 20 mm, narrowing
+linearly to ``PUSH_BAND_DEG`` at 30 mm (docs/uncertainty.md, "Push bands")."""
+
+SLENDER_BAND_DEG = 8.0
+
 SHALLOW_WELLS = 5.0
 """A well shallower than this many vibrations gets the depth rule as well."""
 
@@ -61,18 +68,36 @@ class Mechanics:
         cx, cy = self.com
         return max((x - cx) * u[0] + (y - cy) * u[1] for x, y in self.hull)
 
+    def ordinary_band(self) -> float:
+        """The push band (deg) on each side of an ordinary hilltop: ``PUSH_BAND_DEG``, wider
+        for a slender hull (``SLENDER_REL``); the gyration from a fan of triangles at the COM.
+        """
+        cx, cy = self.com
+        pts = [(x - cx, y - cy) for x, y in self.hull]
+        area = inertia = 0.0
+        for (ax, ay), (bx, by) in zip(pts, pts[1:] + pts[:1], strict=True):
+            a = (ax * by - bx * ay) / 2.0  # the triangle (COM, a, b)
+            area += a
+            inertia += a * (ax * ax + ay * ay + bx * bx + by * by + ax * bx + ay * by) / 6.0
+        size = max(math.dist(p, q) for p in self.hull for q in self.hull)
+        if math.sqrt(inertia / area) >= SLENDER_REL * size:
+            return PUSH_BAND_DEG
+        share = min(max((30.0 - size) / 10.0, 0.0), 1.0)
+        return PUSH_BAND_DEG + (SLENDER_BAND_DEG - PUSH_BAND_DEG) * share
+
     def bands(self, depth: float) -> list[tuple[float, float]]:
         """Around each divergent orientation, the fence orientations from which a push may
         end on either side (docs/uncertainty.md, "Push bands"), up to the stable normals on
         either side; ``depth`` 0: the orientation itself (the ideal model).
 
-        With ``depth`` (twice the vibration) > 0: ``PUSH_BAND_DEG`` on each side; beside a
+        With ``depth`` (twice the vibration) > 0: :meth:`ordinary_band` on each side; beside a
         shallow well (the hilltop less than ``SHALLOW_WELLS`` vibrations above either
         neighbouring normal's radius) also where the radius stays within ``depth`` of the
         hilltop."""
         out = []
         normals = sorted(self.normals.values())
         vibration = depth / 2.0
+        band = self.ordinary_band() if depth > 0.0 else 0.0
         for d in self.divergent:
             if depth == 0.0:
                 out.append((d, d))
@@ -84,7 +109,7 @@ class Mechanics:
             shallow = min(top - self.radius(left), top - self.radius(right)) < (
                 SHALLOW_WELLS * vibration
             )
-            ends = [max(left, d - PUSH_BAND_DEG), min(right, d + PUSH_BAND_DEG)]
+            ends = [max(left, d - band), min(right, d + band)]
             if shallow:
                 for k, far in enumerate((left, right)):
                     near = d

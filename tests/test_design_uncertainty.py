@@ -191,7 +191,13 @@ def check_below_and_above(seed: int) -> None:
         (pair,) = strong_mix_critical(StrongMix(pfs, ONE_DEG)).pairs
         x = pair.critical_tolerance
         assert x is not None
-        made = make_plan(pfs, ToleranceSensor(x), uncertainty=ONE_DEG, certify=False)
+        try:
+            made = make_plan(pfs, ToleranceSensor(x), uncertainty=ONE_DEG, certify=False)
+        except NoStrongPlan as exc:
+            # A part no strong plan orients even alone (a slender part's wide push bands):
+            # the pair's critical tolerance says nothing of orienting it.
+            assert "has no strong plan even alone" in str(exc)
+            continue
         assert made.report.ok  # verified for every outcome and reading (verify_strong)
         assert strong_witnesses(made.result.machine, made.result.lumped_pairs) == []
         machine, _test = strong_test(*pfs)
