@@ -153,10 +153,18 @@ def _same_ring(a: Sequence[Point], b: Sequence[Point]) -> bool:
     return sorted(a) == sorted(b)
 
 
+def _near(where: shapely.Geometry) -> str:
+    """`` near (x, y)`` for a point of ``where``, or "" when it is empty (no point to name)."""
+    if where.is_empty:
+        return ""
+    point = where.representative_point()
+    return f" near ({point.x:.6g}, {point.y:.6g})"
+
+
 def hole_fault(shell: Polygon, holes: Sequence[Sequence[Point]]) -> str:
     """What is wrong with the holes of a valid ``shell``, in words naming the holes (by their
-    index in the list): a hole crossing itself, listed twice, outside or across the
-    outline, inside or across another hole."""
+    index in the list): a hole crossing itself, listed twice, outside, enclosing or across
+    the outline, inside or across another hole."""
     polys = [Polygon(np.asarray(h)) for h in holes]
     for i, poly in enumerate(polys):
         if not poly.is_valid:
@@ -164,9 +172,13 @@ def hole_fault(shell: Polygon, holes: Sequence[Sequence[Point]]) -> str:
     for i, poly in enumerate(polys):
         if not shell.intersects(poly) or shell.intersection(poly).area <= 0.0:
             return f"hole {i} lies outside the outline"
+        if poly.covers(shell):
+            if shell.covers(poly):
+                return f"hole {i} is the outline itself (the same shape)"
+            return f"hole {i} encloses the outline"
         if not shell.contains(poly):
-            where = shell.exterior.intersection(poly.exterior).representative_point()
-            return f"hole {i} crosses the outline near ({where.x:.6g}, {where.y:.6g})"
+            near = _near(shell.exterior.intersection(poly.exterior))
+            return f"hole {i} crosses the outline{near}"
     for j, b in enumerate(polys):
         for i, a in enumerate(polys[:j]):
             if _same_ring(holes[i], holes[j]):
@@ -177,8 +189,7 @@ def hole_fault(shell: Polygon, holes: Sequence[Sequence[Point]]) -> str:
                 inner, outer = (j, i) if a.contains(b) else (i, j)
                 return f"hole {inner} lies inside hole {outer}"
             if a.intersection(b).area > 0.0:
-                where = a.exterior.intersection(b.exterior).representative_point()
-                return f"holes {i} and {j} overlap near ({where.x:.6g}, {where.y:.6g})"
+                return f"holes {i} and {j} overlap{_near(a.exterior.intersection(b.exterior))}"
     reason = shapely.is_valid_reason(Polygon(shell.exterior, [list(h) for h in holes]))
     return f"the holes and the outline touch along a line or cut the part apart{near_point(reason)}"
 

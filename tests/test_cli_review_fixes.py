@@ -82,7 +82,7 @@ def test_report_of_a_verified_plan_exits_0(good_plan, tmp_path, capsys):
     page = tmp_path / "ok.html"
     assert main(["report", str(good_plan), "-o", str(page)]) == 0
     captured = capsys.readouterr()
-    assert captured.err == "" and f"wrote {page}" in captured.out
+    assert captured.err == "" and f"wrote the report to {page}" in captured.out
     assert 'id="verification"' not in page.read_text(encoding="utf-8")
 
 

@@ -18,7 +18,9 @@ from feederkit.cli.common import (
     check_outputs,
     check_report_name,
     console,
+    note_written,
     plural,
+    print_written,
     progress_bar,
 )
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
@@ -130,6 +132,7 @@ def report_command(
         verification=verdict,
     )
     write_text_atomic(output, html, what="report")  # its name checked above
+    note_written((output, "report"))
     if simulation is not None:
         console.print(
             f"simulated {plural(simulation['successes'], 'success', 'successes')} in "
@@ -137,7 +140,7 @@ def report_command(
             highlight=False,
             markup=False,
         )
-    console.print(f"wrote {output}", highlight=False, markup=False, soft_wrap=True)
+    print_written(None, output)  # in the words of plan and changeover
     if not verdict.ok:
         raise CheckFailed(
             f"the plan failed verification: {verdict.first_problem()} (the report {output} "

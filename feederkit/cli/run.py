@@ -21,6 +21,7 @@ from typing import Annotated, Any
 
 import typer
 
+from feederkit.angles import norm360
 from feederkit.cli.common import CatalogOpt, JsonOpt, console, print_json
 from feederkit.cli.plan_render import (
     DEFAULT_MAX_PLAN_MB,
@@ -110,7 +111,8 @@ def run_command(
         if not report.ok:
             raise CheckFailed(f"the plan failed: {report.first_problem()}")
         return
-    start = 0.0 if start_deg is None else start_deg
+    # The same orientation on the circle, said as 40 degrees rather than 400.
+    start = 0.0 if start_deg is None else norm360(start_deg)
     traces = [execute(plan, k, start) for k in indices]
     if json_out:
         runs = [t.to_dict() for t in traces]

@@ -104,6 +104,8 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         "wall time", f"{s.wall_time_s:.2f} s ({plural(s.pushes, 'push-align operation')})"
     )
     console.print(table)
+    for note in s.scale_notes():  # "N of N" is about the part at the simulated size
+        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
     if s.beyond_certified:
         console.print(f"[yellow]note:[/] {escape(s.beyond_certified)}", highlight=False)
     if s.width_warning:

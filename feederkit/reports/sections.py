@@ -166,8 +166,9 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
     successes with their 95 % Wilson interval (the rightly rejected and the unrecognized
     counted apart), what
     was sampled and the seed, the failures by cause, the model errors, per part, the push
-    agreement, and the notes on what the plan certifies, the simulator's width accuracy and a
-    part simulated beyond the plan's declared shape tolerance."""
+    agreement, and the notes on what the plan certifies, the simulator's width accuracy, a
+    part simulated at another size than its own and a part simulated beyond the plan's
+    declared shape tolerance."""
     trials, successes = _int(simulation.get("trials")), _int(simulation.get("successes"))
     if trials is None or successes is None:
         raise InputError("simulation results need integer 'trials' and 'successes'")
@@ -222,6 +223,9 @@ def simulation_text(simulation: Mapping[str, Any]) -> str:
         text = simulation.get(key)
         if isinstance(text, str) and text:
             words.append(f"{label}: {text}")
+    scaled = simulation.get("scale_notes")  # a part simulated at another size than its own
+    if isinstance(scaled, list):
+        words += [f"note: {n}" for n in scaled if isinstance(n, str) and n]
     geometry = simulation.get("warnings")  # with --part: a part beyond the shape tolerance
     if isinstance(geometry, list):
         words += [f"warning: {w}" for w in geometry if isinstance(w, str) and w]

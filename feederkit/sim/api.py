@@ -376,6 +376,7 @@ def simulate_plan(
             for k in range(len(members))
         ),
         scales=tuple(a.scale for a in aligners),
+        sizes=tuple(a.part.size for a in aligners),
         min_margin_deg=sim_plan.stats.min_margin_deg,
         certified=certified_bounds(
             sim_plan.uncertainty, sim_plan.stats.min_margin_deg, sim_plan.stats.certificate

@@ -502,12 +502,32 @@ class SimulationSummary:
     """Each member's part name and landing (None: a plan not over landings), as the plan file
     names them, beside its label in ``parts``: the JSON's ``per_part`` gives both, so that a
     reader need not split a label (part names are free text)."""
+    sizes: tuple[float, ...] = ()
+    """Each member's size (mm, its hull's diameter) before :attr:`scales` (empty: not known)."""
 
     def geometry_warnings(self) -> list[str]:
         """The members simulated on a part beyond the plan's declared shape tolerance, one
         line each (:meth:`~feederkit.sim.real.RealPart.tolerance_warning`)."""
         found = (r.tolerance_warning() for r in self.real_parts)
         return [w for w in found if w is not None]
+
+    def scale_notes(self) -> list[str]:
+        """One line per member simulated at another size than its own (docs/simulation.md,
+        "Scale"): its trials say nothing of the real part's dynamics."""
+        notes = []
+        for i, (label, scale) in enumerate(zip(self.parts, self.scales, strict=True)):
+            if scale == 1.0:
+                continue
+            which = "small" if scale > 1.0 else "large"
+            sized = ""
+            if i < len(self.sizes):
+                size = self.sizes[i]
+                sized = f"a {size:.3g} mm part at {size * scale:.3g} mm, "
+            notes.append(
+                f"{label} was simulated at {scale:.3g}x its size ({sized}as docs/simulation.md "
+                f'"Scale" says): the dynamics of the real {which} part are not checked'
+            )
+        return notes
 
     def geometry(self) -> list[tuple[str, str]]:
         """Each member and the geometry simulated for it, in words."""
@@ -613,6 +633,7 @@ class SimulationSummary:
                 )
             ],
             "scale": [_r(s, 6) for s in self.scales],
+            "scale_notes": self.scale_notes(),
             "min_margin_deg": _r(self.min_margin_deg),
             "certified": None if self.certified is None else self.certified.to_dict(),
             "beyond_certified": self.beyond_certified,
