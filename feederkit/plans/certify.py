@@ -85,7 +85,8 @@ VIBRATION_OBSTACLE = (
     "a strong plan exists only on the ideal model (rotation error 0): what leaves none is not "
     "the rotation error but the feeder's vibration, which any declared uncertainty switches "
     f"on (a push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the "
-    "push bands, and fragile states merge: docs/uncertainty.md), so no smaller rotation error "
+    "push bands, a push may roll on over a shallow well, and fragile states merge: "
+    "docs/uncertainty.md), so no smaller rotation error "
     "helps; --rotation-error 0 plans on the ideal model, with no margin for that vibration"
 )
 """The largest rotation error with a strong plan, in words, when it is 0 and nothing else is
@@ -262,7 +263,8 @@ def _tolerance_words(u: Uncertainty, exists: Callable[[Uncertainty], bool | None
 VIBRATION_ONLY = (
     "what leaves none is the feeder's vibration, which any declared uncertainty switches on (a "
     f"push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the push "
-    "bands, and fragile states merge: docs/uncertainty.md); only the ideal model (rotation "
+    "bands, a push may roll on over a shallow well, and fragile states merge: "
+    "docs/uncertainty.md); only the ideal model (rotation "
     "error 0, no shape or COM tolerance) has a plan, with no margin for that vibration"
 )
 """:func:`_tolerance_words`' cause when no rotation error above 0 has a strong plan even
