@@ -355,9 +355,12 @@ def test_a_plan_on_a_simplified_hull_fails_on_the_washers_true_outline(
     that hold the part where its arc rolls), the plan passes ``simulate`` and names the wrong
     pose on the true outline; the plan the import now makes passes on both.
 
-    Measured (30 trials, seed 0): 12 of 30 on the true outline (95 % Wilson 24.5-57.7 %; 3
-    named the flat for a washer on its arc, 15 a pose 2.9-3.6 degrees off), 30 of 30 on the
-    plan's hull; the import's plan 30 of 30 on the true outline (docs/simulation.md).
+    Measured (30 trials, seed 0) with that plan made under 1 degree: 12 of 30 on the true
+    outline (95 % Wilson 24.5-57.7 %; 3 named the flat for a washer on its arc, 15 a pose
+    2.9-3.6 degrees off), 30 of 30 on the plan's hull; the import's plan 30 of 30 on the true
+    outline (docs/simulation.md). Under 1 degree the chords now have no strong plan (a push
+    rolls on over their shallow wells, docs/uncertainty.md): the plan on them is the ideal
+    model's: 2 of 30 on the true outline, its wrong poses chord states 1.6-3.6 degrees off.
     """
     trials = 30
     old = _write(tmp_path, "old.plan.json", _washer_plan(str(washer), 0.05))
@@ -374,7 +377,6 @@ def test_a_plan_on_a_simplified_hull_fails_on_the_washers_true_outline(
     failures = on_outline["failures"]
     assert {r["cause"] for r in failures} <= {"wrong result", "reading in no branch"}
     wrong = [r for r in failures if r["cause"] == "wrong result"]
-    assert all(r["pose_error_deg"] > 2.0 for r in wrong)
-    assert any(r["pose_error_deg"] > 170.0 for r in wrong)  # the flat named for the arc
+    assert wrong and all(r["pose_error_deg"] > 1.0 for r in wrong)  # chord states, not the arc
     fixed = _run(["simulate", str(new), *common, "--part", str(washer)], capsys)
     assert fixed["successes"] == trials, fixed["went_wrong"][:1]
