@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 from shared import catalog_snapshot as snapshot
 from shared import no_stray_profile  # noqa: F401 - autouse: a clean working folder
+from shared import run_cli as run
 
 import feederkit.catalog as cat
 from feederkit.catalog.schema import SCHEMA_V1, SCHEMA_V2
@@ -20,17 +21,10 @@ from feederkit.catalog.tolerances import (
     RevisionTolerances,
     declared_tolerances,
 )
-from feederkit.cli.app import main
 from feederkit.errors import InputError
 from feederkit.landing.model import landings_of_outline
 from feederkit.outline import make_outline, outline_to_dict, save_outline_json
 from feederkit.part import make_part
-
-
-def run(capsys, *args: str) -> tuple[int, str, str]:
-    code = main(list(args))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def run_json(capsys, *args: str):
