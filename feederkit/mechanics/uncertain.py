@@ -123,7 +123,7 @@ there by the same rule (an outcome, as a carry crossing: a part at rest stays). 
 larger than :data:`OVERSHOOT_MIN_SIZE_MM` the factor falls as the square of the size: the
 turn a part carries on by falls as the size (:data:`OVERSHOOT_DEG_MM`), the height of a
 hilltop that far from a normal as its square over the size, and the vibration grows as the
-size (the 20 mm 12-gon of ``tests/test_overshoot.py``, its state 7 a hilltop 1.7 vibrations
+size (the 20 mm 12-gon of ``tests/test_overshoot.py``, its state 7 a hilltop 1.8 vibrations
 above its well, was carried over in 4-15 of 100 pushes at 20 mm, 1 of 105 at 30 mm, none at
 40 mm).
 
