@@ -14,9 +14,11 @@ from pathlib import Path
 import pytest
 
 LIMIT_S = 10.0
-SLACK_S = 2.5
-"""What the command may take past its limit: Python's start (about 0.8 s here) and the
-first plan's grace (``FIRST_PLAN_GRACE_S``, not needed by this case)."""
+SLACK_S = 3.0
+"""What the command may take past its limit: Python's start (about 0.8 s here), the
+planner's own overshoot and the first plan's grace (``FIRST_PLAN_GRACE_S``, not needed by
+this case). It was 2.5 s: in CI's parallel slow run the command answered after 12.6 and
+12.7 s at a 10 s limit."""
 
 
 def _mix(folder: Path, count: int, monkeypatch) -> list[str]:
