@@ -149,6 +149,49 @@ def test_the_certificates_stop_at_their_deadline():
         max_shape_tolerance_mm(made.plan, deadline=Deadline(0.0))
 
 
+class _PollsLeft(Deadline):
+    """A deadline that passes after ``n`` more polls: where the work stops, not when."""
+
+    def __init__(self, n: int) -> None:
+        super().__init__()
+        self.left = n
+
+    def check(self) -> None:
+        super().check()
+        self.left -= 1
+        if self.left < 0:
+            raise Timeout("time")
+
+
+def test_a_certificate_stops_inside_a_verification_not_after_it(monkeypatch):
+    # Each bisection step of the shape certificate rebuilds every part's mechanics and walks
+    # the plan: 0.4 s CPU for a 100-part mix, so a deadline polled only between steps let
+    # `plan --time-limit 10` answer after 12.6 s. It is polled per part rebuilt and per
+    # (node, state) pair walked.
+    pfs = [random_pf(7000 + k) for k in range(4)]
+    made = make_plan(pfs, ToleranceSensor(0.2), uncertainty=Uncertainty(1.0), certify=False)
+    import feederkit.plans.strong as strong_module
+
+    built = []
+    real = strong_module.uncertain_mechanics
+
+    def counted(*args, **kwargs):
+        built.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(strong_module, "uncertain_mechanics", counted)
+    for figure in (max_shape_tolerance_mm, max_rotation_error_deg):
+        built.clear()
+        with pytest.raises(Timeout):
+            figure(made.plan, deadline=_PollsLeft(2 + len(pfs)))
+        assert len(built) <= len(pfs)  # stopped within its first rebuild and walk
+    built.clear()
+    with pytest.raises(Timeout):
+        # a poll per part read from the file, per part rebuilt, then the walk's
+        strong_holds(made.plan, Uncertainty(1.0), deadline=_PollsLeft(2 * len(pfs) + 1))
+    assert len(built) == len(pfs)  # rebuilt, then stopped in the walk
+
+
 def test_a_certificate_out_of_time_states_the_declared_values_and_says_so(monkeypatch):
     unc = Uncertainty(1.0, 0.01)
     options = PlanningOptions(time_limit_s=30.0)
@@ -183,6 +226,25 @@ def test_the_certificate_leaves_the_time_its_plan_needs_to_be_written(monkeypatc
     cert = made.plan["stats"]["certificate"]
     assert cert["max_rotation_error_deg"] == 1.0 and cert["max_shape_tolerance_mm"] == 0.01
     assert cert["ideal_length"] is None
+    assert any("no time for the whole certificate" in w for w in made.warnings)
+
+
+def test_the_limit_counts_from_the_callers_start():
+    # A command passes its own start: the time it took to read its parts is spent. Started
+    # 29.5 s before a 30 s limit, no time is left for the certificate (declared values).
+    import time
+
+    unc = Uncertainty(1.0, 0.01)
+    options = PlanningOptions(time_limit_s=30.0)
+    made = make_plan(
+        [random_pf(7000)],
+        ToleranceSensor(0.2),
+        options,
+        uncertainty=unc,
+        started=time.monotonic() - 29.5,
+    )
+    cert = made.plan["stats"]["certificate"]
+    assert cert["max_rotation_error_deg"] == 1.0 and cert["max_shape_tolerance_mm"] == 0.01
     assert any("no time for the whole certificate" in w for w in made.warnings)
 
 

@@ -482,6 +482,7 @@ def compile_command(
             uncertainty=uncertainty,
             shares=shares,
             loaded=loaded,
+            started=started,
             **over,
         )
     DONE_WORK.note(f"stored changeover {name!r} in {path}")

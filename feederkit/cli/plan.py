@@ -12,6 +12,7 @@ and the warnings (a margin below 1 degree, a time limit reached).
 from __future__ import annotations
 
 import sys
+import time
 from typing import Annotated, Any
 
 import typer
@@ -228,6 +229,7 @@ def plan_command(
     parts' catalog revisions store. Exit 1 when some parts of a mix, or some landings, cannot
     be told apart (the plan is still written) or an accepted and a rejected landing cannot be.
     """
+    started = time.monotonic()  # --time-limit counts reading the parts too
     terms = (*FLAG_TERMS, *LANDING_TERMS)
     check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
@@ -261,7 +263,9 @@ def plan_command(
             flag_words(),
             stored_tolerance_words(declared),
         ):
-            made, witnesses = plan_mix(pfs, sensor, options, uncertainty=uncertainty)
+            made, witnesses = plan_mix(
+                pfs, sensor, options, uncertainty=uncertainty, started=started
+            )
     else:
         every = found.all
         names = {x.name for x in every} | {m for x in every for m in x.merged}
@@ -274,7 +278,9 @@ def plan_command(
             flag_words(terms),
             stored_tolerance_words(declared),
         ):
-            planned = plan_landings(every, sensor, options, uncertainty=uncertainty, accept=taken)
+            planned = plan_landings(
+                every, sensor, options, uncertainty=uncertainty, accept=taken, started=started
+            )
         made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]
     plan = made.plan
     cycle = annotate_cycle_time(made, settings)  # stats.cycle_time, before anything is written

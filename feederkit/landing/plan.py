@@ -157,6 +157,7 @@ def plan_landings(
     uncertainty: Uncertainty | None = None,
     accept: Collection[str] | None = None,
     part_shares: Sequence[float] | None = None,
+    started: float | None = None,
 ) -> LandingPlan:
     """Plan over ``landings`` (of one part, or of several) as the members of one mix.
 
@@ -179,7 +180,13 @@ def plan_landings(
     if dup:
         raise InputError(f"landing {dup[0]} is given twice")
     mix = plan_landing_members(
-        members, sensor, options, uncertainty=uncertainty, accept=accept, part_shares=part_shares
+        members,
+        sensor,
+        options,
+        uncertainty=uncertainty,
+        accept=accept,
+        part_shares=part_shares,
+        started=started,
     )
     by_label = {x.label: x for x in members}
     found = tuple(LandingPair(by_label[w.part_a], by_label[w.part_b], w) for w in mix.witnesses)

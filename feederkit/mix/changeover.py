@@ -181,6 +181,7 @@ def plan_mix(
     uncertainty: Uncertainty | None = None,
     members: Sequence[PlanMember] | None = None,
     weights: Sequence[float] | None = None,
+    started: float | None = None,
 ) -> tuple[MadePlan, list[PairWitness]]:
     """A verified plan for one part or a mix (section 8.5), and the pairs of parts no plan
     can tell apart (section 8.4), each with its witness.
@@ -188,13 +189,21 @@ def plan_mix(
     ``uncertainty`` defaults to design.md's ``Uncertainty()``. ``members`` name the parts in
     the plan file with their landings, prior shares and accept/reject
     (:class:`~feederkit.plans.model.PlanMember`; None: as the parts are, equal shares);
-    ``weights`` give the parts' prior shares alone (a product mix's, normalised). On
-    the ideal model the pairs are the exact analysis of :mod:`feederkit.mix.pairs`; under
-    uncertainty they are the cross pairs of the strong machine's bisimilar states, the
-    relation the planner's results use. Pairs name the parts as ``parts`` do.
+    ``weights`` give the parts' prior shares alone (a product mix's, normalised);
+    ``started`` the instant the time limit counts from (:func:`~feederkit.plans.make.make_plan`,
+    None: now). On the ideal model the pairs are the exact analysis of
+    :mod:`feederkit.mix.pairs`; under uncertainty they are the cross pairs of the strong
+    machine's bisimilar states, the relation the planner's results use. Pairs name the parts
+    as ``parts`` do.
     """
     made = make_plan(
-        parts, sensor, options, uncertainty=uncertainty, members=members, weights=weights
+        parts,
+        sensor,
+        options,
+        uncertainty=uncertainty,
+        members=members,
+        weights=weights,
+        started=started,
     )
     if len(parts) < 2:
         return made, []
@@ -375,6 +384,7 @@ def plan_landing_members(
     uncertainty: Uncertainty | None = None,
     accept: Collection[str] | None = None,
     part_shares: Sequence[float] | None = None,
+    started: float | None = None,
 ) -> LandingMix:
     """Plan over ``landings`` (of one part or of several) as the members of one mix
     (section 8.5): their shares and accept/reject from :func:`landing_members`, the plan
@@ -383,7 +393,9 @@ def plan_landing_members(
     compile`` over landings. Raises as :func:`landing_members` and :func:`plan_mix` do."""
     named = landing_members(landings, accept, part_shares)
     pfs = tuple(push_function(x.part) for x in landings)
-    made, pairs = plan_mix(list(pfs), sensor, options, uncertainty=uncertainty, members=named)
+    made, pairs = plan_mix(
+        list(pfs), sensor, options, uncertainty=uncertainty, members=named, started=started
+    )
     rejected = {x.label for x, m in zip(landings, named, strict=True) if not m.accept}
     return LandingMix(pfs, named, made, tuple(reported_pairs(pairs, rejected)))
 
@@ -455,6 +467,7 @@ def compile_changeover(
     landings: str | Sequence[str] | None = None,
     accept: Collection[str] | None = None,
     loaded: LoadedParts | None = None,
+    started: float | None = None,
 ) -> CompiledChangeover:
     """Plan, verify and store the changeover ``name`` for ``members`` (catalog parts).
 
@@ -472,8 +485,9 @@ def compile_changeover(
     store's transaction, so either the changeover is stored and its files written, or
     neither. ``uncertainty`` is the declared one (default ``Uncertainty()``); ``loaded``
     the members as the caller loaded them (:func:`load_parts`), e.g. to declare the
-    tolerances their revisions store (:func:`feederkit.catalog.declared_tolerances`). Raises
-    InputError for an existing name (unless ``replace``), bad parts, a landing a part does
+    tolerances their revisions store (:func:`feederkit.catalog.declared_tolerances`);
+    ``started`` the instant the time limit counts from (:func:`~feederkit.plans.make.make_plan`).
+    Raises InputError for an existing name (unless ``replace``), bad parts, a landing a part does
     not have or an accepted name no landing has, PlanningError when no plan meets the
     request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
     plan fails verification.
@@ -499,13 +513,16 @@ def compile_changeover(
             uncertainty=uncertainty,
             accept=accept,
             part_shares=shares,
+            started=started,
         )
         pfs, made, witnesses, rejected = list(mix.parts), mix.made, mix.witnesses, mix.rejected
         # Fragile states named per landing, with the landing's own numbers (as plan says).
         landed = [(m.name, m.landing, pf) for m, pf in zip(mix.members, mix.parts, strict=True)]
         warnings = [*loaded.import_warnings, *member_fragile_warnings(landed)]
     else:
-        made, pairs = plan_mix(pfs, sensor, options, uncertainty=uncertainty, weights=shares)
+        made, pairs = plan_mix(
+            pfs, sensor, options, uncertainty=uncertainty, weights=shares, started=started
+        )
         witnesses = tuple(pairs)
         warnings = list(loaded.warnings)
     warnings += [*made.warnings, *stale_revisions(catalog, revisions)]

@@ -94,6 +94,7 @@ def make_plan(
     certify: bool = True,
     members: Sequence[PlanMember] | None = None,
     weights: Sequence[float] | None = None,
+    started: float | None = None,
 ) -> MadePlan:
     """Plan for ``push_functions`` (one part, or a mix: section 8.5) and verify the plan file.
 
@@ -106,6 +107,8 @@ def make_plan(
 
     ``options`` default to ``PlanningOptions()``. ``uncertainty``
     defaults to ``Uncertainty()`` (rotation error 1 degree); ``IDEAL`` is the paper's model.
+    ``started`` is the :func:`time.monotonic` instant the options' time limit counts from
+    (None: now): a command passes its own start, so that reading its parts counts too.
     ``certify=False`` skips the certificate (the plan file then has none; for callers that
     re-plan many times, such as property tests). The result's ``warnings`` flag a plan that
     holds rotation errors below ``LOW_MARGIN_DEG`` (its declared rotation error plus its
@@ -127,6 +130,7 @@ def make_plan(
             certify=certify,
             members=members,
             weights=weights,
+            started=started,
         )
 
 
@@ -139,6 +143,7 @@ def _make_plan(
     certify: bool,
     members: Sequence[PlanMember] | None,
     weights: Sequence[float] | None,
+    started: float | None,
 ) -> MadePlan:
     """:func:`make_plan`'s work."""
     opts = PlanningOptions() if options is None else options
@@ -147,7 +152,8 @@ def _make_plan(
     unc = Uncertainty() if uncertainty is None else uncertainty
     if not isinstance(unc, Uncertainty):
         raise InputError(f"the uncertainty must be an Uncertainty, got {unc!r}")
-    started = time.monotonic()
+    if started is None:
+        started = time.monotonic()
     pfs = list(push_functions)
     for pf in pfs:
         check_for_part(unc, pf.part)

@@ -109,9 +109,11 @@ class StrongModel:
                 yield (p, s.id)
 
 
-def _parts(plan: Mapping[str, Any]) -> list[PushFunction]:
+def _parts(plan: Mapping[str, Any], deadline: Deadline | None = None) -> list[PushFunction]:
     out = []
     for part in plan["parts"]:
+        if deadline is not None:
+            deadline.check()
         pp = PlanPart(
             name=part["name"],
             revision=part.get("revision"),
@@ -137,6 +139,7 @@ def strong_model(
     vibration_mm: float | None = None,
     parts: Sequence[PushFunction] | None = None,
     vibrating: bool = False,
+    deadline: Deadline | None = None,
 ) -> StrongModel:
     """The plan's parts rebuilt from its hulls and COMs, with their mechanics.
 
@@ -150,14 +153,19 @@ def strong_model(
     unc = declared if uncertainty is None else uncertainty
     if vibration_mm is None and declared.is_ideal and not vibrating:
         vibration_mm = 0.0
-    pfs = list(parts) if parts is not None else _parts(plan)
+    pfs = list(parts) if parts is not None else _parts(plan, deadline)
 
     def vibration(pf: PushFunction) -> float | None:
         if vibration_mm is None and vibrating:
             return FRAGILE_BARRIER_REL * pf.part.size  # the mechanics' rule off the ideal
         return vibration_mm
 
-    mechs = tuple(uncertain_mechanics(pf.part, unc, vibration_mm=vibration(pf)) for pf in pfs)
+    def mechanics(pf: PushFunction) -> UncertainMechanics:
+        if deadline is not None:
+            deadline.check()  # a mix's parts take a while: a certificate stops between them
+        return uncertain_mechanics(pf.part, unc, vibration_mm=vibration(pf))
+
+    mechs = tuple(mechanics(pf) for pf in pfs)
     eps = DIAMETER_REL_EPS * max(pf.part.size for pf in pfs)
     # The same outward-snapped intervals the machine's states read in (machine.build).
     ends = snap_intervals([s.diameter for m in mechs for s in m.states], eps)
@@ -194,8 +202,10 @@ class _Run:
         model: StrongModel,
         margins: bool = False,
         tighten: bool = False,
+        deadline: Deadline | None = None,
     ) -> None:
         self.model = model
+        self.deadline = deadline
         self.margins = margins
         self.tighten = tighten
         self.lowered = 0  # margins lowered to what their rotation keeps (``tighten``)
@@ -437,6 +447,8 @@ class _Run:
         key = (id(node), x)
         hit = self._handles.get(key)
         if hit is None:
+            if self.deadline is not None:
+                self.deadline.check()  # once per (node, state) pair: the walk's work
             if "result" in node:
                 hit = self.named(node, x)
             else:
@@ -687,16 +699,23 @@ def strong_holds(
     vibration_mm: float | None = None,
     parts: Sequence[PushFunction] | None = None,
     vibrating: bool = False,
+    deadline: Deadline | None = None,
 ) -> bool:
     """Whether every path of ``plan`` under ``uncertainty`` ends in a leaf naming its state
-    (``vibrating``: as :func:`strong_model`)."""
+    (``vibrating``: as :func:`strong_model`). Timeout when ``deadline`` passes first (polled
+    per part rebuilt and per (node, state) pair walked)."""
     try:
         model = strong_model(
-            plan, uncertainty, vibration_mm=vibration_mm, parts=parts, vibrating=vibrating
+            plan,
+            uncertainty,
+            vibration_mm=vibration_mm,
+            parts=parts,
+            vibrating=vibrating,
+            deadline=deadline,
         )
     except InputError:
         return False
-    run = _Run(plan, model)
+    run = _Run(plan, model, deadline=deadline)
     return all(run.handles(plan["root"], x) for x in model.states())
 
 
@@ -715,8 +734,8 @@ def max_rotation_error_deg(
     new to it. Timeout when ``deadline`` passes first (a minimum over some nodes is no
     bound)."""
     deadline = deadline or Deadline()
-    model = strong_model(plan, parts=parts, vibrating=True)
-    run = _Run(plan, model)
+    model = strong_model(plan, parts=parts, vibrating=True, deadline=deadline)
+    run = _Run(plan, model, deadline=deadline)
     best = MAX_ROTATION_ERROR_DEG
     # Per (node, part): the part's states the node's subtree handles after its rotation.
     handled: dict[tuple[int, int], frozenset[int]] = {}
@@ -788,7 +807,7 @@ def certificate_problems(
     if not cert:
         return []
     deadline = deadline or Deadline()
-    pfs = list(parts) if parts is not None else _parts(plan)
+    pfs = list(parts) if parts is not None else _parts(plan, deadline)
     out = []
     rot = cert.get("max_rotation_error_deg")
     if rot is not None:
@@ -801,9 +820,8 @@ def certificate_problems(
     shape = cert.get("max_shape_tolerance_mm")
     declared = declared_uncertainty(plan)
     if shape is not None and shape > declared.shape_tolerance_mm:
-        deadline.check()
         unc = Uncertainty(declared.rotation_error_deg, shape, declared.com_tolerance_mm)
-        if not strong_holds(plan, unc, parts=pfs, vibrating=True):
+        if not strong_holds(plan, unc, parts=pfs, vibrating=True, deadline=deadline):
             out.append(
                 f"the certificate's shape tolerance {shape:.6g} mm is more than the plan "
                 "holds: some path fails there"
@@ -827,14 +845,13 @@ def max_shape_tolerance_mm(
     re-verification)."""
     deadline = deadline or Deadline()
     declared = declared_uncertainty(plan)
-    pfs = list(parts) if parts is not None else _parts(plan)
+    pfs = list(parts) if parts is not None else _parts(plan, deadline)
     limit = min(shape_tolerance_limit(pf.part) for pf in pfs)
 
     def holds(t: float) -> bool:
         # With the feeder's vibration, as every certificate (strong_model's ``vibrating``).
-        deadline.check()
         unc = Uncertainty(declared.rotation_error_deg, t, declared.com_tolerance_mm)
-        return strong_holds(plan, unc, parts=pfs, vibrating=True)
+        return strong_holds(plan, unc, parts=pfs, vibrating=True, deadline=deadline)
 
     lo = declared.shape_tolerance_mm
     hi = limit * (1.0 - 1e-9)
