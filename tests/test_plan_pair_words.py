@@ -269,7 +269,7 @@ def test_the_lumping_warning_points_to_a_smaller_rotation_error_when_it_helps(ca
     code, _, err = run_cli(capsys, "plan", src, *args)
     assert code == 0
     line = _lumping_warning(err)
-    assert "a smaller rotation error helps: at ±0.03 deg a strong plan tells each pair" in line
+    assert "a smaller rotation error helps: up to ±19 deg a strong plan tells each pair" in line
     assert "--rotation-error" in line and "vibration" not in line
 
 

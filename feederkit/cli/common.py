@@ -335,8 +335,11 @@ def with_flags(message: str, terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> s
 
 
 def _no_help(lower: str, term: str) -> bool:
-    """Whether a (lower-case) message says that changing ``term`` does not help."""
-    return f"no smaller {term} helps" in lower or f"no {term} helps" in lower
+    """Whether a (lower-case) message says that changing ``term`` does not help, or helps
+    only beyond what a cell can keep ("a smaller rotation error helps only below ±0.01
+    deg, finer than a robot turns")."""
+    said = (f"no smaller {term} helps", f"no {term} helps", f"{term} helps only below")
+    return any(words in lower for words in said)
 
 
 @contextmanager

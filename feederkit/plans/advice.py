@@ -27,8 +27,8 @@ from feederkit.mechanics.push import PushFunction
 from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
 from feederkit.part import make_part
 from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.lumping import unresolvable_pairs
-from feederkit.planning.options import PlanningOptions
+from feederkit.planning.lumping import may_lump, unresolvable_pairs
+from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
 from feederkit.plans.certify import decided_exists
@@ -247,9 +247,92 @@ SMALLER_ERROR_FACTOR = 1e-3
 """A rotation error this fraction of the declared one stands for "a smaller rotation error":
 :func:`smaller_error_words` asks whether the lumped pairs are still unresolvable there."""
 
+PRACTICAL_ROTATION_ERROR_DEG = 0.01
+"""The finest rotation error a cell can keep (deg): a robot's wrist repeats to about ±0.01
+degree at best, and the drop onto the belt adds more. A smaller rotation error that helps
+only below it is named as out of reach, not as a remedy (:func:`smaller_error_words`)."""
+
+SMALLER_ERROR_DIGITS = 2
+"""Significant digits of the largest rotation error :func:`smaller_error_words` names: it
+bisects (geometrically) over rotation errors of this many digits, a figure a user can pass
+to ``--rotation-error`` as is, and stops when no such figure lies between what helps and
+what does not (a step of 1-10 %)."""
+
 SMALLER_ERROR_S = 5.0
 """The most seconds :func:`smaller_error_words` spends deciding (less when the time limit
 leaves less); undecided, it says a smaller rotation error may or may not help."""
+
+
+@dataclass(frozen=True)
+class _Reach:
+    """The largest rotation error found at which a strong plan tells the helped pairs apart
+    (``deg``, checked there): ``decided`` when the search ended (no figure of
+    :data:`SMALLER_ERROR_DIGITS` digits left between it and one that fails), ``practical``
+    False when it is below :data:`PRACTICAL_ROTATION_ERROR_DEG` though the declared error
+    is not (:data:`PRACTICAL_ROTATION_ERROR_DEG` itself fails)."""
+
+    deg: float
+    decided: bool = True
+    practical: bool = True
+
+
+def _between(lo: float, hi: float) -> float | None:
+    """The rotation error of :data:`SMALLER_ERROR_DIGITS` significant digits nearest the
+    geometric mean of ``lo`` and ``hi`` and strictly between them; None when there is none."""
+    mean = math.sqrt(lo * hi)
+    step = 10.0 ** (math.floor(math.log10(mean)) - SMALLER_ERROR_DIGITS + 1)
+    down = math.floor(mean / step) * step
+    for x in sorted((down, down + step), key=lambda x: abs(x - mean)):
+        x = float(f"{x:.{SMALLER_ERROR_DIGITS}g}")
+        if lo < x < hi:
+            return x
+    return None
+
+
+def largest_helping_error(helps: Callable[[float], bool | None], good: float, bad: float) -> _Reach:
+    """The largest rotation error at which ``helps`` (whether a strong plan tells the pairs
+    apart there; None: undecided in time) holds, given that it holds at ``good`` and not at
+    ``bad`` (the declared error). Bisection (telling apart at a rotation error tells apart
+    at every smaller one: outcome sets shrink) over figures of
+    :data:`SMALLER_ERROR_DIGITS` digits, after one look at
+    :data:`PRACTICAL_ROTATION_ERROR_DEG` when it lies between: a user needs the largest a
+    robot can keep, or to know that none it can keep would do."""
+    floor = PRACTICAL_ROTATION_ERROR_DEG
+    if good < floor < bad:
+        at_floor = helps(floor)
+        if at_floor is None:
+            return _Reach(good, decided=False)
+        if not at_floor:
+            return _Reach(good, practical=False)
+        good = floor
+    while (mid := _between(good, bad)) is not None:
+        found = helps(mid)
+        if found is None:
+            return _Reach(good, decided=False)
+        good, bad = (mid, bad) if found else (good, mid)
+    return _Reach(good)
+
+
+def _reach_words(reach: _Reach, them: str) -> tuple[str, str]:
+    """How far a smaller rotation error helps, in words: what follows "a smaller rotation
+    error helps" ("" or " only below" the practical floor) and where it tells ``them`` (the
+    pairs it helps) apart."""
+    at = f"±{reach.deg:.{SMALLER_ERROR_DIGITS + 1}g} deg"
+    if not reach.practical:
+        limit = f" only below ±{PRACTICAL_ROTATION_ERROR_DEG:g} deg, finer than a robot turns"
+        return limit, f"at {at} a strong plan tells {them} apart"
+    if not reach.decided:
+        return "", (
+            f"at {at} a strong plan tells {them} apart (whether a larger rotation error does "
+            "was not decided in time)"
+        )
+    return "", f"up to {at} a strong plan tells {them} apart"
+
+
+_VIBRATION = (
+    "the feeder's vibration, which any declared uncertainty switches on (push bands and "
+    "merged fragile states: docs/uncertainty.md)"
+)
 
 
 def smaller_error_words(
@@ -265,10 +348,12 @@ def smaller_error_words(
     builds at :data:`SMALLER_ERROR_FACTOR` of the declared rotation error, then with the
     declared shape and COM tolerances at 0 too, the feeder's vibration on in both (any
     declared uncertainty switches it on). Told apart at the smaller rotation error: "a
-    smaller rotation error helps"; else, told apart without the tolerances: a smaller
-    --shape-tolerance / --com-tolerance helps; else the vibration keeps them together, or
-    not even the ideal model tells them apart. The command line names a flag only where the
-    words say it helps (``with_flags``).
+    smaller rotation error helps", up to the largest rotation error that does
+    (:func:`largest_helping_error`, with the time left: a figure a robot must keep, or
+    "only below" :data:`PRACTICAL_ROTATION_ERROR_DEG` when none it can keep would do); else,
+    told apart without the tolerances: a smaller --shape-tolerance / --com-tolerance helps;
+    else the vibration keeps them together, or not even the ideal model tells them apart.
+    The command line names a flag only where the words say it helps (``with_flags``).
     """
     r = uncertainty.rotation_error_deg
     tiny = replace(uncertainty, rotation_error_deg=r * SMALLER_ERROR_FACTOR)
@@ -276,19 +361,16 @@ def smaller_error_words(
     exact = replace(tiny, shape_tolerance_mm=0.0, com_tolerance_mm=0.0)
     if exact.is_ideal:  # nothing declared but the rotation error, and that is 0
         exact = replace(exact, rotation_error_deg=SMALLER_ERROR_FACTOR)
-    vibration = (
-        "the feeder's vibration, which any declared uncertainty switches on (push bands and "
-        "merged fragile states: docs/uncertainty.md)"
-    )
     stop = time.monotonic() + max(seconds, 0.0)
+    built: dict[Uncertainty, PushAlignMachine] = {}
 
-    def left_at(u: Uncertainty) -> list[tuple[int, int]] | None:
-        """The pairs still unresolvable at ``u`` (None: undecided in time)."""
+    def left_at(u: Uncertainty, among: Sequence[tuple[int, int]]) -> list[tuple[int, int]] | None:
+        """The pairs of ``among`` still unresolvable at ``u`` (None: undecided in time)."""
         rest = stop - time.monotonic()
         if rest <= 0.0:
             return None
         try:
-            at = machine_at(u)
+            at = built[u] = machine_at(u)
             found = unresolvable_pairs(Problem(at, "exact", 0.0), Deadline(rest))
         except Timeout:
             return None
@@ -297,7 +379,7 @@ def smaller_error_words(
         kept = set(found)
         return [
             (i, j)
-            for i, j in pairs
+            for i, j in among
             if any(
                 (min(x, y), max(x, y)) in kept
                 for x in _alike(machine, i, at)
@@ -305,40 +387,83 @@ def smaller_error_words(
             )
         ]
 
-    left = left_at(tiny) if r > 0.0 else list(pairs)
+    def reach(helped: Sequence[tuple[int, int]]) -> _Reach:
+        """The largest rotation error telling the ``helped`` pairs apart with a strong plan
+        for the whole machine (each pair told apart alone is not enough: a set of them may
+        have none), in the time left."""
+        options = PlanningOptions(lumping=_lumping_rule(machine, pairs))
+
+        def helps(deg: float) -> bool | None:
+            u = replace(uncertainty, rotation_error_deg=deg)
+            still = left_at(u, helped)
+            if still is None or still:
+                return None if still is None else False
+            rest = stop - time.monotonic()
+            return decided_exists(built[u], options, rest) if rest > 0.0 else None
+
+        return largest_helping_error(helps, tiny.rotation_error_deg, r)
+
+    left = left_at(tiny, pairs) if r > 0.0 else list(pairs)
     at = f"±{tiny.rotation_error_deg:.3g} deg"
     if left is None:
         return (
             "; whether a smaller rotation error or tighter tolerances help was not decided: "
-            f"they may or may not, since {vibration} may keep them together whatever they are"
+            f"they may or may not, since {_VIBRATION} may keep them together whatever they are"
         )
     if not left:
-        return f"; a smaller rotation error helps: at {at} a strong plan tells each pair apart"
-    helped = len(pairs) - len(left)
-    head = (
-        f"; a smaller rotation error helps {plural(helped, 'pair')} only: at {at} "
-        f"{len(left)} of the {len(pairs)} are still not told apart"
-        if helped
-        else (
-            f"; no smaller rotation error helps: at {at} they are still not told apart"
-            if r > 0.0
-            else ""
+        limit, where = _reach_words(reach(pairs), "each pair")
+        return f"; a smaller rotation error helps{limit}: {where}"
+    helped = [p for p in pairs if p not in left]
+    rest = _rest_words(machine_at, machine, pairs, left, exact if loose else None, left_at)
+    if helped:
+        # the rest is decided first: the search for the largest helping error takes the time left
+        limit, where = _reach_words(reach(helped), "them")
+        head = (
+            f"; a smaller rotation error helps{limit}{',' * bool(limit)} "
+            f"{plural(len(helped), 'pair')} only ({where}): at {at} {len(left)} of the "
+            f"{len(pairs)} are still not told apart"
         )
-    )
-    if loose:
-        still = left_at(exact)
+    elif r > 0.0:
+        head = f"; no smaller rotation error helps: at {at} they are still not told apart"
+    else:
+        head = ""
+    return f"{head}{': ' if head else '; '}{rest}"
+
+
+def _lumping_rule(machine: PushAlignMachine, pairs: Sequence[tuple[int, int]]) -> Lumping:
+    """The strictest lumping rule that lists the lumped ``pairs`` together: ``any`` only when
+    some pair's poses do not look alike (the plan's own rule is not passed here; a stricter
+    one can only find a smaller helping rotation error, so the words stay true)."""
+    strict = Lumping.NEAR_SYMMETRIC
+    return strict if all(may_lump(machine, i, j, strict) for i, j in pairs) else Lumping.ANY
+
+
+def _rest_words(
+    machine_at: Callable[[Uncertainty], PushAlignMachine],
+    machine: PushAlignMachine,
+    pairs: Sequence[tuple[int, int]],
+    left: list[tuple[int, int]],
+    exact: Uncertainty | None,
+    left_at: Callable[[Uncertainty, Sequence[tuple[int, int]]], list[tuple[int, int]] | None],
+) -> str:
+    """What keeps the ``left`` pairs (of ``pairs``, not told apart at the smallest rotation
+    error) together, in words: the declared tolerances (``exact``, the uncertainty without
+    them, when any is declared), the feeder's vibration, or not even the ideal model tells
+    them apart (:func:`smaller_error_words`)."""
+    if exact is not None:
+        still = left_at(exact, left)
         if still is not None and len(still) < len(left):
             fixed = len(left) - len(still)
             which = "them" if not still else plural(fixed, "pair")
             return (
-                f"{head}{': ' if head else '; '}the declared shape and COM tolerances keep "
-                f"{which} together: with none a strong plan tells {which} apart (a smaller "
-                "shape tolerance or COM tolerance helps)"
+                f"the declared shape and COM tolerances keep {which} together: with none a "
+                f"strong plan tells {which} apart (a smaller shape tolerance or COM "
+                "tolerance helps)"
             )
         if still is None:
             return (
-                f"{head}{': ' if head else '; '}the declared shape and COM tolerances or "
-                f"{vibration} keep them together (not decided which)"
+                f"the declared shape and COM tolerances or {_VIBRATION} keep them together "
+                "(not decided which)"
             )
         left = still
     ideal = machine_at(IDEAL)
@@ -350,14 +475,13 @@ def smaller_error_words(
         # the ideal model does not tell them apart either: no uncertainty is the cause
         which = "them" if len(left) == len(pairs) else "those left"
         return (
-            f"{head}{': ' if head else '; '}no rotation error helps, not even 0: the ideal "
-            f"model does not tell {which} apart either (the mix's pairs say why)"
+            f"no rotation error helps, not even 0: the ideal model does not tell {which} "
+            "apart either (the mix's pairs say why)"
         )
-    cause = (
-        f"{vibration} keeps them together, whatever else is declared; the ideal model (no "
+    return (
+        f"{_VIBRATION} keeps them together, whatever else is declared; the ideal model (no "
         "uncertainty declared) plans with no margin for that vibration"
     )
-    return f"{head}{': ' if head else '; '}{cause}"
 
 
 def _alike(machine: PushAlignMachine, i: int, table: PushAlignMachine) -> list[int]:
