@@ -21,7 +21,7 @@ from typing import Any
 from feederkit.machine import PushAlignMachine
 from feederkit.machine.build import build_machine
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.uncertain import PUSH_BAND_DEG
+from feederkit.mechanics.uncertain import PUSH_BAND_DEG, ordinary_push_band_deg
 from feederkit.planning.api import shortest_length, strong_plan_exists
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions
@@ -84,14 +84,38 @@ BISECT_STEPS = 12
 VIBRATION_OBSTACLE = (
     "a strong plan exists only on the ideal model (rotation error 0): what leaves none is not "
     "the rotation error but the feeder's vibration, which any declared uncertainty switches "
-    f"on (a push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the "
-    "push bands, a push may roll on over a shallow well, and fragile states merge: "
-    "docs/uncertainty.md), so no smaller rotation error "
-    "helps; --rotation-error 0 plans on the ideal model, with no margin for that vibration"
+    "on ({push_band}, the push bands, a push may roll on over a shallow well, and fragile "
+    "states merge: docs/uncertainty.md), so no smaller rotation error helps; "
+    "--rotation-error 0 plans on the ideal model, with no margin for that vibration"
 )
 """The largest rotation error with a strong plan, in words, when it is 0 and nothing else is
 declared: every positive rotation error switches the vibration on (push bands, merged fragile
-states), and that is what no plan survives, however small the rotation error."""
+states), and that is what no plan survives, however small the rotation error. A template:
+``push_band`` is :func:`push_band_words` of the parts."""
+
+
+def push_band_words(push_functions: Sequence[PushFunction]) -> str:
+    """The words "a push starting within B° of a hilltop may end on either side", B the push
+    band the parts have at an ordinary hilltop (:func:`~feederkit.mechanics.uncertain.
+    ordinary_push_band_deg`): :data:`PUSH_BAND_DEG`, wider on a small slender part (up to
+    ``SLENDER_BAND_DEG``), which is named; over a mix, the range and the widest part."""
+    bands = {pf.part.name: ordinary_push_band_deg(pf.part) for pf in push_functions}
+    name, widest = max(bands.items(), key=_second, default=("", PUSH_BAND_DEG))
+    narrowest = min(bands.values(), default=PUSH_BAND_DEG)
+    if widest <= PUSH_BAND_DEG:
+        within = f"{PUSH_BAND_DEG:g}° of a hilltop"
+    elif narrowest == widest:  # a part's landings, or slender parts alike
+        within = f"{widest:.3g}° of a hilltop (the band of a small slender part)"
+    else:
+        within = (
+            f"{narrowest:.3g}-{widest:.3g}° of a hilltop ({widest:.3g}° on {name}, a small "
+            "slender part)"
+        )
+    return f"a push starting within {within} may end on either side"
+
+
+def _second(item: tuple[str, float]) -> float:
+    return item[1]
 
 
 def largest_uncertainty(
@@ -133,7 +157,8 @@ def largest_uncertainty(
     if r.value is None and not r.done:
         return "the largest uncertainty with a strong plan was not found within the time limit"
     if r.value is not None:
-        words.append(r.said("rotation error", "deg", vibration=at_zero_is_ideal))
+        band = push_band_words(push_functions) if at_zero_is_ideal else ""
+        words.append(r.said("rotation error", "deg", vibration=band))
     if u.shape_tolerance_mm > 0.0:
         t = _largest(
             exists,
@@ -143,7 +168,7 @@ def largest_uncertainty(
         if t.value is not None:
             words.append(t.said("shape tolerance", "mm"))
     if not words:
-        return _tolerance_words(u, exists)
+        return _tolerance_words(u, exists, push_band_words(push_functions))
     return " and ".join(words)
 
 
@@ -168,12 +193,13 @@ class _Largest:
     done: bool
     width: float
 
-    def said(self, what: str, unit: str, *, vibration: bool = False) -> str:
-        """In words; ``vibration``: 0 is the ideal model, so a plan only at 0 means the
-        vibration any positive value switches on leaves none (:data:`VIBRATION_OBSTACLE`)."""
+    def said(self, what: str, unit: str, *, vibration: str = "") -> str:
+        """In words; ``vibration`` (when 0 is the ideal model): the parts' push band words
+        (:func:`push_band_words`), for a plan only at 0, which means the vibration any
+        positive value switches on leaves none (:data:`VIBRATION_OBSTACLE`)."""
         value = self.value or 0.0
         if self.done and value == 0.0 and vibration:
-            return VIBRATION_OBSTACLE
+            return VIBRATION_OBSTACLE.format(push_band=vibration)
         if self.done and value > 0.0:
             # A bisection: a plan at ``value`` (printed rounded down), none a bracket above.
             return (
@@ -208,13 +234,16 @@ def _largest(
     return _Largest(lo, True, hi - lo)
 
 
-def _tolerance_words(u: Uncertainty, exists: Callable[[Uncertainty], bool | None]) -> str:
+def _tolerance_words(
+    u: Uncertainty, exists: Callable[[Uncertainty], bool | None], push_band: str
+) -> str:
     """In words, when no rotation error, however small, has a strong plan under the declared
     shape and COM tolerances (nor any shape tolerance under the declared rotation error):
     the tolerances are what is left to loosen. Names the COM tolerance when it alone leaves
     none, and the largest rotation error with a plan once both are 0. Only when that is 0 is
     the feeder's vibration, which any positive rotation error switches on, the cause
-    (tried first, at the bisection's smallest step: the one machine build it then takes)."""
+    (tried first, at the bisection's smallest step: the one machine build it then takes;
+    ``push_band``: :func:`push_band_words` of the parts)."""
     declared = [
         f"{what} {value:g} mm"
         for what, value in (
@@ -232,7 +261,8 @@ def _tolerance_words(u: Uncertainty, exists: Callable[[Uncertainty], bool | None
         if exists(Uncertainty(least)) is False:
             return (
                 f"{lead}, nor does any rotation error without "
-                f"{'them' if len(declared) > 1 else 'it'}: {VIBRATION_ONLY}"
+                f"{'them' if len(declared) > 1 else 'it'}: "
+                f"{VIBRATION_ONLY.format(push_band=push_band)}"
             )
     flags = "a smaller --shape-tolerance or --com-tolerance"
     if u.shape_tolerance_mm == 0.0:
@@ -261,11 +291,11 @@ def _tolerance_words(u: Uncertainty, exists: Callable[[Uncertainty], bool | None
 
 
 VIBRATION_ONLY = (
-    "what leaves none is the feeder's vibration, which any declared uncertainty switches on (a "
-    f"push starting within {PUSH_BAND_DEG:g}° of a hilltop may end on either side, the push "
-    "bands, a push may roll on over a shallow well, and fragile states merge: "
-    "docs/uncertainty.md); only the ideal model (rotation "
-    "error 0, no shape or COM tolerance) has a plan, with no margin for that vibration"
+    "what leaves none is the feeder's vibration, which any declared uncertainty switches on "
+    "({push_band}, the push bands, a push may roll on over a shallow well, and fragile states "
+    "merge: docs/uncertainty.md); only the ideal model (rotation error 0, no shape or COM "
+    "tolerance) has a plan, with no margin for that vibration"
 )
 """:func:`_tolerance_words`' cause when no rotation error above 0 has a strong plan even
-without the declared tolerances (:data:`VIBRATION_OBSTACLE`'s case, the tolerances too)."""
+without the declared tolerances (:data:`VIBRATION_OBSTACLE`'s case, the tolerances too). A
+template: ``push_band`` is :func:`push_band_words` of the parts."""
