@@ -19,6 +19,7 @@ from test_strong_plans import strong_search
 import feederkit.planning.api as api
 from feederkit.errors import PlanningError
 from feederkit.machine import (
+    Grouping,
     MachineState,
     OutcomeRange,
     PushAlignMachine,
@@ -30,6 +31,7 @@ from feederkit.machine.inseparable import kept_apart
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning.budget import Deadline
 from feederkit.planning.lumping import (
     LumpedGoal,
     LumpingTry,
@@ -372,6 +374,19 @@ def test_a_lumped_goal_too_large_to_decide_is_planned_to(monkeypatch, wired):
     assert planned.result.length == decided.result.length
     assert planned.result.lumped_pairs
     assert set(planned.result.lumped_pairs) <= {(0, 2), (1, 3)}
+
+
+def test_a_share_of_the_limit_run_out_leaves_lumping_undecided_not_timed_out():
+    """Past its share of the limit (a plan's stage), lumping hands its goals to the search as
+    past its set caps; only the plan's own deadline ends it in a time cut."""
+    pf = near_rectangle()
+    machine = by_diameter(build_machine([pf], NoSensor(), Uncertainty()))[0]
+    by_sets = try_lumping(machine, max_sets=0, pair_sets=0)
+    by_share = try_lumping(machine, Grouping.EXACT, Deadline(60.0), share=Deadline(0.0))
+    assert by_share.goal is None and not by_share.decided and by_share.cut_by == "sets"
+    assert by_share.undecided == by_sets.undecided and by_share.undecided
+    out = try_lumping(machine, Grouping.EXACT, Deadline(0.0), share=Deadline(0.0))
+    assert out.cut_by == "time" and not out.undecided
 
 
 def test_an_undecided_lumped_goal_with_no_plan_says_so(monkeypatch):

@@ -197,15 +197,37 @@ def try_lumping(
     max_sets: int = MAX_SETS,
     pair_sets: int = PAIR_SETS,
     rule: Lumping | str = Lumping.NEAR_SYMMETRIC,
+    share: Deadline | None = None,
 ) -> LumpingTry:
     """The lumped goal of ``machine`` under ``rule`` (:func:`lumped_goal`), with the pairs the
-    rule left out and whether it was decided."""
+    rule left out and whether it was decided.
+
+    ``share``, a deadline before ``deadline`` (a stage of a plan's budget): past it what is
+    not yet decided is left as past ``pair_sets`` and ``max_sets`` (the pairs from
+    :func:`kept_apart`, the goals ``undecided`` for a search to try), so that deciding
+    cannot take the time a search needs; only ``deadline`` itself ends in Timeout's reason.
+    """
     rule = _rule(rule)
     if machine.deterministic or machine.n < 2 or rule is Lumping.NONE:
         return LumpingTry(None)
     problem = Problem(machine, grouping, 0.0)
+    inner = deadline if share is None else share
+
+    def cut(exc: Timeout) -> bool:
+        """Whether the Timeout is the share's own, with ``deadline`` still running."""
+        return (
+            share is not None
+            and exc.reason == "time"
+            and not (deadline is not None and deadline.expired())
+        )
+
     try:
-        pairs = unresolvable_pairs(problem, deadline, pair_sets)
+        try:
+            pairs = unresolvable_pairs(problem, inner, pair_sets)
+        except Timeout as exc:
+            if not cut(exc):
+                raise
+            pairs = None
         exact = pairs is not None
         if pairs is None:
             pairs = tuple(sorted(kept_apart(problem.machine, alike_pairs(problem))))
@@ -215,13 +237,23 @@ def try_lumping(
             return LumpingTry(None, unlike)
         # Fewer pairs across parts first (within_first); every lumpable pair if those
         # leave a root without a strong plan (or that is undecided).
-        fewer = within_first(problem, pairs, deadline, pair_sets) if exact else None
+        try:
+            fewer = within_first(problem, pairs, inner, pair_sets) if exact else None
+        except Timeout as exc:
+            if not cut(exc):
+                raise
+            fewer = None
         tries = [pairs] if fewer is None else [fewer, pairs]
         for k, lumps in enumerate(tries):
             goal = lumped(problem.insep, lumps)
             wide = Problem(machine, grouping, 0.0, goal)
             roots = sorted(maximal_sets(b.mask for b in wide.readings.branches(wide.full)))
-            value = solve(wide, roots, deadline, max_sets)
+            try:
+                value = solve(wide, roots, inner, max_sets)
+            except Timeout as exc:
+                if not cut(exc):
+                    raise
+                value = None
             if value is not None and all(value[r] < math.inf for r in roots):
                 return LumpingTry(LumpedGoal(goal, lumps, exact), unlike)
             if value is None:
