@@ -14,6 +14,7 @@ from feederkit.outline import make_outline, save_outline_json
 from feederkit.part import make_part
 from feederkit.plans.make import make_plan
 from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
 
 
 def link(slot: bool):
@@ -47,3 +48,22 @@ def test_the_plan_command_writes_the_plan_and_exits_1(tmp_path, capsys):
     (line,) = [x for x in err.splitlines() if x.startswith("result:")]
     assert "not oriented between them" in line
     assert json.loads((tmp_path / "p.json").read_text())["format"] == "feederkit-plan"
+
+
+def test_a_link_whose_holes_move_its_com_is_not_oriented_under_uncertainty_either():
+    # A larger hole at one end moves the COM 0.7 mm: under 1 degree the two sides are no
+    # longer bisimilar, so the planner lumps them (no plan tells them apart even on the ideal
+    # model, which the near-symmetric rule allows) and the plan exited 0 with a warning,
+    # where the ideal model (inseparable) exits 1.
+    body = LineString([(0, 0), (40, 0)]).buffer(10, quad_segs=16)
+    hole = Point(0, 0).buffer(4, quad_segs=16)
+    slot = LineString([(34, 0), (44, 0)]).buffer(3, quad_segs=16)
+    holes = [list(h.exterior.coords)[:-1] for h in (hole, slot)]
+    outline = make_outline("link", list(body.exterior.coords)[:-1], holes=holes)
+    pf = push_function(make_part(outline))
+    assert abs(pf.part.com[0] - 20.0) > 0.5
+    made = make_plan([pf], ToleranceSensor(0.5), certify=False)
+    assert made.result.lumped_pairs == ((0, 1),)
+    assert made.unoriented is not None and "link states 0 and 1" in made.unoriented
+    ideal = make_plan([pf], ToleranceSensor(0.5), uncertainty=IDEAL, certify=False)
+    assert ideal.unoriented is not None

@@ -175,7 +175,12 @@ def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str |
     look alike (holes, slots or notches placed differently: ``look_alike`` compares the
     outline) while no plan tells them apart (the contact hull, all the fence and the sensor
     feel, is symmetric: the paper's indistinguishable poses); None when there are none.
-    Pairs the lumping already named (``lumped_pairs``) are left to its warning."""
+    Pairs the lumping listed together because its rule allowed poses that do not look alike
+    (``lumped_pairs``, lumping ``any``) are left to its warning; a lumped pair the machine
+    records as alike (``MachineState.alike``: no plan tells it apart even on the ideal model,
+    :func:`~feederkit.machine.build.ideal_twins`) is named here, as on the ideal model, where it
+    is inseparable and never lumped: the part is not oriented between them whatever the
+    rotation error."""
     machine = result.machine
     lumped = set(result.lumped_pairs)
     found: dict[tuple[int, int], None] = {}
@@ -189,8 +194,9 @@ def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str |
                 continue
             groups = [machine.states[i].ideal_states for i in idx]
             for a, b in unlike_pairs(pfs[part], groups):
-                if (idx[a], idx[b]) not in lumped:
-                    found[(idx[a], idx[b])] = None
+                i, j = idx[a], idx[b]
+                if (i, j) not in lumped or machine.states[i].alike(machine.states[j]):
+                    found[(i, j)] = None
     if not found:
         return None
     named = []
