@@ -191,6 +191,35 @@ def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):
     assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == tree_length(root)
 
 
+def test_a_shallow_target_that_fails_slowly_leaves_time_for_the_deep_one(monkeypatch):
+    # Until a first plan, a target below the cap gets SHALLOW_SHARE of the time left: here
+    # every shallow search would run until its deadline, and the plan within the cap is
+    # still found (without the share the first shallow target took the whole limit).
+    import time
+
+    from feederkit.planning import beam as beam_module
+
+    machine = _random_part_machine(seed=1, n=10, rel=0.2)
+    problem, branches, roots = _problem(machine)
+    cap = 2 * machine.n + 1
+    real = beam_module._lengths
+    seen = []
+
+    def slow_below_cap(beam, roots_, target):
+        seen.append(target)
+        if target < cap:
+            while True:  # a search that fails only when its deadline stops it
+                beam.deadline.check()
+                time.sleep(0.005)
+        return real(beam, roots_, target)
+
+    monkeypatch.setattr(beam_module, "_lengths", slow_below_cap)
+    found = beam_plan(problem, roots, None, Deadline(2.0), cap)
+    assert found is not None and seen[0] < cap and cap in seen
+    root = _choice_plan(problem, found[0].choice, roots, branches, Deadline())
+    assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == tree_length(root)
+
+
 def test_a_passed_deadline_leaves_no_beam_plan():
     machine = _random_part_machine()
     problem, _branches, roots = _problem(machine)
