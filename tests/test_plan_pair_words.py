@@ -279,3 +279,9 @@ def test_a_flag_is_not_named_for_a_term_the_message_says_does_not_help() -> None
     assert with_flags("no smaller rotation error helps") == "no smaller rotation error helps"
     assert with_flags("no rotation error helps, not even 0").endswith("even 0")
     assert with_flags("a smaller rotation error helps").endswith("(--rotation-error)")
+    # A tolerance declared 0 cannot be made smaller: its flag is not offered.
+    declared = "no strong plan (rotation error 1 deg, shape tolerance 0 mm, COM tolerance 0 mm)"
+    out = with_flags(declared + "; lumping 'any'")
+    assert out == f"{declared}; lumping 'any' (--rotation-error, --lumping)"
+    loose = "no strong plan (rotation error 1 deg, shape tolerance 0.05 mm, COM tolerance 0 mm)"
+    assert with_flags(loose) == f"{loose} (--rotation-error, --shape-tolerance)"

@@ -337,9 +337,13 @@ def with_flags(message: str, terms: Sequence[tuple[str, str]] = FLAG_TERMS) -> s
 def _no_help(lower: str, term: str) -> bool:
     """Whether a (lower-case) message says that changing ``term`` does not help, or helps
     only beyond what a cell can keep ("a smaller rotation error helps only below ±0.01
-    deg, finer than a robot turns")."""
+    deg, finer than a robot turns"), or declares it 0 already ("shape tolerance 0 mm": no
+    smaller value exists, and a larger one never makes a plan)."""
     said = (f"no smaller {term} helps", f"no {term} helps", f"{term} helps only below")
-    return any(words in lower for words in said)
+    if any(words in lower for words in said):
+        return True
+    zero = f"{term} 0 mm"
+    return zero in lower and f"smaller {term}" not in lower
 
 
 @contextmanager
