@@ -308,6 +308,7 @@ def test_a_flag_overrides_the_catalog_with_one_warning(capsys, mix):
     data, err = compile_json(capsys, mix, "--shape-tolerance", "0.01")
     assert data["plan"]["uncertainty"]["shape_tolerance_mm"] == 0.01
     assert data["plan"]["uncertainty"]["com_tolerance_mm"] == 0.03  # not given: the catalog's
+    assert data["uncertainty"] == data["plan"]["uncertainty"]  # as the exit-1 object has it
     assert data["uncertainty_from"] == {
         "shape_tolerance_mm": "given",
         "com_tolerance_mm": "catalog: rb r1",

@@ -504,6 +504,7 @@ def compile_command(
                     for n, r in compiled.revisions
                 ],
                 "cell": settings.to_dict(),
+                "uncertainty": plan.get("uncertainty"),  # as the exit-1 object says it
                 "uncertainty_from": declared.sources(),
                 "landings": landing_rows(plan, compiled.rejected),
                 "cycle_time": cycle,
