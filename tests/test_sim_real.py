@@ -218,6 +218,8 @@ def test_a_part_beyond_the_declared_shape_tolerance_is_simulated_with_a_warning(
     assert "guaranteed only within its declared tolerance" in line
     assert "its certificate's largest shape tolerance: " in line
     assert "up to 0.2601 mm is accepted" in line
+    # The plan file does not record its import's hull tolerance: the default is a bound.
+    assert "up to 0.05 mm of it may be the hull tolerance of the plan's import" in line
     assert beyond.to_dict()["warning"] == line
     within = check_match(plan, 0, _bracket_corner_moved(0.2), "within.json")
     assert not within.beyond_tolerance and within.tolerance_warning() is None

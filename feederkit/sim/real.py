@@ -163,8 +163,11 @@ class RealPart:
         measured against its catalog revision's drawing when known, else the most it may be."""
         h = self.hull
         if self.simplified_mm is None or h.drawing is None:
+            # A default is a guess: the plan file does not record the hull tolerance its
+            # import used (an import lowers it where arcs need it), so "up to".
+            amount = f"{h.mm:g} mm of it is" if h.given else f"up to {h.mm:g} mm of it may be"
             return (
-                f"{h.mm:g} mm of it is the hull tolerance of the plan's import ({h.words()}), "
+                f"{amount} the hull tolerance of the plan's import ({h.words()}), "
                 f"not a tolerance the plan declares, so the part may lie up to "
                 f"{self.allowed_mm - self.slack_mm:.4g} mm from its drawing unnoticed"
             )
