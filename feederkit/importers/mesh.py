@@ -21,8 +21,12 @@ from feederkit.errors import InputError
 from feederkit.hull import convex_hull
 from feederkit.importers.budget import MAX_COORD_MM, Budget, ImportLimits
 from feederkit.importers.meshbodies import (
+    BENT_GUESS_SHARE,
     SURFACE_EPS,
     Shell,
+    bent_holes,
+    bent_note,
+    bent_reason,
     close_shell,
     describe_body,
     edge_counts,
@@ -241,20 +245,31 @@ INSIDE_OUT = "the mesh is inside out (its triangles face inward): its normals we
 
 def _pieces(
     mesh: trimesh.Trimesh, size: float, budget: Budget | None
-) -> tuple[list[Shell], list[trimesh.Trimesh], list[trimesh.Trimesh]]:
-    """The mesh's connected pieces: closed shells, open pieces, and flat debris (no volume)."""
-    shells, open_bodies, debris = [], [], []
-    for body in list(mesh.split(only_watertight=False)) or [mesh]:
+) -> tuple[list[Shell], list[trimesh.Trimesh], list[trimesh.Trimesh], list[tuple[float, float]]]:
+    """The mesh's connected pieces: closed shells, open pieces, flat debris (no volume), and
+    the holes a shell had filled whose borders are not flat, each as far out of plane as it
+    lies and the volume its fill guesses (:func:`.meshbodies.bent_holes`, read from the
+    piece as written).
+
+    Each piece's one-triangle and four-sided holes are filled as trimesh's ``split`` fills
+    them (its ``repair``), after its holes are read.
+    """
+    shells, open_bodies, debris, bent = [], [], [], []
+    for raw in list(mesh.split(only_watertight=False, repair=False)) or [mesh]:
         if budget is not None:
             budget.check_time()
+        body = raw.copy()
+        if len(body.faces) >= 4:
+            body.fill_holes()
         shell = close_shell(body)
         if shell is not None:
             shells.append(shell)
+            bent += bent_holes(raw)
         elif is_debris(body, size):
             debris.append(body)
         else:
             open_bodies.append(body)
-    return shells, open_bodies, debris
+    return shells, open_bodies, debris, bent
 
 
 def _debris_note(debris: list[trimesh.Trimesh]) -> str:
@@ -296,21 +311,35 @@ def solid(
     one physical part, whose COM is that of the solid with its cavities; an inner shell
     facing outward is an inner body, taken as the solid's own material with a warning.
     Shells side by side, touching or overlapping are separate parts and refused; a surface
-    that is not closed is refused as "not a closed solid" unless ``--com`` is given. A mesh
-    of many bodies costs a repair per body and a test per pair of shells: the deadline of
-    ``budget`` is checked between them.
+    that is not closed, or whose holes' borders are not flat (across an edge: any fill is a
+    guess) and guess more than :data:`.meshbodies.BENT_GUESS_SHARE` of its volume, is
+    refused as "not a closed solid" unless ``--com`` is given (a smaller guess is filled
+    and said). A mesh of many bodies costs a repair per body and a test per pair of shells:
+    the deadline of ``budget`` is checked between them.
     """
     size = float(mesh.extents.max())
-    shells, open_bodies, debris = _pieces(mesh, size, budget)
+    shells, open_bodies, debris, bent = _pieces(mesh, size, budget)
     notes = [_debris_note(debris)] if debris else []
     if open_bodies:
         if com_given and len(open_bodies) == 1 and not shells:
             return Solid(open_bodies[0], None, (OPEN_WITH_COM, *notes))
         raise _refuse_open(mesh, label, debris, len(open_bodies) + len(shells))
+    volume = max((float(sh.mesh.volume) for sh in shells), default=0.0)
+    if bent and sum(g for _, g in bent) > BENT_GUESS_SHARE * volume:  # a fill across an edge
+        if com_given and len(shells) == 1:  # guesses the solid: its COM is unknown
+            return Solid(shells[0].mesh, None, (OPEN_WITH_COM, *notes))
+        hint = "; give --com X Y" if len(shells) == 1 else ""
+        reason = bent_reason(bent, volume, len(shells))
+        raise InputError(
+            f"{label}: not a closed solid ({reason}), so its center of mass is unknown{hint}"
+        )
     shells.sort(key=lambda sh: -float(sh.mesh.volume))
     repairs = {sh.repair for sh in shells}
     if _open_edges(mesh, debris)[0]:  # split() itself fills single-triangle holes
         repairs.add("filled")
+    if bent:
+        repairs.discard("filled")
+        notes.append(bent_note(bent, volume, float(np.linalg.norm(mesh.extents))))
     notes += [REPAIR_NOTES[r] for r in REPAIR_NOTES if r in repairs]
     if shells[0].facing < 0:
         notes.append(INSIDE_OUT)
