@@ -27,20 +27,25 @@ from feederkit.importers.drawingnotes import (
 )
 from feederkit.importers.frames import frame_doubt, frame_kind, free_title_block
 from feederkit.importers.loops import (
+    CONSTRUCTION_LAYER,
     Loop,
     Point,
     Region,
     closed_loops,
+    crossed_loops,
     crosses_the_outline,
     crossing_loop,
+    drawn_twice,
     heal_gaps,
     is_closed,
     joined,
     line_cycles,
+    lines_on,
     near_copy,
     open_ends,
     repeated_lines,
     self_crossing,
+    shapes_overlap,
     snap_endpoints,
     without_slivers,
 )
@@ -311,6 +316,38 @@ def drawing_from_lines(
             raise InputError(
                 f"{label}: {what} seems drawn twice, {copy[1]:.2g} mm apart ({name(copy[0])} "
                 f"and {name(crossing)}): delete one copy"
+            )
+        crossing_poly = Polygon(healed[crossing])
+        crossed_polys = crossed_loops(healed, crossing, gap)
+
+        def loop_name(loop: Polygon) -> str:
+            on = lines_on(healed[: len(snapped)], loop, gap, crossing)
+            if not on:
+                return "a loop of lines over it"
+            if len(on) == 1:
+                return name(on[0])
+            return f"the loop of {name(on[0])} and {plural(len(on) - 1, 'other line')}"
+
+        twin = drawn_twice(crossing_poly, crossed_polys)
+        if twin is not None:
+            largest = max(p.area for p in shells)
+            what = "the outline" if crossing_poly.area >= 0.9 * largest else "a loop"
+            raise InputError(
+                f"{label}: {what} seems drawn twice (a copy shifted by about {twin[1]:.2g} mm: "
+                f"{name(crossing)} and {loop_name(twin[0])}): delete one copy"
+            )
+        helper = layers is not None and bool(CONSTRUCTION_LAYER.search(layers[crossing]))
+        if (
+            crossed == 1
+            and crossed_polys
+            and not helper
+            and shapes_overlap(crossing_poly, crossed_polys[0])
+        ):
+            raise InputError(
+                f"{label}: two closed loops overlap ({name(crossing)} and "
+                f"{loop_name(crossed_polys[0])}, neither inside the other): a part drawn as "
+                "overlapping shapes? join them into one outline (e.g. a union) or put the stray "
+                "one on another layer"
             )
         if crosses_the_outline(healed, closed, shells, crossing):
             raise InputError(

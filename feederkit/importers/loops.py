@@ -41,6 +41,22 @@ NEAR_COPY_SHARE = 0.01
 """Two closed lines within this share of their size of each other are one loop drawn twice."""
 
 
+DRAWN_TWICE_SHARE = 0.05
+"""A closed line and a loop of other lines it crosses, each within this share of the
+closed line's size of the other and sharing :data:`DRAWN_TWICE_COMMON` of their area, are
+one loop drawn twice (an outline pasted again as lines, shifted by a millimetre)."""
+
+DRAWN_TWICE_COMMON = 0.8
+"""The least share of two loops' union their intersection holds for them to be one loop
+drawn twice (:data:`DRAWN_TWICE_SHARE`)."""
+
+MOSTLY_INSIDE = 0.4
+"""The share of a crossing loop's area inside the loop it crosses from which it is taken for
+a hole across that loop's outline (a circle centred on the outline's edge has half of it
+inside, a little less once flattened); below it on both sides, the two loops are shapes
+that overlap (a T drawn as two rectangles, one a seventh inside the other)."""
+
+
 @dataclass(frozen=True)
 class Region:
     """A part found in a drawing: its outer loop and its holes (mm); ``area`` excludes holes."""
@@ -795,6 +811,50 @@ def near_copy(
         if gap < apart <= reach:
             return j, apart
     return None
+
+
+def crossed_loops(lines: Sequence[np.ndarray], k: int, gap: float) -> list[Polygon]:
+    """The loops the other lines close that closed line ``k`` crosses (as
+    :func:`crossing_loop` found them), the one it shares most area with first."""
+    poly = Polygon(np.asarray(lines[k], dtype=float))
+    loops, _ = closed_loops([ln for i, ln in enumerate(lines) if i != k])
+    tiny = 1e-9 * poly.area
+    crossed = [lp.polygon for lp in loops if _overlap(poly, lp.polygon, tiny, 2.0 * gap)]
+    return sorted(crossed, key=lambda p: -float(p.intersection(poly).area))
+
+
+def drawn_twice(poly: Polygon, crossed: Sequence[Polygon]) -> tuple[Polygon, float] | None:
+    """The loop of ``crossed`` that repeats ``poly``, shifted (each boundary within
+    :data:`DRAWN_TWICE_SHARE` of ``poly``'s size of the other, sharing
+    :data:`DRAWN_TWICE_COMMON` of their union), and how far its centroid lies from
+    ``poly``'s, else None."""
+    x0, y0, x1, y1 = poly.bounds
+    reach = DRAWN_TWICE_SHARE * max(x1 - x0, y1 - y0)
+    for other in crossed:
+        if float(poly.exterior.hausdorff_distance(other.exterior)) > reach:
+            continue
+        if poly.intersection(other).area >= DRAWN_TWICE_COMMON * poly.union(other).area:
+            return other, float(poly.centroid.distance(other.centroid))
+    return None
+
+
+def shapes_overlap(poly: Polygon, other: Polygon) -> bool:
+    """Whether two crossing loops are shapes that overlap (each holds less than
+    :data:`MOSTLY_INSIDE` of the other's area), not a hole across the other's outline."""
+    common = float(poly.intersection(other).area)
+    return common < MOSTLY_INSIDE * min(poly.area, other.area)
+
+
+def lines_on(lines: Sequence[np.ndarray], loop: Polygon, gap: float, skip: int) -> list[int]:
+    """The lines (but ``skip``) lying wholly on the outline of ``loop``, within ``gap``."""
+    ring = loop.exterior
+    return [
+        j
+        for j, ln in enumerate(lines)
+        if j != skip
+        and len(ln) >= 2
+        and bool((shapely.distance(shapely.points(np.asarray(ln, dtype=float)), ring) <= gap).all())
+    ]
 
 
 def without_slivers(loops: Sequence[Loop], gap: float, bridged: float) -> tuple[list[Loop], str]:
