@@ -116,7 +116,9 @@ class PushOutcome:
     ``edge`` the hull edge flush with the fence (None when the run never settled);
     ``width_mm`` the width across the belt the LED array reads, in the part's millimetres;
     ``tilt_deg`` how far the part's plane leans from the belt's at the end (a part above
-    :data:`TILT_MAX_DEG` stands on an edge or turned over: it never settles).
+    :data:`TILT_MAX_DEG` stands on an edge or turned over: it never settles);
+    ``turned_deg`` how far it turned from the drop to the rest, counter-clockwise positive
+    and unwrapped (which hilltops it went over, ``benchmarks/bench_overshoot.py``).
     """
 
     theta_start_deg: float
@@ -127,6 +129,7 @@ class PushOutcome:
     sim_time_s: float
     steps: int
     tilt_deg: float = 0.0
+    turned_deg: float = 0.0
 
 
 TILT_MAX_DEG = 10.0
@@ -437,6 +440,7 @@ class PushAligner:
                     widths.clear()
                     checks = 0  # the whole travel to come to rest again
                     continue
+            turned = rest - theta_deg
             rest = norm360(rest)
             edge, off = self._nearest_edge(rest)
             if self._lowest is not None:
@@ -453,9 +457,11 @@ class PushAligner:
                     sim_time_s=float(d.time),
                     steps=steps,
                     tilt_deg=self._tilt(),
+                    turned_deg=turned,
                 )
         if self._rests is not None and len(thetas) >= window:  # the end of the fence
             rest, width = rule.reading(thetas[-window:], widths[-window:])
+            turned = rest - theta_deg
             rest = norm360(rest)
             if _range_distance(rest, self._rests) <= rule.align_tol_deg:
                 return PushOutcome(
@@ -467,6 +473,7 @@ class PushAligner:
                     sim_time_s=float(d.time),
                     steps=steps,
                     tilt_deg=self._tilt(),
+                    turned_deg=turned,
                 )
         lo, hi = self._extent_y()
         return PushOutcome(
