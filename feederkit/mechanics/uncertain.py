@@ -83,6 +83,36 @@ OVERSHOOT_MIN_SIZE_MM = 20.0
 """Parts smaller than this are taken at this size for :data:`OVERSHOOT_DEG_MM`, as the physics
 check simulates them (docs/simulation.md, "Scale"); a small part's own dynamics are not
 modelled."""
+OVERSHOOT_BAND_DEG = 6.0
+"""A push starting less than this many degrees from a hilltop (or inside its push band) may
+come down the basin beside it and go on over the far hilltop into the state beyond, when that
+hilltop is near and low (:func:`_overshoot_chain`): the overshoot of a push started near a
+hilltop.
+
+Measured, not derived (docs/uncertainty.md, "Overshoot"; ``benchmarks/bench_overshoot.py``):
+pushes that went over started at most 3 degrees from their hilltop (the notched tab and random
+polygons at 20 mm; at most 0.5 at 100 and 150 mm); 6 is the margin. The tab's pushes from 5 to
+30 degrees below a hilltop never went over (6 frictions each), so a push from deep in a basin
+is not carried this way: that is :data:`OVERSHOOT_DEG_MM`'s case.
+"""
+OVERSHOOT_FAR_DEG = 28.5
+"""A push started near a hilltop (:data:`OVERSHOOT_BAND_DEG`) may go over a far hilltop less
+than this many degrees past the normal of the state it comes down to.
+
+Measured (docs/uncertainty.md, "Overshoot"): far hilltops up to 27.4 degrees past the normal
+were gone over (a random 20 mm hexagon; the catalog's rectangle-2x1 26.6), the catalog
+l-bracket's at 29.45 degrees not (0 of 99 pushes, at 72 mm and at 20 mm), whatever the size:
+the notched tab went over the same hilltops at 20-150 mm, the chamfered plate at 20-100 mm.
+The measurements leave no room for a wide margin here (1.04 either side).
+"""
+OVERSHOOT_DOWN_DEG = 60.0
+"""... when it comes down to the normal from less than this many degrees (a longer descent
+loses the turn: measured, docs/uncertainty.md, "Overshoot": went over from up to 56.5 degrees,
+never from 64-100 degrees, over 14 basins; from 54 degrees both)."""
+OVERSHOOT_CLIMB_REL = 1.5
+"""... and when the far hilltop stands less than this many times as high above the state's
+well as the hilltop it came down from (measured: at most as high, the catalog octagon's equal
+hilltops in 1 of 35 pushes at each; 1.5 is the margin)."""
 SLENDER_GYRATION_REL = 0.27
 """A part whose radius of gyration about its COM (its hull as a plate, as the physics check
 simulates it) is less than this share of its size is slender: its ordinary hilltops get
@@ -1001,6 +1031,9 @@ def uncertain_mechanics(
         pf, eps, _certain_hills(peaks, heights[right], eps), peaks, heights, vibration_mm
     )
     cells = _fence_cells(bands, cands, destinations, _profile(pf, eps) if eps > 0.0 else None)
+    if vibration_mm > 0.0:
+        # Overshoot from near a hilltop (OVERSHOOT_BAND_DEG, OVERSHOOT_FAR_DEG).
+        cells = _overlay(cells, _band_overshoots(pf, peaks, heights, bands, destinations, eps))
     return UncertainMechanics(
         push=pf,
         uncertainty=uncertainty,
@@ -1140,6 +1173,111 @@ def _fence_cells(
         cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
         cells.append(FenceCell(b_hi, n_lo, False, _cell_targets(arr, dest, *gap_region)))
     return tuple(cells)
+
+
+def _overshoot_chain(
+    pf: PushFunction, peaks: np.ndarray, heights: np.ndarray, k: int, way: int, eps: float
+) -> list[int]:
+    """The ideal states a push coming down from hilltop ``k`` (``way`` +1: counter-clockwise)
+    may go on to over near, low hilltops: past the state below ``k`` over its far hilltop
+    when that lies less than :data:`OVERSHOOT_FAR_DEG` past the state's normal, ``k`` less
+    than :data:`OVERSHOOT_DOWN_DEG` before it, and the far hilltop stands less than
+    :data:`OVERSHOOT_CLIMB_REL` times as high above the well as ``k`` (with ``2 eps`` to
+    spare, F1); and on from the state beyond by the same rule, still measured from ``k``
+    (the turn the part came down with carries it on)."""
+    div = np.asarray(pf.divergent_deg, dtype=float)
+    m = len(div)
+    rs = pf.range_state
+    out: list[int] = []
+    r = k if way > 0 else (k - 1) % m  # the range below hilltop k on this side
+    for _ in range(m - 2):
+        far = (r + 1) % m if way > 0 else r
+        s, beyond = rs[r], rs[(r + way) % m]
+        nrm = pf.states[s].normal_deg
+        far_deg = abs(norm360(div[far] - nrm + 180.0) - 180.0)
+        down_deg = way * (nrm - div[k]) % 360.0
+        climb = peaks[far] - heights[s] + 2.0 * eps
+        drop = peaks[k] - heights[s] - 2.0 * eps
+        if (
+            beyond == s
+            or far_deg >= OVERSHOOT_FAR_DEG
+            or down_deg >= OVERSHOOT_DOWN_DEG
+            or climb >= OVERSHOOT_CLIMB_REL * drop
+        ):
+            break
+        out.append(beyond)
+        r = (r + way) % m
+    return out
+
+
+def _band_overshoots(
+    pf: PushFunction,
+    peaks: np.ndarray,
+    heights: np.ndarray,
+    bands: Sequence[Band],
+    dest: Sequence[frozenset[int]],
+    eps: float,
+) -> list[tuple[float, float, frozenset[int]]]:
+    """Fence intervals ``(lo, hi, extra)`` near hilltops from which a push may come down the
+    basin beside the hilltop and go on over its far hilltop (docs/uncertainty.md,
+    "Overshoot"): from less than :data:`OVERSHOOT_BAND_DEG` beside hilltop ``k`` on one side,
+    or from inside its band (carried over it), a push may also end in the destinations of the
+    states :func:`_overshoot_chain` reaches on that side. ``hi`` may pass 360."""
+    div = np.asarray(pf.divergent_deg, dtype=float)
+    out: list[tuple[float, float, frozenset[int]]] = []
+    for k, d in enumerate(div):
+        lo, hi = d, d  # the band holding hilltop k (F2 and push band)
+        for b in bands:
+            off = norm360(d - b.top_lo_deg + 1e-6) - 1e-6
+            if off <= b.top_hi_deg - b.top_lo_deg:
+                lo, hi = d - off - (b.top_lo_deg - b.lo_deg), d - off + (b.hi_deg - b.top_lo_deg)
+        for way, zone in (
+            (1, (lo, max(hi, d + OVERSHOOT_BAND_DEG))),
+            (-1, (min(lo, d - OVERSHOOT_BAND_DEG), hi)),
+        ):
+            reached = _overshoot_chain(pf, peaks, heights, k, way, eps)
+            if reached:
+                out.append((*zone, frozenset().union(*(dest[i] for i in reached))))
+    return out
+
+
+def _overlay(
+    cells: Sequence[FenceCell], zones: Sequence[tuple[float, float, frozenset[int]]]
+) -> tuple[FenceCell, ...]:
+    """``cells`` cut at the ends of ``zones`` (closed fence intervals ``(lo, hi, extra)``), each
+    piece also targeting the ``extra`` of every zone holding it; a piece keeps its cell's
+    ``closed``, and pieces of one cell with the same targets stay one cell."""
+    if not zones:
+        return tuple(cells)
+    base = cells[0].lo
+    spans: list[tuple[float, float, frozenset[int]]] = []
+    for lo, hi, extra in zones:
+        if hi - lo >= 360.0:
+            spans.append((base, base + 360.0, extra))
+            continue
+        x = base + norm360(lo - base)
+        y = x + (hi - lo)
+        spans.append((x, min(y, base + 360.0), extra))
+        if y > base + 360.0:
+            spans.append((base, y - 360.0, extra))
+    out: list[FenceCell] = []
+    for cell in cells:
+        cuts = sorted(
+            {cell.lo, cell.hi} | {v for a, b, _ in spans for v in (a, b) if cell.lo < v < cell.hi}
+        )
+        for a, b in zip(cuts, cuts[1:], strict=False):
+            targets = cell.targets.union(*(extra for x, y, extra in spans if x <= a and b <= y))
+            if (
+                out
+                and out[-1].hi == a
+                and out[-1].closed == cell.closed
+                and (out[-1].targets == targets)
+                and out[-1].lo >= cell.lo
+            ):
+                out[-1] = FenceCell(out[-1].lo, b, cell.closed, targets)
+            else:
+                out.append(FenceCell(a, b, cell.closed, targets))
+    return tuple(out)
 
 
 # --- outcome sets ---------------------------------------------------------------------------
