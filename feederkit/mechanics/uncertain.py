@@ -20,7 +20,8 @@ highest stands more than ``2 eps`` above the wells on either side), and never wh
 radius is more than ``2 eps`` above its start (F1); a push starting within ``PUSH_BAND_DEG``
 of a hilltop (``SLENDER_BAND_DEG`` on a slender part checked at 20 mm), or beside a shallow
 state or a near-metastable facet less than twice the vibration below it, may be carried over it
-(the push bands, measured in the physics check).
+(the push bands, measured in the physics check), and may then go on over a near, low hilltop
+beyond (``OVERSHOOT_BAND_DEG``, measured too).
 With ``t = c = 0`` and no vibration every set here is the ideal one exactly; otherwise each is
 a superset of what the perturbed parts can do (provably conservative), and the docstrings say
 which.
@@ -84,35 +85,37 @@ OVERSHOOT_MIN_SIZE_MM = 20.0
 check simulates them (docs/simulation.md, "Scale"); a small part's own dynamics are not
 modelled."""
 OVERSHOOT_BAND_DEG = 6.0
-"""A push starting less than this many degrees from a hilltop (or inside its push band) may
-come down the basin beside it and go on over the far hilltop into the state beyond, when that
+"""A push starting less than this many degrees beside a hilltop (or inside its band) may come
+down the basin on that side and go on over the far hilltop into the state beyond, when that
 hilltop is near and low (:func:`_overshoot_chain`): the overshoot of a push started near a
-hilltop.
+hilltop, at any size.
 
 Measured, not derived (docs/uncertainty.md, "Overshoot"; ``benchmarks/bench_overshoot.py``):
-pushes that went over started at most 3 degrees from their hilltop (the notched tab and random
-polygons at 20 mm; at most 0.5 at 100 and 150 mm); 6 is the margin. The tab's pushes from 5 to
-30 degrees below a hilltop never went over (6 frictions each), so a push from deep in a basin
-is not carried this way: that is :data:`OVERSHOOT_DEG_MM`'s case.
+such pushes started at most 3 degrees from their hilltop (the notched tab, random polygons, at
+20 mm; at most 0.5 at 100 and 150 mm); 6 is the margin. The tab's pushes from 5 to 30 degrees
+below a hilltop never went over (6 frictions each): a push from deep in a basin is not carried
+this way, which is :data:`OVERSHOOT_DEG_MM`'s case.
 """
 OVERSHOOT_FAR_DEG = 28.5
 """A push started near a hilltop (:data:`OVERSHOOT_BAND_DEG`) may go over a far hilltop less
 than this many degrees past the normal of the state it comes down to.
 
 Measured (docs/uncertainty.md, "Overshoot"): far hilltops up to 27.4 degrees past the normal
-were gone over (a random 20 mm hexagon; the catalog's rectangle-2x1 26.6), the catalog
-l-bracket's at 29.45 degrees not (0 of 99 pushes, at 72 mm and at 20 mm), whatever the size:
-the notched tab went over the same hilltops at 20-150 mm, the chamfered plate at 20-100 mm.
-The measurements leave no room for a wide margin here (1.04 either side).
+were gone over (a random 20 mm polygon; the catalog's rectangle-2x1 26.6), the catalog
+l-bracket's at 29.45 degrees not (0 of 99 pushes at 72 mm, none at 20 and 40 mm), whatever
+the size: the notched tab went over the same hilltops at 20-150 mm, the chamfered plate at
+20-100 mm. The measurements leave no room for a wide margin here (1.04 either side).
 """
 OVERSHOOT_DOWN_DEG = 60.0
-"""... when it comes down to the normal from less than this many degrees (a longer descent
-loses the turn: measured, docs/uncertainty.md, "Overshoot": went over from up to 56.5 degrees,
-never from 64-100 degrees, over 14 basins; from 54 degrees both)."""
+"""... when it comes down to that normal from a hilltop less than this many degrees before it:
+a longer descent loses the turn (measured: gone over from up to 57.7 degrees, never from the
+12 basins come down from 60.3-99.6 degrees with a far hilltop inside
+:data:`OVERSHOOT_FAR_DEG`; a margin of 1.04)."""
 OVERSHOOT_CLIMB_REL = 1.5
 """... and when the far hilltop stands less than this many times as high above the state's
-well as the hilltop it came down from (measured: at most as high, the catalog octagon's equal
-hilltops in 1 of 35 pushes at each; 1.5 is the margin)."""
+well as the hilltop it came down from (measured: gone over up to as high, the catalog octagon's
+equal hilltops in 1-2 of 27-46 pushes each, a chamfered square's at 20 and 60 mm; 1.5 is the
+margin)."""
 SLENDER_GYRATION_REL = 0.27
 """A part whose radius of gyration about its COM (its hull as a plate, as the physics check
 simulates it) is less than this share of its size is slender: its ordinary hilltops get
@@ -885,7 +888,9 @@ def uncertain_mechanics(
     ``PUSH_BAND_FACTOR`` vibrations of its height (:func:`_bands`). Overshoot: with the
     vibration on, a push ending in a state may also end beyond a hilltop close to its normal
     (:data:`OVERSHOOT_DEG_MM`; an outcome, as a carry crossing), and roll on over a hilltop
-    standing less than :data:`ROLL_WELL_FACTOR` vibrations above its well. Raises InputError
+    standing less than :data:`ROLL_WELL_FACTOR` vibrations above its well; a push starting
+    near a hilltop may also go over a near, low far hilltop (:data:`OVERSHOOT_BAND_DEG`:
+    the cells there target the states beyond). Raises InputError
     for a shape tolerance of half the smallest hull edge or more.
     """
     check_for_part(uncertainty, part)
