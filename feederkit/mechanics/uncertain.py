@@ -110,7 +110,7 @@ OVERSHOOT_DOWN_DEG = 60.0
 """... when it comes down to that normal from a hilltop less than this many degrees before it:
 a longer descent loses the turn (measured: gone over from up to 57.7 degrees, never from the
 12 basins come down from 60.3-99.6 degrees with a far hilltop inside
-:data:`OVERSHOOT_FAR_DEG`; a margin of 1.04)."""
+:data:`OVERSHOOT_FAR_DEG`; no room for a margin: 1.04 and 1.005)."""
 OVERSHOOT_CLIMB_REL = 1.5
 """... and when the far hilltop stands less than this many times as high above the state's
 well as the hilltop it came down from (measured: gone over up to as high, the catalog octagon's
