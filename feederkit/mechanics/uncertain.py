@@ -1188,29 +1188,30 @@ def _overshoot_chain(
     when that lies less than :data:`OVERSHOOT_FAR_DEG` past the state's normal, ``k`` less
     than :data:`OVERSHOOT_DOWN_DEG` before it, and the far hilltop stands less than
     :data:`OVERSHOOT_CLIMB_REL` times as high above the well as ``k`` (with ``2 eps`` to
-    spare, F1); and on from the state beyond by the same rule, still measured from ``k``
-    (the turn the part came down with carries it on)."""
+    spare, F1); and on from the state beyond by the same rule, from ``k`` or from any
+    hilltop gone over since (the turn the part came down with carries it on)."""
     div = np.asarray(pf.divergent_deg, dtype=float)
     m = len(div)
     rs = pf.range_state
     out: list[int] = []
+    tops = [k]  # the hilltops the part may be taken to have come down from
     r = k if way > 0 else (k - 1) % m  # the range below hilltop k on this side
     for _ in range(m - 2):
         far = (r + 1) % m if way > 0 else r
         s, beyond = rs[r], rs[(r + way) % m]
+        if beyond == s:
+            break
         nrm = pf.states[s].normal_deg
         far_deg = abs(norm360(div[far] - nrm + 180.0) - 180.0)
-        down_deg = way * (nrm - div[k]) % 360.0
         climb = peaks[far] - heights[s] + 2.0 * eps
-        drop = peaks[k] - heights[s] - 2.0 * eps
-        if (
-            beyond == s
-            or far_deg >= OVERSHOOT_FAR_DEG
-            or down_deg >= OVERSHOOT_DOWN_DEG
-            or climb >= OVERSHOOT_CLIMB_REL * drop
+        if far_deg >= OVERSHOOT_FAR_DEG or not any(
+            way * (nrm - div[top]) % 360.0 < OVERSHOOT_DOWN_DEG
+            and climb < OVERSHOOT_CLIMB_REL * (peaks[top] - heights[s] - 2.0 * eps)
+            for top in tops
         ):
             break
         out.append(beyond)
+        tops.append(far)
         r = (r + way) % m
     return out
 
