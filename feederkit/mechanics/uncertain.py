@@ -116,6 +116,11 @@ OVERSHOOT_CLIMB_REL = 1.5
 well as the hilltop it came down from (measured: gone over up to as high, the catalog octagon's
 equal hilltops in 1-2 of 27-46 pushes each, a chamfered square's at 20 and 60 mm; 1.5 is the
 margin)."""
+OVERSHOOT_MAX_HILLTOPS = 4
+"""... over at most this many hilltops in a row (measured: at most 2, on six random polygons
+and the 12-gon of ``tests/test_overshoot.py``; rolling over a flattened arc's facets is
+:data:`ROLL_WELL_FACTOR`'s). It also bounds the work on outlines with many near, low
+hilltops (a fine flattening's)."""
 SLENDER_GYRATION_REL = 0.27
 """A part whose radius of gyration about its COM (its hull as a plate, as the physics check
 simulates it) is less than this share of its size is slender: its ordinary hilltops get
@@ -1189,14 +1194,15 @@ def _overshoot_chain(
     than :data:`OVERSHOOT_DOWN_DEG` before it, and the far hilltop stands less than
     :data:`OVERSHOOT_CLIMB_REL` times as high above the well as ``k`` (with ``2 eps`` to
     spare, F1); and on from the state beyond by the same rule, from ``k`` or from any
-    hilltop gone over since (the turn the part came down with carries it on)."""
+    hilltop gone over since (the turn the part came down with carries it on), over at most
+    :data:`OVERSHOOT_MAX_HILLTOPS`."""
     div = np.asarray(pf.divergent_deg, dtype=float)
     m = len(div)
     rs = pf.range_state
     out: list[int] = []
     tops = [k]  # the hilltops the part may be taken to have come down from
     r = k if way > 0 else (k - 1) % m  # the range below hilltop k on this side
-    for _ in range(m - 2):
+    for _ in range(min(m - 2, OVERSHOOT_MAX_HILLTOPS)):
         far = (r + 1) % m if way > 0 else r
         s, beyond = rs[r], rs[(r + way) % m]
         if beyond == s:
