@@ -841,8 +841,8 @@ def max_shape_tolerance_mm(
     reading intervals grow with the tolerance) to ``rel_tol`` of the bound, half the parts'
     smallest hull edge. Returns the lower end of the final bracket, where the plan holds.
     A plan that fails at the smallest midpoint the bisection could try ends it at once (the
-    declared tolerance). Timeout when ``deadline`` passes first (checked before each
-    re-verification)."""
+    declared tolerance). Timeout when ``deadline`` passes first (polled inside each
+    re-verification, per part rebuilt and per (node, state) pair: :func:`strong_holds`)."""
     deadline = deadline or Deadline()
     declared = declared_uncertainty(plan)
     pfs = list(parts) if parts is not None else _parts(plan, deadline)
