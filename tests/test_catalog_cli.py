@@ -255,6 +255,8 @@ def test_directory_with_one_bad_file_adds_nothing(tmp_path, db, capsys):
 def test_usage_errors(db, capsys, args, message):
     code, _, err = run(capsys, *args, "--catalog", str(db))
     assert code == 2 and message in err and "Traceback" not in err
+    if "no part named" in message:  # which catalog file was searched
+        assert str(db) in "".join(err.split())  # a wrapped line joined
 
 
 def test_export_to_a_missing_folder(tmp_path, db, capsys):

@@ -809,11 +809,14 @@ def _revision_from_row(row: Sequence[Any], landing_rows: Sequence[Sequence[Any]]
 
 
 def _unknown(conn: sqlite3.Connection, name: str) -> NoSuchPartError:
+    """The error naming an unknown part, the catalog file it was looked up in (a default
+    catalog or ``$FEEDERKIT_CATALOG`` may not be the one meant) and the names like it."""
     valid = _suggestable([r[0] for r in conn.execute("SELECT name FROM parts")])
+    shown = shown_name(name) if not is_valid_name(name) else repr(name)
+    file = next((row[2] for row in conn.execute("PRAGMA database_list") if row[1] == "main"), "")
+    where = f" {file}" if file else ""
     return NoSuchPartError(
-        f"no part named {shown_name(name)!s} in the catalog{did_you_mean(_similar(valid, name))}"
-        if not is_valid_name(name)
-        else f"no part named {name!r} in the catalog{did_you_mean(_similar(valid, name))}"
+        f"no part named {shown!s} in the catalog{where}{did_you_mean(_similar(valid, name))}"
     )
 
 
