@@ -68,3 +68,16 @@ def test_plan_on_a_mesh_of_arcs_does_not_offer_a_coarser_hull_tolerance(
     assert "ell/pose-0's contact hull has edges as short as" in text
     assert "a coarser --hull-tolerance cannot help" in text
     assert "imported with a coarser --hull-tolerance" not in text
+
+
+def test_a_small_part_s_own_short_edge_is_not_guessed_an_arc() -> None:
+    """A 3 x 2 mm plate with one 0.3 mm chamfer (a new user's review: "an arc drawn as many
+    chords?" on a part with no arc): the hint names the short edge and a smaller shape
+    tolerance, not fewer arc points; the ellipse's 128 chords still are guessed an arc."""
+    plate = [(0.0, 0.0), (3.0, 0.0), (3.0, 1.7), (2.7, 2.0), (0.0, 2.0)]
+    pf = push_function(make_part(make_outline("plate", plate)))
+    words = short_chords_words([pf], 0.05)
+    assert "edges as short as 0.424 mm, which" in words and "a smaller --shape-tolerance" in words
+    assert "arc" not in words and "hull-tolerance" not in words
+    ellipse = push_function(make_part(make_outline("ellipse", _ellipse_points())))
+    assert "(an arc drawn as many chords?)" in short_chords_words([ellipse], 0.1)

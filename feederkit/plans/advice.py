@@ -110,6 +110,27 @@ def _chord_tilt(hull: Sequence[tuple[float, float]], t: float) -> tuple[float, f
     return shortest, math.degrees(math.asin(min(1.0, 2.0 * t / shortest)))
 
 
+CHORD_RUN = 3
+"""Short hull edges (within twice the shortest) this many in a row look like an arc drawn as
+chords; fewer are the part's own short edges (a small part's chamfer), and the hint does not
+guess an arc (:func:`short_chords_words`)."""
+
+
+def _chord_run(hull: Sequence[tuple[float, float]], shortest: float) -> int:
+    """The most consecutive hull edges (around the closed hull) no longer than twice
+    ``shortest``."""
+    n = len(hull)
+    short = [math.dist(hull[i], hull[(i + 1) % n]) <= 2.0 * shortest for i in range(n)]
+    if all(short):
+        return n
+    start = short.index(False)  # count runs from an edge that is not short: none wraps
+    best = run = 0
+    for k in range(1, n + 1):
+        run = run + 1 if short[(start + k) % n] else 0
+        best = max(best, run)
+    return best
+
+
 def _hull_gap(exact: Sequence[tuple[float, float]], hull: Sequence[tuple[float, float]]) -> float:
     """How far the outline's exact hull strays outside a contact hull simplified inside it."""
     ring = shapely.LinearRing(hull)
@@ -147,11 +168,19 @@ def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
     if tilt < SHORT_CHORD_TILT_DEG:
         return ""
     name = pf.part.name
+    # An arc is guessed only where short edges come in a run (CHORD_RUN): a small part's
+    # own short edge is no arc, and fewer arc points cannot lengthen it.
+    arc = _chord_run(pf.part.hull, length) >= CHORD_RUN
     head = (
-        f"; {name}'s contact hull has edges as short as {length:.3g} mm (an arc drawn as many "
-        f"chords?), which the shape tolerance may tilt by {tilt:.3g} degrees, each then a "
-        "possible resting edge near a corner: a smaller --shape-tolerance, or an outline with "
-        "fewer arc points (a coarser tessellation in a mesh's CAD export)"
+        f"; {name}'s contact hull has edges as short as {length:.3g} mm"
+        f"{' (an arc drawn as many chords?)' if arc else ''}, which the shape tolerance may "
+        f"tilt by {tilt:.3g} degrees, each then a possible resting edge near a corner: a "
+        "smaller --shape-tolerance"
+        + (
+            ", or an outline with fewer arc points (a coarser tessellation in a mesh's CAD export)"
+            if arc
+            else ""
+        )
     )
     coarser = coarser_kept_hull(pf, t)
     if coarser is not None:
@@ -159,6 +188,8 @@ def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
             f"{head}, or the part imported with --hull-tolerance {coarser:.3g} (its resting "
             "states kept, no edge that short), may have a plan (docs/uncertainty.md)"
         )
+    if not arc:
+        return f"{head}, may have a plan (docs/uncertainty.md)"
     return (
         f"{head}, may have a plan; a coarser --hull-tolerance cannot help: import lowers it "
         f"to what keeps {name}'s resting states (chords across its arcs would hold the part "
