@@ -50,14 +50,20 @@ from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
 from feederkit.sim.pushalign import PushAligner, size_scale
 from feederkit.sources import load_part
-from feederkit.uncertainty import Uncertainty
 
-ROOT = Path(__file__).resolve().parents[1]
-SAMPLES = ROOT.parent / "shared" / "samples"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_push_bands import (  # noqa: E402
+    ROOT,
+    SAMPLES,
+    UNCERTAINTY,
+    drawn_frictions,
+    settled_state,
+)
+
 TAB = str(ROOT / "benchmarks" / "parts" / "tab-notch.json")
 OFFSETS = (0.1, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0)
 QUICK_OFFSETS = (0.1, 0.5, 1.5, 3.0, 6.0)
-UNCERTAINTY = Uncertainty(1.0, 0.0, 0.0)
 
 
 def default_sources() -> list[str]:
@@ -154,8 +160,7 @@ def sweep(spec: str, offsets: tuple[float, ...], frictions: int) -> list[dict]:
     """One row per basin come down: the pushes filed under it, how many went over, how many
     of those the model's outcome sets miss, the farthest start (deg from its hilltop) that went
     over and the most hilltops one push went over."""
-    rng = np.random.default_rng(0)
-    drawn = [(rng.uniform(0.4, 0.6), rng.uniform(0.1, 0.3)) for _ in range(frictions)]
+    drawn = drawn_frictions(frictions)
     rows = []
     for landing in landings_of_outline(load(spec))[:2]:
         part = landing.part
@@ -178,8 +183,7 @@ def sweep(spec: str, offsets: tuple[float, ...], frictions: int) -> list[dict]:
                         if not out.settled:
                             continue
                         key, over, less = file_push(div, hill, side, off, out.turned_deg)
-                        off_normal = np.abs((normals - out.theta_end_deg + 180.0) % 360.0 - 180.0)
-                        state = mech.state_of[int(np.argmin(off_normal))]
+                        state = settled_state(mech, normals, out.theta_end_deg)
                         t = tally.setdefault(
                             key,
                             {

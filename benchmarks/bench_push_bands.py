@@ -29,7 +29,7 @@ import numpy as np
 
 from feederkit.landing.model import landings_of_outline
 from feederkit.mechanics.push import push_function
-from feederkit.mechanics.uncertain import fence_outcomes, uncertain_mechanics
+from feederkit.mechanics.uncertain import UncertainMechanics, fence_outcomes, uncertain_mechanics
 from feederkit.sim.pushalign import PushAligner, size_scale
 from feederkit.sources import load_part
 from feederkit.uncertainty import Uncertainty
@@ -37,6 +37,22 @@ from feederkit.uncertainty import Uncertainty
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT.parent / "shared" / "samples"
 UNCERTAINTY = Uncertainty(1.0, 0.0, 0.0)
+
+
+def drawn_frictions(count: int) -> list[tuple[float, float]]:
+    """``count`` (belt, fence) frictions from the simulator's default ranges (belt 0.4-0.6,
+    fence 0.1-0.3), seed 0: the same draws in every push benchmark."""
+    rng = np.random.default_rng(0)
+    return [(rng.uniform(0.4, 0.6), rng.uniform(0.1, 0.3)) for _ in range(count)]
+
+
+def settled_state(
+    mech: UncertainMechanics, normals: np.ndarray, theta_end_deg: float
+) -> int | None:
+    """The model's physical state a push settled in: that of the ideal state whose normal
+    lies nearest its end orientation (None: a state the model merged away)."""
+    off_normal = np.abs((normals - theta_end_deg + 180.0) % 360.0 - 180.0)
+    return mech.state_of[int(np.argmin(off_normal))]
 
 
 def default_sources() -> list[str]:
@@ -49,8 +65,7 @@ def default_sources() -> list[str]:
 def sweep(source: str, step: float, reach: float, frictions: int) -> list[dict]:
     """One row per landing: pushes settled, misses, and per missed (hilltop, side) the
     farthest start missed."""
-    rng = np.random.default_rng(0)
-    drawn = [(rng.uniform(0.4, 0.6), rng.uniform(0.1, 0.3)) for _ in range(frictions)]
+    drawn = drawn_frictions(frictions)
     rows = []
     for landing in landings_of_outline(load_part(source))[:2]:
         part = landing.part
@@ -70,8 +85,7 @@ def sweep(source: str, step: float, reach: float, frictions: int) -> list[dict]:
                         if not out.settled:
                             continue
                         settled += 1
-                        off_normal = np.abs((normals - out.theta_end_deg + 180.0) % 360.0 - 180.0)
-                        state = mech.state_of[int(np.argmin(off_normal))]
+                        state = settled_state(mech, normals, out.theta_end_deg)
                         if state is None or state not in allowed:
                             missed += 1
                             key = (round(float(hill), 2), side)
