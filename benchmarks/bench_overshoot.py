@@ -44,8 +44,8 @@ import numpy as np
 
 from feederkit.angles import norm360
 from feederkit.landing.model import landings_of_outline
-from feederkit.mechanics.push import PushFunction, push_function
-from feederkit.mechanics.uncertain import _radius, fence_outcomes, uncertain_mechanics
+from feederkit.mechanics.push import PushFunction, push_function, radius
+from feederkit.mechanics.uncertain import fence_outcomes, uncertain_mechanics
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
 from feederkit.sim.pushalign import PushAligner, size_scale
@@ -114,18 +114,16 @@ class Basin:
 
 def basins(pf: PushFunction, part: Part, scale: float) -> dict[tuple[int, int], Basin]:
     """Every (range k, way) of the push function: range k lies between hilltops k and k+1."""
-    h = np.asarray(part.hull, float)
-    com = np.asarray(part.com, float)
     div = np.asarray(pf.divergent_deg, float)
     m = len(div)
     out = {}
     for k in range(m):
         s = pf.range_state[k]
         n = pf.states[s].normal_deg
-        well = float(_radius(h, com, np.asarray([n]))[0])
+        well = float(radius(part, n))
         lo, hi = div[k], div[(k + 1) % m]
         a_lo, a_hi = norm360(n - lo), norm360(hi - n)
-        p_lo, p_hi = (float(x) for x in _radius(h, com, np.asarray([lo, hi])))
+        p_lo, p_hi = (float(x) for x in radius(part, np.asarray([lo, hi])))
         size = part.size * scale
         # way +1: come down from hilltop k (below the normal), towards hilltop k+1.
         out[(k, 1)] = Basin(
