@@ -374,6 +374,53 @@ def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
 # --- plan() answers within its limits ---------------------------------------------------
 
 
+def test_with_the_fallback_off_the_exact_search_has_the_whole_limit_then_no_plan(monkeypatch):
+    # The exact search never ends on its own: with the fallback off it polls until the end of
+    # the whole limit (no checkpoint hands over early, no share is kept for a fallback), and
+    # then there is no plan, in one line naming the limit, not the fallback's unproven one.
+    machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
+    budgets = []
+
+    def endless(problem, worst, *_args, **_kwargs):
+        budgets.append(worst.deadline)
+        while True:
+            worst.deadline.check()
+
+    monkeypatch.setattr(api, "longest_root", endless)
+    monkeypatch.setattr(fallback, "sensorless_plan", lambda *_a, **_k: pytest.fail("it ran"))
+    limit = 0.6
+    start = time.perf_counter()
+    with pytest.raises(fallback.NoFallback) as info:
+        plan(machine, PlanningOptions(time_limit_s=limit, fallback=False))
+    took = time.perf_counter() - start
+    assert limit - 0.05 <= took < limit + 0.5
+    assert len(budgets) == 1 and not isinstance(budgets[0], Checkpoint)
+    assert info.value.reason == "time" and isinstance(info.value, PlanningError)
+    message = str(info.value)
+    assert "\n" not in message and "time limit of 0.6 s" in message
+
+
+def test_with_the_fallback_off_a_tie_break_cut_by_the_limit_is_no_plan(monkeypatch):
+    # The lengths are proven, the tie-breaking stage runs out of time: with the fallback off
+    # no tree of undecided ties is built (an unlimited run would have decided them).
+    machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
+
+    def out_of_time(*_args, **_kwargs):
+        raise Timeout("time")
+
+    monkeypatch.setattr(api, "stage", out_of_time)
+    with pytest.raises(fallback.NoFallback):
+        plan(machine, PlanningOptions(time_limit_s=60.0, fallback=False))
+    result = plan(machine, PlanningOptions(time_limit_s=60.0))  # on: the ties' first tree
+    assert result.ties_cut_by == "time" and check_plan(result) == result.length
+
+
+@pytest.mark.parametrize("bad", [None, 0, "no"])
+def test_a_fallback_that_is_not_a_bool_is_refused(bad):
+    with pytest.raises(InputError, match="fallback must be True or False"):
+        PlanningOptions(fallback=bad)
+
+
 def _timed_plan(machine, **options):
     start = time.perf_counter()
     try:

@@ -446,3 +446,23 @@ def test_a_plan_whose_ties_are_undecided_counts_only_before_the_fallback_may_ans
     else:
         with pytest.raises(Timeout):
             clock.plan(make)
+
+
+def test_the_planner_of_a_limited_design_has_its_fallback_off_and_its_cut_is_a_timeout():
+    # A plan not proven optimal is no design: the planner stops where its fallback would
+    # start (seconds of a large unproven plan's statistics and verification, past the limit,
+    # on the 20-part ellipse mix), and that stop is the design's Timeout.
+    from feederkit.planning.fallback import NoFallback
+
+    asked = []
+
+    def make(options):
+        asked.append(options)
+        raise NoFallback(options, "time")
+
+    with pytest.raises(Timeout) as info:
+        DesignClock(5.0).plan(make)
+    assert info.value.reason == "time"
+    assert [o.fallback for o in asked] == [False]
+    made = object()
+    assert DesignClock().plan(lambda options: made if options is None else None) is made

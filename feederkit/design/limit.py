@@ -24,6 +24,7 @@ from collections.abc import Callable
 from feederkit.errors import PlanningError
 from feederkit.planning.api import EXACT_CHECK_SHARE, FALLBACK_SHARE
 from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.fallback import NoFallback
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.tree import TIES_EXACT
 from feederkit.plans.make import MadePlan
@@ -140,12 +141,13 @@ class DesignClock:
         """``make(options)`` (a verified plan) within what is left of the limit.
 
         Unlimited: ``make(None)``, the planner's defaults. Limited: the planner gets the time
-        left and the memory limit as its own, and any answer that may come from its budget
-        rather than from the search is a Timeout here: a plan not proven optimal, and a
+        left and the memory limit as its own with its fallback off (its plan, not proven
+        optimal, would be discarded after seconds of statistics and verification), and any
+        answer that may come from its budget rather than from the search is a Timeout here:
+        the exact stages running out (NoFallback), a plan not proven optimal, and a
         PlanningError or tie-breaks left undecided once the planner's exact stages may have
-        handed the time to its fallback (from ``EXACT_CHECK_SHARE`` of their share
-        ``1 - FALLBACK_SHARE`` on: the fallback answers then, and the expected number of
-        operations would not be the unlimited design's).
+        handed the time over (from ``EXACT_CHECK_SHARE`` of their share ``1 - FALLBACK_SHARE``
+        on: the expected number of operations would not be the unlimited design's).
         """
         if self.time_limit_s is None and self.memory_limit_mb is None:
             return make(None)
@@ -160,9 +162,13 @@ class DesignClock:
         )
         # Out of time once the exact stages may have handed over; otherwise the memory ran out.
         stopped = "time" if self.memory_limit_mb is None else "memory"
-        options = PlanningOptions(time_limit_s=left, memory_limit_mb=self.memory_limit_mb)
+        options = PlanningOptions(
+            time_limit_s=left, memory_limit_mb=self.memory_limit_mb, fallback=False
+        )
         try:
             made = make(options)
+        except NoFallback as exc:  # the exact stages ran out: the fallback's plan is no answer
+            raise Timeout(exc.reason) from None
         except PlanningError:
             # After its exact stages ran out the planner's fallback may give up early.
             if time.perf_counter() >= exact_end or self.deadline.expired():

@@ -33,7 +33,7 @@ from feederkit.planning.budget import (
     WorkBudget,
     collector_paused,
 )
-from feederkit.planning.fallback import fallback, sensorless_plan
+from feederkit.planning.fallback import NoFallback, fallback, sensorless_plan
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
@@ -420,7 +420,7 @@ def _plan(
     every = sorted({b.mask for b in root_branches})
     roots = sorted(maximal_sets(every)) if min_margin == 0.0 else every
     start_mass = [s.weight for s in machine.states]
-    exact_deadline = _exact_budget(budget)
+    exact_deadline = _exact_budget(budget, options.fallback)
     limit = None
     known: dict[int, float] | None = None
     kept_known = False  # whether kept_roots found that nature keeps no pair of a root apart
@@ -534,6 +534,8 @@ def _plan(
         worst.deadline = refiner.deadline = budget.until(FIRST_TREE_SHARE)
         ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
         cut = exc.reason
+        if cut != "work" and not options.fallback:
+            raise NoFallback(options, cut) from None  # a limit, not the ties' own work: cut short
         if not staged:
             refiner.floor = tie_floor(refiner.floor_found) if objective == "worst" else -math.inf
         try:
@@ -549,11 +551,14 @@ def _plan(
     return root, complete, length if shortest else None, length, ties, cut
 
 
-def _exact_budget(budget: Deadline) -> Deadline:
+def _exact_budget(budget: Deadline, fallback: bool = True) -> Deadline:
     """The exact search's budget: ``1 - FALLBACK_SHARE`` of the time limit and
     ``EXACT_MEMORY_SHARE`` of the memory; with a time limit a
     :class:`~feederkit.planning.budget.Checkpoint` at ``EXACT_CHECK_SHARE`` of the time from
-    now to that share's end (its ``on_course`` set when the roots' lengths are searched)."""
+    now to that share's end (its ``on_course`` set when the roots' lengths are searched).
+    Without a ``fallback`` to hand over to: all of ``budget``'s limits, no checkpoint."""
+    if not fallback:
+        return budget.until(1.0)
     share = budget.until(1.0 - FALLBACK_SHARE, EXACT_MEMORY_SHARE)
     if share.end is None:
         return share

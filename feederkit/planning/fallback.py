@@ -77,6 +77,18 @@ a little late beats none (the command then answers at most this much past its li
 later still is dropped like one too slow to find."""
 
 
+class NoFallback(PlanningError):
+    """The exact search ran out of its share of a limit and the options turn the fallback
+    off (``PlanningOptions.fallback``): no plan, as none is proven shortest. ``reason``: the
+    Timeout's (``"time"`` or ``"memory"``)."""
+
+    def __init__(self, options: PlanningOptions, reason: str) -> None:
+        super().__init__(
+            f"no plan proven shortest within {out_of_budget(options, reason)} (the fallback is off)"
+        )
+        self.reason = reason
+
+
 def fallback(
     problem: Problem,
     worst: WorstCase,
@@ -111,7 +123,11 @@ def fallback(
     No Timeout is kept past its ``except`` block: its traceback holds the frames of the
     search, and a frame holding it would make the searches' tables cyclic garbage that only
     the collector (paused while planning) could free.
+
+    With the fallback off (``options.fallback`` False) it raises :class:`NoFallback` at once.
     """
+    if not options.fallback:
+        raise NoFallback(options, stop)
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
     if stop == "memory":
         # Let the exact search's tables go: the fallback starts from a fresh problem.

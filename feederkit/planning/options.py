@@ -156,7 +156,10 @@ class PlanningOptions:
     of an operation (:class:`ActionCosts`), needed by the ``time`` and ``worst-time``
     objectives; with the operation objectives it breaks ties among equal operation counts
     toward less time; ``lumping``: which states no strong plan resolves a plan may list
-    together under uncertainty (:class:`Lumping`).
+    together under uncertainty (:class:`Lumping`); ``fallback``: past the exact search's
+    share of a limit, answer with the best plan the fallback finds (not proven shortest);
+    False: stop there with :class:`~feederkit.planning.fallback.NoFallback` instead (a
+    sensor design, which is the unlimited one or nothing, wants no plan it would discard).
     """
 
     objective: Objective = Objective.WORST
@@ -167,6 +170,7 @@ class PlanningOptions:
     memory_limit_mb: float | None = None
     costs: ActionCosts | None = None
     lumping: Lumping = Lumping.NEAR_SYMMETRIC
+    fallback: bool = True
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -196,6 +200,8 @@ class PlanningOptions:
             ):
                 raise InputError(f"the memory limit must be a positive number of MB, got {mem}")
             set_(self, "memory_limit_mb", float(mem))
+        if not isinstance(self.fallback, bool):
+            raise InputError(f"the fallback must be True or False, got {self.fallback!r}")
         if self.costs is not None and not isinstance(self.costs, ActionCosts):
             raise InputError(f"the action costs must be ActionCosts, got {self.costs!r}")
         if self.objective.timed and self.costs is None:  # type: ignore[attr-defined]
