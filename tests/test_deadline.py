@@ -22,6 +22,7 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning import api, fallback
+from feederkit.planning import budget as budget_module
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import goal_relation, plan
 from feederkit.planning.budget import Checkpoint, Deadline, Timeout, WorkBudget, rss_mb
@@ -126,6 +127,32 @@ def test_committed_nodes_bring_every_share_of_a_budget_forward():
     unlimited = Deadline(per_pair_s=1.0)
     unlimited.commit(10)
     assert unlimited.end is None
+
+
+def test_on_a_loaded_machine_committed_pairs_cost_their_slowness():
+    # The cost per pair is measured idle: a budget whose process got half the CPU since it
+    # began (2 wall seconds, 1 CPU second) keeps twice as much for the work after it, and
+    # every share counts from the same instant.
+    now_wall, now_cpu = time.perf_counter(), time.process_time()
+    d = Deadline(10.0, per_pair_s=0.01, clock_start=(now_wall - 2.0, now_cpu - 1.0))
+    assert d.slowness() == pytest.approx(2.0, rel=0.05)
+    end = d.end
+    d.commit(100)
+    assert d.end == pytest.approx(end - 2.0, rel=0.05)
+    share = d.until(0.5)
+    assert share.clock_start == d.clock_start
+    checkpoint = Checkpoint(share, time.perf_counter() + 1.0, share.end)
+    later = checkpoint.later
+    checkpoint.commit(50)
+    assert checkpoint.later == pytest.approx(later - 1.0, rel=0.05)
+    for copy in (share.share_from_now(0.1), share.ending(None), WorkBudget(checkpoint, 5)):
+        assert copy.clock_start == d.clock_start
+    # Never below 1 (threads may add CPU seconds), at most SLOWNESS_MAX (a process that
+    # waited), and 1 until SLOWNESS_MIN_S have passed (too little to tell).
+    assert Deadline(clock_start=(now_wall - 1.0, now_cpu - 3.0)).slowness() == 1.0
+    waited = Deadline(clock_start=(now_wall - 100.0, now_cpu - 1.0))
+    assert waited.slowness() == budget_module.SLOWNESS_MAX
+    assert Deadline(clock_start=(now_wall, now_cpu - 0.0)).slowness() == 1.0
 
 
 def test_a_checkpoint_goes_on_only_when_on_course():

@@ -33,6 +33,14 @@ with a 60 s limit grew by about 2 GB, and 2.4 s passed between the searches' Tim
 the answer (0.9 s of it in the lumping stage's return, 1.5 s unwinding the planner); a
 dictionary of 6 million tuples (1.9 GB) takes 0.4 CPU s to free."""
 
+SLOWNESS_MIN_S = 0.25
+"""A budget measures its :meth:`Deadline.slowness` once this many wall seconds have passed
+(before that it is 1: too little to tell)."""
+
+SLOWNESS_MAX = 4.0
+"""The largest :meth:`Deadline.slowness` a budget counts (a process that waited rather than
+computed would otherwise keep most of its limit back)."""
+
 _PAGE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
 
 
@@ -65,7 +73,9 @@ class Deadline:
     per (node, state) pair of the plan it is handed, a state that can reach a node
     (verifying the plan walks each pair once; writing it grows with them): a planner that
     makes nodes says how many pairs (:meth:`commit`) and its deadline comes that much
-    earlier, so a large plan leaves time for its own verification and file.
+    earlier, so a large plan leaves time for its own verification and file; that cost is
+    measured idle, so it is scaled by the budget's :meth:`slowness`. ``clock_start`` is the
+    (wall, CPU) instant the slowness counts from (now unless given: shares keep it).
     """
 
     def __init__(
@@ -78,8 +88,10 @@ class Deadline:
         memory_base: float | None = None,
         per_pair_s: float = 0.0,
         grace_s: float = 0.0,
+        clock_start: tuple[float, float] | None = None,
     ) -> None:
         now = time.perf_counter()
+        self.clock_start = (now, time.process_time()) if clock_start is None else clock_start
         self.per_pair_s = per_pair_s
         self.grace_s = grace_s
         self.start = now if start is None else start
@@ -125,15 +137,31 @@ class Deadline:
             return True
         return False
 
+    def slowness(self) -> float:
+        """Wall seconds per CPU second of this process since the budget began, between 1 and
+        :data:`SLOWNESS_MAX` (1 in its first :data:`SLOWNESS_MIN_S`): on a loaded machine the
+        work after the planner, whose cost per pair was measured idle, takes that much
+        longer (two busy processes beside a plan on two cores make it about 1.5).
+
+        >>> Deadline().slowness()
+        1.0
+        """
+        wall0, cpu0 = self.clock_start
+        wall = time.perf_counter() - wall0
+        if wall < SLOWNESS_MIN_S:
+            return 1.0
+        cpu = time.process_time() - cpu0
+        return min(SLOWNESS_MAX, max(1.0, wall / max(cpu, 1e-9)))
+
     def commit(self, pairs: int, stop: bool = True) -> None:
         """A planner has made plan nodes with ``pairs`` more (node, state) pairs (fewer when
-        negative: a plan it no longer holds): the deadline moves ``per_pair_s`` earlier for
-        each (nothing without a deadline or a cost), past the first ``grace_s`` seconds of
-        them. With ``stop``, Timeout is raised when that end has passed (a tree's last nodes
-        need no poll after them to stop it); without, the end only moves (a plan already
-        made and kept)."""
+        negative: a plan it no longer holds): the deadline moves ``per_pair_s`` times the
+        :meth:`slowness` earlier for each (nothing without a deadline or a cost), past the
+        first ``grace_s`` seconds of them. With ``stop``, Timeout is raised when that end has
+        passed (a tree's last nodes need no poll after them to stop it); without, the end
+        only moves (a plan already made and kept)."""
         if self.end is not None and self.per_pair_s:
-            cost = pairs * self.per_pair_s
+            cost = pairs * self.per_pair_s * self.slowness()
             if cost > 0.0 and self.grace_s > 0.0:
                 free = min(cost, self.grace_s)
                 self.grace_s -= free
@@ -170,6 +198,7 @@ class Deadline:
             start=self.start,
             memory_base=base,
             per_pair_s=self.per_pair_s,
+            clock_start=self.clock_start,
         )
 
     def share_from_now(self, time_share: float) -> Deadline:
@@ -198,6 +227,7 @@ class Deadline:
             start=self.start,
             memory_base=self.memory_base,
             per_pair_s=self.per_pair_s,
+            clock_start=self.clock_start,
         )
 
 
@@ -236,6 +266,7 @@ class Checkpoint(Deadline):
             start=outer.start,
             memory_base=outer.memory_base,
             per_pair_s=outer.per_pair_s,
+            clock_start=outer.clock_start,
         )
         self.later = end
         self.on_course = on_course
@@ -244,10 +275,11 @@ class Checkpoint(Deadline):
     def commit(self, pairs: int, stop: bool = True) -> None:
         """:meth:`Deadline.commit` for both ends; a passed end is left to :meth:`check`,
         which asks whether the stage is on course (``stop`` has no effect here)."""
-        if self.end is not None and self.per_pair_s:
-            self.end -= pairs * self.per_pair_s
+        cost = pairs * self.per_pair_s * self.slowness() if self.per_pair_s else 0.0
+        if self.end is not None:
+            self.end -= cost
         if self.later is not None:
-            self.later -= pairs * self.per_pair_s
+            self.later -= cost
 
     def go_on(self) -> None:
         """The end is ``end`` from now on (no question asked at ``first``)."""
@@ -294,6 +326,7 @@ class WorkBudget(Deadline):
             start=outer.start,
             memory_base=outer.memory_base,
             per_pair_s=outer.per_pair_s,
+            clock_start=outer.clock_start,
         )
         self.allowance = polls
 

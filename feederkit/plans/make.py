@@ -173,8 +173,9 @@ def _make_plan(
     machine = widen_widths(unwidened, offsets)
     if rejected:
         _check_rejects_separable(machine, named, lambda: _finest_machine(pfs, unc))
+    budget = planner_budget(opts, started, certify)
     try:
-        result = plan_machine(machine, opts, budget=planner_budget(opts, started, certify))
+        result = plan_machine(machine, opts, budget=budget)
     except NoStrongPlan as exc:
         left = seconds_left(opts, started)
         blame = blocking_members(
@@ -247,7 +248,7 @@ def _make_plan(
             "what holds"
         )
     if certify:
-        output_s = output_seconds(data)
+        output_s = output_seconds(data) * budget.slowness()  # measured idle: as loaded now
         cert, cut = certificate(data, unc, opts, started, output_s)
         if not unc.is_ideal:
             cert = replace(cert, ideal_length=ideal_length(ideal, opts, started, output_s))

@@ -44,12 +44,14 @@ comes this much earlier per pair of the nodes it makes (``Deadline.per_pair_s``)
 plan leaves time for its own verification and file. Measured about 3.2e-5 s on two plans
 (``python benchmarks/bench_command_deadline.py``): a 100-part mix's under 1 degree, 164,000
 pairs in 5.3 s, and a 1000-point outline's over both landings on the ideal model, 265,000
-pairs in 8.5 s."""
+pairs in 8.5 s. Measured idle, so scaled by the planner's budget's slowness
+(``Deadline.slowness``: wall over CPU seconds since it began) on a loaded machine."""
 
 OUTPUT_S_PER_NODE = 7e-5
 """Seconds per node of the plan file (each shared step once, each result in place) of what
 comes after the certificate: writing the file, reading it back and drawing it (2.5 s for the
-44,000 nodes of the 100-part mix's plan above)."""
+44,000 nodes of the 100-part mix's plan above); scaled by the planner's budget's slowness as
+``POST_S_PER_PAIR`` is."""
 
 
 def planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
