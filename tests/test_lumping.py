@@ -31,7 +31,7 @@ from feederkit.machine.inseparable import kept_apart
 from feederkit.mechanics import push_function, uncertain
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.budget import Deadline
+from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.lumping import (
     LumpedGoal,
     LumpingTry,
@@ -387,6 +387,35 @@ def test_a_share_of_the_limit_run_out_leaves_lumping_undecided_not_timed_out():
     assert by_share.undecided == by_sets.undecided and by_share.undecided
     out = try_lumping(machine, Grouping.EXACT, Deadline(0.0), share=Deadline(0.0))
     assert out.cut_by == "time" and not out.undecided
+
+
+def test_the_pairs_nature_keeps_apart_are_polled_and_made_once_per_machine(monkeypatch):
+    """A plan asks for them first (its kept roots), its lumping again, and past the lumping's
+    share once more: one fixpoint, polled (on the 100-part mix at 5 % under 1 degree it ran
+    unpolled twice past the share, 2 s past a 10 s limit); a cut-short one is not kept."""
+    from feederkit.planning import solvable
+
+    machine = by_diameter(build_machine([near_rectangle()], NoSensor(), Uncertainty()))[0]
+    problem = Problem(machine, Grouping.EXACT, 0.0)
+    calls = []
+    real = solvable.kept_apart
+
+    def counted(m, pairs, check=None):
+        calls.append(check)
+        return real(m, pairs, check)
+
+    monkeypatch.setattr(solvable, "kept_apart", counted)
+    with pytest.raises(Timeout):
+        solvable.kept_pairs(problem, Deadline(0.0))
+    assert len(calls) == 1 and calls[0] is not None
+    out = try_lumping(machine, Grouping.EXACT, Deadline(60.0), share=Deadline(0.0))
+    assert out.cut_by == "sets" and len(calls) == 3  # cut by the share, then made and kept
+    again = try_lumping(machine, Grouping.EXACT, Deadline(60.0))
+    kept = solvable.kept_pairs(problem)
+    assert len(calls) == 3 and again.goal is not None
+    assert kept == frozenset(real(machine, solvable.alike_pairs(problem))) == {(0, 1), (2, 3)}
+    assert solvable.kept_roots(problem, [0b1111, 0b0101]) == [0b1111]
+    assert len(calls) == 3
 
 
 def test_an_undecided_lumped_goal_with_no_plan_says_so(monkeypatch):

@@ -55,6 +55,8 @@ class SearchSpace:
         self._rows: dict[int, list[int]] = {}
         self._bit_rows: dict[int, list[int]] = {}
         self._pickers: dict[int, Callable[[list[int]], tuple[int, ...]]] = {}
+        # Pairs nature keeps apart per (grouping, goal relation): planning.solvable.kept_pairs.
+        self.kept: dict[tuple[object, tuple[int, ...]], frozenset[tuple[int, int]]] = {}
 
     @property
     def machine(self) -> PushAlignMachine:

@@ -48,12 +48,11 @@ from dataclasses import dataclass
 
 from feederkit.errors import InputError
 from feederkit.machine import Grouping, PushAlignMachine, members
-from feederkit.machine.inseparable import kept_apart
 from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import MAX_SETS, alike_pairs, candidate_pairs, solve
+from feederkit.planning.solvable import MAX_SETS, candidate_pairs, kept_pairs, solve
 from feederkit.planning.tree import PlanTree, leaf_masks
 from feederkit.planning.wandering import is_twin_pair, wandering_words
 
@@ -117,7 +116,7 @@ def unresolvable_pairs(
     together, those sets pruned.
     """
     pairs = candidate_pairs(problem)
-    kept = kept_apart(problem.machine, alike_pairs(problem))
+    kept = kept_pairs(problem, deadline)
     rest = [p for p in pairs if p not in kept]
     found = set(kept)
     if rest:
@@ -204,8 +203,9 @@ def try_lumping(
 
     ``share``, a deadline before ``deadline`` (a stage of a plan's budget): past it what is
     not yet decided is left as past ``pair_sets`` and ``max_sets`` (the pairs from
-    :func:`kept_apart`, the goals ``undecided`` for a search to try), so that deciding
-    cannot take the time a search needs; only ``deadline`` itself ends in Timeout's reason.
+    :func:`~feederkit.planning.solvable.kept_pairs`, the goals ``undecided`` for a search to
+    try), so that deciding cannot take the time a search needs; only ``deadline`` itself
+    ends in Timeout's reason.
     """
     rule = _rule(rule)
     if machine.deterministic or machine.n < 2 or rule is Lumping.NONE:
@@ -230,7 +230,8 @@ def try_lumping(
             pairs = None
         exact = pairs is not None
         if pairs is None:
-            pairs = tuple(sorted(kept_apart(problem.machine, alike_pairs(problem))))
+            # Past the share, under the plan's own limit (its Timeout ends the decision).
+            pairs = tuple(sorted(kept_pairs(problem, deadline)))
         unlike = tuple(p for p in pairs if not may_lump(machine, *p, rule))
         pairs = tuple(p for p in pairs if may_lump(machine, *p, rule))
         if not pairs:
