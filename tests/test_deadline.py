@@ -198,6 +198,20 @@ def test_the_exact_search_is_on_course_with_its_share_of_roots_proven():
     assert api._on_course(problem, worst, roots)
 
 
+def _endless_length_search(monkeypatch) -> list[Deadline]:
+    """The length search replaced by one that never ends on its own (it polls until
+    stopped); the budgets it was given, as it is called."""
+    budgets: list[Deadline] = []
+
+    def endless(problem, worst, *_args, **_kwargs):
+        budgets.append(worst.deadline)
+        while True:
+            worst.deadline.check()
+
+    monkeypatch.setattr(api, "longest_root", endless)
+    return budgets
+
+
 def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(monkeypatch):
     # The checkpoint at once (share 0) and never on course; the exact search never ends on
     # its own (it polls until stopped): the fallback starts with nearly the whole limit, not
@@ -206,14 +220,7 @@ def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(
     exact = plan(machine)
     monkeypatch.setattr(api, "EXACT_CHECK_SHARE", 0.0)
     monkeypatch.setattr(api, "_on_course", lambda *_args: False)
-    budgets = []
-
-    def endless(problem, worst, *_args, **_kwargs):
-        budgets.append(worst.deadline)
-        while True:
-            worst.deadline.check()
-
-    monkeypatch.setattr(api, "longest_root", endless)
+    budgets = _endless_length_search(monkeypatch)
     left = []
     real = api.fallback
 
@@ -406,14 +413,7 @@ def test_with_the_fallback_off_the_exact_search_has_the_whole_limit_then_no_plan
     # the whole limit (no checkpoint hands over early, no share is kept for a fallback), and
     # then there is no plan, in one line naming the limit, not the fallback's unproven one.
     machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
-    budgets = []
-
-    def endless(problem, worst, *_args, **_kwargs):
-        budgets.append(worst.deadline)
-        while True:
-            worst.deadline.check()
-
-    monkeypatch.setattr(api, "longest_root", endless)
+    budgets = _endless_length_search(monkeypatch)
     monkeypatch.setattr(fallback, "sensorless_plan", lambda *_a, **_k: pytest.fail("it ran"))
     limit = 0.6
     start = time.perf_counter()
