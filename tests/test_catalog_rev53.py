@@ -231,6 +231,57 @@ def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys
     assert code == 0 and [c["name"] for c in json.loads(out)] == ["c1"]
 
 
+def test_ctrl_c_just_after_the_commit_keeps_the_files_of_the_stored_changeover(
+    here, capsys, monkeypatch
+):
+    # A new user's review: one Ctrl-C in about a hundred left a changeover stored with no plan
+    # file (it came after the COMMIT, and the files were taken back as if nothing was stored).
+    import feederkit.mix.changeover as changeover_lib
+
+    db = two_parts(here, capsys, "octagon.json", "isosceles-right-triangle.json")
+    real = changeover_lib.save_changeover
+
+    def then_interrupt(*args: object, **kwargs: object) -> None:
+        real(*args, **kwargs)  # committed
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(changeover_lib, "save_changeover", then_interrupt)
+    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
+    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    assert code == 130
+    (line,) = err.splitlines()
+    assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
+    assert "wrote the plan to c1.json" in line
+    assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
+    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
+    assert code == 0 and [c["name"] for c in json.loads(out)] == ["c1"]
+
+
+def test_ctrl_c_after_the_files_are_placed_and_before_the_commit_leaves_neither(
+    here, capsys, monkeypatch
+):
+    import feederkit.mix.changeover as changeover_lib
+
+    db = two_parts(here, capsys, "octagon.json", "isosceles-right-triangle.json")
+    real = changeover_lib.save_changeover
+
+    def files_then_interrupt(*args: object, before_commit=None, **kwargs: object) -> None:
+        def placed_then_interrupt() -> None:
+            before_commit()
+            assert (here / "c1.json").is_file()
+            raise KeyboardInterrupt
+
+        real(*args, before_commit=placed_then_interrupt, **kwargs)
+
+    monkeypatch.setattr(changeover_lib, "save_changeover", files_then_interrupt)
+    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
+    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    assert (code, err) == (130, "error: interrupted\n")
+    assert not (here / "c1.json").exists() and list(here.glob(".c1.json.*")) == []
+    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
+    assert code == 0 and json.loads(out) == []
+
+
 def test_ctrl_c_before_anything_is_stored_says_only_interrupted(here, capsys, monkeypatch):
     import feederkit.cli.changeover as changeover_cli
 

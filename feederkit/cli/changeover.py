@@ -483,10 +483,9 @@ def compile_command(
             shares=shares,
             loaded=loaded,
             started=started,
+            on_stored=lambda: stored_and_written(name, path, output, report),
             **over,
         )
-    DONE_WORK.note(f"stored changeover {name!r} in {path}")
-    note_written((output, "plan"), (report, "report"))
     plan, witnesses = compiled.plan, list(compiled.witnesses)
     lands = landings_text(plan, compiled.rejected)
     cycle = plan["stats"].get("cycle_time")
@@ -562,6 +561,14 @@ def _shares(plan: dict[str, Any]) -> dict[str, float]:
             return {n: 1.0 / len(names) for n in names}
         out[p.get("name")] = out.get(p.get("name"), 0.0) + float(share)
     return out
+
+
+def stored_and_written(
+    name: str, path: Path | str, output: Path | None, report: Path | None
+) -> None:
+    """Note for a Ctrl-C from now on that the changeover is stored and its files written."""
+    DONE_WORK.note(f"stored changeover {name!r} in {path}")
+    note_written((output, "plan"), (report, "report"))
 
 
 def listed_uncertainty(stored: object) -> tuple[Uncertainty | None, bool | None]:

@@ -468,6 +468,7 @@ def compile_changeover(
     accept: Collection[str] | None = None,
     loaded: LoadedParts | None = None,
     started: float | None = None,
+    on_stored: Callable[[], None] | None = None,
 ) -> CompiledChangeover:
     """Plan, verify and store the changeover ``name`` for ``members`` (catalog parts).
 
@@ -486,7 +487,9 @@ def compile_changeover(
     neither. ``uncertainty`` is the declared one (default ``Uncertainty()``); ``loaded``
     the members as the caller loaded them (:func:`load_parts`), e.g. to declare the
     tolerances their revisions store (:func:`feederkit.catalog.declared_tolerances`);
-    ``started`` the instant the time limit counts from (:func:`~feederkit.plans.make.make_plan`).
+    ``started`` the instant the time limit counts from (:func:`~feederkit.plans.make.make_plan`);
+    ``on_stored`` is called once the changeover and its files are in place, also when an
+    interrupt comes after that (it then goes on up: the caller can say what was done).
     Raises InputError for an existing name (unless ``replace``), bad parts, a landing a part does
     not have or an accepted name no landing has, PlanningError when no plan meets the
     request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
@@ -530,6 +533,7 @@ def compile_changeover(
         name, tuple(revisions), tuple(pfs), made, tuple(witnesses), tuple(warnings), rejected
     )
     files = [] if outputs is None else list(outputs(compiled))
+    text = None
     with StagedFiles(files) as staged:
         try:
             text, view = read_back(made.plan)  # after ``outputs``, which may annotate it
@@ -543,9 +547,24 @@ def compile_changeover(
                 before_commit=staged.commit,
             )
         except BaseException:
-            staged.undo()
+            # An interrupt after the COMMIT (leaving the catalog's context) must not take the
+            # files of a stored changeover away: the catalog says whether it holds this plan.
+            if not (staged.committed and _stored_as(catalog, name, text)):
+                staged.undo()
+            elif on_stored is not None:
+                on_stored()
             raise
+    if on_stored is not None:
+        on_stored()
     return dataclasses.replace(compiled, view=view)
+
+
+def _stored_as(catalog: str | os.PathLike[str], name: str, text: str | None) -> bool:
+    """Whether the catalog holds the changeover ``name`` with the plan JSON ``text``."""
+    try:
+        return text is not None and get_changeover(catalog, name).plan_json == text
+    except InputError:
+        return False
 
 
 def _stored_landings(
