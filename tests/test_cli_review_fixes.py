@@ -341,3 +341,58 @@ def test_the_search_spinner_keeps_its_clock_on_a_narrow_terminal(monkeypatch):
         pass
     frame = out.getvalue().split("\r")[1]
     assert "0:00:00" in frame and "…" in frame and "compiling changeover" in frame
+
+
+def test_ctrl_c_inside_a_finalizer_prints_no_traceback_and_other_errors_still_do():
+    """A Ctrl-C inside a weak reference's callback while the results print was "Exception
+    ignored in: <function WeakSet...> Traceback ... KeyboardInterrupt" (a new user's review)."""
+    import types
+
+    from feederkit.cli.app import _quiet_interrupts
+
+    seen = []
+    hook = _quiet_interrupts(seen.append)
+
+    def unraisable(exc: BaseException) -> types.SimpleNamespace:
+        return types.SimpleNamespace(exc_value=exc, exc_type=type(exc), object=None)
+
+    assert hook(unraisable(KeyboardInterrupt())) is None and seen == []
+    other = unraisable(ValueError("a real one"))
+    hook(other)
+    assert seen == [other]
+
+
+def test_ctrl_c_while_the_modules_load_is_interrupted_even_as_an_import_error(capsys, monkeypatch):
+    """A C extension interrupted in its initialisation fails with ImportError ("initialization
+    failed", scipy): after a SIGINT that is the interrupt's, one line and 130, no traceback."""
+    import feederkit.cli.app as app_module
+
+    monkeypatch.setattr(app_module, "_loading_interrupted", True)
+    with pytest.raises(SystemExit) as info:
+        app_module._loading_failed(ImportError("initialization failed"))
+    assert info.value.code == 130 and capsys.readouterr().err == "error: interrupted\n"
+    monkeypatch.setattr(app_module, "_loading_interrupted", False)
+    app_module._loading_failed(ImportError("no module named scipy"))  # not ours: goes on up
+    with pytest.raises(SystemExit):
+        app_module._loading_failed(KeyboardInterrupt())
+    assert signal.getsignal(signal.SIGINT) is not app_module._note_loading_interrupt  # loaded
+
+
+def test_once_the_command_answered_a_late_ctrl_c_changes_nothing(monkeypatch):
+    """SIGINT is ignored while Python exits after the answer (a new user's review: a finished
+    compile, its files written, ended 130 with no word when Ctrl-C came at the very end)."""
+    import sys
+
+    import feederkit.cli.app as app_module
+
+    monkeypatch.setattr(app_module, "main", lambda: 0)
+    monkeypatch.setattr(app_module, "end_quietly_on_closed_pipe", lambda: None)
+    monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        with pytest.raises(SystemExit) as info:
+            app_module.run()
+        assert info.value.code == 0
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -13,15 +13,40 @@ fails later with an unrelated TypeError); :class:`_CtrlCWatch` notes that SIGINT
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import sys
 
+_loading_interrupted = False  # a SIGINT came while the modules below were loading
+
+
+def _note_loading_interrupt(signum: int, frame: object) -> None:
+    """SIGINT while the modules load: noted, then the previous handler (KeyboardInterrupt).
+    A C extension interrupted in its initialisation fails with an ImportError instead
+    (scipy: "initialization failed"), which is then the interrupt's, not a broken install."""
+    global _loading_interrupted
+    _loading_interrupted = True
+    _previous_sigint(signum, frame)
+
+
+_previous_sigint = signal.getsignal(signal.SIGINT)
+if callable(_previous_sigint):
+    with contextlib.suppress(ValueError):  # not the main thread: no handler can be set
+        signal.signal(signal.SIGINT, _note_loading_interrupt)
+
+
+def _loading_failed(exc: BaseException) -> None:
+    """Ctrl-C while the modules load: one line, 130; any other failure goes on up."""
+    if isinstance(exc, KeyboardInterrupt) or _loading_interrupted:
+        sys.stderr.write("error: interrupted\n")
+        raise SystemExit(130) from None
+
+
 try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one line, too.
-    import contextlib
     import errno
     import functools
     import importlib
     import os
-    import signal
     import sqlite3
     import tempfile
     import traceback
@@ -50,9 +75,9 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
         print_json,
     )
     from feederkit.errors import FeederkitError
-except KeyboardInterrupt:
-    sys.stderr.write("error: interrupted\n")
-    raise SystemExit(130) from None
+except (KeyboardInterrupt, ImportError) as exc:
+    _loading_failed(exc)
+    raise
 
 helpstyle.apply()
 
@@ -121,9 +146,12 @@ def _register() -> None:
 
 try:
     _register()
-except KeyboardInterrupt:
-    sys.stderr.write("error: interrupted\n")
-    raise SystemExit(EXIT_INTERRUPTED) from None
+except (KeyboardInterrupt, ImportError) as exc:
+    _loading_failed(exc)
+    raise
+finally:
+    if signal.getsignal(signal.SIGINT) is _note_loading_interrupt:
+        signal.signal(signal.SIGINT, _previous_sigint)  # loaded: the handler as it was
 
 
 @functools.cache
@@ -446,12 +474,30 @@ def end_quietly_on_closed_pipe() -> None:
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
 
 
+def _quiet_interrupts(hook: Callable[[Any], object]) -> Callable[[Any], object]:
+    """``sys.unraisablehook`` that drops a KeyboardInterrupt (Ctrl-C inside a finalizer or a
+    weak reference's callback, which Python would print as "Exception ignored" with a
+    traceback) and passes anything else to ``hook``; the command says "interrupted"."""
+
+    def quiet(unraisable: Any) -> object:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return None
+        return hook(unraisable)
+
+    return quiet
+
+
 def run() -> None:
-    """Console-script wrapper around :func:`main`."""
+    """Console-script wrapper around :func:`main`. Once it has answered, a Ctrl-C changes
+    nothing: SIGINT is ignored while Python exits (else an interrupt in its shutdown would
+    end a finished command with 130 and no word)."""
     end_quietly_on_closed_pipe()
+    sys.unraisablehook = _quiet_interrupts(sys.unraisablehook)
     try:
         code = main()
     except KeyboardInterrupt:  # Ctrl-C while printing the error itself
         sys.stderr.write("error: interrupted\n")
         code = EXIT_INTERRUPTED
+    with contextlib.suppress(ValueError):  # not the main thread
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     sys.exit(code)
