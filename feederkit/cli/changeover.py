@@ -248,18 +248,25 @@ REPORT_DESIGN_MIN_S = 1.0
 left: a small mix's design still comes out; a large one's section says it was cut short."""
 
 
-def report_design_budget(time_limit_s: float | None, started: float) -> float:
+REPORT_DRAW_S_PER_PART = 0.35
+"""Seconds the report takes to draw each part's section (its outline, radius function, push
+function and diameters in one SVG figure; 20 landings of a 10-part mix took 6-7 s): kept
+from the report's sensor design, so that the command answers within about its limit."""
+
+
+def report_design_budget(time_limit_s: float | None, started: float, parts: int = 0) -> float:
     """Seconds the report's sensor design may take in a command that started at ``started``
-    (``time.monotonic()``) under ``--time-limit`` ``time_limit_s``: what is left of it (at least
+    (``time.monotonic()``) under ``--time-limit`` ``time_limit_s``: what is left of it less
+    ``REPORT_DRAW_S_PER_PART`` for each of the report's ``parts`` (at least
     ``REPORT_DESIGN_MIN_S``), never more than ``REPORT_DESIGN_LIMIT_S``; with no time limit,
-    that (docs/reports.md)."""
+    that (docs/reports.md). Tenths of a second: the warning of a design cut short names it."""
     from feederkit.design import sensor
 
     cap = sensor.REPORT_DESIGN_LIMIT_S
     if time_limit_s is None:
         return cap
-    left = time_limit_s - (time.monotonic() - started)
-    return min(cap, max(REPORT_DESIGN_MIN_S, left))
+    left = time_limit_s - (time.monotonic() - started) - REPORT_DRAW_S_PER_PART * parts
+    return min(cap, max(REPORT_DESIGN_MIN_S, math.floor(10.0 * left) / 10.0))
 
 
 def changeover_design(
@@ -461,7 +468,7 @@ def compile_command(
         annotate_cycle_time(c.made, settings)
         files, _view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
         if report is not None:
-            budget = report_design_budget(options.time_limit_s, started)
+            budget = report_design_budget(options.time_limit_s, started, len(c.parts))
             html = changeover_report(c.plan, list(c.parts), list(c.witnesses), budget)
             files.append(OutputFile(report, html, "report"))
         return files
@@ -821,8 +828,9 @@ def report_command(
         typer.Option(
             "--time-limit",
             metavar="S",
-            help="Seconds for the report's sensor design (default 60); past them its section "
-            "is cut short and says what it decided.",
+            help="Seconds the report may take (default 60): its sensor design gets them less "
+            "the drawing of each part; past them its section is cut short and says what it "
+            "decided.",
         ),
     ] = None,
     catalog: CatalogOpt = None,
@@ -830,12 +838,16 @@ def report_command(
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
     from feederkit.design.limit import check_limits
 
-    design_limit, _ = check_limits(time_limit, None)  # InputError before any work
+    started = time.monotonic()
+    with flag_words():
+        design_limit, _ = check_limits(time_limit, None)  # InputError before any work
     check_report_name(output)  # a .txt or .pdf would hold HTML: refused before any work
     check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    html = changeover_report(co.plan, list(co.parts), co.witnesses(), design_limit, co.warnings)
+    limit = 60.0 if design_limit is None else design_limit
+    budget = min(limit, report_design_budget(limit, started, len(co.parts)))
+    html = changeover_report(co.plan, list(co.parts), co.witnesses(), budget, co.warnings)
     write_files([OutputFile(output, html, "report")])
     note_written((output, "report"))
     console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)
