@@ -398,3 +398,18 @@ def test_bad_uncertainties_are_one_line_exit_2(cli, capsys, args, needle):
     assert main(["design", "sensor", *MIX[:2], *args]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and needle in err
+
+
+def test_an_answer_names_its_uncertainty_once():
+    """A pair no sensor separates under uncertainty gives its reason with the uncertainty in
+    it: the answer's end does not say it again (a new user's review: "(no strong plan tells
+    ... under rotation error 1 deg, ...) (strong plans, rotation error 1 deg, ...)")."""
+    from feederkit.design.sensor import _model_words
+    from feederkit.design.strong import uncertainty_words
+
+    u = Uncertainty(1.0, 0.0, 0.0)
+    end = f" (strong plans, {uncertainty_words(u)})"
+    assert _model_words(("a", "b"), None, u, "") == end
+    said = f"no sensor separates a and b (no strong plan tells them apart under {end[16:-1]})"
+    assert _model_words(("a", "b"), None, u, said) == ""
+    assert _model_words(("a", "b"), None, IDEAL, "") == ""

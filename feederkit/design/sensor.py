@@ -148,6 +148,16 @@ def member_landing_rows(members: Sequence[PlanMember] | None) -> list[dict[str, 
     ]
 
 
+def _model_words(
+    parts: Sequence[str], members: Sequence[PlanMember] | None, u: Uncertainty, said: str
+) -> str:
+    """An answer's end: the members the plans reject, then the model they are for, unless
+    ``said`` (the answer so far) names the uncertainty already (a pair's reason does)."""
+    named = uncertainty_words(u)
+    words = "" if u.is_ideal or named in said else f" (strong plans, {named})"
+    return _rejected_words(parts, members) + words
+
+
 def _pairs_words(pairs: Sequence[PairCritical], limit: int = 5) -> str:
     words = [f"{p.a} and {p.b}" for p in pairs[:limit]]
     more = len(pairs) - limit
@@ -223,11 +233,9 @@ class ToleranceDesign:
                 return s
         return None
 
-    def _model_words(self) -> str:
-        """The answer's end: the members the plans reject, then the model they are for."""
-        u = self.uncertainty
-        words = "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
-        return _rejected_words(self.parts, self.members) + words
+    def _model_words(self, said: str = "") -> str:
+        """The answer's end (:func:`_model_words`)."""
+        return _model_words(self.parts, self.members, self.uncertainty, said)
 
     def answer(self) -> str:
         """The design in one line, naming the members it rejects and the uncertainty it is
@@ -248,7 +256,8 @@ class ToleranceDesign:
             limit = self.plan_limit
             if self.critical.inseparable or limit is None:
                 text = "no tolerance makes this mix recognizable: no sensor separates "
-                return text + _pairs_words(self.critical.inseparable) + self._model_words()
+                text += _pairs_words(self.critical.inseparable)
+                return text + self._model_words(text)
             where = "at any tolerance" if limit.hi is None else f"up to {limit.hi:.6g} mm"
             return (
                 f"no tolerance makes this mix recognizable: {_limit_words(limit)} {where}"
@@ -399,11 +408,9 @@ class PitchDesign:
         """Whether some pitch of the list makes the mix recognizable."""
         return self.critical_pitch is not None
 
-    def _model_words(self) -> str:
-        """The answer's end: the members the plans reject, then the model they are for."""
-        u = self.uncertainty
-        words = "" if u.is_ideal else f" (strong plans, {uncertainty_words(u)})"
-        return _rejected_words(self.parts, self.members) + words
+    def _model_words(self, said: str = "") -> str:
+        """The answer's end (:func:`_model_words`)."""
+        return _model_words(self.parts, self.members, self.uncertainty, said)
 
     def answer(self) -> str:
         """The design in one line, naming the members it rejects and the uncertainty it is
@@ -419,7 +426,7 @@ class PitchDesign:
                 text += "; try finer pitches"
             else:
                 text += ": no strong plan exists with any of them"
-            return text + self._model_words()
+            return text + self._model_words(text)
         row = next(r for r in self.rows if r.pitch == y)
         return (
             f"this mix is recognizable with an LED pitch of {y:.6g} mm "
