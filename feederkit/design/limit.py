@@ -39,7 +39,8 @@ PITCHES = "deciding the LED pitches"
 
 _NOUNS = {
     PAIRS: "pairs",
-    GOALS: "steps of the length table's goal search",
+    # Two passes over the intervals (goal_segments): a cut in the second reads "N of 2N".
+    GOALS: "steps of the length table's goal search, two an interval",
     LENGTHS: "tolerance intervals of the length table",
     PITCHES: "LED pitches",
 }
