@@ -211,6 +211,20 @@ def test_is_outline_file_decides_by_whether_the_text_parses(tmp_path) -> None:
 # 8e. A Ctrl-C while the results are printed, after the work is stored and written, says so.
 
 
+def compile_c1(capsys, db: str, *extra: str) -> tuple[int, str]:
+    """``changeover compile c1`` of the octagon and the triangle at 0.2 mm: exit code, stderr."""
+    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
+    code, _, err = run(capsys, *args, "--tolerance", "0.2", *extra, "--catalog", db)
+    return code, err
+
+
+def stored_names(capsys, db: str) -> list[str]:
+    """The names of the catalog's stored changeovers."""
+    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
+    assert code == 0
+    return [c["name"] for c in json.loads(out)]
+
+
 def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys, monkeypatch):
     import feederkit.cli.changeover as changeover_cli
 
@@ -220,15 +234,13 @@ def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys
         raise KeyboardInterrupt
 
     monkeypatch.setattr(changeover_cli, "plan_tree", interrupt)  # drawn after the commit
-    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
-    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    code, err = compile_c1(capsys, db, "-o", "c1.json")
     assert code == 130
     (line,) = err.splitlines()
     assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
     assert "wrote the plan to c1.json" in line and "only the printing was cut" in line
     assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
-    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
-    assert code == 0 and [c["name"] for c in json.loads(out)] == ["c1"]
+    assert stored_names(capsys, db) == ["c1"]
 
 
 def test_ctrl_c_just_after_the_commit_keeps_the_files_of_the_stored_changeover(
@@ -246,15 +258,13 @@ def test_ctrl_c_just_after_the_commit_keeps_the_files_of_the_stored_changeover(
         raise KeyboardInterrupt
 
     monkeypatch.setattr(changeover_lib, "save_changeover", then_interrupt)
-    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
-    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    code, err = compile_c1(capsys, db, "-o", "c1.json")
     assert code == 130
     (line,) = err.splitlines()
     assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
     assert "wrote the plan to c1.json" in line
     assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
-    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
-    assert code == 0 and [c["name"] for c in json.loads(out)] == ["c1"]
+    assert stored_names(capsys, db) == ["c1"]
 
 
 def test_ctrl_c_after_the_files_are_placed_and_before_the_commit_leaves_neither(
@@ -274,12 +284,10 @@ def test_ctrl_c_after_the_files_are_placed_and_before_the_commit_leaves_neither(
         real(*args, before_commit=placed_then_interrupt, **kwargs)
 
     monkeypatch.setattr(changeover_lib, "save_changeover", files_then_interrupt)
-    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
-    code, _, err = run(capsys, *args, "--tolerance", "0.2", "-o", "c1.json", "--catalog", db)
+    code, err = compile_c1(capsys, db, "-o", "c1.json")
     assert (code, err) == (130, "error: interrupted\n")
     assert not (here / "c1.json").exists() and list(here.glob(".c1.json.*")) == []
-    code, out, _ = run(capsys, "changeover", "list", "--catalog", db, "--json")
-    assert code == 0 and json.loads(out) == []
+    assert stored_names(capsys, db) == []
 
 
 def test_ctrl_c_before_anything_is_stored_says_only_interrupted(here, capsys, monkeypatch):
@@ -291,6 +299,5 @@ def test_ctrl_c_before_anything_is_stored_says_only_interrupted(here, capsys, mo
         raise KeyboardInterrupt
 
     monkeypatch.setattr(changeover_cli, "compile_changeover", interrupt)
-    args = ["changeover", "compile", "c1", "--mix", "octagon,isosceles-right-triangle"]
-    code, _, err = run(capsys, *args, "--tolerance", "0.2", "--catalog", db)
+    code, err = compile_c1(capsys, db)
     assert (code, err) == (130, "error: interrupted\n")
