@@ -44,11 +44,11 @@ import numpy as np
 
 from feederkit.angles import norm360
 from feederkit.landing.model import landings_of_outline
-from feederkit.mechanics.push import PushFunction, push_function, radius
-from feederkit.mechanics.uncertain import fence_outcomes, uncertain_mechanics
+from feederkit.mechanics.push import PushFunction, radius
+from feederkit.mechanics.uncertain import fence_outcomes
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
-from feederkit.sim.pushalign import PushAligner, size_scale
+from feederkit.sim.pushalign import size_scale
 from feederkit.sources import load_part
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -56,8 +56,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_push_bands import (  # noqa: E402
     ROOT,
     SAMPLES,
-    UNCERTAINTY,
     drawn_frictions,
+    landing_models,
     settled_state,
 )
 
@@ -162,11 +162,8 @@ def sweep(spec: str, offsets: tuple[float, ...], frictions: int) -> list[dict]:
     rows = []
     for landing in landings_of_outline(load(spec))[:2]:
         part = landing.part
-        pf = push_function(part)
-        mech = uncertain_mechanics(part, UNCERTAINTY)
+        pf, mech, aligner, normals = landing_models(part)
         scale = size_scale(part)
-        aligner = PushAligner(part, None, None, vibration_mm=mech.vibration_mm)
-        normals = np.array([s.normal_deg for s in pf.states])
         div = np.asarray(pf.divergent_deg, float)
         geo = basins(pf, part, scale)
         tally: dict[tuple[int, int], dict] = {}

@@ -55,6 +55,16 @@ def settled_state(
     return mech.state_of[int(np.argmin(off_normal))]
 
 
+def landing_models(part) -> tuple:
+    """What a push sweep over one landing needs: its push function, its mechanics at the
+    declared uncertainty, a simulator of its pushes (the mechanics' vibration) and its
+    states' normals."""
+    pf = push_function(part)
+    mech = uncertain_mechanics(part, UNCERTAINTY)
+    aligner = PushAligner(part, None, None, vibration_mm=mech.vibration_mm)
+    return pf, mech, aligner, np.array([s.normal_deg for s in pf.states])
+
+
 def default_sources() -> list[str]:
     files = sorted((ROOT / "catalog").glob("*.json"))
     if SAMPLES.is_dir():
@@ -69,10 +79,7 @@ def sweep(source: str, step: float, reach: float, frictions: int) -> list[dict]:
     rows = []
     for landing in landings_of_outline(load_part(source))[:2]:
         part = landing.part
-        pf = push_function(part)
-        mech = uncertain_mechanics(part, UNCERTAINTY)
-        aligner = PushAligner(part, None, None, vibration_mm=mech.vibration_mm)
-        normals = np.array([s.normal_deg for s in pf.states])
+        pf, mech, aligner, normals = landing_models(part)
         settled, missed, farthest = 0, 0, {}
         for hill in pf.divergent_deg:
             for side in (1, -1):
