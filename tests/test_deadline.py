@@ -618,6 +618,17 @@ def test_the_goal_fixpoint_is_the_plain_one(pfs, tolerance, uncertainty):
     assert inseparable_masks(machine) == _plain_inseparable(machine)
 
 
+def test_a_plan_cut_short_in_its_goal_fixpoint_says_the_limit_ran_out():
+    # OutOfBudget, not a plain PlanningError: a caller with its own budget (the sensor
+    # design) tells a limit that ran out from a problem with no plan by the type.
+    from feederkit.planning.options import OutOfBudget
+
+    machine = build_machine([near_round(40, 0.002)], ToleranceSensor(0.3), IDEAL)
+    with pytest.raises(OutOfBudget, match="inseparable") as info:
+        plan(machine, PlanningOptions(time_limit_s=1e-4))
+    assert info.value.reason == "time"
+
+
 def test_the_goal_fixpoint_polls_the_budget():
     from feederkit.machine.inseparable import inseparable_masks
 

@@ -417,22 +417,18 @@ def test_the_benchmark_ellipse_mix_stops_at_the_limit(uncertainty):
     )
 
 
-@pytest.mark.parametrize(("wait_s", "answers"), [(0.0, True), (0.35, False)])
-def test_a_plan_whose_ties_are_undecided_counts_only_before_the_fallback_may_answer(
-    wait_s, answers
+@pytest.mark.parametrize("wait_s", [0.0, 0.5])
+def test_a_proven_plan_whose_ties_the_work_budget_cut_is_the_design_answer_whenever_it_comes(
+    wait_s,
 ):
-    # The planner's exact search may hand the time to its fallback from EXACT_CHECK_SHARE of
-    # its share on (planning.budget.Checkpoint): a plan with undecided tie-breaks returned
-    # after that may be the fallback's, so it stops the design instead of answering.
+    # With the fallback off every plan the planner returns is proven shortest, and ties cut
+    # by its work budget (the same on any computer) are cut alike without a limit: the
+    # unlimited design's answer, however late inside the limit it comes.
     from types import SimpleNamespace
 
-    from feederkit.design import limit as limit_module
     from feederkit.planning.tree import TIES_NONE
 
     limit_s = 1.0
-    assert wait_s == 0.0 or wait_s > (
-        limit_module.EXACT_CHECK_SHARE * (1.0 - limit_module.FALLBACK_SHARE) * limit_s
-    )
     made = SimpleNamespace(result=SimpleNamespace(optimal=True, tie_breaks=TIES_NONE))
 
     def make(options):
@@ -440,12 +436,35 @@ def test_a_plan_whose_ties_are_undecided_counts_only_before_the_fallback_may_ans
         time.sleep(wait_s)
         return made
 
-    clock = DesignClock(limit_s)
-    if answers:
-        assert clock.plan(make) is made
-    else:
-        with pytest.raises(Timeout):
-            clock.plan(make)
+    assert DesignClock(limit_s).plan(make) is made
+
+
+def test_a_limit_that_ran_out_in_the_planner_is_a_timeout_and_other_errors_are_answers():
+    # The planner's goal relation or lumping cut short (OutOfBudget) stops the design
+    # whenever it happens, with the limit that ran out; a PlanningError about the problem
+    # (no strong plan exists) is the design's answer, as without a limit.
+    from feederkit.errors import PlanningError
+    from feederkit.planning.options import OutOfBudget
+
+    def cut(options):
+        raise OutOfBudget("no plan found within the memory limit of 300 MB: ...", "memory")
+
+    with pytest.raises(Timeout) as info:
+        DesignClock(30.0).plan(cut)
+    assert info.value.reason == "memory"
+
+    def none(options):
+        raise PlanningError("no strong plan exists under the declared uncertainty")
+
+    with pytest.raises(PlanningError, match="no strong plan exists"):
+        DesignClock(30.0).plan(none)
+
+    def late(options):  # the limit passed while the planner gave up
+        time.sleep(0.25)
+        raise PlanningError("no strong plan found within 36 operations")
+
+    with pytest.raises(Timeout):
+        DesignClock(0.2).plan(late)
 
 
 def test_the_planner_of_a_limited_design_has_its_fallback_off_and_its_cut_is_a_timeout():

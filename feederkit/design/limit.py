@@ -17,16 +17,11 @@ each time a pair, a probe of the goal search, a run of the table or a pitch is d
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable
 
 from feederkit.errors import PlanningError
-from feederkit.planning.api import EXACT_CHECK_SHARE, FALLBACK_SHARE
 from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.fallback import NoFallback
-from feederkit.planning.options import PlanningOptions
-from feederkit.planning.tree import TIES_EXACT
+from feederkit.planning.options import OutOfBudget, PlanningOptions
 from feederkit.plans.make import MadePlan
 
 Progress = Callable[[str, int, int], None]
@@ -143,12 +138,14 @@ class DesignClock:
 
         Unlimited: ``make(None)``, the planner's defaults. Limited: the planner gets the time
         left and the memory limit as its own with its fallback off (its plan, not proven
-        optimal, would be discarded after seconds of statistics and verification), and any
-        answer that may come from its budget rather than from the search is a Timeout here:
-        the exact stages running out (NoFallback), a plan not proven optimal, and a
-        PlanningError or tie-breaks left undecided once the planner's exact stages may have
-        handed the time over (from ``EXACT_CHECK_SHARE`` of their share ``1 - FALLBACK_SHARE``
-        on: the expected number of operations would not be the unlimited design's).
+        optimal, would be discarded after seconds of statistics and verification), so every
+        plan it returns is the unlimited design's: proven shortest, its tie-breaks decided
+        as far as the planner's work budget (the same on any computer) lets them. A limit
+        running out is a Timeout here: :class:`~feederkit.planning.options.OutOfBudget` (the
+        planner's exact stages, its goal relation or its lumping cut short; the fallback's
+        :class:`~feederkit.planning.fallback.NoFallback` is one), a plan not proven optimal,
+        and any PlanningError once the limit has passed. Any other PlanningError (no strong
+        plan exists, say) is the design's answer.
         """
         if self.time_limit_s is None and self.memory_limit_mb is None:
             return make(None)
@@ -156,30 +153,21 @@ class DesignClock:
         left = self.deadline.remaining()
         if left is not None and left <= 0.0:
             raise Timeout("time")
-        exact_end = (
-            math.inf
-            if left is None
-            else time.perf_counter() + EXACT_CHECK_SHARE * (1.0 - FALLBACK_SHARE) * left
-        )
-        # Out of time once the exact stages may have handed over; otherwise the memory ran out.
+        # What ran out when the planner's answer came from its budget without saying which.
         stopped = "time" if self.memory_limit_mb is None else "memory"
         options = PlanningOptions(
             time_limit_s=left, memory_limit_mb=self.memory_limit_mb, fallback=False
         )
         try:
             made = make(options)
-        except NoFallback as exc:  # the exact stages ran out: the fallback's plan is no answer
+        except OutOfBudget as exc:  # a limit, not the problem, ended the planner
             raise Timeout(exc.reason) from None
         except PlanningError:
-            # After its exact stages ran out the planner's fallback may give up early.
-            if time.perf_counter() >= exact_end or self.deadline.expired():
-                raise Timeout("time" if time.perf_counter() >= exact_end else stopped) from None
+            if self.deadline.expired():
+                raise Timeout(stopped) from None
             raise
-        result = made.result
-        if not result.optimal:
-            raise Timeout("time" if time.perf_counter() >= exact_end else stopped)
-        if result.tie_breaks != TIES_EXACT and time.perf_counter() >= exact_end:
-            raise Timeout("time")
+        if not made.result.optimal:
+            raise Timeout(stopped)
         self.check()
         return made
 

@@ -37,7 +37,7 @@ from feederkit.planning.fallback import NoFallback, fallback, sensorless_plan
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
-from feederkit.planning.options import Lumping, PlanningOptions, out_of_budget
+from feederkit.planning.options import Lumping, OutOfBudget, PlanningOptions, out_of_budget
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
@@ -298,9 +298,10 @@ def _plan_machine(
         try:
             split, twin_of = twinned(machine, budget.check)
         except Timeout as exc:
-            raise PlanningError(
+            raise OutOfBudget(
                 f"no plan found within {out_of_budget(options, exc.reason)}: it ran out while "
-                f"finding which of the {machine.n} states are inseparable"
+                f"finding which of the {machine.n} states are inseparable",
+                exc.reason,
             ) from None
     if split is machine:
         twin_of = None
@@ -330,10 +331,11 @@ def _plan_machine(
         goals = (tried.goal,) if tried.goal is not None else tried.undecided
         if not goals and tried.cut_by in ("time", "memory"):
             # Unproven: listing near-symmetric states together may still give a plan.
-            raise PlanningError(
+            raise OutOfBudget(
                 f"no plan found within {out_of_budget(options, tried.cut_by)}: no strong "
                 "plan tells every pair of states apart, and it ran out while deciding which "
-                "near-symmetric states a plan may list together"
+                "near-symmetric states a plan may list together",
+                tried.cut_by,
             ) from None
         hint = unlike_words(sorted_machine, tried.unlike)
         if not goals:
@@ -401,9 +403,10 @@ def _plan(
     try:
         insep = goal_relation(machine, budget) if goal is None else goal
     except Timeout as exc:
-        raise PlanningError(
+        raise OutOfBudget(
             f"no plan found within {out_of_budget(options, exc.reason)}: it ran out while "
-            f"finding which of the {machine.n} states are inseparable"
+            f"finding which of the {machine.n} states are inseparable",
+            exc.reason,
         ) from None
     problem = Problem(machine, grouping, min_margin, insep)
     if problem.sensorless and objective == "expected":

@@ -19,12 +19,11 @@ from __future__ import annotations
 import gc
 import time
 
-from feederkit.errors import PlanningError
 from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
 from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.options import PlanningOptions, out_of_budget
+from feederkit.planning.options import OutOfBudget, PlanningOptions, out_of_budget
 from feederkit.planning.pairwise import applies as pairwise_applies
 from feederkit.planning.pairwise import pairwise_plan
 from feederkit.planning.problem import Problem
@@ -77,16 +76,17 @@ a little late beats none (the command then answers at most this much past its li
 later still is dropped like one too slow to find."""
 
 
-class NoFallback(PlanningError):
+class NoFallback(OutOfBudget):
     """The exact search ran out of its share of a limit and the options turn the fallback
     off (``PlanningOptions.fallback``): no plan, as none is proven shortest. ``reason``: the
     Timeout's (``"time"`` or ``"memory"``)."""
 
     def __init__(self, options: PlanningOptions, reason: str) -> None:
         super().__init__(
-            f"no plan proven shortest within {out_of_budget(options, reason)} (the fallback is off)"
+            f"no plan proven shortest within {out_of_budget(options, reason)} "
+            "(the fallback is off)",
+            reason,
         )
-        self.reason = reason
 
 
 def fallback(
@@ -118,7 +118,8 @@ def fallback(
     greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
     shorter still. A tree follows the actions that proved it; a reading set the searches
     never met lies inside one they did (its "witness"), and follows the witness's
-    rotations. PlanningError when none finds a plan in time.
+    rotations. :class:`~feederkit.planning.options.OutOfBudget` when none finds a plan in
+    time.
 
     No Timeout is kept past its ``except`` block: its traceback holds the frames of the
     search, and a frame holding it would make the searches' tables cyclic garbage that only
@@ -302,9 +303,10 @@ def fallback(
             return blind, False, None, lower, TIES_NONE, None
         reason = last if last == "memory" else stop
         which = "one that tells every pair of states apart" if apart else "a plan"
-        raise PlanningError(
+        raise OutOfBudget(
             f"no plan found within {out_of_budget(options, reason)} "
-            f"({which} needs at least {plural(lower, 'operation')})"
+            f"({which} needs at least {plural(lower, 'operation')})",
+            reason,
         )
     return root, False, None, lower, TIES_NONE, None
 

@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
-from feederkit.errors import InputError
+from feederkit.errors import InputError, PlanningError
 from feederkit.machine import Grouping
 
 __all__ = ["ActionCosts", "Grouping", "Lumping", "Method", "Objective", "PlanningOptions"]
@@ -216,3 +216,13 @@ def out_of_budget(options: PlanningOptions, reason: str) -> str:
     if reason == "memory" and options.memory_limit_mb is not None:
         return f"the memory limit of {options.memory_limit_mb:g} MB"
     return f"the time limit of {options.time_limit_s:g} s"
+
+
+class OutOfBudget(PlanningError):
+    """No plan, because a limit of the options ran out (``reason``: the Timeout's, ``"time"``
+    or ``"memory"``) rather than because none exists: a caller with a budget of its own (the
+    sensor design) tells the two apart by type, not by the message."""
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason
