@@ -378,6 +378,22 @@ def test_ctrl_c_while_the_modules_load_is_interrupted_even_as_an_import_error(ca
     assert signal.getsignal(signal.SIGINT) is not app_module._note_loading_interrupt  # loaded
 
 
+def test_a_real_import_failure_while_loading_puts_the_sigint_handler_back(monkeypatch):
+    # The loading handler notes a Ctrl-C for the interrupt's ImportError; a real failure goes
+    # on up with the handler the process had, so whoever catches it keeps a plain Ctrl-C.
+    import feederkit.cli.app as app_module
+
+    before = signal.getsignal(signal.SIGINT)
+    monkeypatch.setattr(app_module, "_loading_interrupted", False)
+    monkeypatch.setattr(app_module, "_previous_sigint", before)
+    try:
+        signal.signal(signal.SIGINT, app_module._note_loading_interrupt)
+        app_module._loading_failed(ImportError("no module named scipy"))
+        assert signal.getsignal(signal.SIGINT) is before
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
 def test_once_the_command_answered_a_late_ctrl_c_changes_nothing(monkeypatch):
     """SIGINT is ignored while Python exits after the answer (a new user's review: a finished
     compile, its files written, ended 130 with no word when Ctrl-C came at the very end)."""

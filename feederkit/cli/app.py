@@ -35,11 +35,19 @@ if callable(_previous_sigint):
         signal.signal(signal.SIGINT, _note_loading_interrupt)
 
 
+def _restore_sigint() -> None:
+    """The SIGINT handler as it was before the modules began loading."""
+    if signal.getsignal(signal.SIGINT) is _note_loading_interrupt:
+        signal.signal(signal.SIGINT, _previous_sigint)
+
+
 def _loading_failed(exc: BaseException) -> None:
-    """Ctrl-C while the modules load: one line, 130; any other failure goes on up."""
+    """Ctrl-C while the modules load: one line, 130; any other failure goes on up, with the
+    SIGINT handler as it was (an importer that catches the failure keeps a working Ctrl-C)."""
     if isinstance(exc, KeyboardInterrupt) or _loading_interrupted:
         sys.stderr.write("error: interrupted\n")
         raise SystemExit(130) from None
+    _restore_sigint()
 
 
 try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one line, too.
@@ -150,8 +158,7 @@ except (KeyboardInterrupt, ImportError) as exc:
     _loading_failed(exc)
     raise
 finally:
-    if signal.getsignal(signal.SIGINT) is _note_loading_interrupt:
-        signal.signal(signal.SIGINT, _previous_sigint)  # loaded: the handler as it was
+    _restore_sigint()  # loaded: the handler as it was
 
 
 @functools.cache
