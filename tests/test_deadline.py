@@ -12,6 +12,8 @@ import time
 from dataclasses import dataclass
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from shared import small_mix
 from test_planners import check_plan
 
@@ -33,7 +35,7 @@ from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.stats import node_states
 from feederkit.plans.timelimit import POST_S_PER_PAIR, planner_budget
-from feederkit.sensors import NoSensor, ToleranceSensor
+from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
 OVERSHOOT_S = 2.0
@@ -609,13 +611,73 @@ def _plain_inseparable(machine):
         (lambda: [near_round(24, 0.0)], 0.05, IDEAL),  # a regular 24-gon: symmetric pairs
         (lambda: small_mix(6), 1.0, IDEAL),
         (lambda: small_mix(6), 1.0, Uncertainty()),
+        (lambda: small_mix(12), LedSensor(0.7, 0.2), IDEAL),  # the LED's reading reach
+        (lambda: small_mix(12), LedSensor(1.0), Uncertainty()),
+        (lambda: small_mix(12), NoSensor(), IDEAL),  # every pair: no reach
     ],
 )
 def test_the_goal_fixpoint_is_the_plain_one(pfs, tolerance, uncertainty):
     from feederkit.machine.inseparable import inseparable_masks
 
-    machine = build_machine(pfs(), ToleranceSensor(tolerance), uncertainty)
+    sensor = ToleranceSensor(tolerance) if isinstance(tolerance, float) else tolerance
+    machine = build_machine(pfs(), sensor, uncertainty)
     assert inseparable_masks(machine) == _plain_inseparable(machine)
+
+
+@pytest.mark.parametrize(
+    "sensor",
+    [ToleranceSensor(0.4), ToleranceSensor(3.0), LedSensor(0.7, 0.2), LedSensor(1.0), NoSensor()],
+    ids=["tol-0.4", "tol-3", "led-noise", "led", "none"],
+)
+@pytest.mark.parametrize("uncertainty", [IDEAL, Uncertainty()], ids=["ideal", "1deg"])
+def test_the_pairs_that_can_read_alike_are_every_such_pair(sensor, uncertainty):
+    # The fixpoint asks each state only against those within the sensor's reading reach;
+    # no pair that can read alike may be skipped (interval diameters under uncertainty).
+    from feederkit.machine.inseparable import _alike_pairs
+
+    machine = build_machine(small_mix(12), sensor, uncertainty)
+    d = [s.sensed for s in machine.states]
+    every = {
+        (i, j)
+        for i in range(machine.n)
+        for j in range(i + 1, machine.n)
+        if sensor.can_read_alike(d[i], d[j])
+    }
+    assert _alike_pairs(machine, lambda: None) == every
+    assert len(every) > 0
+
+
+def _plain_ranges(sa, sb):
+    """Per cell of the two maps' merged boundaries, the range of each holding its middle."""
+    import bisect
+
+    from feederkit.angles import merge_boundaries, norm360
+
+    bounds = merge_boundaries([sa, sb])
+    out = []
+    for k, lo in enumerate(bounds):
+        hi = bounds[k + 1] if k + 1 < len(bounds) else bounds[0] + 360.0
+        mid = norm360((lo + hi) / 2.0)
+        out.append((bisect.bisect_right(sa, mid) - 1, bisect.bisect_right(sb, mid) - 1))
+    return out
+
+
+_ANGLES = st.one_of(
+    st.floats(0.0, 359.999, allow_nan=False),
+    st.sampled_from([0.0, 10.0, 10.0 + 5e-8, 10.0 + 2e-7, 359.99999999, 180.0]),
+)
+
+
+@given(st.lists(_ANGLES, max_size=20), st.lists(_ANGLES, max_size=20))
+@settings(max_examples=300, deadline=None)
+def test_the_overlap_ranges_of_a_pair_are_those_of_their_middles(a, b):
+    # The fixpoint's cells of two action maps (a merge walked with two pointers) hold, per
+    # cell, the range of each map at the cell's middle, boundaries within ANGLE_EPS merged.
+    from feederkit.machine.inseparable import _PairCells
+
+    sa, sb = sorted(set(a)), sorted(set(b))
+    ka, kb = _PairCells([sa, sb]).ranges(0, 1)
+    assert list(zip(list(ka), list(kb), strict=True)) == _plain_ranges(sa, sb)
 
 
 def test_a_plan_cut_short_in_its_goal_fixpoint_says_the_limit_ran_out():

@@ -30,6 +30,7 @@ unresolvable pairs (:mod:`feederkit.planning.lumping`) and of "no strong plan ex
 from __future__ import annotations
 
 import bisect
+import math
 from collections import defaultdict
 from collections.abc import Callable, Hashable, Iterable, Sequence
 from typing import TypeVar
@@ -38,6 +39,7 @@ import numpy as np
 
 from feederkit.angles import ANGLE_EPS, merge_boundaries, norm360
 from feederkit.machine.model import PushAlignMachine, members, target_at
+from feederkit.sensors import span
 
 P = TypeVar("P", bound=Hashable)
 
@@ -147,12 +149,24 @@ class _PairCells:
         if len(sa) + len(sb) < SMALL_MAPS:
             bounds = merge_boundaries([sa, sb])
             m = len(bounds)
+            if not m:
+                return [], []
             ka, kb = [], []
-            for k in range(m):
-                hi = bounds[k + 1] if k + 1 < m else bounds[0] + 360.0
-                mid = norm360((bounds[k] + hi) / 2.0)
-                ka.append(bisect.bisect_right(sa, mid) - 1)
-                kb.append(bisect.bisect_right(sb, mid) - 1)
+            # The cells before the last in rotation order: their middles ascend inside
+            # [0, 360), so each map's count of boundaries at or below the middle only grows.
+            la, lb = len(sa), len(sb)
+            pa = pb = 0
+            for k in range(m - 1):
+                mid = (bounds[k] + bounds[k + 1]) / 2.0
+                while pa < la and sa[pa] <= mid:
+                    pa += 1
+                while pb < lb and sb[pb] <= mid:
+                    pb += 1
+                ka.append(pa - 1)
+                kb.append(pb - 1)
+            mid = norm360((bounds[-1] + bounds[0] + 360.0) / 2.0)  # the cell across 360
+            ka.append(bisect.bisect_right(sa, mid) - 1)
+            kb.append(bisect.bisect_right(sb, mid) - 1)
             return ka, kb
         a, b = self.arrays[i], self.arrays[j]
         allb = np.sort(_norm360(np.concatenate((a, b))))
@@ -182,13 +196,7 @@ def inseparable_masks(machine: PushAlignMachine, check: Check | None = None) -> 
     """
     check = _no_check if check is None else check
     n = machine.n
-    sensor = machine.sensor
-    d = [s.sensed for s in machine.states]
-    alive: set[tuple[int, int]] = set()
-    for i in range(n):
-        check()
-        di = d[i]
-        alive.update((i, j) for j in range(i + 1, n) if sensor.can_read_alike(di, d[j]))
+    alive = _alike_pairs(machine, check)
     cells = _PairCells(machine.starts)
     if not machine.deterministic:
         return _masks(_bisimilar(machine, alive, cells, check), n)
@@ -220,6 +228,39 @@ def inseparable_masks(machine: PushAlignMachine, check: Check | None = None) -> 
         return np.minimum(a, b), np.maximum(a, b)
 
     return _masks(_dense_fixpoint(n, sorted(alive), successor_arrays, check), n)
+
+
+def _alike_pairs(machine: PushAlignMachine, check: Check) -> set[tuple[int, int]]:
+    """The pairs ``i < j`` of states that can read alike (``Sensor.can_read_alike``).
+
+    By the low end of their diameters, each state is asked only against those whose low
+    end is within its high end plus the sensor's ``reading_reach`` (no pair farther apart
+    reads alike): on a 200-part mix at 1 % that is a tenth of all pairs.
+    """
+    sensor = machine.sensor
+    d = [s.sensed for s in machine.states]
+    n = len(d)
+    reach = sensor.reading_reach()
+    alive: set[tuple[int, int]] = set()
+    if not math.isfinite(reach):
+        for i in range(n):
+            check()
+            di = d[i]
+            alive.update((i, j) for j in range(i + 1, n) if sensor.can_read_alike(di, d[j]))
+        return alive
+    spans = [span(x) for x in d]
+    order = sorted(range(n), key=lambda i: spans[i][0])
+    for at, i in enumerate(order):
+        check()
+        di = d[i]
+        limit = spans[i][1] + reach
+        limit += 1e-9 * max(1.0, abs(limit))  # rounding: never skip a pair that reads alike
+        for j in order[at + 1 :]:
+            if spans[j][0] > limit:
+                break
+            if sensor.can_read_alike(di, d[j]):
+                alive.add((i, j) if i < j else (j, i))
+    return alive
 
 
 def _dense_fixpoint(
