@@ -691,6 +691,53 @@ def test_a_plan_cut_short_in_its_goal_fixpoint_says_the_limit_ran_out():
     assert info.value.reason == "time"
 
 
+@pytest.mark.parametrize("share", [0.0, 1.0], ids=["passes", "worklist"])
+@pytest.mark.parametrize(
+    ("pfs", "tolerance"),
+    [(lambda: small_mix(8), 1.0), (lambda: [near_round(24, 0.0)], 0.05)],
+    ids=["mix", "24-gon"],
+)
+def test_the_outcome_set_fixpoint_by_passes_or_by_worklist_is_the_plain_one(
+    pfs, tolerance, share, monkeypatch
+):
+    # Passes over every pair while they drop enough, then a worklist: either way alone
+    # (a share of 0 never leaves the passes, 1 leaves them after the first) is the plain one.
+    import importlib
+
+    module = importlib.import_module("feederkit.machine.inseparable")
+    monkeypatch.setattr(module, "PASS_MIN_SHARE", share)
+    machine = build_machine(pfs(), ToleranceSensor(tolerance), Uncertainty())
+    assert module.inseparable_masks(machine) == _plain_inseparable(machine)
+
+
+def test_a_long_chain_of_drops_reaches_every_pair_by_passes_or_by_worklist(monkeypatch):
+    # One action moves each state to the next of a chain (the last stays), the other keeps
+    # it (the last may also go back one): the last pair is merged, and each pair falls
+    # only after the pair it moves to. A pass drops some, the worklist must requeue the rest.
+    import importlib
+
+    from feederkit.machine import MachineState, OutcomeRange
+
+    module = importlib.import_module("feederkit.machine.inseparable")
+    order = [5, 2, 9, 0, 11, 7, 3, 10, 1, 6, 8, 4]  # the chain, in neither pass's order
+    n = len(order)
+    after = {a: b for a, b in zip(order, order[1:] + order[-1:], strict=True)}
+    states = tuple(MachineState(0, i, 1.0, 1.0 / n, (1.0, 1.0), (i,)) for i in range(n))
+    last = 1 << order[-1] | 1 << order[-2]  # two outcomes: a machine under uncertainty
+    maps = tuple(
+        (
+            OutcomeRange(0.0, 180.0, 1 << after[i]),
+            OutcomeRange(180.0, 360.0, last if i == order[-1] else 1 << i),
+        )
+        for i in range(n)
+    )
+    machine = PushAlignMachine(("chain",), states, maps, NoSensor())
+    assert not machine.deterministic
+    for share in (0.0, 1.0):
+        monkeypatch.setattr(module, "PASS_MIN_SHARE", share)
+        assert module.inseparable_masks(machine) == (0,) * n == _plain_inseparable(machine)
+
+
 def test_the_goal_fixpoint_polls_the_budget():
     from feederkit.machine.inseparable import inseparable_masks
 

@@ -327,6 +327,11 @@ def pair_outcomes(machine: PushAlignMachine, i: int, j: int) -> list[tuple[int, 
     return out
 
 
+PASS_MIN_SHARE = 0.05
+"""The outcome-set fixpoint goes on by passes over every pair while a pass drops at least
+this share of the pairs left, then by a worklist (:func:`_bisimilar`)."""
+
+
 def _bisimilar(
     machine: PushAlignMachine,
     alive: set[tuple[int, int]],
@@ -337,11 +342,14 @@ def _bisimilar(
     while, on every overlap range, each outcome of either state has a different outcome of
     the other that is still paired with it.
 
-    A worklist: a pair is looked at again only when a pair its cases mention was dropped.
-    The pairs alive are kept as a bit mask per state, so an outcome set is matched by one
-    OR per state: with the large outcome sets of a near-round part under a rotation error
-    (a 64-gon with 1 % radial noise at 0.3 mm under 1 degree, states by diameter) the
-    fixpoint takes 1.1 s where the pairs looked up one by one took 17 s.
+    Passes over the pairs first, each pair asked until a case fails and dropped at once
+    (most pairs of a mix or a near-round part fall in the first pass, at their first case);
+    once a pass drops fewer than ``PASS_MIN_SHARE`` of the pairs left, a worklist: a pair
+    is looked at again only when a pair its cases mention was dropped (a long chain of
+    drops then costs no pass per link). The pairs alive are kept as a bit mask per state,
+    so an outcome set is matched by one OR per state. A near-round 64-gon with 1 % radial
+    noise at 0.3 mm under 1 degree (states by diameter): 0.2 s, where the worklist alone
+    took 2 s and the pairs looked up one by one 17 s.
     """
     outs = machine.outcomes_of
     # The pairs alive as a bit mask per state (``adj[x]`` never holds ``x``): an outcome
@@ -369,18 +377,36 @@ def _bisimilar(
         # Every state of each outcome set paired with some state of the other.
         return not a & ~near(b) and not b & ~near(a)
 
-    # Who mentions whom: a pair's cases name the alive pairs (x, y) of an outcome of each
-    # state, found per x as the outcomes of the other state it meets.
+    def drop(p: tuple[int, int]) -> None:
+        alive.discard(p)
+        i, j = p
+        adj[i] &= ~(1 << j)
+        adj[j] &= ~(1 << i)
+
     cases: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    users: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
     for p in alive:
         check()
         i, j = p
         ka, kb = cells.ranges(i, j)
         oi, oj = outs[i], outs[j]
-        cs = cases[p] = sorted({(oi[x], oj[y]) for x, y in zip(ka, kb, strict=True)})
+        cases[p] = sorted({(oi[x], oj[y]) for x, y in zip(ka, kb, strict=True)})
+    while alive:
+        before = len(alive)
+        for p in sorted(alive):
+            check()
+            if not all(matched(a, b) for a, b in cases[p]):
+                drop(p)
+        if len(alive) == before:
+            return alive
+        if before - len(alive) < PASS_MIN_SHARE * before:
+            break
+    # Who mentions whom: a pair's cases name the alive pairs (x, y) of an outcome of each
+    # state, found per x as the outcomes of the other state it meets.
+    users: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
+    for p in alive:
+        check()
         partner: dict[int, int] = {}
-        for a, b in cs:
+        for a, b in cases[p]:
             for x in states(a):
                 partner[x] = partner.get(x, 0) | b
         named = set()
@@ -396,10 +422,7 @@ def _bisimilar(
         p = todo.pop()
         queued.discard(p)
         if p in alive and not all(matched(a, b) for a, b in cases[p]):
-            alive.discard(p)
-            i, j = p
-            adj[i] &= ~(1 << j)
-            adj[j] &= ~(1 << i)
+            drop(p)
             for u in users.get(p, ()):
                 if u in alive and u not in queued:
                     queued.add(u)
