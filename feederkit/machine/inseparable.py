@@ -455,10 +455,20 @@ def kept_apart(
     for p in alive:
         check()
         cases[p] = sorted(set(pair_outcomes(machine, *p)))
+    # The kept pairs as a bit mask per state (``adj[x]`` never holds ``x``): whether an
+    # outcome of the one and a different outcome of the other form a kept pair is one AND
+    # per state of the one.
+    adj = [0] * machine.n
+    for i, j in alive:
+        adj[i] |= 1 << j
+        adj[j] |= 1 << i
+    idx: dict[int, list[int]] = {}
 
     def keeps(a: int, b: int) -> bool:
-        xs, ys = members(a), members(b)
-        return any(x != y and ((x, y) if x < y else (y, x)) in alive for x in xs for y in ys)
+        xs = idx.get(a)
+        if xs is None:
+            xs = idx[a] = members(a)
+        return any(adj[x] & b for x in xs)
 
     changed = True
     while changed:
@@ -467,5 +477,8 @@ def kept_apart(
             check()
             if not all(keeps(a, b) for a, b in cases[p]):
                 alive.discard(p)
+                i, j = p
+                adj[i] &= ~(1 << j)
+                adj[j] &= ~(1 << i)
                 changed = True
     return alive
