@@ -21,6 +21,7 @@ QUICK = [
     ("bench_analysis.py",),
     ("bench_mix.py",),
     ("bench_import_catalog.py", "--parts", "300"),
+    ("bench_goal_relation.py", "64-gon 1%, 3%"),
 ]
 
 
