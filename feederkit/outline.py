@@ -38,6 +38,17 @@ UNIT_TO_MM: dict[str, float] = {
 }
 
 
+UNIT_ALIASES: dict[str, str] = {"inch": "in", "inches": "in"}
+
+
+def unit_name(units: str) -> str:
+    """The canonical name of ``units`` (``Inches`` is ``in``), as catalogs and messages give
+    it; an unknown unit is bad input."""
+    unit_scale(units)
+    key = units.strip().lower()
+    return UNIT_ALIASES.get(key, key)
+
+
 def unit_scale(units: str) -> float:
     """Millimetres per unit of ``units``; an unknown unit is bad input."""
     try:
@@ -288,13 +299,23 @@ def outline_to_dict(outline: Outline) -> dict[str, object]:
 def load_outline_json(path: str | os.PathLike[str], units: str | None = None) -> Outline:
     """Load an outline file; unreadable or malformed files are bad input. ``units``, when
     given, overrides the file's ``units`` (as ``--units`` does for every drawing)."""
+    return read_outline_file(path, units)[0]
+
+
+def read_outline_file(
+    path: str | os.PathLike[str], units: str | None = None
+) -> tuple[Outline, str]:
+    """:func:`load_outline_json` and the unit its coordinates were read in (canonical name),
+    which the catalog records as the source's units: the outline itself is in mm."""
     data = read_json(path, "file")
     if units is not None and isinstance(data, dict):
         data = {**data, "units": units}
     try:
-        return outline_from_dict(data, default_name=Path(path).stem)
+        outline = outline_from_dict(data, default_name=Path(path).stem)
     except InputError as exc:  # name the file the user gave, not only the outline's name
         raise InputError(f"{os.fspath(path)}: {exc}") from None
+    assert isinstance(data, dict)  # outline_from_dict refused anything else
+    return outline, unit_name(str(data.get("units", "mm")))
 
 
 def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:

@@ -38,7 +38,7 @@ from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
 from feederkit.importers.loops import Region, closing_lines
 from feederkit.importers.model import ImportedOutline, ImportOptions
 from feederkit.importers.plausible import measurement_warnings, outline_size, size_warnings
-from feederkit.outline import make_outline, unit_scale
+from feederkit.outline import make_outline, unit_name, unit_scale
 from feederkit.words import plural
 
 logging.getLogger("ezdxf").addHandler(logging.NullHandler())  # a library never prints
@@ -163,7 +163,7 @@ def drawing_units(
 ) -> tuple[str, float, list[str]]:
     """The drawing's unit name, millimetres per unit, and warnings (unitless files)."""
     if override is not None:
-        return override, unit_scale(override), []
+        return unit_name(override), unit_scale(override), []
     code = int(doc.header.get("$INSUNITS", 0) or 0)
     if code in INSUNITS:
         name, scale = INSUNITS[code]

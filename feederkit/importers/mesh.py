@@ -38,7 +38,7 @@ from feederkit.importers.meshbodies import (
 )
 from feederkit.importers.model import ImportedOutline, ImportOptions, MeshPose
 from feederkit.importers.plausible import outline_size, size_warnings, unitless_warnings
-from feederkit.outline import make_outline, unit_scale
+from feederkit.outline import make_outline, unit_name, unit_scale
 from feederkit.words import plural
 
 if TYPE_CHECKING:
@@ -162,8 +162,8 @@ def load_mesh(
 
     budget = budget or Budget(ImportLimits(), str(path))
     notes: list[str] = []
-    unit_name = units or "mm"
-    scale = unit_scale(unit_name)
+    name = unit_name(units or "mm")
+    scale = unit_scale(name)
     _precount_faces(path, budget)
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -197,7 +197,7 @@ def load_mesh(
     notes += drop_bad_faces(mesh)
     if scale != 1.0:
         mesh.apply_scale(scale)
-    return mesh, unit_name, notes
+    return mesh, name, notes
 
 
 def drop_bad_faces(mesh: trimesh.Trimesh) -> list[str]:

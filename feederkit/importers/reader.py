@@ -23,7 +23,7 @@ from feederkit.importers.model import (
 from feederkit.importers.orientable import Orientability, orientability
 from feederkit.importers.plausible import outline_size
 from feederkit.mechanics.modelerror import KeptTolerance, kept_part
-from feederkit.outline import load_outline_json
+from feederkit.outline import read_outline_file
 from feederkit.part import Part, make_part
 
 NOT_ORIENTABLE = "not orientable by pushing"
@@ -85,14 +85,14 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     others: list[str] = []
     warnings: list[str] = []
     if suffix in OUTLINE_SUFFIXES:
-        outline = load_outline_json(p, options.units)
+        outline, unit = read_outline_file(p, options.units)
         budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
         budget.loops(1 + len(outline.holes))
         if name:
             outline = dataclasses.replace(outline, name=name)
         if options.com is not None:
             outline = dataclasses.replace(outline, com=options.com)
-        parts = [ImportedOutline(outline=outline, kind="outline", source_units="mm")]
+        parts = [ImportedOutline(outline=outline, kind="outline", source_units=unit)]
     elif suffix in CAD_SUFFIXES:
         from feederkit.importers.dxf import read_dxf  # ezdxf loads slowly: only when needed
 

@@ -1,0 +1,39 @@
+"""Review 51: a new user's import, plan-file and simulation checks."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from feederkit.importers import ImportOptions, import_parts
+
+
+def write_inch_outline(path: Path) -> Path:
+    """A 2 x 1 inch plate as an outline file that says its units are inches."""
+    data = {"name": "plate-in", "units": "in", "vertices": [[0, 0], [2, 0], [2, 1], [0, 1]]}
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_outline_file_keeps_its_source_units(tmp_path):
+    path = write_inch_outline(tmp_path / "plate-in.json")
+    result, parts = import_parts(path, ImportOptions())
+    assert parts[0].part.outline.vertices[1] == (50.8, 0.0)
+    assert result.parts[0].source_units == "in"
+    _, parts = import_parts(path, ImportOptions(units="cm"))
+    assert parts[0].source.source_units == "cm"
+    _, parts = import_parts(path, ImportOptions(units="Inches"))
+    assert parts[0].source.source_units == "in"
+
+
+def test_cad_files_name_an_override_unit_canonically(tmp_path):
+    import ezdxf
+    import trimesh
+
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_lwpolyline([(0, 0), (2, 0), (2, 1), (0, 1)], close=True)
+    doc.saveas(tmp_path / "plate.dxf")
+    trimesh.creation.box((2, 1, 0.2)).export(tmp_path / "plate.stl")
+    for name in ("plate.dxf", "plate.stl"):
+        _, parts = import_parts(tmp_path / name, ImportOptions(units="Inches"))
+        assert parts[0].source.source_units == "in"
