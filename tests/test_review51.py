@@ -37,3 +37,31 @@ def test_cad_files_name_an_override_unit_canonically(tmp_path):
     for name in ("plate.dxf", "plate.stl"):
         _, parts = import_parts(tmp_path / name, ImportOptions(units="Inches"))
         assert parts[0].source.source_units == "in"
+
+
+def test_catalog_refuses_a_tolerance_too_large_for_another_mesh_pose(tmp_path, capsys):
+    """A 50 x 30 x 3 mm plate's pose 0 allows a shape tolerance below 15 mm, its poses on an
+    edge below 1.5 mm: plans cover every landing, so the revision may store only the latter."""
+    import trimesh
+    from shared import run_cli
+
+    trimesh.creation.box((50, 30, 3)).export(tmp_path / "plate.stl")
+    db = str(tmp_path / "c.db")
+    code, _, err = run_cli(
+        capsys, "catalog", "add", str(tmp_path / "plate.stl"), "--catalog", db,
+        "--shape-tolerance", "4.9",
+    )  # fmt: skip
+    assert code == 2
+    assert "pose-" in err and "1.5 mm" in err and "--shape-tolerance" in err
+    code, _, err = run_cli(
+        capsys, "catalog", "add", str(tmp_path / "plate.stl"), "--catalog", db,
+        "--com-tolerance", "2",
+    )  # fmt: skip
+    assert code == 2 and "pose-" in err and "--com-tolerance" in err
+    code, _, err = run_cli(
+        capsys, "catalog", "add", str(tmp_path / "plate.stl"), "--catalog", db,
+        "--shape-tolerance", "1", "--com-tolerance", "1",
+    )  # fmt: skip
+    assert code == 0, err
+    code, _, err = run_cli(capsys, "plan", "plate", "--catalog", db, "--tolerance", "0.5")
+    assert "must be below" not in err

@@ -307,8 +307,9 @@ def write_revision(
                 f"landings: all {len(landings)} resting poses stored (revision {rev} was "
                 "stored before landings)",
             )
-    if check_part is not None:
-        _check_tolerances(check_part, part, stored, kept, int(rev))
+    if check_part is not None:  # plans cover every landing: a mesh's poses have other hulls
+        for checked in (part, *(landing.part for landing in landings)):
+            _check_tolerances(check_part, checked, stored, kept, int(rev))
     src = imported.source
     pose = None
     if src.pose is not None:

@@ -162,8 +162,8 @@ StoredShapeToleranceOpt = Annotated[
         "--shape-tolerance",
         metavar="MM",
         help="Store with the new revision: its hull vertices lie within MM of their drawn "
-        "positions (below half its smallest hull edge); plans declare the largest their parts "
-        "store unless given. Not given, the previous revision's is kept.",
+        "positions (below half its smallest hull edge in every landing); plans declare the "
+        "largest their parts store unless given. Not given, the previous revision's is kept.",
     ),
 ]
 StoredComToleranceOpt = Annotated[
