@@ -211,7 +211,10 @@ def test_open_outline(tmp_path):
         msp.add_line((10, 0), (10, 10))
         msp.add_line((10, 10), (0, 10))
 
-    bad(fx.write_entities(tmp_path / "open.dxf", build), r"no closed outline.*\(2 open ends\)")
+    bad(
+        fx.write_entities(tmp_path / "open.dxf", build),
+        r"no closed outline.*\(2 open ends, 10 mm apart at \(0, 10\) and \(0, 0\)\)",
+    )
 
 
 def test_an_open_polyline_has_two_open_ends(tmp_path):
@@ -220,7 +223,10 @@ def test_an_open_polyline_has_two_open_ends(tmp_path):
     def build(msp):
         msp.add_lwpolyline([(0, 0), (10, 0), (10, 5), (0, 5)], close=False)
 
-    bad(fx.write_entities(tmp_path / "open.dxf", build), r"\(2 open ends\)$")
+    bad(
+        fx.write_entities(tmp_path / "open.dxf", build),
+        r"\(2 open ends, 5 mm apart at \(0, 0\) and \(0, 5\)\)$",
+    )
 
 
 def test_zero_area_outline(tmp_path):

@@ -65,3 +65,26 @@ def test_catalog_refuses_a_tolerance_too_large_for_another_mesh_pose(tmp_path, c
     assert code == 0, err
     code, _, err = run_cli(capsys, "plan", "plate", "--catalog", db, "--tolerance", "0.5")
     assert "must be below" not in err
+
+
+def test_an_outline_left_open_is_refused_naming_where(tmp_path):
+    """A plate whose last LINE stops 0.3 mm short (more than the 0.1 mm import bridges): the
+    refusal says where the outline is open and how far apart its ends are, so the user can
+    find the gap in CAD."""
+    import ezdxf
+    import pytest
+
+    from feederkit.errors import InputError
+
+    doc = ezdxf.new("R2010", units=4)  # mm
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (40, 0))
+    msp.add_arc((40, 10), 10, -90, 90)
+    msp.add_line((40, 20), (0, 20))
+    msp.add_line((0, 20), (0, 0.3))
+    doc.saveas(tmp_path / "open.dxf")
+    with pytest.raises(InputError) as exc:
+        import_parts(tmp_path / "open.dxf", ImportOptions())
+    words = str(exc.value)
+    assert "no closed outline" in words
+    assert words.endswith("(2 open ends, 0.3 mm apart at (0, 0.3) and (0, 0))")

@@ -20,6 +20,7 @@ from feederkit.errors import InputError
 from feederkit.importers.budget import Budget
 from feederkit.importers.drawingnotes import (
     cut_off_note,
+    ends_words,
     open_line_notes,
     outside_note,
     side_by_side_note,
@@ -301,9 +302,10 @@ def drawing_from_lines(
     if budget is not None:
         budget.check_time()
     loops, dangles = closed_loops(healed, budget, [healed[k] for k in closed], gap)
-    if not loops:
-        ends = len(open_ends([np.asarray(d.coords) for d in dangles], gap))
-        detail = f" ({plural(ends, 'open end')})" if ends else ""
+    if not loops:  # where the outline is open, so the user can find the gap in CAD
+        lines = [np.asarray(d.coords) for d in dangles]
+        found = [lines[e // 2][0 if e % 2 == 0 else -1] for e in open_ends(lines, gap)]
+        detail = f" ({ends_words(np.asarray(found), counted=True)})" if found else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
     shells = [lp.polygon for lp in loops]
     found = crossing_loop(healed, closed, shells, gap, budget, layers)

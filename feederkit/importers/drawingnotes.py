@@ -128,7 +128,7 @@ def open_line_notes(
     if around:
         ends = _free_ends(around[0])
         notes.append(
-            f"an open outline ({_ends(ends)}, too far apart to close) surrounds the imported "
+            f"an open outline ({ends_words(ends)}, too far apart to close) surrounds the imported "
             "part: the drawing's real outer outline may be open and the part one of its holes; "
             "close the outline in the drawing"
         )
@@ -150,8 +150,8 @@ def open_line_notes(
         more = f" and {len(inside) - 1} more" if len(inside) > 1 else ""
         notes.append(
             f"open lines inside the part nearly close {plural(len(inside), 'loop')} "
-            f"({box_words(g.bounds)}, {_ends(ends)}{more}), left out: if they are a hole whose "
-            "outline is open, the part's area and COM are off; close the gap in the drawing"
+            f"({box_words(g.bounds)}, {ends_words(ends)}{more}), left out: if they are a hole "
+            "whose outline is open, the part's area and COM are off; close the gap in the drawing"
         )
     return notes
 
@@ -174,12 +174,14 @@ def _around(group: shapely.Geometry, part: Polygon) -> bool:
     return bool(inside.covers(part))
 
 
-def _ends(ends: np.ndarray) -> str:
-    """Open ends in words: ``its ends 0.5 mm apart at (79.5, 0) and (80, 0)``."""
+def ends_words(ends: np.ndarray, counted: bool = False) -> str:
+    """Open ends in words: ``its ends 0.5 mm apart at (79.5, 0) and (80, 0)`` (``counted``:
+    ``2 open ends, 0.5 mm apart at ...``)."""
     if len(ends) == 2:
         (ax, ay), (bx, by) = ends
         return (
-            f"its ends {float(np.hypot(ax - bx, ay - by)):.3g} mm apart at "
+            f"{'2 open ends,' if counted else 'its ends'} "
+            f"{float(np.hypot(ax - bx, ay - by)):.3g} mm apart at "
             f"({ax:.4g}, {ay:.4g}) and ({bx:.4g}, {by:.4g})"
         )
     where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends[:3])
