@@ -88,3 +88,14 @@ def test_an_outline_left_open_is_refused_naming_where(tmp_path):
     words = str(exc.value)
     assert "no closed outline" in words
     assert words.endswith("(2 open ends, 0.3 mm apart at (0, 0.3) and (0, 0))")
+
+
+def test_com_given_for_a_file_in_inches_warns_that_it_is_read_in_mm(tmp_path):
+    """--com is in mm (the part frame's unit); a user reading an inch drawing may give inches,
+    which lands inside the part and is taken without a word."""
+    path = write_inch_outline(tmp_path / "plate-in.json")
+    _, parts = import_parts(path, ImportOptions(com=(1.1, 0.5)))
+    assert parts[0].part.com == (1.1, 0.5)
+    assert any("--com" in w and "mm" in w and " in " in w for w in parts[0].warnings)
+    _, parts = import_parts(path, ImportOptions(units="mm", com=(1.1, 0.5)))
+    assert not any("--com" in w for w in parts[0].warnings)

@@ -23,7 +23,7 @@ from feederkit.importers.model import (
 from feederkit.importers.orientable import Orientability, orientability
 from feederkit.importers.plausible import outline_size
 from feederkit.mechanics.modelerror import KeptTolerance, kept_part
-from feederkit.outline import read_outline_file
+from feederkit.outline import read_outline_file, unit_scale
 from feederkit.part import Part, make_part
 
 NOT_ORIENTABLE = "not orientable by pushing"
@@ -143,6 +143,17 @@ def lowered_warning(kept: KeptTolerance) -> str:
     )
 
 
+def com_units_note(com: tuple[float, float], units: str) -> str:
+    """The warning that ``--com`` is read in mm while the file's coordinates are in ``units``:
+    a COM given in the drawing's units may still lie inside the part, wrong without a word."""
+    scale = unit_scale(units)
+    x, y = com
+    return (
+        f"--com ({x:g}, {y:g}) is read in mm, the file's coordinates in {units}: it lies at "
+        f"({x / scale:.4g}, {y / scale:.4g}) in the file's units; check that it was given in mm"
+    )
+
+
 def build_part(
     imported: ImportedOutline, options: ImportOptions, extra_warnings: tuple[str, ...] = ()
 ) -> ImportedPart:
@@ -154,6 +165,8 @@ def build_part(
     size = outline_size(imported.outline)
     tol = effective_hull_tolerance(imported.kind, options, size)
     notes = list(extra_warnings) + list(imported.warnings)
+    if options.com is not None and imported.source_units != "mm":
+        notes.append(com_units_note(options.com, imported.source_units))
     try:
         part, kept = kept_part(make_part(imported.outline, options.com), tol)
         if kept is not None and kept.lowered:
