@@ -19,7 +19,7 @@ from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
 from feederkit.mechanics.analysis import fragile_warnings
 from feederkit.mechanics.push import PushFunction, push_function
-from feederkit.sources import load_parts_with_warnings
+from feederkit.sources import labelled_warnings, load_parts_with_warnings
 
 
 @dataclass(frozen=True)
@@ -93,6 +93,7 @@ def load_parts(
     tolerances: list[RevisionTolerances] = []
     for source in sources:
         every = load_parts_with_warnings(source, catalog=db, options=options)
+        kept = []
         for loaded in every:
             where = source if len(every) == 1 else f"{source} ({loaded.part.name})"
             if not loaded.orientability.orientable:
@@ -101,11 +102,12 @@ def load_parts(
                     raise InputError(line)
                 left_out.append(line)
                 continue
-            import_warnings += [f"{where}: {w}" for w in loaded.warnings]
+            kept.append(loaded)
             pfs.append(push_function(loaded.part))
             origins.append(source)
             if loaded.tolerances is not None:
                 tolerances.append(loaded.tolerances)
+        import_warnings += labelled_warnings(source, kept, several=len(every) > 1)
     names = [pf.part.name for pf in pfs]
     for name in names:
         if names.count(name) > 1:

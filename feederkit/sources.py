@@ -147,6 +147,24 @@ def load_parts_with_warnings(
     return (found,)
 
 
+def labelled_warnings(
+    source: str, parts: Sequence[LoadedPart], several: bool | None = None
+) -> list[str]:
+    """The import warnings of ``parts`` (those a SOURCE holds) as lines ``SOURCE: ...``.
+
+    When the SOURCE holds several parts (``several``, default: more than one given), a
+    warning every part carries (the drawing's own: its units, a frame, parts in holes) is
+    said once under the SOURCE, and one of only some parts names them, ``SOURCE (NAME):
+    ...``: a 6 mm square cut from a plate's hole is no '60 x 30 mm rectangle'."""
+    if not (len(parts) > 1 if several is None else several):
+        return [f"{source}: {w}" for p in parts for w in p.warnings]
+    common = [w for w in parts[0].warnings if all(w in p.warnings for p in parts)] if parts else []
+    lines = [f"{source}: {w}" for w in common]
+    for p in parts:
+        lines += [f"{source} ({p.part.name}): {w}" for w in p.warnings if w not in common]
+    return lines
+
+
 def load_part_with_warnings(
     source: str,
     *,

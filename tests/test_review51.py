@@ -99,3 +99,35 @@ def test_com_given_for_a_file_in_inches_warns_that_it_is_read_in_mm(tmp_path):
     assert any("--com" in w and "mm" in w and " in " in w for w in parts[0].warnings)
     _, parts = import_parts(path, ImportOptions(units="mm", com=(1.1, 0.5)))
     assert not any("--com" in w for w in parts[0].warnings)
+
+
+def write_plate_with_island(path: Path) -> Path:
+    """A 60 x 30 mm plate with a square hole that holds a 6 mm square: two parts."""
+    import ezdxf
+
+    doc = ezdxf.new("R2010", units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (60, 0), (60, 30), (0, 30)], close=True)
+    msp.add_lwpolyline([(10, 10), (20, 10), (20, 20), (10, 20)], close=True)
+    msp.add_lwpolyline([(12, 12), (18, 12), (18, 18), (12, 18)], close=True)
+    doc.saveas(path)
+    return path
+
+
+def test_all_parts_warnings_said_once_and_true_of_all_parts(tmp_path, capsys):
+    """With --all-parts a drawing's own warnings are said once, under the file, not once per
+    part under each part's name (the 6 mm square is no '60 x 30 mm rectangle'); and the
+    nested part is imported, not left out."""
+    from shared import run_cli
+
+    path = str(write_plate_with_island(tmp_path / "sheet.dxf"))
+    for args in (
+        ["part", "analyze", path, "--all-parts"],
+        ["plan", path, "--all-parts", "--tolerance", "0.3", "-o", "/dev/null"],
+    ):
+        _, _, err = run_cli(capsys, *args)
+        lines = [ln for ln in err.splitlines() if "holes hold" in ln]
+        assert len(lines) == 1, err
+        assert lines[0].startswith(f"warning: {path}: ")
+        assert "imported the outer part" not in lines[0]
+        assert "sheet-2): the part is a 60 x 30" not in err

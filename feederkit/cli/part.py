@@ -24,8 +24,9 @@ from feederkit.cli.common import (
     err_console,
     plural,
     print_json,
+    print_warnings,
 )
-from feederkit.cli.importopts import print_import_warnings, takes_import_options
+from feederkit.cli.importopts import takes_import_options
 from feederkit.cli.part_plot import plot_command
 from feederkit.importers import ImportOptions
 from feederkit.mechanics.analysis import (
@@ -35,7 +36,7 @@ from feederkit.mechanics.analysis import (
     fragile_warning,
 )
 from feederkit.sensors import make_sensor
-from feederkit.sources import load_parts_with_warnings
+from feederkit.sources import labelled_warnings, load_parts_with_warnings
 
 NEAR_LIST_MAX = 8
 """At most this many near-metastable edges are named in a warning line; the rest are counted."""
@@ -171,9 +172,9 @@ def analyze_command(
     )
     parts = []
     for src in sources:
-        for loaded in load_parts_with_warnings(src, com=com, catalog=catalog, options=import_opts):
-            print_import_warnings(src, loaded.warnings)
-            parts.append(loaded.part)
+        every = load_parts_with_warnings(src, com=com, catalog=catalog, options=import_opts)
+        print_warnings(labelled_warnings(src, every))
+        parts += [loaded.part for loaded in every]
     analyses = [analyze_part(p, sensor) for p in parts]
     for a in analyses:
         for warning in (near_metastable_warning(a), fragile_warning(a.push)):

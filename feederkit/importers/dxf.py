@@ -1093,8 +1093,8 @@ def _read_doc(
     if drawing.nested:
         warnings_.append(
             f"the part's holes hold {drawing.nested} other part(s), as in a cut sheet: imported "
-            "the outer part (if the outer loop is a drawing frame, leave its layer out with "
-            "--layer)"
+            + ("them as parts of their own" if options.all_parts else "the outer part")
+            + " (if the outer loop is a drawing frame, leave its layer out with --layer)"
         )
     if others:
         warnings_.append(
