@@ -131,3 +131,22 @@ def test_all_parts_warnings_said_once_and_true_of_all_parts(tmp_path, capsys):
         assert lines[0].startswith(f"warning: {path}: ")
         assert "imported the outer part" not in lines[0]
         assert "sheet-2): the part is a 60 x 30" not in err
+
+
+def test_an_outline_drawn_twice_with_an_inner_copy_is_no_drawing_frame(tmp_path):
+    """A 50 x 30 mm plate whose outline is drawn twice, the copy 0.02 mm inside (more than
+    the flatten tolerance, so not a repeat): it was taken for a double-line drawing frame
+    and the plate's 8 mm hole imported as the part, with only 'skipped 1 drawing frame'."""
+    import ezdxf
+    import pytest
+
+    from feederkit.errors import InputError
+
+    doc = ezdxf.new("R2010", units=4)
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (50, 0), (50, 30), (0, 30)], close=True)
+    msp.add_lwpolyline([(0.02, 0.02), (49.98, 0.02), (49.98, 29.98), (0.02, 29.98)], close=True)
+    msp.add_circle((15, 15), 4)
+    doc.saveas(tmp_path / "twice.dxf")
+    with pytest.raises(InputError, match=r"the outline seems drawn twice, 0.028 mm apart"):
+        import_parts(tmp_path / "twice.dxf", ImportOptions())

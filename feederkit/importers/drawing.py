@@ -38,6 +38,7 @@ from feederkit.importers.loops import (
     crossing_loop,
     drawn_twice,
     heal_gaps,
+    inner_copy,
     is_closed,
     joined,
     line_cycles,
@@ -308,6 +309,13 @@ def drawing_from_lines(
         detail = f" ({ends_words(np.asarray(found), counted=True)})" if found else ""
         raise InputError(f"{label}: no closed outline: the lines do not close into a loop{detail}")
     shells = [lp.polygon for lp in loops]
+    copied = inner_copy(shells, HEAL_GAP_REL, gap)
+    if copied is not None:
+        raise InputError(
+            f"{label}: the outline seems drawn twice, {copied:.2g} mm apart (a copy just inside "
+            "it, which would make the two a drawing frame and the part what the copy holds): "
+            "delete one copy"
+        )
     found = crossing_loop(healed, closed, shells, gap, budget, layers)
     if found is not None:
         crossing, crossed = found

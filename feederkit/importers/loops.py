@@ -813,6 +813,27 @@ def near_copy(
     return None
 
 
+def inner_copy(shells: Sequence[Polygon], share: float, gap: float) -> float | None:
+    """How far a loop lying inside the largest one stays from it all along, when that is at
+    most ``share`` of its size and more than ``gap`` (the outline drawn twice, the copy
+    offset inward), else None. Left to nesting, the two were a double-line drawing frame and
+    what the copy holds was taken for the part."""
+    if len(shells) < 2:
+        return None
+    big = max(range(len(shells)), key=lambda k: shells[k].area)
+    outer = shells[big]
+    x0, y0, x1, y1 = outer.bounds
+    reach = share * max(x1 - x0, y1 - y0)
+    for k, loop in enumerate(shells):
+        a0, b0, a1, b1 = loop.bounds
+        if k == big or max(a0 - x0, b0 - y0, x1 - a1, y1 - b1) > reach:
+            continue
+        apart = float(outer.exterior.hausdorff_distance(loop.exterior))
+        if gap < apart <= reach and outer.covers(loop):
+            return apart
+    return None
+
+
 def crossed_loops(lines: Sequence[np.ndarray], k: int, gap: float) -> list[Polygon]:
     """The loops the other lines close that closed line ``k`` crosses (as
     :func:`crossing_loop` found them), the one it shares most area with first."""
