@@ -1,4 +1,5 @@
-"""Review 51: a new user's import, plan-file and simulation checks."""
+"""A new user's import findings: source units, a tolerance checked on every pose, an outline
+drawn twice inside itself, --com in a file not in mm, warnings of several parts, open ends."""
 
 from __future__ import annotations
 
