@@ -10,20 +10,28 @@ from hypothesis import strategies as st
 from test_planners import check_plan
 from test_planners_bruteforce import Degenerate, OwnPart, own_length, polygon
 
-from feederkit.machine import build_machine
+from feederkit.machine import PushAlignMachine, build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning import api, fallback
+from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import _result, goal_relation, plan
-from feederkit.planning.beam import BeamSearch, _depth, _lengths, beam_plan, branch_key
+from feederkit.planning.beam import (
+    SMALL_SET,
+    BeamSearch,
+    _depth,
+    _lengths,
+    beam_plan,
+    branch_key,
+)
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.fallback import _choice_plan
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.stats import tree_length
-from feederkit.sensors import ToleranceSensor
+from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL
 
 
@@ -103,7 +111,7 @@ def test_a_cheap_failure_probes_the_beam_twice_as_wide_at_the_same_target(monkey
     the probe the target grows as before."""
     from feederkit.planning import beam as beam_module
 
-    machine = _random_part_machine(seed=8, n=14, rel=0.2)
+    machine = _random_part_machine(seed=61, n=14, rel=0.2)
     problem, branches, roots = _problem(machine)
     assert _lengths(BeamSearch(problem, 4, Deadline()), roots, 3) is None
     assert max(_lengths(BeamSearch(problem, 8, Deadline()), roots, 3)) == 3
@@ -127,18 +135,64 @@ def test_a_cheap_failure_probes_the_beam_twice_as_wide_at_the_same_target(monkey
     assert calls[:2] == [(4, 3, None), (4, 4, 4)]
 
 
+def _kept(problem, mask, width):
+    """What a beam of ``width`` keeps of a set's actions: the ``width`` with the smallest
+    branches (ties in the length view's order), every one of a small set."""
+    every = problem.choices.actions(mask)
+    return list(every) if mask.bit_count() <= SMALL_SET else sorted(every, key=branch_key)[:width]
+
+
 def test_the_beam_keeps_the_actions_with_the_smallest_branches():
-    problem, _branches, roots = _problem(_random_part_machine())
+    problem, _branches, roots = _problem(_random_part_machine(seed=61, n=14, rel=0.2))
     mask = max(roots, key=int.bit_count)
-    assert not problem.is_goal(mask)
+    assert not problem.is_goal(mask) and mask.bit_count() > SMALL_SET
     every = problem.choices.actions(mask)
     beam = BeamSearch(problem, 2)
     kept = list(beam.actions_of(mask))
     assert len(kept) == min(2, len(every))
     assert [branch_key(a) for a in kept] == sorted(branch_key(a) for a in every)[: len(kept)]
     # The very actions of the length view, ties in its order, made from the cells alone.
-    assert kept == sorted(every, key=branch_key)[:2]
+    assert kept == _kept(problem, mask, 2)
     assert beam.cut == (len(every) > 2)
+
+
+def _chains_machine() -> PushAlignMachine:
+    """Two states 0 and 1 that one narrow range sends to a pair merged by the next action,
+    and four wide ranges to pairs of four chains, each three pairs long before it merges (no
+    sensor, the ideal model)."""
+    from feederkit.angles import ActionRange
+    from feederkit.machine import MachineState
+
+    bounds = [(0.0, 80.0), (80.0, 160.0), (160.0, 240.0), (240.0, 320.0), (320.0, 360.0)]
+    n = 4 + 4 * 6
+    targets = [[0] * 5 for _ in range(n)]
+    targets[0] = [4, 10, 16, 22, 2]  # the chains' first pairs, then the pair {2, 3}
+    targets[1] = [5, 11, 17, 23, 3]
+    targets[2] = targets[3] = [2] * 5
+    for c in range(4):
+        for k in range(3):
+            a = 4 + 6 * c + 2 * k
+            nxt = a + 2 if k < 2 else a  # the last pair of a chain merges into its first state
+            targets[a] = [nxt] * 5
+            targets[a + 1] = [nxt + 1 if k < 2 else a] * 5
+    states = tuple(MachineState(0, i, 1.0, 1.0 / n) for i in range(n))
+    maps = tuple(
+        tuple(ActionRange(lo, hi, t) for (lo, hi), t in zip(bounds, row, strict=True))
+        for row in targets
+    )
+    return PushAlignMachine(("chains",), states, maps, NoSensor())
+
+
+def test_a_small_set_keeps_every_action_in_a_beam():
+    # The pair's five actions all leave one pair, so the beam's order keeps the four widest,
+    # the chains (four more operations); only the narrow one orients it in two. A beam of
+    # four that kept only the widest would find no plan within three operations.
+    problem = Problem(_chains_machine(), "exact", 0.0, goal_relation(_chains_machine(), Deadline()))
+    pair = 0b11
+    assert WorstCase(problem).length(pair) == 2
+    beam = BeamSearch(problem, 4)
+    assert len(list(beam.actions_of(pair))) == 5 and not beam.cut
+    assert beam.within(pair, 2)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -151,8 +205,7 @@ def test_the_beams_ranking_keeps_what_sorting_every_action_keeps(seed, n, rel):
         for mask in roots:
             if problem.is_goal(mask):
                 continue
-            every = problem.choices.actions(mask)
-            assert list(beam.actions_of(mask)) == sorted(every, key=branch_key)[:width]
+            assert list(beam.actions_of(mask)) == _kept(problem, mask, width)
 
 
 def test_until_a_plan_the_beams_deepen_by_growing_steps(monkeypatch):

@@ -49,6 +49,14 @@ that fails slowly must not take the time of the deeper one that succeeds (the 50
 5 % under 1 degree: width 4 failed at 8 operations after 11.6 s of the 19 s left, and the
 search at 12 ran out of time)."""
 
+SMALL_SET = 4
+"""A set of at most this many states keeps every action in a beam. Its few actions all leave
+branches about as small, so the beam's order (:func:`branch_key`) picks among them by the
+image and the width alone, and can keep only actions that never resolve it: on the 50-part
+mix at 5 % under 1 degree (lumped goal) three states with an exact length of 3 had no plan in
+the width-4 beam within 27 operations, and no width-4 plan of the mix existed within 100;
+with every action of the small sets, 10 operations at a target of 10."""
+
 PROBE_POLLS = 4_000
 """The beam twice as wide tried at the same target gets at most this many polls: past them
 the target grows, with the beam that failed cheaply."""
@@ -62,8 +70,9 @@ def branch_key(act: Act) -> tuple[int, int]:
 
 class BeamSearch(WorstCase):
     """:class:`~feederkit.planning.andor.WorstCase` over the ``width`` best actions of each
-    set (:func:`branch_key`). ``within`` answers for that restricted space: True is a plan,
-    False only that this beam has none."""
+    set (:func:`branch_key`; every action of a set of at most ``SMALL_SET`` states).
+    ``within`` answers for that restricted space: True is a plan, False only that this beam
+    has none."""
 
     SUBSET_REFUTES = False  # a beam's failure is no proof: it does not refute supersets
 
@@ -79,7 +88,11 @@ class BeamSearch(WorstCase):
         acts = self._beam.get(mask)
         if acts is None:
             choices = self.p.choices
-            if self.p.min_margin > 0.0:  # margins are not monotone: every branch counts
+            if mask.bit_count() <= SMALL_SET:
+                # Every action of a small set: they are few, and the beam's order cannot tell
+                # them apart (each leaves branches of two states at most, for a pair).
+                acts = tuple(choices.search_actions(mask))
+            elif self.p.min_margin > 0.0:  # margins are not monotone: every branch counts
                 every = choices.exact_actions(mask)
                 self.cut |= len(every) > self.width
                 acts = tuple(sorted(every, key=branch_key)[: self.width])
