@@ -463,8 +463,12 @@ def test_a_limit_that_ran_out_in_the_planner_is_a_timeout_and_other_errors_are_a
         time.sleep(0.25)
         raise PlanningError("no strong plan found within 36 operations")
 
-    with pytest.raises(Timeout):
+    with pytest.raises(Timeout) as info:
         DesignClock(0.2).plan(late)
+    assert info.value.reason == "time"
+    with pytest.raises(Timeout) as info:  # the time ran out, though a memory limit is set
+        DesignClock(0.2, memory_limit_mb=1e6).plan(late)
+    assert info.value.reason == "time"
 
 
 def test_the_planner_of_a_limited_design_has_its_fallback_off_and_its_cut_is_a_timeout():

@@ -153,8 +153,6 @@ class DesignClock:
         left = self.deadline.remaining()
         if left is not None and left <= 0.0:
             raise Timeout("time")
-        # What ran out when the planner's answer came from its budget without saying which.
-        stopped = "time" if self.memory_limit_mb is None else "memory"
         options = PlanningOptions(
             time_limit_s=left, memory_limit_mb=self.memory_limit_mb, fallback=False
         )
@@ -163,11 +161,12 @@ class DesignClock:
         except OutOfBudget as exc:  # a limit, not the problem, ended the planner
             raise Timeout(exc.reason) from None
         except PlanningError:
-            if self.deadline.expired():
-                raise Timeout(stopped) from None
+            ran_out = self.deadline.ran_out()
+            if ran_out is not None:
+                raise Timeout(ran_out) from None
             raise
-        if not made.result.optimal:
-            raise Timeout(stopped)
+        if not made.result.optimal:  # not with the fallback off: a limit must have cut it
+            raise Timeout(self.deadline.ran_out() or "time")
         self.check()
         return made
 

@@ -130,12 +130,17 @@ class Deadline:
 
     def expired(self) -> bool:
         """Whether a limit has passed (reads the clock and the memory now)."""
+        return self.ran_out() is not None
+
+    def ran_out(self) -> str | None:
+        """Which limit has passed, as a Timeout names it (``"memory"``, else ``"time"``;
+        reads the clock and the memory now), None when neither has."""
         self._next_memory = 0.0
         try:
             self.check()
-        except Timeout:
-            return True
-        return False
+        except Timeout as exc:
+            return exc.reason
+        return None
 
     def slowness(self) -> float:
         """Wall seconds per CPU second of this process since the budget began, between 1 and
