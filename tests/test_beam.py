@@ -185,9 +185,10 @@ def _chains_machine() -> PushAlignMachine:
 
 def test_a_small_set_keeps_every_action_in_a_beam():
     # The pair's five actions all leave one pair, so the beam's order keeps the four widest,
-    # the chains (four more operations); only the narrow one orients it in two. A beam of
+    # the chains (four operations in all); only the narrow one orients it in two. A beam of
     # four that kept only the widest would find no plan within three operations.
-    problem = Problem(_chains_machine(), "exact", 0.0, goal_relation(_chains_machine(), Deadline()))
+    machine = _chains_machine()
+    problem = Problem(machine, "exact", 0.0, goal_relation(machine, Deadline()))
     pair = 0b11
     assert WorstCase(problem).length(pair) == 2
     beam = BeamSearch(problem, 4)
