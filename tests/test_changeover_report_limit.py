@@ -137,6 +137,34 @@ def test_the_design_budget_is_what_the_time_limit_leaves(monkeypatch):
     assert 3.0 < budget <= 3.5 and budget == round(budget, 1)
     monkeypatch.setattr(sensor, "REPORT_DESIGN_LIMIT_S", 0.25)
     assert report_design_budget(5.0, now - 30.0) == 0.25
+    assert 298.0 < report_design_budget(300.0, now, parts=2, cap=300.0) <= 299.3  # its own cap
+
+
+def test_changeover_report_gives_its_design_a_long_time_limit_less_the_drawings(
+    db, tmp_path, capsys, monkeypatch
+):
+    # `changeover report --time-limit 300` is the report's own limit: its design gets it less
+    # the drawings, not the 60 s a compile's report is capped at.
+    import feederkit.cli.changeover as changeover_cli
+
+    ok(
+        capsys,
+        ["changeover", "compile", "mix", "--mix", MIX, "--tolerance", "0.01", "--catalog", str(db)],
+    )
+    budgets = []
+
+    def report(plan, parts, witnesses, budget, warnings=()):
+        budgets.append(budget)
+        return "<html></html>"
+
+    monkeypatch.setattr(changeover_cli, "changeover_report", report)
+    html = str(tmp_path / "mix.html")
+    for limit in ("300", None):
+        flag = [] if limit is None else ["--time-limit", limit]
+        ok(capsys, ["changeover", "report", "mix", "-o", html, *flag, "--catalog", str(db)])
+    parts = len(MIX.split(","))
+    assert 290.0 < budgets[0] <= 300.0 - changeover_cli.REPORT_DRAW_S_PER_PART * parts
+    assert 50.0 < budgets[1] <= 60.0 - changeover_cli.REPORT_DRAW_S_PER_PART * parts
 
 
 def test_a_design_the_mix_cannot_have_leaves_the_compile_and_its_report(

@@ -254,15 +254,18 @@ function and diameters in one SVG figure; 20 landings of a 10-part mix took 6-7 
 from the report's sensor design, so that the command answers within about its limit."""
 
 
-def report_design_budget(time_limit_s: float | None, started: float, parts: int = 0) -> float:
+def report_design_budget(
+    time_limit_s: float | None, started: float, parts: int = 0, cap: float | None = None
+) -> float:
     """Seconds the report's sensor design may take in a command that started at ``started``
     (``time.monotonic()``) under ``--time-limit`` ``time_limit_s``: what is left of it less
     ``REPORT_DRAW_S_PER_PART`` for each of the report's ``parts`` (at least
-    ``REPORT_DESIGN_MIN_S``), never more than ``REPORT_DESIGN_LIMIT_S``; with no time limit,
-    that (docs/reports.md). Tenths of a second: the warning of a design cut short names it."""
+    ``REPORT_DESIGN_MIN_S``), never more than ``cap`` (default ``REPORT_DESIGN_LIMIT_S``: a
+    compile's limit is the plan's); with no time limit, the cap (docs/reports.md). Tenths of
+    a second: the warning of a design cut short names it."""
     from feederkit.design import sensor
 
-    cap = sensor.REPORT_DESIGN_LIMIT_S
+    cap = sensor.REPORT_DESIGN_LIMIT_S if cap is None else cap
     if time_limit_s is None:
         return cap
     left = time_limit_s - (time.monotonic() - started) - REPORT_DRAW_S_PER_PART * parts
@@ -837,6 +840,7 @@ def report_command(
 ) -> None:
     """Write a stored changeover's HTML report, with the pairs of parts no plan can tell apart."""
     from feederkit.design.limit import check_limits
+    from feederkit.design.sensor import REPORT_DESIGN_LIMIT_S
 
     started = time.monotonic()
     with flag_words():
@@ -845,8 +849,10 @@ def report_command(
     check_outputs((output, "report"))
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
-    limit = 60.0 if design_limit is None else design_limit
-    budget = min(limit, report_design_budget(limit, started, len(co.parts)))
+    # The report's own limit (default the design's 60 s) is all the report's: its design gets
+    # it less the drawings, however long.
+    limit = REPORT_DESIGN_LIMIT_S if design_limit is None else design_limit
+    budget = report_design_budget(limit, started, len(co.parts), cap=limit)
     html = changeover_report(co.plan, list(co.parts), co.witnesses(), budget, co.warnings)
     write_files([OutputFile(output, html, "report")])
     note_written((output, "report"))
