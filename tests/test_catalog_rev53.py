@@ -225,6 +225,19 @@ def stored_names(capsys, db: str) -> list[str]:
     return [c["name"] for c in json.loads(out)]
 
 
+def interrupted_after_storing(here, capsys, db: str) -> str:
+    """Compile c1 with ``-o c1.json`` under an interrupt that comes after the COMMIT: one line,
+    exit 130, naming the stored changeover and the plan file, both in place. The line."""
+    code, err = compile_c1(capsys, db, "-o", "c1.json")
+    assert code == 130
+    (line,) = err.splitlines()
+    assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
+    assert "wrote the plan to c1.json" in line
+    assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
+    assert stored_names(capsys, db) == ["c1"]
+    return line
+
+
 def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys, monkeypatch):
     import feederkit.cli.changeover as changeover_cli
 
@@ -234,13 +247,8 @@ def test_ctrl_c_after_the_changeover_is_stored_says_nothing_is_lost(here, capsys
         raise KeyboardInterrupt
 
     monkeypatch.setattr(changeover_cli, "plan_tree", interrupt)  # drawn after the commit
-    code, err = compile_c1(capsys, db, "-o", "c1.json")
-    assert code == 130
-    (line,) = err.splitlines()
-    assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
-    assert "wrote the plan to c1.json" in line and "only the printing was cut" in line
-    assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
-    assert stored_names(capsys, db) == ["c1"]
+    line = interrupted_after_storing(here, capsys, db)
+    assert "only the printing was cut" in line
 
 
 def test_ctrl_c_just_after_the_commit_keeps_the_files_of_the_stored_changeover(
@@ -258,13 +266,7 @@ def test_ctrl_c_just_after_the_commit_keeps_the_files_of_the_stored_changeover(
         raise KeyboardInterrupt
 
     monkeypatch.setattr(changeover_lib, "save_changeover", then_interrupt)
-    code, err = compile_c1(capsys, db, "-o", "c1.json")
-    assert code == 130
-    (line,) = err.splitlines()
-    assert line.startswith("error: interrupted after it stored changeover 'c1' in c.db")
-    assert "wrote the plan to c1.json" in line
-    assert json.loads((here / "c1.json").read_text())["format"] == "feederkit-plan"
-    assert stored_names(capsys, db) == ["c1"]
+    interrupted_after_storing(here, capsys, db)
 
 
 def test_ctrl_c_after_the_files_are_placed_and_before_the_commit_leaves_neither(
