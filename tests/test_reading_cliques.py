@@ -21,6 +21,7 @@ from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning import readings as readings_module
+from feederkit.planning.choices import children_key
 from feederkit.planning.readings import Readings, _cells_are_runs
 from feederkit.planning.reindex import by_diameter
 from feederkit.sensors import ToleranceSensor
@@ -83,3 +84,49 @@ def test_cells_that_skip_a_state_are_not_runs():
     # State 0 in cells 0 and 2 but not 1: its span (0, 3) is not what the cells hold.
     assert not _cells_are_runs([0b01, 0b10, 0b01], [(0, 3), (1, 2)])
     assert _cells_are_runs([0b01, 0b11, 0b10], [(0, 2), (1, 3)])
+
+
+def _one_landing_machine(tolerance: float):
+    """A mix of random hexagons to decagons under 1 degree, numbered by diameter: the
+    sensor's reading windows apply."""
+    rng = random.Random(7)
+    pfs = []
+    for k in range(6):
+        m = rng.randint(6, 10)
+        pts = []
+        for t in sorted(rng.uniform(0.0, 2 * math.pi) for _ in range(m)):
+            f = rng.uniform(20.0, 30.0)
+            pts.append((f * math.cos(t), f * math.sin(t)))
+        pfs.append(push_function(make_part(make_outline(f"hex-{k}", pts))))
+    machine = build_machine(pfs, ToleranceSensor(tolerance), Uncertainty(1.0))
+    return by_diameter(machine)[0]
+
+
+@pytest.fixture(scope="module", params=[0.05, 0.5, 2.0])
+def windowed(request):
+    machine = _one_landing_machine(request.param)
+    out = Readings(machine, Grouping.EXACT, (0,) * machine.n)
+    assert out._window  # the windows' own case
+    return out
+
+
+@settings(max_examples=150, deadline=None)
+@given(data=st.data())
+def test_the_window_walk_finds_the_maximal_sets_that_read_alike(windowed, data):
+    # The walk jumps from one maximal run to the next (``_first_reaching``); against the
+    # readings themselves, and against a run per member kept when it reaches further.
+    n = windowed.machine.n
+    image = data.draw(st.integers(1, (1 << n) - 1))
+    got = windowed.children(image)
+    assert set(got) == _brute_force_maximal(windowed, image)
+    runs, top = [], -1
+    for i in members(image):
+        r = image & windowed._window[i]
+        if r.bit_length() > top:
+            runs.append(r)
+            top = r.bit_length()
+    assert got == tuple(sorted(runs, key=int.bit_count, reverse=True))
+    # The ranking's numbers for many images at once (Readings.branch_keys): the largest
+    # maximal branch and the branches' sizes added up.
+    more = [image, *data.draw(st.lists(st.integers(1, (1 << n) - 1), max_size=6))]
+    assert windowed.branch_keys(more) == [children_key(windowed.children(m)) for m in more]

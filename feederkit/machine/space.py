@@ -289,7 +289,8 @@ class SearchSpace:
         bits = np.zeros((len(lo), n + 1), dtype=bool)
         bits[np.arange(len(lo))[:, None], rows] = True
         packed = np.packbits(bits[:, :n], axis=1, bitorder="little")
-        images = [int.from_bytes(r.tobytes(), "little") for r in packed]
+        raw, width = packed.tobytes(), packed.shape[1]
+        images = [int.from_bytes(raw[k : k + width], "little") for k in range(0, len(raw), width)]
         return lo, hi, images
 
     @cached_property

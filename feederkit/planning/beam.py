@@ -28,7 +28,6 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 
-from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.choices import children_key
@@ -101,9 +100,7 @@ class BeamSearch(WorstCase):
                 # (a set has about a hundred on a near-round part, and the beam keeps four).
                 ranked = choices.useful_cells(mask)  # in branch_key order
                 self.cut |= len(ranked) > self.width
-                acts = tuple(
-                    Act(OverlapRange(*cell), children) for cell, children in ranked[: self.width]
-                )
+                acts = tuple(choices.useful_act(cell) for cell in ranked[: self.width])
             self._beam[mask] = acts
         return iter(acts)
 

@@ -187,39 +187,19 @@ class Choices:
         if fast is not None:
             # The same cells and images as fixed_cells, from the machine's cell table.
             los, his, imgs = fast
-            width = his - los
-            keep = np.flatnonzero(width >= floor)
-            key = np.rint(width[keep] * 1e9)  # width_key, vectorised
-            by_width = np.argsort(-key, kind="stable")  # widest first
-            order = keep[by_width]
-            kept = len(order)
-            ordered = key[by_width]
-            if bool(np.all(ordered[1:] < ordered[:-1])):
-                # No two widths alike: the first cell of each image is its widest, and the
-                # order of first cells is the final one (widest first).
-                seq = [imgs[k] for k in order.tolist()]
-                first = dict(zip(reversed(seq), range(kept - 1, -1, -1), strict=True))
-                lo_l, hi_l = los[order].tolist(), his[order].tolist()
-                cells = [(lo_l[i], hi_l[i], seq[i]) for i in sorted(first.values())]
-                return self._keep_cells(mask, useful, cells)
-            for k, lo, hi in zip(
-                order.tolist(), los[order].tolist(), his[order].tolist(), strict=True
-            ):
-                img = imgs[k]
-                old = best.get(img)
-                if old is None or _wider((lo, hi, img), old):
-                    best[img] = (lo, hi, img)
-        else:
-            for cell in self.fixed_cells(mask):
-                lo, hi, img = cell
-                if hi - lo < floor:
-                    continue
-                key: object = img
-                if self.distinct_maps:
-                    key = self.targets(mask, OverlapRange(lo, hi, img))
-                old = best.get(key)
-                if old is None or _wider(cell, old):
-                    best[key] = cell
+            keep = np.flatnonzero(his - los >= floor)
+            kept = [imgs[k] for k in keep.tolist()]
+            return self._keep_cells(mask, useful, _widest_cells(los[keep], his[keep], kept))
+        for cell in self.fixed_cells(mask):
+            lo, hi, img = cell
+            if hi - lo < floor:
+                continue
+            key: object = img
+            if self.distinct_maps:
+                key = self.targets(mask, OverlapRange(lo, hi, img))
+            old = best.get(key)
+            if old is None or _wider(cell, old):
+                best[key] = cell
         keyed = [
             (-width_key(hi - lo), norm360((lo + hi) / 2.0), img, lo, hi)
             for lo, hi, img in best.values()
@@ -301,17 +281,24 @@ class Choices:
                 yield made[i]
                 i += 1
                 continue
-            nxt = next(cells, None)
-            if nxt is None:
+            cell = next(cells, None)
+            if cell is None:
                 self._lazy.pop(mask, None)
                 self._actions.setdefault(mask, tuple(made))
                 return
-            cell, children = nxt
-            made.append(Act(OverlapRange(*cell), children))
+            made.append(self.useful_act(cell))
 
-    def useful_cells(self, mask: int) -> list[tuple[tuple[float, float, int], tuple[int, ...]]]:
-        """The cells of :meth:`lazy_actions` with their maximal branches, before any action
-        is made: a caller that ranks them makes only the actions it keeps.
+    def useful_act(self, cell: tuple[float, float, int]) -> Act:
+        """The length view's action of one of :meth:`useful_cells`: its maximal reading
+        branches (none holds the set: each lies inside the image, which does not)."""
+        img = cell[2]
+        return Act(
+            OverlapRange(*cell), (img,) if self.readings.sensorless else self.readings.children(img)
+        )
+
+    def useful_cells(self, mask: int) -> list[tuple[float, float, int]]:
+        """The cells of :meth:`lazy_actions`, ranked before any action is made: a caller
+        that ranks them makes only the actions it keeps (:meth:`useful_act`).
 
         Ordered by :func:`search_key` (the smallest largest branch, then the fewest states
         over all branches: the likeliest to succeed; then the smallest image, the widest).
@@ -319,13 +306,14 @@ class Choices:
         first) is left out (dominated): the branches of a subset lie inside the
         branches of the set (each reading cell, or component, restricted), and a subset
         needs no more operations; testing against every earlier image costs more than it
-        saves on sets with hundreds of ranges. So are cells with a branch holding the set.
+        saves on sets with hundreds of ranges. No cell's image holds the set
+        (:meth:`cells`), so no branch does. The branch keys come from the readings' windows
+        for every cell at once where they apply (``Readings.branch_keys``), else per image.
         """
         cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
         kept: list[int] = []
-        out: list[tuple[tuple, int, tuple[float, float, int], tuple[int, ...]]] = []
-        readings = self.readings
-        for n, cell in enumerate(cells):
+        undominated: list[tuple[float, float, int]] = []
+        for cell in cells:
             img = cell[2]
             # Sorted by size: only an earlier image can lie inside this one.
             dominated = False
@@ -337,22 +325,31 @@ class Choices:
                 continue
             if len(kept) < _DOMINATORS:
                 kept.append(img)
-            children = (img,) if readings.sensorless else readings.children(img)
-            if any(c & mask == mask for c in children):
-                continue
-            out.append((self.search_key(cell), n, cell, children))
-        out.sort()
-        return [(cell, children) for _key, _n, cell, children in out]
+            undominated.append(cell)
+        keys = None
+        if not self.readings.sensorless:
+            keys = self.readings.branch_keys([c[2] for c in undominated])
+        if keys is None:
+            keys = [self.branch_key(c[2]) for c in undominated]
+        ranked = sorted(
+            ((*key, c[2].bit_count(), c[0] - c[1]), n)
+            for n, (key, c) in enumerate(zip(keys, undominated, strict=True))
+        )
+        return [undominated[n] for _key, n in ranked]
 
     def search_key(self, cell: tuple[float, float, int]) -> tuple[int, int, int, float]:
         """:func:`search_key` of a cell with its image's maximal branches (the image itself
         without a sensor), their :func:`children_key` cached per image."""
-        img = cell[2]
+        return (*self.branch_key(cell[2]), cell[2].bit_count(), cell[0] - cell[1])
+
+    def branch_key(self, img: int) -> tuple[int, int]:
+        """:func:`children_key` of an image's maximal branches (the image itself without a
+        sensor), cached per image."""
         key = self._branch_keys.get(img)
         if key is None:
             children = (img,) if self.readings.sensorless else self.readings.children(img)
             key = self._branch_keys[img] = children_key(children)
-        return (*key, img.bit_count(), cell[0] - cell[1])
+        return key
 
     def targets(self, mask: int, sa: OverlapRange) -> tuple[int, ...]:
         """Where each member of ``mask`` (ascending) can go under the range's representative:
@@ -444,6 +441,28 @@ def _widest_per_image(
             best[img] = entry
     keyed = sorted(best.values())
     return [(lo, hi, img) for _w, _r, img, lo, hi in keyed]
+
+
+def _widest_cells(
+    lo: np.ndarray, hi: np.ndarray, imgs: list[int]
+) -> list[tuple[float, float, int]]:
+    """:meth:`Choices.cells` from a set's cells as arrays, vectorised: per image the wider
+    cell, then the smaller representative rotation (:func:`_wider`), the first of equals;
+    widest first, then the smaller rotation. The same floats as :func:`~feederkit.angles.width_key`
+    and :func:`~feederkit.angles.norm360` of each cell, one array operation each."""
+    wkey = np.rint((hi - lo) * 1e9)
+    mid = np.fmod((lo + hi) / 2.0, 360.0) + 0.0
+    mid = np.where(mid < 0.0, mid + 360.0, mid)
+    mid = np.where(mid >= 360.0 - 1e-12, 0.0, mid)
+    ids: dict[int, int] = {}
+    group = np.fromiter((ids.setdefault(img, len(ids)) for img in imgs), np.intp, len(imgs))
+    order = np.lexsort((mid, -wkey, group))  # stable: the first of equals stays first
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = group[order[1:]] != group[order[:-1]]
+    best = order[first]
+    best = best[np.lexsort((mid[best], -wkey[best]))]
+    lo_l, hi_l = lo[best].tolist(), hi[best].tolist()
+    return [(a, z, imgs[k]) for a, z, k in zip(lo_l, hi_l, best.tolist(), strict=True)]
 
 
 def _wider(a: tuple[float, float, int], b: tuple[float, float, int]) -> bool:
