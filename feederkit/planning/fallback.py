@@ -209,6 +209,7 @@ def fallback(
         cap,
         lower - 1,
         first,
+        in_hand=blind is not None,
     )
     if beamed is not None:
         search, best = beamed
