@@ -196,6 +196,40 @@ def test_a_small_set_keeps_every_action_in_a_beam():
     assert beam.within(pair, 2)
 
 
+def test_a_small_set_with_no_plan_fails_a_deep_target_at_small_depth():
+    # Two pairs each rotation swaps, never merged (no sensor, no inseparable states): asked
+    # within 60 operations the beam tries them within SMALL_DEPTH only and then knows them
+    # to have none, instead of at every budget down from 60. A solvable pair asked within a
+    # deep budget still gets its plan.
+    from feederkit.angles import ActionRange
+    from feederkit.machine import MachineState
+    from feederkit.planning import beam as beam_module
+
+    bounds = [(0.0, 120.0), (120.0, 240.0), (240.0, 360.0)]
+    targets = [[2, 3, 2], [3, 2, 3], [0, 1, 1], [1, 0, 0]]
+    states = tuple(MachineState(0, i, 1.0, 0.25) for i in range(4))
+    maps = tuple(
+        tuple(ActionRange(lo, hi, t) for (lo, hi), t in zip(bounds, row, strict=True))
+        for row in targets
+    )
+    machine = PushAlignMachine(("swaps",), states, maps, NoSensor())
+    problem = Problem(machine, "exact", 0.0, (0,) * 4)
+    polls = {}
+    for depth in (beam_module.SMALL_DEPTH, 100):
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(beam_module, "SMALL_DEPTH", depth)
+            beam = BeamSearch(problem, 4, Deadline())
+            beam._quiet = None  # no shortest-path shortcut: the AND/OR search meets the pair
+            assert not beam.within(0b0011, 60)
+            polls[depth] = beam.deadline.polls
+            assert (0b0011 in beam.never) == (depth < 60)
+    assert polls[beam_module.SMALL_DEPTH] * 3 < polls[100]
+    chains = _chains_machine()
+    solvable = Problem(chains, "exact", 0.0, goal_relation(chains, Deadline()))
+    beam = BeamSearch(solvable, 4)
+    assert beam.within(0b11, 60) and 0b11 not in beam.never
+
+
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(0, 10**6), st.integers(6, 12), st.floats(0.005, 0.1))
 def test_the_beams_ranking_keeps_what_sorting_every_action_keeps(seed, n, rel):
