@@ -196,23 +196,53 @@ def test_a_small_set_keeps_every_action_in_a_beam():
     assert beam.within(pair, 2)
 
 
-def test_a_small_set_with_no_plan_fails_a_deep_target_at_small_depth():
-    # Two pairs each rotation swaps, never merged (no sensor, no inseparable states): asked
-    # within 60 operations the beam tries them within SMALL_DEPTH only and then knows them
-    # to have none, instead of at every budget down from 60. A solvable pair asked within a
-    # deep budget still gets its plan.
+def _chain_pair_machine(k: int, outcome_sets: bool) -> PushAlignMachine:
+    """A pair {0, 1} that every rotation moves along a chain of ``k`` pairs, the last
+    merging into one state that reads apart from the rest (so no set is quiet): its exact
+    length is ``k``. ``outcome_sets``: under uncertainty (outcome sets)."""
     from feederkit.angles import ActionRange
-    from feederkit.machine import MachineState
+    from feederkit.machine import MachineState, OutcomeRange
+
+    n = 2 * k + 1
+    bounds = [(0.0, 120.0), (120.0, 240.0), (240.0, 360.0)]
+    targets = [2 * (i // 2 + 1) + i % 2 if i // 2 < k - 1 else n - 1 for i in range(n - 1)]
+    targets.append(n - 1)
+    states = tuple(MachineState(0, i, 10.0 if i < n - 1 else 20.0, 1.0 / n) for i in range(n))
+    # Under uncertainty the first state of a pair may end in either state of the next pair:
+    # the pair's image, and so its length, stay the same.
+    wide = [
+        (1 << t) | (1 << (t + 1)) if i % 2 == 0 and t < n - 1 else 1 << t
+        for i, t in enumerate(targets)
+    ]
+    maps = tuple(
+        tuple(
+            OutcomeRange(lo, hi, wide[i]) if outcome_sets else ActionRange(lo, hi, t)
+            for lo, hi in bounds
+        )
+        for i, t in enumerate(targets)
+    )
+    return PushAlignMachine(("chain",), states, maps, ToleranceSensor(1.0))
+
+
+def test_a_small_set_with_no_plan_fails_a_deep_target_at_small_depth():
+    # Under uncertainty, two pairs each rotation swaps, never merged (no inseparable
+    # states): asked within 60 operations the beam tries them within SMALL_DEPTH only and
+    # then takes them to have none (and is no longer exhaustive), instead of asking at every
+    # budget down from 60. On the ideal model, and under uncertainty for a pair whose one
+    # plan is longer than SMALL_DEPTH but proven so, a deep pair still gets its plan.
+    from feederkit.machine import MachineState, OutcomeRange
     from feederkit.planning import beam as beam_module
 
     bounds = [(0.0, 120.0), (120.0, 240.0), (240.0, 360.0)]
-    targets = [[2, 3, 2], [3, 2, 3], [0, 1, 1], [1, 0, 0]]
+    # Each pair goes to the other (state 0 to either state of the pair {2, 3} at first).
+    targets = [[0b1100, 0b1000, 0b0100], [0b1000, 0b0100, 0b1000], [1, 2, 2], [2, 1, 1]]
     states = tuple(MachineState(0, i, 1.0, 0.25) for i in range(4))
     maps = tuple(
-        tuple(ActionRange(lo, hi, t) for (lo, hi), t in zip(bounds, row, strict=True))
+        tuple(OutcomeRange(lo, hi, t) for (lo, hi), t in zip(bounds, row, strict=True))
         for row in targets
     )
     machine = PushAlignMachine(("swaps",), states, maps, NoSensor())
+    assert not machine.deterministic
     problem = Problem(machine, "exact", 0.0, (0,) * 4)
     polls = {}
     for depth in (beam_module.SMALL_DEPTH, 100):
@@ -222,12 +252,27 @@ def test_a_small_set_with_no_plan_fails_a_deep_target_at_small_depth():
             beam._quiet = None  # no shortest-path shortcut: the AND/OR search meets the pair
             assert not beam.within(0b0011, 60)
             polls[depth] = beam.deadline.polls
-            assert (0b0011 in beam.never) == (depth < 60)
+            assert (0b0011 in beam.never) == beam.gave_up == (depth < 60)
     assert polls[beam_module.SMALL_DEPTH] * 3 < polls[100]
     chains = _chains_machine()
     solvable = Problem(chains, "exact", 0.0, goal_relation(chains, Deadline()))
     beam = BeamSearch(solvable, 4)
     assert beam.within(0b11, 60) and 0b11 not in beam.never
+    k = beam_module.SMALL_DEPTH + 1
+    ideal = _chain_pair_machine(k, outcome_sets=False)
+    assert ideal.deterministic
+    problem = Problem(ideal, "exact", 0.0, goal_relation(ideal, Deadline()))
+    assert not problem.carries_no_information(0b11)
+    assert WorstCase(problem).length(0b11) == k
+    found = beam_plan(problem, [0b11], None, Deadline(), 2 * k)
+    assert found is not None and found[1] == k
+    uncertain = _chain_pair_machine(k, outcome_sets=True)
+    assert not uncertain.deterministic
+    problem = Problem(uncertain, "exact", 0.0, goal_relation(uncertain, Deadline()))
+    exact = WorstCase(problem)
+    assert not exact.within(0b11, k - 1) and 0b11 not in exact.ub  # a bound, no plan
+    found = beam_plan(problem, [0b11], exact, Deadline(), 2 * k)  # seeded with the bound
+    assert found is not None and found[1] == k
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -15,14 +15,17 @@ import math
 import random
 import time
 
+import numpy as np
 import pytest
 from test_deadline import near_round, small_mix
 from test_planners import check_plan, random_convex
 
 import feederkit.planning.api as api
 import feederkit.planning.refine as refine
+from feederkit.angles import norm360
 from feederkit.machine import build_machine, members, search_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
+from feederkit.planning.choices import _widest_cells
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
@@ -247,6 +250,37 @@ def test_cells_from_the_cell_table_are_the_boundary_cells(rotation_error, monkey
     monkeypatch.setattr(search_space(m), "cells_and_images", lambda mask: None)
     slow = Problem(m).choices
     assert got == [(slow.cells(x, False), slow.cells(x, True)) for x in masks]
+
+
+def _widest_per_image_by_hand(lo, hi, imgs):
+    """Per image the cell of the largest width (in whole 1e-9 deg), then the smallest
+    representative rotation in [0, 360) (its middle), the first of equals; widest first, then
+    the smaller rotation."""
+    best = {}
+    for a, z, img in zip(lo, hi, imgs, strict=True):
+        key = (-round((z - a) * 1e9), norm360((a + z) / 2.0))
+        if img not in best or key < best[img][0]:
+            best[img] = (key, (a, z, img))
+    return [cell for _key, cell in sorted(best.values(), key=lambda e: e[0])]
+
+
+def test_the_widest_cell_of_each_image_by_array_sorts():
+    # choices._widest_cells against a loop over the cells: widths that tie (and differ by
+    # less than the width quantum), middles past 360 and just below it, repeated images.
+    rng = random.Random(5)
+    for _ in range(3000):
+        step = rng.choice([0.5, 1.0, 5.0, 30.0])
+        start = rng.choice([0.0, -0.5, 359.5, 360.0 - 5e-13, rng.uniform(0.0, 360.0)])
+        jitter = [0.0, 0.0, 3e-10, -3e-10, 6e-10]
+        pts = sorted(
+            {start + step * rng.randrange(int(360 / step)) + rng.choice(jitter) for _ in range(12)}
+        )
+        lo = np.array(pts)
+        hi = np.append(lo[1:], lo[0] + 360.0)
+        imgs = [rng.randint(1, rng.randint(1, 5)) for _ in pts]
+        want = _widest_per_image_by_hand(lo.tolist(), hi.tolist(), imgs)
+        assert _widest_cells(lo, hi, imgs) == want
+    assert _widest_cells(np.array([]), np.array([]), []) == []
 
 
 @pytest.mark.parametrize("rotation_error", [0.0, 1.0])

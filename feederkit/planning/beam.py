@@ -57,8 +57,9 @@ the width-4 beam within 27 operations, and no width-4 plan of the mix existed wi
 with every action of the small sets, 10 operations at a target of 10."""
 
 SMALL_DEPTH = 12
-"""A set of at most ``SMALL_SET`` states that has no plan within this many operations is taken,
-in a beam, to have none (``BeamSearch.never``). Under uncertainty a set reached by a
+"""Under uncertainty, a set of at most ``SMALL_SET`` states that has no plan within this many
+operations (and no proven bound above it) is taken, in a beam, to have none
+(``BeamSearch.never``; the beam is then not exhaustive). A set reached by a
 rotation can hold a pair no strong plan orients; a deep target asks it at every budget below
 (the 100-part mix at 5 % under 1 degree: 5,400 sets, most of them failing at budgets of 80-99,
 and no width-4 plan within 100 after 12 s)."""
@@ -86,18 +87,29 @@ class BeamSearch(WorstCase):
         super().__init__(problem, deadline)
         self.width = width
         self.cut = False
-        """Whether some set met had more actions than the beam keeps (False: the search
-        was exhaustive, and its failures are proofs)."""
+        """Whether some set met had more actions than the beam keeps (a wider beam may then
+        find more)."""
+        self.gave_up = False
+        """Whether some small set was taken to have no plan past ``SMALL_DEPTH``. With
+        neither, the search was exhaustive and its failures are proofs."""
         self._beam: dict[int, tuple[Act, ...]] = {}
 
     def _known(self, mask: int, k: int) -> bool | None:
-        # A small set asked within a deep budget is asked within SMALL_DEPTH first: past it,
-        # taken as having no plan at all (for this beam).
+        # Under uncertainty a small set asked within a deep budget is asked within SMALL_DEPTH
+        # first: past it, taken as having no plan at all (for this beam, which is then no
+        # longer exhaustive: ``gave_up``).
         out = super()._known(mask, k)
-        if out is None and k > SMALL_DEPTH and mask.bit_count() <= SMALL_SET:
+        if (
+            out is None
+            and k > SMALL_DEPTH
+            and not self.p.machine.deterministic
+            and mask.bit_count() <= SMALL_SET
+            and self.lb.get(mask, 1) <= SMALL_DEPTH
+        ):
             if self.within(mask, SMALL_DEPTH):
                 return True
             self.never.add(mask)
+            self.gave_up = True
             return False
         return out
 
@@ -146,7 +158,7 @@ def beam_plan(
     1000-point outline at 0.9 % on the ideal model, bound 6, 19 in hand: width 4 fails at 8
     exhaustively in 8.8 s and runs out at 10, where the targets 12, 15 and 18 each find a
     plan in 1-1.6 s). Stops early when a plan meets ``lower`` (a proven bound on the
-    largest root length) or a beam was exhaustive. Every entry of a beam's ``choice`` is a
+    largest root length) or a beam kept every action. Every entry of a beam's ``choice`` is a
     plan of its set within its bound, so each wider beam starts from the last one's.
     """
     best: int | None = None
@@ -198,7 +210,9 @@ def beam_plan(
             beam = _beam(problem, 2 * beam.width, beam.deadline, seed, beam)
             aim, step = start, 1
         else:
-            break  # exhaustive: no plan within the target exists
+            # Every action kept: no plan within the target exists (unless small sets were
+            # given up, ``gave_up``; a wider beam gives them up the same way).
+            break
     return None if best is None else (beam, best)
 
 
