@@ -314,6 +314,14 @@ def _masks(pairs: set[tuple[int, int]], n: int) -> tuple[int, ...]:
     return tuple(masks)
 
 
+def _drop(alive: set[tuple[int, int]], adj: list[int], p: tuple[int, int]) -> None:
+    """Drop the pair ``p`` from ``alive`` and from its states' masks (:func:`_masks`)."""
+    alive.discard(p)
+    i, j = p
+    adj[i] &= ~(1 << j)
+    adj[j] &= ~(1 << i)
+
+
 def pair_outcomes(machine: PushAlignMachine, i: int, j: int) -> list[tuple[int, int]]:
     """The outcome sets ``(of i, of j)`` (masks) on each overlap range of the two states'
     action maps (section 3.2.2), in rotation order."""
@@ -375,12 +383,6 @@ def _bisimilar(
         # Every state of each outcome set paired with some state of the other.
         return not a & ~near(b) and not b & ~near(a)
 
-    def drop(p: tuple[int, int]) -> None:
-        alive.discard(p)
-        i, j = p
-        adj[i] &= ~(1 << j)
-        adj[j] &= ~(1 << i)
-
     cases: dict[tuple[int, int], list[tuple[int, int]]] = {}
     for p in alive:
         check()
@@ -393,7 +395,7 @@ def _bisimilar(
         for p in sorted(alive):
             check()
             if not all(matched(a, b) for a, b in cases[p]):
-                drop(p)
+                _drop(alive, adj, p)
         if len(alive) == before:
             return alive
         if before - len(alive) < PASS_MIN_SHARE * before:
@@ -420,7 +422,7 @@ def _bisimilar(
         p = todo.pop()
         queued.discard(p)
         if p in alive and not all(matched(a, b) for a, b in cases[p]):
-            drop(p)
+            _drop(alive, adj, p)
             for u in users.get(p, ()):
                 if u in alive and u not in queued:
                     queued.add(u)
@@ -471,9 +473,6 @@ def kept_apart(
         for p in sorted(alive):
             check()
             if not all(keeps(a, b) for a, b in cases[p]):
-                alive.discard(p)
-                i, j = p
-                adj[i] &= ~(1 << j)
-                adj[j] &= ~(1 << i)
+                _drop(alive, adj, p)
                 changed = True
     return alive
