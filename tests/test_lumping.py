@@ -376,6 +376,29 @@ def test_a_lumped_goal_too_large_to_decide_is_planned_to(monkeypatch, wired):
     assert set(planned.result.lumped_pairs) <= {(0, 2), (1, 3)}
 
 
+def test_the_exact_search_to_an_undecided_lumped_goal_must_be_on_course_sooner(monkeypatch):
+    """An undecided lumped goal reaches more sets than lumping explored: its exact search is
+    judged at UNDECIDED_CHECK_SHARE of its time, a decided one's at EXACT_CHECK_SHARE, and
+    the rest goes to the anytime plans. Both plans still come (a limit long enough)."""
+    pf, sensor = near_rectangle(), NoSensor()
+    shares: list[float] = []
+    real = api._exact_budget
+
+    def exact_budget(budget, fallback=True, check_share=None):
+        shares.append(api.EXACT_CHECK_SHARE if check_share is None else check_share)
+        return real(budget, fallback, check_share)
+
+    monkeypatch.setattr(api, "_exact_budget", exact_budget)
+    options = PlanningOptions(time_limit_s=120.0)
+    decided = make_plan([pf], sensor, certify=False, options=options)
+    assert shares[-1] == api.EXACT_CHECK_SHARE and decided.result.lumped_pairs
+    shares.clear()
+    monkeypatch.setattr(api, "LUMPED_ROOT_SETS", 0)
+    undecided = make_plan([pf], sensor, certify=False, options=options)
+    assert shares[-1] == api.UNDECIDED_CHECK_SHARE < api.EXACT_CHECK_SHARE
+    assert undecided.result.length == decided.result.length
+
+
 def test_a_share_of_the_limit_run_out_leaves_lumping_undecided_not_timed_out():
     """Past its share of the limit (a plan's stage), lumping hands its goals to the search as
     past its set caps; only the plan's own deadline ends it in a time cut."""

@@ -128,5 +128,9 @@ def test_the_window_walk_finds_the_maximal_sets_that_read_alike(windowed, data):
     assert got == tuple(sorted(runs, key=int.bit_count, reverse=True))
     # The ranking's numbers for many images at once (Readings.branch_keys): the largest
     # maximal branch and the branches' sizes added up.
+    # Both ways: the walk per image and the arrays (each the faster at some image size).
     more = [image, *data.draw(st.lists(st.integers(1, (1 << n) - 1), max_size=6))]
-    assert windowed.branch_keys(more) == [children_key(windowed.children(m)) for m in more]
+    want = [children_key(windowed.children(m)) for m in more]
+    assert windowed.branch_keys(more) == want
+    assert [windowed.window_key(m) for m in more] == want
+    assert windowed._array_keys(more) == want

@@ -288,6 +288,42 @@ class Choices:
                 return
             made.append(self.useful_act(cell))
 
+    def branch_sets(self, mask: int) -> set[tuple[int, ...]]:
+        """The distinct branch tuples of :meth:`search_actions`, unordered: what a pass over
+        every action of a set needs (:func:`~feederkit.planning.solvable.solve`), from the
+        images alone, without ranking the cells or making the actions.
+
+        In the length view an image holding one of the ``_DOMINATORS`` smallest useful
+        images (by size, then value: the same tuples whatever is cached) is left out, as
+        :meth:`useful_cells` leaves such images out: its action needs no fewer operations.
+        """
+        if self.min_margin > 0.0:
+            return {a.children for a in self.exact_actions(mask)}
+        images: list[int] | None = None
+        if not self.distinct_maps and (mask, True) not in self._cells:
+            listed = self._space.cell_lists(mask)
+            if listed is not None:
+                images = listed[2]
+            else:
+                fast = self._space.cells_and_images(mask)
+                if fast is not None:
+                    images = fast[2]
+        if images is None:
+            images = [c[2] for c in self.cells(mask)]
+        useful = sorted(
+            {img for img in images if img & mask != mask}, key=lambda i: (i.bit_count(), i)
+        )
+        kept: list[int] = []
+        out: set[tuple[int, ...]] = set()
+        sensorless = self.readings.sensorless
+        for img in useful:
+            if _holds_one(img, kept):
+                continue
+            if len(kept) < _DOMINATORS:
+                kept.append(img)
+            out.add((img,) if sensorless else self.readings.children(img))
+        return out
+
     def useful_act(self, cell: tuple[float, float, int]) -> Act:
         """The length view's action of one of :meth:`useful_cells`: its maximal reading
         branches (none holds the set: each lies inside the image, which does not)."""
@@ -315,13 +351,7 @@ class Choices:
         undominated: list[tuple[float, float, int]] = []
         for cell in cells:
             img = cell[2]
-            # Sorted by size: only an earlier image can lie inside this one.
-            dominated = False
-            for k in kept:
-                if k & img == k:
-                    dominated = True
-                    break
-            if dominated:
+            if _holds_one(img, kept):  # sorted by size: only an earlier image lies inside
                 continue
             if len(kept) < _DOMINATORS:
                 kept.append(img)
@@ -407,6 +437,15 @@ def spread(masses, outcomes) -> dict[int, float]:
         for t in ts:
             moved[t] = moved.get(t, 0.0) + share
     return moved
+
+
+def _holds_one(img: int, kept: list[int]) -> bool:
+    """Whether the image ``img`` holds one of the images ``kept`` (a loop, not ``any()``: the
+    dominance test is a large part of a pass over a set's actions)."""
+    for k in kept:  # noqa: SIM110 (a generator costs more here)
+        if k & img == k:
+            return True
+    return False
 
 
 def _widest_per_image(

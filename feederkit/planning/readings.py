@@ -47,6 +47,13 @@ CLIQUE_SCAN_STATES = 128
 """Up to this many states an image's members are taken in the order their reading runs end
 by one scan of the machine's states; above it, by sorting the members."""
 
+WALK_BITS = 32
+"""``Readings.branch_keys`` walks each image's runs in Python when the images hold at most
+this many states on average, and uses arrays above it: on the 50-part mix at 5 % under 1
+degree (240 states) the walk took 0.4 of the arrays' time for a beam's sets of at most four
+states and 0.9 for the larger ones; on the 100-part mix (478 states) 0.9 at 27 states an
+image, 1.5 at 77 and 7 at 216 (docs/performance.md, "Reading keys walked")."""
+
 
 class Readings:
     """The reading branches of the sets a search meets, cached per set.
@@ -241,6 +248,29 @@ class Readings:
             runs.sort(key=int.bit_count, reverse=True)
         return tuple(runs)
 
+    def window_key(self, image: int) -> tuple[int, int]:
+        """``choices.children_key`` of the image's maximal reading branches (the largest
+        branch's size, the sizes added up) by :meth:`_window_runs`'s walk, without making the
+        branches (the reading windows must exist)."""
+        win = self._window
+        first = self._window_first
+        largest = total = 0
+        rest = image
+        while rest:
+            low = rest & -rest
+            r = image & win[low.bit_length() - 1]
+            c = r.bit_count()
+            total += c
+            if c > largest:
+                largest = c
+            top = r.bit_length()
+            above = image >> top
+            if not above:
+                break
+            reach = first[top + (above & -above).bit_length() - 1]
+            rest = image >> reach << reach
+        return largest, total
+
     def branch_keys(self, images: list[int]) -> list[tuple[int, int]] | None:
         """Per image, the size of its largest maximal reading branch and the sizes of its
         maximal branches added up (``choices.children_key`` of :meth:`children`), for many
@@ -252,10 +282,18 @@ class Readings:
         members, a run of the member ``i`` holds ``P[end(i)] - P[i]`` states, and it is
         maximal when it counts more members below its end than the previous member's run
         (the same runs as :meth:`_window_runs`): a few array operations over every image,
-        where the runs themselves cost a loop per branch and image.
+        where the runs themselves cost a loop per branch and image. Images of at most
+        ``WALK_BITS`` states on average are walked instead (:meth:`window_key`): the arrays'
+        fixed cost and their width (every state of the machine) then cost more.
         """
         if not self._window or not images:
             return None
+        if sum(map(int.bit_count, images)) <= WALK_BITS * len(images):
+            return [self.window_key(img) for img in images]
+        return self._array_keys(images)
+
+    def _array_keys(self, images: list[int]) -> list[tuple[int, int]]:
+        """:meth:`branch_keys` by array operations over every image at once."""
         n = self.machine.n
         width = (n + 7) // 8
         raw = b"".join(img.to_bytes(width, "little") for img in images)

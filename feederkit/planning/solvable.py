@@ -61,7 +61,7 @@ def solve(
         if hopeless is not None and hopeless(m):
             value[m] = math.inf
             continue
-        children = [tuple(set(a.children)) for a in problem.choices.search_actions(m)]
+        children = list(problem.choices.branch_sets(m))
         acts[m] = children
         if len(acts) > max_sets:
             return None
