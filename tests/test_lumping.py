@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import random
+import time
 from pathlib import Path
 
 import pytest
@@ -31,7 +32,7 @@ from feederkit.machine.inseparable import kept_apart
 from feederkit.mechanics import push_function, uncertain
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning.budget import Deadline, Timeout
+from feederkit.planning.budget import Checkpoint, Deadline, Timeout
 from feederkit.planning.lumping import (
     LumpedGoal,
     LumpingTry,
@@ -384,18 +385,24 @@ def test_the_exact_search_to_an_undecided_lumped_goal_must_be_on_course_sooner(m
     shares: list[float] = []
     real = api._exact_budget
 
-    def exact_budget(budget, fallback=True, check_share=None):
-        shares.append(api.EXACT_CHECK_SHARE if check_share is None else check_share)
-        return real(budget, fallback, check_share)
+    def exact_budget(*args, **kwargs):
+        # The checkpoint built: when it judges, as a share of the search's own time.
+        now = time.perf_counter()
+        out = real(*args, **kwargs)
+        assert isinstance(out, Checkpoint)
+        shares.append((out.end - now) / (out.later - now))
+        return out
 
     monkeypatch.setattr(api, "_exact_budget", exact_budget)
     options = PlanningOptions(time_limit_s=120.0)
     decided = make_plan([pf], sensor, certify=False, options=options)
-    assert shares[-1] == api.EXACT_CHECK_SHARE and decided.result.lumped_pairs
+    assert shares[-1] == pytest.approx(api.EXACT_CHECK_SHARE, abs=1e-3)
+    assert decided.result.lumped_pairs
     shares.clear()
     monkeypatch.setattr(api, "LUMPED_ROOT_SETS", 0)
     undecided = make_plan([pf], sensor, certify=False, options=options)
-    assert shares[-1] == api.UNDECIDED_CHECK_SHARE < api.EXACT_CHECK_SHARE
+    assert shares[-1] == pytest.approx(api.UNDECIDED_CHECK_SHARE, abs=1e-3)
+    assert api.UNDECIDED_CHECK_SHARE < api.EXACT_CHECK_SHARE
     assert undecided.result.length == decided.result.length
 
 

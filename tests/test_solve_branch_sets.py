@@ -36,7 +36,13 @@ def _machine(k: int, err: float, sensor=None):
 
 
 def _every_action(problem: Problem, mask: int) -> set[tuple[int, ...]]:
-    """The maximal branches of every useful cell's action, none left out for dominance."""
+    """The maximal branches of every useful cell's action, none left out for dominance
+    (with a margin floor every branch of every cell wide enough: the exact view)."""
+    if problem.min_margin > 0.0:
+        return {
+            problem.choices.act(mask, c, exact=True).children
+            for c in problem.choices.cells(mask, False)
+        }
     out = set()
     for cell in problem.choices.cells(mask):
         act = problem.choices.act(mask, cell)
@@ -115,3 +121,27 @@ def test_sensorless_branch_sets_are_the_images():
         got = problem.choices.branch_sets(mask)
         assert all(len(t) == 1 for t in got)
         assert got <= _every_action(problem, mask)
+
+
+@pytest.mark.parametrize(("k", "err"), [(6, 0.0), (5, 1.0)])
+def test_with_a_margin_floor_every_branch_of_every_wide_cell_counts(k, err):
+    # Margins are not monotone under subsets: the exact view, nothing left out.
+    machine = _machine(k, err)
+    problem = Problem(machine, min_margin=0.3)
+    rng = random.Random(k)
+    for t in range(30):
+        mask = machine.all_states if t == 0 else rng.getrandbits(machine.n) or 1
+        assert problem.choices.branch_sets(mask) == _every_action(problem, mask)
+    roots = sorted(maximal_sets({b.mask for b in problem.readings.branches(problem.full)}))
+    want = _brute_values(problem, roots)
+    got = solve(Problem(machine, min_margin=0.3), roots)
+    assert got is not None and all(got[m] == want[m] for m in got)
+
+
+def test_distinct_maps_give_the_same_branch_sets():
+    machine = _machine(6, 1.0)
+    plain, by_map = Problem(machine), Problem(machine, distinct_maps=True)
+    rng = random.Random(5)
+    for t in range(30):
+        mask = machine.all_states if t == 0 else rng.getrandbits(machine.n) or 1
+        assert by_map.choices.branch_sets(mask) == plain.choices.branch_sets(mask)

@@ -74,12 +74,14 @@ of the root branches' lengths is proven (:func:`_on_course`); else the fallback 
 rest of the limit (:class:`~feederkit.planning.budget.Checkpoint`)."""
 
 UNDECIDED_CHECK_SHARE = 0.1
-"""``EXACT_CHECK_SHARE`` for a lumped goal that lumping left undecided: more sets reach it
-from the roots than ``LUMPED_ROOT_SETS``, so an exact search rarely finishes, and the time
-goes to the anytime plans sooner (the 50-part mix at 5 % under 1 degree, 60 s: the exact
-search gave up after 14 s at ``EXACT_CHECK_SHARE`` and the first plan came at 36 s, 13
-operations by the limit; at this share after 3 s, the first plan at 22 s, 11-12 by the
-limit)."""
+"""For a lumped goal that lumping left undecided (more sets reach it from the roots than
+``LUMPED_ROOT_SETS``, or lumping's share of the limit ran out), the share of the exact
+search's own time after which it is judged, instead of ``EXACT_CHECK_SHARE``; it must still
+have proven ``EXACT_CHECK_SHARE`` of the roots by then, so it goes on only when well ahead of
+pace: such a search rarely finishes, and the time goes to the anytime plans sooner (the
+50-part mix at 5 % under 1 degree, 60 s: the exact search handed over after 14 s at
+``EXACT_CHECK_SHARE`` and the first plan came at 36 s, 13 operations at the limit; at this
+share after 3 s, the first plan at 21.5 s, 12 at the limit)."""
 
 EXACT_MEMORY_SHARE = 0.8
 """With a memory limit, the share of it the exact search may hold; the rest is headroom for

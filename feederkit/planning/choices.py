@@ -289,18 +289,22 @@ class Choices:
             made.append(self.useful_act(cell))
 
     def branch_sets(self, mask: int) -> set[tuple[int, ...]]:
-        """The distinct branch tuples of :meth:`search_actions`, unordered: what a pass over
-        every action of a set needs (:func:`~feederkit.planning.solvable.solve`), from the
-        images alone, without ranking the cells or making the actions.
+        """The distinct branch tuples of the actions :meth:`search_actions` offers,
+        unordered: what a pass over every action of a set needs
+        (:func:`~feederkit.planning.solvable.solve`), from the images alone, without ranking
+        the cells or making the actions.
 
         In the length view an image holding one of the ``_DOMINATORS`` smallest useful
         images (by size, then value: the same tuples whatever is cached) is left out, as
-        :meth:`useful_cells` leaves such images out: its action needs no fewer operations.
+        :meth:`useful_cells` leaves such images out (its dominators picked by size, then
+        width, so the two may leave out different actions): its action needs no fewer
+        operations, so a set's length is the same either way. The images are the same with
+        ``distinct_maps`` (which keeps one cell per map of the members, not per image).
         """
         if self.min_margin > 0.0:
             return {a.children for a in self.exact_actions(mask)}
         images: list[int] | None = None
-        if not self.distinct_maps and (mask, True) not in self._cells:
+        if (mask, True) not in self._cells:
             listed = self._space.cell_lists(mask)
             if listed is not None:
                 images = listed[2]

@@ -50,9 +50,10 @@ by one scan of the machine's states; above it, by sorting the members."""
 WALK_BITS = 32
 """``Readings.branch_keys`` walks each image's runs in Python when the images hold at most
 this many states on average, and uses arrays above it: on the 50-part mix at 5 % under 1
-degree (240 states) the walk took 0.4 of the arrays' time for a beam's sets of at most four
-states and 0.9 for the larger ones; on the 100-part mix (478 states) 0.9 at 27 states an
-image, 1.5 at 77 and 7 at 216 (docs/performance.md, "Reading keys walked")."""
+degree (240 states) the walk took 0.25-0.4 of the arrays' time for a beam's sets of at most
+four states and 0.85 for the larger ones; on the 100-part mix (478 states) 0.9 at 27 states
+an image, 1.5 at 77 and 7 at 216 (docs/performance.md, "Solvability from the images alone;
+reading keys walked")."""
 
 
 class Readings:
