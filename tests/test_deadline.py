@@ -214,6 +214,47 @@ def _endless_length_search(monkeypatch) -> list[Deadline]:
     return budgets
 
 
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_the_beams_get_most_of_the_time_when_the_plan_in_hand_is_far_from_the_bound(
+    monkeypatch, far
+):
+    # The exact search off course at once; the backchaining plan in hand. Far from the bound
+    # (FAR_GAP forced below any gap) the beams may use FAR_BEAM_SHARE of what is left, else
+    # BEAM_SHARE; the beams' deadline is read, then the plan stops.
+    machine = build_machine([near_round(12, 0.05, seed=1)], ToleranceSensor(0.2), IDEAL)
+    monkeypatch.setattr(api, "EXACT_CHECK_SHARE", 0.0)
+    monkeypatch.setattr(api, "_on_course", lambda *_args: False)
+    monkeypatch.setattr(fallback, "FAR_GAP", -1000 if far else 1000)
+    _endless_length_search(monkeypatch)
+    seen = []
+
+    def beams(problem, roots, seed, deadline, cap, lower, first, in_hand):
+        seen.append((in_hand, deadline.remaining(), time.perf_counter()))
+        raise _Stop
+
+    monkeypatch.setattr(fallback, "beam_plan", beams)
+    rests = []
+    real = fallback.sensorless_plan
+
+    def blind(*args, **kwargs):
+        out = real(*args, **kwargs)
+        rests.append((args[2].remaining(), time.perf_counter()))
+        return out
+
+    monkeypatch.setattr(fallback, "sensorless_plan", blind)
+    with pytest.raises(_Stop):
+        plan(machine, PlanningOptions(time_limit_s=60.0))
+    (in_hand, beam_s, at), (rest, then) = seen[0], rests[0]  # the whole budget's rest
+    assert in_hand  # the backchaining plan
+    share = beam_s / (rest - (at - then))
+    want = fallback.FAR_BEAM_SHARE if far else fallback.BEAM_SHARE
+    assert share == pytest.approx(want, abs=0.05)
+
+
 def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(monkeypatch):
     # The checkpoint at once (share 0) and never on course; the exact search never ends on
     # its own (it polls until stopped): the fallback starts with nearly the whole limit, not
