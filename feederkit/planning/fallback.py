@@ -122,7 +122,8 @@ def fallback(
     parts' chains in turn (:func:`~feederkit.planning.sequential.sequential_plan`, when the
     readings after them leave goals), else the plan that tells the states apart one pair at
     a time (within ``PAIRWISE_SHARE``); the
-    widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``) for something
+    widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``, or
+    ``FAR_BEAM_SHARE`` with a plan in hand more than ``FAR_GAP`` above the bound) for something
     shorter; with a plan in hand, the hardest subsets' bound
     (:func:`~feederkit.planning.subsets.subset_lower_bound`); then a depth-first search (the
     greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
@@ -203,7 +204,8 @@ def fallback(
     gap = reserve / 2.0  # the tree of a plan found must be built by this long before the end
     rest = budget.remaining()
     # The widening beams (feederkit.planning.beam): a plan first, then shorter ones, within
-    # BEAM_SHARE of what is left; what they find is where the search below starts.
+    # BEAM_SHARE of what is left (FAR_BEAM_SHARE with a plan in hand far above the bound);
+    # what they find is where the search below starts.
     far = blind is not None and tree_length(blind) - lower > FAR_GAP
     beam_share = FAR_BEAM_SHARE if far else BEAM_SHARE
     beam_end = None if rest is None else budget.end - max(rest * (1.0 - beam_share), reserve)
