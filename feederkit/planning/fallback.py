@@ -48,11 +48,16 @@ FAR_GAP = 3
 """A plan in hand more than this many operations above the proven bound is far from it: the
 searches at the bound and one above it seldom succeed, and the beams, which improve a plan
 one operation at a time from the one in hand, get ``FAR_BEAM_SHARE`` of the time instead of
-``BEAM_SHARE`` (the random 1000-point outline at 0.9 % on the ideal model, 60 s, 19 in hand
-against a bound of 6: 11 operations against 13, both runs at once on the two cores)."""
+``BEAM_SHARE``."""
 
-FAR_BEAM_SHARE = 0.8
-"""The beams' share with a plan in hand far from the bound (``FAR_GAP``)."""
+FAR_BEAM_SHARE = 0.5
+"""The beams' share with a plan in hand far from the bound (``FAR_GAP``); the searches at the
+bound, whose failures raise it, keep the rest. The random 1000-point outline at 0.9 % on the
+ideal model, 60 s (19 in hand against a bound of 6): 11 against a bound of 8 (13 against 7
+at ``BEAM_SHARE``, in a run beside the 0.8 one; 11 against 7 at 0.8); the command on the
+1000-point outline at 3 % on the ideal model (``bench_command_deadline.py``): 39 against 13
+at 0.5 and 0.8, 39 against 15 at ``BEAM_SHARE``. One run each: the bound's searches lose
+time to the beams."""
 
 READ_SHARE = 0.5
 """With a time limit, the share of what is left after the backchaining plan that the plan
