@@ -219,7 +219,7 @@ class _Stop(Exception):
 
 
 @pytest.mark.parametrize("far", [False, True])
-def test_the_beams_get_most_of_the_time_when_the_plan_in_hand_is_far_from_the_bound(
+def test_the_beams_get_more_of_the_time_when_the_plan_in_hand_is_far_from_the_bound(
     monkeypatch, far
 ):
     # The exact search off course at once; the backchaining plan in hand. Far from the bound
