@@ -23,6 +23,7 @@ Planner and statistics use this same model.
 from __future__ import annotations
 
 import bisect
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -51,7 +52,7 @@ WALK_BITS = 32
 """``Readings.branch_keys`` walks each image's runs in Python when the images hold at most
 this many states on average, and uses arrays above it: on the 50-part mix at 5 % under 1
 degree (240 states) the walk took 0.25-0.4 of the arrays' time for a beam's sets of at most
-four states and 0.85 for the larger ones; on the 100-part mix (478 states) 0.9 at 27 states
+four states and 0.85-0.9 for the larger ones; on the 100-part mix (478 states) 0.9 at 27 states
 an image, 1.5 at 77 and 7 at 216 (docs/performance.md, "Solvability from the images alone;
 reading keys walked")."""
 
@@ -223,7 +224,15 @@ class Readings:
         return out
 
     def _window_runs(self, image: int) -> tuple[int, ...]:
-        """Maximal branches from the sensor's reading windows (states numbered by diameter).
+        """Maximal branches from the sensor's reading windows (states numbered by diameter),
+        largest first (:meth:`_walk_runs`)."""
+        runs = list(self._walk_runs(image))
+        if len(runs) > 1:
+            runs.sort(key=int.bit_count, reverse=True)
+        return tuple(runs)
+
+    def _walk_runs(self, image: int) -> Iterator[int]:
+        """The image's maximal runs along the reading axis, in order.
 
         A member's run (its window within the image) is maximal when it reaches further than
         the one before, so the walk jumps from run to run: the next maximal run is the one
@@ -233,44 +242,28 @@ class Readings:
         """
         win = self._window
         first = self._window_first
-        runs = []
         rest = image
         while rest:
             low = rest & -rest
             r = image & win[low.bit_length() - 1]
-            runs.append(r)
+            yield r
             top = r.bit_length()
             above = image >> top
             if not above:
-                break
+                return
             reach = first[top + (above & -above).bit_length() - 1]
             rest = image >> reach << reach
-        if len(runs) > 1:
-            runs.sort(key=int.bit_count, reverse=True)
-        return tuple(runs)
 
     def window_key(self, image: int) -> tuple[int, int]:
         """``choices.children_key`` of the image's maximal reading branches (the largest
-        branch's size, the sizes added up) by :meth:`_window_runs`'s walk, without making the
-        branches (the reading windows must exist). The walk is written out again here:
-        ``children_key(self._window_runs(image))`` cost twice as much on a beam's sets."""
-        win = self._window
-        first = self._window_first
+        branch's size, the sizes added up) from :meth:`_walk_runs`, without making the
+        branches (the reading windows must exist)."""
         largest = total = 0
-        rest = image
-        while rest:
-            low = rest & -rest
-            r = image & win[low.bit_length() - 1]
+        for r in self._walk_runs(image):
             c = r.bit_count()
             total += c
             if c > largest:
                 largest = c
-            top = r.bit_length()
-            above = image >> top
-            if not above:
-                break
-            reach = first[top + (above & -above).bit_length() - 1]
-            rest = image >> reach << reach
         return largest, total
 
     def branch_keys(self, images: list[int]) -> list[tuple[int, int]] | None:
