@@ -245,13 +245,18 @@ def test_held_by_is_every_branch_whose_closed_interval_holds_the_reading(count):
         assert step.held_by(r) == tuple(k for k, b in enumerate(branches) if b.holds(r))
 
 
+@pytest.mark.parametrize("shuffled", [False, True])
 @pytest.mark.parametrize("count", [3, 8, 40])
-def test_meeting_is_every_branch_whose_interval_meets_the_readings(count):
-    # The branches a state whose readings lie in [lo, hi] may follow: by arrays for many
-    # branches, one at a time for few, the same indices as the closed-interval test.
+def test_meeting_is_every_branch_whose_interval_meets_the_readings(count, shuffled):
+    # The branches a state whose readings lie in [lo, hi] may follow: by bisection for
+    # many branches in reading order (the planner's), by arrays for many in any order (a
+    # hand-written file), one at a time for few: the same indices as the closed-interval
+    # test.
     rng = random.Random(100 + count)
     ends = sorted(round(rng.uniform(0.0, 50.0), 1) for _ in range(count + 1))
     spans = [(ends[k], ends[min(k + rng.randint(1, 2), count)]) for k in range(count)]
+    if shuffled:
+        rng.shuffle(spans)
     branches = tuple(
         Branch(span, Leaf((ResultEntry("p", k, 0.0),))) for k, span in enumerate(spans)
     )
@@ -260,3 +265,5 @@ def test_meeting_is_every_branch_whose_interval_meets_the_readings(count):
         a, b = sorted(rng.choice([*ends, rng.uniform(-5.0, 55.0)]) for _ in range(2))
         want = tuple(k for k, (x, y) in enumerate(spans) if x <= b and a <= y)
         assert step.meeting(a, b) == want
+    if count >= 8:  # indexed: bisection exactly when the branches come in reading order
+        assert (step._ends()[2] is None) == shuffled

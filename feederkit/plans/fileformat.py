@@ -581,6 +581,7 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
     """
     value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
     out: list[str] = []
+    keys: dict[str, str] = {}  # each key's text once: a plan repeats a few keys
     stack: list[str | tuple[object, int]] = [(value, 0)]
     while stack:
         item = stack.pop()
@@ -593,19 +594,23 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
             out.append(line)
             continue
         pad = "  " * (indent + 1)
-        work: list[str | tuple[object, int]] = []
+        # The closing line first: the stack pops the pieces in reverse.
         if isinstance(v, dict):
-            work.append("{\n")
-            for k, (key, child) in enumerate(v.items()):
-                work += [",\n"] if k else []
-                work += [f"{pad}{json.dumps(key)}: ", (child, indent + 1)]
-            work.append("\n" + "  " * indent + "}")
+            stack.append("\n" + "  " * indent + "}")
+            sep = ""
+            for key, child in reversed(v.items()):
+                text = keys.get(key)
+                if text is None:
+                    text = keys[key] = f"{json.dumps(key)}: "
+                stack += [sep, (child, indent + 1), pad + text]
+                sep = ",\n"
+            stack.append("{\n")
         else:
             assert isinstance(v, list | tuple)
-            work.append("[\n")
-            for k, child in enumerate(v):
-                work += [",\n"] if k else []
-                work += [pad, (child, indent + 1)]
-            work.append("\n" + "  " * indent + "]")
-        stack.extend(reversed(work))
+            stack.append("\n" + "  " * indent + "]")
+            sep = ""
+            for child in reversed(v):
+                stack += [sep, (child, indent + 1), pad]
+                sep = ",\n"
+            stack.append("[\n")
     return "".join(out) + "\n"

@@ -21,6 +21,7 @@ part.
 
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 from collections.abc import Iterable, Iterator, Sequence
@@ -326,17 +327,27 @@ class Step:
                 for k, b in enumerate(self.branches)
                 if b.reading is None or (b.reading[0] <= hi and lo <= b.reading[1])
             )
-        ends_lo, ends_hi = self._ends()
+        ends_lo, ends_hi, ascending = self._ends()
+        if ascending is not None:
+            # Both ends ascending (the planner's reading cells): the branches meeting
+            # [lo, hi] are one run, from the first reaching lo to the last starting by hi.
+            los, his = ascending
+            return tuple(range(bisect.bisect_left(his, lo), bisect.bisect_right(los, hi)))
         return tuple(((ends_lo <= hi) & (lo <= ends_hi)).nonzero()[0].tolist())
 
-    def _ends(self) -> tuple[np.ndarray, np.ndarray]:
-        """The branches' reading intervals' ends as two arrays (made once per step)."""
+    def _ends(self) -> tuple[np.ndarray, np.ndarray, tuple[list[float], list[float]] | None]:
+        """The branches' reading intervals' ends as two arrays, and as two lists when both
+        ascend (None otherwise: a hand-written file), made once per step."""
         table = self.__dict__.get("_ends_table")
         if table is None:
             inf = math.inf
-            lo = np.array([-inf if b.reading is None else b.reading[0] for b in self.branches])
-            hi = np.array([inf if b.reading is None else b.reading[1] for b in self.branches])
-            table = (lo, hi)
+            los = [-inf if b.reading is None else float(b.reading[0]) for b in self.branches]
+            his = [inf if b.reading is None else float(b.reading[1]) for b in self.branches]
+            ascending = all(
+                a0 <= a1 and b0 <= b1
+                for a0, a1, b0, b1 in zip(los, los[1:], his, his[1:], strict=False)
+            )
+            table = (np.array(los), np.array(his), (los, his) if ascending else None)
             object.__setattr__(self, "_ends_table", table)
         return table
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -76,6 +76,13 @@ SHAPE_REL_TOL = 1e-3
 
 State = tuple[int, int]
 """A physical state of the plan: (part index, physical state id)."""
+
+Branch = tuple[Sequence[float], Mapping[str, Any]]
+"""A branch of a plan node: its reading interval and its next node (a reference resolved)."""
+
+Tally = tuple[int, int, int, int]
+"""From a (node, state) on: the worst operations, the paths, those ending in a reject and
+those ending in an unrecognized result."""
 
 
 @dataclass(frozen=True)
@@ -211,13 +218,12 @@ class _Run:
         self.lowered = 0  # margins lowered to what their rotation keeps (``tighten``)
         self.shared = plan.get("nodes") or {}
         self.by_name = {n: p for p, n in enumerate(model.members)}
-        self._worst: dict[tuple[int, State], int] = {}
-        self._paths: dict[tuple[int, State], int] = {}
-        self.rejected: dict[tuple[int, State], int] = {}
-        self.unrecognized: dict[tuple[int, State], int] = {}  # paths to an unrecognized result
+        # Per (node, state): (worst operations, paths, paths to a reject, paths to an
+        # unrecognized result), from the node on.
+        self.tally: dict[tuple[int, State], Tally] = {}
         self._handles: dict[tuple[int, State], bool] = {}
         self.arrivals: dict[int, set[tuple[int, int]]] = {}  # leaf id: (part, ideal state)
-        self._outcomes: dict[tuple[int, State], list[State]] = {}
+        self._outcomes: dict[tuple[float, State], list[State]] = {}
         self._follow: dict[tuple[int, State], list[Mapping[str, Any]] | float] = {}
         self._index: dict[int, _BranchIndex] = {}
         # The ideal verifier's rounding policy: touching open ends do not overlap.
@@ -241,7 +247,7 @@ class _Run:
         a = node.get("action_deg")
         if a is None:
             return [x]
-        key = (id(node), x)
+        key = (a, x)  # the rotation's, not the node's: many nodes share a rotation
         hit = self._outcomes.get(key)
         if hit is None:
             p, s = x
@@ -278,16 +284,22 @@ class _Run:
             f"{sorted(wide - base)} besides {sorted(base)}"
         )
 
-    def branches_of(
-        self, node: Mapping[str, Any], x: State, sensor: Sensor | None = None
-    ) -> list[Mapping[str, Any]] | None:
-        """The node's branches a resting state ``x`` may read into under ``sensor`` (default:
-        the verifier's, narrowed by rounding), in the node's order: a superset, those whose
-        interval comes within the sensor's reach of the state's reading set. None when the
-        node has no readings (every branch is followed)."""
+    def branch_index(self, node: Mapping[str, Any]) -> _BranchIndex:
+        """The node's branches indexed by reading, their next nodes resolved."""
         index = self._index.get(id(node))
         if index is None:
-            index = self._index[id(node)] = _BranchIndex(node["branches"])
+            index = self._index[id(node)] = _BranchIndex(node["branches"], self.node)
+        return index
+
+    def branches_of(
+        self, node: Mapping[str, Any], x: State, sensor: Sensor | None = None
+    ) -> list[Branch] | None:
+        """The node's branches a resting state ``x`` may read into under ``sensor`` (default:
+        the verifier's, narrowed by rounding), in the node's order, as (reading interval,
+        next node resolved): a superset, those whose interval comes within the sensor's
+        reach of the state's reading set. None when the node has no readings (every branch
+        is followed)."""
+        index = self.branch_index(node)
         if index.blind or not self.model.sensor.informative:
             return None
         p, s = x
@@ -332,16 +344,16 @@ class _Run:
         """:meth:`follow` computed: the next nodes, or a reading no branch holds."""
         near = self.branches_of(node, x)
         if near is None:
-            return [b["next"] for b in node["branches"]]
+            return self.branch_index(node).nexts
         p, s = x
         diam = self.model.diameters[p][s]
         sensor = self._sensors[p]
         # Branches out of reach hold none of the state's readings: leaving them out changes
         # neither the uncovered reading found nor the branches followed.
-        miss = sensor.uncovered_reading(diam, [b["reading"] for b in near])
+        miss = sensor.uncovered_reading(diam, [r for r, _n in near])
         if miss is not None:
             return float(miss)
-        return [b["next"] for b in near if sensor.reads_into(diam, *b["reading"])]
+        return [n for r, n in near if sensor.reads_into(diam, *r)]
 
     def named(self, leaf: Mapping[str, Any], x: State) -> bool:
         """Whether a leaf names state ``x``: every ideal member of it, for its part and
@@ -357,9 +369,17 @@ class _Run:
     def worst(self, node: Mapping[str, Any], x: State) -> int:
         """Operations from ``node`` on for a part resting in ``x`` before it, worst case;
         CheckFailed on the first path that fails."""
+        return self.walk(node, x)[0]
+
+    def walk(self, node: Mapping[str, Any], x: State) -> Tally:
+        """(worst operations, paths, paths to a reject, paths to an unrecognized result)
+        from ``node`` on for a part resting in ``x`` before it; CheckFailed on the first path
+        that fails. The followed nodes come resolved (:meth:`follow`), and a memoised
+        (node, state) is read without a call: most pairs are met on several paths."""
         node = self.node(node)
         key = (id(node), x)
-        hit = self._worst.get(key)
+        tally = self.tally
+        hit = tally.get(key)
         if hit is not None:
             return hit
         if "result" in node:
@@ -370,31 +390,31 @@ class _Run:
                     f"{self.model.label(p)}: a path ends in a result that does not name its "
                     f"physical state {s} (ideal states {ideal})"
                 )
-            self._worst[key], self._paths[key] = 0, 1
             reject = node.get("reject") is True
-            self.rejected[key] = 1 if reject else 0
             members = ((e["part"], e.get("landing")) for e in node["result"])
-            self.unrecognized[key] = 1 if names_several(members, reject) else 0
+            hit = (0, 1, 1 if reject else 0, 1 if names_several(members, reject) else 0)
             p, s = x
             self.arrivals.setdefault(id(node), set()).update(
                 (p, m) for m in self.model.mechanics[p].states[s].members
             )
-            return 0
-        longest, paths, rejected, unrecognized = 0, 0, 0, 0
-        if self.margins:
-            # On the verified paths only: the expected walk also follows branches a reading
-            # meets within rounding (probability ~1e-16), where no margin is claimed.
-            self._check_margin(node, x, frozenset(t for _p, t in self.outcomes(node, x)))
-        for y in self.outcomes(node, x):
-            for nxt in self.follow(node, y):
-                longest = max(longest, self.worst(nxt, y))
-                paths += self._paths[(id(self.node(nxt)), y)]
-                rejected += self.rejected[(id(self.node(nxt)), y)]
-                unrecognized += self.unrecognized[(id(self.node(nxt)), y)]
-        self._worst[key], self._paths[key] = 1 + longest, paths
-        self.rejected[key] = rejected
-        self.unrecognized[key] = unrecognized
-        return 1 + longest
+        else:
+            if self.margins:
+                # On the verified paths only: the expected walk also follows branches a
+                # reading meets within rounding (probability ~1e-16), where no margin is
+                # claimed.
+                self._check_margin(node, x, frozenset(t for _p, t in self.outcomes(node, x)))
+            longest, paths, rejected, unrecognized = 0, 0, 0, 0
+            for y in self.outcomes(node, x):
+                for nxt in self.follow(node, y):
+                    sub = tally.get((id(nxt), y)) or self.walk(nxt, y)
+                    if sub[0] > longest:
+                        longest = sub[0]
+                    paths += sub[1]
+                    rejected += sub[2]
+                    unrecognized += sub[3]
+            hit = (1 + longest, paths, rejected, unrecognized)
+        tally[key] = hit
+        return hit
 
     def results(self, root: Mapping[str, Any]) -> list[Mapping[str, Any]]:
         """Every distinct result node, references resolved."""
@@ -470,18 +490,27 @@ class _BranchIndex:
     bisection. Otherwise (a hand-written file) every branch is a candidate.
     """
 
-    def __init__(self, branches: Sequence[Mapping[str, Any]]) -> None:
-        with_reading = [b for b in branches if b["reading"] is not None]
+    def __init__(
+        self,
+        branches: Sequence[Mapping[str, Any]],
+        resolve: Callable[[Mapping[str, Any]], Mapping[str, Any]],
+    ) -> None:
+        self.nexts = [resolve(b["next"]) for b in branches]  # every branch's, in order
+        with_reading = [
+            (b["reading"], n)
+            for b, n in zip(branches, self.nexts, strict=True)
+            if b["reading"] is not None
+        ]
         self.blind = not with_reading
         self.with_reading = with_reading
-        ends = [(float(b["reading"][0]), float(b["reading"][1])) for b in with_reading]
+        ends = [(float(r[0]), float(r[1])) for r, _n in with_reading]
         self._los = [a for a, _b in ends]
         self._his = [b for _a, b in ends]
         self._sorted = all(
             a0 <= a1 and b0 <= b1 for (a0, b0), (a1, b1) in zip(ends, ends[1:], strict=False)
         )
 
-    def within(self, lo: float, hi: float) -> list[Mapping[str, Any]]:
+    def within(self, lo: float, hi: float) -> list[Branch]:
         """The branches whose interval meets ``[lo, hi]`` (all of them when unsorted)."""
         if not self._sorted:
             return self.with_reading
@@ -529,10 +558,11 @@ def verify_strong(
         worst, paths, rejected, unrecognized = 0, 0, 0, 0
         states = [x for x in model.states() if x[0] == p]
         for x in states:
-            worst = max(worst, run.worst(root, x))
-            paths += run._paths[(id(run.node(root)), x)]
-            rejected += run.rejected[(id(run.node(root)), x)]
-            unrecognized += run.unrecognized[(id(run.node(root)), x)]
+            w, n, r, u = run.walk(root, x)
+            worst = max(worst, w)
+            paths += n
+            rejected += r
+            unrecognized += u
         overall = max(overall, worst)
         checks.append(
             PartCheck(name, len(states), paths, worst, 0, landing, rejected, unrecognized)
@@ -640,25 +670,24 @@ def expected_operations(
     run = _Run(plan, model) if run is None else run
     sensor = model.sensor
     memo: dict[tuple[int, State], float] = {}
-    open_steps: dict[tuple[int, State], list[tuple[float, Any, State]]] = {}
+    open_steps: dict[tuple[int, State], list[tuple[float, tuple[int, State], Any, State]]] = {}
 
     def continuations(node: Mapping[str, Any], x: State) -> list[tuple[float, Any, State]]:
         """(probability, next node, state) of every continuation of ``x`` at a step."""
         outs = run.outcomes(node, x)
-        branches = node["branches"]
         out = []
         for y in outs:
             near = run.branches_of(node, y, sensor)
             if near is None:
-                out.append((1.0 / len(outs), run.node(branches[0]["next"]), y))
+                out.append((1.0 / len(outs), run.branch_index(node).nexts[0], y))
                 continue
             diam = model.diameters[y[0]][y[1]]
             # A branch out of the state's reach has probability 0: leaving it out changes no
             # term of the (exactly rounded) sum.
-            for b in near:
-                pr = sensor.reading_probability(diam, *b["reading"])
+            for reading, nxt in near:
+                pr = sensor.reading_probability(diam, *reading)
                 if pr > 0.0:
-                    out.append((pr / len(outs), run.node(b["next"]), y))
+                    out.append((pr / len(outs), nxt, y))
         return out
 
     expected = 0.0
@@ -674,19 +703,25 @@ def expected_operations(
             stack: list[tuple[Mapping[str, Any], State]] = [(root, (p, s))]
             while stack:
                 node, x = stack[-1]
-                if (id(node), x) in memo:
+                key = (id(node), x)
+                if key in memo:
                     stack.pop()
                     continue
-                steps = open_steps.get((id(node), x))
+                # Back at a step, its continuations are done: those pushed above it were
+                # popped only once memoised (the plan is acyclic).
+                steps = open_steps.pop(key, None)
                 if steps is None:
-                    steps = [c for c in continuations(node, x) if "result" not in c[1]]
-                    open_steps[(id(node), x)] = steps
-                missing = [(n, y) for _pr, n, y in steps if (id(n), y) not in memo]
-                if missing:
-                    stack.extend(missing)
-                    continue
-                del open_steps[(id(node), x)]
-                memo[(id(node), x)] = 1.0 + math.fsum(pr * memo[(id(n), y)] for pr, n, y in steps)
+                    steps = [
+                        (pr, (id(n), y), n, y)
+                        for pr, n, y in continuations(node, x)
+                        if "result" not in n
+                    ]
+                    todo = [(n, y) for _pr, k, n, y in steps if k not in memo]
+                    if todo:
+                        open_steps[key] = steps
+                        stack.extend(todo)
+                        continue
+                memo[key] = 1.0 + math.fsum(pr * memo[k] for pr, k, _n, _y in steps)
                 stack.pop()
             expected += shares[p] * weight[s] * memo[(id(root), (p, s))]
     return expected

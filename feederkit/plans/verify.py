@@ -167,9 +167,9 @@ def candidate_readings(sensor: Sensor, step: Step, diameter: float) -> list[floa
     interval = sensor.reading_interval(diameter)
     assert interval is not None
     lo, hi = interval
-    inner = sorted(
-        {x for b in step.branches if b.reading is not None for x in b.reading if lo < x < hi}
-    )
+    # An end strictly inside (lo, hi) is one of a branch meeting [lo, hi].
+    met = (step.branches[k].reading for k in step.meeting(lo, hi))
+    inner = sorted({x for r in met if r is not None for x in r if lo < x < hi})
     points = [lo, *inner, hi]
     mids = [(a + b) / 2.0 for a, b in zip(points, points[1:], strict=False) if a < b]
     out = sorted({*inner, *mids})
@@ -557,27 +557,31 @@ EXPECTED_REL_TOL = 1e-6
 """The stated expected length must be the computed one within this fraction."""
 
 
-def _branch_probabilities(sensor: Sensor, step: Step, diameter: float) -> list[float]:
-    """The probability that a state of this diameter follows each branch of ``step``: the
-    controller takes the first branch holding the reading (design.md), so a reading on a
-    shared endpoint (a positive probability only for an LED array's counts) counts once."""
+def _branch_probabilities(sensor: Sensor, step: Step, diameter: float) -> list[tuple[int, float]]:
+    """``(branch index, probability)`` of each branch of ``step`` a state of this diameter
+    follows with a positive probability, in order: the controller takes the first branch
+    holding the reading (design.md), so a reading on a shared endpoint (a positive
+    probability only for an LED array's counts) counts once. Only the branches within the
+    sensor's reach are looked at: a step may have thousands."""
     if not sensor.informative:
-        return [1.0] + [0.0] * (len(step.branches) - 1)
+        return [(0, 1.0)]
     if _discrete(sensor, diameter):
-        out = [0.0] * len(step.branches)
+        out: dict[int, float] = {}
         for r in sorted(set(sensor.probe_readings(diameter, 0.0))):
             k = step.follow(r)
             if k is not None:
-                out[k] += sensor.reading_probability(diameter, r, r)
-        return out
-    out = [0.0] * len(step.branches)
+                out[k] = out.get(k, 0.0) + sensor.reading_probability(diameter, r, r)
+        return [(k, pr) for k, pr in sorted(out.items()) if pr > 0.0]
     reach = sensor.branch_reach(diameter)
     near = range(len(step.branches)) if reach is None else step.meeting(*reach)
+    shares = []
     for k in near:
         b = step.branches[k]
         if b.reading is not None:
-            out[k] = sensor.reading_probability(diameter, *b.reading)
-    return out
+            pr = sensor.reading_probability(diameter, *b.reading)
+            if pr > 0.0:
+                shares.append((k, pr))
+    return shares
 
 
 def expected_operations(plan: Plan) -> float:
@@ -593,27 +597,37 @@ def expected_operations(plan: Plan) -> float:
         listed = {s.id: s.diameter for s in plan.parts[p].states}
         by_id = {s.id: s for s in pf.states}
         memo: dict[tuple[int, int], float] = {}
+        # A step's continuations, kept while those pushed above it are worked out.
+        open_steps: dict[tuple[int, int], list[tuple[float, tuple[int, int]]]] = {}
         for s0 in pf.states:
-            stack: list[tuple[Step, StableState, bool]] = [(plan.root, s0, False)]
+            stack: list[tuple[Step, StableState]] = [(plan.root, s0)]
             while stack:
-                node, state, expanded = stack.pop()
+                node, state = stack[-1]
                 key = (id(node), state.id)
                 if key in memo:
+                    stack.pop()
                     continue
-                d = listed.get(state.id, state.diameter)
-                probs = _branch_probabilities(plan.sensor, node, d)
-                todo = []
-                for b, pr in zip(node.branches, probs, strict=True):
-                    nxt = b.next
-                    if pr > 0.0 and isinstance(nxt, Step):
-                        assert nxt.action_deg is not None
-                        s2 = by_id[push(pf, rotation_after(state.normal_deg, nxt.action_deg)).id]
-                        todo.append((pr, nxt, s2))
-                if not expanded and any((id(n), t.id) not in memo for _, n, t in todo):
-                    stack.append((node, state, True))
-                    stack.extend((n, t, False) for _, n, t in todo)
-                    continue
-                memo[key] = 1.0 + math.fsum(pr * memo[(id(n), t.id)] for pr, n, t in todo)
+                # Back at a step, its continuations are done: those pushed above it were
+                # popped only once memoised (the plan is acyclic).
+                steps = open_steps.pop(key, None)
+                if steps is None:
+                    d = listed.get(state.id, state.diameter)
+                    steps, todo = [], []
+                    for k, pr in _branch_probabilities(plan.sensor, node, d):
+                        nxt = node.branches[k].next
+                        if isinstance(nxt, Step):
+                            assert nxt.action_deg is not None
+                            turned = rotation_after(state.normal_deg, nxt.action_deg)
+                            s2 = by_id[push(pf, turned).id]
+                            steps.append((pr, (id(nxt), s2.id)))
+                            if (id(nxt), s2.id) not in memo:
+                                todo.append((nxt, s2))
+                    if todo:
+                        open_steps[key] = steps
+                        stack.extend(todo)
+                        continue
+                memo[key] = 1.0 + math.fsum(pr * memo[k] for pr, k in steps)
+                stack.pop()
             lo, hi = s0.resting_range_deg
             total += share * (hi - lo) / 360.0 * memo[(id(plan.root), s0.id)]
     return total
