@@ -34,7 +34,7 @@ from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.stats import node_states
-from feederkit.plans.timelimit import POST_S_PER_PAIR, planner_budget
+from feederkit.plans.timelimit import POST_MIN_S, POST_S_PER_PAIR, planner_budget
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -446,6 +446,41 @@ def test_the_fallbacks_plan_in_hand_holds_its_pairs_and_gives_them_back():
     late = Deadline(0.0, per_pair_s=1.0)
     fallback._Held(late).hold(full.root)
     assert late.expired()
+
+
+def test_the_plan_in_hands_verification_may_take_the_callers_reserve():
+    # The caller keeps reserve_s after the end for work it may cut (the certificate): the
+    # plan in hand's verification takes it first, up to what the plan costs, so a large
+    # first plan is kept rather than dropped; giving the plan back gives the credit back.
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    full = plan(machine, PlanningOptions())
+    pairs = node_states(full.root)
+    budget = Deadline(3600.0, per_pair_s=0.01, reserve_s=1.0)
+    end = budget.end
+    held = fallback._Held(budget)
+    held.hold(full.root)
+    assert end - budget.end == pytest.approx(0.01 * pairs - 1.0, abs=1e-9)
+    held.hold(None)
+    assert budget.end == pytest.approx(end, abs=1e-9)
+    # A plan that costs less than the reserve never moves the end later than it was.
+    roomy = Deadline(3600.0, per_pair_s=0.01, reserve_s=100.0)
+    end = roomy.end
+    fallback._Held(roomy).hold(full.root)
+    assert roomy.end == pytest.approx(end, abs=1e-9)
+    # Building the first plan, its verification's first FIRST_PLAN_GRACE_S and the reserve
+    # are free; with a plan in hand, nothing is.
+    first = fallback._graced(budget, None)
+    assert first.grace_s == pytest.approx(fallback.FIRST_PLAN_GRACE_S + 1.0)
+    assert fallback._graced(budget, full.root).grace_s == 0.0
+    # Every share of a budget keeps its reserve.
+    checkpoint = Checkpoint(budget, time.perf_counter() + 1.0, budget.end)
+    copies = (budget.until(0.5), budget.ending(None), budget.share_from_now(0.1), checkpoint)
+    assert all(copy.reserve_s == 1.0 for copy in (*copies, WorkBudget(checkpoint, 5)))
+    # A checkpoint moves both its ends.
+    first_end, later = checkpoint.end, checkpoint.later
+    checkpoint.credit(2.0)
+    assert checkpoint.end == pytest.approx(first_end + 2.0, abs=1e-9)
+    assert checkpoint.later == pytest.approx(later + 2.0, abs=1e-9)
 
 
 # --- plan() answers within its limits ---------------------------------------------------
@@ -978,6 +1013,8 @@ def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, c
     assert budget.end - time.perf_counter() == pytest.approx(planner_s, abs=0.05)
     # The plan's own size counts too, certified or not: every plan is verified.
     assert budget.per_pair_s == POST_S_PER_PAIR
+    # What is kept past POST_MIN_S (the certificate's) the plan's verification may take.
+    assert budget.reserve_s == pytest.approx(max(limit - planner_s - POST_MIN_S, 0.0), abs=0.05)
 
 
 def test_a_deadline_keeps_time_in_hand_to_let_go_of_what_the_process_grew_by(monkeypatch):

@@ -76,6 +76,9 @@ class Deadline:
     earlier, so a large plan leaves time for its own verification and file; that cost is
     measured idle, so it is scaled by the budget's :meth:`slowness`. ``clock_start`` is the
     (wall, CPU) instant the slowness counts from (now unless given: shares keep it).
+    ``reserve_s`` is what the caller keeps after the end for work it may cut (a plan's
+    certificate): a first plan's verification may take it instead (a plan whose certificate
+    is cut beats none); shares keep it.
     """
 
     def __init__(
@@ -89,11 +92,13 @@ class Deadline:
         per_pair_s: float = 0.0,
         grace_s: float = 0.0,
         clock_start: tuple[float, float] | None = None,
+        reserve_s: float = 0.0,
     ) -> None:
         now = time.perf_counter()
         self.clock_start = (now, time.process_time()) if clock_start is None else clock_start
         self.per_pair_s = per_pair_s
         self.grace_s = grace_s
+        self.reserve_s = reserve_s
         self.start = now if start is None else start
         self.end = end if end is not None or seconds is None else now + seconds
         self.memory_mb = memory_mb
@@ -166,7 +171,7 @@ class Deadline:
         passed (a tree's last nodes need no poll after them to stop it); without, the end
         only moves (a plan already made and kept)."""
         if self.end is not None and self.per_pair_s:
-            cost = pairs * self.per_pair_s * self.slowness()
+            cost = self.seconds_for(pairs)
             if cost > 0.0 and self.grace_s > 0.0:
                 free = min(cost, self.grace_s)
                 self.grace_s -= free
@@ -174,6 +179,17 @@ class Deadline:
             self.end -= cost
             if stop and pairs > 0 and time.perf_counter() > self.end - self._release_s:
                 raise Timeout("time")
+
+    def seconds_for(self, pairs: int) -> float:
+        """What the caller needs after the planner for a plan of ``pairs`` (node, state) pairs:
+        ``per_pair_s`` each, scaled by the :meth:`slowness` (0 without a cost)."""
+        return pairs * self.per_pair_s * self.slowness() if self.per_pair_s else 0.0
+
+    def credit(self, seconds: float) -> None:
+        """The deadline moves ``seconds`` later (earlier when negative): time the caller
+        gives back, such as the part of its ``reserve_s`` a held plan's verification takes."""
+        if self.end is not None:
+            self.end += seconds
 
     def with_grace(self, seconds: float) -> Deadline:
         """A copy of this budget whose first ``seconds`` of committed pairs are free: a plan
@@ -204,6 +220,7 @@ class Deadline:
             memory_base=base,
             per_pair_s=self.per_pair_s,
             clock_start=self.clock_start,
+            reserve_s=self.reserve_s,
         )
 
     def share_from_now(self, time_share: float) -> Deadline:
@@ -233,6 +250,7 @@ class Deadline:
             memory_base=self.memory_base,
             per_pair_s=self.per_pair_s,
             clock_start=self.clock_start,
+            reserve_s=self.reserve_s,
         )
 
 
@@ -272,6 +290,7 @@ class Checkpoint(Deadline):
             memory_base=outer.memory_base,
             per_pair_s=outer.per_pair_s,
             clock_start=outer.clock_start,
+            reserve_s=outer.reserve_s,
         )
         self.later = end
         self.on_course = on_course
@@ -280,11 +299,14 @@ class Checkpoint(Deadline):
     def commit(self, pairs: int, stop: bool = True) -> None:
         """:meth:`Deadline.commit` for both ends; a passed end is left to :meth:`check`,
         which asks whether the stage is on course (``stop`` has no effect here)."""
-        cost = pairs * self.per_pair_s * self.slowness() if self.per_pair_s else 0.0
+        self.credit(-self.seconds_for(pairs))
+
+    def credit(self, seconds: float) -> None:
+        """:meth:`Deadline.credit` for both ends."""
         if self.end is not None:
-            self.end -= cost
+            self.end += seconds
         if self.later is not None:
-            self.later -= cost
+            self.later += seconds
 
     def go_on(self) -> None:
         """The end is ``end`` from now on (no question asked at ``first``)."""
@@ -332,6 +354,7 @@ class WorkBudget(Deadline):
             memory_base=outer.memory_base,
             per_pair_s=outer.per_pair_s,
             clock_start=outer.clock_start,
+            reserve_s=outer.reserve_s,
         )
         self.allowance = polls
 

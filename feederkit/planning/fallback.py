@@ -85,10 +85,13 @@ reserves (``TREE_RESERVE``) before the limit, past their ``BEAM_SHARE``; shorter
 within it."""
 
 FIRST_PLAN_GRACE_S = 1.5
-"""With no plan in hand, the first this many seconds of the first plan's verification are
-not committed to the budget (:meth:`~feederkit.planning.budget.Deadline.with_grace`): a plan
-a little late beats none (the command then answers at most this much past its limit); one
-later still is dropped like one too slow to find."""
+"""With no plan in hand, the first this many seconds of the first plan's verification,
+besides the caller's reserve (``Deadline.reserve_s``: the certificate's time, which the
+plan's verification takes instead), are not committed to the budget
+(:meth:`~feederkit.planning.budget.Deadline.with_grace`): a plan a little late beats none
+(the command then answers at most this much past its limit); one later still is dropped
+like one too slow to find. The plan in hand's verification may take the reserve as well
+(``_Held``)."""
 
 
 class NoFallback(OutOfBudget):
@@ -333,8 +336,10 @@ def fallback(
 
 def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
     """A copy of ``budget`` to build a plan under; with no plan ``in_hand``, the first
-    ``FIRST_PLAN_GRACE_S`` of its verification free (a plan a little late beats none)."""
-    return budget.with_grace(0.0 if in_hand is not None else FIRST_PLAN_GRACE_S)
+    ``FIRST_PLAN_GRACE_S`` and the reserve of its verification free (a plan a little late
+    beats none)."""
+    free = FIRST_PLAN_GRACE_S + budget.reserve_s
+    return budget.with_grace(0.0 if in_hand is not None else free)
 
 
 class _Held:
@@ -345,12 +350,17 @@ class _Held:
     def __init__(self, budget: Deadline) -> None:
         self.budget = budget
         self.pairs = 0
+        self.credit = 0.0  # of the budget's reserve, given back for the plan in hand
 
     def hold(self, root: Step | None) -> None:
-        """``root`` is the plan in hand now (None: none)."""
+        """``root`` is the plan in hand now (None: none). Its verification may take the
+        caller's reserve (``Deadline.reserve_s``, a certificate's time) up to what it costs:
+        that much is given back to the budget."""
         pairs = 0 if root is None else node_states(root)
         self.budget.commit(pairs - self.pairs, stop=False)  # the plan is made: keep it
-        self.pairs = pairs
+        credit = min(self.budget.reserve_s, self.budget.seconds_for(pairs))
+        self.budget.credit(credit - self.credit)
+        self.pairs, self.credit = pairs, credit
 
 
 def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:

@@ -60,7 +60,12 @@ from feederkit.plans.fileformat import plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.readplan import as_plan
 from feederkit.plans.strong import ideal_view, verify_strong
-from feederkit.plans.timelimit import output_seconds, planner_budget, seconds_left
+from feederkit.plans.timelimit import (
+    OUTPUT_SHARE,
+    output_seconds,
+    planner_budget,
+    seconds_left,
+)
 from feederkit.plans.verify import VerificationReport, check_plan
 from feederkit.plans.verify import expected_operations as file_expected
 from feederkit.sensors import Sensor, ToleranceSensor, sensor_warnings
@@ -247,8 +252,10 @@ def _make_plan(
             f"of its interval lets reach it, less than --min-margin {floor:g}: the file says "
             "what holds"
         )
+    # What the caller needs to write and show the plan (measured idle: as loaded now); the
+    # certificate and the advice below take only what is left besides.
+    output_s = output_seconds(data) * budget.slowness() if certify else 0.0
     if certify:
-        output_s = output_seconds(data) * budget.slowness()  # measured idle: as loaded now
         cert, cut = certificate(data, unc, opts, started, output_s)
         if not unc.is_ideal:
             cert = replace(cert, ideal_length=ideal_length(ideal, opts, started, output_s))
@@ -269,7 +276,7 @@ def _make_plan(
     warnings = sensor_warnings(sensor, diameters)
     lumped = lumped_words(result.machine, result.lumped_pairs)
     if lumped:
-        left = seconds_left(opts, started)
+        left = seconds_left(opts, started, OUTPUT_SHARE if certify else 0.0, output_s)
         smaller = smaller_error_words(
             lambda u: widen_widths(weighed(u), offsets),
             unc,

@@ -59,15 +59,21 @@ def planner_budget(options: PlanningOptions, started: float, certify: bool) -> D
     ``POST_SHARE`` of it or ``POST_MIN_S`` (at most ``POST_MAX_SHARE`` of it), whichever is
     more (at least a tenth of the limit is left to plan), and their memory limit; the
     deadline comes ``POST_S_PER_PAIR`` earlier per pair of the plan made, whose
-    verification follows whether certified or not."""
+    verification follows whether certified or not. What is kept past ``POST_MIN_S`` is the
+    certificate's, which takes only the time left: the plan in hand's verification may take
+    it first (``Deadline.reserve_s``; a plan with its certificate cut beats none)."""
     limit = options.time_limit_s
     if limit is None:
         return Deadline(None, options.memory_limit_mb)
     left = seconds_left(options, started) or 0.0
     keep = max(POST_SHARE * limit, min(POST_MIN_S, POST_MAX_SHARE * limit)) if certify else 0.0
+    span = max(left - keep, 0.1 * limit)
     # A design's plan of 11,559 nodes took 7.6 s to verify past a 5 s limit uncommitted.
     return Deadline(
-        max(left - keep, 0.1 * limit), options.memory_limit_mb, per_pair_s=POST_S_PER_PAIR
+        span,
+        options.memory_limit_mb,
+        per_pair_s=POST_S_PER_PAIR,
+        reserve_s=max(left - span - POST_MIN_S, 0.0),
     )
 
 
