@@ -435,6 +435,36 @@ def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(mo
     assert result.lower_bound <= exact.length
 
 
+def test_a_proven_length_whose_tree_ran_out_follows_the_proof_not_the_pairs(monkeypatch):
+    # The exact search proves the length; every tree of the tie-breaks runs out. The
+    # fallback's beams follow the proof's choices at once (a plan of the proven length);
+    # the pairs told apart one at a time, a longer plan, are not made first.
+    machine = _random_part_machine()
+    exact = plan(machine)
+
+    def no_tree(*_args, **_kwargs):
+        raise Timeout("time")
+
+    monkeypatch.setattr(api, "_build", no_tree)
+    for maker in ("sensorless_plan", "sequential_plan"):  # no plan in hand before them
+        monkeypatch.setattr(fallback, maker, lambda *_args, **_kwargs: None)
+    made = []
+    real = fallback.pairwise_plan
+
+    def pairs(*args, **kwargs):
+        made.append(True)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fallback, "pairwise_plan", pairs)
+    result = plan(machine, PlanningOptions(time_limit_s=60.0))
+    assert not made
+    assert check_plan(result) == result.length == exact.length
+    # Without the proof (the length search out of time at once), they are made first.
+    monkeypatch.setattr(api, "longest_root", no_tree)
+    other = plan(machine, PlanningOptions(time_limit_s=60.0))
+    assert made and check_plan(other) == other.length >= exact.length
+
+
 @pytest.mark.slow
 def test_a_mix_the_exact_search_cannot_finish_gets_a_verified_plan(monkeypatch):
     # 20 random 6-10-gons at 5 % of 60 mm under 1 degree: the exact search proves a bound

@@ -86,6 +86,14 @@ class WorstCase:
         ok = monotone and isinstance(machine, PushAlignMachine)
         self._refuted = RefutedSets(machine.n) if ok else None
 
+    def holds_plan(self, mask: int, k: int) -> bool:
+        """Whether the memo already holds a plan of ``mask`` within ``k`` operations, without
+        a search: a plan the search found (``ub``, its action in ``choice``). An exact
+        length alone is not one (another algorithm's, recorded without its action)."""
+        return self.p.is_goal(mask) or (
+            k > 0 and self.ub.get(mask, k + 1) <= k and mask in self.choice
+        )
+
     def _known(self, mask: int, k: int) -> bool | None:
         """What the memo already says about ``within(mask, k)`` (None: search)."""
         if self.p.is_goal(mask):
