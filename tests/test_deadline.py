@@ -426,10 +426,10 @@ def test_a_plan_too_large_to_verify_in_time_gives_way_to_a_smaller_one(monkeypat
     assert time.perf_counter() - start < 20.0
 
 
-def test_the_tree_of_a_proven_length_is_a_first_plan_with_its_grace(monkeypatch):
+def test_the_tree_of_a_proven_length_may_take_the_callers_reserve(monkeypatch):
     # The tie-breaks ran out: the tree that follows the margin probes is the first plan,
-    # built with FIRST_PLAN_GRACE_S and the caller's reserve of its verification free, as
-    # the fallback's first plan is.
+    # built with the caller's reserve of its verification free (not FIRST_PLAN_GRACE_S: a
+    # short limit, which keeps no reserve, is not passed).
     machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
     real = api._build
     graces: list[float] = []
@@ -443,7 +443,7 @@ def test_the_tree_of_a_proven_length_is_a_first_plan_with_its_grace(monkeypatch)
     monkeypatch.setattr(api, "_build", build)
     budget = Deadline(60.0, per_pair_s=1e-6, reserve_s=2.0)
     result = plan(machine, PlanningOptions(time_limit_s=60.0), budget=budget)
-    assert graces == [pytest.approx(fallback.FIRST_PLAN_GRACE_S + 2.0)]
+    assert graces == [pytest.approx(2.0)]
     check_plan(result)
 
 
@@ -490,9 +490,9 @@ def test_the_plan_in_hands_verification_may_take_the_callers_reserve():
     assert roomy.end == pytest.approx(end, abs=1e-9)
     # Building the first plan, its verification's first FIRST_PLAN_GRACE_S and the reserve
     # are free; with a plan in hand, nothing is.
-    first = fallback.graced(budget, None)
+    first = fallback._graced(budget, None)
     assert first.grace_s == pytest.approx(fallback.FIRST_PLAN_GRACE_S + 1.0)
-    assert fallback.graced(budget, full.root).grace_s == 0.0
+    assert fallback._graced(budget, full.root).grace_s == 0.0
     # Every share of a budget keeps its reserve.
     checkpoint = Checkpoint(budget, time.perf_counter() + 1.0, budget.end)
     copies = (budget.until(0.5), budget.ending(None), budget.share_from_now(0.1), checkpoint)

@@ -33,7 +33,7 @@ from feederkit.planning.budget import (
     WorkBudget,
     collector_paused,
 )
-from feederkit.planning.fallback import NoFallback, fallback, graced, sensorless_plan
+from feederkit.planning.fallback import NoFallback, fallback, sensorless_plan
 from feederkit.planning.lumping import try_lumping, unlike_words
 from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
@@ -89,9 +89,8 @@ the plan built when it stops."""
 
 FIRST_TREE_SHARE = 0.85
 """Where (as a share of the time limit) the tree of a proven length with no tie-breaking
-must be built; after that the fallback answers. It is a first plan: its verification's
-first seconds and the caller's reserve are free as the fallback's first plan's are
-(:func:`~feederkit.planning.fallback.graced`)."""
+must be built; after that the fallback answers. It is a first plan: its verification may
+take the caller's reserve (``Deadline.reserve_s``, :func:`_first_tree_budget`)."""
 
 TIE_SHARE = 3.0
 """The ``worst`` objective's tie-breaking stages (the margin, then the expected operations)
@@ -545,7 +544,7 @@ def _plan(
             worst.deadline = refiner.deadline = WorkBudget(exact_deadline, min(left, cap))
 
             def then() -> Deadline:
-                return graced(budget.until(FIRST_TREE_SHARE), None)
+                return _first_tree_budget(budget)
 
         root, cut = _build(refiner, children, roots, horizon, tie, then)
         ties = TIES_EXACT if cut is None else TIES_MARGIN
@@ -553,7 +552,7 @@ def _plan(
         # The lengths are proven; the tie-breaking stages ran out of time: a tree that
         # keeps the proven length and the margin decided or found so far, following the
         # plans the margin probes found (Refiner.follow), while time remains.
-        worst.deadline = refiner.deadline = graced(budget.until(FIRST_TREE_SHARE), None)
+        worst.deadline = refiner.deadline = _first_tree_budget(budget)
         ties = TIES_MARGIN if staged and objective == "worst" else TIES_NONE
         cut = exc.reason
         if cut != "work" and not options.fallback:
@@ -571,6 +570,14 @@ def _plan(
         complete = True
     shortest = objective in ("worst", "worst-time")
     return root, complete, length if shortest else None, length, ties, cut
+
+
+def _first_tree_budget(budget: Deadline) -> Deadline:
+    """The budget of the tree of a proven length once the tie-breaks ran out: until
+    ``FIRST_TREE_SHARE`` of ``budget``, the caller's reserve of its verification free (a
+    plan whose certificate is cut beats none; a short limit keeps no reserve, and its end
+    holds)."""
+    return budget.until(FIRST_TREE_SHARE).with_grace(budget.reserve_s)
 
 
 def _exact_budget(

@@ -197,7 +197,7 @@ def fallback(
         rest = budget.remaining()
         share = budget
         if rest is not None:
-            share = graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)), None)
+            share = _graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)), None)
         try:
             told = pairwise_plan(problem, root_branches, share)
         except Timeout:
@@ -250,7 +250,7 @@ def fallback(
         held.hold(None)  # the plan in hand gives way to it: only its own pairs count
         try:
             blind = _choice_plan(
-                problem, search.choice, roots, root_branches, graced(budget, blind)
+                problem, search.choice, roots, root_branches, _graced(budget, blind)
             )
             # Its statistics and renumbering after the searches below cost up to about as
             # much as building it: they stop WALK_SHARE of that before the limit, when more
@@ -325,7 +325,7 @@ def fallback(
         anytime.deadline = tree_budget
         try:
             root = _choice_plan(
-                problem, anytime.choice, roots, root_branches, graced(tree_budget, blind)
+                problem, anytime.choice, roots, root_branches, _graced(tree_budget, blind)
             )
             held.hold(root)
         except Timeout as exc:
@@ -343,7 +343,7 @@ def fallback(
     return root, False, None, lower, TIES_NONE, None
 
 
-def graced(budget: Deadline, in_hand: Step | None) -> Deadline:
+def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
     """A copy of ``budget`` to build a plan under; with no plan ``in_hand``, the first
     ``FIRST_PLAN_GRACE_S`` and the reserve of its verification free (a plan a little late
     beats none)."""
