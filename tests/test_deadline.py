@@ -426,6 +426,22 @@ def test_a_plan_too_large_to_verify_in_time_gives_way_to_a_smaller_one(monkeypat
     assert time.perf_counter() - start < 20.0
 
 
+def test_a_plan_given_back_gives_back_what_it_took_whatever_the_load(monkeypatch):
+    # Held at one slowness and let go at another: the end comes back exactly, never later
+    # than with no plan.
+    machine = build_machine(small_mix(8), ToleranceSensor(1.0), IDEAL)
+    root = plan(machine, PlanningOptions()).root
+    budget = Deadline(3600.0, per_pair_s=0.01, reserve_s=0.5)
+    end = budget.end
+    held = fallback._Held(budget)
+    held.hold(root)
+    monkeypatch.setattr(Deadline, "slowness", lambda _self: 2.0)
+    held.hold(None)
+    assert budget.end == pytest.approx(end, abs=1e-9)
+    held.hold(root)  # at twice the slowness: twice the cost, the same reserve
+    assert end - budget.end == pytest.approx(0.02 * node_states(root) - 0.5, abs=1e-9)
+
+
 def test_the_tree_of_a_proven_length_may_take_the_callers_reserve(monkeypatch):
     # The tie-breaks ran out: the tree that follows the margin probes is the first plan,
     # built with the caller's reserve of its verification free (not FIRST_PLAN_GRACE_S: a
@@ -493,6 +509,13 @@ def test_the_plan_in_hands_verification_may_take_the_callers_reserve():
     first = fallback._graced(budget, None)
     assert first.grace_s == pytest.approx(fallback.FIRST_PLAN_GRACE_S + 1.0)
     assert fallback._graced(budget, full.root).grace_s == 0.0
+    # A plan built to replace the one in hand may use the seconds it holds, and only those:
+    # should the build run out, the plan in hand still has its verification's time.
+    held.hold(full.root)
+    replacing = held.building(budget, full.root)
+    assert replacing.end == budget.end
+    assert replacing.grace_s == pytest.approx(0.01 * pairs - 1.0)
+    assert held.building(budget, None).grace_s == pytest.approx(fallback.FIRST_PLAN_GRACE_S + 1.0)
     # Every share of a budget keeps its reserve.
     checkpoint = Checkpoint(budget, time.perf_counter() + 1.0, budget.end)
     copies = (budget.until(0.5), budget.ending(None), budget.share_from_now(0.1), checkpoint)
@@ -1036,6 +1059,19 @@ def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, c
     assert budget.per_pair_s == POST_S_PER_PAIR
     # What is kept past POST_MIN_S (the certificate's) the plan's verification may take.
     assert budget.reserve_s == pytest.approx(max(limit - planner_s - POST_MIN_S, 0.0), abs=0.05)
+
+
+def test_a_second_walk_of_a_made_plan_needs_as_long_as_the_first_besides_the_output():
+    # The plan in hand's verification may have taken the certificate's reserve: its second
+    # walk (the pruned file's counts) is made only when the time left, less the output's
+    # share, holds another walk as long as the first.
+    from feederkit.plans.make import _time_left
+
+    now = time.monotonic()
+    limited = PlanningOptions(time_limit_s=10.0)
+    assert _time_left(limited, now, 1.0)
+    assert not _time_left(limited, now, 9.6)  # 9.5 s left besides the output's 5 %
+    assert _time_left(PlanningOptions(), now, 1e9)
 
 
 def test_a_deadline_keeps_time_in_hand_to_let_go_of_what_the_process_grew_by(monkeypatch):

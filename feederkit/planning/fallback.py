@@ -247,10 +247,9 @@ def fallback(
         # Its tree now, under the whole budget: a plan in hand (shorter than blind) beats none,
         # though its statistics may then run past the limit by one walk of the tree.
         built = time.perf_counter()
-        held.hold(None)  # the plan in hand gives way to it: only its own pairs count
-        try:
+        try:  # the plan in hand stays held until this one replaces it
             blind = _choice_plan(
-                problem, search.choice, roots, root_branches, _graced(budget, blind)
+                problem, search.choice, roots, root_branches, held.building(budget, blind)
             )
             # Its statistics and renumbering after the searches below cost up to about as
             # much as building it: they stop WALK_SHARE of that before the limit, when more
@@ -318,14 +317,13 @@ def fallback(
                 break
     root = None
     if found is not None:
-        # The shorter plan replaces the one in hand: only its own pairs count.
-        held.hold(None)
+        # The shorter plan replaces the one in hand, which stays held until it does.
         if budget.end is not None and blind is not None:
             tree_budget = budget.ending(budget.end - gap)
         anytime.deadline = tree_budget
         try:
             root = _choice_plan(
-                problem, anytime.choice, roots, root_branches, _graced(tree_budget, blind)
+                problem, anytime.choice, roots, root_branches, held.building(tree_budget, blind)
             )
             held.hold(root)
         except Timeout as exc:
@@ -352,24 +350,32 @@ def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
 
 
 class _Held:
-    """The (node, state) pairs of the plan in hand, committed to the fallback's budget
-    (:meth:`~feederkit.planning.budget.Deadline.commit`): its verification and file come out
-    of the time left, and a plan that replaces it gives its pairs back."""
+    """The plan in hand's verification, held as seconds of the fallback's budget
+    (:meth:`~feederkit.planning.budget.Deadline.seconds_for` its (node, state) pairs): its
+    verification and file come out of the time left, less the caller's reserve it may take
+    (``Deadline.reserve_s``, a certificate's time), and a plan that replaces it gives exactly
+    those seconds back, however the machine's load changed meanwhile."""
 
     def __init__(self, budget: Deadline) -> None:
         self.budget = budget
-        self.pairs = 0
-        self.credit = 0.0  # of the budget's reserve, given back for the plan in hand
+        self.held_s = 0.0  # seconds the plan in hand took from the budget's end
 
     def hold(self, root: Step | None) -> None:
-        """``root`` is the plan in hand now (None: none). Its verification may take the
-        caller's reserve (``Deadline.reserve_s``, a certificate's time) up to what it costs:
-        that much is given back to the budget."""
-        pairs = 0 if root is None else node_states(root)
-        self.budget.commit(pairs - self.pairs, stop=False)  # the plan is made: keep it
-        credit = min(self.budget.reserve_s, self.budget.seconds_for(pairs))
-        self.budget.credit(credit - self.credit)
-        self.pairs, self.credit = pairs, credit
+        """``root`` is the plan in hand now (None: none): the budget's end moves by the
+        difference of what the two plans take."""
+        cost = 0.0 if root is None else self.budget.seconds_for(node_states(root))
+        held = cost - min(self.budget.reserve_s, cost)
+        self.budget.credit(self.held_s - held)  # the plan is made: keep it, never raise
+        self.held_s = held
+
+    def building(self, budget: Deadline, in_hand: Step | None) -> Deadline:
+        """A copy of ``budget`` (a share of the held one) to build a plan under that would
+        replace ``in_hand``: the seconds the plan in hand holds are free to it, and kept
+        for the plan in hand should the build run out (a failed replacement must not take
+        its verification's time); with none in hand, :func:`_graced`'s."""
+        if in_hand is None:
+            return _graced(budget, None)
+        return budget.with_grace(self.held_s)
 
 
 def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadline) -> Step:

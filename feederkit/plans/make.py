@@ -216,8 +216,9 @@ def _make_plan(
         if widened:
             data["stats"]["expected_length"] = file_expected(as_plan(data))
         listed = _entries(data)
+        walk = time.monotonic()
         report = check_plan(data, prune=True)
-        if _entries(data) != listed and _time_left(opts, started):
+        if _entries(data) != listed and _time_left(opts, started, time.monotonic() - walk):
             report = check_plan(data)  # its counts (runs ending unrecognized) are the file's
     else:
         ideal = weigh_members(build_machine(pfs, sensor, IDEAL), shares, rejected)
@@ -226,8 +227,9 @@ def _make_plan(
         # Its paths and its margins: a margin the rebuilt model finds more than some state at
         # the node keeps is lowered to what it keeps, so the file claims no more than holds.
         listed = _entries(data)
+        walk = time.monotonic()
         report = verify_strong(data, tighten_margins=True, restate_expected=widened, prune=True)
-        if _entries(data) != listed and _time_left(opts, started):
+        if _entries(data) != listed and _time_left(opts, started, time.monotonic() - walk):
             report = verify_strong(data, restate_expected=widened)  # the file's counts
         written = data["stats"]["min_margin_deg"]
         if written is not None and written < result.min_margin:
@@ -303,10 +305,12 @@ def _make_plan(
     return MadePlan(data, result, report, tuple(warnings + notes), unoriented)
 
 
-def _time_left(opts: PlanningOptions, started: float) -> bool:
-    """Whether the time limit (if any) leaves time for one more walk of the plan."""
-    left = seconds_left(opts, started)
-    return left is None or left > 0.0
+def _time_left(opts: PlanningOptions, started: float, walk_s: float) -> bool:
+    """Whether the time limit (if any) leaves time for one more walk of the plan, which
+    takes about as long as the last one (``walk_s``), besides the output's share: the plan
+    in hand's verification may have taken the certificate's reserve."""
+    left = seconds_left(opts, started, OUTPUT_SHARE)
+    return left is None or left > walk_s
 
 
 def _entries(data: Mapping[str, Any]) -> int:

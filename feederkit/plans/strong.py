@@ -77,7 +77,7 @@ SHAPE_REL_TOL = 1e-3
 State = tuple[int, int]
 """A physical state of the plan: (part index, physical state id)."""
 
-Branch = tuple[Sequence[float], Mapping[str, Any]]
+ReadBranch = tuple[Sequence[float], Mapping[str, Any]]
 """A branch of a plan node: its reading interval and its next node (a reference resolved)."""
 
 Tally = tuple[int, int, int, int]
@@ -196,11 +196,12 @@ def strong_model(
 class _Run:
     """Every path of every start through one plan, memoised per (node, state).
 
-    Each node's branches are indexed by their reading intervals once, so a state's branches
-    are found by bisection (a node of a large mix has hundreds of branches and a state reads
-    into a few); where a node's own outcomes and branches of a state are asked again (the
-    length, the handled states, the expected length, the rotation certificate) they come from
-    a memo.
+    Each node's branches are indexed by their reading intervals once, their next nodes
+    resolved, so a state's branches are found by bisection (a node of a large mix has
+    hundreds of branches and a state reads into a few); a state's outcomes are memoised per
+    rotation (nodes share rotations), its branches per (node, state), and the walk's tally
+    (:meth:`walk`) per (node, state), so the length, the handled states, the expected length
+    and the rotation certificate ask each once.
     """
 
     def __init__(
@@ -293,7 +294,7 @@ class _Run:
 
     def branches_of(
         self, node: Mapping[str, Any], x: State, sensor: Sensor | None = None
-    ) -> list[Branch] | None:
+    ) -> list[ReadBranch] | None:
         """The node's branches a resting state ``x`` may read into under ``sensor`` (default:
         the verifier's, narrowed by rounding), in the node's order, as (reading interval,
         next node resolved): a superset, those whose interval comes within the sensor's
@@ -365,11 +366,6 @@ class _Run:
             if self.by_name.get((e["part"], e.get("landing"))) == p
         }
         return set(self.model.mechanics[p].states[s].members) <= listed
-
-    def worst(self, node: Mapping[str, Any], x: State) -> int:
-        """Operations from ``node`` on for a part resting in ``x`` before it, worst case;
-        CheckFailed on the first path that fails."""
-        return self.walk(node, x)[0]
 
     def walk(self, node: Mapping[str, Any], x: State) -> Tally:
         """(worst operations, paths, paths to a reject, paths to an unrecognized result)
@@ -510,7 +506,7 @@ class _BranchIndex:
             a0 <= a1 and b0 <= b1 for (a0, b0), (a1, b1) in zip(ends, ends[1:], strict=False)
         )
 
-    def within(self, lo: float, hi: float) -> list[Branch]:
+    def within(self, lo: float, hi: float) -> list[ReadBranch]:
         """The branches whose interval meets ``[lo, hi]`` (all of them when unsorted)."""
         if not self._sorted:
             return self.with_reading

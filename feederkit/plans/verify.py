@@ -735,7 +735,7 @@ def verify_declared(
     """
     plan = as_plan(plan)
     old = sys.getrecursionlimit()
-    # The strong checks recurse a few frames per operation (``_Run.handles``, ``worst``).
+    # The strong checks recurse a few frames per operation (``_Run.handles``, ``_Run.walk``).
     sys.setrecursionlimit(max(old, 8 * plan.stats.length + 200))
     try:
         return _verify_declared(plan, part_indices)
