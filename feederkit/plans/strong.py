@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -54,6 +54,7 @@ from feederkit.plans.model import PlanPart, member_label, names_several, push_fu
 from feederkit.plans.verify import (
     PartCheck,
     VerificationReport,
+    expected_walk,
     unsupported,
     unsupported_words,
 )
@@ -661,15 +662,19 @@ def expected_operations(
     resting ranges of the ideal states a first alignment can end there (each shared equally
     among its destinations) times its member's share; a rotation by ``action_deg`` shares a
     state's mass equally among its outcome set; a branch keeps the probability that the
-    state's reading falls in it. Memoised per (node, state), without recursion; ``run``, a
-    walk of the same plan and model (the verification's), lends its indexes and memos."""
+    state's reading falls in it. Memoised per (node, state), without recursion
+    (:func:`~feederkit.plans.verify.expected_walk`); ``run``, a walk of the same plan and
+    model (the verification's), lends its indexes and memos."""
     run = _Run(plan, model) if run is None else run
     sensor = model.sensor
-    memo: dict[tuple[int, State], float] = {}
-    open_steps: dict[tuple[int, State], list[tuple[float, tuple[int, State], Any, State]]] = {}
+    memo: dict[Hashable, float] = {}
 
-    def continuations(node: Mapping[str, Any], x: State) -> list[tuple[float, Any, State]]:
-        """(probability, next node, state) of every continuation of ``x`` at a step."""
+    def continuations(
+        at: tuple[Mapping[str, Any], State],
+    ) -> list[tuple[float, tuple[Mapping[str, Any], State]]]:
+        """(probability, (next step, state)) of every continuation of a state at a step
+        that goes on to another step."""
+        node, x = at
         outs = run.outcomes(node, x)
         out = []
         for y in outs:
@@ -684,7 +689,10 @@ def expected_operations(
                 pr = sensor.reading_probability(diam, *reading)
                 if pr > 0.0:
                     out.append((pr / len(outs), nxt, y))
-        return out
+        return [(pr, (n, y)) for pr, n, y in out if "result" not in n]
+
+    def key(at: tuple[Mapping[str, Any], State]) -> tuple[int, State]:
+        return id(at[0]), at[1]
 
     expected = 0.0
     shares = member_shares(plan)
@@ -696,30 +704,8 @@ def expected_operations(
             for t in dest:
                 weight[t] += widths[i] / 360.0 / len(dest)
         for s in range(mech.n):
-            stack: list[tuple[Mapping[str, Any], State]] = [(root, (p, s))]
-            while stack:
-                node, x = stack[-1]
-                key = (id(node), x)
-                if key in memo:
-                    stack.pop()
-                    continue
-                # Back at a step, its continuations are done: those pushed above it were
-                # popped only once memoised (the plan is acyclic).
-                steps = open_steps.pop(key, None)
-                if steps is None:
-                    steps = [
-                        (pr, (id(n), y), n, y)
-                        for pr, n, y in continuations(node, x)
-                        if "result" not in n
-                    ]
-                    todo = [(n, y) for _pr, k, n, y in steps if k not in memo]
-                    if todo:
-                        open_steps[key] = steps
-                        stack.extend(todo)
-                        continue
-                memo[key] = 1.0 + math.fsum(pr * memo[k] for pr, k, _n, _y in steps)
-                stack.pop()
-            expected += shares[p] * weight[s] * memo[(id(root), (p, s))]
+            e = expected_walk((root, (p, s)), continuations, key, memo)
+            expected += shares[p] * weight[s] * e
     return expected
 
 

@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Container, Iterable, Mapping, Sequence
+from collections.abc import Callable, Container, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -584,53 +584,98 @@ def _branch_probabilities(sensor: Sensor, step: Step, diameter: float) -> list[t
     return shares
 
 
+Item = TypeVar("Item")
+"""A (step, state) of an expected walk, in whatever form its caller keeps it."""
+
+
+def expected_walk(
+    start: Item,
+    continuations: Callable[[Item], Iterable[tuple[float, Item]]],
+    key: Callable[[Item], Hashable],
+    memo: dict[Hashable, float],
+) -> float:
+    """The expected number of operations from ``start`` on (itself counted): one, plus each
+    continuation's (probability, next step) expectation, over a plan's steps and states
+    (acyclic: a DAG of shared subplans), memoised in ``memo`` by ``key``, without recursion.
+    ``continuations`` lists only those that go on to another step (a result ends the run).
+
+    >>> chain = {"a": [(0.5, "b")], "b": []}
+    >>> expected_walk("a", chain.__getitem__, str, {})
+    1.5
+    """
+    open_steps: dict[Hashable, list[tuple[float, Hashable]]] = {}
+    stack = [start]
+    while stack:
+        item = stack[-1]
+        k = key(item)
+        if k in memo:
+            stack.pop()
+            continue
+        # Back at a step, its continuations are done: those pushed above it were popped
+        # only once memoised (the plan is acyclic).
+        steps = open_steps.pop(k, None)
+        if steps is None:
+            steps, todo = [], []
+            for pr, nxt in continuations(item):
+                nk = key(nxt)
+                steps.append((pr, nk))
+                if nk not in memo:
+                    todo.append(nxt)
+            if todo:
+                open_steps[k] = steps
+                stack.extend(todo)
+                continue
+        memo[k] = 1.0 + math.fsum(pr * memo[nk] for pr, nk in steps)
+        stack.pop()
+    return memo[key(start)]
+
+
 def expected_operations(plan: Plan) -> float:
     """The expected number of operations of a plan on the kinematic model (the first
     alignment counted): the start uniform on the circle (a state weighs its resting range
     over 360), each member weighted by its normalised share (:meth:`Plan.shares`), a
     rotation by the step's ``action_deg``, and each branch followed with the probability
     that the state's reading falls in it (the sensor model, section 5). Memoised per
-    (node, state), without recursion."""
+    (node, state), without recursion (:func:`expected_walk`)."""
     total = 0.0
     for p, share in enumerate(plan.shares()):
         pf = push_function_of(plan.parts[p])
         listed = {s.id: s.diameter for s in plan.parts[p].states}
-        by_id = {s.id: s for s in pf.states}
-        memo: dict[tuple[int, int], float] = {}
-        # A step's continuations, kept while those pushed above it are worked out.
-        open_steps: dict[tuple[int, int], list[tuple[float, tuple[int, int]]]] = {}
+        continuations = _continuations(plan.sensor, pf, listed)
+        memo: dict[Hashable, float] = {}
         for s0 in pf.states:
-            stack: list[tuple[Step, StableState]] = [(plan.root, s0)]
-            while stack:
-                node, state = stack[-1]
-                key = (id(node), state.id)
-                if key in memo:
-                    stack.pop()
-                    continue
-                # Back at a step, its continuations are done: those pushed above it were
-                # popped only once memoised (the plan is acyclic).
-                steps = open_steps.pop(key, None)
-                if steps is None:
-                    d = listed.get(state.id, state.diameter)
-                    steps, todo = [], []
-                    for k, pr in _branch_probabilities(plan.sensor, node, d):
-                        nxt = node.branches[k].next
-                        if isinstance(nxt, Step):
-                            assert nxt.action_deg is not None
-                            turned = rotation_after(state.normal_deg, nxt.action_deg)
-                            s2 = by_id[push(pf, turned).id]
-                            steps.append((pr, (id(nxt), s2.id)))
-                            if (id(nxt), s2.id) not in memo:
-                                todo.append((nxt, s2))
-                    if todo:
-                        open_steps[key] = steps
-                        stack.extend(todo)
-                        continue
-                memo[key] = 1.0 + math.fsum(pr * memo[k] for pr, k in steps)
-                stack.pop()
+            e = expected_walk((plan.root, s0), continuations, _step_key, memo)
             lo, hi = s0.resting_range_deg
-            total += share * (hi - lo) / 360.0 * memo[(id(plan.root), s0.id)]
+            total += share * (hi - lo) / 360.0 * e
     return total
+
+
+def _continuations(
+    sensor: Sensor, pf: PushFunction, listed: Mapping[int, float]
+) -> Callable[[tuple[Step, StableState]], list[tuple[float, tuple[Step, StableState]]]]:
+    """The continuations of a (step, state) of part ``pf`` that go on to another step: each
+    branch's probability (the state read at its ``listed`` diameter) and the next step with
+    the state its rotation leaves."""
+    by_id = {s.id: s for s in pf.states}
+
+    def continuations(at: tuple[Step, StableState]) -> list[tuple[float, tuple[Step, StableState]]]:
+        node, state = at
+        d = listed.get(state.id, state.diameter)
+        out = []
+        for k, pr in _branch_probabilities(sensor, node, d):
+            nxt = node.branches[k].next
+            if isinstance(nxt, Step):
+                assert nxt.action_deg is not None
+                turned = rotation_after(state.normal_deg, nxt.action_deg)
+                out.append((pr, (nxt, by_id[push(pf, turned).id])))
+        return out
+
+    return continuations
+
+
+def _step_key(at: tuple[Step, StableState]) -> tuple[int, int]:
+    """A (step, state) of the expected walk, by the step's identity and the state's id."""
+    return id(at[0]), at[1].id
 
 
 def expected_problems(plan: Plan, expected: float) -> list[str]:
