@@ -505,10 +505,10 @@ def test_the_plan_in_hands_verification_may_take_the_callers_reserve():
     fallback._Held(roomy).hold(full.root)
     assert roomy.end == pytest.approx(end, abs=1e-9)
     # Building the first plan, its verification's first FIRST_PLAN_GRACE_S and the reserve
-    # are free; with a plan in hand, nothing is.
-    first = fallback._graced(budget, None)
+    # are free; with a plan in hand, only what it holds.
+    first = fallback._graced(budget)
     assert first.grace_s == pytest.approx(fallback.FIRST_PLAN_GRACE_S + 1.0)
-    assert fallback._graced(budget, full.root).grace_s == 0.0
+    assert fallback._Held(budget).building(budget, full.root).grace_s == 0.0  # holds none
     # A plan built to replace the one in hand may use the seconds it holds, and only those:
     # should the build run out, the plan in hand still has its verification's time.
     held.hold(full.root)

@@ -197,7 +197,7 @@ def fallback(
         rest = budget.remaining()
         share = budget
         if rest is not None:
-            share = _graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)), None)
+            share = _graced(budget.ending(budget.end - rest * (1 - PAIRWISE_SHARE)))
         try:
             told = pairwise_plan(problem, root_branches, share)
         except Timeout:
@@ -341,12 +341,11 @@ def fallback(
     return root, False, None, lower, TIES_NONE, None
 
 
-def _graced(budget: Deadline, in_hand: Step | None) -> Deadline:
-    """A copy of ``budget`` to build a plan under; with no plan ``in_hand``, the first
+def _graced(budget: Deadline) -> Deadline:
+    """A copy of ``budget`` to build a first plan under (none in hand): the first
     ``FIRST_PLAN_GRACE_S`` and the reserve of its verification free (a plan a little late
     beats none)."""
-    free = FIRST_PLAN_GRACE_S + budget.reserve_s
-    return budget.with_grace(0.0 if in_hand is not None else free)
+    return budget.with_grace(FIRST_PLAN_GRACE_S + budget.reserve_s)
 
 
 class _Held:
@@ -374,7 +373,7 @@ class _Held:
         for the plan in hand should the build run out (a failed replacement must not take
         its verification's time); with none in hand, :func:`_graced`'s."""
         if in_hand is None:
-            return _graced(budget, None)
+            return _graced(budget)
         return budget.with_grace(self.held_s)
 
 
