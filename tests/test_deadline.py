@@ -34,7 +34,12 @@ from feederkit.planning.reindex import by_diameter
 from feederkit.planning.sensorless import Backchain, push_circle
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.stats import node_states
-from feederkit.plans.timelimit import POST_MIN_S, POST_S_PER_PAIR, planner_budget
+from feederkit.plans.timelimit import (
+    POST_MIN_S,
+    POST_S_PER_PAIR,
+    POST_S_STRONG_PER_PAIR,
+    planner_budget,
+)
 from feederkit.sensors import LedSensor, NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 
@@ -1059,6 +1064,36 @@ def test_a_made_plan_keeps_enough_of_a_short_limit_for_its_verification(limit, c
     assert budget.per_pair_s == POST_S_PER_PAIR
     # What is kept past POST_MIN_S (the certificate's) the plan's verification may take.
     assert budget.reserve_s == pytest.approx(max(limit - planner_s - POST_MIN_S, 0.0), abs=0.05)
+    # A strong plan's verifier costs less per pair: the same shares, a smaller commit.
+    strong = planner_budget(PlanningOptions(time_limit_s=limit), time.monotonic(), certify, True)
+    assert strong.per_pair_s == POST_S_STRONG_PER_PAIR < POST_S_PER_PAIR
+    assert strong.reserve_s == pytest.approx(budget.reserve_s, abs=0.05)
+
+
+@pytest.mark.parametrize(("rotation_error_deg", "strong"), [(1.0, True), (0.0, False)])
+def test_the_command_commits_the_cost_of_the_verifier_its_plan_gets(
+    monkeypatch, rotation_error_deg, strong
+):
+    # Under uncertainty the plan is verified by verify_strong, on the ideal model by
+    # check_plan: the planner's budget commits that verifier's cost per pair.
+    import feederkit.plans.make as make
+
+    seen: list[float] = []
+
+    def recording(options, started, certify, strong=False):
+        budget = planner_budget(options, started, certify, strong)
+        seen.append(budget.per_pair_s)
+        return budget
+
+    monkeypatch.setattr(make, "planner_budget", recording)
+    pf = push_function(make_part(make_outline("trapezoid", [(0, 0), (40, 0), (30, 20), (0, 20)])))
+    make.make_plan(
+        [pf],
+        LedSensor(0.5),
+        PlanningOptions(time_limit_s=30.0),
+        uncertainty=Uncertainty(rotation_error_deg=rotation_error_deg),
+    )
+    assert seen == [POST_S_STRONG_PER_PAIR if strong else POST_S_PER_PAIR]
 
 
 def test_a_second_walk_of_a_made_plan_needs_as_long_as_the_first_besides_the_output():

@@ -178,7 +178,7 @@ def _make_plan(
     machine = widen_widths(unwidened, offsets)
     if rejected:
         _check_rejects_separable(machine, named, lambda: _finest_machine(pfs, unc))
-    budget = planner_budget(opts, started, certify)
+    budget = planner_budget(opts, started, certify, strong=not unc.is_ideal)
     try:
         result = plan_machine(machine, opts, budget=budget)
     except NoStrongPlan as exc:

@@ -17,6 +17,7 @@ constants and the text itself are :mod:`feederkit.plans.fileformat`'s.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
@@ -119,12 +120,20 @@ class _Checker:
     def only(self, d: dict[str, Any], keys: tuple[str, ...], where: str, form: str) -> None:
         """Refuse a key of ``d`` that design.md's grammar does not give ``form``: a node
         that is both an operation and a result means two things to a controller."""
+        if d.keys() <= _allowed(keys):
+            return
         extra = next((k for k in d if k not in keys), None)
         if extra is not None:
             allowed = ", ".join(repr(k) for k in keys)
             raise self.fail(
                 f"{where} has {extra!r}, but {form} has only {allowed} (design.md, Plan file)"
             )
+
+
+@functools.cache
+def _allowed(keys: tuple[str, ...]) -> frozenset[str]:
+    """The keys a form allows, as a set (made once per form)."""
+    return frozenset(keys)
 
 
 SENSOR_PARAMETERS = {"none": (), "tolerance": ("tolerance_mm",), "led": ("pitch_mm", "noise_mm")}
@@ -351,6 +360,9 @@ class _Members:
         self.ids = {key: {s.id for s in p.states} for key, p in parts.items()}
 
 
+_ENTRY_KEYS = frozenset(("part", "landing", "state", "pose_deg"))
+
+
 def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) -> Leaf:
     c.only(node, ("result", "reject"), where, "a result")
     entries = c.lst(node["result"], f"{where} result")
@@ -359,9 +371,31 @@ def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) 
     reject = node.get("reject", False)
     if not isinstance(reject, bool):
         raise c.fail(f"{where} 'reject' must be true or false, got {shown(reject)}")
-    parts, names = known.parts, known.names
+    parts, names, ids = known.parts, known.names, known.ids
     out = []
     for e in entries:
+        if type(e) is dict and e.keys() <= _ENTRY_KEYS:
+            # A well-formed entry, as the writer writes it, without the messages' texts.
+            part, landing, sid, pose = (
+                e.get("part"),
+                e.get("landing"),
+                e.get("state"),
+                e.get("pose_deg"),
+            )
+            listed = (
+                ids.get((part, landing))
+                if type(part) is str and (landing is None or type(landing) is str)
+                else None
+            )
+            if (
+                listed is not None
+                and type(sid) is int
+                and sid in listed
+                and type(pose) is float
+                and 0.0 <= pose < 360.0
+            ):
+                out.append(ResultEntry(part, sid, pose, landing))
+                continue
         ed = c.obj(e, f"{where} result entry")
         c.only(ed, ("part", "landing", "state", "pose_deg"), f"{where} result entry", "an entry")
         part = c.key(ed, "part", f"{where} result entry")
@@ -518,6 +552,24 @@ def _check_step_fields(
         raise c.fail(f"{where} branches on a reading, but the plan is sensorless")
     out: list[tuple[tuple[float, float] | None, object]] = []
     for k, b in enumerate(branches):
+        if type(b) is dict and len(b) == 2 and "reading" in b and "next" in b:
+            # A well-formed branch, as the writer writes it, without the messages' texts.
+            reading = b["reading"]
+            if sensorless:
+                if reading is None:
+                    out.append((None, b["next"]))
+                    continue
+            elif type(reading) is list and len(reading) == 2:
+                lo, hi = reading
+                if (
+                    type(lo) is float
+                    and type(hi) is float
+                    and lo <= hi
+                    and math.isfinite(lo)
+                    and math.isfinite(hi)
+                ):
+                    out.append(((lo, hi), b["next"]))
+                    continue
         bd = c.obj(b, f"{where} branch")
         c.only(bd, ("reading", "next"), f"{where} branch {k}", "a branch")
         reading = c.key(bd, "reading", f"{where} branch")

@@ -2,8 +2,9 @@
 then the certificate, then the caller's writing and showing of the plan.
 
 The limit is the command's, counted from its start; the planner stops early enough
-(``POST_SHARE``, ``POST_S_PER_PAIR``) for the verified file to follow, and the certificate
-leaves ``OUTPUT_SHARE`` and ``OUTPUT_S_PER_NODE`` per node to the output.
+(``POST_SHARE``, ``POST_S_PER_PAIR`` or ``POST_S_STRONG_PER_PAIR``) for the verified file to
+follow, and the certificate leaves ``OUTPUT_SHARE`` and ``OUTPUT_S_PER_NODE`` per node to the
+output.
 """
 
 from __future__ import annotations
@@ -38,14 +39,24 @@ time left) leaves to the caller for writing and showing the plan, besides
 ``OUTPUT_S_PER_NODE`` per node of the plan file."""
 
 POST_S_PER_PAIR = 4e-5
-"""Seconds per (node, state) pair of a plan (a state that can reach a node) of the work after
-the planner: the file, its verification and the command's output. The planner's deadline
-comes this much earlier per pair of the nodes it makes (``Deadline.per_pair_s``), so a large
-plan leaves time for its own verification and file. Measured about 3.2e-5 s on two plans
-(``python benchmarks/bench_command_deadline.py``): a 100-part mix's under 1 degree, 164,000
-pairs in 5.3 s, and a 1000-point outline's over both landings on the ideal model, 265,000
-pairs in 8.5 s. Measured idle, so scaled by the planner's budget's slowness
-(``Deadline.slowness``: wall over CPU seconds since it began) on a loaded machine."""
+"""Seconds per (node, state) pair of a plan on the ideal model (a state that can reach a
+node) of the work after the planner: the file, its verification (``check_plan``, one path
+per start, outcome and reading) and the command's output. The planner's deadline comes this
+much earlier per pair of the nodes it makes (``Deadline.per_pair_s``), so a large plan leaves
+time for its own verification and file. Measured 3.2e-5 s on a 1000-point outline's plan
+over both landings (265,000 pairs in 8.5 s) and 4.1-5.5e-5 s on a 200-part mix's at 1 %
+(203,000 pairs; ``python benchmarks/bench_command_deadline.py``), the high end covered by the
+certificate's reserve (``Deadline.reserve_s``). Measured idle, so scaled by the planner's
+budget's slowness (``Deadline.slowness``: wall over CPU seconds since it began) on a loaded
+machine."""
+
+POST_S_STRONG_PER_PAIR = 3e-5
+"""``POST_S_PER_PAIR`` for a strong plan (under uncertainty), whose verifier
+(``verify_strong``) walks each (node, state) pair once with its outcome sets memoised per
+rotation: measured 1.95-2.4e-5 s on a 50-part mix's plan at 5 % (857,000 pairs), 2.9e-5 s on
+a 20-part mix's over both landings (283,000) and 3.1e-5 s on a 50-part mix's at 3 %
+(111,000, whose fixed costs weigh more). Half again the ideal model's cost would give the
+largest plans up to a third of their verification's time back as planning time."""
 
 OUTPUT_S_PER_NODE = 7e-5
 """Seconds per node of the plan file (each shared step once, each result in place) of what
@@ -54,12 +65,15 @@ comes after the certificate: writing the file, reading it back and drawing it (2
 ``POST_S_PER_PAIR`` is."""
 
 
-def planner_budget(options: PlanningOptions, started: float, certify: bool) -> Deadline:
+def planner_budget(
+    options: PlanningOptions, started: float, certify: bool, strong: bool = False
+) -> Deadline:
     """The planner's budget: the options' time limit from ``started`` less, when certifying,
     ``POST_SHARE`` of it or ``POST_MIN_S`` (at most ``POST_MAX_SHARE`` of it), whichever is
     more (at least a tenth of the limit is left to plan), and their memory limit; the
-    deadline comes ``POST_S_PER_PAIR`` earlier per pair of the plan made, whose
-    verification follows whether certified or not. What is kept past ``POST_MIN_S`` is the
+    deadline comes ``POST_S_PER_PAIR`` (``POST_S_STRONG_PER_PAIR`` for a ``strong`` plan,
+    one under uncertainty) earlier per pair of the plan made, whose verification follows
+    whether certified or not. What is kept past ``POST_MIN_S`` is the
     certificate's, which takes only the time left: the plan in hand's verification may take
     it first (``Deadline.reserve_s``; a plan with its certificate cut beats none)."""
     limit = options.time_limit_s
@@ -72,7 +86,7 @@ def planner_budget(options: PlanningOptions, started: float, certify: bool) -> D
     return Deadline(
         span,
         options.memory_limit_mb,
-        per_pair_s=POST_S_PER_PAIR,
+        per_pair_s=POST_S_STRONG_PER_PAIR if strong else POST_S_PER_PAIR,
         reserve_s=max(left - span - POST_MIN_S, 0.0),
     )
 
