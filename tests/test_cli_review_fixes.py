@@ -401,7 +401,7 @@ def test_once_the_command_answered_a_late_ctrl_c_changes_nothing(monkeypatch):
 
     import feederkit.cli.app as app_module
 
-    monkeypatch.setattr(app_module, "main", lambda: 0)
+    monkeypatch.setattr(app_module, "main", lambda **_: 0)
     monkeypatch.setattr(app_module, "end_quietly_on_closed_pipe", lambda: None)
     monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)
     before = signal.getsignal(signal.SIGINT)

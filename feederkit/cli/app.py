@@ -76,6 +76,7 @@ try:  # Ctrl-C while the heavy modules load (typer, rich, numpy, shapely) is one
     from feederkit.catalog import set_busy_notifier
     from feederkit.cli import helpstyle
     from feederkit.cli.common import (
+        COMMAND_START,
         DONE_WORK,
         JSON_ANSWER,
         err_console,
@@ -370,8 +371,11 @@ def _from_interrupt(exc: BaseException) -> bool:
     return False
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, from_process: bool = False) -> int:
     """Entry point: run the app and turn every error into one line on stderr and an exit code.
+
+    ``from_process``: the command's ``--time-limit`` counts from the process's start (the
+    console script, :func:`run`), not from this call.
 
     Usage errors (unknown options, missing arguments, bad values) are one line too, naming
     the command's ``--help``, and exit with 2, as click does. After Ctrl-C the end is
@@ -381,6 +385,7 @@ def main(argv: list[str] | None = None) -> int:
     set_busy_notifier(_notify_busy)
     JSON_ANSWER.reset()
     DONE_WORK.reset()
+    COMMAND_START.mark(from_process)
     args = sys.argv[1:] if argv is None else list(argv)
     with _CtrlCWatch() as ctrl_c, _guarded_stdout():
         try:
@@ -399,6 +404,7 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_INTERRUPTED
         finally:
             set_busy_notifier(None)
+            COMMAND_START.reset()
 
 
 def _run_app(args: list[str]) -> int:
@@ -501,7 +507,7 @@ def run() -> None:
     end_quietly_on_closed_pipe()
     sys.unraisablehook = _quiet_interrupts(sys.unraisablehook)
     try:
-        code = main()
+        code = main(from_process=True)
     except KeyboardInterrupt:  # Ctrl-C while printing the error itself
         sys.stderr.write("error: interrupted\n")
         code = EXIT_INTERRUPTED

@@ -39,6 +39,7 @@ from feederkit.catalog import (
 from feederkit.cell import annotate_cycle_time, cycle_time_text
 from feederkit.cli.catalog_analyze import add_pair_column, pair_cell
 from feederkit.cli.common import (
+    COMMAND_START,
     DEFAULT_TIME_LIMIT_S,
     DONE_WORK,
     FLAG_TERMS,
@@ -431,7 +432,7 @@ def compile_command(
     (the plan is still written and stored), or when an accepted and a rejected landing
     cannot be.
     """
-    started = time.monotonic()  # --time-limit bounds the plan, then the report's design
+    started = COMMAND_START.started()  # --time-limit bounds the plan, then the report's design
     members, shares = parse_mix_shares(mix)
     check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)

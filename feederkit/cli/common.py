@@ -12,6 +12,7 @@ import json
 import os
 import re
 import sys
+import time
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -98,6 +99,49 @@ class DoneWork:
 
 
 DONE_WORK = DoneWork()
+
+PROCESS_AGE_MAX_S = 30.0
+"""A process older than this when its command starts is not a console script just started
+(a test runs ``main`` in a long-lived process): its command starts when ``main`` is called."""
+
+
+def process_age_s() -> float | None:
+    """Seconds since this process began (Linux: its start in ``/proc/self/stat`` against
+    ``/proc/uptime``, to 10 ms), None where that is not known or not plausible."""
+    try:
+        with open("/proc/self/stat", encoding="ascii") as f:
+            fields = f.read().rsplit(")", 1)[1].split()  # the name may hold spaces
+        with open("/proc/uptime", encoding="ascii") as f:
+            uptime = float(f.read().split()[0])
+        age = uptime - int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22: starttime
+    except (OSError, ValueError, IndexError):
+        return None
+    return age if 0.0 <= age <= PROCESS_AGE_MAX_S else None
+
+
+class CommandStart:
+    """When this run's command began, the start ``--time-limit`` counts from: the process's
+    own start when run as the console script (Python's start and the imports, about a second,
+    are part of what a user times), else when ``main`` was called."""
+
+    def __init__(self) -> None:
+        self.at: float | None = None
+
+    def mark(self, from_process: bool) -> None:
+        """Start the clock now, or at the process's start when ``from_process`` and known."""
+        age = process_age_s() if from_process else None
+        self.at = time.monotonic() - (age or 0.0)
+
+    def reset(self) -> None:
+        """Forget the mark: the run is over (a command called without ``main`` starts now)."""
+        self.at = None
+
+    def started(self) -> float:
+        """The ``time.monotonic()`` of the command's start (now when not marked)."""
+        return time.monotonic() if self.at is None else self.at
+
+
+COMMAND_START = CommandStart()
 
 
 def _note_json(value: bool) -> bool:

@@ -12,7 +12,6 @@ and the warnings (a margin below 1 degree, a time limit reached).
 from __future__ import annotations
 
 import sys
-import time
 from typing import Annotated, Any
 
 import typer
@@ -21,6 +20,7 @@ from rich.markup import escape
 from feederkit.catalog import DeclaredTolerances
 from feederkit.cell import annotate_cycle_time
 from feederkit.cli.common import (
+    COMMAND_START,
     DEFAULT_TIME_LIMIT_S,
     FLAG_TERMS,
     JSON_ANSWER,
@@ -229,7 +229,7 @@ def plan_command(
     parts' catalog revisions store. Exit 1 when some parts of a mix, or some landings, cannot
     be told apart (the plan is still written) or an accepted and a rejected landing cannot be.
     """
-    started = time.monotonic()  # --time-limit counts reading the parts too
+    started = COMMAND_START.started()  # --time-limit counts reading the parts too
     terms = (*FLAG_TERMS, *LANDING_TERMS)
     check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
