@@ -386,7 +386,14 @@ def main(argv: list[str] | None = None, *, from_process: bool = False) -> int:
     JSON_ANSWER.reset()
     DONE_WORK.reset()
     COMMAND_START.mark(from_process)
-    args = sys.argv[1:] if argv is None else list(argv)
+    try:
+        return _main(sys.argv[1:] if argv is None else list(argv))
+    finally:
+        COMMAND_START.reset()
+
+
+def _main(args: list[str]) -> int:
+    """:func:`main` once its run's state is set."""
     with _CtrlCWatch() as ctrl_c, _guarded_stdout():
         try:
             code = _run_app(args)
@@ -404,7 +411,6 @@ def main(argv: list[str] | None = None, *, from_process: bool = False) -> int:
             return EXIT_INTERRUPTED
         finally:
             set_busy_notifier(None)
-            COMMAND_START.reset()
 
 
 def _run_app(args: list[str]) -> int:

@@ -843,7 +843,7 @@ def report_command(
     from feederkit.design.limit import check_limits
     from feederkit.design.sensor import REPORT_DESIGN_LIMIT_S
 
-    started = time.monotonic()
+    started = COMMAND_START.started()  # --time-limit bounds the report's design
     with flag_words():
         design_limit, _ = check_limits(time_limit, None)  # InputError before any work
     check_report_name(output)  # a .txt or .pdf would hold HTML: refused before any work

@@ -100,20 +100,23 @@ class DoneWork:
 
 DONE_WORK = DoneWork()
 
-PROCESS_AGE_MAX_S = 30.0
-"""A process older than this when its command starts is not a console script just started
-(a test runs ``main`` in a long-lived process): its command starts when ``main`` is called."""
+PROCESS_AGE_MAX_S = 10.0
+"""A process older than this when its command starts is taken not to be a console script
+just started (Python's start and the imports take a second or two, more on a loaded
+machine): its command starts when ``main`` is called. The start is the process's creation,
+so a wrapper's own work before it ``exec``s feederkit counts too, up to this long."""
 
 
-def process_age_s() -> float | None:
-    """Seconds since this process began (Linux: its start in ``/proc/self/stat`` against
-    ``/proc/uptime``, to 10 ms), None where that is not known or not plausible."""
+def process_age_s(stat: str = "/proc/self/stat", uptime: str = "/proc/uptime") -> float | None:
+    """Seconds since this process began (Linux: its start time in ``stat``, in clock ticks
+    since boot, against ``uptime``; to 10 ms), None where that is not known or not plausible
+    (``PROCESS_AGE_MAX_S``)."""
     try:
-        with open("/proc/self/stat", encoding="ascii") as f:
-            fields = f.read().rsplit(")", 1)[1].split()  # the name may hold spaces
-        with open("/proc/uptime", encoding="ascii") as f:
-            uptime = float(f.read().split()[0])
-        age = uptime - int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22: starttime
+        with open(stat, "rb") as f:
+            fields = f.read().rsplit(b")", 1)[1].split()  # the name may hold spaces and ')'
+        with open(uptime, "rb") as f:
+            up = float(f.read().split()[0])
+        age = up - int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22: starttime
     except (OSError, ValueError, IndexError):
         return None
     return age if 0.0 <= age <= PROCESS_AGE_MAX_S else None

@@ -558,14 +558,24 @@ per call, which dominated writing a plan of tens of thousands of results."""
 
 
 def _one_line_encoder() -> Callable[[object], str]:
-    """``_ONE_LINE.encode``, or the C encoder it makes per call made once (the same text:
-    half the cost of writing a plan of a million values, each a call)."""
+    """``_ONE_LINE.encode``, or the C encoder it makes per call made once (the same text and
+    errors, a circular reference included: half the cost of writing a plan of a million
+    values, each a call)."""
     if c_make_encoder is None:  # a Python without the json accelerator
         return _ONE_LINE.encode
+    markers: dict[int, object] = {}  # the values being written, as the circular check keeps
     chunks = c_make_encoder(
-        None, _ONE_LINE.default, encode_basestring_ascii, None, ": ", ", ", False, False, False
+        markers, _ONE_LINE.default, encode_basestring_ascii, None, ": ", ", ", False, False, False
     )
-    return lambda value: "".join(chunks(value, 0))
+
+    def encode(value: object) -> str:
+        try:
+            return "".join(chunks(value, 0))
+        except BaseException:
+            markers.clear()  # an error leaves its values marked
+            raise
+
+    return encode
 
 
 _ENCODE = _one_line_encoder()
@@ -582,7 +592,7 @@ def _one_line(value: object) -> str | None:
     kind = type(value)
     if kind is float:
         if not math.isfinite(value):  # type: ignore[arg-type]
-            raise ValueError(f"Out of range float values are not JSON compliant: {value!r}")
+            return _ONE_LINE.encode(value)  # json's own ValueError
         return float.__repr__(value)  # type: ignore[arg-type]
     if kind is str:
         return encode_basestring_ascii(value)
@@ -604,7 +614,9 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
     """The plan file's text: indented JSON (short lists on one line), no NaN or infinity.
 
     Written with an explicit stack, so any depth the reader accepts can be written; each
-    value's one-line text is tried once, by its parent.
+    value's one-line text is tried once, by its parent, in order. With several values that
+    cannot be written, the error names the first an object's own values meet (an object's
+    own values before those of the objects inside it).
     """
     value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
     line = _one_line(value)
@@ -626,11 +638,11 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
         if isinstance(v, dict):
             push("\n" + "  " * indent + "}")
             sep = ""
-            for key, child in reversed(v.items()):
+            lines = [_one_line(child) for child in v.values()]
+            for (key, child), line in zip(reversed(v.items()), reversed(lines), strict=True):
                 text = keys.get(key)
                 if text is None:
                     text = keys[key] = f"{json.dumps(key)}: "
-                line = _one_line(child)
                 if line is None:
                     push(sep)
                     push((child, indent + 1))
@@ -643,8 +655,8 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
             assert isinstance(v, list | tuple)
             push("\n" + "  " * indent + "]")
             sep = ""
-            for child in reversed(v):
-                line = _one_line(child)
+            lines = [_one_line(child) for child in v]
+            for child, line in zip(reversed(v), reversed(lines), strict=True):
                 if line is None:
                     push(sep)
                     push((child, indent + 1))

@@ -55,7 +55,8 @@ POST_S_STRONG_PER_PAIR = 2.7e-5
 (``verify_strong``) walks each (node, state) pair once with its outcome sets memoised per
 rotation: measured 1.95-2.7e-5 s on a 50-part mix's plan at 5 % (857,000 pairs, on two days),
 2.9e-5 s on a 20-part mix's over both landings (283,000) and 3.1e-5 s on a 50-part mix's at
-3 % (111,000, whose fixed costs weigh more: the reserve covers them). At 4e-5 the 50-part
+3 % (111,000, whose fixed costs weigh more: the certificate's reserve covers them; a caller
+that does not certify, with no reserve, may end a fraction of a second late). At 4e-5 the 50-part
 mix's first plan, found at 29 s of 60, was dropped as too slow to verify ("no plan found"
 at 47 s); at 3e-5 it was kept in some runs and dropped in others once the limit counted
 Python's start too."""
