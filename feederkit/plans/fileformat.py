@@ -614,9 +614,9 @@ def plan_json(plan: Plan | Mapping[str, Any]) -> str:
     """The plan file's text: indented JSON (short lists on one line), no NaN or infinity.
 
     Written with an explicit stack, so any depth the reader accepts can be written; each
-    value's one-line text is tried once, by its parent, in order. With several values that
-    cannot be written, the error names the first an object's own values meet (an object's
-    own values before those of the objects inside it).
+    value's one-line text is tried once, by its parent, in order. Of several values that
+    cannot be written, the error is about the first of an object's own values, before any
+    inside the objects it holds.
     """
     value = plan_to_dict(plan) if isinstance(plan, Plan) else plan
     line = _one_line(value)
