@@ -232,6 +232,7 @@ def fallback(
     first = None
     if blind is None and budget.end is not None:
         first = budget.ending(max(beam_end, budget.end - FIRST_PLAN_RESERVE * reserve))
+    unbuilt: int | None = None  # the length of the shortest plan found but never built
     beamed = beam_plan(
         problem,
         roots,
@@ -255,8 +256,8 @@ def fallback(
             # much as building it: they stop WALK_SHARE of that before the limit, when more
             # than the reserve's half.
             gap = max(gap, WALK_SHARE * (time.perf_counter() - built))
-        except Timeout:
-            pass  # the plan in hand, if any, stays
+        except Timeout:  # the plan in hand, if any, stays
+            unbuilt = best + 1  # the first alignment besides the root's rotations
         held.hold(blind)
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
@@ -328,14 +329,23 @@ def fallback(
             held.hold(root)
         except Timeout as exc:
             last = exc.reason
+            unbuilt = min(unbuilt or found + 1, found + 1)
     if root is None:
         if blind is not None:
             return blind, False, None, lower, TIES_NONE, None
         reason = last if last == "memory" else stop
         which = "one that tells every pair of states apart" if apart else "a plan"
+        # A plan the searches found whose tree or its verification did not fit: more time
+        # would give it.
+        seen = (
+            ""
+            if unbuilt is None
+            else f"; one of {plural(unbuilt, 'operation')} was found, but not built and verified "
+            "in time"
+        )
         raise OutOfBudget(
             f"no plan found within {out_of_budget(options, reason)} "
-            f"({which} needs at least {plural(lower, 'operation')})",
+            f"({which} needs at least {plural(lower, 'operation')}{seen})",
             reason,
         )
     return root, False, None, lower, TIES_NONE, None
