@@ -215,8 +215,9 @@ TimeLimitOpt = Annotated[
         "--time-limit",
         metavar="S",
         help=(
-            "Seconds for the plan, its verification and its file (a --report is drawn after);"
-            " then the best plan found (optimal: false) and a proven lower bound."
+            "Seconds, from the command's start, for the plan, its verification and its file (a"
+            " --report is drawn after); then the best plan found (optimal: false) and a proven"
+            " lower bound."
         ),
     ),
 ]

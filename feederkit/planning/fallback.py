@@ -329,7 +329,7 @@ def fallback(
             held.hold(root)
         except Timeout as exc:
             last = exc.reason
-            unbuilt = min(unbuilt or found + 1, found + 1)
+            unbuilt = found + 1  # shorter than the beams' plan: the search looks below it
     if root is None:
         if blind is not None:
             return blind, False, None, lower, TIES_NONE, None

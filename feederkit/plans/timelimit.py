@@ -44,9 +44,10 @@ node) of the work after the planner: the file, its verification (``check_plan``,
 per start, outcome and reading) and the command's output. The planner's deadline comes this
 much earlier per pair of the nodes it makes (``Deadline.per_pair_s``), so a large plan leaves
 time for its own verification and file. Measured 3.2e-5 s on a 1000-point outline's plan
-over both landings (265,000 pairs in 8.5 s) and 4.1-5.5e-5 s on a 200-part mix's at 1 %
-(203,000 pairs; ``python benchmarks/bench_command_deadline.py``), the high end covered by the
-certificate's reserve (``Deadline.reserve_s``). Measured idle, so scaled by the planner's
+over both landings (265,000 pairs in 8.5 s; ``python benchmarks/bench_command_deadline.py``)
+and, traced in process, 4.1e-5 s on a 200-part mix's at 1 % (203,000 pairs; 5.5e-5 s before
+the plan file's writer and reader were sped up), the high end covered by the certificate's
+reserve (``Deadline.reserve_s``). Measured idle, so scaled by the planner's
 budget's slowness (``Deadline.slowness``: wall over CPU seconds since it began) on a loaded
 machine."""
 
@@ -58,8 +59,8 @@ rotation: measured 1.95-2.7e-5 s on a 50-part mix's plan at 5 % (857,000 pairs, 
 3 % (111,000, whose fixed costs weigh more: the certificate's reserve covers them; a caller
 that does not certify, with no reserve, may end a fraction of a second late). At 4e-5 the 50-part
 mix's first plan, found at 29 s of 60, was dropped as too slow to verify ("no plan found"
-at 47 s); at 3e-5 it was kept in some runs and dropped in others once the limit counted
-Python's start too."""
+at 47 s); at 3e-5 it was kept in two runs, then dropped again in the one run after the limit
+counted Python's start too."""
 
 OUTPUT_S_PER_NODE = 7e-5
 """Seconds per node of the plan file (each shared step once, each result in place) of what
