@@ -50,6 +50,8 @@ CASES: dict[str, tuple[str, float, tuple[str, ...]]] = {
         ("--rotation-error", "0"),
     ),
     "random 200-point outline, 1%": ("[random_outline(200, 4)]", 1.0, ()),
+    # Both landings of a near-round part whose diameters read alike: a sensorless problem.
+    "near-round 64-gon 1%, 3%, ideal": ("[near_round(64, 0.01)]", 3.0, ("--rotation-error", "0")),
 }
 
 
@@ -73,6 +75,16 @@ def random_outline(n: int, seed: int) -> dict:
         f = 30.0 * rng.uniform(0.7, 1.0)
         pts.append([f * math.cos(t), f * math.sin(t)])
     return {"name": f"rand-{n}-{seed}", "units": "mm", "vertices": pts}
+
+
+def near_round(n: int, noise: float, seed: int = 0, r: float = 10.0) -> dict:
+    """bench_planners.near_round: a regular n-gon of radius r mm with radial noise."""
+    rng = random.Random(seed)
+    pts = []
+    for k in range(n):
+        a, f = 2 * math.pi * k / n, 1 + rng.uniform(-noise, noise)
+        pts.append([r * f * math.cos(a), r * f * math.sin(a)])
+    return {"name": f"round-{n}", "units": "mm", "vertices": pts}
 
 
 def size_of(outline: dict) -> float:

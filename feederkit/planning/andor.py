@@ -157,7 +157,8 @@ class WorstCase:
         shortest path to a goal (section 4): A* with :meth:`part_bound` as the heuristic,
         breadth-first search where it is 0. Sets on the path found are proven with their
         actions (``choice``, so a plan can be rebuilt); a set met at depth ``d`` of a search
-        of length ``L`` needs at least ``L - d``. Polls the deadline once per set expanded.
+        of length ``L`` needs at least ``L - d``. Polls the deadline once per set expanded;
+        when it runs out, the least f-value still open is recorded as the set's lower bound.
         """
         e = self.exact.get(mask)
         if e is not None:
@@ -177,15 +178,24 @@ class WorstCase:
         done: set[int] = set()
         found = None
         depth = 0
+        reached = 0  # the least f-value still open: a lower bound on the length
         while heap:
-            _f, neg, cur = heapq.heappop(heap)
+            f, neg, cur = heapq.heappop(heap)
             if cur in done:
                 continue
             if self.p.is_goal(cur):
                 found, depth = cur, -neg
                 break
             done.add(cur)
-            self.deadline.check()
+            reached = max(reached, f)
+            try:
+                self.deadline.check()
+            except Timeout:
+                # The heuristic is consistent, so a set on a shortest path is open with its
+                # least f-value, which is at most the length: what the search proved.
+                if reached > self.lb.get(mask, 1):
+                    self.lb[mask] = reached
+                raise
             g = 1 - neg
             for cell in choices.cells(cur, useful):
                 img = cell[2]

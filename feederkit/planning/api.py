@@ -39,6 +39,7 @@ from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping, OutOfBudget, PlanningOptions, out_of_budget
 from feederkit.planning.problem import Problem
+from feederkit.planning.quiet import QuietWorst, chain_plan
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
@@ -522,6 +523,16 @@ def _plan(
                 problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
             )
         if chain is not None and tree_length(chain) == length:
+            return chain, True, length, length, TIES_CHAIN, None
+    if objective == "worst" and isinstance(worst, QuietWorst):
+        # The same with several parts: the shortest paths the length search found, one chain.
+        try:
+            chain = chain_plan(problem, worst, roots, root_branches, budget.ending(None))
+        except Timeout as exc:
+            return fallback(
+                problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
+            )
+        if tree_length(chain) == length:
             return chain, True, length, length, TIES_CHAIN, None
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline

@@ -27,6 +27,7 @@ from feederkit.planning.options import OutOfBudget, PlanningOptions, out_of_budg
 from feederkit.planning.pairwise import applies as pairwise_applies
 from feederkit.planning.pairwise import pairwise_plan
 from feederkit.planning.problem import Problem
+from feederkit.planning.quiet import QuietWorst, chain_plan, widening_chains
 from feederkit.planning.sensorless import Backchain, BackchainWorst, push_circle
 from feederkit.planning.sequential import sequential_plan
 from feederkit.planning.solvable import no_strong_plan, unsolvable_by_pairs
@@ -74,6 +75,11 @@ building time before the limit (when more than half the tree reserve): the resul
 statistics and renumbering walk that tree once more after them (the 50-part mix at 3 %
 under 1 degree: the answer 2.6-4.5 s past a 60 s limit without this; 1.5 left the 20-part
 mix at 5 % under 10 s no time for the subsets' bound)."""
+
+QUIET_SHARE = 0.8
+"""With readings that carry nothing on several parts (:mod:`~feederkit.planning.quiet`), the
+share of what is left that its widening beams over sets may take (the AND/OR beams are not
+run: every reading set they would open needs as many operations as its image)."""
 
 PAIRWISE_SHARE = 0.7
 """With a time limit and no plan in hand, the share of what is left that the plan telling
@@ -181,6 +187,23 @@ def fallback(
             blind = None
     held = _Held(budget)  # the plan in hand's verification comes out of the time left
     held.hold(blind)
+    quiet = stop != "memory" and isinstance(worst, QuietWorst)
+    if quiet:
+        # Readings that carry nothing on several parts: the widening beams over sets, within
+        # QUIET_SHARE of what is left (feederkit.planning.quiet).
+        rest = budget.remaining()
+        share = budget if rest is None else budget.ending(budget.end - rest * (1 - QUIET_SHARE))
+        quick = None
+        if widening_chains(worst, roots, share) is not None:
+            try:
+                quick = chain_plan(
+                    problem, worst, roots, root_branches, held.building(budget, blind)
+                )
+            except Timeout:
+                quick = None
+        if quick is not None and (blind is None or tree_length(quick) < tree_length(blind)):
+            blind = quick
+            held.hold(blind)
     # The exact search proved every root's length and only the tree ran out (the tie-breaks
     # or the tree of the margin probes): the proof's choices are a plan of the proven length,
     # which the beams below follow at once (a 200-part mix at 1 % on the ideal model, its
@@ -205,8 +228,8 @@ def fallback(
         if told is not None and tree_length(told) <= FALLBACK_MAX_OPERATIONS:
             blind = told
             held.hold(blind)
-    anytime = WorstCase(problem, budget)
-    if stop != "memory" and type(worst) is WorstCase:
+    anytime = QuietWorst(problem, budget) if quiet else WorstCase(problem, budget)
+    if stop != "memory" and type(worst) in (WorstCase, QuietWorst):
         # What the exact search proved stays true (its exact lengths are left out: they
         # may come without the action that proves them).
         anytime.lb.update(worst.lb)
@@ -233,15 +256,19 @@ def fallback(
     if blind is None and budget.end is not None:
         first = budget.ending(max(beam_end, budget.end - FIRST_PLAN_RESERVE * reserve))
     unbuilt: int | None = None  # the length of the shortest plan found but never built
-    beamed = beam_plan(
-        problem,
-        roots,
-        seed,
-        budget.ending(beam_end),
-        cap,
-        lower - 1,
-        first,
-        in_hand=blind is not None,
+    beamed = (
+        None
+        if quiet
+        else beam_plan(
+            problem,
+            roots,
+            seed,
+            budget.ending(beam_end),
+            cap,
+            lower - 1,
+            first,
+            in_hand=blind is not None,
+        )
     )
     if beamed is not None:
         search, best = beamed
@@ -316,6 +343,8 @@ def fallback(
             last = exc.reason
             if last == "memory":
                 break
+    if quiet:  # A* at the bound records the least f-value it reached: a bound too
+        lower = max(lower, 1 + max((_proven(anytime, r) for r in roots), default=0))
     root = None
     if found is not None:
         # The shorter plan replaces the one in hand, which stays held until it does.
@@ -323,9 +352,11 @@ def fallback(
             tree_budget = budget.ending(budget.end - gap)
         anytime.deadline = tree_budget
         try:
-            root = _choice_plan(
-                problem, anytime.choice, roots, root_branches, held.building(tree_budget, blind)
-            )
+            building = held.building(tree_budget, blind)
+            if quiet:  # its choices are images' (one chain), not reading sets'
+                root = chain_plan(problem, anytime, roots, root_branches, building)
+            else:
+                root = _choice_plan(problem, anytime.choice, roots, root_branches, building)
             held.hold(root)
         except Timeout as exc:
             last = exc.reason

@@ -5,8 +5,9 @@
 - ``bfs``: breadth-first search over sets, sensorless (section 4);
 - ``backchain``: Goldberg's backchaining, sensorless one-part push machines (section 4);
 - ``auto``: backchaining where it applies (one part, no margin floor, the ideal model, and
-  sensorless or with readings that carry no information: :func:`readings_carry_nothing`),
-  else AND/OR search.
+  sensorless or with readings that carry no information: :func:`readings_carry_nothing`);
+  with several parts and such readings, A* over sets (:mod:`feederkit.planning.quiet`,
+  the plan's length only); else AND/OR search.
 
 Under uncertainty (outcome sets) every method but backchaining searches sets of states with
 the union image and the bisimulation goal, so each finds the minimum worst-case length of a
@@ -22,6 +23,7 @@ from feederkit.machine import Grouping, search_space
 from feederkit.planning.andor import Deadline, WorstCase
 from feederkit.planning.bottomup import bottom_up_lengths
 from feederkit.planning.problem import Problem
+from feederkit.planning.quiet import QuietWorst
 from feederkit.planning.sensorless import Backchain, BackchainWorst, bfs_length, push_circle
 
 
@@ -61,7 +63,10 @@ def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
     """The worst-case length oracle for ``method`` (backchaining when it applies)."""
     if method in ("auto", "backchain"):
         circle = None
-        if problem.min_margin == 0.0 and (problem.sensorless or readings_carry_nothing(problem)):
+        quiet = problem.min_margin == 0.0 and (
+            problem.sensorless or readings_carry_nothing(problem)
+        )
+        if quiet:
             circle = push_circle(problem.machine, problem.insep)
         if circle is not None:
             return BackchainWorst(problem, Backchain(circle), deadline)
@@ -69,6 +74,15 @@ def make_oracle(problem: Problem, method: str, deadline: Deadline) -> WorstCase:
             raise InputError(
                 "backchaining needs a sensorless one-part push machine and no margin floor"
             )
+        if (
+            quiet
+            and not problem.sensorless
+            and problem.machine.deterministic
+            and not problem.distinct_maps
+        ):
+            # Several parts, readings that carry nothing: every set's length is its
+            # sensorless length (feederkit.planning.quiet).
+            return QuietWorst(problem, deadline)
     return WorstCase(problem, deadline)
 
 

@@ -180,8 +180,10 @@ TIES_MARGIN = "margin"
 TIES_NONE = "none"
 """``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
 TIES_CHAIN = "backchain"
-"""``tie_breaks``: the backchaining plan of a set whose readings carry nothing (its
-rotations the widest that shorten the set; no tie-break searched, none cut short)."""
+"""``tie_breaks``: the sensorless chain of a set whose readings carry nothing (Goldberg's
+backchaining with one part, its rotations the widest that shorten the set; a shortest path
+over sets with several, :mod:`~feederkit.planning.quiet`): no tie-break searched, none cut
+short."""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,151 @@
+"""Readings that carry nothing on several parts (``feederkit.planning.quiet``): the lengths
+agree with the tests' own brute-force search over reading branches, every plan made is a
+plan (run from every start and every reading by the executor of test_planners), a beam
+is never shorter than the length and exact when no level was cut, a search cut short records a bound
+no greater than the length, and the time-limited plan of both landings of a near-round part
+is a plan above that bound."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from shared import brute_lengths, small_mix
+from test_planners import check_plan
+from test_strong_plans import random_pf
+
+from feederkit.landing.model import landings_of_outline
+from feederkit.machine import build_machine
+from feederkit.mechanics import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning.api import _result, plan
+from feederkit.planning.budget import Deadline, Timeout, WorkBudget
+from feederkit.planning.methods import make_oracle
+from feederkit.planning.options import PlanningOptions
+from feederkit.planning.problem import Problem, maximal_sets
+from feederkit.planning.quiet import QuietWorst, beam_chain, chain_plan, widening_chains
+from feederkit.planning.stats import tree_length
+from feederkit.planning.tree import TIES_CHAIN
+from feederkit.sensors import ToleranceSensor
+from feederkit.uncertainty import IDEAL
+
+
+def _coarse(pfs):
+    """The machine of ``pfs`` under a sensor whose one reading fits every diameter, and the
+    tolerance (each state's diameter read within it)."""
+    ds = [s.diameter for s in build_machine(pfs, ToleranceSensor(0.05), IDEAL).states]
+    tol = (max(ds) - min(ds)) / 2.0 + 0.01
+    return build_machine(pfs, ToleranceSensor(tol), IDEAL), tol
+
+
+def _cases():
+    for count, seed in ((2, 100), (2, 200), (3, 300), (4, 200)):
+        yield f"mix{count}-{seed}", small_mix(count, seed)
+    for seed in (8, 9, 15, 28):  # both landings, each state with one exact diameter
+        yield (
+            f"landings-{seed}",
+            [push_function(x.part) for x in landings_of_outline(random_pf(seed).part)],
+        )
+
+
+CASES = dict(_cases())
+
+
+def _roots(problem: Problem) -> tuple[list[int], tuple]:
+    branches = problem.readings.branches(problem.full)
+    return sorted(maximal_sets(sorted({b.mask for b in branches}))), branches
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_lengths_agree_with_the_brute_force_search_and_the_plan_is_a_chain(name):
+    machine, tol = _coarse(CASES[name])
+    assert all(s.diameter_range is None for s in machine.states)
+    assert isinstance(make_oracle(Problem(machine), "auto", Deadline()), QuietWorst)
+    length, _children = brute_lengths(machine, tol)
+    own = length(machine.all_states)
+    assert own is not None
+    result = plan(machine)
+    assert result.optimal and result.length == 1 + own
+    assert result.tie_breaks == TIES_CHAIN
+    assert check_plan(result) == result.length
+
+
+@pytest.mark.parametrize("width", [1, 4, 10_000])
+@pytest.mark.parametrize("name", CASES)
+def test_a_beam_finds_a_plan_no_shorter_than_the_length_and_the_length_uncut(name, width):
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    worst = QuietWorst(problem)
+    for r in roots:
+        k, cut = beam_chain(worst, r, width, Deadline())
+        assert k is not None and k >= exact(r)
+        assert cut or k == exact(r)
+        if width == 10_000:
+            assert not cut
+    root = chain_plan(problem, worst, roots, branches, Deadline())
+    result = _result(machine, root, False, None, 1, "worst", "none")
+    assert check_plan(result) == result.length == tree_length(root)
+    assert result.length >= 1 + max(exact(r) for r in roots)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_widening_beams_end_at_the_length_and_their_plan_is_a_plan(name):
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    worst = QuietWorst(problem)
+    assert widening_chains(worst, roots, Deadline()) == max(exact(r) for r in roots)
+    result = _result(
+        machine,
+        chain_plan(problem, worst, roots, branches, Deadline()),
+        False,
+        None,
+        1,
+        "worst",
+        "none",
+    )
+    assert check_plan(result) == result.length == 1 + max(exact(r) for r in roots)
+
+
+@pytest.mark.parametrize("polls", [1, 3, 10])
+@pytest.mark.parametrize("name", CASES)
+def test_a_search_cut_short_records_a_bound_no_greater_than_the_length(name, polls):
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    (root,), _branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    worst = QuietWorst(problem, WorkBudget(Deadline(), polls))
+    try:
+        assert worst.length(root) == exact(root)
+    except Timeout:
+        assert worst.part_bound(root) <= worst.lb[root] <= exact(root)
+
+
+def _near_round_both_landings(tolerance_pct: float):
+    """Both landings of a 64-gon with 1 % radial noise: its diameters read alike at 3 %."""
+    pts = []
+    for k in range(64):
+        a, f = 2 * math.pi * k / 64, 1 + 0.01 * math.sin(7.3 * k * k + 1.1)
+        pts.append((10 * f * math.cos(a), 10 * f * math.sin(a)))
+    part = make_part(make_outline("round-64", pts))
+    pfs = [push_function(x.part) for x in landings_of_outline(part)]
+    size = max(pf.part.size for pf in pfs)
+    return build_machine(pfs, ToleranceSensor(tolerance_pct / 100.0 * size), IDEAL)
+
+
+@pytest.mark.slow
+def test_a_time_limited_plan_of_both_landings_is_a_plan_above_the_parts_bound():
+    machine = _near_round_both_landings(3.0)
+    problem = Problem(machine)
+    worst = make_oracle(problem, "auto", Deadline())
+    assert isinstance(worst, QuietWorst)
+    (root,), _branches = _roots(problem)
+    result = plan(machine, PlanningOptions(time_limit_s=4.0))
+    assert not result.optimal
+    # Each part's backchaining length bounds the set's (the readings carry nothing).
+    assert result.lower_bound >= 1 + worst.part_bound(root)
+    assert result.lower_bound < result.length == check_plan(result)
