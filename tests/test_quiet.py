@@ -71,6 +71,17 @@ def test_lengths_agree_with_the_brute_force_search_and_the_plan_is_a_chain(name)
     assert check_plan(result) == result.length
 
 
+@pytest.mark.parametrize("name", CASES)
+def test_within_answers_as_the_brute_force_search(name):
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, _branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    for k in range(7):
+        worst = QuietWorst(problem)
+        assert [worst.within(r, k) for r in roots] == [exact(r) <= k for r in roots]
+
+
 @pytest.mark.parametrize("width", [1, 4, 10_000])
 @pytest.mark.parametrize("name", CASES)
 def test_a_beam_finds_a_plan_no_shorter_than_the_length_and_the_length_uncut(name, width):

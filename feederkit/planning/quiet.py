@@ -87,6 +87,16 @@ class QuietWorst(WorstCase):
         out = self._lengths[mask] = (big, total)
         return out
 
+    def _known(self, mask: int, k: int) -> bool | None:
+        """As :meth:`WorstCase._known`, refuting a set whose part bound exceeds ``k``
+        before any search (A* itself has no budget of operations)."""
+        if k > 0 and mask not in self.exact and not self.p.is_goal(mask):
+            bound = self.part_bound(mask)
+            if bound > k:
+                self.lb[mask] = max(self.lb.get(mask, 1), bound)
+                return False
+        return super()._known(mask, k)
+
     def part_bound(self, mask: int) -> int:
         """:meth:`WorstCase.part_bound` from the memoised :meth:`part_lengths` (A*'s
         heuristic)."""
