@@ -2,6 +2,7 @@
 
     python benchmarks/bench_planners.py           # everything (a few minutes: the baseline)
     python benchmarks/bench_planners.py --quick   # skip the slowest baseline runs
+    python benchmarks/bench_planners.py "12-gon"  # the cases whose name holds "12-gon"
 
 For each case: the time of ``feederkit.planning.plan`` (proven optimal, default options),
 split into the length proof (everything but the tie-breaking stages) and the tie-breaking
@@ -23,7 +24,9 @@ which the plain search of section 6.1 also assumes; under the default 1 degree r
 error the random parts have no strong plan. The last case is a mix whose readings carry no
 information once they name the part (a triangle and both landings of an off-centre
 octagon, all octagon states reading one diameter): the planner solves that branch as a
-sensorless problem (docs/planning.md), the plain search takes minutes.
+sensorless problem (docs/planning.md), the plain search takes minutes. The very last is
+both landings of a near-round 12-gon under a sensor whose one reading fits every state:
+the planner's A* over sets (feederkit.planning.quiet) against a plain search that gives up.
 """
 
 from __future__ import annotations
@@ -264,15 +267,24 @@ def cases(quick: bool):
         yield name, m, target, not quick
     m = build_machine(triangle_and_octagon(), ToleranceSensor(0.01), IDEAL)
     yield f"triangle + octagon up/down, 0.01 mm [{m.n} states]", m, 2.0, not quick
+    # Both landings of a near-round part whose every diameter fits one reading: A* over sets
+    # (feederkit.planning.quiet); the plain search gives up.
+    pfs = [push_function(x.part) for x in landings_of_outline(near_round(12, 0.03, 3).part)]
+    m = build_machine(pfs, ToleranceSensor(2.0), IDEAL)
+    name = f"near-round 12-gon up/down, 2 mm [{m.n} states]"
+    yield name, m, 0.5, not quick
 
 
 def main(argv: list[str]) -> int:
     quick = "--quick" in argv
+    wanted = [a for a in argv if not a.startswith("--")]  # substrings of case names
     missed = 0
     head = ("case", "plan s", "cpu s", "proof", "ties", "target", "base s", "base cpu", "ratio",
             "proof x")  # fmt: skip
     print(f"{head[0]:58} " + " ".join(f"{h:>8}" for h in head[1:]) + "  len")
     for name, machine, target, with_baseline in cases(quick):
+        if wanted and not any(w in name for w in wanted):
+            continue
         repeats = 3 if target <= 0.5 else 1
         wall, cpu, ties, result = timed_plan(machine, repeats)
         assert result.optimal
@@ -297,7 +309,7 @@ def main(argv: list[str]) -> int:
             f"{base:>8} {base_cpu:>8} {ratio:>8} {proof_ratio:>8} {result.length:4d}{flag}",
             flush=True,
         )
-    for count, rel in ((20, 0.02), (50, 0.01)):
+    for count, rel in ((20, 0.02), (50, 0.01)) if not wanted else ():
         parts = mix(count)
         size = max(pf.part.size for pf in parts)
         m = build_machine(parts, ToleranceSensor(rel * size), IDEAL)
