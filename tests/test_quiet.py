@@ -8,6 +8,7 @@ is a plan above that bound."""
 from __future__ import annotations
 
 import math
+import random
 
 import pytest
 from shared import brute_lengths, small_mix
@@ -19,15 +20,18 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
+from feederkit.planning import fallback
+from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
-from feederkit.planning.methods import make_oracle
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem, maximal_sets
 from feederkit.planning.quiet import QuietWorst, beam_chain, chain_plan, widening_chains
+from feederkit.planning.sequential import sequential_plan
 from feederkit.planning.stats import tree_length
 from feederkit.planning.tree import TIES_CHAIN
-from feederkit.sensors import ToleranceSensor
+from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL
 
 
@@ -40,7 +44,8 @@ def _coarse(pfs):
 
 
 def _cases():
-    for count, seed in ((2, 100), (2, 200), (3, 300), (4, 200)):
+    # mix3-700's part bound (2) is below its length (3): A* itself must prove it.
+    for count, seed in ((2, 100), (2, 200), (3, 300), (4, 200), (3, 700)):
         yield f"mix{count}-{seed}", small_mix(count, seed)
     for seed in (8, 9, 15, 28):  # both landings, each state with one exact diameter
         yield (
@@ -80,6 +85,34 @@ def test_within_answers_as_the_brute_force_search(name):
     for k in range(7):
         worst = QuietWorst(problem)
         assert [worst.within(r, k) for r in roots] == [exact(r) <= k for r in roots]
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_every_subsets_length_agrees_with_the_brute_force_search(name):
+    machine, tol = _coarse(CASES[name])
+    exact, _children = brute_lengths(machine, tol)
+    rng = random.Random(name)
+    worst = QuietWorst(Problem(machine))
+    for _ in range(40):
+        mask = rng.randrange(1, 1 << machine.n)
+        own = exact(mask)
+        if own is not None:
+            assert worst.part_bound(mask) <= own
+            assert worst.length(mask) == own
+
+
+def test_the_oracle_is_a_quiet_one_only_where_every_length_is_sensorless():
+    machine, _tol = _coarse(CASES["mix3-700"])
+    deadline = Deadline()
+    assert isinstance(make_oracle(Problem(machine), "auto", deadline), QuietWorst)
+    for problem in (
+        Problem(machine, min_margin=0.5),  # margins: the AND/OR search's exact view
+        Problem(machine, distinct_maps=True),  # the expected objective's actions
+        Problem(build_machine(CASES["mix3-700"], NoSensor(), IDEAL)),  # no sensor at all
+        Problem(build_machine(CASES["mix3-700"], ToleranceSensor(0.05), IDEAL)),  # readings
+    ):
+        worst = make_oracle(problem, "auto", deadline)
+        assert type(worst) is WorstCase
 
 
 @pytest.mark.parametrize("width", [1, 4, 10_000])
@@ -160,3 +193,73 @@ def test_a_time_limited_plan_of_both_landings_is_a_plan_above_the_parts_bound():
     # Each part's backchaining length bounds the set's (the readings carry nothing).
     assert result.lower_bound >= 1 + worst.part_bound(root)
     assert result.lower_bound < result.length == check_plan(result)
+    # The beams over sets beat the parts' chains in turn (43 operations here).
+    chains = sequential_plan(problem, problem.readings.branches(problem.full), Deadline())
+    assert chains is not None and result.length < tree_length(chains)
+
+
+def test_a_search_cut_short_proves_more_than_the_parts_bound_where_it_can():
+    machine, tol = _coarse(CASES["mix3-700"])
+    problem = Problem(machine)
+    (root,), _branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    assert QuietWorst(problem).part_bound(root) < exact(root)
+    recorded = []
+    for polls in range(1, 8):
+        worst = QuietWorst(problem, WorkBudget(Deadline(), polls))
+        with pytest.raises(Timeout):
+            worst.length(root)
+        recorded.append(worst.lb[root])
+    assert max(recorded) == exact(root)
+    # And a search with a budget of operations stops as soon as the bound passes it.
+    worst = QuietWorst(problem)
+    assert not worst.within(root, exact(root) - 1)
+    assert worst.lb[root] == exact(root) and root not in worst.exact
+
+
+def _cut_short(name: str):
+    """The machine of a case, its problem, roots and branches, and a QuietWorst whose length
+    search ran out after one poll (as the fallback receives it)."""
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, branches = _roots(problem)
+    worst = QuietWorst(problem, WorkBudget(Deadline(), 1))
+    with pytest.raises(Timeout):
+        longest_root(problem, worst, roots, "auto")
+    return machine, tol, problem, roots, branches, worst
+
+
+def _never(*_args, **_kwargs):
+    raise AssertionError("the AND/OR beams over reading sets ran on a quiet machine")
+
+
+@pytest.mark.parametrize("stop", ["time", "memory"])
+@pytest.mark.parametrize("name", ["mix3-700", "landings-8"])
+def test_the_fallback_plans_by_sets_and_never_by_reading_sets(monkeypatch, name, stop):
+    machine, tol, problem, roots, branches, worst = _cut_short(name)
+    exact, _children = brute_lengths(machine, tol)
+    monkeypatch.setattr(fallback, "beam_plan", _never)
+    options = PlanningOptions(time_limit_s=20.0)
+    root, optimal, _length, lower, _ties, _cut = fallback.fallback(
+        problem, worst, roots, branches, Deadline(20.0), options, stop
+    )
+    result = _result(machine, root, optimal, None, lower, "worst", "none")
+    assert lower <= 1 + exact(roots[0]) <= result.length == check_plan(result)
+
+
+@pytest.mark.parametrize("name", ["mix3-700", "mix3-300", "landings-8"])
+def test_the_fallbacks_search_at_the_bound_makes_its_chain(monkeypatch, name):
+    # Every other plan out of the way: the A* at the bound finds the shortest, and its
+    # choices (images', copied from the cut search) make the chain.
+    machine, tol, problem, roots, branches, worst = _cut_short(name)
+    exact, _children = brute_lengths(machine, tol)
+    for plan_maker in ("widening_chains", "sequential_plan", "pairwise_plan", "sensorless_plan"):
+        monkeypatch.setattr(fallback, plan_maker, lambda *_a, **_k: None)
+    monkeypatch.setattr(fallback, "beam_plan", _never)
+    options = PlanningOptions(time_limit_s=20.0)
+    root, _optimal, _length, lower, _ties, _cut = fallback.fallback(
+        problem, worst, roots, branches, Deadline(20.0), options, "time"
+    )
+    result = _result(machine, root, False, None, lower, "worst", "none")
+    assert result.length == 1 + exact(roots[0]) == check_plan(result)
+    assert lower == result.length  # A* at the bound proved it too

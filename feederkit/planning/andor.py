@@ -110,7 +110,7 @@ class WorstCase:
         if mask in self.never:
             return False
         if self._quiet is not None and self._quiet(mask):
-            e = self.sensorless_length(mask)
+            e = self.sensorless_length(mask, k)
             return e is not None and e <= k
         pb = self.pair_bound(mask)
         if pb > k:
@@ -149,16 +149,18 @@ class WorstCase:
             self._pair_memo[mask] = v
         return v
 
-    def sensorless_length(self, mask: int) -> int | None:
+    def sensorless_length(self, mask: int, cap: int | None = None) -> int | None:
         """The length of a set no reading can split, by a shortest-path search over sets
-        (None: no plan orients it).
+        (None: no plan orients it); with ``cap``, ``cap + 1`` as soon as the length is known
+        to exceed ``cap``.
 
         Every action then has one branch, its image, so the minimum worst-case length is a
         shortest path to a goal (section 4): A* with :meth:`part_bound` as the heuristic,
         breadth-first search where it is 0. Sets on the path found are proven with their
         actions (``choice``, so a plan can be rebuilt); a set met at depth ``d`` of a search
-        of length ``L`` needs at least ``L - d``. Polls the deadline once per set expanded;
-        when it runs out, the least f-value still open is recorded as the set's lower bound.
+        of length ``L`` needs at least ``L - d``. Polls the deadline once per set expanded.
+        When the deadline passes or the least f-value still open exceeds ``cap``, that
+        value is recorded as the set's lower bound.
         """
         e = self.exact.get(mask)
         if e is not None:
@@ -187,14 +189,17 @@ class WorstCase:
                 found, depth = cur, -neg
                 break
             done.add(cur)
+            # The heuristic is consistent (a set no plan orients counts 0, but no shortest
+            # path passes through one), so a set on a shortest path is open with its least
+            # f-value, which is at most the length: what the search has proved.
             reached = max(reached, f)
+            if cap is not None and reached > cap:
+                self.lb[mask] = max(self.lb.get(mask, 1), reached)
+                return cap + 1
             try:
                 self.deadline.check()
             except Timeout:
-                # The heuristic is consistent, so a set on a shortest path is open with its
-                # least f-value, which is at most the length: what the search proved.
-                if reached > self.lb.get(mask, 1):
-                    self.lb[mask] = reached
+                self.lb[mask] = max(self.lb.get(mask, 1), reached)
                 raise
             g = 1 - neg
             for cell in choices.cells(cur, useful):

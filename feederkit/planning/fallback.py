@@ -4,7 +4,8 @@ The best of Goldberg's backchaining plan (one part), each part's chain in turn, 
 told apart one at a time (the ideal model), the widening beams and the AND/OR search again,
 with the lower bound the searches proved (the hardest subsets' among them), all within the
 rest of the plan's budget (docs/planning.md, "Time and memory limits"). Where the readings
-carry nothing, :func:`sensorless_plan` is also the exact search's shortest plan.
+carry nothing, :func:`sensorless_plan` is also the exact search's shortest plan; with
+several parts the beams and the search are over sets (:mod:`~feederkit.planning.quiet`).
 
 References
 ----------
@@ -135,7 +136,10 @@ def fallback(
     within ``READ_SHARE`` of what is left, when it is shorter); else, on the ideal model, the
     parts' chains in turn (:func:`~feederkit.planning.sequential.sequential_plan`, when the
     readings after them leave goals), else the plan that tells the states apart one pair at
-    a time (within ``PAIRWISE_SHARE``); the
+    a time (within ``PAIRWISE_SHARE``); where the readings carry nothing on several parts
+    (:class:`~feederkit.planning.quiet.QuietWorst`), the widening beams over sets instead
+    (:func:`~feederkit.planning.quiet.widening_chains`, within ``QUIET_SHARE``, their plan
+    a chain) and A* at the bound below; else the
     widening beams (:func:`~feederkit.planning.beam.beam_plan`, within ``BEAM_SHARE``, or
     ``FAR_BEAM_SHARE`` with a plan in hand more than ``FAR_GAP`` above the bound) for something
     shorter; with a plan in hand, the hardest subsets' bound
@@ -155,11 +159,17 @@ def fallback(
     if not options.fallback:
         raise NoFallback(options, stop)
     lower = 1 + max((_proven(worst, r) for r in roots), default=0)
+    # Readings that carry nothing on several parts (feederkit.planning.quiet): every search
+    # below is over images, and its plans are chains (chain_plan); the AND/OR searches over
+    # reading sets are not run (their choices are reading sets', which a chain cannot follow).
+    quiet = isinstance(worst, QuietWorst)
     if stop == "memory":
         # Let the exact search's tables go: the fallback starts from a fresh problem.
         problem = Problem(problem.machine, problem.grouping, problem.min_margin, problem.insep)
         del worst
         gc.collect()
+        if quiet:
+            worst = QuietWorst(problem, budget)
     # Each plan below is built under a copy of the budget (its nodes' verification
     # committed there while it is built) and held, once made, by ``held`` on the budget.
     try:  # the backchaining plan itself first: one chain, one step per operation
@@ -187,23 +197,20 @@ def fallback(
             blind = None
     held = _Held(budget)  # the plan in hand's verification comes out of the time left
     held.hold(blind)
-    quiet = stop != "memory" and isinstance(worst, QuietWorst)
-    if quiet:
-        # Readings that carry nothing on several parts: the widening beams over sets, within
-        # QUIET_SHARE of what is left (feederkit.planning.quiet).
+    unbuilt: int | None = None  # the length of the shortest plan found but never built
+    if quiet and (blind is None or tree_length(blind) > lower):
+        # The widening beams over sets, within QUIET_SHARE of what is left.
         rest = budget.remaining()
         share = budget if rest is None else budget.ending(budget.end - rest * (1 - QUIET_SHARE))
-        quick = None
-        if widening_chains(worst, roots, share) is not None:
+        longest = widening_chains(worst, roots, share)
+        if longest is not None and (blind is None or longest + 1 < tree_length(blind)):
             try:
-                quick = chain_plan(
+                blind = chain_plan(
                     problem, worst, roots, root_branches, held.building(budget, blind)
                 )
-            except Timeout:
-                quick = None
-        if quick is not None and (blind is None or tree_length(quick) < tree_length(blind)):
-            blind = quick
-            held.hold(blind)
+                held.hold(blind)
+            except Timeout:  # the plan in hand, if any, stays
+                unbuilt = longest + 1
     # The exact search proved every root's length and only the tree ran out (the tie-breaks
     # or the tree of the margin probes): the proof's choices are a plan of the proven length,
     # which the beams below follow at once (a 200-part mix at 1 % on the ideal model, its
@@ -255,7 +262,6 @@ def fallback(
     first = None
     if blind is None and budget.end is not None:
         first = budget.ending(max(beam_end, budget.end - FIRST_PLAN_RESERVE * reserve))
-    unbuilt: int | None = None  # the length of the shortest plan found but never built
     beamed = (
         None
         if quiet
