@@ -62,6 +62,16 @@ def _roots(problem: Problem) -> tuple[list[int], tuple]:
     return sorted(maximal_sets(sorted({b.mask for b in branches}))), branches
 
 
+def _case(name: str):
+    """A case's coarse machine, its problem, roots and root branches, and the tests' own
+    length of a set (brute force)."""
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    return machine, problem, roots, branches, exact
+
+
 @pytest.mark.parametrize("name", CASES)
 def test_lengths_agree_with_the_brute_force_search_and_the_plan_is_a_chain(name):
     machine, tol = _coarse(CASES[name])
@@ -78,10 +88,7 @@ def test_lengths_agree_with_the_brute_force_search_and_the_plan_is_a_chain(name)
 
 @pytest.mark.parametrize("name", CASES)
 def test_within_answers_as_the_brute_force_search(name):
-    machine, tol = _coarse(CASES[name])
-    problem = Problem(machine)
-    roots, _branches = _roots(problem)
-    exact, _children = brute_lengths(machine, tol)
+    _machine, problem, roots, _branches, exact = _case(name)
     for k in range(7):
         worst = QuietWorst(problem)
         assert [worst.within(r, k) for r in roots] == [exact(r) <= k for r in roots]
@@ -118,10 +125,7 @@ def test_the_oracle_is_a_quiet_one_only_where_every_length_is_sensorless():
 @pytest.mark.parametrize("width", [1, 4, 10_000])
 @pytest.mark.parametrize("name", CASES)
 def test_a_beam_finds_a_plan_no_shorter_than_the_length_and_the_length_uncut(name, width):
-    machine, tol = _coarse(CASES[name])
-    problem = Problem(machine)
-    roots, branches = _roots(problem)
-    exact, _children = brute_lengths(machine, tol)
+    machine, problem, roots, branches, exact = _case(name)
     worst = QuietWorst(problem)
     for r in roots:
         k, cut = beam_chain(worst, r, width, Deadline())
@@ -137,10 +141,7 @@ def test_a_beam_finds_a_plan_no_shorter_than_the_length_and_the_length_uncut(nam
 
 @pytest.mark.parametrize("name", CASES)
 def test_the_widening_beams_end_at_the_length_and_their_plan_is_a_plan(name):
-    machine, tol = _coarse(CASES[name])
-    problem = Problem(machine)
-    roots, branches = _roots(problem)
-    exact, _children = brute_lengths(machine, tol)
+    machine, problem, roots, branches, exact = _case(name)
     worst = QuietWorst(problem)
     assert widening_chains(worst, roots, Deadline()) == max(exact(r) for r in roots)
     result = _result(
