@@ -27,7 +27,14 @@ from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem, maximal_sets
-from feederkit.planning.quiet import QuietWorst, beam_chain, chain_plan, widening_chains
+from feederkit.planning.quiet import (
+    MARGIN_STEP_DEG,
+    QuietWorst,
+    beam_chain,
+    chain_plan,
+    widening_chains,
+    widest_chain,
+)
 from feederkit.planning.sequential import sequential_plan
 from feederkit.planning.stats import tree_length
 from feederkit.planning.tree import TIES_CHAIN
@@ -264,3 +271,36 @@ def test_the_fallbacks_search_at_the_bound_makes_its_chain(monkeypatch, name):
     result = _result(machine, root, False, None, lower, "worst", "none")
     assert result.length == 1 + exact(roots[0]) == check_plan(result)
     assert lower == result.length  # A* at the bound proved it too
+
+
+def _chain_max_min(problem: Problem, mask: int, k: int, memo: dict) -> float:
+    """The largest smallest margin of a chain of images from ``mask`` to a goal within
+    ``k``: every action (the tests' exhaustive recursion)."""
+    if problem.is_goal(mask):
+        return math.inf
+    if k <= 0:
+        return -math.inf
+    hit = memo.get((mask, k))
+    if hit is None:
+        hit = -math.inf
+        for act in problem.choices.exact_actions(mask):
+            v = min(act.action.margin, _chain_max_min(problem, act.action.image, k - 1, memo))
+            hit = max(hit, v)
+        memo[(mask, k)] = hit
+    return hit
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_widest_chain_keeps_the_largest_margin_within_the_step(name):
+    machine, problem, roots, _branches, exact = _case(name)
+    longest = max(exact(r) for r in roots)
+    memo: dict = {}
+    want = min(_chain_max_min(problem, r, longest, memo) for r in roots)
+    found = widest_chain(problem, roots, longest, 0.0, Deadline())
+    assert found is not None
+    search, kept = found
+    assert want - MARGIN_STEP_DEG <= kept <= want
+    # And the plan: its length proven, its smallest margin what the search kept.
+    result = plan(machine)
+    assert result.length == 1 + longest == check_plan(result)
+    assert result.min_margin >= want - MARGIN_STEP_DEG

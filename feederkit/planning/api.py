@@ -17,6 +17,7 @@ Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Callable
@@ -39,7 +40,7 @@ from feederkit.planning.margins import largest_margin
 from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.options import Lumping, OutOfBudget, PlanningOptions, out_of_budget
 from feederkit.planning.problem import Problem
-from feederkit.planning.quiet import QuietWorst, chain_plan
+from feederkit.planning.quiet import QuietWorst, chain_plan, widest_chain
 from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner, child_masses, stage, tie_floor
 from feederkit.planning.reindex import by_diameter, remap_tree, share_bisimilar
@@ -525,7 +526,8 @@ def _plan(
         if chain is not None and tree_length(chain) == length:
             return chain, True, length, length, TIES_CHAIN, None
     if objective == "worst" and isinstance(worst, QuietWorst):
-        # The same with several parts: the shortest paths the length search found, one chain.
+        # The same with several parts: the shortest paths the length search found, one chain,
+        # then the largest margin among such chains under the tie-breaking budget.
         try:
             chain = chain_plan(problem, worst, roots, root_branches, budget.ending(None))
         except Timeout as exc:
@@ -533,6 +535,15 @@ def _plan(
                 problem, worst, roots, root_branches, budget, options, exc.reason, apart, kept_known
             )
         if tree_length(chain) == length:
+            allowance = TIE_SHARE * exact_deadline.polls + TIE_GRACE_POLLS
+            floor = tree_min_margin(chain)
+            wider = widest_chain(
+                problem, roots, longest, floor, WorkBudget(exact_deadline, allowance)
+            )
+            if wider is not None and wider[1] > floor:
+                search = wider[0]
+                with contextlib.suppress(Timeout):  # else the first chain stays
+                    chain = chain_plan(search.p, search, roots, root_branches, budget.ending(None))
             return chain, True, length, length, TIES_CHAIN, None
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline

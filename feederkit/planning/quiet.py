@@ -18,6 +18,9 @@ A* with each part's backchaining length as its heuristic
   level, keeping the sets nearest a goal by the parts' backchaining lengths, each beam
   wider than the last; on that outline a plan of 27 operations (the first alignment
   included) after 17 s of beams, where the parts' chains in turn take 39;
+- :func:`widest_chain` breaks the ties among the shortest chains by their smallest margin:
+  "within the length with every margin at least ``m``?" is the same A* under a margin
+  floor, bisected over ``m``;
 - :func:`chain_plan` makes the plan of a path: one step per operation, every reading
   going on with the subplan of the step's whole image (a reading leaves a subset of it).
 
@@ -207,6 +210,55 @@ def widening_chains(worst: QuietWorst, roots, deadline: Deadline) -> int | None:
     if any(not worst.p.is_goal(r) and r not in best for r in roots):
         return None
     return max(best.values(), default=0)
+
+
+MARGIN_STEP_DEG = 0.01
+"""The margin bisection of :func:`widest_chain` stops when its interval is this narrow."""
+
+
+def widest_chain(
+    problem: Problem, roots, longest: int, floor: float, deadline: Deadline
+) -> tuple[QuietWorst, float] | None:
+    """A search whose choices hold chains of every root within ``longest`` operations that
+    keep a smallest margin above ``floor`` (deg), and that margin; None when none is found.
+
+    The margin is the plan's tie-break after the length (docs/planning.md, "Which plan among
+    the shortest"), decided as a feasibility question: "within ``longest`` with every
+    margin at least ``m``?" is A* over sets of the problem with that margin floor (its
+    heuristic stays consistent: a floor only takes actions away), bisected between the
+    largest margin found and one that failed, until the interval is ``MARGIN_STEP_DEG``
+    wide or ``deadline`` passes (the best found by then). A set's chain keeps the margin of
+    its own ranges for the reading sets that follow it (a subset's range holding the same
+    rotation is no narrower).
+    """
+    best: tuple[QuietWorst, float] | None = None
+    lo, hi = floor, 90.0  # a margin is the half of a range narrower than 180 degrees
+    with contextlib.suppress(Timeout):
+        while hi - lo > MARGIN_STEP_DEG:
+            mid = (lo + hi) / 2.0
+            search = QuietWorst(problem.with_margin(mid), deadline)
+            if all(search.within(r, longest) for r in roots):
+                kept = _chain_margin(search, roots)
+                best, lo = (search, kept), max(kept, mid)
+            else:
+                hi = mid
+    return best
+
+
+def _chain_margin(search: WorstCase, roots) -> float:
+    """The smallest margin of the actions on the chains ``search`` chose from ``roots``."""
+    out = 90.0
+    seen: set[int] = set()
+    todo = [r for r in roots if r in search.choice]
+    while todo:
+        mask = todo.pop()
+        if mask in seen or search.p.is_goal(mask):
+            continue
+        seen.add(mask)
+        act = search.choice[mask][1]
+        out = min(out, act.action.margin)
+        todo.append(act.action.image)
+    return out
 
 
 def chain_plan(

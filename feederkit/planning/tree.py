@@ -181,9 +181,9 @@ TIES_NONE = "none"
 """``tie_breaks``: no tie-break is proven (the margin is the best found in the budget)."""
 TIES_CHAIN = "backchain"
 """``tie_breaks``: the sensorless chain of a set whose readings carry nothing (Goldberg's
-backchaining with one part, its rotations the widest that shorten the set; a shortest path
-over sets with several, :mod:`~feederkit.planning.quiet`): no tie-break searched, none cut
-short."""
+backchaining with one part, its rotations the widest that shorten the set; with several, a
+shortest path over sets keeping the largest margin found by bisection,
+:func:`~feederkit.planning.quiet.widest_chain`): no expected-operations tie-break."""
 
 
 @dataclass(frozen=True)

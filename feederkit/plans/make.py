@@ -42,7 +42,7 @@ from feederkit.planning.lumping import lumped_words
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.planning.tree import Leaf as TreeLeaf
-from feederkit.planning.tree import PlanResult, PlanTree, leaf_masks, map_tree
+from feederkit.planning.tree import PlanResult, PlanTree, leaf_masks
 from feederkit.planning.tree import Step as TreeStep
 from feederkit.plans.advice import (
     SMALLER_ERROR_S,
@@ -319,32 +319,27 @@ def _entries(data: Mapping[str, Any]) -> int:
 
 
 def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
-    """The planner's tree with each leaf's mask cut to the states its results in the plan
-    file's object ``data`` (written from that tree, then pruned) still list: a state stays
-    when one of its ideal members is listed at one of the leaf's places."""
+    """The planner's tree with each leaf's mask cut to the states its result in the plan
+    file's object ``data`` (written from that tree, then pruned) still lists: a state stays
+    when one of its ideal members is listed there.
+
+    The tree is rebuilt as the file shares it: a leaf the planner shares between places whose
+    results were pruned apart (a chain's last reading set, also a root branch's) becomes one
+    leaf per place, and a subplan the file shares (its ``nodes`` table, pruned in place for
+    all its places) stays one object.
+    """
     machine = result.machine
     parts = [(part["name"], part.get("landing")) for part in data["parts"]]
-    shared = data.get("nodes") or {}
-    listed: dict[int, set[tuple[int, int]]] = {}  # tree leaf id: (part, ideal state) listed
     index = {key: p for p, key in enumerate(parts)}
-    seen: set[tuple[int, int]] = set()
-    stack: list[tuple[PlanTree, Any]] = [(result.root, data["root"])]
-    while stack:
-        node, raw = stack.pop()
+    shared = data.get("nodes") or {}
+
+    def resolve(raw: Any) -> Any:
         while "ref" in raw:
             raw = shared[raw["ref"]]
-        if (id(node), id(raw)) in seen:
-            continue
-        seen.add((id(node), id(raw)))
-        if isinstance(node, TreeLeaf):
-            names = listed.setdefault(id(node), set())
-            names.update((index[(e["part"], e.get("landing"))], e["state"]) for e in raw["result"])
-            continue
-        pairs = zip(node.branches, raw["branches"], strict=True)
-        stack.extend((child, b["next"]) for (_b, child), b in pairs)
+        return raw
 
-    def cut(leaf: TreeLeaf) -> TreeLeaf:
-        names = listed[id(leaf)]
+    def cut(leaf: TreeLeaf, raw: Any) -> TreeLeaf:
+        names = {(index[(e["part"], e.get("landing"))], e["state"]) for e in raw["result"]}
         mask = 0
         for i in members(leaf.mask):
             ms = machine.states[i]
@@ -352,7 +347,32 @@ def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
                 mask |= 1 << i
         return leaf if mask == leaf.mask else TreeLeaf(mask)
 
-    return _map_leaves(result.root, cut)
+    made: dict[tuple[int, int], PlanTree] = {}  # (tree node id, file node id): rebuilt
+    top = (result.root, resolve(data["root"]))
+    stack: list[tuple[PlanTree, Any, bool]] = [(*top, False)]
+    while stack:  # children before their parent, on an explicit stack (plans can be long)
+        node, raw, ready = stack.pop()
+        key = (id(node), id(raw))
+        if key in made:
+            continue
+        if isinstance(node, TreeLeaf):
+            made[key] = cut(node, raw)
+            continue
+        pairs = [
+            (child, resolve(b["next"]))
+            for (_b, child), b in zip(node.branches, raw["branches"], strict=True)
+        ]
+        if not ready:
+            stack.append((node, raw, True))
+            stack.extend((c, r, False) for c, r in pairs if (id(c), id(r)) not in made)
+            continue
+        subs = tuple(
+            (b, made[(id(c), id(r))])
+            for (b, _old), (c, r) in zip(node.branches, pairs, strict=True)
+        )
+        same = all(new is old for (_b, new), (_c, old) in zip(subs, node.branches, strict=True))
+        made[key] = node if same else TreeStep(node.action, subs)
+    return made[(id(top[0]), id(top[1]))]
 
 
 def listed_together(
@@ -367,17 +387,6 @@ def listed_together(
     """
     masks = leaf_masks(root)
     return tuple((i, j) for i, j in pairs if any(m >> i & 1 and m >> j & 1 for m in masks))
-
-
-def _map_leaves(root: PlanTree, leaf: Callable[[TreeLeaf], TreeLeaf]) -> PlanTree:
-    """The tree with every leaf replaced by ``leaf`` of it (shared subplans kept shared; a
-    step none of whose leaves changes is kept, :func:`~feederkit.planning.tree.map_tree`)."""
-
-    def step(n: TreeStep, subs: tuple) -> TreeStep:
-        same = all(new is old for (_b, new), (_c, old) in zip(subs, n.branches, strict=True))
-        return n if same else TreeStep(n.action, subs)
-
-    return map_tree(root, leaf, step)
 
 
 def _weighted_members(
