@@ -20,7 +20,7 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import fallback
+from feederkit.planning import api, fallback
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
@@ -37,7 +37,7 @@ from feederkit.planning.quiet import (
 )
 from feederkit.planning.sequential import sequential_plan
 from feederkit.planning.stats import tree_length
-from feederkit.planning.tree import TIES_CHAIN
+from feederkit.planning.tree import TIES_CHAIN, TIES_NONE
 from feederkit.sensors import NoSensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL
 
@@ -296,11 +296,26 @@ def test_the_widest_chain_keeps_the_largest_margin_within_the_step(name):
     longest = max(exact(r) for r in roots)
     memo: dict = {}
     want = min(_chain_max_min(problem, r, longest, memo) for r in roots)
-    found = widest_chain(problem, roots, longest, 0.0, Deadline())
-    assert found is not None
-    search, kept = found
-    assert want - MARGIN_STEP_DEG <= kept <= want
-    # And the plan: its length proven, its smallest margin what the search kept.
+    found = widest_chain(QuietWorst(problem), roots, longest, 0.0, Deadline())
+    assert found.search is not None and found.cut_by is None
+    assert want - MARGIN_STEP_DEG <= found.margin <= want
+    # And the plan: its length proven, its smallest margin the largest within the step
+    # (the chain the bisection kept, or the first path's when that was already as wide).
     result = plan(machine)
     assert result.length == 1 + longest == check_plan(result)
-    assert result.min_margin >= want - MARGIN_STEP_DEG
+    assert result.tie_breaks == TIES_CHAIN and result.ties_cut_by is None
+    assert want - MARGIN_STEP_DEG <= result.min_margin <= want
+
+
+def test_a_margin_bisection_cut_short_says_so_and_keeps_a_proven_plan(monkeypatch):
+    # mix3-300: the first shortest path keeps far less than the widest chain.
+    machine, problem, roots, _branches, exact = _case("mix3-300")
+    longest = max(exact(r) for r in roots)
+    want = min(_chain_max_min(problem, r, longest, {}) for r in roots)
+    first = plan(machine, PlanningOptions())
+    monkeypatch.setattr(api, "TIE_GRACE_POLLS", 0)
+    monkeypatch.setattr(api, "TIE_SHARE", 0.0)
+    cut = plan(machine)
+    assert cut.optimal and cut.length == first.length == check_plan(cut)
+    assert cut.tie_breaks == TIES_NONE and cut.ties_cut_by == "work"
+    assert cut.min_margin < want - MARGIN_STEP_DEG <= first.min_margin

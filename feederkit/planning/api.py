@@ -17,7 +17,6 @@ Goldberg, K. Y. (1993). Orienting polygonal parts without sensors. Algorithmica 
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
 from collections.abc import Callable
@@ -538,13 +537,18 @@ def _plan(
             allowance = TIE_SHARE * exact_deadline.polls + TIE_GRACE_POLLS
             floor = tree_min_margin(chain)
             wider = widest_chain(
-                problem, roots, longest, floor, WorkBudget(exact_deadline, allowance)
+                worst, roots, longest, floor, WorkBudget(exact_deadline, allowance)
             )
-            if wider is not None and wider[1] > floor:
-                search = wider[0]
-                with contextlib.suppress(Timeout):  # else the first chain stays
-                    chain = chain_plan(search.p, search, roots, root_branches, budget.ending(None))
-            return chain, True, length, length, TIES_CHAIN, None
+            cut = wider.cut_by
+            if wider.search is not None and wider.margin > floor:
+                try:
+                    chain = chain_plan(
+                        wider.search.p, wider.search, roots, root_branches, budget.ending(None)
+                    )
+                except Timeout as exc:  # the first chain stays
+                    cut = exc.reason
+            # Cut short, the margin is the best found, not proven the largest.
+            return chain, True, length, length, TIES_CHAIN if cut is None else TIES_NONE, cut
     children = _root_children(problem, root_branches, start_mass)
     ties_deadline = exact_deadline
     if objective == "worst":

@@ -37,6 +37,8 @@ determination of minimum cost paths. IEEE Transactions on Systems Science and Cy
 from __future__ import annotations
 
 import contextlib
+import math
+from dataclasses import dataclass
 
 from feederkit.planning.andor import WorstCase, part_chains
 from feederkit.planning.budget import Deadline, Timeout
@@ -99,6 +101,13 @@ class QuietWorst(WorstCase):
                 self.lb[mask] = max(self.lb.get(mask, 1), bound)
                 return False
         return super()._known(mask, k)
+
+    def share_heuristic(self, other: QuietWorst) -> None:
+        """Use ``other``'s tables of the parts' backchaining lengths (the same machine; a
+        margin floor does not change them)."""
+        if other._parts is None:
+            other.part_lengths(other.p.full)
+        self._parts, self._lengths = other._parts, other._lengths
 
     def part_bound(self, mask: int) -> int:
         """:meth:`WorstCase.part_bound` from the memoised :meth:`part_lengths` (A*'s
@@ -216,38 +225,65 @@ MARGIN_STEP_DEG = 0.01
 """The margin bisection of :func:`widest_chain` stops when its interval is this narrow."""
 
 
+@dataclass(frozen=True)
+class WidestChain:
+    """What :func:`widest_chain` found: a search whose choices hold the chains (None: none
+    found above the floor), their smallest margin (deg), and what cut the bisection short
+    (a Timeout's reason; None when it ran to ``MARGIN_STEP_DEG``)."""
+
+    search: QuietWorst | None
+    margin: float
+    cut_by: str | None
+
+
 def widest_chain(
-    problem: Problem, roots, longest: int, floor: float, deadline: Deadline
-) -> tuple[QuietWorst, float] | None:
-    """A search whose choices hold chains of every root within ``longest`` operations that
-    keep a smallest margin above ``floor`` (deg), and that margin; None when none is found.
+    worst: QuietWorst, roots, longest: int, floor: float, deadline: Deadline
+) -> WidestChain:
+    """Chains of every root within ``longest`` operations keeping the largest smallest margin
+    above ``floor`` (deg) that the bisection finds under ``deadline``.
 
     The margin is the plan's tie-break after the length (docs/planning.md, "Which plan among
     the shortest"), decided as a feasibility question: "within ``longest`` with every
-    margin at least ``m``?" is A* over sets of the problem with that margin floor (its
-    heuristic stays consistent: a floor only takes actions away), bisected between the
-    largest margin found and one that failed, until the interval is ``MARGIN_STEP_DEG``
-    wide or ``deadline`` passes (the best found by then). A set's chain keeps the margin of
-    its own ranges for the reading sets that follow it (a subset's range holding the same
-    rotation is no narrower).
+    margin at least ``m``?" is A* over sets of ``worst``'s problem with that margin floor
+    (its heuristic, ``worst``'s tables, stays consistent: a floor only takes actions away),
+    bisected between the largest margin found and one that failed (at first the roots'
+    widest range: a chain starts with one of its root's), until the interval is
+    ``MARGIN_STEP_DEG`` wide or ``deadline`` passes. A set's chain keeps the margin of its
+    own ranges for the reading sets that follow it (a subset's range holding the same
+    rotation is no narrower), and a reading that fits every state leaves the whole image, so
+    no plan keeps more than the best chain.
     """
-    best: tuple[QuietWorst, float] | None = None
-    lo, hi = floor, 90.0  # a margin is the half of a range narrower than 180 degrees
-    with contextlib.suppress(Timeout):
+    problem = worst.p
+    found: QuietWorst | None = None
+    lo = kept = floor
+    # A chain starts with one of its root's ranges: none keeps more than the widest of them.
+    hi = min(
+        (
+            max(((c[1] - c[0]) / 2.0 for c in problem.choices.cells(r, False)), default=floor)
+            for r in roots
+            if not problem.is_goal(r)
+        ),
+        default=floor,
+    )
+    cut_by = None
+    try:
         while hi - lo > MARGIN_STEP_DEG:
             mid = (lo + hi) / 2.0
             search = QuietWorst(problem.with_margin(mid), deadline)
+            search.share_heuristic(worst)
             if all(search.within(r, longest) for r in roots):
-                kept = _chain_margin(search, roots)
-                best, lo = (search, kept), max(kept, mid)
+                found, kept = search, _chain_margin(search, roots)
+                lo = max(kept, mid)
             else:
                 hi = mid
-    return best
+    except Timeout as exc:
+        cut_by = exc.reason
+    return WidestChain(found, kept, cut_by)
 
 
 def _chain_margin(search: WorstCase, roots) -> float:
     """The smallest margin of the actions on the chains ``search`` chose from ``roots``."""
-    out = 90.0
+    out = math.inf
     seen: set[int] = set()
     todo = [r for r in roots if r in search.choice]
     while todo:

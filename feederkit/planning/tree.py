@@ -205,10 +205,11 @@ class PlanResult:
     the choice among plans of the proven length went (docs/planning.md, "Which plan among
     the shortest"): ``"exact"`` every stage, ``"margin"`` the largest smallest margin but
     not the fewest expected operations, ``"none"`` the margin found when the tie-breaking
-    budget ran out, ``"backchain"`` the backchaining plan where readings carry nothing (no
-    tie-break searched). ``ties_cut_by``: what cut the choice short, ``"work"`` (the
-    tie-breaking stages' budget, a multiple of the length proof's work: the same on any
-    computer), ``"time"`` or ``"memory"`` (the run's limits); None when nothing did.
+    budget ran out, ``"backchain"`` the sensorless chain where readings carry nothing (with
+    several parts the largest margin among chains, :data:`TIES_CHAIN`). ``ties_cut_by``:
+    what cut the choice short, ``"work"`` (the tie-breaking stages' budget, a multiple of
+    the length proof's work: the same on any computer), ``"time"`` or ``"memory"`` (the
+    run's limits); None when nothing did.
     """
 
     machine: PushAlignMachine

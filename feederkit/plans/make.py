@@ -323,10 +323,11 @@ def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
     file's object ``data`` (written from that tree, then pruned) still lists: a state stays
     when one of its ideal members is listed there.
 
-    The tree is rebuilt as the file shares it: a leaf the planner shares between places whose
+    The tree is rebuilt along the file: a leaf the planner shares between places whose
     results were pruned apart (a chain's last reading set, also a root branch's) becomes one
-    leaf per place, and a subplan the file shares (its ``nodes`` table, pruned in place for
-    all its places) stays one object.
+    leaf per place; a subplan the planner shares and the file writes once (its ``nodes``
+    table, pruned in place for all its places) stays one object, and one whose leaves keep
+    their masks is the planner's own.
     """
     machine = result.machine
     parts = [(part["name"], part.get("landing")) for part in data["parts"]]
