@@ -14,6 +14,7 @@ import pytest
 from shared import brute_lengths, small_mix
 from test_planners import check_plan
 from test_strong_plans import random_pf
+from test_tie_breaks import _max_min
 
 from feederkit.landing.model import landings_of_outline
 from feederkit.machine import build_machine
@@ -273,29 +274,14 @@ def test_the_fallbacks_search_at_the_bound_makes_its_chain(monkeypatch, name):
     assert lower == result.length  # A* at the bound proved it too
 
 
-def _chain_max_min(problem: Problem, mask: int, k: int, memo: dict) -> float:
-    """The largest smallest margin of a chain of images from ``mask`` to a goal within
-    ``k``: every action (the tests' exhaustive recursion)."""
-    if problem.is_goal(mask):
-        return math.inf
-    if k <= 0:
-        return -math.inf
-    hit = memo.get((mask, k))
-    if hit is None:
-        hit = -math.inf
-        for act in problem.choices.exact_actions(mask):
-            v = min(act.action.margin, _chain_max_min(problem, act.action.image, k - 1, memo))
-            hit = max(hit, v)
-        memo[(mask, k)] = hit
-    return hit
-
-
 @pytest.mark.parametrize("name", CASES)
 def test_the_widest_chain_keeps_the_largest_margin_within_the_step(name):
     machine, problem, roots, _branches, exact = _case(name)
     longest = max(exact(r) for r in roots)
     memo: dict = {}
-    want = min(_chain_max_min(problem, r, longest, memo) for r in roots)
+    # The largest smallest margin over every plan (every action, every reading branch): a
+    # reading that fits every state leaves the whole image, so a chain keeps as much.
+    want = min(_max_min(problem, r, longest, memo) for r in roots)
     found = widest_chain(QuietWorst(problem), roots, longest, 0.0, Deadline())
     assert found.search is not None and found.cut_by is None
     assert want - MARGIN_STEP_DEG <= found.margin <= want
@@ -311,7 +297,7 @@ def test_a_margin_bisection_cut_short_says_so_and_keeps_a_proven_plan(monkeypatc
     # mix3-300: the first shortest path keeps far less than the widest chain.
     machine, problem, roots, _branches, exact = _case("mix3-300")
     longest = max(exact(r) for r in roots)
-    want = min(_chain_max_min(problem, r, longest, {}) for r in roots)
+    want = min(_max_min(problem, r, longest, {}) for r in roots)
     first = plan(machine, PlanningOptions())
     monkeypatch.setattr(api, "TIE_GRACE_POLLS", 0)
     monkeypatch.setattr(api, "TIE_SHARE", 0.0)
