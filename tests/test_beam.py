@@ -407,6 +407,59 @@ def test_a_first_plan_may_take_until_its_own_deadline():
     assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == 1 + best
 
 
+def test_a_first_plan_past_the_beams_deadline_is_shortened_by_the_same_beam(monkeypatch):
+    # The beams' deadline has passed and the first plan's has a limit: the first plan (8
+    # operations after the first alignment, at a target of 8) is shortened one operation at
+    # a time by the same beam within DESCENT_SHARE of what is left (7, 6, 5; 4 fails), and no
+    # wider beam is tried past the beams' own deadline. With no share for the descent, the
+    # first plan is the answer.
+    from feederkit.planning import beam as beam_module
+
+    machine = _random_part_machine(seed=1, n=10, rel=0.2)
+    problem, branches, roots = _problem(machine)
+    cap = 2 * machine.n + 1
+    calls = []
+    real = beam_module._lengths
+
+    def spy(beam, roots_, target):
+        out = real(beam, roots_, target)
+        calls.append((target, None if out is None else max(out), beam.width))
+        return out
+
+    monkeypatch.setattr(beam_module, "_lengths", spy)
+    found = beam_plan(problem, roots, None, Deadline(0.0), cap, 1, Deadline(60.0))
+    first = next(i for i, c in enumerate(calls) if c[1] is not None)
+    width = calls[first][2]
+    assert calls[first][1] == 8
+    assert [(t, n) for t, n, _w in calls[first + 1 :]] == [(7, 7), (6, 6), (5, 5), (4, None)]
+    assert all(w == width for _t, _n, w in calls[first + 1 :])
+    assert found is not None and found[1] == 5
+    root = _choice_plan(problem, found[0].choice, roots, branches, Deadline())
+    assert check_plan(_result(machine, root, False, None, 1, "worst", "exact")) == tree_length(root)
+    assert tree_length(root) <= 1 + 5
+
+    calls.clear()
+    monkeypatch.setattr(beam_module, "DESCENT_SHARE", 0.0)
+    found = beam_plan(problem, roots, None, Deadline(0.0), cap, 1, Deadline(60.0))
+    assert found is not None and found[1] == 8
+
+
+def test_the_descent_takes_its_share_of_the_first_plans_deadline():
+    import time
+
+    from feederkit.planning.beam import DESCENT_SHARE, _descent
+
+    passed = Deadline(0.0)
+    assert _descent(passed, None) is passed
+    assert _descent(passed, Deadline()) is passed  # no limit to take a share of
+    later = Deadline(10.0)
+    late = _descent(passed, later)
+    expected = time.perf_counter() + DESCENT_SHARE * 10.0
+    assert late.end is not None and abs(late.end - expected) < 0.5
+    roomy = Deadline(100.0)
+    assert _descent(roomy, later) is roomy  # the beams' own deadline is later still
+
+
 def test_when_the_exact_search_runs_out_the_fallback_answers_with_a_beam_plan(monkeypatch):
     machine = _random_part_machine()
     exact = plan(machine)
