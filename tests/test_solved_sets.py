@@ -1,32 +1,32 @@
-"""Sets inside solved sets (``feederkit.planning.solved``, ``WorstCase.inside_solved``).
+"""Sets inside sets a margin probe found a plan for (``feederkit.planning.solved``,
+``Refiner._inside_kept``).
 
-Without a margin floor a plan of a set orients every subset of it, so the AND/OR search and
-the beams take a set inside a set they solved within a budget as solved within it, with the
-larger set's action. Here the index is checked against a plain scan, the exact search's
-lengths (the shortcut taken) against the tests' own exhaustive search, the plans a beam
-builds with it (the shortcut taken) by running them from every start, every outcome of a
-1-degree rotation error and every reading, and a margin floor keeps no index.
+Without a margin floor a plan of a set orients every subset of it keeping its margins, so a
+probe "keeps ``x`` within ``k``?" of a set inside a set already found to keep ``x`` within
+``k`` answers yes at once. Here the index is checked against a plain scan, the largest
+margins with the shortcut taken against the tests' own max-min over every action and
+reading branch, the plans made with it by running them from every start and reading, and a
+margin floor keeps no index.
 """
 
 from __future__ import annotations
 
 import random
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from shared import brute_lengths, small_mix
-from test_beam import _problem
+from shared import small_mix
+from test_planners import check_plan
+from test_tie_breaks import _max_min, _proven
 
-from feederkit.machine import build_machine, members
-from feederkit.planning.andor import WorstCase
-from feederkit.planning.beam import BeamSearch, _lengths
-from feederkit.planning.budget import Deadline
-from feederkit.planning.fallback import _choice_plan
+from feederkit.machine import build_machine
+from feederkit.planning.api import plan
 from feederkit.planning.problem import Problem
+from feederkit.planning.refine import Refiner
 from feederkit.planning.solved import MAX_TRIES, SolvedSets
-from feederkit.planning.tree import Leaf
 from feederkit.sensors import ToleranceSensor
-from feederkit.uncertainty import IDEAL, Uncertainty
+from feederkit.uncertainty import IDEAL
 
 
 @settings(max_examples=60, deadline=None)
@@ -68,84 +68,54 @@ def test_the_index_stops_growing_at_its_cap(monkeypatch):
     assert index.holder(1 << 3, lambda m: True) == 0b1001
 
 
-def _spied(search):
+def _spied(refiner):
     hits = []
-    real = search.inside_solved
+    real = refiner._inside_kept
 
-    def spy(mask, k):
-        out = real(mask, k)
+    def spy(mask, k, x, strict):
+        out = real(mask, k, x, strict)
         if out:
             hits.append(mask)
         return out
 
-    search.inside_solved = spy
+    refiner._inside_kept = spy
     return hits
 
 
-def test_lengths_with_the_shortcut_are_the_exhaustive_searchs():
-    machine = build_machine(small_mix(5, 100), ToleranceSensor(2.0), IDEAL)
-    length, _children = brute_lengths(machine, 2.0)
-    problem, _branches, roots = _problem(machine)
-    w = WorstCase(problem)
-    hits = _spied(w)
-    rng = random.Random(5)
-    masks = roots + [rng.getrandbits(machine.n) | rng.getrandbits(machine.n) for _ in range(60)]
-    for mask in masks:
-        want = length(mask)
-        if want is None:
-            continue
-        assert w.length(mask) == want
-        if want >= 1:
-            assert not w.within(mask, want - 1)
+@pytest.mark.parametrize(("count", "tol"), [(6, 3.0), (8, 2.0), (8, 3.0)])
+def test_margins_with_the_shortcut_are_the_max_min_over_every_branch(count, tol):
+    machine = build_machine(small_mix(count, 100), ToleranceSensor(tol), IDEAL)
+    refiner, every, k = _proven(machine)
+    hits = _spied(refiner)
+    memo: dict = {}
+    for r in every:
+        assert refiner.margin(r, k) == _max_min(refiner.p, r, k, memo)
     assert hits  # the shortcut was taken
+    for (mask, j), lo in refiner._lo.items():  # every recorded floor is kept by some plan
+        assert lo <= _max_min(refiner.p, mask, j, memo)
 
 
-def _run(machine, insep, node, state, ops, tol):
-    """The longest run of ``node`` from ``state`` over every outcome and reading (asserting
-    that each reading has a branch listing the state and each leaf lists only states
-    inseparable from the true one)."""
-    if isinstance(node, Leaf):
-        assert node.mask >> state & 1
-        assert all(j == state or insep[state] >> j & 1 for j in members(node.mask))
-        return ops
-    after = (
-        [state]
-        if node.action is None
-        else members(machine.outcomes(state, node.action.representative))
-    )
-    longest = ops + 1
-    for t in after:
-        d = machine.states[t].sensed  # a diameter interval under a rotation error
-        lo, hi = (d[0] - tol, d[1] + tol) if isinstance(d, tuple) else (d - tol, d + tol)
-        mine = [(b, sub) for b, sub in node.branches if b.lo is None or (b.lo < hi and lo < b.hi)]
-        assert mine and all(b.mask >> t & 1 for b, _sub in mine)
-        covered = sorted((max(lo, b.lo), min(hi, b.hi)) for b, _sub in mine if b.lo is not None)
-        if covered:  # every reading the state can give lies in some branch
-            reach = lo
-            for a, z in covered:
-                assert a <= reach + 1e-9
-                reach = max(reach, z)
-            assert reach >= hi - 1e-9
-        for _b, sub in mine:
-            longest = max(longest, _run(machine, insep, sub, t, ops + 1, tol))
-    return longest
+def test_a_plan_made_with_the_shortcut_runs_from_every_start_and_reading(monkeypatch):
+    machine = build_machine(small_mix(8, 100), ToleranceSensor(3.0), IDEAL)
+    hits = []
+    real = Refiner._inside_kept
 
+    def spy(self, mask, k, x, strict):
+        out = real(self, mask, k, x, strict)
+        hits.append(out)
+        return out
 
-def test_a_beams_plan_with_the_shortcut_runs_from_every_start_outcome_and_reading():
-    tol = 3.0
-    machine = build_machine(small_mix(8, 100), ToleranceSensor(tol), Uncertainty(1.0))
-    problem, branches, roots = _problem(machine)
-    beam = BeamSearch(problem, 4, Deadline())
-    hits = _spied(beam)
-    lengths = _lengths(beam, roots, 12)
-    assert lengths is not None and hits
-    root = _choice_plan(problem, beam.choice, roots, branches, Deadline())
-    longest = max(_run(machine, problem.insep, root, s, 0, tol) for s in range(machine.n))
-    assert longest <= 1 + max(lengths)
+    monkeypatch.setattr(Refiner, "_inside_kept", spy)
+    result = plan(machine)
+    assert any(hits) and result.tie_breaks == "exact"
+    assert check_plan(result) == result.length
+    refiner, every, k = _proven(machine)
+    assert result.min_margin == pytest.approx(refiner.largest_floor(every, k), abs=1e-6)
 
 
 def test_no_index_under_a_margin_floor():
-    machine = build_machine(small_mix(3, 200), ToleranceSensor(4.0), IDEAL)
-    assert WorstCase(Problem(machine))._solved is not None
-    assert BeamSearch(Problem(machine), 2)._solved is not None  # a plan is a plan
-    assert WorstCase(Problem(machine, min_margin=1.0))._solved is None
+    machine = build_machine(small_mix(8, 100), ToleranceSensor(3.0), IDEAL)
+    floored, every, k = _proven(machine)
+    floored = Refiner(Problem(floored.p.machine, min_margin=0.5), floored.w)
+    floored.margin(every[-1], k)
+    assert floored._kept_sets == {}

@@ -51,6 +51,7 @@ from feederkit.planning.choices import spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.refuted import RefutedSets
+from feederkit.planning.solved import SolvedSets
 from feederkit.planning.tree import Leaf, Step, branch_pairs
 
 EXPECTED_HORIZON = 2
@@ -146,6 +147,8 @@ class Refiner:
         # (``_lt``: at least it; ``_le``: above it), for the sets that hold them.
         self._lt_sets: dict[int, RefutedSets] = {}
         self._le_sets: dict[int, RefutedSets] = {}
+        # The sets of each budget a probe found a plan for (``_lo``), for the sets inside them.
+        self._kept_sets: dict[int, SolvedSets] = {}
         self._exp: dict[tuple[int, int, tuple[float, ...]], tuple[Value, Act | None]] = {}
         self._wsec: dict[tuple[int, int], tuple[float, Act | None]] = {}
         self._cheap: dict[tuple[int, bool, float], list[Cell]] = {}
@@ -266,11 +269,17 @@ class Refiner:
         self.deadline.check()
         if self._holds_refuted(mask, k, x, strict):
             return False
+        if self._inside_kept(mask, k, x, strict):
+            return True
         kept = self._keeping_plan(mask, k, x, strict)
         if kept is not None:
             found, cell = kept
             if lo is None or found > lo:
                 self._lo[key], self._how[key] = found, cell
+            if self._monotone:
+                if k not in self._kept_sets:
+                    self._kept_sets[k] = SolvedSets(self.p.machine.n)
+                self._kept_sets[k].add(mask)
             return True
         if strict:
             self._le[key] = x if le is None else min(le, x)
@@ -282,6 +291,30 @@ class Refiner:
                 sets[k] = RefutedSets(self.p.machine.n)
             sets[k].add(mask, -x)
         return False
+
+    def _inside_kept(self, mask: int, k: int, x: float, strict: bool) -> bool:
+        """Whether ``mask`` lies inside a set for which a probe found a plan within ``k``
+        keeping ``x`` (above ``x`` when ``strict``): margins are monotone under subsets, so
+        that plan keeps it for ``mask`` too (:mod:`~feederkit.planning.solved`); its smallest
+        margin and first cell become ``mask``'s (:meth:`follow` finds ``mask``'s own range
+        around that cell)."""
+        index = self._kept_sets.get(k) if self._monotone else None
+        if index is None:
+            return False
+        lows = self._lo
+
+        def fits(s: int) -> bool:
+            lo = lows[(s, k)]
+            return lo > x or (lo == x and not strict)
+
+        s = index.holder(mask, fits)
+        if s is None:
+            return False
+        key = (mask, k)
+        lo = lows.get(key)
+        if lo is None or lows[(s, k)] > lo:
+            lows[key], self._how[key] = lows[(s, k)], self._how[(s, k)]
+        return True
 
     def _holds_refuted(self, mask: int, k: int, x: float, strict: bool) -> bool:
         """Whether ``mask`` holds a set that no plan within ``k`` keeps ``x`` for (above
