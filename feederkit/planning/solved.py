@@ -24,12 +24,12 @@ MAX_ROWS = 32768
 operations on integers of this many bits; past it nothing more is kept."""
 
 MAX_TRIES = 8
-"""A query tries at most this many of the sets holding ``mask``, the latest first (the
-budget they were solved within may be too large)."""
+"""A query tries at most this many of the sets holding ``mask``, the latest first (what was
+found for one may not be enough: too small a margin)."""
 
 
 class SolvedSets:
-    """Sets with a plan, as a bitmap per state of the sets that hold it.
+    """Sets a plan was found for, as a bitmap per state of the sets that hold it.
 
     >>> s = SolvedSets(4)
     >>> s.add(0b0111)
