@@ -6,7 +6,8 @@ operations that orient every state of ``mask`` (0 for a goal). The search is dep
 iterative deepening with memoised proven bounds per set (a set that failed with ``k`` steps
 is never retried with ``k``), so repeated sets and repeated depths cost nothing; lengths being
 monotone under subsets (no margin floor), a set holding a set refuted with ``k`` steps is
-refuted with ``k`` unopened (:mod:`~feederkit.planning.refuted`).
+refuted with ``k`` unopened (:mod:`~feederkit.planning.refuted`), and a set inside a set
+solved within ``k`` is solved within ``k`` the same way (:mod:`~feederkit.planning.solved`).
 
 Where readings carry no information (every set reachable from a set reads alike:
 :meth:`~feederkit.planning.readings.Readings.carries_no_information`) the AND/OR tree is a
@@ -31,6 +32,7 @@ from feederkit.machine import PushAlignMachine, members
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.refuted import RefutedSets
+from feederkit.planning.solved import SolvedSets
 
 __all__ = ["Deadline", "Timeout", "WorstCase"]
 
@@ -58,7 +60,10 @@ class WorstCase:
 
     Without a margin floor lengths are monotone under subsets, so a set holding a set the
     search refuted at a depth is refuted there too (:mod:`~feederkit.planning.refuted`);
-    ``SUBSET_REFUTES`` False turns that off for searches whose failures are not proofs.
+    ``SUBSET_REFUTES`` False turns that off for searches whose failures are not proofs. A set
+    inside a set solved within a depth is solved within it, following the larger set's plan
+    (:mod:`~feederkit.planning.solved`; its ``choice`` is the larger set's action, whose
+    rotation sends it inside the larger set's image): a plan is a plan in any search.
     """
 
     SUBSET_REFUTES = True
@@ -85,6 +90,9 @@ class WorstCase:
         monotone = self.SUBSET_REFUTES and getattr(problem, "min_margin", None) == 0.0
         ok = monotone and isinstance(machine, PushAlignMachine)
         self._refuted = RefutedSets(machine.n) if ok else None
+        inside = getattr(problem, "min_margin", None) == 0.0
+        ok = inside and isinstance(machine, PushAlignMachine)
+        self._solved = SolvedSets(machine.n) if ok else None
 
     def holds_plan(self, mask: int, k: int) -> bool:
         """Whether the memo already holds a plan of ``mask`` within ``k`` operations, without
@@ -272,6 +280,8 @@ class WorstCase:
         known = self._known(mask, k)
         if known is None and self.holds_refuted(mask, k):
             known = False
+        if known is None and self.inside_solved(mask, k):
+            known = True
         if known is not None:
             return known
         self.deadline.check()
@@ -299,6 +309,8 @@ class WorstCase:
                     known = self._known(c, fk - 1)
                     if known is None and self.holds_refuted(c, fk - 1):
                         known = False
+                    if known is None and self.inside_solved(c, fk - 1):
+                        known = True
                     if known is None:
                         f[3], f[4] = act, ci
                         self.deadline.check()
@@ -323,6 +335,8 @@ class WorstCase:
                 self.ub[fmask] = fk
                 if fmask not in self.choice or self.choice[fmask][0] > fk:
                     self.choice[fmask] = (fk, act)
+                if self._solved is not None:
+                    self._solved.add(fmask)
                 result = True
             else:
                 self.lb[fmask] = fk + 1
@@ -336,6 +350,27 @@ class WorstCase:
                 else:
                     parent[3] = None  # the parent's action failed: its next action
         return result
+
+    def inside_solved(self, mask: int, k: int) -> bool:
+        """Whether ``mask`` lies inside a set the search solved within ``k`` (it is then
+        solved too: its ``ub`` and ``choice`` become that set's), asked before the search
+        opens it."""
+        if self._solved is None:
+            return False
+        choice = self.choice
+
+        def fits(s: int) -> bool:
+            entry = choice.get(s)
+            return entry is not None and entry[0] <= k
+
+        s = self._solved.holder(mask, fits)
+        if s is None:
+            return False
+        entry = choice[s]
+        self.ub[mask] = min(self.ub.get(mask, entry[0]), entry[0])
+        if mask not in choice or choice[mask][0] > entry[0]:
+            choice[mask] = entry
+        return True
 
     def holds_refuted(self, mask: int, k: int) -> bool:
         """Whether ``mask`` holds a set the search refuted within ``k`` (it is then

@@ -313,7 +313,9 @@ def _depth(search: WorstCase, mask: int, memo: dict[int, int]) -> int:
 
     A set's choice is a plan within the budget it was proven under and its branches' within
     one less (a later, smaller budget replaces it), so the walk goes no deeper than that
-    budget: the search's target.
+    budget: the search's target. A set holding a larger set's action
+    (:meth:`~feederkit.planning.andor.WorstCase.inside_solved`) counts that set's plan,
+    which its own node in the plan follows, no deeper.
     """
     if search.p.is_goal(mask):
         return 0

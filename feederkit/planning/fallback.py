@@ -20,6 +20,7 @@ from __future__ import annotations
 import gc
 import time
 
+from feederkit.angles import norm360
 from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.beam import beam_plan
@@ -434,7 +435,15 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
     of a goal is a goal. So the plan has one node per witness, not one per reading set met
     (the 50-part mix at 3 % under 1 degree: about a tenth of the nodes), and every consumer
     (verification, certificate, file, drawing) walks that much less.
+
+    A set may hold a larger set's action (``WorstCase.inside_solved``: solved inside it);
+    then its node is its own: its overlap range around that action's rotation, its own
+    image's reading branches, each going on with the maximal branch of its own image that
+    holds it, following the plan of the larger set's branch around it. A node is keyed by
+    its set and the set whose plan it follows (as ``Refiner.follow``), so every node is
+    reached by all of its states and no branch is one that no state takes.
     """
+    readings = problem.readings
 
     def witness_of(mask: int, supersets) -> int:
         # The set itself or a searched set containing it, whichever has the shorter plan: a
@@ -449,19 +458,32 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
                 best, bound = c, choice[c][0]
         return best
 
-    def expand(witness: int):
-        if problem.is_goal(witness):
-            return Leaf(witness)
-        _k, act = choice[witness]
-        subs = [
-            (b, witness_of(b.mask, act.children))
-            for b in problem.readings.image_branches(act.action.image)
-        ]
-        return act.action, subs
+    def expand(key: tuple[int, int]):
+        mask, lender = key
+        if problem.is_goal(mask):
+            return Leaf(mask)
+        _k, act = choice[lender]
+        sa = act.action
+        # The set's own range around the chosen rotation (a bisection per member); the
+        # chosen action itself where the image is the same (the set's own choice, or a
+        # larger set's that moves it alike).
+        cell = problem.choices.cell_at(mask, norm360((sa.lo + sa.hi) / 2.0))
+        if cell is None or cell[2] == sa.image:
+            subs = []
+            for b in readings.image_branches(sa.image):
+                w = witness_of(b.mask, act.children)
+                subs.append((b, (w, w)))
+            return sa, subs
+        maximal = readings.children(cell[2])
+        subs = []
+        for b in readings.image_branches(cell[2]):
+            own = next(m for m in maximal if b.mask & m == b.mask)
+            subs.append((b, (own, witness_of(own, act.children))))
+        return OverlapRange(*cell), subs
 
     top = [(b, witness_of(b.mask, roots)) for b in root_branches]
-    made = build_dag([k for _b, k in top], expand, deadline)
-    return root_step(((b, made[k]) for b, k in top), deadline)
+    made = build_dag([(w, w) for _b, w in top], expand, deadline)
+    return root_step(((b, made[(w, w)]) for b, w in top), deadline)
 
 
 def sensorless_plan(

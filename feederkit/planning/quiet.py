@@ -61,6 +61,9 @@ class QuietWorst(WorstCase):
     ) -> None:
         super().__init__(problem, deadline, pair_bound)
         self._quiet = _always
+        # No set borrows a larger set's plan (WorstCase.inside_solved): chain_plan follows
+        # each image's own chosen action, whose image must be that set's.
+        self._solved = None
         # Per part: its mask, a table per byte of the machine's mask to the part's own
         # numbering, and its backchaining table (made when first asked).
         self._parts: list[tuple[int, list[list[int]], object]] | None = None

@@ -7,7 +7,9 @@ overlap range around that rotation is as wide or wider (docs/planning.md, "Which
 the shortest"). So a set lying inside a set that some plan within ``k`` orients keeping a
 margin of ``x`` has such a plan too. The margin stage's probes (``Refiner.keeps``) ask
 "keeps ``x`` within ``k``?" of many sets that are new but lie inside a set a probe already
-answered: on a 50-part mix at 1 % of 60 mm, half of the probes' searches.
+answered: on a 50-part mix at 1 % of 60 mm, half of the probes' searches. The length search
+and the beams ask "within ``k``?" the same way (``WorstCase.inside_solved``, a set then
+taking the larger set's action, whose node in a plan is the smaller set's own).
 :class:`SolvedSets` answers "which kept set holds ``mask``?" by a bitmap of the kept sets
 per state, the dual of :class:`~feederkit.planning.refuted.RefutedSets` (a set holding a
 refuted set is refuted).
