@@ -21,7 +21,7 @@ from feederkit.machine import build_machine
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import api, fallback
+from feederkit.planning import api, fallback, quiet
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
@@ -305,3 +305,19 @@ def test_a_margin_bisection_cut_short_says_so_and_keeps_a_proven_plan(monkeypatc
     assert cut.optimal and cut.length == first.length == check_plan(cut)
     assert cut.tie_breaks == TIES_NONE and cut.ties_cut_by == "work"
     assert cut.min_margin < want - MARGIN_STEP_DEG <= first.min_margin
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_parts_lengths_of_many_sets_at_once_are_those_of_one_at_a_time(monkeypatch, name):
+    monkeypatch.setattr(quiet, "VECTOR_MIN", 0)  # every batch by arrays
+    machine, _tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    rng = random.Random(name)
+    masks = [rng.getrandbits(machine.n) for _ in range(300)]
+    masks += [1 << i | 1 << j for i in range(machine.n) for j in range(i)]  # every pair
+    one = QuietWorst(problem)
+    many = QuietWorst(problem)
+    many.part_lengths_of(masks)
+    assert all(m in many._lengths for m in masks)
+    assert [many.part_lengths(m) for m in masks] == [one.part_lengths(m) for m in masks]
+    assert any(one.part_lengths(m)[0] > 0 for m in masks)

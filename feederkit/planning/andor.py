@@ -210,7 +210,9 @@ class WorstCase:
                 self.lb[mask] = max(self.lb.get(mask, 1), reached)
                 raise
             g = 1 - neg
-            for cell in choices.cells(cur, useful):
+            cells = choices.cells(cur, useful)
+            self.bounds_ahead([c[2] for c in cells])
+            for cell in cells:
                 img = cell[2]
                 old = met.get(img)
                 if old is not None and old <= g:
@@ -241,6 +243,11 @@ class WorstCase:
                 self.choice[prev] = (k, act)
             step = prev
         return depth
+
+    def bounds_ahead(self, masks: list[int]) -> None:
+        """Make :meth:`part_bound` of many sets at once, ahead of their asking, where a
+        subclass can do so more cheaply than one at a time (A* asks it of every image of
+        the set it expands); here nothing."""
 
     def part_bound(self, mask: int) -> int:
         """A lower bound on the length of ``mask``: the largest, over the machine's parts,

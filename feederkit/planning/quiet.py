@@ -40,6 +40,8 @@ import contextlib
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from feederkit.planning.andor import WorstCase, part_chains
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Problem
@@ -50,6 +52,10 @@ FIRST_WIDTH = 1
 next beam is ``WIDTH_FACTOR`` times as wide."""
 
 WIDTH_FACTOR = 2
+
+VECTOR_MIN = 16
+""":meth:`QuietWorst.part_lengths_of` takes fewer new sets than this one at a time (the
+arrays' fixed cost is then more than the loops')."""
 
 
 class QuietWorst(WorstCase):
@@ -68,6 +74,9 @@ class QuietWorst(WorstCase):
         # numbering, and its backchaining table (made when first asked).
         self._parts: list[tuple[int, list[list[int]], object]] | None = None
         self._lengths: dict[int, tuple[int, int]] = {}
+        # Per part: its states' columns in its own numbering and its backchaining table
+        # (part_lengths_of).
+        self._columns: list[tuple[np.ndarray, object]] | None = None
 
     def part_lengths(self, mask: int) -> tuple[int, int]:
         """The largest and the sum, over the machine's parts, of the backchaining length of
@@ -77,9 +86,7 @@ class QuietWorst(WorstCase):
         if out is not None:
             return out
         if self._parts is None:
-            self._parts = [
-                (part, _byte_tables(local), chain) for part, local, chain in part_chains(self.p)
-            ]
+            self._make_tables()
         big = total = 0
         for part, tables, chain in self._parts:
             sub = mask & part
@@ -95,6 +102,46 @@ class QuietWorst(WorstCase):
         out = self._lengths[mask] = (big, total)
         return out
 
+    def part_lengths_of(self, masks: list[int]) -> None:
+        """:meth:`part_lengths` of many sets at once, into its memo: each part's states of
+        every set as one boolean matrix and each part's backchaining lengths by array
+        operations (:meth:`~feederkit.planning.sensorless.Backchain.lengths_of`), the same
+        numbers. A beam meets a few hundred new images per set it expands, where one at a
+        time each cost a loop over its members."""
+        memo = self._lengths
+        new = [m for m in dict.fromkeys(masks) if m not in memo]
+        if len(new) < VECTOR_MIN:
+            for m in new:
+                self.part_lengths(m)
+            return
+        if self._columns is None:
+            self._make_tables()
+        n = self.p.machine.n
+        width = (n + 7) // 8
+        raw = np.frombuffer(b"".join(m.to_bytes(width, "little") for m in new), np.uint8)
+        bits = np.unpackbits(raw.reshape(len(new), width), axis=1, count=n, bitorder="little")
+        inside = bits.astype(bool)
+        big = np.zeros(len(new), dtype=np.int64)
+        total = np.zeros(len(new), dtype=np.int64)
+        for cols, chain in self._columns:
+            sub = inside[:, cols]
+            v = chain.lengths_of(sub)  # type: ignore[attr-defined]
+            keep = (sub.sum(axis=1) >= 2) & np.isfinite(v)
+            v = np.where(keep, v, 0.0).astype(np.int64)
+            big = np.maximum(big, v)
+            total += v
+        for m, b, t in zip(new, big.tolist(), total.tolist(), strict=True):
+            memo[m] = (b, t)
+
+    def _make_tables(self) -> None:
+        """The parts' tables of :meth:`part_lengths` and :meth:`part_lengths_of`."""
+        chains = part_chains(self.p)
+        self._parts = [(part, _byte_tables(local), chain) for part, local, chain in chains]
+        self._columns = [
+            (np.array(sorted(local, key=local.__getitem__), dtype=np.intp), chain)
+            for _part, local, chain in chains
+        ]
+
     def _known(self, mask: int, k: int) -> bool | None:
         """As :meth:`WorstCase._known`, refuting a set whose part bound exceeds ``k``
         before any search (A* itself has no budget of operations)."""
@@ -108,14 +155,20 @@ class QuietWorst(WorstCase):
     def share_heuristic(self, other: QuietWorst) -> None:
         """Use ``other``'s tables of the parts' backchaining lengths (the same machine; a
         margin floor does not change them)."""
-        if other._parts is None:
-            other.part_lengths(other.p.full)
+        if other._parts is None or other._columns is None:
+            other._make_tables()
         self._parts, self._lengths = other._parts, other._lengths
+        self._columns = other._columns
 
     def part_bound(self, mask: int) -> int:
         """:meth:`WorstCase.part_bound` from the memoised :meth:`part_lengths` (A*'s
         heuristic)."""
         return self.part_lengths(mask)[0]
+
+    def bounds_ahead(self, masks: list[int]) -> None:
+        """:meth:`part_lengths_of` (A* asks :meth:`part_bound` of each image of the set it
+        expands)."""
+        self.part_lengths_of(masks)
 
 
 def _byte_tables(local: dict[int, int]) -> list[list[int]]:
@@ -164,7 +217,9 @@ def beam_chain(
         scored: dict[int, tuple[int, int, int]] = {}
         for cur in level:
             deadline.check()
-            for cell in p.choices.cells(cur, useful):
+            cells = p.choices.cells(cur, useful)
+            worst.part_lengths_of([c[2] for c in cells if c[2] not in parent])
+            for cell in cells:
                 img = cell[2]
                 if img in parent:
                     continue

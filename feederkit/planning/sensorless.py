@@ -234,6 +234,37 @@ class Backchain:
             self._lengths[mask] = v
         return v
 
+    def lengths_of(self, inside: np.ndarray) -> np.ndarray:
+        """:meth:`length` of many sets at once (not memoised): ``inside`` holds a row per
+        set and a column per state, True for its members. The same floats as
+        :meth:`hull`, one array operation each: each member's gap from the member before
+        it by position, the largest of them and the gap that wraps around the circle.
+
+        >>> import numpy as np
+        >>> from feederkit.planning.sensorless import PushCircle
+        >>> chain = Backchain(PushCircle(360.0, (0, 1, 2), (0.0, 120.0, 240.0),
+        ...                              (60.0,) * 3, (60.0,) * 3))
+        >>> inside = np.array([[1, 1, 1], [1, 0, 1], [0, 1, 0]], dtype=bool)
+        >>> chain.lengths_of(inside).tolist() == [chain.length(m) for m in (7, 5, 2)]
+        True
+        """
+        t = self.c.period
+        pos = self._sorted_pos
+        m = inside[:, self._order]  # columns by position
+        cols = np.arange(m.shape[1])
+        last = np.maximum.accumulate(np.where(m, cols, -1), axis=1)
+        prev = np.full_like(last, -1)
+        prev[:, 1:] = last[:, :-1]  # the member before each column (-1: none)
+        gaps = np.where(m & (prev >= 0), pos - pos[np.maximum(prev, 0)], 0.0)
+        first = pos[np.argmax(m, axis=1)]
+        end = pos[np.maximum(last[:, -1], 0)]
+        hull = t - np.maximum(gaps.max(axis=1, initial=0.0), first + t - end)
+        hull = np.where(end == first, 0.0, hull)
+        k = np.searchsorted(np.asarray(self.table), hull + ANGLE_EPS, side="left")
+        out = np.where(k < len(self.table), k, np.inf).astype(float)
+        out[hull == 0.0] = 0.0
+        return out
+
 
 class BackchainWorst(WorstCase):
     """The worst-case oracle of a sensorless push machine, answered by backchaining."""
