@@ -444,6 +444,38 @@ def test_a_first_plan_past_the_beams_deadline_is_shortened_by_the_same_beam(monk
     assert found is not None and found[1] == 8
 
 
+def test_with_a_plan_in_hand_a_wider_beam_gets_the_beams_own_deadline(monkeypatch):
+    # The first plan comes well before the beams' deadline and the descent's is later still:
+    # the shorter targets run under the descent's, but a wider beam tried after one fails
+    # runs under the beams' own deadline, not past it.
+    from feederkit.planning import beam as beam_module
+
+    machine = _random_part_machine(seed=1, n=10, rel=0.2)
+    problem, _branches, roots = _problem(machine)
+    made = []
+    found_at = []
+    real_beam, real_lengths = beam_module._beam, beam_module._lengths
+
+    def beam_spy(problem_, width, deadline_, seed, last):
+        made.append((width, deadline_, bool(found_at)))
+        return real_beam(problem_, width, deadline_, seed, last)
+
+    def lengths_spy(beam, roots_, target):
+        out = real_lengths(beam, roots_, target)
+        if out is not None and not found_at:
+            found_at.append(beam.width)
+        return out
+
+    monkeypatch.setattr(beam_module, "_beam", beam_spy)
+    monkeypatch.setattr(beam_module, "_lengths", lengths_spy)
+    own = Deadline(30.0)
+    found = beam_plan(problem, roots, None, own, 2 * machine.n + 1, 1, Deadline(600.0))
+    assert found is not None
+    after = [(w, d) for w, d, late in made if late]
+    assert after  # some wider beam was tried with the plan in hand
+    assert all(d is own for _w, d in after)
+
+
 def test_the_descent_takes_its_share_of_the_first_plans_deadline():
     import time
 

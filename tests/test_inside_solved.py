@@ -18,12 +18,13 @@ from hypothesis import strategies as st
 from shared import small_mix
 from test_beam import _problem
 from test_planners import check_plan
+from test_quiet import _coarse
 
 from feederkit.angles import norm360
 from feederkit.machine import build_machine, successor
 from feederkit.planning.andor import WorstCase
 from feederkit.planning.api import _result
-from feederkit.planning.beam import BeamSearch, _lengths
+from feederkit.planning.beam import SMALL_DEPTH, SMALL_SET, BeamSearch, _lengths
 from feederkit.planning.budget import Deadline
 from feederkit.planning.fallback import _choice_plan
 from feederkit.planning.quiet import QuietWorst
@@ -103,11 +104,61 @@ def test_a_beam_plan_through_borrowed_actions_takes_every_branch(count, tol, wid
     result = _result(machine, root, False, None, 1, "worst", "exact")
     assert check_plan(result) == result.length <= 1 + max(lengths)
     assert _unreached(result) == 0
+    assert _goals_going_on(problem, result.root) == 0  # an oriented branch ends in a leaf
+
+
+def _goals_going_on(problem, root) -> int:
+    """How many reading branches past the first alignment are goals (the reading orients
+    the part) and yet go on with another operation."""
+    seen: set[int] = set()
+    todo = [root]
+    out = 0
+    while todo:
+        node = todo.pop()
+        if isinstance(node, Leaf) or id(node) in seen:
+            continue
+        seen.add(id(node))
+        for b, sub in node.branches:
+            if node.action is not None and problem.is_goal(b.mask) and not isinstance(sub, Leaf):
+                out += 1
+            todo.append(sub)
+    return out
 
 
 def test_a_quiet_search_borrows_no_action():
-    # Its plans are chains (quiet.chain_plan) that follow each image's own action.
-    machine = build_machine(small_mix(4, 100), ToleranceSensor(3.0), IDEAL)
-    problem, _branches, _roots = _problem(machine)
+    # Its plans are chains (quiet.chain_plan) that follow each image's own action: no
+    # entry of its choices is another set's.
+    machine, _tol = _coarse(small_mix(3, 700))  # one reading fits every state
+    problem, _branches, roots = _problem(machine)
     assert WorstCase(problem)._solved is not None
-    assert QuietWorst(problem)._solved is None
+    worst = QuietWorst(problem)
+    for r in roots:
+        for k in range(1, 8):
+            worst.within(r, k)
+    assert worst.choice
+    assert len({id(e) for e in worst.choice.values()}) == len(worst.choice)
+    assert all(
+        worst.p.choices.cell_at(m, norm360((e[1].action.lo + e[1].action.hi) / 2.0))[2]
+        == e[1].action.image
+        for m, e in worst.choice.items()
+    )
+
+
+def test_a_small_set_inside_a_solved_one_is_not_given_up_in_a_beam(monkeypatch):
+    # Under uncertainty a beam takes a small set with no plan within SMALL_DEPTH to have
+    # none; one inside a set solved within the budget is solved first.
+    machine = build_machine(small_mix(4, 100), ToleranceSensor(3.0))
+    assert not machine.deterministic
+    problem, _branches, _roots = _problem(machine)
+    beam = BeamSearch(problem, 4)
+    big = next(m for m in problem.choices.cells(problem.full) if m[2].bit_count() > SMALL_SET)
+    act = problem.choices.act(problem.full, big, exact=True)
+    lender = big[2]
+    beam.choice[lender] = (SMALL_DEPTH + 5, act)
+    beam.ub[lender] = SMALL_DEPTH + 5
+    beam._solved.add(lender)
+    small = lender & -lender | (lender & (lender - 1)) & -(lender & (lender - 1))
+    assert small.bit_count() == 2 and not problem.is_goal(small)
+    monkeypatch.setattr(beam, "within", lambda mask, k: False)  # none within SMALL_DEPTH
+    assert beam._known(small, SMALL_DEPTH + 5) is True
+    assert small not in beam.never and not beam.gave_up

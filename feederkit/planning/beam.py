@@ -118,7 +118,9 @@ class BeamSearch(WorstCase):
             and mask.bit_count() <= SMALL_SET
             and self.lb.get(mask, 1) <= SMALL_DEPTH
         ):
-            if self.within(mask, SMALL_DEPTH):
+            # A set inside a set solved within ``k`` is solved (asked first: the give-up
+            # below would hold for the rest of this beam).
+            if self.inside_solved(mask, k) or self.within(mask, SMALL_DEPTH):
                 return True
             self.never.add(mask)
             self.gave_up = True
@@ -222,7 +224,9 @@ def beam_plan(
         elif reach < target:
             aim, step = reach + step, 2 * step
         elif beam.cut and (best is None or not deadline.expired()):
-            beam = _beam(problem, 2 * beam.width, beam.deadline, seed, beam)
+            # With a plan in hand a wider beam gets the beams' own deadline, not the descent's.
+            wider = beam.deadline if best is None else deadline
+            beam = _beam(problem, 2 * beam.width, wider, seed, beam)
             aim, step = start, 1
         else:
             # Every action kept: no plan within the target exists (unless small sets were

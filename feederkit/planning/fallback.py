@@ -148,8 +148,9 @@ def fallback(
     greedy action order of ``Choices.lazy_actions``, on an explicit stack) for something
     shorter still. A tree follows the actions that proved it; a reading set the searches
     never met lies inside one they did (its "witness"), and follows the witness's
-    rotations. :class:`~feederkit.planning.options.OutOfBudget` when none finds a plan in
-    time.
+    rotations, in a node of its own where its image there is not the witness's
+    (:func:`_choice_plan`). :class:`~feederkit.planning.options.OutOfBudget` when none finds
+    a plan in time.
 
     No Timeout is kept past its ``except`` block: its traceback holds the frames of the
     search, and a frame holding it would make the searches' tables cyclic garbage that only
@@ -436,11 +437,12 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
     (the 50-part mix at 3 % under 1 degree: about a tenth of the nodes), and every consumer
     (verification, certificate, file, drawing) walks that much less.
 
-    A set may hold a larger set's action (``WorstCase.inside_solved``: solved inside it);
-    then its node is its own: its overlap range around that action's rotation, its own
-    image's reading branches, each going on with the maximal branch of its own image that
-    holds it, following the plan of the larger set's branch around it. A node is keyed by
-    its set and the set whose plan it follows (as ``Refiner.follow``), so every node is
+    A set may hold a larger set's action (``WorstCase.inside_solved``: solved inside it).
+    Where its image under that rotation is not the larger set's, its node is its own: its
+    overlap range around the rotation, its own image's reading branches, each a leaf where
+    the reading orients the part, else going on with the maximal branch of its own image
+    that holds it, following the plan of the larger set's branch around it. A node is keyed
+    by its set and the set whose plan it follows (as ``Refiner.follow``), so every node is
     reached by all of its states and no branch is one that no state takes.
     """
     readings = problem.readings
@@ -458,32 +460,53 @@ def _choice_plan(problem: Problem, choice, roots, root_branches, deadline: Deadl
                 best, bound = c, choice[c][0]
         return best
 
+    cells: dict[tuple[int, int], tuple[float, float, int] | None] = {}
+
+    def own_cell(mask: int, lender: int) -> tuple[float, float, int] | None:
+        # The set's own range around the lender's chosen rotation (a bisection per member),
+        # None where its image there is the lender's: it then follows the lender's node,
+        # every branch of which its states take. (The rotation lies strictly inside one of
+        # the set's cells: a subset's cell boundaries are among the larger set's.)
+        key = (mask, lender)
+        if key not in cells:
+            sa = choice[lender][1].action
+            cell = problem.choices.cell_at(mask, norm360((sa.lo + sa.hi) / 2.0))
+            cells[key] = None if cell is None or cell[2] == sa.image else cell
+        return cells[key]
+
+    def key_of(mask: int, lender: int) -> tuple[int, int]:
+        # A plan node's key: the set arriving and the set whose plan it follows.
+        if problem.is_goal(mask):
+            return (mask, mask)
+        if mask == lender or own_cell(mask, lender) is None:
+            return (lender, lender)
+        return (mask, lender)
+
     def expand(key: tuple[int, int]):
         mask, lender = key
         if problem.is_goal(mask):
             return Leaf(mask)
-        _k, act = choice[lender]
-        sa = act.action
-        # The set's own range around the chosen rotation (a bisection per member); the
-        # chosen action itself where the image is the same (the set's own choice, or a
-        # larger set's that moves it alike).
-        cell = problem.choices.cell_at(mask, norm360((sa.lo + sa.hi) / 2.0))
-        if cell is None or cell[2] == sa.image:
+        act = choice[lender][1]
+        cell = own_cell(mask, lender)
+        if cell is None:  # the chosen action moves the set as it moves the lender
             subs = []
-            for b in readings.image_branches(sa.image):
+            for b in readings.image_branches(act.action.image):
                 w = witness_of(b.mask, act.children)
-                subs.append((b, (w, w)))
-            return sa, subs
+                subs.append((b, key_of(w, w)))
+            return act.action, subs
         maximal = readings.children(cell[2])
         subs = []
         for b in readings.image_branches(cell[2]):
+            if problem.is_goal(b.mask):  # oriented by the reading
+                subs.append((b, (b.mask, b.mask)))
+                continue
             own = next(m for m in maximal if b.mask & m == b.mask)
-            subs.append((b, (own, witness_of(own, act.children))))
+            subs.append((b, key_of(own, witness_of(own, act.children))))
         return OverlapRange(*cell), subs
 
-    top = [(b, witness_of(b.mask, roots)) for b in root_branches]
-    made = build_dag([(w, w) for _b, w in top], expand, deadline)
-    return root_step(((b, made[(w, w)]) for b, w in top), deadline)
+    top = [(b, key_of(w, w)) for b in root_branches for w in (witness_of(b.mask, roots),)]
+    made = build_dag([k for _b, k in top], expand, deadline)
+    return root_step(((b, made[k]) for b, k in top), deadline)
 
 
 def sensorless_plan(
