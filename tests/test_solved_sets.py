@@ -22,8 +22,12 @@ from test_tie_breaks import _max_min, _proven
 
 from feederkit.machine import build_machine
 from feederkit.planning.api import plan
+from feederkit.planning.budget import Deadline
+from feederkit.planning.methods import longest_root, make_oracle
 from feederkit.planning.problem import Problem
+from feederkit.planning.readings import maximal_sets
 from feederkit.planning.refine import Refiner
+from feederkit.planning.reindex import by_diameter
 from feederkit.planning.solved import MAX_TRIES, SolvedSets
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL
@@ -114,8 +118,17 @@ def test_a_plan_made_with_the_shortcut_runs_from_every_start_and_reading(monkeyp
 
 
 def test_no_index_under_a_margin_floor():
+    # Margins are not monotone under subsets once a floor drops ranges: neither the probes
+    # nor the length search of a floored problem keep an index (each with its own oracle).
     machine = build_machine(small_mix(8, 100), ToleranceSensor(3.0), IDEAL)
-    floored, every, k = _proven(machine)
-    floored = Refiner(Problem(floored.p.machine, min_margin=0.5), floored.w)
+    plain, every, k = _proven(machine)
+    plain.margin(every[-1], k)
+    assert plain._kept_sets  # without a floor the probes keep one
+    problem = Problem(by_diameter(machine)[0], min_margin=0.5)
+    worst = make_oracle(problem, "auto", Deadline())
+    every = sorted({b.mask for b in problem.readings.branches(problem.full)})
+    k = longest_root(problem, worst, sorted(maximal_sets(every)), "auto", None)
+    floored = Refiner(problem, worst)
     floored.margin(every[-1], k)
     assert floored._kept_sets == {}
+    assert worst._solved is None
