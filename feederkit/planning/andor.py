@@ -64,9 +64,12 @@ class WorstCase:
     inside a set solved within a depth is solved within it, following the larger set's plan
     (:mod:`~feederkit.planning.solved`; its ``choice`` is the larger set's action, whose
     rotation sends it inside the larger set's image): a plan is a plan in any search.
+    ``SUBSET_SOLVES`` False turns that off for searches whose plans follow each set's own
+    action.
     """
 
     SUBSET_REFUTES = True
+    SUBSET_SOLVES = True
 
     def __init__(
         self, problem: Problem, deadline: Deadline | None = None, pair_bound: bool = True
@@ -87,12 +90,11 @@ class WorstCase:
         self._deep = False  # pair bounds pay: PAIR_BOUND_DEPTH or PAIR_BOUND_SETS reached
         self._opened = 0  # sets the searches have opened (frames pushed)
         machine = getattr(problem, "machine", None)
-        monotone = self.SUBSET_REFUTES and getattr(problem, "min_margin", None) == 0.0
-        ok = monotone and isinstance(machine, PushAlignMachine)
-        self._refuted = RefutedSets(machine.n) if ok else None
-        inside = getattr(problem, "min_margin", None) == 0.0
-        ok = inside and isinstance(machine, PushAlignMachine)
-        self._solved = SolvedSets(machine.n) if ok else None
+        # Lengths are monotone under subsets (no margin floor): both indexes are sound.
+        monotone = getattr(problem, "min_margin", None) == 0.0
+        monotone = monotone and isinstance(machine, PushAlignMachine)
+        self._refuted = RefutedSets(machine.n) if monotone and self.SUBSET_REFUTES else None
+        self._solved = SolvedSets(machine.n) if monotone and self.SUBSET_SOLVES else None
 
     def holds_plan(self, mask: int, k: int) -> bool:
         """Whether the memo already holds a plan of ``mask`` within ``k`` operations, without

@@ -62,14 +62,13 @@ class QuietWorst(WorstCase):
     """The worst-case oracle of a machine whose readings carry nothing: every set's length is
     its sensorless length (module docstring), searched by A* over sets."""
 
+    SUBSET_SOLVES = False  # chain_plan follows each image's own chosen action
+
     def __init__(
         self, problem: Problem, deadline: Deadline | None = None, pair_bound: bool = True
     ) -> None:
         super().__init__(problem, deadline, pair_bound)
         self._quiet = _always
-        # No set borrows a larger set's plan (WorstCase.inside_solved): chain_plan follows
-        # each image's own chosen action, whose image must be that set's.
-        self._solved = None
         # Per part: its mask, a table per byte of the machine's mask to the part's own
         # numbering, and its backchaining table (made when first asked).
         self._parts: list[tuple[int, list[list[int]], object]] | None = None
