@@ -36,7 +36,7 @@ from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.api import _result, plan
 from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.fallback import sensorless_plan
+from feederkit.planning.fallback import _fewest_after, sensorless_plan
 from feederkit.planning.options import Grouping, Method, Objective, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.sensorless import Backchain, push_circle
@@ -430,6 +430,38 @@ def test_backchaining_length_of_any_set_is_the_breadth_first_length(kind, seed, 
         seen |= frontier
         depth += 1
     assert Backchain(circle).length(start) == depth
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.sampled_from([("random", 9), ("random", 16), ("regular", 11)]),
+    st.integers(0, 10**6),
+    st.integers(1, 2**20 - 1),
+)
+def test_the_rotation_by_the_readings_left_is_the_first_fewest_one_set_at_a_time(kind, seed, bits):
+    # The plan that follows the readings takes the first rotation whose reading sets need
+    # the fewest sensorless operations (the largest, then their sum): all the sets' lengths
+    # by array operations against Goldberg's table one set at a time.
+    name, n = kind
+    offset = (0.01 + seed % 7 / 100, 0.004 + seed % 5 / 200)
+    pf = random_convex(seed, n) if name == "random" else regular(n, offset)
+    m = build_machine([pf], ToleranceSensor(0.02 * pf.part.size), IDEAL)
+    problem = Problem(m)
+    circle = push_circle(m, problem.insep)
+    start = bits & m.all_states
+    assume(circle is not None and start and not problem.is_goal(start))
+    chain = Backchain(circle)
+    kids = [problem.readings.children(c[2]) for c in problem.choices.cells(start, False)]
+    sets = [b for ks in kids for b in ks]
+    assert Backchain(circle).lengths_of_sets(sets).tolist() == [chain.length(b) for b in sets]
+
+    def fewest(ks):
+        lengths = [chain.length(b) for b in ks]
+        return max(lengths), sum(lengths)
+
+    assert _fewest_after(Backchain(circle), kids) == min(
+        range(len(kids)), key=lambda i: fewest(kids[i])
+    )
 
 
 @pytest.mark.slow

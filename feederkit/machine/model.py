@@ -19,6 +19,8 @@ import bisect
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from feederkit.angles import ActionRange, RotationRange, norm360
 from feederkit.sensors import Diameter, Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
@@ -210,6 +212,19 @@ def members(mask: int) -> list[int]:
         out.append(low.bit_length() - 1)
         mask ^= low
     return out
+
+
+def bit_rows(masks: Sequence[int], n: int) -> np.ndarray:
+    """Sets as a boolean matrix, a row per mask and a column per state (``n`` states): many
+    sets at once for array operations.
+
+    >>> bit_rows([0b101, 0b010], 3).tolist()
+    [[True, False, True], [False, True, False]]
+    """
+    width = (n + 7) // 8
+    raw = np.frombuffer(b"".join(m.to_bytes(width, "little") for m in masks), np.uint8)
+    rows = raw.reshape(len(masks), width)
+    return np.unpackbits(rows, axis=1, count=n, bitorder="little").astype(bool)
 
 
 def successor(machine: PushAlignMachine, state: int, action: float) -> int:

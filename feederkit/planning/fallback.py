@@ -20,6 +20,8 @@ from __future__ import annotations
 import gc
 import time
 
+import numpy as np
+
 from feederkit.angles import norm360
 from feederkit.machine import OverlapRange
 from feederkit.planning.andor import WorstCase
@@ -534,11 +536,6 @@ def sensorless_plan(
         return None
     chain = Backchain(circle)
 
-    def after(cell: tuple[float, float, int]) -> tuple[float, float]:
-        # The sensorless lengths the readings can leave: the largest, then their sum.
-        lengths = [chain.length(b) for b in problem.readings.children(cell[2])]
-        return max(lengths), sum(lengths)
-
     def expand(mask: int):
         if problem.is_goal(mask):
             return Leaf(mask)
@@ -555,8 +552,10 @@ def sensorless_plan(
         # set holding it (its witness: a plan of a set orients its subsets), so the plan
         # has a node per maximal set, not one per reading set (on the 1000-point outline
         # above 136 s became about 2).
-        lo, hi, img = min(cells, key=after)
-        wider = problem.readings.children(img)
+        kids = [problem.readings.children(c[2]) for c in cells]
+        best = _fewest_after(chain, kids)
+        lo, hi, img = cells[best]
+        wider = kids[best]
 
         def witness(m: int) -> int:
             return m if problem.is_goal(m) else next((c for c in wider if m & ~c == 0), m)
@@ -573,6 +572,27 @@ def sensorless_plan(
         keys = {b.mask: b.mask for b in root_branches}
     made = build_dag(list(keys.values()), expand, deadline)
     return root_step(((b, made[keys[b.mask]]) for b in root_branches), deadline)
+
+
+def _fewest_after(chain: Backchain, kids: list[tuple[int, ...]]) -> int:
+    """The first rotation whose reading sets (``kids``, per rotation) need the fewest
+    sensorless operations: the largest, then their sum; all the sets' lengths at once
+    (:meth:`~feederkit.planning.sensorless.Backchain.lengths_of_sets`).
+
+    >>> from feederkit.planning.sensorless import PushCircle
+    >>> chain = Backchain(PushCircle(360.0, (0, 1, 2, 3), (0.0, 60.0, 180.0, 200.0),
+    ...                              (30.0, 20.0, 50.0, 40.0), (30.0, 20.0, 50.0, 40.0)))
+    >>> [chain.length(m) for m in (0b1111, 0b0011, 0b1100, 0b0110, 0b0100)]
+    [inf, 1, 1, inf, 0]
+    >>> _fewest_after(chain, [(0b1111,), (0b0011, 0b1100), (0b0011, 0b0100, 0b1000)])
+    2
+    """
+    lengths = chain.lengths_of_sets([b for ks in kids for b in ks])
+    starts = np.cumsum([0, *(len(ks) for ks in kids[:-1])])
+    largest = np.maximum.reduceat(lengths, starts)
+    total = np.add.reduceat(lengths, starts)
+    tied = np.flatnonzero(largest == largest.min())
+    return int(tied[np.argmin(total[tied])])
 
 
 def _proven(worst: WorstCase, mask: int) -> int:

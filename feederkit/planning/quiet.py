@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from feederkit.machine import bit_rows
 from feederkit.planning.andor import WorstCase, part_chains
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.problem import Problem
@@ -115,11 +116,7 @@ class QuietWorst(WorstCase):
             return
         if self._columns is None:
             self._make_tables()
-        n = self.p.machine.n
-        width = (n + 7) // 8
-        raw = np.frombuffer(b"".join(m.to_bytes(width, "little") for m in new), np.uint8)
-        bits = np.unpackbits(raw.reshape(len(new), width), axis=1, count=n, bitorder="little")
-        inside = bits.astype(bool)
+        inside = bit_rows(new, self.p.machine.n)
         big = np.zeros(len(new), dtype=np.int64)
         total = np.zeros(len(new), dtype=np.int64)
         for cols, chain in self._columns:

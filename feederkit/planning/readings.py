@@ -27,7 +27,14 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from feederkit.machine import Grouping, PushAlignMachine, ReadingBranch, members, search_space
+from feederkit.machine import (
+    Grouping,
+    PushAlignMachine,
+    ReadingBranch,
+    bit_rows,
+    members,
+    search_space,
+)
 
 
 def reading_probability(machine: PushAlignMachine, branch: ReadingBranch, state: int) -> float:
@@ -290,10 +297,7 @@ class Readings:
     def _array_keys(self, images: list[int]) -> list[tuple[int, int]]:
         """:meth:`branch_keys` by array operations over every image at once."""
         n = self.machine.n
-        width = (n + 7) // 8
-        raw = b"".join(img.to_bytes(width, "little") for img in images)
-        packed = np.frombuffer(raw, dtype=np.uint8).reshape(len(images), width)
-        bits = np.unpackbits(packed, axis=1, count=n, bitorder="little").astype(np.int32)
+        bits = bit_rows(images, n).astype(np.int32)
         counts = np.zeros((len(images), n + 1), dtype=np.int32)
         np.cumsum(bits, axis=1, out=counts[:, 1:])
         below_end = counts[:, self._window_end] * bits  # members before each run's end
