@@ -305,7 +305,7 @@ class _Choices:
     def __init__(self, depth: int) -> None:
         self.depth = depth
 
-    def search_actions(self, m: int):
+    def search_actions(self, m: int, check=None):
         return iter([_Act((m + 1,))] if m < self.depth else [])
 
 
@@ -358,6 +358,70 @@ def test_the_largest_margin_polls_its_deadline_per_set_it_discovers(monkeypatch)
     with pytest.raises(Timeout):
         largest_margin(problem, roots, WorkBudget(Deadline(), 3))
     assert len(made) <= 3
+
+
+def _counting(monkeypatch, obj, name: str) -> list:
+    """Replace ``obj.name`` by a wrapper that records each call's first argument."""
+    calls: list = []
+    fn = getattr(obj, name)
+
+    def counted(first, *args, **kwargs):
+        calls.append(first)
+        return fn(first, *args, **kwargs)
+
+    monkeypatch.setattr(obj, name, counted)
+    return calls
+
+
+def test_a_large_sets_actions_poll_the_deadline_as_they_are_made(monkeypatch):
+    # Without reading windows (the components rule) each cell's rank is a split of its
+    # image's reading branches, and a set with thousands of cells took seconds before the
+    # search's first poll (the largest root of a 200-part mix at 0.5 %: 4.6 s); so did the
+    # exact view's actions (with a margin floor). Both now poll every POLL_CELLS.
+    from feederkit.planning.choices import POLL_CELLS
+
+    machine = build_machine(small_mix(12), ToleranceSensor(0.4), IDEAL)
+    sorted_machine = by_diameter(machine)[0]
+    full = sorted_machine.all_states
+    problem = Problem(sorted_machine, grouping="components")
+    assert problem.readings.branch_keys([full]) is None  # no windows: one split per cell
+    assert len(problem.choices.cells(full)) > 3 * POLL_CELLS
+    keyed = _counting(monkeypatch, problem.choices, "branch_key")
+    with pytest.raises(Timeout):
+        problem.choices.useful_cells(full, WorkBudget(Deadline(), 1).check)
+    assert len(keyed) <= 2 * POLL_CELLS
+    made = _counting(monkeypatch, problem.choices, "act")
+    with pytest.raises(Timeout):
+        problem.choices.exact_actions(full, WorkBudget(Deadline(), 1).check)
+    assert len(made) <= 2 * POLL_CELLS
+    # A search hands its own deadline down.
+    search = WorstCase(problem, WorkBudget(Deadline(), 2))
+    keyed.clear()
+    with pytest.raises(Timeout):
+        search.within(full, 3)
+    assert len(keyed) <= 2 * POLL_CELLS
+
+
+def test_the_pairs_of_the_roots_and_the_widest_first_actions_poll_the_deadline(monkeypatch):
+    # Listing every pair inside the roots (the check that some pair has no strong plan) and
+    # the margin stage's first pass over every root's cells made no poll.
+    from feederkit.planning.refine import Refiner
+    from feederkit.planning.solvable import _pairs_within
+
+    machine = build_machine(small_mix(12), ToleranceSensor(0.4), IDEAL)
+    problem = Problem(by_diameter(machine)[0])
+    roots = [problem.full]
+    with pytest.raises(Timeout):
+        _pairs_within(problem, roots, None, WorkBudget(Deadline(), 3))
+    assert len(_pairs_within(problem, roots, None, Deadline())) > 100
+    opened = [b.mask for b in problem.readings.branches(problem.full)]
+    opened = [m for m in opened if not problem.is_goal(m)]
+    assert len(opened) > 4
+    listed = _counting(monkeypatch, problem.choices, "cells")
+    refiner = Refiner(problem, WorstCase(problem), WorkBudget(Deadline(), 2))
+    with pytest.raises(Timeout):
+        refiner.largest_floor(opened, 3)
+    assert len(listed) <= 2
 
 
 def _proven_refiner(machine, deadline: Deadline):

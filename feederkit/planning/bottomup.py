@@ -41,6 +41,7 @@ def bottom_up_lengths(
     for r in roots:
         idx = members(r)
         for size in range(1, len(idx) + 1):
+            deadline.check()  # up to MAX_SUBSETS sets are listed before any search
             lev = levels.setdefault(size, set())
             for combo in combinations(idx, size):
                 m = 0
@@ -62,7 +63,7 @@ def bottom_up_lengths(
             for s in todo:
                 deadline.check()
                 best = value[s]
-                for act in problem.choices.search_actions(s):
+                for act in problem.choices.search_actions(s, deadline.check):
                     v = 1 + max(value.get(c, math.inf) for c in act.children)
                     if v < best:
                         best = v

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import bisect
 import itertools
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +33,13 @@ import numpy as np
 from feederkit.angles import ANGLE_EPS, cells_between, norm360, width_key
 from feederkit.machine import OverlapRange, PushAlignMachine, members, search_space
 from feederkit.planning.readings import Readings
+
+Poll = Callable[[], None]
+"""A deadline's ``check``: raises Timeout once the time or memory is out."""
+
+POLL_CELLS = 32
+"""A set's actions or branch keys made one at a time poll the caller's deadline once per
+this many (each a split of an image's reading branches)."""
 
 _DOMINATORS = 8
 """The length view tests an image against this many smaller ones for dominance."""
@@ -233,24 +240,32 @@ class Choices:
             return None
         return Act(sa, children)
 
-    def exact_actions(self, mask: int) -> tuple[Act, ...]:
+    def exact_actions(self, mask: int, check: Poll | None = None) -> tuple[Act, ...]:
         """Every action of the set above the margin floor with all its branch sets (cached).
 
         The margin of a merged overlap range holds for the set but not for its subsets (a
         subset's image can change inside it where the set's does not), so margins and
         margin floors are not monotone under subsets: the stages that depend on margins
-        use this exact view.
+        use this exact view. ``check`` (a deadline's) is polled every ``POLL_CELLS``
+        actions made: a set of hundreds of states has thousands.
         """
         acts = self._exact.get(mask)
         if acts is None:
-            acts = tuple(self.act(mask, c, exact=True) for c in self.cells(mask, useful=False))
-            self._exact[mask] = acts  # type: ignore[assignment]
+            made = []
+            for n, c in enumerate(self.cells(mask, useful=False)):
+                if check is not None and n % POLL_CELLS == POLL_CELLS - 1:
+                    check()
+                made.append(self.act(mask, c, exact=True))
+            acts = self._exact[mask] = tuple(made)  # type: ignore[assignment]
         return acts  # type: ignore[return-value]
 
-    def search_actions(self, mask: int) -> Iterator[Act]:
+    def search_actions(self, mask: int, check: Poll | None = None) -> Iterator[Act]:
         """The actions the length search uses: the length view when lengths are monotone
-        under subsets (no margin floor), else the exact view."""
-        return self.lazy_actions(mask) if self.min_margin == 0.0 else iter(self.exact_actions(mask))
+        under subsets (no margin floor), else the exact view; ``check`` as in
+        :meth:`useful_cells` and :meth:`exact_actions`."""
+        if self.min_margin == 0.0:
+            return self.lazy_actions(mask, check)
+        return iter(self.exact_actions(mask, check))
 
     def actions(self, mask: int) -> tuple[Act, ...]:
         """Useful representative actions of a set (``lazy_actions``, all made; cached)."""
@@ -261,11 +276,12 @@ class Choices:
             acts = self._actions[mask]
         return acts
 
-    def lazy_actions(self, mask: int) -> Iterator[Act]:
+    def lazy_actions(self, mask: int, check: Poll | None = None) -> Iterator[Act]:
         """The length view's actions, made only as far as a search consumes them.
 
         In :meth:`useful_cells`'s order (the smallest largest reading branch first): the
         search usually succeeds, or fails at a memoised depth, long before the last one.
+        ``check`` as in :meth:`useful_cells`.
         """
         done = self._actions.get(mask)
         if done is not None:
@@ -273,7 +289,7 @@ class Choices:
             return
         state = self._lazy.get(mask)
         if state is None:
-            state = self._lazy[mask] = [iter(self.useful_cells(mask)), []]
+            state = self._lazy[mask] = [iter(self.useful_cells(mask, check)), []]
         cells, made = state
         i = 0
         while True:
@@ -336,7 +352,7 @@ class Choices:
             OverlapRange(*cell), (img,) if self.readings.sensorless else self.readings.children(img)
         )
 
-    def useful_cells(self, mask: int) -> list[tuple[float, float, int]]:
+    def useful_cells(self, mask: int, check: Poll | None = None) -> list[tuple[float, float, int]]:
         """The cells of :meth:`lazy_actions`, ranked before any action is made: a caller
         that ranks them makes only the actions it keeps (:meth:`useful_act`).
 
@@ -348,7 +364,10 @@ class Choices:
         needs no more operations; testing against every earlier image costs more than it
         saves on sets with hundreds of ranges. No cell's image holds the set
         (:meth:`cells`), so no branch does. The branch keys come from the readings' windows
-        for every cell at once where they apply (``Readings.branch_keys``), else per image.
+        for every cell at once where they apply (``Readings.branch_keys``), else per image,
+        a split of its reading branches each, ``check`` (a deadline's) polled every
+        ``POLL_CELLS`` of them: under the components rule the largest root of a 200-part
+        mix at 0.5 % has 4,013 cells, 4.6 s of splits.
         """
         cells = sorted(self.cells(mask), key=lambda c: (c[2].bit_count(), c[0] - c[1]))
         kept: list[int] = []
@@ -364,7 +383,11 @@ class Choices:
         if not self.readings.sensorless:
             keys = self.readings.branch_keys([c[2] for c in undominated])
         if keys is None:
-            keys = [self.branch_key(c[2]) for c in undominated]
+            keys = []
+            for n, c in enumerate(undominated):
+                if check is not None and n % POLL_CELLS == POLL_CELLS - 1:
+                    check()
+                keys.append(self.branch_key(c[2]))
         ranked = sorted(
             ((*key, c[2].bit_count(), c[0] - c[1]), n)
             for n, (key, c) in enumerate(zip(keys, undominated, strict=True))
