@@ -13,6 +13,7 @@ from shared import catalog_with, no_stray_profile, run_cli  # noqa: F401 (autous
 
 from feederkit.cli.catalog_analyze import IDEAL_ONLY_NOTE, _Readings
 from feederkit.errors import PlanningError
+from feederkit.machine import build_machine
 from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import push_function
 from feederkit.outline import load_outline_json, make_outline
@@ -126,6 +127,24 @@ def test_the_vibration_is_the_cause_only_when_no_rotation_error_has_a_plan():
     text = largest_uncertainty([_cham()], SENSOR, Uncertainty(1.0, 0.02, 0.1), PlanningOptions())
     assert "nor does any rotation error without them" in text
     assert "the feeder's vibration" in text and "no shape or COM tolerance" in text
+
+
+def test_out_of_time_the_largest_uncertainty_builds_no_machine():
+    # Each step of the bisection builds a machine (0.3 s on a 200-part mix); once the time
+    # is out it is undecided at once, with no build for nothing.
+    built = []
+
+    def build(unc):
+        built.append(unc)
+        return build_machine([_cham()], SENSOR, unc)
+
+    text = largest_uncertainty(
+        [_cham()], SENSOR, Uncertainty(1.0), PlanningOptions(), seconds=0.0, build=build
+    )
+    assert text == "the largest uncertainty with a strong plan was not found within the time limit"
+    assert built == []
+    largest_uncertainty([_cham()], SENSOR, Uncertainty(1.0), PlanningOptions(), build=build)
+    assert built
 
 
 # --- the command line -----------------------------------------------------------------------

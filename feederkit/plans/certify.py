@@ -143,7 +143,9 @@ def largest_uncertainty(
 
     def exists(unc: Uncertainty) -> bool | None:
         """Whether a strong plan exists at ``unc``; None when not decided in time."""
-        left = None if stop is None else max(stop - time.monotonic(), 0.0)
+        left = None if stop is None else stop - time.monotonic()
+        if left is not None and left <= 0.0:
+            return None  # out of time: no machine built for nothing (each build costs)
         machine = build_machine(push_functions, sensor, unc) if build is None else build(unc)
         return decided_exists(machine, options, left)
 
