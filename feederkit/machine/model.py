@@ -221,6 +221,8 @@ def bit_rows(masks: Sequence[int], n: int) -> np.ndarray:
     >>> bit_rows([0b101, 0b010], 3).tolist()
     [[True, False, True], [False, True, False]]
     """
+    if any(m >> n for m in masks):
+        raise ValueError(f"a set holds states beyond the {n} of the machine")
     width = (n + 7) // 8
     raw = np.frombuffer(b"".join(m.to_bytes(width, "little") for m in masks), np.uint8)
     rows = raw.reshape(len(masks), width)

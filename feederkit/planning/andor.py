@@ -395,7 +395,7 @@ class WorstCase:
     def actions_of(self, mask: int) -> Iterator[Act]:
         """The actions :meth:`within` tries for a set, in order: every one the length search
         needs (``Choices.search_actions``); a restricted search overrides it."""
-        return self.p.choices.search_actions(mask, self.deadline.check)
+        return self.p.choices.search_actions(mask, self.deadline.limits)
 
     def length(self, mask: int, limit: int | None = None) -> int:
         """The minimum worst-case number of operations for ``mask`` (iterative deepening).

@@ -225,8 +225,8 @@ RESULT_S_PER_PAIR = 3e-6
 """Seconds per (node, state) pair of the plan of what :func:`plan` does after its last poll:
 the result's statistics (expected operations, a walk of every pair) and the renumbering of
 the tree. With no caller's budget its deadline comes this much earlier per pair of the plan
-it makes (``Deadline.per_pair_s``), as a command's does for its verification and file
-(``plans.timelimit.POST_S_PER_PAIR``, which counts this too). Measured 2.8e-6 s on a
+it makes (``Deadline.per_pair_s``), as a command's own budget does for its verification
+and file (``plans.timelimit.POST_S_PER_PAIR``). Measured 2.8e-6 s on a
 200-part mix's fallback plan at 1 % on the ideal model (994,000 pairs, 2.8 s: it answered
 1.3 s past a 15 s limit) and 3.3-4.5e-6 s on 50- and 100-part mixes' plans (43,000-114,000
 pairs, whose fixed costs weigh more)."""
@@ -282,7 +282,8 @@ def plan(
     ``options`` default to :class:`PlanningOptions` ``()``. ``budget`` is the deadline and
     memory limit to plan under when a caller keeps part of the options' limits for its own
     work after the plan (a command's verification and file); by default the options' limits
-    from now. Messages name the options' limits.
+    from now, the deadline coming ``RESULT_S_PER_PAIR`` earlier per (node, state) pair of the
+    plan made (its statistics after the last poll). Messages name the options' limits.
 
     Raises InputError for bad options and PlanningError when no plan keeps the minimum
     margin (naming the largest margin that works) or none is found within the time limit.

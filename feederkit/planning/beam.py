@@ -134,15 +134,15 @@ class BeamSearch(WorstCase):
             if mask.bit_count() <= SMALL_SET:
                 # Every action of a small set: they are few, and the beam's order cannot tell
                 # them apart (each leaves branches of two states at most, for a pair).
-                acts = tuple(choices.search_actions(mask, self.deadline.check))
+                acts = tuple(choices.search_actions(mask, self.deadline.limits))
             elif self.p.min_margin > 0.0:  # margins are not monotone: every branch counts
-                every = choices.exact_actions(mask, self.deadline.check)
+                every = choices.exact_actions(mask, self.deadline.limits)
                 self.cut |= len(every) > self.width
                 acts = tuple(sorted(every, key=branch_key)[: self.width])
             else:
                 # Ranked from the cells and their branches; only the kept actions are made
                 # (a set has about a hundred on a near-round part, and the beam keeps four).
-                ranked = choices.useful_cells(mask, self.deadline.check)  # branch_key order
+                ranked = choices.useful_cells(mask, self.deadline.limits)  # branch_key order
                 self.cut |= len(ranked) > self.width
                 acts = tuple(choices.useful_act(cell) for cell in ranked[: self.width])
             self._beam[mask] = acts

@@ -63,7 +63,7 @@ def bottom_up_lengths(
             for s in todo:
                 deadline.check()
                 best = value[s]
-                for act in problem.choices.search_actions(s, deadline.check):
+                for act in problem.choices.search_actions(s, deadline.limits):
                     v = 1 + max(value.get(c, math.inf) for c in act.children)
                     if v < best:
                         best = v

@@ -133,6 +133,20 @@ class Deadline:
         if self.end is not None and now > self.end - self._release_s:
             raise Timeout("time")
 
+    def limits(self) -> None:
+        """:meth:`check` not counted as a poll (nor against a work budget's allowance): for
+        polls inside work a stage already counts once (a set's actions made one at a time,
+        only when first asked), so the counts that size the tie-breaking stages' work do not
+        depend on what a cache already holds.
+
+        >>> budget = WorkBudget(Deadline(), 1)
+        >>> budget.limits(); budget.limits(); budget.check()
+        >>> budget.polls
+        1
+        """
+        self.polls -= 1
+        self.check()
+
     def expired(self) -> bool:
         """Whether a limit has passed (reads the clock and the memory now)."""
         return self.ran_out() is not None

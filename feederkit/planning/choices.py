@@ -304,7 +304,7 @@ class Choices:
                 return
             made.append(self.useful_act(cell))
 
-    def branch_sets(self, mask: int) -> set[tuple[int, ...]]:
+    def branch_sets(self, mask: int, check: Poll | None = None) -> set[tuple[int, ...]]:
         """The distinct branch tuples of the actions :meth:`search_actions` offers,
         unordered: what a pass over every action of a set needs
         (:func:`~feederkit.planning.solvable.solve`), from the images alone, without ranking
@@ -316,9 +316,10 @@ class Choices:
         width, so the two may leave out different actions): its action needs no fewer
         operations, so a set's length is the same either way. The images are the same with
         ``distinct_maps`` (which keeps one cell per map of the members, not per image).
+        ``check`` is polled every ``POLL_CELLS`` reading splits, as in :meth:`useful_cells`.
         """
         if self.min_margin > 0.0:
-            return {a.children for a in self.exact_actions(mask)}
+            return {a.children for a in self.exact_actions(mask, check)}
         images: list[int] | None = None
         if (mask, True) not in self._cells:
             listed = self._space.cell_lists(mask)
@@ -336,11 +337,13 @@ class Choices:
         kept: list[int] = []
         out: set[tuple[int, ...]] = set()
         sensorless = self.readings.sensorless
-        for img in useful:
+        for n, img in enumerate(useful):
             if _holds_one(img, kept):
                 continue
             if len(kept) < _DOMINATORS:
                 kept.append(img)
+            if check is not None and n % POLL_CELLS == POLL_CELLS - 1:
+                check()
             out.add((img,) if sensorless else self.readings.children(img))
         return out
 

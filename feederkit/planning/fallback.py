@@ -587,6 +587,8 @@ def _fewest_after(chain: Backchain, kids: list[tuple[int, ...]]) -> int:
     >>> _fewest_after(chain, [(0b1111,), (0b0011, 0b1100), (0b0011, 0b0100, 0b1000)])
     2
     """
+    if not all(kids):
+        raise ValueError("a rotation with no reading sets")  # an image is never empty
     lengths = chain.lengths_of_sets([b for ks in kids for b in ks])
     starts = np.cumsum([0, *(len(ks) for ks in kids[:-1])])
     largest = np.maximum.reduceat(lengths, starts)

@@ -46,7 +46,7 @@ def largest_margin(problem: Problem, roots: list[int], deadline: Deadline | None
         if problem.is_goal(mask):
             solved.add(mask)
             return
-        for act in problem.choices.exact_actions(mask):
+        for act in problem.choices.exact_actions(mask, deadline.limits):
             heapq.heappush(heap, (-act.action.margin, next(tick), mask, act.children))
 
     for r in open_roots:

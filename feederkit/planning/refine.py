@@ -425,7 +425,7 @@ class Refiner:
         # (a pass over each set's cells: polled per set, a 200-part mix has hundreds).
         top = math.inf
         for r in open_:
-            self.deadline.check()
+            self.deadline.limits()
             cells = self.p.choices.cells(r, useful=False)
             top = min(top, max(((c[1] - c[0]) / 2.0 for c in cells), default=0.0))
         x = -math.inf

@@ -311,7 +311,7 @@ def bfs_length(problem: Problem, mask: int, deadline: Deadline | None = None) ->
     while frontier:
         deadline.check()
         cur, d = frontier.popleft()
-        for act in problem.choices.search_actions(cur, deadline.check):
+        for act in problem.choices.search_actions(cur, deadline.limits):
             img = act.children[0]
             if problem.is_goal(img):
                 return d + 1

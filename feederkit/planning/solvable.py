@@ -61,7 +61,7 @@ def solve(
         if hopeless is not None and hopeless(m):
             value[m] = math.inf
             continue
-        children = list(problem.choices.branch_sets(m))
+        children = list(problem.choices.branch_sets(m, deadline.limits))
         acts[m] = children
         if len(acts) > max_sets:
             return None
