@@ -406,6 +406,14 @@ def test_the_plan_that_follows_the_readings_is_a_valid_plan_shorter_than_the_cha
     assert check_plan(read) == read.length == 7
 
 
+def _random_or_regular(kind: tuple[str, int], seed: int):
+    """A random convex ``n``-gon of ``seed``, or a regular one with its COM off centre by
+    ``seed``."""
+    name, n = kind
+    offset = (0.01 + seed % 7 / 100, 0.004 + seed % 5 / 200)
+    return random_convex(seed, n) if name == "random" else regular(n, offset)
+
+
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     st.sampled_from([("random", 9), ("random", 16), ("regular", 10), ("regular", 11)]),
@@ -416,10 +424,7 @@ def test_backchaining_length_of_any_set_is_the_breadth_first_length(kind, seed, 
     # Goldberg's table against a breadth-first search over the machine's own images, on
     # random parts (4-8 states) and off-centre regular polygons (10 and 11: more than a
     # byte of states).
-    name, n = kind
-    offset = (0.01 + seed % 7 / 100, 0.004 + seed % 5 / 200)
-    pf = random_convex(seed, n) if name == "random" else regular(n, offset)
-    m = build_machine([pf], NoSensor(), uncertainty=IDEAL)
+    m = build_machine([_random_or_regular(kind, seed)], NoSensor(), uncertainty=IDEAL)
     insep = inseparable(m)
     circle = push_circle(m, insep)
     assume(circle is not None and bits & m.all_states)
@@ -442,9 +447,7 @@ def test_the_rotation_by_the_readings_left_is_the_first_fewest_one_set_at_a_time
     # The plan that follows the readings takes the first rotation whose reading sets need
     # the fewest sensorless operations (the largest, then their sum): all the sets' lengths
     # by array operations against Goldberg's table one set at a time.
-    name, n = kind
-    offset = (0.01 + seed % 7 / 100, 0.004 + seed % 5 / 200)
-    pf = random_convex(seed, n) if name == "random" else regular(n, offset)
+    pf = _random_or_regular(kind, seed)
     m = build_machine([pf], ToleranceSensor(0.02 * pf.part.size), IDEAL)
     problem = Problem(m)
     circle = push_circle(m, problem.insep)
