@@ -424,6 +424,31 @@ def test_a_large_sets_actions_poll_the_deadline_as_they_are_made(monkeypatch):
     assert len(split) <= 3 * POLL_CELLS
 
 
+def test_the_tie_breaking_stages_passes_over_a_sets_cells_poll_the_deadline(monkeypatch):
+    # The margin probes rank a set's wide cells by their reading branches, and the last
+    # operation's choice makes the exact actions of a set's cells: without reading windows
+    # each is a split, polled every POLL_CELLS without counting as work.
+    from feederkit.planning.choices import POLL_CELLS
+    from feederkit.planning.refine import Refiner
+
+    machine = build_machine(small_mix(12), ToleranceSensor(0.4), IDEAL)
+    sorted_machine = by_diameter(machine)[0]
+    full = sorted_machine.all_states
+    problem = Problem(sorted_machine, grouping="components")
+    assert len(problem.choices.cells(full, useful=False)) > 3 * POLL_CELLS
+    keyed = _counting(monkeypatch, problem.choices, "search_key")
+    refiner = Refiner(problem, WorstCase(problem), _After(1))
+    with pytest.raises(Timeout):
+        refiner._keeping_plan(full, 3, 0.0, False)
+    assert len(keyed) <= 3 * POLL_CELLS
+    made = _counting(monkeypatch, problem.choices, "act")
+    refiner = Refiner(problem, WorstCase(problem), _After(1))
+    refiner.floor = -math.inf
+    with pytest.raises(Timeout):
+        refiner._one_step(full)
+    assert len(made) <= 3 * POLL_CELLS
+
+
 def test_the_pairs_of_the_roots_and_the_widest_first_actions_poll_the_deadline(monkeypatch):
     # Listing every pair inside the roots (the check that some pair has no strong plan) and
     # the margin stage's first pass over every root's cells made no poll.

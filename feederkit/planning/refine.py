@@ -47,7 +47,7 @@ from collections.abc import Callable
 from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
 from feederkit.planning.andor import Deadline, WorstCase
-from feederkit.planning.choices import spread
+from feederkit.planning.choices import POLL_CELLS, spread
 from feederkit.planning.options import ActionCosts
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.refuted import RefutedSets
@@ -363,10 +363,13 @@ class Refiner:
         range's branches first.
         """
         choices = self.p.choices
-        cells = sorted(
-            (c for c in choices.cells(mask, useful=False) if _wide(c, x, strict)),
-            key=choices.search_key,
-        )
+        wide = [c for c in choices.cells(mask, useful=False) if _wide(c, x, strict)]
+        keys = []
+        for n, c in enumerate(wide):
+            if n % POLL_CELLS == POLL_CELLS - 1:
+                self.deadline.limits()  # a key not yet made is a reading split
+            keys.append(choices.search_key(c))
+        cells = [c for _key, c in sorted(zip(keys, wide, strict=True), key=_first)]
         for cell in cells:
             m = (cell[1] - cell[0]) / 2.0
             if self.p.sensorless:
@@ -547,15 +550,21 @@ class Refiner:
             # Without costs the cells' own order is (larger margin, smaller rotation):
             # make the exact branches only of the cells that can orient the set at once.
             # The margin floor and the image are asked first (``allowed`` asks them too).
-            acts = (
-                self.p.choices.act(mask, c, exact=True)
-                for c in self.p.choices.cells(mask, useful=False)
-                if (c[1] - c[0]) / 2.0 >= self.floor and self.feasible_image(c[2], 0) is not False
-            )
-        else:
-            made = [self.p.choices.act(mask, c, exact=True) for c in self.cells(mask, True)]
-            acts = iter(sorted(made, key=lambda a: (self.seconds(a), -a.action.margin, a.rotation)))
-        for act in acts:
+            for n, c in enumerate(self.p.choices.cells(mask, useful=False)):
+                if n % POLL_CELLS == POLL_CELLS - 1:
+                    self.deadline.limits()
+                if (c[1] - c[0]) / 2.0 < self.floor or self.feasible_image(c[2], 0) is False:
+                    continue
+                act = self.p.choices.act(mask, c, exact=True)
+                if self.allowed(act, 1):
+                    return self._step(act), act
+            return (math.inf, math.inf), None
+        made = []
+        for n, c in enumerate(self.cells(mask, True)):
+            if n % POLL_CELLS == POLL_CELLS - 1:
+                self.deadline.limits()
+            made.append(self.p.choices.act(mask, c, exact=True))
+        for act in sorted(made, key=lambda a: (self.seconds(a), -a.action.margin, a.rotation)):
             if self.allowed(act, 1):
                 return self._step(act), act
         return (math.inf, math.inf), None
@@ -635,9 +644,11 @@ class Refiner:
             act = self.worst_seconds(mask, k)[1]
             assert act is not None
             return act
-        for cell in sorted(
-            self.p.choices.cells(mask, False), key=lambda c: norm360((c[0] + c[1]) / 2.0)
+        for n, cell in enumerate(
+            sorted(self.p.choices.cells(mask, False), key=lambda c: norm360((c[0] + c[1]) / 2.0))
         ):
+            if n % POLL_CELLS == POLL_CELLS - 1:
+                self.deadline.limits()
             if (cell[1] - cell[0]) / 2.0 < self.floor:
                 continue
             act = self.p.choices.act(mask, cell, exact=True)
@@ -768,6 +779,11 @@ class Refiner:
                     return None
                 return self.p.choices.act(mask, (lo, hi, img), exact=True)
         return None
+
+
+def _first(pair: tuple) -> object:
+    """A pair's first item: a sort key that leaves ties in their order."""
+    return pair[0]
 
 
 def _wide(cell: Cell, x: float, strict: bool) -> bool:
