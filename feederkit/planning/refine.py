@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from operator import itemgetter
 
 from feederkit.angles import WIDTH_QUANTUM_DEG, norm360, width_key
 from feederkit.machine import OverlapRange, ReadingBranch, members
@@ -369,7 +370,7 @@ class Refiner:
             if n % POLL_CELLS == POLL_CELLS - 1:
                 self.deadline.limits()  # a key not yet made is a reading split
             keys.append(choices.search_key(c))
-        cells = [c for _key, c in sorted(zip(keys, wide, strict=True), key=_first)]
+        cells = [c for _key, c in sorted(zip(keys, wide, strict=True), key=itemgetter(0))]
         for cell in cells:
             m = (cell[1] - cell[0]) / 2.0
             if self.p.sensorless:
@@ -779,11 +780,6 @@ class Refiner:
                     return None
                 return self.p.choices.act(mask, (lo, hi, img), exact=True)
         return None
-
-
-def _first(pair: tuple) -> object:
-    """A pair's first item: a sort key that leaves ties in their order."""
-    return pair[0]
 
 
 def _wide(cell: Cell, x: float, strict: bool) -> bool:
