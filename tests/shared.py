@@ -17,6 +17,7 @@ from feederkit.machine import OutcomeRange, PushAlignMachine, is_goal, search_sp
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
+from feederkit.planning.budget import Deadline, Timeout
 
 
 @pytest.fixture(autouse=True)
@@ -174,3 +175,18 @@ def catalog_with(tmp_path: Path, capsys, names: Sequence[str]) -> str:
             run_cli(capsys, "catalog", "add", str(root / f"{name}.json"), "--catalog", path)[0] == 0
         )
     return path
+
+
+class PollsLeft(Deadline):
+    """A deadline that passes after ``n`` more polls of any kind (``check``, or ``limits``,
+    which calls it): where the work stops, not when."""
+
+    def __init__(self, n: int) -> None:
+        super().__init__()
+        self.left = n
+
+    def check(self) -> None:
+        super().check()
+        self.left -= 1
+        if self.left < 0:
+            raise Timeout("time")

@@ -16,6 +16,7 @@ import math
 import random
 
 import pytest
+from shared import PollsLeft
 from test_strong_plans import random_pf
 
 from feederkit.angles import ActionRange, width_key
@@ -149,20 +150,6 @@ def test_the_certificates_stop_at_their_deadline():
         max_shape_tolerance_mm(made.plan, deadline=Deadline(0.0))
 
 
-class _PollsLeft(Deadline):
-    """A deadline that passes after ``n`` more polls: where the work stops, not when."""
-
-    def __init__(self, n: int) -> None:
-        super().__init__()
-        self.left = n
-
-    def check(self) -> None:
-        super().check()
-        self.left -= 1
-        if self.left < 0:
-            raise Timeout("time")
-
-
 def test_a_certificate_stops_inside_a_verification_not_after_it(monkeypatch):
     # Each bisection step of the shape certificate rebuilds every part's mechanics and walks
     # the plan: 0.4 s CPU for a 100-part mix, so a deadline polled only between steps let
@@ -183,12 +170,12 @@ def test_a_certificate_stops_inside_a_verification_not_after_it(monkeypatch):
     for figure in (max_shape_tolerance_mm, max_rotation_error_deg):
         built.clear()
         with pytest.raises(Timeout):
-            figure(made.plan, deadline=_PollsLeft(2 + len(pfs)))
+            figure(made.plan, deadline=PollsLeft(2 + len(pfs)))
         assert len(built) <= len(pfs)  # stopped within its first rebuild and walk
     built.clear()
     with pytest.raises(Timeout):
         # a poll per part read from the file, per part rebuilt, then the walk's
-        strong_holds(made.plan, Uncertainty(1.0), deadline=_PollsLeft(2 * len(pfs) + 1))
+        strong_holds(made.plan, Uncertainty(1.0), deadline=PollsLeft(2 * len(pfs) + 1))
     assert len(built) == len(pfs)  # rebuilt, then stopped in the walk
 
 

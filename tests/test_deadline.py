@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from shared import small_mix
+from shared import PollsLeft, small_mix
 from test_planners import check_plan
 
 from feederkit.errors import InputError, PlanningError
@@ -373,20 +373,6 @@ def _counting(monkeypatch, obj, name: str) -> list:
     return calls
 
 
-class _After(Deadline):
-    """A deadline that passes after ``n`` polls of any kind (``check`` or ``limits``)."""
-
-    def __init__(self, n: int) -> None:
-        super().__init__()
-        self.n = n
-
-    def check(self) -> None:
-        super().check()
-        self.n -= 1
-        if self.n < 0:
-            raise Timeout("time")
-
-
 def test_a_large_sets_actions_poll_the_deadline_as_they_are_made(monkeypatch):
     # Without reading windows (the components rule) each cell's rank is a split of its
     # image's reading branches, and a set with thousands of cells took seconds before the
@@ -410,7 +396,7 @@ def test_a_large_sets_actions_poll_the_deadline_as_they_are_made(monkeypatch):
     assert len(made) <= 2 * POLL_CELLS
     # A search hands its own deadline down, polled without counting as work: the counts
     # that size the tie-breaking stages do not depend on what the cache holds.
-    deadline = _After(2)
+    deadline = PollsLeft(2)
     search = WorstCase(problem, deadline)
     keyed.clear()
     with pytest.raises(Timeout):
@@ -420,7 +406,7 @@ def test_a_large_sets_actions_poll_the_deadline_as_they_are_made(monkeypatch):
     # The solvability fixpoint's pass over a set's branch sets too.
     split = _counting(monkeypatch, problem.readings, "children")
     with pytest.raises(Timeout):
-        solve(problem, [full], _After(2))
+        solve(problem, [full], PollsLeft(2))
     assert len(split) <= 3 * POLL_CELLS
 
 
@@ -437,12 +423,12 @@ def test_the_tie_breaking_stages_passes_over_a_sets_cells_poll_the_deadline(monk
     problem = Problem(sorted_machine, grouping="components")
     assert len(problem.choices.cells(full, useful=False)) > 3 * POLL_CELLS
     keyed = _counting(monkeypatch, problem.choices, "search_key")
-    refiner = Refiner(problem, WorstCase(problem), _After(1))
+    refiner = Refiner(problem, WorstCase(problem), PollsLeft(1))
     with pytest.raises(Timeout):
         refiner._keeping_plan(full, 3, 0.0, False)
     assert len(keyed) <= 3 * POLL_CELLS
     made = _counting(monkeypatch, problem.choices, "act")
-    refiner = Refiner(problem, WorstCase(problem), _After(1))
+    refiner = Refiner(problem, WorstCase(problem), PollsLeft(1))
     refiner.floor = -math.inf
     with pytest.raises(Timeout):
         refiner._one_step(full)
@@ -465,7 +451,7 @@ def test_the_pairs_of_the_roots_and_the_widest_first_actions_poll_the_deadline(m
     opened = [m for m in opened if not problem.is_goal(m)]
     assert len(opened) > 4
     listed = _counting(monkeypatch, problem.choices, "cells")
-    refiner = Refiner(problem, WorstCase(problem), _After(2))
+    refiner = Refiner(problem, WorstCase(problem), PollsLeft(2))
     with pytest.raises(Timeout):
         refiner.largest_floor(opened, 3)
     assert len(listed) <= 3
