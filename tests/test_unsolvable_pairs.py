@@ -257,3 +257,63 @@ def test_the_fallback_does_not_ask_the_kept_pairs_again(monkeypatch):
         pytest.skip("this seed keeps a pair apart")
     monkeypatch.setattr(solvable, "kept_roots", lambda *a, **k: pytest.fail("asked again"))
     assert unsolvable_by_pairs(problem, roots, kept_known=True) == expected
+
+
+def _all_pairs(problem: Problem, roots: list[int]) -> list[int]:
+    pairs = set()
+    for r in roots:
+        idx = [k for k in range(problem.n) if r >> k & 1]
+        pairs.update(
+            (1 << a) | (1 << b)
+            for i, a in enumerate(idx)
+            for b in idx[i + 1 :]
+            if not problem.is_goal((1 << a) | (1 << b))
+        )
+    return sorted(pairs)
+
+
+MIXED_PAIRS = [8, 9, 13, 18, 20]
+"""Seeds whose pairs have plans of 1 to 4 operations and, some, none (under 4 degrees)."""
+
+
+@pytest.mark.parametrize("seed", MIXED_PAIRS)
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+@pytest.mark.parametrize("depth", [1, 2, 4])
+def test_the_pairs_left_unsettled_are_those_without_a_short_plan(
+    seed, rotation, tolerance, depth, monkeypatch
+):
+    # Against the plain fixpoint over every pair (solve): the depth-first search per pair
+    # sets aside exactly the pairs with a plan of at most SETTLE_DEPTH operations.
+    problem = Problem(_two_parts(seed, rotation, tolerance))
+    pairs = _all_pairs(problem, _roots(problem))
+    value = solve(problem, pairs)
+    assert value is not None
+    monkeypatch.setattr(solvable, "SETTLE_DEPTH", depth)
+    want = [q for q in pairs if value[q] > depth]
+    assert solvable._unsettled(problem, pairs, None) == want
+
+
+@pytest.mark.parametrize("seed", MIXED_PAIRS)
+@pytest.mark.parametrize(("rotation", "tolerance"), CASES)
+def test_the_pairs_verdict_is_the_same_by_either_way(seed, rotation, tolerance, monkeypatch):
+    # SETS_PER_PAIR 0: the pairs with a short plan are always set aside first (those of a
+    # single operation, so that pairs of 2-4 and none are left for the exploration).
+    monkeypatch.setattr(solvable, "SETTLE_DEPTH", 1)
+    problem = Problem(_two_parts(seed, rotation, tolerance))
+    pairs = _all_pairs(problem, _roots(problem))
+    value = solve(problem, pairs)
+    assert value is not None
+    calls: list[int] = []
+    real = solvable.solve
+
+    def counted(*args, **kwargs):
+        calls.append(len(args[1]))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(solvable, "solve", counted)
+    monkeypatch.setattr(solvable, "SETS_PER_PAIR", 0)
+    got = solvable.unsolvable_pairs(problem, pairs)
+    assert got == [q for q in pairs if value[q] == math.inf]
+    # The quick exploration gave up at once; only the unsettled pairs were explored after.
+    unsettled = sum(value[q] > solvable.SETTLE_DEPTH for q in pairs)
+    assert calls == [len(pairs)] + ([unsettled] if unsettled else [])

@@ -96,6 +96,11 @@ class WorstCase:
         self._refuted = RefutedSets(machine.n) if monotone and self.SUBSET_REFUTES else None
         self._solved = SolvedSets(machine.n) if monotone and self.SUBSET_SOLVES else None
 
+    @property
+    def opened(self) -> int:
+        """How many sets the searches have opened below the sets asked (frames pushed)."""
+        return self._opened
+
     def holds_plan(self, mask: int, k: int) -> bool:
         """Whether the memo already holds a plan of ``mask`` within ``k`` operations, without
         a search: a plan the search found (``ub``, its action in ``choice``). An exact

@@ -12,8 +12,9 @@ exact symmetry (section 3.3: a result lists the poses no plan can tell apart):
   the machine's inseparable pairs (``R``), i.e. separates them by readings or merges them
   for every outcome; :func:`~feederkit.machine.inseparable.kept_apart` proves many pairs
   unresolvable cheaply (a pair fixpoint like the bisimulation),
-  :func:`~feederkit.planning.solvable.solve` decides the
-  rest from their pair sets at once (one pass over the sets they reach, shared);
+  :func:`~feederkit.planning.solvable.unsolvable_pairs` decides the
+  rest from their pair sets at once (one pass over the sets they reach, shared; the pairs
+  with a short plan set aside first where they reach many);
 - the *lumped* relation is ``R`` together with the unresolvable pairs ``U``; a set is a
   goal when every pair in it is lumped (the same pairwise test as before, over more pairs).
 
@@ -52,7 +53,13 @@ from feederkit.planning.andor import Deadline, Timeout
 from feederkit.planning.options import Lumping
 from feederkit.planning.problem import Problem
 from feederkit.planning.readings import maximal_sets
-from feederkit.planning.solvable import MAX_SETS, candidate_pairs, kept_pairs, solve
+from feederkit.planning.solvable import (
+    MAX_SETS,
+    candidate_pairs,
+    kept_pairs,
+    solve,
+    unsolvable_pairs,
+)
 from feederkit.planning.tree import PlanTree, leaf_masks
 from feederkit.planning.wandering import is_twin_pair, wandering_words
 
@@ -112,8 +119,8 @@ def unresolvable_pairs(
 
     The pairs :func:`~feederkit.machine.inseparable.kept_apart` finds are unresolvable at
     once, and so is every set that holds one (nature keeps that pair);
-    :func:`~feederkit.planning.solvable.solve` decides the rest from their pair sets
-    together, those sets pruned.
+    :func:`~feederkit.planning.solvable.unsolvable_pairs` decides the rest from their pair
+    sets together, those sets pruned.
     """
     pairs = candidate_pairs(problem)
     kept = kept_pairs(problem, deadline)
@@ -126,10 +133,11 @@ def unresolvable_pairs(
             return any(holds[i] & mask for i in members(mask))
 
         roots = [(1 << i) | (1 << j) for i, j in rest]
-        value = solve(problem.with_margin(0.0), roots, deadline, max_sets, hopeless)
-        if value is None:
+        bad = unsolvable_pairs(problem.with_margin(0.0), roots, deadline, max_sets, hopeless)
+        if bad is None:
             return None
-        found.update(p for p, r in zip(rest, roots, strict=True) if value[r] == math.inf)
+        refused = set(bad)
+        found.update(p for p, r in zip(rest, roots, strict=True) if r in refused)
     return tuple(sorted(found))
 
 
