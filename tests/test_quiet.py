@@ -215,13 +215,13 @@ def test_a_search_cut_short_proves_more_than_the_parts_bound_where_it_can():
     assert QuietWorst(problem).part_bound(root) < exact(root)
     recorded = []
     for polls in range(1, 8):
-        worst = QuietWorst(problem, WorkBudget(Deadline(), polls))
+        worst = QuietWorst(problem, WorkBudget(Deadline(), polls), arcs=False)
         with pytest.raises(Timeout):
             worst.length(root)
         recorded.append(worst.lb[root])
     assert max(recorded) == exact(root)
     # And a search with a budget of operations stops as soon as the bound passes it.
-    worst = QuietWorst(problem)
+    worst = QuietWorst(problem, arcs=False)
     assert not worst.within(root, exact(root) - 1)
     assert worst.lb[root] == exact(root) and root not in worst.exact
 
@@ -232,7 +232,7 @@ def _cut_short(name: str):
     machine, tol = _coarse(CASES[name])
     problem = Problem(machine)
     roots, branches = _roots(problem)
-    worst = QuietWorst(problem, WorkBudget(Deadline(), 1))
+    worst = QuietWorst(problem, WorkBudget(Deadline(), 1), arcs=False)
     with pytest.raises(Timeout):
         longest_root(problem, worst, roots, "auto")
     return machine, tol, problem, roots, branches, worst
