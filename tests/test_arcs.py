@@ -49,7 +49,7 @@ def test_the_arc_search_gives_every_sets_exact_length_and_a_chain_of_it(name):
         got = worst.sensorless_length(mask)
         assert got == exact(mask), hex(mask)
         assert got == QuietWorst(problem, arcs=False).sensorless_length(mask)
-        assert worst._arc_space() is not None  # its chain was followed on the machine
+        assert worst.arc_space() is not None  # its chain was followed on the machine
         if got:
             assert worst.exact[mask] == got and _follow(worst, mask) == got
 

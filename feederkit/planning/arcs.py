@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from feederkit.angles import ANGLE_EPS
 from feederkit.planning.problem import Problem
 
 ARC_STATES_MAX = 4_000_000
@@ -53,6 +54,9 @@ tie-breaking stages' budget, a multiple of the proof's polls, means the same tim
 
 _EPS = 1e-9
 """Arc lengths (deg) below this are a point; above the period less this, the circle."""
+
+_FAR = 10_000
+"""The heuristic of an arc no chain collapses (never opened)."""
 
 
 @dataclass(frozen=True)
@@ -116,7 +120,7 @@ class ArcSpace:
         self._moves: list[dict[int, tuple[np.ndarray, np.ndarray]]] = [{} for _ in parts]
         self._h = [
             np.array(
-                [min(pt.chain_length(pt.length_of(a // (pt.k + 1), a % (pt.k + 1))), 10_000)
+                [min(pt.chain_length(pt.length_of(a // (pt.k + 1), a % (pt.k + 1))), _FAR)
                  for a in range(pt.arcs)],
                 dtype=np.int64,
             )
@@ -168,13 +172,18 @@ class ArcSpace:
         return out
 
     def shortest_chain(
-        self, mask: int, cap: int | None, check: Callable[[], None]
+        self, mask: int, cap: int | None, check: Callable[[], None], floor: float = 0.0
     ) -> list[float] | None:
         """The rotations of a shortest chain orienting ``mask``, in the machine's convention
         (the middle of each cell where the arcs' images hold; its length is the set's),
         or None: none within ``cap`` operations, or none at all. ``check`` is polled every
         ``POLL_STATES`` states expanded; ``reached`` is then the least f-value the search
-        left open (a lower bound on the set's length), also when ``check`` raises."""
+        left open (a lower bound on the set's length), also when ``check`` raises.
+
+        ``floor`` (deg): only rotations whose cell is at least twice as wide. The arcs'
+        ends are states of the set, so a set's range around a rotation lies inside that
+        cell: no chain keeps every margin at least ``floor`` where this finds none, though
+        a chain found may keep less (the set's ranges are narrower than the arcs')."""
         parts = [i for i, part in enumerate(self.masks) if mask & part]
         sizes = [self.parts[i].arcs for i in parts]
         stride = [int(np.prod(sizes[j + 1 :], dtype=np.int64)) for j in range(len(parts))]
@@ -182,7 +191,18 @@ class ArcSpace:
         best = np.full(total, np.iinfo(np.int32).max, dtype=np.int32)
         parent = np.full(total, -1, dtype=np.int64)
         turn = np.zeros(total, dtype=np.float64)
-        heap: list[tuple[int, int, int]] = []
+        # Open states in buckets by (f, -g): the least f first, the deepest among them (a
+        # goal sooner); unit steps and integer lengths make the buckets few.
+        buckets: dict[tuple[int, int], list[int]] = {}
+        keys: list[tuple[int, int]] = []
+
+        def push(f: int, g: int, codes: list[int]) -> None:
+            key = (f, -g)
+            bucket = buckets.get(key)
+            if bucket is None:
+                bucket = buckets[key] = []
+                heapq.heappush(keys, key)
+            bucket.extend(codes)
 
         def h_of(arcs: list[np.ndarray]) -> np.ndarray:
             out = self._h[parts[0]][arcs[0]]
@@ -196,14 +216,20 @@ class ArcSpace:
             starts = (starts[:, None] + hulls[None, :] * stride[j]).ravel()
         starts = np.unique(starts)
         best[starts] = 0
-        start_arcs = [(starts // stride[j]) % sizes[j] for j in range(len(parts))]
-        for code, f in zip(starts.tolist(), h_of(start_arcs).tolist(), strict=True):
-            heapq.heappush(heap, (f, 0, code))
+        start_h = h_of([(starts // stride[j]) % sizes[j] for j in range(len(parts))])
+        for h in np.unique(start_h).tolist():
+            if h < _FAR:
+                push(h, 0, starts[start_h == h].tolist())
         self.reached = 0
         expanded = 0
-        while heap:
-            f, neg, code = heapq.heappop(heap)
-            g = -neg
+        while keys:
+            key = keys[0]
+            bucket = buckets[key]
+            code = bucket.pop()
+            if not bucket:
+                heapq.heappop(keys)
+                del buckets[key]
+            f, g = key[0], -key[1]
             if g != best[code]:
                 continue
             self.reached = max(self.reached, f)
@@ -217,7 +243,10 @@ class ArcSpace:
                 check()
             moves = [self._moves_of(i, a) for i, a in zip(parts, arcs, strict=True)]
             cuts = np.unique(np.concatenate([c for c, _o in moves]))
-            mids = (cuts + np.append(cuts[1:], cuts[0] + 360.0)) / 2.0
+            ends = np.append(cuts[1:], cuts[0] + 360.0)
+            # A range no wider than ANGLE_EPS is no action (Choices.cells).
+            wide = ends - cuts > max(ANGLE_EPS, 2.0 * floor)
+            mids = ((cuts + ends) / 2.0)[wide]
             nxt = np.zeros(len(mids), dtype=np.int64)
             outs = []
             for j, (c, o) in enumerate(moves):
@@ -227,14 +256,13 @@ class ArcSpace:
             hs = h_of(outs)
             nxt, first = np.unique(nxt, return_index=True)
             hs = hs[first]
-            better = best[nxt] > g + 1
+            better = (best[nxt] > g + 1) & (hs < _FAR)
             nxt, hs, first = nxt[better], hs[better], first[better]
             best[nxt] = g + 1
             parent[nxt] = code
             turn[nxt] = mids[first]
-            for c2, h2 in zip(nxt.tolist(), hs.tolist(), strict=True):
-                if h2 < 10_000:
-                    heapq.heappush(heap, (g + 1 + h2, -(g + 1), c2))
+            for h in np.unique(hs).tolist():
+                push(g + 1 + h, g + 1, nxt[hs == h].tolist())
         return None
 
     def _is_goal(self, parts: list[int], arcs: list[int]) -> bool:

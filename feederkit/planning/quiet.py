@@ -96,7 +96,7 @@ class QuietWorst(WorstCase):
         else by A* over sets. The chain found is recorded as the set search records its
         path (``exact``, ``ub`` and ``choice`` of each set on it), each rotation the widest
         range of its set with the same image."""
-        space = self._arc_space()
+        space = self.arc_space()
         if space is None:
             return super().sensorless_length(mask, cap)
         e = self.exact.get(mask)
@@ -120,11 +120,25 @@ class QuietWorst(WorstCase):
             return super().sensorless_length(mask, cap)
         return len(found)
 
-    def _arc_space(self) -> ArcSpace | None:
-        """The arc search of this problem (made once), None where it does not apply."""
+    def arc_space(self) -> ArcSpace | None:
+        """The arc search of this problem (made once), None where it is not used."""
         if self._arcs is None:
             self._arcs = arc_space(self.p, part_chains(self.p)) or False
         return self._arcs or None
+
+    def arc_chains(self, space: ArcSpace, roots, longest: int, floor: float) -> bool:
+        """Whether the arc search finds a chain of every root within ``longest`` operations
+        whose rotations' cells are at least twice ``floor`` wide
+        (:meth:`~feederkit.planning.arcs.ArcSpace.shortest_chain`); the chains are
+        recorded as this search's choices."""
+        self._arcs = space
+        for r in roots:
+            if self.p.is_goal(r):
+                continue
+            rotations = space.shortest_chain(r, longest, self.deadline.check, floor)
+            if rotations is None or not self._record_chain(r, rotations):
+                return False
+        return True
 
     def _record_chain(self, mask: int, rotations: list[float]) -> bool:
         """Record the chain of ``rotations`` from ``mask`` as each of its sets' plan; False
@@ -396,9 +410,22 @@ def widest_chain(
         default=floor,
     )
     cut_by = None
+    space = worst.arc_space() if problem.min_margin == 0.0 else None
     try:
         while hi - lo > MARGIN_STEP_DEG:
             mid = (lo + hi) / 2.0
+            if space is not None:
+                # The arc search with every cell at least 2 * mid wide: where it finds no
+                # chain none keeps mid; a chain it finds keeps its own smallest margin.
+                search = QuietWorst(problem, deadline)
+                if search.arc_chains(space, roots, longest, mid):
+                    margin = _chain_margin(search, roots)
+                    if margin > kept:
+                        found, kept = search, margin
+                    lo = max(margin, mid)
+                else:
+                    hi = mid
+                continue
             search = QuietWorst(problem.with_margin(mid), deadline)
             search.share_heuristic(worst)
             if all(search.within(r, longest) for r in roots):
