@@ -97,19 +97,38 @@ def test_the_roots_kept_pairs_name_have_no_strong_plan(seed):
     assert set(got) <= set(unsolvable(problem, roots))
 
 
-def _every_pair_refused(problem: Problem, roots: list[int]) -> bool:
-    """The plain check: some pair inside some root has no strong plan (solve over all)."""
+def _all_pairs(problem: Problem, roots: list[int]) -> list[int]:
     pairs = set()
     for r in roots:
         idx = [k for k in range(problem.n) if r >> k & 1]
-        for i, a in enumerate(idx):
-            for b in idx[i + 1 :]:
-                pair = (1 << a) | (1 << b)
-                if not problem.is_goal(pair):
-                    pairs.add(pair)
-    value = solvable.solve(problem, sorted(pairs))
+        pairs.update(
+            (1 << a) | (1 << b)
+            for i, a in enumerate(idx)
+            for b in idx[i + 1 :]
+            if not problem.is_goal((1 << a) | (1 << b))
+        )
+    return sorted(pairs)
+
+
+def _every_pair_refused(problem: Problem, roots: list[int]) -> bool:
+    """The plain check: some pair inside some root has no strong plan (solve over all)."""
+    pairs = _all_pairs(problem, roots)
+    value = solvable.solve(problem, pairs)
     assert value is not None
     return any(value[p] == math.inf for p in pairs)
+
+
+def _counted_solve(monkeypatch) -> list[int]:
+    """How many sets each call of solvable.solve starts from, as it is called."""
+    calls: list[int] = []
+    real = solvable.solve
+
+    def counted(*args, **kwargs):
+        calls.append(len(args[1]))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(solvable, "solve", counted)
+    return calls
 
 
 @pytest.mark.parametrize("seed", range(12, 24, 2))
@@ -123,14 +142,7 @@ def test_the_neighbours_first_give_the_verdict_of_every_pair(
     roots = _roots(problem)
     want = _every_pair_refused(problem, roots)
     exact = set(unsolvable(problem, roots))
-    calls: list[int] = []
-    real = solvable.solve
-
-    def counted(*args, **kwargs):
-        calls.append(len(args[1]))
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(solvable, "solve", counted)
+    calls = _counted_solve(monkeypatch)
     # The pairs' searches alone: no pair is taken as kept apart beforehand.
     monkeypatch.setattr(solvable, "kept_apart", lambda *_a: set())
     got = unsolvable_by_pairs(problem, roots)
@@ -259,19 +271,6 @@ def test_the_fallback_does_not_ask_the_kept_pairs_again(monkeypatch):
     assert unsolvable_by_pairs(problem, roots, kept_known=True) == expected
 
 
-def _all_pairs(problem: Problem, roots: list[int]) -> list[int]:
-    pairs = set()
-    for r in roots:
-        idx = [k for k in range(problem.n) if r >> k & 1]
-        pairs.update(
-            (1 << a) | (1 << b)
-            for i, a in enumerate(idx)
-            for b in idx[i + 1 :]
-            if not problem.is_goal((1 << a) | (1 << b))
-        )
-    return sorted(pairs)
-
-
 MIXED_PAIRS = [8, 9, 13, 18, 20]
 """Seeds whose pairs have plans of 1 to 4 operations and, some, none (under 4 degrees)."""
 
@@ -303,14 +302,7 @@ def test_the_pairs_verdict_is_the_same_by_either_way(seed, rotation, tolerance, 
     pairs = _all_pairs(problem, _roots(problem))
     value = solve(problem, pairs)
     assert value is not None
-    calls: list[int] = []
-    real = solvable.solve
-
-    def counted(*args, **kwargs):
-        calls.append(len(args[1]))
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(solvable, "solve", counted)
+    calls = _counted_solve(monkeypatch)
     monkeypatch.setattr(solvable, "SETS_PER_PAIR", 0)
     got = solvable.unsolvable_pairs(problem, pairs)
     assert got == [q for q in pairs if value[q] == math.inf]
