@@ -3,18 +3,28 @@ readings carry nothing, against the tests' own search over every rotation and re
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
-from shared import brute_lengths
+from shared import brute_lengths, small_mix
+from test_planners import check_plan
 from test_quiet import CASES, _coarse, _roots
+from test_strong_plans import random_pf
+from test_tie_breaks import _max_min
 
-from feederkit.planning import arcs
+from feederkit.landing.model import landings_of_outline
+from feederkit.mechanics import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.planning import arcs, quiet
 from feederkit.planning.andor import part_chains
+from feederkit.planning.api import plan
 from feederkit.planning.arcs import arc_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.problem import Problem
-from feederkit.planning.quiet import QuietWorst
+from feederkit.planning.quiet import MARGIN_STEP_DEG, QuietWorst, widest_chain
+from feederkit.planning.tree import TIES_NONE
 
 
 def _sets(machine, count: int, seed: str) -> list[int]:
@@ -49,7 +59,7 @@ def test_the_arc_search_gives_every_sets_exact_length_and_a_chain_of_it(name):
         got = worst.sensorless_length(mask)
         assert got == exact(mask), hex(mask)
         assert got == QuietWorst(problem, arcs=False).sensorless_length(mask)
-        assert worst.arc_space() is not None  # its chain was followed on the machine
+        assert worst.arc_misses == 0  # its chain was followed on the machine
         if got:
             assert worst.exact[mask] == got and _follow(worst, mask) == got
 
@@ -95,3 +105,82 @@ def test_the_arc_search_does_not_apply_under_a_margin_floor():
     assert arc_space(problem, part_chains(problem)) is not None
     assert arc_space(problem.with_margin(0.5), part_chains(problem)) is None
     assert arc_space(problem, []) is None
+
+
+def _polygon(name: str, points, com=None):
+    return push_function(make_part(make_outline(name, [list(p) for p in points]), com))
+
+
+def _triangle_and_rectangle():
+    """A near-equilateral triangle (its centre of mass 0.05 mm off) and a 30 x 12 rectangle:
+    the first rotation of the arcs' chain, taken at its cell's middle, is 300 degrees
+    exactly, a boundary of a state inside the arcs."""
+    tri = [
+        (10 * math.cos(2 * math.pi * k / 3), 10 * math.sin(2 * math.pi * k / 3)) for k in range(3)
+    ]
+    return [
+        _polygon("tri", tri, [0.05, 0.0]),
+        _polygon("rect", [(0, 0), (30, 0), (30, 12), (0, 12)]),
+    ]
+
+
+def _landings(seed: int):
+    return [push_function(x.part) for x in landings_of_outline(random_pf(seed).part)]
+
+
+WIDE = {
+    "mix2-37": lambda: small_mix(2, 37),
+    "mix2-111": lambda: small_mix(2, 111),
+    "landings-16": lambda: _landings(16),
+    "landings-7": lambda: _landings(7),
+    "triangle+rectangle": _triangle_and_rectangle,
+}
+"""Machines where a chain whose arcs' ranges are wide can keep a far smaller margin (its
+sets' states inside the arcs add boundaries), and one whose arcs' chain starts on a
+state's boundary."""
+
+
+def _setup(pfs):
+    machine, _tol = _coarse(pfs)
+    problem = Problem(machine)
+    roots, _branches = _roots(problem)
+    longest = max(QuietWorst(problem, arcs=False).sensorless_length(r) for r in roots)
+    want = min(_max_min(problem, r, longest, {}) for r in roots)
+    return machine, problem, roots, longest, want
+
+
+@pytest.mark.parametrize("name", WIDE)
+def test_the_margin_bisection_keeps_the_largest_margin_with_the_arcs(name):
+    # Against the brute force over every plan (test_tie_breaks._max_min): where the arcs'
+    # chain keeps less than the probed margin, the search over sets decides the probe.
+    machine, problem, roots, longest, want = _setup(WIDE[name]())
+    worst = QuietWorst(problem)
+    assert worst.arc_space() is not None
+    found = widest_chain(worst, roots, longest, 0.0, Deadline())
+    assert want - MARGIN_STEP_DEG <= found.margin <= want
+    assert want - MARGIN_STEP_DEG <= plan(machine).min_margin <= want
+
+
+def test_a_chain_starting_on_a_states_boundary_is_followed_on_the_machine():
+    machine, problem, roots, longest, _want = _setup(_triangle_and_rectangle())
+    worst = QuietWorst(problem)
+    assert worst.sensorless_length(machine.all_states) == longest
+    assert worst.arc_misses == 0
+    # Under a floor the set search keeps, the arc search finds chains too (its "none"
+    # would say that none keeps the floor).
+    assert QuietWorst(problem.with_margin(0.05), arcs=False).within(roots[0], longest)
+    search = QuietWorst(problem)
+    margin = search.arc_chains(worst.arc_space(), roots, longest, 0.05)
+    assert margin is not None and margin > 0.0 and search.arc_misses == 0
+
+
+def test_a_margin_probe_the_search_over_sets_leaves_open_is_not_called_proven(monkeypatch):
+    # landings-16: some probe's arc chain keeps less than the probe (the search over sets
+    # decides it); with no polls for that search the bisection says it is not proven.
+    machine, problem, roots, longest, want = _setup(WIDE["landings-16"]())
+    monkeypatch.setattr(quiet, "SET_PROBE_POLLS", 0)
+    found = widest_chain(QuietWorst(problem), roots, longest, 0.0, Deadline())
+    assert found.cut_by == "work" and found.margin <= want
+    result = plan(machine)
+    assert result.tie_breaks == TIES_NONE and result.ties_cut_by == "work"
+    assert result.optimal and result.length == 1 + longest == check_plan(result)

@@ -58,6 +58,9 @@ _EPS = 1e-9
 _FAR = 10_000
 """The heuristic of an arc no chain collapses (never opened)."""
 
+_UNSEEN = np.iinfo(np.int16).max
+"""The depth of an arc state not yet reached."""
+
 
 @dataclass(frozen=True)
 class ArcPart:
@@ -173,24 +176,27 @@ class ArcSpace:
 
     def shortest_chain(
         self, mask: int, cap: int | None, check: Callable[[], None], floor: float = 0.0
-    ) -> list[float] | None:
-        """The rotations of a shortest chain orienting ``mask``, in the machine's convention
-        (the middle of each cell where the arcs' images hold; its length is the set's),
-        or None: none within ``cap`` operations, or none at all. ``check`` is polled every
+    ) -> list[list[tuple[float, float]]] | None:
+        """A shortest chain orienting ``mask`` as the ranges of rotations of each operation,
+        in the machine's convention (``(lo, hi)`` with ``0 <= lo < 360``, ``hi`` past 360
+        when it wraps): those where the arcs go as the chain has them. Any rotation inside
+        one will do, so each step may take any range of its set inside one (the arcs' ends
+        are states of the set, so the set's ranges lie inside the arcs'). None: no
+        chain within ``cap`` operations, or none at all. ``check`` is polled every
         ``POLL_STATES`` states expanded; ``reached`` is then the least f-value the search
         left open (a lower bound on the set's length), also when ``check`` raises.
 
-        ``floor`` (deg): only rotations whose cell is at least twice as wide. The arcs'
-        ends are states of the set, so a set's range around a rotation lies inside that
-        cell: no chain keeps every margin at least ``floor`` where this finds none, though
-        a chain found may keep less (the set's ranges are narrower than the arcs')."""
+        ``floor`` (deg): only ranges at least twice as wide. Where this finds no chain,
+        no chain keeps every margin at least ``floor``; a chain found may keep less (its
+        set's ranges can be narrower than the arcs'). Its tables hold a few bytes per arc
+        state (``ARC_STATES_MAX`` of them at most).
+        """
         parts = [i for i, part in enumerate(self.masks) if mask & part]
         sizes = [self.parts[i].arcs for i in parts]
         stride = [int(np.prod(sizes[j + 1 :], dtype=np.int64)) for j in range(len(parts))]
         total = int(np.prod(sizes, dtype=np.int64))
-        best = np.full(total, np.iinfo(np.int32).max, dtype=np.int32)
-        parent = np.full(total, -1, dtype=np.int64)
-        turn = np.zeros(total, dtype=np.float64)
+        best = np.full(total, _UNSEEN, dtype=np.int16)
+        parent = np.full(total, -1, dtype=np.int32)
         # Open states in buckets by (f, -g): the least f first, the deepest among them (a
         # goal sooner); unit steps and integer lengths make the buckets few.
         buckets: dict[tuple[int, int], list[int]] = {}
@@ -237,33 +243,67 @@ class ArcSpace:
                 return None
             arcs = [(code // stride[j]) % sizes[j] for j in range(len(parts))]
             if f == g and self._is_goal(parts, arcs):
-                return self._rotations(code, parent, turn)
+                return self._ranges(code, parent, parts, stride, sizes, floor)
             expanded += 1
             if expanded % POLL_STATES == 0:
                 check()
-            moves = [self._moves_of(i, a) for i, a in zip(parts, arcs, strict=True)]
-            cuts = np.unique(np.concatenate([c for c, _o in moves]))
-            ends = np.append(cuts[1:], cuts[0] + 360.0)
-            # A range no wider than ANGLE_EPS is no action (Choices.cells).
-            wide = ends - cuts > max(ANGLE_EPS, 2.0 * floor)
-            mids = ((cuts + ends) / 2.0)[wide]
-            nxt = np.zeros(len(mids), dtype=np.int64)
-            outs = []
-            for j, (c, o) in enumerate(moves):
-                at = np.searchsorted(c, mids, side="right") - 1  # -1: the last, wrapping
-                outs.append(o[at])
-                nxt += o[at] * stride[j]
-            hs = h_of(outs)
+            nxt, _cuts, _widths = self._next(parts, arcs, stride, floor)
+            hs = h_of([(nxt // stride[j]) % sizes[j] for j in range(len(parts))])
             nxt, first = np.unique(nxt, return_index=True)
             hs = hs[first]
             better = (best[nxt] > g + 1) & (hs < _FAR)
-            nxt, hs, first = nxt[better], hs[better], first[better]
+            nxt, hs = nxt[better], hs[better]
             best[nxt] = g + 1
             parent[nxt] = code
-            turn[nxt] = mids[first]
             for h in np.unique(hs).tolist():
                 push(g + 1 + h, g + 1, nxt[hs == h].tolist())
         return None
+
+    def _next(
+        self, parts: list[int], arcs: list[int], stride: list[int], floor: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The arc states one rotation leads to from ``arcs`` (one per range of rotations,
+        repeats included), each range's start and width (deg, ``x -> x + theta``): the
+        ranges between the arcs' ends' crossings, those no wider than ``ANGLE_EPS`` (no
+        action, as in ``Choices.cells``) or narrower than ``2 * floor`` left out."""
+        moves = [self._moves_of(i, a) for i, a in zip(parts, arcs, strict=True)]
+        cuts = np.unique(np.concatenate([c for c, _o in moves]))
+        widths = np.append(cuts[1:], cuts[0] + 360.0) - cuts
+        wide = (widths > ANGLE_EPS) & (widths >= 2.0 * floor)
+        cuts, widths = cuts[wide], widths[wide]
+        mids = cuts + widths / 2.0
+        nxt = np.zeros(len(mids), dtype=np.int64)
+        for j, (c, o) in enumerate(moves):
+            at = np.searchsorted(c, mids, side="right") - 1  # -1: the last, wrapping
+            nxt += o[at] * stride[j]
+        return nxt, cuts, widths
+
+    def _ranges(
+        self,
+        code: int,
+        parent: np.ndarray,
+        parts: list[int],
+        stride: list[int],
+        sizes: list[int],
+        floor: float,
+    ) -> list[list[tuple[float, float]]]:
+        """The chain ending at ``code``, first step first: per step the ranges of rotations
+        leading from its state to the next, in the machine's convention (a rotation by
+        ``theta`` here is the machine's ``-theta``)."""
+        path = [code]
+        while parent[path[-1]] >= 0:
+            path.append(int(parent[path[-1]]))
+        path.reverse()
+        out = []
+        for here, there in zip(path, path[1:], strict=False):
+            arcs = [(here // stride[j]) % sizes[j] for j in range(len(parts))]
+            nxt, cuts, widths = self._next(parts, arcs, stride, floor)
+            step = []
+            for k in np.flatnonzero(nxt == there).tolist():
+                lo = float((-(cuts[k] + widths[k])) % 360.0)
+                step.append((lo, lo + float(widths[k])))
+            out.append(step)
+        return out
 
     def _is_goal(self, parts: list[int], arcs: list[int]) -> bool:
         """Whether every part's arc is a point and the points' states make a goal."""
@@ -275,16 +315,6 @@ class ArcSpace:
                 return False
             states |= pt.states[a]
         return self.p.is_goal(states)
-
-    @staticmethod
-    def _rotations(code: int, parent: np.ndarray, turn: np.ndarray) -> list[float]:
-        """The rotations of the chain ending at ``code``, first to last, in the machine's
-        convention (a rotation by ``theta`` here is the machine's ``-theta``)."""
-        out = []
-        while parent[code] >= 0:
-            out.append(float((-turn[code]) % 360.0))
-            code = int(parent[code])
-        return out[::-1]
 
 
 def arc_space(problem: Problem, chains) -> ArcSpace | None:

@@ -47,8 +47,8 @@ import numpy as np
 from feederkit.machine import bit_rows
 from feederkit.planning.andor import WorstCase, part_chains
 from feederkit.planning.arcs import ArcSpace, arc_space
-from feederkit.planning.budget import Deadline, Timeout
-from feederkit.planning.problem import Problem
+from feederkit.planning.budget import Deadline, Timeout, WorkBudget
+from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step, build_dag, root_step
 
 FIRST_WIDTH = 1
@@ -89,13 +89,16 @@ class QuietWorst(WorstCase):
         # The arc search (made when first asked; False: not used, ``arcs`` False or it does
         # not apply).
         self._arcs: ArcSpace | None | bool = None if arcs else False
+        self.arc_misses = 0
+        """Chains the arc search found that could not be followed on the machine (the set
+        search answered instead); none is expected."""
 
     def sensorless_length(self, mask: int, cap: int | None = None) -> int | None:
         """:meth:`WorstCase.sensorless_length` by A* over the parts' arc hulls where it
         applies (:mod:`~feederkit.planning.arcs`: exact, and far fewer states than sets),
         else by A* over sets. The chain found is recorded as the set search records its
-        path (``exact``, ``ub`` and ``choice`` of each set on it), each rotation the widest
-        range of its set with the same image."""
+        path (``exact``, ``ub`` and ``choice`` of each set on it), each step the widest
+        range of its set inside the chain's range (:meth:`_record_chain`)."""
         space = self.arc_space()
         if space is None:
             return super().sensorless_length(mask, cap)
@@ -116,7 +119,7 @@ class QuietWorst(WorstCase):
             self.never.add(mask)
             return None
         if not self._record_chain(mask, found):
-            self._arcs = False  # not seen: the set search answers instead
+            self.arc_misses += 1
             return super().sensorless_length(mask, cap)
         return len(found)
 
@@ -126,47 +129,72 @@ class QuietWorst(WorstCase):
             self._arcs = arc_space(self.p, part_chains(self.p)) or False
         return self._arcs or None
 
-    def arc_chains(self, space: ArcSpace, roots, longest: int, floor: float) -> bool:
-        """Whether the arc search finds a chain of every root within ``longest`` operations
-        whose rotations' cells are at least twice ``floor`` wide
-        (:meth:`~feederkit.planning.arcs.ArcSpace.shortest_chain`); the chains are
-        recorded as this search's choices."""
+    def arc_chains(self, space: ArcSpace, roots, longest: int, floor: float) -> float | None:
+        """The smallest margin of chains of every root within ``longest`` operations that
+        the arc search finds with every range at least twice ``floor`` wide
+        (:meth:`~feederkit.planning.arcs.ArcSpace.shortest_chain`), recorded as this
+        search's choices (not as exact lengths: a chain under a floor need not be a
+        shortest one); None when it finds none for some root (then no chain keeps
+        ``floor``), -inf when one could not be followed on the machine."""
         self._arcs = space
         for r in roots:
             if self.p.is_goal(r):
                 continue
-            rotations = space.shortest_chain(r, longest, self.deadline.check, floor)
-            if rotations is None or not self._record_chain(r, rotations):
-                return False
-        return True
+            ranges = space.shortest_chain(r, longest, self.deadline.check, floor)
+            if ranges is None:
+                return None
+            if not self._record_chain(r, ranges, exact=False):
+                self.arc_misses += 1
+                return -math.inf
+        return _chain_margin(self, roots)
 
-    def _record_chain(self, mask: int, rotations: list[float]) -> bool:
-        """Record the chain of ``rotations`` from ``mask`` as each of its sets' plan; False
-        (nothing recorded) when a rotation lies on a boundary of its set or the chain does
-        not end in a goal."""
-        choices = self.p.choices
+    def _record_chain(
+        self, mask: int, ranges: list[list[tuple[float, float]]], exact: bool = True
+    ) -> bool:
+        """Record the chain of ``ranges`` (the ranges of rotations of each step,
+        :meth:`~feederkit.planning.arcs.ArcSpace.shortest_chain`) from ``mask`` as each of
+        its sets' plan (with ``exact``, as their exact lengths too). Each step takes the
+        widest range of its set whose image is that of one of its cells inside one of the
+        step's ranges: any rotation there keeps the set inside the chain's arcs. False
+        (nothing recorded) when some step has no such range or the chain ends outside a
+        goal."""
         steps = []
         cur = mask
-        for x in rotations:
-            cell = choices.cell_at(cur, x)
-            if cell is None:
-                return False
-            img = cell[2]
-            widest = next((c for c in choices.cells(cur, False) if c[2] == img), cell)
-            act = choices.act(cur, widest)
-            if act is None:  # its image holds the set: no shortest chain does that
+        for step in ranges:
+            act = self._widest_inside(cur, step)
+            if act is None:
                 return False
             steps.append((cur, act))
-            cur = img
+            cur = act.action.image
         if not self.p.is_goal(cur):
             return False
         for t, (cur, act) in enumerate(steps):
             k = len(steps) - t
-            self.exact[cur] = k
+            if exact:
+                self.exact[cur] = k
             self.ub[cur] = min(self.ub.get(cur, k), k)
             if cur not in self.choice or self.choice[cur][0] > k:
                 self.choice[cur] = (k, act)
         return True
+
+    def _widest_inside(self, mask: int, ranges: list[tuple[float, float]]) -> Act | None:
+        """The action of the widest range of ``mask`` whose image is that of one of its
+        cells inside one of the rotation ranges ``[lo, hi)`` (None: no cell there, or each
+        image holds the set)."""
+        choices = self.p.choices
+        widest = {c[2]: c for c in choices.cells(mask, False)}  # the widest per image
+        best: tuple[float, Act] | None = None
+        for clo, chi, img in choices.fixed_cells(mask):
+            mid = (clo + chi) / 2.0
+            if not any((mid - lo) % 360.0 < hi - lo for lo, hi in ranges):
+                continue
+            cell = widest.get(img)
+            if cell is None or (best is not None and cell[1] - cell[0] <= best[0]):
+                continue
+            act = choices.act(mask, cell)
+            if act is not None:  # its image holds the set: no shortest chain does that
+                best = (cell[1] - cell[0], act)
+        return None if best is None else best[1]
 
     def part_lengths(self, mask: int) -> tuple[int, int]:
         """The largest and the sum, over the machine's parts, of the backchaining length of
@@ -411,31 +439,54 @@ def widest_chain(
     )
     cut_by = None
     space = worst.arc_space() if problem.min_margin == 0.0 else None
+    undecided = False  # a probe the search over sets left open within SET_PROBE_POLLS
     try:
         while hi - lo > MARGIN_STEP_DEG:
             mid = (lo + hi) / 2.0
+            probe = deadline
             if space is not None:
-                # The arc search with every cell at least 2 * mid wide: where it finds no
-                # chain none keeps mid; a chain it finds keeps its own smallest margin.
+                # The arc search with every range at least 2 * mid wide: where it finds no
+                # chain none keeps mid; where its chains keep mid they answer; else (a
+                # set's ranges are narrower than its arcs') the search over sets decides,
+                # within SET_PROBE_POLLS (past them the probe counts as failed, unproven).
                 search = QuietWorst(problem, deadline)
-                if search.arc_chains(space, roots, longest, mid):
-                    margin = _chain_margin(search, roots)
+                margin = search.arc_chains(space, roots, longest, mid)
+                if margin is None:
+                    hi = mid
+                    continue
+                if margin >= mid:
                     if margin > kept:
                         found, kept = search, margin
-                    lo = max(margin, mid)
-                else:
-                    hi = mid
-                continue
-            search = QuietWorst(problem.with_margin(mid), deadline)
+                    lo = margin
+                    continue
+                probe = WorkBudget(deadline, SET_PROBE_POLLS)
+            search = QuietWorst(problem.with_margin(mid), probe)
             search.share_heuristic(worst)
-            if all(search.within(r, longest) for r in roots):
+            try:
+                fits = all(search.within(r, longest) for r in roots)
+            except Timeout as exc:
+                if probe is deadline or exc.reason != "work":
+                    raise
+                fits, undecided = False, True
+            finally:
+                if probe is not deadline:
+                    deadline.polls += probe.polls  # the probe's work is the bisection's
+            if fits:
                 found, kept = search, _chain_margin(search, roots)
                 lo = max(kept, mid)
             else:
                 hi = mid
     except Timeout as exc:
         cut_by = exc.reason
+    if cut_by is None and undecided:
+        cut_by = "work"
     return WidestChain(found, kept, cut_by)
+
+
+SET_PROBE_POLLS = 2_000
+"""A margin probe the arc search leaves open (its chain keeps less than the probe) gets the
+search over sets for at most this many polls (about a second); past them :func:`widest_chain`
+takes the probe as failed and says the margin is not proven the largest."""
 
 
 def _chain_margin(search: WorstCase, roots) -> float:
