@@ -66,8 +66,9 @@ _UNSEEN = np.iinfo(np.int16).max
 class ArcPart:
     """One part's circle for the arc search: ``k`` states up to symmetry at positions
     ``pos`` (ascending from 0) on a circle of circumference ``period``, ``ends[c]`` the end of
-    state ``c``'s resting range, its backchaining table ``table`` (Goldberg's ``D_k``), and
-    ``states[c]`` the machine's states of class ``c`` (a mask)."""
+    state ``c``'s resting range and ``start`` the start of state 0's, its backchaining table
+    ``table`` (Goldberg's ``D_k``), and ``states[c]`` the machine's states of class ``c`` (a
+    mask)."""
 
     k: int
     period: float
@@ -95,7 +96,8 @@ class ArcPart:
         """The fewest operations collapsing an arc of ``length`` (Goldberg's table)."""
         if length <= _EPS:
             return 0
-        j = int(np.searchsorted(np.asarray(self.table), length + 1e-7, side="left"))
+        # As Backchain.length: the first D_j above the length (within ANGLE_EPS).
+        j = int(np.searchsorted(np.asarray(self.table), length + ANGLE_EPS, side="left"))
         return j if j < len(self.table) else math.inf
 
     def push(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
