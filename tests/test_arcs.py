@@ -17,11 +17,13 @@ from feederkit.landing.model import landings_of_outline
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.planning import arcs, quiet
+from feederkit.planning import arcs, fallback, quiet
 from feederkit.planning.andor import part_chains
-from feederkit.planning.api import plan
+from feederkit.planning.api import _result, plan
 from feederkit.planning.arcs import arc_space
 from feederkit.planning.budget import Deadline, Timeout, WorkBudget
+from feederkit.planning.methods import longest_root
+from feederkit.planning.options import PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.quiet import MARGIN_STEP_DEG, QuietWorst, widest_chain
 from feederkit.planning.tree import TIES_NONE
@@ -184,3 +186,29 @@ def test_a_margin_probe_the_search_over_sets_leaves_open_is_not_called_proven(mo
     result = plan(machine)
     assert result.tie_breaks == TIES_NONE and result.ties_cut_by == "work"
     assert result.optimal and result.length == 1 + longest == check_plan(result)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_weighted_chains_are_plans_within_their_weight_of_the_shortest(name, monkeypatch):
+    machine, tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    roots, _branches = _roots(problem)
+    exact, _children = brute_lengths(machine, tol)
+    want = max(exact(r) for r in roots)
+    worst = QuietWorst(problem)
+    longest = worst.weighted_chains(roots, Deadline())
+    assert longest is not None and worst.arc_misses == 0
+    assert want <= longest <= quiet.CHAIN_WEIGHTS[-1] * want
+    for r in roots:
+        assert _follow(worst, r) <= longest and r not in worst.exact
+    # The fallback's first plan where the exact search ran out: no beams over sets needed.
+    monkeypatch.setattr(fallback, "widening_chains", lambda *_a, **_k: pytest.fail("beams"))
+    monkeypatch.setattr(arcs, "POLL_STATES", 1)  # the exact arc search cut at once
+    cut = QuietWorst(problem, WorkBudget(Deadline(), 0))
+    with pytest.raises(Timeout):
+        longest_root(problem, cut, roots, "auto")
+    root, _optimal, _length, lower, _ties, _cut = fallback.fallback(
+        problem, cut, roots, _branches, Deadline(20.0), PlanningOptions(time_limit_s=20.0), "time"
+    )
+    result = _result(machine, root, False, None, lower, "worst", "none")
+    assert lower <= 1 + want <= result.length == check_plan(result)

@@ -177,7 +177,12 @@ class ArcSpace:
         return out
 
     def shortest_chain(
-        self, mask: int, cap: int | None, check: Callable[[], None], floor: float = 0.0
+        self,
+        mask: int,
+        cap: int | None,
+        check: Callable[[], None],
+        floor: float = 0.0,
+        weight: float = 1.0,
     ) -> list[list[tuple[float, float]]] | None:
         """A shortest chain orienting ``mask`` as the ranges of rotations of each operation,
         in the machine's convention (``(lo, hi)`` with ``0 <= lo < 360``, ``hi`` past 360
@@ -192,6 +197,10 @@ class ArcSpace:
         no chain keeps every margin at least ``floor``; a chain found may keep less (its
         set's ranges can be narrower than the arcs'). Its tables hold a few bytes per arc
         state (``ARC_STATES_MAX`` of them at most).
+
+        ``weight`` above 1: weighted A* (the heuristic times ``weight``), a chain at most
+        that many times as long as the shortest, found sooner; ``reached`` and ``cap``
+        then mean nothing (Pohl 1970).
         """
         parts = [i for i, part in enumerate(self.masks) if mask & part]
         sizes = [self.parts[i].arcs for i in parts]
@@ -201,10 +210,10 @@ class ArcSpace:
         parent = np.full(total, -1, dtype=np.int32)
         # Open states in buckets by (f, -g): the least f first, the deepest among them (a
         # goal sooner); unit steps and integer lengths make the buckets few.
-        buckets: dict[tuple[int, int], list[int]] = {}
-        keys: list[tuple[int, int]] = []
+        buckets: dict[tuple[float, int], list[int]] = {}
+        keys: list[tuple[float, int]] = []
 
-        def push(f: int, g: int, codes: list[int]) -> None:
+        def push(f: float, g: int, codes: list[int]) -> None:
             key = (f, -g)
             bucket = buckets.get(key)
             if bucket is None:
@@ -227,7 +236,7 @@ class ArcSpace:
         start_h = h_of([(starts // stride[j]) % sizes[j] for j in range(len(parts))])
         for h in np.unique(start_h).tolist():
             if h < _FAR:
-                push(h, 0, starts[start_h == h].tolist())
+                push(weight * h, 0, starts[start_h == h].tolist())
         self.reached = 0
         expanded = 0
         while keys:
@@ -240,7 +249,7 @@ class ArcSpace:
             f, g = key[0], -key[1]
             if g != best[code]:
                 continue
-            self.reached = max(self.reached, f)
+            self.reached = max(self.reached, int(f))
             if cap is not None and f > cap:
                 return None
             arcs = [(code // stride[j]) % sizes[j] for j in range(len(parts))]
@@ -258,7 +267,7 @@ class ArcSpace:
             best[nxt] = g + 1
             parent[nxt] = code
             for h in np.unique(hs).tolist():
-                push(g + 1 + h, g + 1, nxt[hs == h].tolist())
+                push(g + 1 + weight * h, g + 1, nxt[hs == h].tolist())
         return None
 
     def _next(

@@ -203,10 +203,13 @@ def fallback(
     held.hold(blind)
     unbuilt: int | None = None  # the length of the shortest plan found but never built
     if quiet and (blind is None or tree_length(blind) > lower):
-        # The widening beams over sets, within QUIET_SHARE of what is left.
+        # Weighted A* over the parts' arc hulls where it applies, else the widening beams
+        # over sets, within QUIET_SHARE of what is left.
         rest = budget.remaining()
         share = budget if rest is None else budget.ending(budget.end - rest * (1 - QUIET_SHARE))
-        longest = widening_chains(worst, roots, share)
+        longest = worst.weighted_chains(roots, share) if isinstance(worst, QuietWorst) else None
+        if longest is None:
+            longest = widening_chains(worst, roots, share)
         if longest is not None and (blind is None or longest + 1 < tree_length(blind)):
             try:
                 blind = chain_plan(

