@@ -259,14 +259,16 @@ class ArcSpace:
             if expanded % POLL_STATES == 0:
                 check()
             nxt, _cuts, _widths = self._next(parts, arcs, stride, floor)
+            nxt = nxt[best[nxt] > g + 1]  # most were met no deeper: few are left
+            if not len(nxt):
+                continue
+            nxt = np.unique(nxt)
             hs = h_of([(nxt // stride[j]) % sizes[j] for j in range(len(parts))])
-            nxt, first = np.unique(nxt, return_index=True)
-            hs = hs[first]
-            better = (best[nxt] > g + 1) & (hs < _FAR)
-            nxt, hs = nxt[better], hs[better]
+            keep = hs < _FAR
+            nxt, hs = nxt[keep], hs[keep]
             best[nxt] = g + 1
             parent[nxt] = code
-            for h in np.unique(hs).tolist():
+            for h in set(hs.tolist()):
                 push(g + 1 + weight * h, g + 1, nxt[hs == h].tolist())
         return None
 
@@ -278,15 +280,21 @@ class ArcSpace:
         ranges between the arcs' ends' crossings, those no wider than ``ANGLE_EPS`` (no
         action, as in ``Choices.cells``) or narrower than ``2 * floor`` left out."""
         moves = [self._moves_of(i, a) for i, a in zip(parts, arcs, strict=True)]
-        cuts = np.unique(np.concatenate([c for c, _o in moves]))
-        widths = np.append(cuts[1:], cuts[0] + 360.0) - cuts
-        wide = (widths > ANGLE_EPS) & (widths >= 2.0 * floor)
+        cuts = np.concatenate([c for c, _o in moves])
+        cuts.sort()  # repeats make ranges of width 0, left out below
+        ends = np.empty_like(cuts)
+        ends[:-1] = cuts[1:]
+        ends[-1] = cuts[0] + 360.0
+        widths = ends - cuts
+        wide = widths > max(ANGLE_EPS, 2.0 * floor - 1e-12)
         cuts, widths = cuts[wide], widths[wide]
-        mids = cuts + widths / 2.0
-        nxt = np.zeros(len(mids), dtype=np.int64)
+        mids = cuts + widths * 0.5
+        nxt = None
         for j, (c, o) in enumerate(moves):
-            at = np.searchsorted(c, mids, side="right") - 1  # -1: the last, wrapping
-            nxt += o[at] * stride[j]
+            at = c.searchsorted(mids, "right") - 1  # -1: the last, wrapping
+            term = o.take(at) * stride[j]
+            nxt = term if nxt is None else nxt + term
+        assert nxt is not None  # a set has a part
         return nxt, cuts, widths
 
     def _ranges(
