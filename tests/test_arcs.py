@@ -212,3 +212,41 @@ def test_weighted_chains_are_plans_within_their_weight_of_the_shortest(name, mon
     )
     result = _result(machine, root, False, None, lower, "worst", "none")
     assert lower <= 1 + want <= result.length == check_plan(result)
+
+
+def _regular(n: int, com=None):
+    points = [
+        (10 * math.cos(2 * math.pi * k / n), 10 * math.sin(2 * math.pi * k / n)) for k in range(n)
+    ]
+    return _polygon(f"regular-{n}", points, com)
+
+
+SYMMETRIC = {
+    "square+rectangle": lambda: [
+        _polygon("square", [(0, 0), (10, 0), (10, 10), (0, 10)]),
+        _polygon("rect", [(0, 0), (30, 0), (30, 12), (0, 12)]),
+    ],
+    "hexagon+rectangle": lambda: [
+        _regular(6),
+        _polygon("rect", [(0, 0), (20, 0), (20, 10), (0, 10)]),
+    ],
+    "pentagon+triangle off centre": lambda: [_regular(5), _regular(3, [0.5, 0.1])],
+}
+"""Mixes with parts whose push function repeats within a turn (periods of 60-180 degrees)."""
+
+
+@pytest.mark.parametrize("name", SYMMETRIC)
+def test_the_arc_search_is_exact_on_parts_whose_push_function_repeats(name):
+    # Against the A* over sets (itself checked against the brute force above): a regular
+    # polygon's equal diameters read as one span, which the brute force does not model.
+    machine, _tol = _coarse(SYMMETRIC[name]())
+    problem = Problem(machine)
+    space = arc_space(problem, part_chains(problem))
+    assert space is not None and any(pt.period < 360.0 for pt in space.parts)
+    for mask in _sets(machine, 25, name):
+        worst = QuietWorst(problem)
+        got = worst.sensorless_length(mask)
+        assert got == QuietWorst(problem, arcs=False).sensorless_length(mask), hex(mask)
+        assert worst.arc_misses == 0
+        if got:
+            assert _follow(worst, mask) == got
