@@ -29,6 +29,8 @@ The International Journal of Robotics Research 18(10), section 4 (sensorless pla
 Hart, P. E., Nilsson, N. J. and Raphael, B. (1968). A formal basis for the heuristic
 determination of minimum cost paths. IEEE Transactions on Systems Science and Cybernetics
 4(2) (A*).
+Pohl, I. (1970). Heuristic search viewed as path finding in a graph. Artificial
+Intelligence 1(3-4), 193-204 (weighted A*).
 """
 
 from __future__ import annotations
