@@ -162,8 +162,9 @@ class QuietWorst(WorstCase):
 
         A first plan when the exact search runs out: both landings of the random
         1000-point outline at 3 % on the ideal model, 26 operations after the first
-        alignment (the shortest) in 0.9 s with weight 1.25; of the near-round 64-gon, 28
-        (one above) in 0.3 s, where the widening beams over sets had 31 after 8 s.
+        alignment (the shortest) in 0.3 s with weight 1.25; of the near-round 64-gon, 28
+        (one above) in 0.14 s, then 27 (the shortest) with 1.1 in 1.4 s, where the widening
+        beams over sets gave 31 in a 10 s run of the command.
         """
         space = self.arc_space()
         if space is None:
