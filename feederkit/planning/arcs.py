@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from feederkit.angles import ANGLE_EPS
+from feederkit.planning.andor import part_chains
 from feederkit.planning.problem import Problem
 
 ARC_STATES_MAX = 4_000_000
@@ -338,13 +339,18 @@ class ArcSpace:
         return self.p.is_goal(states)
 
 
-def arc_space(problem: Problem, chains) -> ArcSpace | None:
+def arc_space(problem: Problem, chains=None) -> ArcSpace | None:
     """The arc search of ``problem`` given its parts' backchaining tables (``chains``, as
-    :func:`~feederkit.planning.andor.part_chains` gives them), or None where it does not
-    apply: some state in no part with a table, a margin floor, more than
-    ``ARC_STATES_MAX`` arc states, or a goal relation that pairs some state with only some
-    of another part's symmetric states (the goal of collapsed arcs is then not a product)."""
-    if problem.min_margin != 0.0 or not chains:
+    :func:`~feederkit.planning.andor.part_chains` gives them; made here when not given), or
+    None where it does not apply: a margin floor (asked first: a margin probe's problem
+    makes no tables), some state in no part with a table, more than ``ARC_STATES_MAX`` arc
+    states, or a goal relation that pairs some state with only some of another part's
+    symmetric states (the goal of collapsed arcs is then not a product)."""
+    if problem.min_margin != 0.0:
+        return None
+    if chains is None:
+        chains = part_chains(problem)
+    if not chains:
         return None
     covered = 0
     for part, _local, _chain in chains:

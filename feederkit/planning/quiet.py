@@ -132,7 +132,7 @@ class QuietWorst(WorstCase):
     def arc_space(self) -> ArcSpace | None:
         """The arc search of this problem (made once), None where it is not used."""
         if self._arcs is None:
-            self._arcs = arc_space(self.p, part_chains(self.p)) or False
+            self._arcs = arc_space(self.p) or False
         return self._arcs or None
 
     def arc_chains(self, space: ArcSpace, roots, longest: int, floor: float) -> float | None:
