@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
 import pytest
 from shared import brute_lengths, small_mix
 from test_planners import check_plan
@@ -109,6 +110,29 @@ def test_the_arc_search_does_not_apply_under_a_margin_floor():
     assert arc_space(problem, []) is None
 
 
+@pytest.mark.parametrize("name", ["mix4-200", "mix3-300", "landings-9"])
+@pytest.mark.parametrize("floor", [0.0, 2.0])
+def test_many_arc_states_expanded_at_once_lead_where_each_one_does(name, floor):
+    # The search expands its top bucket in one array pass (ArcSpace._expand); each state's
+    # successors must be those of the one-state expansion (_next), repeats included.
+    machine, _tol = _coarse(CASES[name])
+    problem = Problem(machine)
+    space = arc_space(problem)
+    assert space is not None
+    parts = list(range(len(space.parts)))
+    sizes = [pt.arcs for pt in space.parts]
+    stride = [math.prod(sizes[j + 1 :]) for j in range(len(parts))]
+    rng = random.Random(name)
+    codes = [rng.randrange(math.prod(sizes)) for _ in range(300)]
+    arcs_of = [[(c // stride[j]) % sizes[j] for j in parts] for c in codes]
+    got, source = space._expand(
+        parts, [np.asarray([a[j] for a in arcs_of]) for j in parts], stride, floor
+    )
+    for n, arcs_here in enumerate(arcs_of):
+        want, _cuts, _widths = space._next(parts, arcs_here, stride, floor)
+        assert sorted(got[source == n].tolist()) == sorted(want.tolist()), n
+
+
 def _polygon(name: str, points, com=None):
     return push_function(make_part(make_outline(name, [list(p) for p in points]), com))
 
@@ -177,9 +201,9 @@ def test_a_chain_starting_on_a_states_boundary_is_followed_on_the_machine():
 
 
 def test_a_margin_probe_the_search_over_sets_leaves_open_is_not_called_proven(monkeypatch):
-    # landings-16: some probe's arc chain keeps less than the probe (the search over sets
+    # mix2-37: some probe's arc chain keeps less than the probe (the search over sets
     # decides it); with no polls for that search the bisection says it is not proven.
-    machine, problem, roots, longest, want = _setup(WIDE["landings-16"]())
+    machine, problem, roots, longest, want = _setup(WIDE["mix2-37"]())
     monkeypatch.setattr(quiet, "SET_PROBE_POLLS", 0)
     found = widest_chain(QuietWorst(problem), roots, longest, 0.0, Deadline())
     assert found.cut_by == "work" and found.margin <= want

@@ -50,7 +50,10 @@ ARC_STATES_MAX = 4_000_000
 """The arc search applies only where the parts' arcs together make at most this many states
 (its tables hold one entry per state)."""
 
-POLL_STATES = 8
+CHUNK = 256
+"""The search expands up to this many states of its top bucket in one array pass."""
+
+POLL_STATES = 16
 """The search polls its deadline once per this many states expanded: a poll then stands for
 about as much work as one of the set searches' (a third of a millisecond), so the
 tie-breaking stages' budget, a multiple of the proof's polls, means the same time."""
@@ -113,6 +116,35 @@ class ArcPart:
         return c, self.pos[c] + turns * self.period
 
 
+class _Table:
+    """One part's arcs' moves (:meth:`ArcSpace._moves_of`) in flat arrays, filled as arcs
+    are met: arc ``a``'s cut rotations are ``cuts[first[a]:first[a] + size[a]]`` and their
+    images ``outs[...]`` (``first[a] < 0``: not made yet)."""
+
+    def __init__(self, arcs: int) -> None:
+        self.first = np.full(arcs, -1, dtype=np.int64)
+        self.size = np.zeros(arcs, dtype=np.int64)
+        self.cuts = np.empty(0)
+        self.outs = np.empty(0, dtype=np.int64)
+        self._used = 0
+
+    def add(self, arcs: list[int], moves: Callable[[int], tuple[np.ndarray, np.ndarray]]) -> None:
+        """Make the moves of ``arcs`` (none made yet), growing the arrays by doubling."""
+        made = [moves(a) for a in arcs]
+        need = self._used + sum(len(c) for c, _o in made)
+        if need > len(self.cuts):
+            grow = max(need, 2 * len(self.cuts))
+            self.cuts = np.concatenate([self.cuts[: self._used], np.empty(grow - self._used)])
+            self.outs = np.concatenate(
+                [self.outs[: self._used], np.empty(grow - self._used, dtype=np.int64)]
+            )
+        for a, (c, o) in zip(arcs, made, strict=True):
+            self.first[a], self.size[a] = self._used, len(c)
+            self.cuts[self._used : self._used + len(c)] = c
+            self.outs[self._used : self._used + len(c)] = o
+            self._used += len(c)
+
+
 class ArcSpace:
     """The arc states of a problem's parts and A* over them (module docstring).
 
@@ -125,7 +157,7 @@ class ArcSpace:
         self.masks = masks
         self.reached = 0
         """The least f-value the last :meth:`shortest_chain` left open."""
-        self._moves: list[dict[int, tuple[np.ndarray, np.ndarray]]] = [{} for _ in parts]
+        self._tables: dict[int, _Table] = {}
         self._h = [
             np.array(
                 [min(pt.chain_length(pt.length_of(a // (pt.k + 1), a % (pt.k + 1))), _FAR)
@@ -138,10 +170,8 @@ class ArcSpace:
     def _moves_of(self, i: int, arc: int) -> tuple[np.ndarray, np.ndarray]:
         """Part ``i``'s arc under every rotation: the rotations (deg, ascending in
         [0, 360)) where its image changes, and the image from each to the next (the last
-        to the first, past 360). Rotations act as ``x -> x + theta``."""
-        hit = self._moves[i].get(arc)
-        if hit is not None:
-            return hit
+        to the first, past 360). Rotations act as ``x -> x + theta``; kept in the part's
+        :class:`_Table`."""
         pt = self.parts[i]
         a, m = divmod(arc, pt.k + 1)
         u = float(pt.pos[a])
@@ -164,8 +194,7 @@ class ArcSpace:
                 span <= _EPS, 0, np.where(span >= pt.period - _EPS, pt.k, (c1 - c0) % pt.k)
             )
             out = c0 * (pt.k + 1) + steps
-        hit = self._moves[i][arc] = (cuts, out.astype(np.int64))
-        return hit
+        return cuts, out.astype(np.int64)
 
     def _hulls(self, i: int, mask: int) -> list[int]:
         """The arcs of part ``i`` that are hulls of the set's states of that part."""
@@ -245,34 +274,112 @@ class ArcSpace:
         while keys:
             key = keys[0]
             bucket = buckets[key]
-            code = bucket.pop()
+            # The top bucket's last CHUNK states at once (one array pass each step); the
+            # children may open a deeper bucket of the same f, asked first next round.
+            codes = np.asarray(bucket[-CHUNK:], dtype=np.int64)
+            del bucket[-CHUNK:]
             if not bucket:
                 heapq.heappop(keys)
                 del buckets[key]
             f, g = key[0], -key[1]
-            if g != best[code]:
+            codes = codes[best[codes] == g]
+            if not len(codes):
                 continue
             self.reached = max(self.reached, int(f))
             if cap is not None and f > cap:
                 return None
-            arcs = [(code // stride[j]) % sizes[j] for j in range(len(parts))]
-            if f == g and self._is_goal(parts, arcs):
-                return self._ranges(code, parent, parts, stride, sizes, floor)
-            expanded += 1
-            if expanded % POLL_STATES == 0:
+            arcs = [(codes // stride[j]) % sizes[j] for j in range(len(parts))]
+            if f == g:
+                goal = self._goal_among(parts, arcs)
+                if goal is not None:
+                    return self._ranges(int(codes[goal]), parent, parts, stride, sizes, floor)
+            for _ in range((expanded + len(codes)) // POLL_STATES - expanded // POLL_STATES):
                 check()
-            nxt, _cuts, _widths = self._next(parts, arcs, stride, floor)
-            nxt = nxt[best[nxt] > g + 1]  # most were met no deeper: few are left
+            expanded += len(codes)
+            nxt, source = self._expand(parts, arcs, stride, floor)
+            fresh = best[nxt] > g + 1  # most were met no deeper: few are left
+            nxt, source = nxt[fresh], source[fresh]
             if not len(nxt):
                 continue
-            nxt = np.unique(nxt)
+            nxt, first = np.unique(nxt, return_index=True)
             hs = h_of([(nxt // stride[j]) % sizes[j] for j in range(len(parts))])
             keep = hs < _FAR
-            nxt, hs = nxt[keep], hs[keep]
+            nxt, hs, first = nxt[keep], hs[keep], first[keep]
             best[nxt] = g + 1
-            parent[nxt] = code
-            for h in set(hs.tolist()):
+            parent[nxt] = codes[source[first]]
+            for h in np.unique(hs).tolist():
                 push(g + 1 + weight * h, g + 1, nxt[hs == h].tolist())
+        return None
+
+    def _table(self, i: int, arcs: np.ndarray) -> _Table:
+        """Part ``i``'s :meth:`_moves_of` end to end, with those of ``arcs`` made if new:
+        only the arcs the search meets are made, as a part of many states has many."""
+        table = self._tables.get(i)
+        if table is None:
+            table = self._tables[i] = _Table(self.parts[i].arcs)
+        new = arcs[table.first[arcs] < 0]
+        if len(new):
+            table.add(np.unique(new).tolist(), lambda arc: self._moves_of(i, arc))
+        return table
+
+    def _expand(
+        self, parts: list[int], arcs: list[np.ndarray], stride: list[int], floor: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_next` of many arc states at once (``arcs[j]``: part ``j``'s arc of each):
+        the states one rotation leads to, repeats included, and the index of the state each
+        comes from.
+
+        Each state's cuts are keyed ``720 * index + cut``, so that one sort orders them by
+        state, then by rotation; the keys only order (two cuts they could swap are closer
+        than ``ANGLE_EPS``, a range no action takes), the widths come from the cuts."""
+        count = len(arcs[0])
+        base = 720.0 * np.arange(count)
+        keys, cuts, outs, owners, heads, sizes = [], [], [], [], [], []
+        for j, i in enumerate(parts):
+            table = self._table(i, arcs[j])
+            lo, size = table.first[arcs[j]], table.size[arcs[j]]
+            part_cuts, part_outs = table.cuts, table.outs
+            ends = np.cumsum(size)
+            at = np.arange(int(ends[-1])) - np.repeat(ends - size - lo, size)
+            owners.append(np.repeat(np.arange(count), size))
+            cuts.append(part_cuts[at])
+            keys.append(base[owners[-1]] + cuts[-1])
+            outs.append(part_outs[at])
+            heads.append(ends - size)
+            sizes.append(size)
+        order = np.argsort(np.concatenate(keys), kind="stable")
+        src = np.repeat(np.arange(len(parts)), [len(c) for c in cuts])[order]
+        owner = np.concatenate(owners)[order]
+        cut = np.concatenate(cuts)[order]
+        # Each state's ranges: from each cut to the next, its last to its first past 360.
+        last = np.ones(len(owner), dtype=bool)
+        last[:-1] = owner[1:] != owner[:-1]
+        head = np.flatnonzero(np.concatenate(([True], last[:-1])))
+        ends = np.empty_like(cut)
+        ends[:-1] = cut[1:]
+        ends[last] = cut[head] + 360.0
+        wide = ends - cut > max(ANGLE_EPS, 2.0 * floor - 1e-12)
+        mine = owner[wide]
+        nxt = np.zeros(len(mine), dtype=np.int64)
+        for j in range(len(parts)):
+            # Part j's cuts up to each range's start in its state, less one: the image past
+            # the last of them (none: the state's last, wrapping), as _next's search.
+            seen = np.cumsum(src == j)
+            before = np.concatenate(([0], seen))[head]
+            k = (seen - before[owner])[wide] - 1
+            k = np.where(k < 0, sizes[j][mine] - 1, k)
+            nxt += outs[j][heads[j][mine] + k] * stride[j]
+        return nxt, mine
+
+    def _goal_among(self, parts: list[int], arcs: list[np.ndarray]) -> int | None:
+        """The index of the first state among ``arcs`` (as in :meth:`_expand`) that is a
+        goal (:meth:`_is_goal`), or None."""
+        points = np.ones(len(arcs[0]), dtype=bool)
+        for j, i in enumerate(parts):
+            points &= arcs[j] % (self.parts[i].k + 1) == 0
+        for n in np.flatnonzero(points).tolist():
+            if self._is_goal(parts, [int(a[n]) for a in arcs]):
+                return n
         return None
 
     def _next(
@@ -282,7 +389,11 @@ class ArcSpace:
         repeats included), each range's start and width (deg, ``x -> x + theta``): the
         ranges between the arcs' ends' crossings, those no wider than ``ANGLE_EPS`` (no
         action, as in ``Choices.cells``) or narrower than ``2 * floor`` left out."""
-        moves = [self._moves_of(i, a) for i, a in zip(parts, arcs, strict=True)]
+        moves = []
+        for i, a in zip(parts, arcs, strict=True):
+            table = self._table(i, np.asarray([a]))
+            span = slice(table.first[a], table.first[a] + table.size[a])
+            moves.append((table.cuts[span], table.outs[span]))
         cuts = np.concatenate([c for c, _o in moves])
         cuts.sort()  # repeats make ranges of width 0, left out below
         ends = np.empty_like(cuts)
