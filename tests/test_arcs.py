@@ -227,6 +227,8 @@ def test_weighted_chains_are_plans_within_their_weight_of_the_shortest(name, mon
         assert _follow(worst, r) <= longest and r not in worst.exact
     # The fallback's first plan where the exact search ran out: no beams over sets needed.
     monkeypatch.setattr(fallback, "widening_chains", lambda *_a, **_k: pytest.fail("beams"))
+    # Nor the subsets' AND/OR search over reading sets: the A* at the bound proves it.
+    monkeypatch.setattr(fallback, "subset_lower_bound", lambda *_a, **_k: pytest.fail("subsets"))
     monkeypatch.setattr(arcs, "POLL_STATES", 1)  # the exact arc search cut at once
     cut = QuietWorst(problem, WorkBudget(Deadline(), 0))
     with pytest.raises(Timeout):
@@ -235,7 +237,7 @@ def test_weighted_chains_are_plans_within_their_weight_of_the_shortest(name, mon
         problem, cut, roots, _branches, Deadline(20.0), PlanningOptions(time_limit_s=20.0), "time"
     )
     result = _result(machine, root, False, None, lower, "worst", "none")
-    assert lower <= 1 + want <= result.length == check_plan(result)
+    assert lower == 1 + want == result.length == check_plan(result) and result.optimal
 
 
 def _regular(n: int, com=None):
