@@ -15,6 +15,7 @@ from test_strong_plans import random_pf
 from test_tie_breaks import _max_min
 
 from feederkit.landing.model import landings_of_outline
+from feederkit.machine import members
 from feederkit.mechanics import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
@@ -259,6 +260,45 @@ SYMMETRIC = {
     "pentagon+triangle off centre": lambda: [_regular(5), _regular(3, [0.5, 0.1])],
 }
 """Mixes with parts whose push function repeats within a turn (periods of 60-180 degrees)."""
+
+
+def _target(machine, state: int, alpha: float) -> int | None:
+    """The state the machine's action ranges take ``state`` to under rotation ``alpha``
+    (None within 1e-6 degrees of a range's end)."""
+    for r in machine.action_maps[state]:
+        for x in (alpha, alpha + 360.0):
+            if r.lo + 1e-6 < x < r.hi - 1e-6:
+                return r.target
+    return None
+
+
+@pytest.mark.parametrize("name", [*SYMMETRIC, "mix3-300"])
+def test_an_arcs_image_under_a_rotation_is_the_arc_between_its_ends_images(name):
+    # Against the machine's own action ranges (a rotation theta of the arcs is the
+    # machine's -theta): every part's arcs, symmetric parts (periods below 360) included.
+    machine, _tol = _coarse(SYMMETRIC[name]() if name in SYMMETRIC else CASES[name])
+    space = arc_space(Problem(machine))
+    assert space is not None
+    rng = random.Random(name)
+    for i, pt in enumerate(space.parts):
+        cls = {s: c for c, mask in enumerate(pt.states) for s in members(mask)}
+        checked = 0
+        while checked < 300:
+            a, m = rng.randrange(pt.k), rng.randrange(pt.k)
+            cuts, outs = space._moves_of(i, a * (pt.k + 1) + m)
+            theta = rng.uniform(0.0, 360.0)
+            first = _target(machine, min(members(pt.states[a])), -theta % 360.0)
+            last = _target(machine, min(members(pt.states[(a + m) % pt.k])), -theta % 360.0)
+            if first is None or last is None or np.min(np.abs(cuts - theta)) < 1e-6:
+                continue  # on a boundary: no action there
+            got_first, got_steps = divmod(
+                int(outs[cuts.searchsorted(theta, "right") - 1]), pt.k + 1
+            )
+            assert got_first == cls[first], (i, a, m, theta)
+            steps = (cls[last] - cls[first]) % pt.k
+            # The ends' classes alike: a point, or (grown past a turn) the whole circle.
+            assert got_steps == steps or (steps == 0 and m and got_steps == pt.k), (i, a, m)
+            checked += 1
 
 
 @pytest.mark.parametrize("name", SYMMETRIC)
