@@ -80,7 +80,7 @@ def test_report_names_the_pair_no_plan_can_tell_apart(db, tmp_path, capsys):
 def test_report_is_given_the_stored_parts_and_the_pair(db, tmp_path, capsys, monkeypatch):
     import feederkit.reports
 
-    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=()):
+    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=(), **_kw):
         assert design is not None and design["sensor_model"] == "tolerance"
         pairs = sorted(sorted((u["part_a"], u["part_b"])) for u in unrecognizable)
         return f"<p>{pairs} {sorted(outlines)}</p>"
@@ -125,7 +125,7 @@ def test_a_design_past_its_limit_is_cut_short_in_the_report(db, tmp_path, capsys
 
     got: list = []
 
-    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=()):
+    def fake_report(plan, *, unrecognizable, outlines, design=None, cautions=(), **_kw):
         got.append(design)
         return "<p>report</p>"
 

@@ -153,7 +153,7 @@ def test_changeover_report_gives_its_design_a_long_time_limit_less_the_drawings(
     )
     budgets = []
 
-    def report(plan, parts, witnesses, budget, warnings=()):
+    def report(plan, parts, witnesses, budget, **_kw):
         budgets.append(budget)
         return "<html></html>"
 
@@ -190,3 +190,45 @@ def test_a_design_the_mix_cannot_have_leaves_the_compile_and_its_report(
     assert 'id="design-cut-short"' not in page
     (line,) = [w for w in cap.err.splitlines() if "sensor design" in w]
     assert line.startswith("warning: ") and "could not be made" in line
+
+
+def test_compile_report_takes_the_compiles_verification_and_no_plot_past_the_limit(
+    db, tmp_path, capsys, monkeypatch
+):
+    # The plan was verified by the compile itself: the report does not verify it again (a
+    # 20-part mix's plan over both landings: 14 s), and draws no part plot once the
+    # command's limit has passed (0.2-0.6 s each, 40 of them).
+    import feederkit.reports.report as report_module
+
+    def again(*_a, **_k):
+        raise AssertionError("the report verified the plan again")
+
+    monkeypatch.setattr(report_module, "verify_declared", again)
+    html = tmp_path / "mix.html"
+    args = ["changeover", "compile", "mix", "--mix", MIX, "--tolerance", "0.01"]
+    ok(capsys, [*args, "--report", str(html), "--catalog", str(db)])
+    page = html.read_text()
+    assert page.count('class="plot"') == 2 and "plot-skipped" not in page
+    # Past the limit: each member's section names the command that draws its plot.
+    import feederkit.cli.changeover as changeover_cli
+
+    monkeypatch.setattr(changeover_cli, "limit_instant", lambda *_a: time.monotonic() - 1.0)
+    later = tmp_path / "late.html"
+    ok(capsys, [*args, "--report", str(later), "--catalog", str(db), "--replace"])
+    page = later.read_text()
+    assert 'class="plot"' not in page and page.count("plot-skipped") == 2
+    assert "time limit left no time for this member" in page
+
+
+def test_plan_report_takes_the_plans_verification(tmp_path, capsys, monkeypatch):
+    import feederkit.reports.report as report_module
+
+    def again(*_a, **_k):
+        raise AssertionError("the report verified the plan again")
+
+    monkeypatch.setattr(report_module, "verify_declared", again)
+    html = tmp_path / "plan.html"
+    parts = [str(CATALOG / f"{name}.json") for name in MIX.split(",")]
+    out = str(tmp_path / "plan.json")
+    ok(capsys, ["plan", *parts, "--tolerance", "0.01", "-o", out, "--report", str(html)])
+    assert 'class="plot"' in html.read_text()

@@ -76,6 +76,7 @@ from feederkit.cli.common import (
     flag_tolerance,
     flag_words,
     json_found,
+    limit_instant,
     note_written,
     plan_outputs,
     plural,
@@ -105,6 +106,7 @@ from feederkit.mix.changeover import (
 from feederkit.mix.pairs import PairWitness
 from feederkit.plans.model import pairs_words
 from feederkit.plans.readplan import as_plan
+from feederkit.plans.verify import VerificationReport
 from feederkit.plans.writeplan import plan_file_text
 from feederkit.sensors import LedSensor, ToleranceSensor, sensor_from_dict
 from feederkit.uncertainty import IDEAL, Uncertainty, check_for_part
@@ -329,12 +331,16 @@ def changeover_report(
     pfs: Sequence[PushFunction],
     witnesses: Sequence[PairWitness],
     design_limit_s: float | None = None,
+    verification: VerificationReport | None = None,
+    plots_until: float | None = None,
     cautions: Sequence[str] = (),
 ) -> str:
     """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`changeover_design`; docs/reports.md) within ``design_limit_s`` seconds
-    (None: ``REPORT_DESIGN_LIMIT_S``); ``cautions`` open the page (parts revised since)."""
+    (None: ``REPORT_DESIGN_LIMIT_S``); ``verification``: the compile's own of the plan (None:
+    made here), ``plots_until``: the command's time limit for the part plots
+    (``render_report``); ``cautions`` open the page (parts revised since)."""
     from feederkit.design import sensor
     from feederkit.reports import render_report
 
@@ -347,7 +353,9 @@ def changeover_report(
         unrecognizable=[w.to_dict() for w in witnesses],
         outlines={pf.part.name: pf.part.outline for pf in pfs},
         design=design,
+        verification=verification,
         cautions=cautions,
+        plots_until=plots_until,
     )
 
 
@@ -473,7 +481,10 @@ def compile_command(
         files, _view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
         if report is not None:
             budget = report_design_budget(options.time_limit_s, started, len(c.parts))
-            html = changeover_report(c.plan, list(c.parts), list(c.witnesses), budget)
+            until = limit_instant(started, options.time_limit_s)
+            html = changeover_report(
+                c.plan, list(c.parts), list(c.witnesses), budget, c.made.report, until
+            )
             files.append(OutputFile(report, html, "report"))
         return files
 
@@ -854,7 +865,14 @@ def report_command(
     # it less the drawings, however long.
     limit = REPORT_DESIGN_LIMIT_S if design_limit is None else design_limit
     budget = report_design_budget(limit, started, len(co.parts), cap=limit)
-    html = changeover_report(co.plan, list(co.parts), co.witnesses(), budget, co.warnings)
+    html = changeover_report(
+        co.plan,
+        list(co.parts),
+        co.witnesses(),
+        budget,
+        plots_until=started + limit,
+        cautions=co.warnings,
+    )
     write_files([OutputFile(output, html, "report")])
     note_written((output, "report"))
     console.print(f"wrote the report to {output}", highlight=False, markup=False, soft_wrap=True)

@@ -47,6 +47,7 @@ from feederkit.mix.pairs import PairWitness
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.plans.model import Plan
+from feederkit.plans.verify import VerificationReport
 from feederkit.plans.writeplan import read_back
 from feederkit.sensors import Sensor, make_sensor
 from feederkit.uncertainty import ToleranceTooLarge, Uncertainty
@@ -549,15 +550,23 @@ def time_limit_note(stats: dict[str, Any], time_limit: float | None) -> str | No
 
 
 def report_html(
-    plan: dict[str, Any], pfs: Sequence[PushFunction], witnesses: Sequence[PairWitness]
+    plan: dict[str, Any] | Plan,
+    pfs: Sequence[PushFunction],
+    witnesses: Sequence[PairWitness],
+    verification: VerificationReport | None = None,
+    plots_until: float | None = None,
 ) -> str:
-    """The HTML report of a plan (the report library's, imported only when asked for)."""
+    """The HTML report of a plan (the report library's, imported only when asked for);
+    ``verification``: the command's own of this plan (not made again), ``plots_until``: the
+    command's time limit for the part plots (``render_report``)."""
     from feederkit.reports import render_report
 
     return render_report(
         plan,
         unrecognizable=[w.to_dict() for w in witnesses],
         outlines={pf.part.name: pf.part.outline for pf in pfs},
+        verification=verification,
+        plots_until=plots_until,
     )
 
 
@@ -567,17 +576,26 @@ def plan_outputs(
     witnesses: Sequence[PairWitness],
     output: Path | None,
     report: Path | None,
+    verification: VerificationReport | None = None,
+    plots_until: float | None = None,
 ) -> tuple[list[OutputFile], Plan]:
     """The files ``-o`` and ``--report`` ask for (rendered here, before any write) and the
     plan as its file reads back (:func:`~feederkit.plans.writeplan.read_back`: what the
-    file holds is what the command shows)."""
+    file holds is what the command shows); the report as :func:`report_html` makes it."""
     text, view = read_back(plan)
     files = []
     if output is not None:
         files.append(OutputFile(output, text, "plan file"))
     if report is not None:
-        files.append(OutputFile(report, report_html(view, pfs, witnesses), "report"))
+        html = report_html(view, pfs, witnesses, verification, plots_until)
+        files.append(OutputFile(report, html, "report"))
     return files, view
+
+
+def limit_instant(started: float, time_limit_s: float | None) -> float | None:
+    """The ``time.monotonic()`` instant a command that started at ``started`` reaches its
+    ``--time-limit`` (None: no limit)."""
+    return None if time_limit_s is None else started + time_limit_s
 
 
 def check_outputs(*outputs: tuple[Path | None, str]) -> None:

@@ -54,6 +54,7 @@ from feederkit.cli.common import (
     flag_words,
     json_found,
     json_option,
+    limit_instant,
     note_written,
     plan_outputs,
     print_warnings,
@@ -284,7 +285,10 @@ def plan_command(
         made, witnesses = planned.made, [p.witness for p in planned.indistinguishable]
     plan = made.plan
     cycle = annotate_cycle_time(made, settings)  # stats.cycle_time, before anything is written
-    files, view = plan_outputs(plan, pfs, witnesses, output, report)
+    # The report takes the plan's verification (made once) and draws part plots only
+    # within the limit.
+    until = limit_instant(started, options.time_limit_s)
+    files, view = plan_outputs(plan, pfs, witnesses, output, report, made.report, until)
     write_files(files)
     note_written((output, "plan"), (report, "report"))
     notes = [*made.warnings, *filter(None, [settings.belt_warning()])]

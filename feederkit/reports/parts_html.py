@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import base64
 import functools
+import time
 
 from feederkit.outline import Outline
 from feederkit.plans.model import PlanPart, push_function_of
@@ -68,11 +69,14 @@ def part_section(
     draw: Drawing,
     outline: Outline | None,
     share: float | None = None,
+    plots_until: float | None = None,
 ) -> str:
     """One member (a part, or a part in one landing; ``index`` in the plan): its label, prior
     share (None: not given), stable-state table with poses, and its radius/push/push-diameter
-    plot, or past the first ``PART_PLOTS`` members a line saying how to draw it."""
-    plot = index < PART_PLOTS
+    plot, or past the first ``PART_PLOTS`` members, or once ``time.monotonic()`` passes
+    ``plots_until`` (the command's time limit), a line saying how to draw it."""
+    late = plots_until is not None and time.monotonic() >= plots_until
+    plot = index < PART_PLOTS and not late
     rev = f' <span class="muted">rev {esc(str(entry.revision))}</span>' if entry.revision else ""
     share_text = (
         "" if share is None else f' <span class="muted">share {num(100.0 * share, 3)}%</span>'
@@ -91,7 +95,7 @@ def part_section(
             else ""
         )
         + f'<div class="part-grid"><div>{_states_table(index, entry, draw)}</div>'
-        f"{_plot_figure(entry, outline) if plot else _no_plot(entry)}</div></section>"
+        f"{_plot_figure(entry, outline) if plot else _no_plot(entry, late)}</div></section>"
     )
 
 
@@ -105,9 +109,10 @@ def _plot_figure(entry: PlanPart, outline: Outline | None) -> str:
     )
 
 
-def _no_plot(entry: PlanPart) -> str:
-    """The words in place of a member's part plot past :data:`PART_PLOTS`: the command that
-    draws it (its catalog revision when the plan names one)."""
+def _no_plot(entry: PlanPart, late: bool = False) -> str:
+    """The words in place of a member's part plot past :data:`PART_PLOTS` (``late``: past the
+    command's time limit): the command that draws it (its catalog revision when the plan
+    names one)."""
     if entry.revision is None:
         how = (
             "<code>feederkit part plot SOURCE -o PLOT.svg</code> (its outline or CAD file, or "
@@ -128,7 +133,9 @@ def _no_plot(entry: PlanPart) -> str:
                 else ")"
             )
         )
-    return (
-        f'<p class="muted plot-skipped">The report draws the plots of its first {PART_PLOTS} '
-        f"members only; draw this one with {how}.</p>"
+    why = (
+        "The command's time limit left no time for this member's plot"
+        if late
+        else f"The report draws the plots of its first {PART_PLOTS} members only"
     )
+    return f'<p class="muted plot-skipped">{why}; draw this one with {how}.</p>'

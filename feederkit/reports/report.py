@@ -174,6 +174,7 @@ def render_report(
     design: Mapping[str, Any] | None = None,
     verification: VerificationReport | None = None,
     cautions: Sequence[str] = (),
+    plots_until: float | None = None,
 ) -> str:
     """The HTML report of a plan (or a plan file's JSON object, checked; design.md).
 
@@ -187,7 +188,9 @@ def render_report(
     JSON of ``feederkit design sensor``) adds the sensor design table and plot;
     ``verification``, the plan's :func:`~feederkit.plans.verify.verify_declared` when the
     caller has it (else it is made here), gives the banner; ``cautions`` are lines the page
-    must say first (a stored changeover whose parts have newer revisions). Raises
+    must say first (a stored changeover whose parts have newer revisions);
+    ``plots_until``, a ``time.monotonic()`` instant (a command's time limit) past which the
+    part plots are not drawn (each member then names the command that draws it). Raises
     InputError for a malformed plan or option.
     """
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -219,7 +222,7 @@ def render_report(
             "" if design is None else design_section(design, plan.sensor),
             '<section id="parts"><h2>Parts</h2>',
             "".join(
-                part_section(i, p, draw, member_outline(p, outlines), share)
+                part_section(i, p, draw, member_outline(p, outlines), share, plots_until)
                 for i, (p, share) in enumerate(zip(plan.parts, _shares(plan), strict=True))
             ),
             "</section>",
