@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class FeederkitError(Exception):
     """Base of feederkit's own errors."""
 
     exit_code = 2
+
+    def json_fields(self) -> dict[str, Any]:
+        """Fields a ``--json`` answer without a result adds for this error (docs/cli.md)."""
+        return {}
 
 
 class InputError(FeederkitError):

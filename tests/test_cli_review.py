@@ -107,6 +107,24 @@ def json_result(capsys, args: list[str]) -> dict:
     return data
 
 
+def test_plan_json_without_a_plan_in_time_says_what_stopped_it_and_the_bound(capsys, monkeypatch):
+    # A search stopped by a limit: the JSON says which (``stopped_by``) and the proven
+    # bound (``lower_bound``), not only the sentence.
+    import feederkit.planning.api as api
+    from feederkit.planning.options import OutOfBudget
+
+    def stopped(*_a, **_k):
+        raise OutOfBudget("no plan found within the time limit of 1 s", "time", 4)
+
+    monkeypatch.setattr(api, "_plan", stopped)
+    data = json_result(capsys, ["plan", T_CLIP, "--time-limit", "1"])
+    assert data["stopped_by"] == "time" and data["lower_bound"] == 4
+    assert data["members"] == ["t-clip"]
+    monkeypatch.undo()
+    data = json_result(capsys, ["plan", T_CLIP, "--min-margin", "100"])
+    assert "stopped_by" not in data and "lower_bound" not in data  # no limit stopped it
+
+
 def test_plan_json_without_a_plan_prints_the_error_and_what_was_found(capsys):
     data = json_result(capsys, ["plan", T_CLIP, "--min-margin", "100"])
     assert "no plan keeps a margin of 100 deg" in data["error"]

@@ -577,6 +577,7 @@ def test_a_plan_too_large_to_verify_in_time_gives_way_to_a_smaller_one(monkeypat
         plan(machine, PlanningOptions(time_limit_s=30.0), budget=Deadline(30.0, per_pair_s=1.0))
     # A plan was found, only too large to verify in time: more time would give it.
     assert "one of 2 operations was found, but not built and verified in time" in str(caught.value)
+    assert caught.value.reason == "time" and caught.value.lower_bound == full.length
     assert time.perf_counter() - start < 20.0
 
 

@@ -444,7 +444,7 @@ def _error_exit(exc: Exception, args: list[str]) -> int:
     if isinstance(exc, FeederkitError):
         if exc.exit_code == EXIT_RESULT:
             _say_result(_oneline(exc))
-            _print_json_failure(_oneline(exc), exc.exit_code)
+            _print_json_failure(_oneline(exc), exc.exit_code, exc.json_fields())
         else:
             _say(_oneline(exc))
         return exc.exit_code
@@ -470,11 +470,11 @@ def _error_exit(exc: Exception, args: list[str]) -> int:
     return EXIT_BUG
 
 
-def _print_json_failure(message: str, code: int) -> None:
+def _print_json_failure(message: str, code: int, fields: dict | None = None) -> None:
     """With ``--json``, a result without an answer still prints one JSON object on stdout
     (:func:`feederkit.cli.common.json_failure`); a stdout that cannot take it changes
     nothing (the ``result:`` line on stderr has said it)."""
-    data = json_failure(message, code)
+    data = json_failure(message, code, fields)
     if data is None:
         return
     with contextlib.suppress(OSError):

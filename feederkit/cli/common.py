@@ -165,13 +165,16 @@ def json_found(**fields: Any) -> None:
     JSON_ANSWER.found.update(fields)
 
 
-def json_failure(message: str, code: int) -> dict[str, Any] | None:
+def json_failure(
+    message: str, code: int, fields: dict[str, Any] | None = None
+) -> dict[str, Any] | None:
     """The JSON object a result without an answer prints with ``--json``: ``error`` (the
-    ``result:`` line's message), ``exit_code`` and what the command found; None when
-    ``--json`` was not asked for or the command already printed its answer."""
+    ``result:`` line's message), ``exit_code``, the error's own ``fields``
+    (``FeederkitError.json_fields``) and what the command found; None when ``--json`` was
+    not asked for or the command already printed its answer."""
     if not JSON_ANSWER.requested or JSON_ANSWER.printed:
         return None
-    return {"error": message, "exit_code": code, **JSON_ANSWER.found}
+    return {"error": message, "exit_code": code, **(fields or {}), **JSON_ANSWER.found}
 
 
 SensorlessOpt = Annotated[

@@ -395,6 +395,7 @@ def fallback(
             f"no plan found within {out_of_budget(options, reason)} "
             f"({which} needs at least {plural(lower, 'operation')}{seen})",
             reason,
+            lower if not apart else None,
         )
     return root, False, None, lower, TIES_NONE, None
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import Any
 
 from feederkit.errors import InputError, PlanningError
 from feederkit.machine import Grouping
@@ -221,8 +222,14 @@ def out_of_budget(options: PlanningOptions, reason: str) -> str:
 class OutOfBudget(PlanningError):
     """No plan, because a limit of the options ran out (``reason``: the Timeout's, ``"time"``
     or ``"memory"``) rather than because none exists: a caller with a budget of its own (the
-    sensor design) tells the two apart by type, not by the message."""
+    sensor design) tells the two apart by type, not by the message. ``lower_bound``: the
+    operations any plan needs, the first alignment counted, where the search proved some."""
 
-    def __init__(self, message: str, reason: str) -> None:
+    def __init__(self, message: str, reason: str, lower_bound: int | None = None) -> None:
         super().__init__(message)
         self.reason = reason
+        self.lower_bound = lower_bound
+
+    def json_fields(self) -> dict[str, Any]:
+        """``stopped_by`` (``"time"`` or ``"memory"``) and ``lower_bound`` (None: not known)."""
+        return {"stopped_by": self.reason, "lower_bound": self.lower_bound}
