@@ -125,6 +125,25 @@ def test_plan_json_without_a_plan_in_time_says_what_stopped_it_and_the_bound(cap
     assert "stopped_by" not in data and "lower_bound" not in data  # no limit stopped it
 
 
+def test_no_plan_says_an_earlier_file_at_the_output_is_not_this_runs(capsys, monkeypatch, tmp_path):
+    # Exit 1 also means "written, with parts it cannot tell apart": a script must not read
+    # yesterday's plan at the path as this run's.
+    import feederkit.planning.api as api
+    from feederkit.planning.options import OutOfBudget
+
+    def stopped(*_a, **_k):
+        raise OutOfBudget("no plan found within the time limit of 1 s", "time", 4)
+
+    monkeypatch.setattr(api, "_plan", stopped)
+    old = tmp_path / "p.json"
+    old.write_text("{}")
+    rc, _out, err = run(capsys, ["plan", T_CLIP, "-o", str(old), "--time-limit", "1"])
+    assert rc == 1 and old.read_text() == "{}"
+    assert f"warning: nothing was written: {old} still holds an earlier file" in err
+    rc, _out, err = run(capsys, ["plan", T_CLIP, "-o", str(tmp_path / "new.json")])
+    assert rc == 1 and "earlier file" not in err  # nothing there before
+
+
 def test_plan_json_without_a_plan_prints_the_error_and_what_was_found(capsys):
     data = json_result(capsys, ["plan", T_CLIP, "--min-margin", "100"])
     assert "no plan keeps a margin of 100 deg" in data["error"]

@@ -73,6 +73,7 @@ from feederkit.cli.common import (
     console,
     cycle_line,
     declared_uncertainty,
+    earlier_outputs_noted,
     flag_tolerance,
     flag_words,
     json_found,
@@ -492,6 +493,7 @@ def compile_command(
         searching(f"compiling changeover {name}", options.time_limit_s),
         flag_words(terms),
         stored_tolerance_words(declared),
+        earlier_outputs_noted(output, report),
     ):
         compiled = compile_changeover(
             path,

@@ -40,7 +40,7 @@ from feederkit.catalog import (
 )
 from feederkit.catalog.tolerances import TOLERANCE_WORDS
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
-from feederkit.errors import FeederkitError, InputError
+from feederkit.errors import FeederkitError, InputError, PlanningError
 from feederkit.jsonio import OutputFile, check_writable, is_device
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
@@ -502,6 +502,25 @@ def print_warnings(lines: Iterable[str]) -> None:
         err_console.print(
             f"warning: {with_flags(line)}", highlight=False, markup=False, soft_wrap=True
         )
+
+
+@contextmanager
+def earlier_outputs_noted(*paths: Path | None) -> Iterator[None]:
+    """When the block finds no plan (PlanningError: nothing is written), warn that the
+    output paths already holding a file hold an earlier one, not this run's: a script that
+    reads the path after exit code 1 (which also means "written, with parts it cannot tell
+    apart") must not take it for this run's plan."""
+    try:
+        yield
+    except PlanningError:
+        old = [str(p) for p in paths if p is not None and p.is_file()]
+        if old:
+            print_warnings(
+                [f"nothing was written: {', '.join(old)} still "
+                 f"{'holds an earlier file' if len(old) == 1 else 'hold earlier files'}, "
+                 "not this run's"]
+            )  # fmt: skip
+        raise
 
 
 @contextmanager

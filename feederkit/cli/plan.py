@@ -50,6 +50,7 @@ from feederkit.cli.common import (
     console,
     cycle_line,
     declared_uncertainty,
+    earlier_outputs_noted,
     flag_tolerance,
     flag_words,
     json_found,
@@ -263,6 +264,7 @@ def plan_command(
             searching("planning and verifying", options.time_limit_s),
             flag_words(),
             stored_tolerance_words(declared),
+            earlier_outputs_noted(output, report),
         ):
             made, witnesses = plan_mix(
                 pfs, sensor, options, uncertainty=uncertainty, started=started
@@ -278,6 +280,7 @@ def plan_command(
             searching("planning and verifying", options.time_limit_s),
             flag_words(terms),
             stored_tolerance_words(declared),
+            earlier_outputs_noted(output, report),
         ):
             planned = plan_landings(
                 every, sensor, options, uncertainty=uncertainty, accept=taken, started=started
