@@ -326,3 +326,27 @@ def test_periods_of_finds_the_smallest_period(base, ids, k) -> None:
     q = len(items)
     smallest = next((j for j in range(1, q) if _invariant(items, 360.0 * j / q)), q)
     assert b == q // smallest
+
+
+@pytest.mark.parametrize("n", [5, 40, 3000])
+def test_radius_and_diameter_from_support_vertices_match_every_vertex(n, monkeypatch) -> None:
+    # Past SUPPORT_MATRIX_MAX the functions find each direction's support vertex by a binary
+    # search over the edge normals (a dense outline's wells asked for 25 GiB): the same values
+    # as projecting every vertex, at the edge normals themselves too.
+    import importlib
+
+    push = importlib.import_module("feederkit.mechanics.push")  # the package has push()
+    rng = np.random.default_rng(n)
+    angles = np.sort(rng.uniform(0.0, 2.0 * np.pi, n))
+    radii = rng.uniform(20.0, 30.0, n)
+    points = np.c_[radii * np.cos(angles), radii * np.sin(angles)].tolist()
+    part = make_part(make_outline(f"random-{n}", points))
+    normals = np.asarray(push.edge_normals(part.hull))
+    phis = np.concatenate([rng.uniform(-720.0, 720.0, 500), normals, normals + 360.0])
+    want_r, want_w = push.radius(part, phis), push.diameter(part, phis)
+    one = push.radius(part, 37.0)
+    monkeypatch.setattr(push, "SUPPORT_MATRIX_MAX", 0)
+    assert np.allclose(push.radius(part, phis), want_r, rtol=0.0, atol=1e-9)
+    assert np.allclose(push.diameter(part, phis), want_w, rtol=0.0, atol=1e-9)
+    got = push.radius(part, 37.0)
+    assert isinstance(got, float) and got == pytest.approx(one, abs=1e-9)
