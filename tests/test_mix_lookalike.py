@@ -170,3 +170,25 @@ def test_heptagon_file_is_theorem_4_applied_to_the_catalog_triangle():
     for p, q in zip(stored.vertices, built.outline.vertices, strict=True):
         assert math.dist(p, q) < 1e-12
     assert_same(tri, make_part(stored), "push")
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_an_outline_shows_more_than_its_hull_by_each_vertexs_nearest_edge(seed):
+    # symmetry._has_more_than_hull asks a tree of the hull's edges (a dense outline against
+    # the whole ring was quadratic): the tests' own measure, every vertex against the ring.
+    import numpy as np
+    import shapely
+
+    from feederkit.mechanics.symmetry import OUTLINE_SPACING_REL, _has_more_than_hull
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(8, 400))
+    angles = np.sort(rng.uniform(0.0, 2.0 * math.pi, n))
+    dent = rng.uniform(0.0, 0.1) if seed % 2 else 0.0  # some vertices pulled inwards
+    radii = 20.0 * (1.0 - dent * (rng.uniform(size=n) < 0.2))
+    points = np.c_[radii * np.cos(angles), radii * np.sin(angles)]
+    pf = push_function(make_part(make_outline(f"dent-{seed}", points.tolist())))
+    ring = shapely.LinearRing(np.asarray(pf.part.hull, dtype=float))
+    far = shapely.distance(shapely.points(np.asarray(pf.part.outline.vertices)), ring).max()
+    want = bool(far > 2.0 * OUTLINE_SPACING_REL * pf.part.size)
+    assert _has_more_than_hull(pf) == want
