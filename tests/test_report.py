@@ -653,3 +653,22 @@ def test_report_command_through_the_feederkit_entry_point(tmp_path):
 
 def test_the_report_is_deterministic():
     assert render_report(twin_plan()) == render_report(twin_plan())
+
+
+def test_a_changeover_report_reads_its_plan_once_and_keeps_the_files_cycle_time():
+    # changeover_report reads the plan once (the design's members and the page share it):
+    # the page still shows the file's stats.cycle_time.
+    from feederkit.cli.changeover import changeover_report
+    from feederkit.plans.readplan import as_plan
+
+    plan = triangle_plan()
+    plan["stats"]["cycle_time"] = {
+        "profile": "cell-b.toml",
+        "expected_s": 3.0,
+        "worst_s": 4.0,
+        "parts_per_minute": 20.0,
+        "worst_parts_per_minute": 15.0,
+    }
+    for view in (None, as_plan(plan)):
+        text = "".join(parse(changeover_report(plan, [], [], 1.0, view=view)).text)
+        assert "3 s per part, 20 parts per minute" in text and "cell-b.toml" in text

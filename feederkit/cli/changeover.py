@@ -105,7 +105,7 @@ from feederkit.mix.changeover import (
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
-from feederkit.plans.model import pairs_words
+from feederkit.plans.model import Plan, pairs_words
 from feederkit.plans.readplan import as_plan
 from feederkit.plans.verify import VerificationReport
 from feederkit.plans.writeplan import plan_file_text
@@ -277,7 +277,10 @@ def report_design_budget(
 
 
 def changeover_design(
-    plan: dict[str, Any], pfs: Sequence[PushFunction], time_limit_s: float
+    plan: dict[str, Any],
+    pfs: Sequence[PushFunction],
+    time_limit_s: float,
+    view: Plan | None = None,
 ) -> tuple[dict[str, Any] | None, str | None]:
     """The sensor design a changeover report shows (``ToleranceDesign.to_dict``; None for a
     single part) within ``time_limit_s`` seconds, and a warning when it was cut short there.
@@ -299,7 +302,7 @@ def changeover_design(
             list(pfs),
             uncertainty=unc,
             time_limit_s=time_limit_s,
-            members=plan_members(plan),
+            members=plan_members(plan, view),
             partial=True,
         ).to_dict()
     except (DesignTimeout, InputError) as exc:
@@ -335,22 +338,28 @@ def changeover_report(
     verification: VerificationReport | None = None,
     plots_until: float | None = None,
     cautions: Sequence[str] = (),
+    view: Plan | None = None,
 ) -> str:
     """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
     for a mix, the sensor design (critical tolerances and the plan length against the
     tolerance, :func:`changeover_design`; docs/reports.md) within ``design_limit_s`` seconds
     (None: ``REPORT_DESIGN_LIMIT_S``); ``verification``: the compile's own of the plan (None:
     made here), ``plots_until``: the command's time limit for the part plots
-    (``render_report``); ``cautions`` open the page (parts revised since)."""
+    (``render_report``); ``cautions`` open the page (parts revised since); ``view``: the
+    plan as its file reads back, when the caller has it (else read here, once)."""
     from feederkit.design import sensor
     from feederkit.reports import render_report
 
     limit = sensor.REPORT_DESIGN_LIMIT_S if design_limit_s is None else design_limit_s
-    design, warning = changeover_design(plan, pfs, limit)
+    if view is None:
+        view = as_plan(plan)  # read and checked once: the design's members and the page
+    design, warning = changeover_design(plan, pfs, limit, view)
     if warning is not None:
         print_warnings([warning])
+    stats = plan.get("stats")
     return render_report(
-        plan,
+        view,
+        cycle_time=stats.get("cycle_time") if isinstance(stats, dict) else None,
         unrecognizable=[w.to_dict() for w in witnesses],
         outlines={pf.part.name: pf.part.outline for pf in pfs},
         design=design,
@@ -479,12 +488,18 @@ def compile_command(
     def outputs(c) -> list[OutputFile]:
         # Runs before the changeover is stored: its plan file carries the cycle time.
         annotate_cycle_time(c.made, settings)
-        files, _view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
+        files, view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
         if report is not None:
             budget = report_design_budget(options.time_limit_s, started, len(c.parts))
             until = limit_instant(started, options.time_limit_s)
             html = changeover_report(
-                c.plan, list(c.parts), list(c.witnesses), budget, c.made.report, until
+                c.plan,
+                list(c.parts),
+                list(c.witnesses),
+                budget,
+                c.made.report,
+                until,
+                view=view,
             )
             files.append(OutputFile(report, html, "report"))
         return files

@@ -301,7 +301,7 @@ def accepted_lumps(plan: Mapping[str, Any]) -> list[tuple[str, str]]:
     return sorted(pairs, key=lambda ab: (order[ab[0]], order[ab[1]]))
 
 
-def rejected_members(plan: Mapping[str, Any]) -> frozenset[str]:
+def rejected_members(plan: Plan | Mapping[str, Any]) -> frozenset[str]:
     """The landings (``PART/LANDING``) a plan file rejects: those its reject results name.
 
     The plan file keeps no accept flag per member; a rejected landing's states end in reject
