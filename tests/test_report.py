@@ -328,15 +328,22 @@ def test_statistics_cycle_time_and_simulation():
     assert "not known: give a cell profile with timing" in without
 
 
-def test_the_cell_profiles_cycle_time_is_shown_and_named():
+def timed_triangle_plan(profile: str) -> dict:
+    """:func:`triangle_plan` with a cell profile's cycle time: 3 s (20 parts per minute)
+    expected, 4 s (15) at worst."""
     plan = triangle_plan()
     plan["stats"]["cycle_time"] = {
-        "profile": "cell-a.toml (overridden: --tolerance)",
+        "profile": profile,
         "expected_s": 3.0,
         "worst_s": 4.0,
         "parts_per_minute": 20.0,
         "worst_parts_per_minute": 15.0,
     }
+    return plan
+
+
+def test_the_cell_profiles_cycle_time_is_shown_and_named():
+    plan = timed_triangle_plan("cell-a.toml (overridden: --tolerance)")
     text = "".join(parse(render_report(plan)).text)
     assert "3 s per part, 20 parts per minute" in text
     assert "4 s per part, 15 parts per minute" in text
@@ -661,14 +668,7 @@ def test_a_changeover_report_reads_its_plan_once_and_keeps_the_files_cycle_time(
     from feederkit.cli.changeover import changeover_report
     from feederkit.plans.readplan import as_plan
 
-    plan = triangle_plan()
-    plan["stats"]["cycle_time"] = {
-        "profile": "cell-b.toml",
-        "expected_s": 3.0,
-        "worst_s": 4.0,
-        "parts_per_minute": 20.0,
-        "worst_parts_per_minute": 15.0,
-    }
+    plan = timed_triangle_plan("cell-b.toml")
     for view in (None, as_plan(plan)):
         text = "".join(parse(changeover_report(plan, [], [], 1.0, view=view)).text)
         assert "3 s per part, 20 parts per minute" in text and "cell-b.toml" in text
