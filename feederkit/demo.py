@@ -342,10 +342,11 @@ def _report(compiled: CompiledChangeover, notes: list[str]) -> str:
     if warning is not None:
         notes.append(warning)
     return render_report(
-        compiled.plan,
+        compiled.plan if compiled.view is None else compiled.view,  # the plan as stored
         unrecognizable=[w.to_dict() for w in compiled.witnesses],
         outlines={pf.part.name: pf.part.outline for pf in compiled.parts},
         design=design,
+        verification=compiled.made.report,  # the compile's own, not made again
     )
 
 
@@ -366,10 +367,8 @@ def compile_demo_changeover(
     plan_path, report_path = folder / f"{mix.name}.json", folder / f"{mix.name}.html"
     report_notes: list[str] = []
 
-    def outputs(c: CompiledChangeover) -> list[OutputFile]:
-        if cell is not None:
-            annotate_cycle_time(c.made, cell)  # before the plan is written and stored
-        files = [OutputFile(plan_path, plan_file_text(c.plan), "plan file")]
+    def outputs(c: CompiledChangeover, text: str) -> list[OutputFile]:
+        files = [OutputFile(plan_path, text, "plan file")]
         if report:
             files.append(OutputFile(report_path, _report(c, report_notes), "report"))
         return files
@@ -382,6 +381,7 @@ def compile_demo_changeover(
             sensor,
             replace=True,
             outputs=outputs,
+            prepare=None if cell is None else lambda made: annotate_cycle_time(made, cell),
             landings=mix.landings,
             accept=accept,
         )

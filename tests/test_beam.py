@@ -583,3 +583,43 @@ def test_a_mix_the_exact_search_cannot_finish_gets_a_verified_plan(monkeypatch):
     result = made.result
     assert result.lower_bound <= result.length <= 10  # 8 against 6 on the benchmark machine
     assert tree_length(result.root) == result.length
+
+
+def test_a_plan_the_beams_found_but_could_not_build_proves_one_exists(monkeypatch):
+    # Under uncertainty, with no plan in hand, the fallback asks whether any strong plan
+    # exists (solvable.unsolvable_by_pairs, up to half the time left): not when the beams
+    # found one whose tree ran out of time (the 50-part mix at 5 % under 1 degree lost 4.9 s
+    # of 60 to it); the searches after them look for a shorter plan, and the answer says
+    # one was found.
+    from feederkit.planning.options import OutOfBudget
+    from feederkit.uncertainty import Uncertainty
+
+    pts, com = polygon(3, 10)
+    pf = push_function(make_part(make_outline("random", pts), com))
+    machine = build_machine([pf], ToleranceSensor(0.08 * pf.part.size), uncertainty=Uncertainty())
+    assert not machine.deterministic
+
+    def out_of_time(*_args, **_kwargs):
+        raise Timeout("time")
+
+    monkeypatch.setattr(api, "longest_root", out_of_time)
+    for maker in ("sensorless_plan", "sequential_plan", "pairwise_plan"):
+        monkeypatch.setattr(fallback, maker, lambda *_args, **_kwargs: None)
+    builds: list[bool] = []
+
+    def runs_out(*_args, **_kwargs):
+        builds.append(True)
+        raise Timeout("time")
+
+    asked: list[bool] = []
+    real_pairs = fallback.unsolvable_by_pairs
+
+    def pairs(*args, **kwargs):
+        asked.append(True)
+        return real_pairs(*args, **kwargs)
+
+    monkeypatch.setattr(fallback, "_choice_plan", runs_out)
+    monkeypatch.setattr(fallback, "unsolvable_by_pairs", pairs)
+    with pytest.raises(OutOfBudget, match="was found, but not built and verified in time"):
+        plan(machine, PlanningOptions(time_limit_s=60.0))
+    assert builds and not asked

@@ -232,3 +232,29 @@ def test_plan_report_takes_the_plans_verification(tmp_path, capsys, monkeypatch)
     out = str(tmp_path / "plan.json")
     ok(capsys, ["plan", *parts, "--tolerance", "0.01", "-o", out, "--report", str(html)])
     assert 'class="plot"' in html.read_text()
+
+
+@pytest.mark.parametrize("command", ["plan", "compile"])
+def test_the_plan_file_is_read_back_once(db, tmp_path, capsys, monkeypatch, command):
+    # Reading a plan file's object into a Plan (checked) costs seconds on a large plan
+    # (2 s for a 16 MB one): the plan file, the report, the drawing and the pairs no result
+    # tells apart all take the one reading.
+    import feederkit.plans.readplan as readplan
+    import feederkit.plans.writeplan as writeplan
+
+    reads: list[str] = []
+    real = readplan.plan_from_dict
+
+    def counting(data, source="plan"):
+        reads.append(source)
+        return real(data, source)
+
+    monkeypatch.setattr(readplan, "plan_from_dict", counting)
+    monkeypatch.setattr(writeplan, "plan_from_dict", counting)
+    if command == "plan":
+        args = ["plan", *(str(CATALOG / f"{n}.json") for n in MIX.split(","))]
+    else:
+        args = ["changeover", "compile", "mix", "--mix", MIX, "--catalog", str(db)]
+    html, out = tmp_path / "r.html", tmp_path / "p.json"
+    ok(capsys, [*args, "--tolerance", "0.01", "-o", str(out), "--report", str(html)])
+    assert reads == ["the plan to write"] and html.exists() and out.exists()

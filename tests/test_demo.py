@@ -287,8 +287,11 @@ def test_a_design_past_the_reports_limit_leaves_the_demo_report_without_it(
 
     got: list = []
 
-    def fake_report(plan, *, unrecognizable, outlines, design=None):
+    verified: list = []
+
+    def fake_report(plan, *, unrecognizable, outlines, design=None, verification=None):
         got.append(design)
+        verified.append(verification)
         return "<p>report</p>"
 
     monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
@@ -306,3 +309,5 @@ def test_a_design_past_the_reports_limit_leaves_the_demo_report_without_it(
     monkeypatch.setattr(feederkit.design.sensor, "REPORT_DESIGN_LIMIT_S", 60.0)
     c = compile_demo_changeover(catalog, mix, tmp_path / "b", 1.0)
     assert got[1] is not None and got[1]["sensor_model"] == "tolerance" and c.note is None
+    # The report shows the compile's own verification of the plan, not one made again.
+    assert all(v is not None and v.ok for v in verified) and len(verified) == 2

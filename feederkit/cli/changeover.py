@@ -79,7 +79,6 @@ from feederkit.cli.common import (
     json_found,
     limit_instant,
     note_written,
-    plan_outputs,
     plural,
     print_json,
     print_warnings,
@@ -97,6 +96,7 @@ from feederkit.landing.plan import landing_names
 from feederkit.loading import load_parts
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import (
+    CompiledChangeover,
     changeover_exists,
     compile_changeover,
     landing_rows,
@@ -485,10 +485,9 @@ def compile_command(
             check_for_part(uncertainty, pf.part)
     print_warnings(declared.warnings)
 
-    def outputs(c) -> list[OutputFile]:
-        # Runs before the changeover is stored: its plan file carries the cycle time.
-        annotate_cycle_time(c.made, settings)
-        files, view = plan_outputs(c.plan, list(c.parts), list(c.witnesses), output, None)
+    def outputs(c: CompiledChangeover, text: str) -> list[OutputFile]:
+        # Runs before the changeover is stored, on the plan as its file reads back.
+        files = [] if output is None else [OutputFile(output, text, "plan file")]
         if report is not None:
             budget = report_design_budget(options.time_limit_s, started, len(c.parts))
             until = limit_instant(started, options.time_limit_s)
@@ -499,7 +498,7 @@ def compile_command(
                 budget,
                 c.made.report,
                 until,
-                view=view,
+                view=c.view,
             )
             files.append(OutputFile(report, html, "report"))
         return files
@@ -518,6 +517,7 @@ def compile_command(
             options,
             replace=replace,
             outputs=outputs,
+            prepare=lambda made: annotate_cycle_time(made, settings),  # the file carries it
             uncertainty=uncertainty,
             shares=shares,
             loaded=loaded,

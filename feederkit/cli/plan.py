@@ -315,7 +315,7 @@ def plan_command(
         if planned.indistinguishable or lumps:
             raise CheckFailed(landing_pairs_message(planned, lumps))
     else:
-        lumped = leaf_part_pairs(plan)
+        lumped = leaf_part_pairs(view)  # the plan as read back, not read again
         if witnesses or lumped:
             raise CheckFailed(pairs_message(witnesses, lumped))
     if made.unoriented is not None:

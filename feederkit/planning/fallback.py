@@ -303,10 +303,11 @@ def fallback(
         anytime.ub.update(search.ub)
         anytime.choice.update(search.choice)
         cap = best - 1  # the search below looks only for something shorter
-    if blind is None and not problem.machine.deterministic:
-        # No plan in hand under uncertainty: perhaps none exists. A root holding a pair no
-        # strong plan orients has none (solvable.unsolvable_by_pairs: quick where the roots'
-        # own sets are too many); half of what is left decides it, when it can.
+    if blind is None and unbuilt is None and not problem.machine.deterministic:
+        # No plan in hand under uncertainty: perhaps none exists (not so when a search found
+        # one it could not build in time). A root holding a pair no strong plan orients has
+        # none (solvable.unsolvable_by_pairs: quick where the roots' own sets are too many);
+        # half of what is left decides it, when it can.
         rest = budget.remaining()
         share = budget if rest is None else budget.ending(budget.end - rest / 2.0)
         try:

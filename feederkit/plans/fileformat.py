@@ -321,7 +321,7 @@ def plan_from_result(
         if not result.optimal:
             found += f", not proven optimal; a plan needs at least {result.lower_bound}"
         raise PlanningError(
-            f"{found}) would write {size:.3g} nodes, more than {MAX_FILE_NODES:,}: give the "
+            f"{found}) would write {size:,} nodes, more than {MAX_FILE_NODES:,}: give the "
             "planner more time, use a finer sensor, or ask for a minimum margin"
         )
     from feederkit.plans.stats import plan_stats
