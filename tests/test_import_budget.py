@@ -234,3 +234,22 @@ def test_hostile_inputs_end_within_their_budget(tmp_path, capsys, case):
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and re.search(words, lines[0]), err
+
+
+def test_a_commands_shorter_time_limit_bounds_the_import_and_names_itself():
+    # ``plan --time-limit 5`` on a mesh of hundreds of resting poses merged its landings for
+    # a minute: the import's limit is the plan's when that is shorter, and says so.
+    from dataclasses import replace
+
+    from feederkit.cli.plan import within_limit
+    from feederkit.importers.budget import Budget
+    from feederkit.planning.options import PlanningOptions
+
+    opts = within_limit(ImportOptions(), PlanningOptions(time_limit_s=5.0))
+    assert opts.limits.seconds == 5.0 and opts.limits.seconds_option == "--time-limit"
+    assert within_limit(ImportOptions(), PlanningOptions(time_limit_s=300.0)) == ImportOptions()
+    assert within_limit(ImportOptions(), PlanningOptions()) == ImportOptions()
+    late = Budget(replace(opts.limits, seconds=1e-9), "f.stl")
+    time.sleep(0.01)
+    with pytest.raises(InputError, match=r"f\.stl: the import took longer .* \(use --time-limit"):
+        late.check_time()

@@ -271,3 +271,23 @@ def test_plan_and_catalog_see_one_landing_of_the_nut(tmp_path, capsys):
     db = tmp_path / "c.db"
     cat.add_outline(db, outline)
     assert [(x.name, x.merged) for x in cat.get_revision(db, "nut").landings] == [("up", ("down",))]
+
+
+def test_merging_congruent_landings_polls_the_callers_deadline():
+    # A near-round mesh has hundreds of resting poses and the comparisons took a minute
+    # outside the import's time limit: ``check`` comes before each one.
+    square = make_part(make_outline("sq", [(0, 0), (10, 0), (10, 10), (0, 10)]))
+    bar = make_part(make_outline("bar", [(0, 0), (30, 0), (30, 10), (0, 10)]))
+    candidates = [("a", 0.25, square), ("b", 0.25, bar), ("c", 0.25, square), ("d", 0.25, bar)]
+    calls: list[int] = []
+    merged = merge_congruent("p", candidates, lambda: calls.append(1))
+    assert [(x.name, x.merged) for x in merged] == [("a", ("c",)), ("b", ("d",))]
+    assert len(calls) == 4  # b~a, c~a, d~a, d~b
+
+    def out_of_time() -> None:
+        if len(calls) >= 6:
+            raise TimeoutError("the import's time")
+        calls.append(1)
+
+    with pytest.raises(TimeoutError):
+        merge_congruent("p", candidates, out_of_time)

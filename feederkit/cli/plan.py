@@ -12,6 +12,7 @@ and the warnings (a margin below 1 degree, a time limit reached).
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from typing import Annotated, Any
 
 import typer
@@ -75,6 +76,7 @@ from feederkit.landing.plan import LandingPlan, landing_names, load_landings, pl
 from feederkit.mechanics.push import push_function
 from feederkit.mix.changeover import plan_mix, plans_over_landings
 from feederkit.mix.pairs import PairWitness
+from feederkit.planning.options import PlanningOptions
 from feederkit.plans.fileformat import plan_json
 from feederkit.plans.match import leaf_part_pairs
 from feederkit.plans.model import member_label, pairs_words
@@ -245,7 +247,9 @@ def plan_command(
     json_found(sources=list(sources), sensor=sensor.to_dict(), uncertainty=uncertainty.to_dict())
     with flag_words(terms):
         which = "all" if landings in (None, "all") else landing_names(landings)
-        found = load_landings(sources, catalog=catalog, options=import_opts, which=which)
+        found = load_landings(
+            sources, catalog=catalog, options=within_limit(import_opts, options), which=which
+        )
     loaded = found.parts
     uncertainty, declared = declared_uncertainty(
         settings.rotation_error_deg, loaded.tolerances, shape_tolerance, com_tolerance
@@ -320,6 +324,18 @@ def plan_command(
             raise CheckFailed(pairs_message(witnesses, lumped))
     if made.unoriented is not None:
         raise CheckFailed(made.unoriented)
+
+
+def within_limit(import_opts: ImportOptions, options: PlanningOptions) -> ImportOptions:
+    """The import options with the import's time limit no longer than the plan's
+    ``--time-limit`` (which then names itself when an import runs out of it: a mesh of
+    hundreds of resting poses whose congruent landings take a minute to merge)."""
+    limits, limit = import_opts.limits, options.time_limit_s
+    if limit is None or limit >= limits.seconds:
+        return import_opts
+    return replace(
+        import_opts, limits=replace(limits, seconds=limit, seconds_option="--time-limit")
+    )
 
 
 def register(app: typer.Typer) -> None:

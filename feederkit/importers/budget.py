@@ -49,7 +49,8 @@ class ImportLimits:
     ``crossings``: pairs of drawn lines whose bounding boxes overlap (noding them costs
     about 0.5 s per 50,000); ``faces``: mesh triangles; ``hull_faces``: faces of a mesh's
     convex hull (the resting pose search grows with their square: 4,000 take about 3 s);
-    ``seconds``: wall time of the whole import.
+    ``seconds``: wall time of the whole import; ``seconds_option``: the option that allows
+    more (a command whose own ``--time-limit`` is shorter names that one).
     """
 
     entities: int = DEFAULT_MAX_ENTITIES
@@ -59,6 +60,7 @@ class ImportLimits:
     faces: int = DEFAULT_MAX_FACES
     hull_faces: int = DEFAULT_MAX_HULL_FACES
     seconds: float = DEFAULT_TIME_LIMIT_S
+    seconds_option: str = "--import-time-limit"
 
     def __post_init__(self) -> None:
         for what, option in OPTION.items():
@@ -135,5 +137,5 @@ class Budget:
         if time.monotonic() > self.deadline:
             raise InputError(
                 f"{self.label}: the import took longer than {self.limits.seconds:g} s "
-                "(use --import-time-limit to allow more)"
+                f"(use {self.limits.seconds_option} to allow more)"
             )

@@ -44,7 +44,8 @@ def landings_of_mesh(
     """
     p = Path(path)
     label = name or p.stem
-    mesh, _units, _notes = load_mesh(p, options.units, Budget(options.limits, str(p)))
+    budget = Budget(options.limits, str(p))
+    mesh, _units, _notes = load_mesh(p, options.units, budget)
     s = solid(mesh, options.com is not None, str(p))
     try:
         poses = resting_poses(s)
@@ -58,11 +59,12 @@ def landings_of_mesh(
             raise InputError(f"{p}: no pose {k}: the mesh has {len(poses)} resting poses")
         part = _pose_part(s, poses[k], options.com, label, hull_tolerance)
         return (Landing(label, pose_name(k), 1.0, renamed(part, f"{label}/{pose_name(k)}")),)
-    candidates = [
-        (pose_name(k), pose.probability, _pose_part(s, pose, None, label, hull_tolerance))
-        for k, pose in enumerate(poses)
-    ]
-    return merge_congruent(label, candidates)
+    candidates = []
+    for k, pose in enumerate(poses):
+        budget.check_time()
+        part = _pose_part(s, pose, None, label, hull_tolerance)
+        candidates.append((pose_name(k), pose.probability, part))
+    return merge_congruent(label, candidates, budget.check_time)
 
 
 def _pose_part(s, pose, com2d, label: str, hull_tolerance: float | None) -> Part:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import heapq
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -401,16 +401,22 @@ def landings_of_outline(
 
 
 def merge_congruent(
-    part_name: str, candidates: Sequence[tuple[str, float, Part]]
+    part_name: str,
+    candidates: Sequence[tuple[str, float, Part]],
+    check: Callable[[], None] | None = None,
 ) -> tuple[Landing, ...]:
     """Landings from ``(name, probability, part)`` candidates, congruent ones merged.
 
     Each candidate joins the first earlier landing it is congruent to (its probability is
     added there and its name listed in ``merged``); the order of first appearance is kept.
+    ``check`` is called before each comparison (an import's deadline: a near-round mesh of
+    320 resting poses takes about 1,200 of up to 0.09 s each).
     """
     groups: list[tuple[str, float, Part, list[str]]] = []
     for name, prob, part in candidates:
         for k, (gname, gprob, gpart, merged) in enumerate(groups):
+            if check is not None:
+                check()
             if congruent(part, gpart):
                 merged.append(name)
                 groups[k] = (gname, gprob + prob, gpart, merged)
