@@ -304,9 +304,10 @@ def load_outline_json(path: str | os.PathLike[str], units: str | None = None) ->
 
 def read_outline_file(
     path: str | os.PathLike[str], units: str | None = None
-) -> tuple[Outline, str]:
-    """:func:`load_outline_json` and the unit its coordinates were read in (canonical name),
-    which the catalog records as the source's units: the outline itself is in mm."""
+) -> tuple[Outline, str, bool]:
+    """:func:`load_outline_json`, the unit its coordinates were read in (canonical name),
+    which the catalog records as the source's units (the outline itself is in mm), and
+    whether the file or ``units`` named it (else the coordinates were taken as mm)."""
     data = read_json(path, "file")
     if units is not None and isinstance(data, dict):
         data = {**data, "units": units}
@@ -315,7 +316,7 @@ def read_outline_file(
     except InputError as exc:  # name the file the user gave, not only the outline's name
         raise InputError(f"{os.fspath(path)}: {exc}") from None
     assert isinstance(data, dict)  # outline_from_dict refused anything else
-    return outline, unit_name(str(data.get("units", "mm")))
+    return outline, unit_name(str(data.get("units", "mm"))), "units" in data
 
 
 def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:

@@ -151,3 +151,22 @@ def test_an_outline_drawn_twice_with_an_inner_copy_is_no_drawing_frame(tmp_path)
     doc.saveas(tmp_path / "twice.dxf")
     with pytest.raises(InputError, match=r"the outline seems drawn twice, 0.028 mm apart"):
         import_parts(tmp_path / "twice.dxf", ImportOptions())
+
+
+def test_an_outline_file_of_no_plausible_size_warns_of_its_units(tmp_path):
+    # A plate drawn in metres in a file without units is read as mm: 0.07 mm across, a unit
+    # mistake more likely than a part; drawings and meshes said so, outline files did not.
+    ring = [[0, 0], [0.06, 0], [0.06, 0.04], [0, 0.04]]
+    path = tmp_path / "plate.json"
+    path.write_text(json.dumps({"name": "plate", "vertices": ring}))
+    [part] = import_parts(path, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "check the units" in w]
+    assert "0.07211 mm across" in note and "as the file carries no units" in note
+    assert "72.11 mm in m" in note
+    path.write_text(json.dumps({"name": "plate", "units": "m", "vertices": ring}))
+    [part] = import_parts(path, ImportOptions())[1]
+    assert not [w for w in part.warnings if "check the units" in w]  # 72 mm: plausible
+    path.write_text(json.dumps({"name": "plate", "units": "mm", "vertices": ring}))
+    [part] = import_parts(path, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "check the units" in w]
+    assert "read in mm from the file" in note

@@ -21,7 +21,7 @@ from feederkit.importers.model import (
     ImportResult,
 )
 from feederkit.importers.orientable import Orientability, orientability
-from feederkit.importers.plausible import outline_size
+from feederkit.importers.plausible import outline_size, size_warnings
 from feederkit.mechanics.modelerror import KeptTolerance, kept_part
 from feederkit.outline import read_outline_file, unit_scale
 from feederkit.part import Part, make_part
@@ -85,9 +85,13 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     others: list[str] = []
     warnings: list[str] = []
     if suffix in OUTLINE_SUFFIXES:
-        outline, unit = read_outline_file(p, options.units)
+        outline, unit, named = read_outline_file(p, options.units)
         budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
         budget.loops(1 + len(outline.holes))
+        # A size no feeder part has is likelier a unit mistake (an outline in metres read
+        # as mm): said as for drawings and meshes.
+        given = options.units is not None
+        warnings += size_warnings(outline_size(outline), unit, given, not named)
         if name:
             outline = dataclasses.replace(outline, name=name)
         if options.com is not None:
