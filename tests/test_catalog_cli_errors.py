@@ -179,3 +179,21 @@ def test_a_missing_catalog_is_worded_alike_by_every_command(tmp_path, capsys):
         lines.add(capsys.readouterr().err.strip())
     want = f"error: {missing}: no catalog there (create one with 'feederkit catalog init')"
     assert lines == {want}
+
+
+@pytest.mark.parametrize("command", ["show", "export"])
+def test_a_revision_given_twice_and_differently_is_refused(tmp_path, db, capsys, command):
+    part = square(tmp_path / "clip.json")
+    assert main(["catalog", "add", str(part), "--catalog", str(db)]) == 0
+    square(part, side=12.0)
+    assert main(["catalog", "add", str(part), "--catalog", str(db)]) == 0
+    capsys.readouterr()
+    out = ["-o", str(tmp_path / "x.json")] if command == "export" else []
+    args = ["catalog", command, "clip@1", *out, "--catalog", str(db)]
+    code, _, err = run(capsys, *args, "--revision", "2")
+    assert code == 2 and error_line(err) == (
+        "error: clip@1: the revision is given twice (1 and --revision 2)"
+    )
+    assert not (tmp_path / "x.json").exists()
+    code, stdout, _ = run(capsys, *args, "--revision", "1", "--json")
+    assert code == 0 and json.loads(stdout)["revision"] == 1

@@ -731,11 +731,9 @@ def cmd_show(
 ) -> None:
     """Show a part: source, units, outline, hull, COM, mesh pose, landings, orientability,
     revisions."""
-    part, at = split_revision(name)
-    if at is not None and revision is not None and at != revision:
-        raise InputError(f"{name}: the revision is given twice ({at} and --revision {revision})")
+    part, which = asked_revision(name, revision)
     with opened(catalog, DEFAULT_WAIT) as conn:
-        rev = get_revision(conn, part, at if at is not None else revision)
+        rev = get_revision(conn, part, which)
         history = revision_history(conn, part)
         users = [c.name for c in list_changeovers(conn) if any(n == part for n, _ in c.parts)]
     data = revision_dict(rev, history, users)
@@ -786,6 +784,19 @@ def cmd_show(
 _REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>[0-9]+)$")
 
 
+def asked_revision(text: str, revision: int | None) -> tuple[str, int | None]:
+    """The part and revision (None: the latest) of ``NAME`` or ``NAME@REV`` with
+    ``--revision``; InputError when both name a revision and they differ.
+
+    >>> asked_revision("clip@2", None), asked_revision("clip", 3), asked_revision("clip@2", 2)
+    (('clip', 2), ('clip', 3), ('clip', 2))
+    """
+    part, at = split_revision(text)
+    if at is not None and revision is not None and at != revision:
+        raise InputError(f"{text}: the revision is given twice ({at} and --revision {revision})")
+    return part, at if at is not None else revision
+
+
 def split_revision(text: str) -> tuple[str, int | None]:
     """``NAME@REV`` as (name, revision); plain ``NAME`` as (name, None)."""
     found = _REVISION_RE.match(text)
@@ -833,9 +844,9 @@ def cmd_export(
     """Write a part's outline file (design.md outline format)."""
     if output.suffix.lower() != ".json":
         raise InputError(f"{output}: the outline file must end in .json")
-    part, at = split_revision(name)
+    part, which = asked_revision(name, revision)
     with opened(catalog, DEFAULT_WAIT) as conn:
-        rev = export_part(conn, part, output, at if at is not None else revision)
+        rev = export_part(conn, part, output, which)
     if json_out:
         print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
         return
