@@ -412,3 +412,27 @@ def test_once_the_command_answered_a_late_ctrl_c_changes_nothing(monkeypatch):
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_a_plan_that_fails_says_its_certificate_is_only_claimed(good_plan, tmp_path, capsys):
+    # A strong plan's failing path is a problem with no counts per part: ``--json`` had
+    # "failures": [] and "parts": [] beside "ok": false, and the text printed the
+    # certificate as if it held.
+    def edit(data):
+        for k, branch in enumerate(data["root"]["branches"]):
+            branch["reading"] = [10.0 + 2 * k, 11.0 + 2 * k]
+
+    plan = edited(good_plan, tmp_path, edit)
+    from feederkit.cli.app import main
+
+    assert main(["run", str(plan), "--all", "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert report["ok"] is False
+    assert "no branch after the first alignment" in report["first_problem"]
+    assert main(["run", str(plan), "--all"]) == 1
+    out = capsys.readouterr().out
+    assert "certificate claimed (the plan failed verification):" in out
+    assert main(["run", str(good_plan), "--all", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["first_problem"] is None
+    assert main(["run", str(good_plan), "--all"]) == 0
+    assert "\ncertificate: " in "\n" + capsys.readouterr().out

@@ -91,10 +91,12 @@ def run_command(
             markup=False,
             soft_wrap=True,
         )
-        cert = plan.certificate_words()
-        if cert is not None:
-            console.print(f"certificate: {cert}", highlight=False, markup=False, soft_wrap=True)
     report = verify_declared(plan, None if not sources else indices)
+    cert = plan.certificate_words()
+    if cert is not None and not json_out:
+        # What the file claims; a plan that fails its verification guarantees nothing.
+        said = "certificate" if report.ok else "certificate claimed (the plan failed verification)"
+        console.print(f"{said}: {cert}", highlight=False, markup=False, soft_wrap=True)
     if all_starts:
         if json_out:
             print_json({**report.to_dict(), **_declared(plan), "warnings": warnings})

@@ -113,9 +113,11 @@ class VerificationReport:
         return self.failures[0].message if self.failures else None
 
     def to_dict(self) -> dict[str, Any]:
-        """As JSON."""
+        """As JSON; ``first_problem`` is what failed, whichever verifier found it (a strong
+        plan's first failing path is a problem, with no counts per part)."""
         return {
             "ok": self.ok,
+            "first_problem": self.first_problem(),
             "paths": self.paths,
             "unrecognized": self.unrecognized,
             "parts": [p.to_dict() for p in self.parts],
