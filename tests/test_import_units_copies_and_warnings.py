@@ -170,3 +170,50 @@ def test_an_outline_file_of_no_plausible_size_warns_of_its_units(tmp_path):
     [part] = import_parts(path, ImportOptions())[1]
     [note] = [w for w in part.warnings if "check the units" in w]
     assert "read in mm from the file" in note
+
+
+def test_two_separate_parts_equal_in_size_are_not_called_the_largest(tmp_path):
+    import fixtures_cad as fx
+
+    def two(msp, x: float) -> None:
+        msp.add_lwpolyline([(0, 0), (40, 0), (40, 20), (0, 20)], close=True)
+        msp.add_lwpolyline([(100, 0), (100 + x, 0), (100 + x, 40), (100, 40)], close=True)
+
+    equal = fx.write_entities(tmp_path / "equal.dxf", lambda msp: two(msp, 20.0))
+    [part] = import_parts(equal, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "separate parts" in w]
+    assert "imported one of the 2 largest, equal in size: area 800.0 mm2" in note
+    bigger = fx.write_entities(tmp_path / "bigger.dxf", lambda msp: two(msp, 21.0))
+    [part] = import_parts(bigger, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "separate parts" in w]
+    assert "imported the largest (use --all-parts for all)" in note
+
+
+def test_a_mesh_whose_only_triangle_has_a_nan_says_why_none_is_left(tmp_path):
+    import pytest
+
+    from feederkit.errors import InputError
+
+    path = tmp_path / "nan.stl"
+    path.write_text(
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\n"
+        "vertex nan 10 0\nendloop\nendfacet\nendsolid t\n"
+    )
+    with pytest.raises(InputError, match="no triangles .*NaN or infinite coordinates"):
+        import_parts(path, ImportOptions())
+
+
+def test_a_hull_tolerance_that_is_infinite_or_not_small_against_the_part_is_refused(tmp_path):
+    # It ended in "the center of mass lies on the boundary of the contact hull", naming
+    # neither the option nor the cause.
+    import fixtures_cad as fx
+    import pytest
+
+    from feederkit.errors import InputError
+
+    path = fx.write_two_parts(tmp_path / "two.dxf")
+    for bad, words in ((float("inf"), "finite number"), (1000.0, "not small against the part")):
+        with pytest.raises(InputError, match=f"--hull-tolerance .*{words}"):
+            import_parts(path, ImportOptions(hull_tolerance=bad))
+    [part] = import_parts(path, ImportOptions(hull_tolerance=0.5))[1]
+    assert part.hull_tolerance == 0.5

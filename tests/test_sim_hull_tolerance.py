@@ -140,7 +140,7 @@ def test_without_the_revision_the_refusal_names_hull_tolerance(bracket, no_defau
             real_parts(plan, [str(bracket["dxf"])], catalog=catalog)
         line = str(exc.value)
         assert "\n" not in line and "not the part the plan was made for" in line
-        assert "(a CAD import's default for the part's size)" in line
+        assert "(the default a CAD import takes for the part's size: the plan does not" in line
         assert "give --hull-tolerance MM with the value it was imported with" in line
 
 

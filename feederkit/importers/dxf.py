@@ -939,6 +939,10 @@ def region_fault(region: Region, drawn: DrawnLines, gap: float) -> str | None:
     )
 
 
+AREA_TIE_REL = 1e-9
+"""Separate parts of a drawing whose areas differ by less than this share are equally large."""
+
+
 def _describe(region: Region) -> str:
     xs = [p[0] for p in region.shell]
     ys = [p[1] for p in region.shell]
@@ -1097,8 +1101,16 @@ def _read_doc(
             + " (if the outer loop is a drawing frame, leave its layer out with --layer)"
         )
     if others:
+        # Parts equal in area (within the area's rounding) leave no largest: say which.
+        top = regions[0].loop_area
+        ties = sum(1 for r in regions if r.loop_area >= top * (1.0 - AREA_TIE_REL))
+        which = (
+            "the largest"
+            if ties == 1
+            else f"one of the {ties} largest, equal in size: {_describe(regions[0])}"
+        )
         warnings_.append(
-            f"the drawing holds {len(regions)} separate parts; imported the largest "
+            f"the drawing holds {len(regions)} separate parts; imported {which} "
             "(use --all-parts for all)"
         )
     if options.units is None:

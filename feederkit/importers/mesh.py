@@ -180,7 +180,10 @@ def load_mesh(
         geoms = [g for g in mesh.dump() if isinstance(g, trimesh.Trimesh)]
         mesh = trimesh.util.concatenate(geoms) if geoms else None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise InputError(f"{path}: the file holds no triangles")
+        raise InputError(
+            f"{path}: the file holds no triangles (none left once those with no area or with "
+            "NaN or infinite coordinates are dropped)"
+        )
     budget.faces(len(mesh.faces))
     budget.vertices(len(mesh.vertices))
     if not np.isfinite(mesh.vertices).all():

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -117,6 +118,12 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     )
 
 
+HULL_TOLERANCE_MAX_SHARE = 0.25
+"""A ``--hull-tolerance`` of this share of the part's size or more is refused: chords that far
+from the outline leave no hull of the part (the review's 1000 mm on a 60 mm plate ended in
+"the center of mass lies on the boundary of the contact hull")."""
+
+
 def effective_hull_tolerance(
     kind: str, options: ImportOptions, size_mm: float | None = None
 ) -> float | None:
@@ -127,9 +134,16 @@ def effective_hull_tolerance(
     exact (``None``) for outline files.
     """
     if options.hull_tolerance is not None:
-        if not options.hull_tolerance >= 0:
-            raise InputError(f"--hull-tolerance must be >= 0, got {options.hull_tolerance:g}")
-        return options.hull_tolerance
+        t = options.hull_tolerance
+        if not (t >= 0 and math.isfinite(t)):
+            raise InputError(f"--hull-tolerance must be a finite number of mm >= 0, got {t:g}")
+        if size_mm is not None and t >= HULL_TOLERANCE_MAX_SHARE * size_mm:
+            # Simplified that far the hull is no longer the part's (its COM ends on it).
+            raise InputError(
+                f"--hull-tolerance {t:g} mm is not small against the part ({size_mm:.4g} mm "
+                f"across): a hull simplified that far is not the part's"
+            )
+        return t
     if kind == "outline":
         return None
     if size_mm is None:

@@ -98,7 +98,10 @@ class HullAllowance:
             return "given with --hull-tolerance"
         if self.drawing is not None:
             return f"stored with {self.drawing.where}"
-        return "a CAD import's default for the part's size"
+        return (
+            "the default a CAD import takes for the part's size: the plan does not say how "
+            "its hull was made"
+        )
 
 
 @dataclass(frozen=True)
