@@ -122,10 +122,11 @@ def read_json(
 
     ``what`` names the file in the message: ``<path>: no such <what>``. Numbers must fit a
     float and be finite, and nesting is limited to ``max_depth`` (see :func:`parse_json`).
+    A UTF-8 byte order mark (Windows tools write one) is skipped, as RFC 8259 lets a parser.
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"{p}: no such {what}") from None
     except IsADirectoryError:

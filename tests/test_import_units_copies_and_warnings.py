@@ -217,3 +217,12 @@ def test_a_hull_tolerance_that_is_infinite_or_not_small_against_the_part_is_refu
             import_parts(path, ImportOptions(hull_tolerance=bad))
     [part] = import_parts(path, ImportOptions(hull_tolerance=0.5))[1]
     assert part.hull_tolerance == 0.5
+
+
+def test_an_outline_file_with_a_byte_order_mark_is_read(tmp_path):
+    # Windows tools write a UTF-8 BOM; it was "not valid JSON (Unexpected UTF-8 BOM)".
+    path = tmp_path / "bom.json"
+    data = {"name": "bom", "units": "mm", "vertices": [[0, 0], [20, 0], [20, 10], [0, 10]]}
+    path.write_bytes(b"\xef\xbb\xbf" + json.dumps(data).encode("utf-8"))
+    [part] = import_parts(path, ImportOptions())[1]
+    assert part.part.name == "bom" and part.part.outline.vertices[2] == (20.0, 10.0)
