@@ -413,3 +413,24 @@ def test_an_answer_names_its_uncertainty_once():
     said = f"no sensor separates a and b (no strong plan tells them apart under {end[16:-1]})"
     assert _model_words(("a", "b"), None, u, said) == ""
     assert _model_words(("a", "b"), None, IDEAL, "") == ""
+
+
+def test_a_member_with_no_strong_plan_alone_is_named_by_the_design():
+    # d-washer has no strong plan at a 0.02 mm shape tolerance: "no tolerance makes this
+    # mix recognizable: no strong plan exists up to ..." beside a table deciding every pair
+    # read as a contradiction; the design now says which member leaves none, as the
+    # compile does.
+    from feederkit.uncertainty import Uncertainty
+
+    root = Path(__file__).resolve().parents[1] / "catalog"
+    pfs = list(
+        load_parts(
+            [str(root / f"{n}.json") for n in ("l-bracket", "t-clip", "d-washer")]
+        ).push_functions
+    )
+    design = design_tolerance(pfs, uncertainty=Uncertainty(1.0, 0.02, 0.0), time_limit_s=60.0)
+    assert design.critical_tolerance is None and design.critical.critical_tolerance is not None
+    assert design.blame.startswith("d-washer has no strong plan even alone")
+    assert "(d-washer has no strong plan even alone" in design.answer()
+    fine = design_tolerance(pfs[:2], uncertainty=Uncertainty(1.0, 0.02, 0.0), time_limit_s=60.0)
+    assert fine.blame == "" and fine.critical_tolerance is not None

@@ -168,8 +168,10 @@ def test_an_outline_file_of_no_plausible_size_warns_of_its_units(tmp_path):
     assert not [w for w in part.warnings if "check the units" in w]  # 72 mm: plausible
     path.write_text(json.dumps({"name": "plate", "units": "mm", "vertices": ring}))
     [part] = import_parts(path, ImportOptions())[1]
-    [note] = [w for w in part.warnings if "check the units" in w]
-    assert "read in mm from the file" in note
+    assert not [w for w in part.warnings if "check the units" in w]  # the file says mm
+    path.write_text(json.dumps({"name": "plate", "vertices": ring}))
+    [part] = import_parts(path, ImportOptions(units="mm"))[1]
+    assert not [w for w in part.warnings if "check the units" in w]  # so does --units
 
 
 def test_two_separate_parts_equal_in_size_are_not_called_the_largest(tmp_path):

@@ -40,8 +40,11 @@ from feederkit.mechanics.modelerror import part_offsets
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import landing_members, member_name, rejected_members
 from feederkit.planning.budget import Timeout
+from feederkit.planning.options import PlanningOptions
+from feederkit.plans.advice import blocking_members
 from feederkit.plans.make import check_plan_members
 from feederkit.plans.model import Plan, PlanMember
+from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import at_most
 
@@ -185,6 +188,10 @@ class ToleranceDesign:
     length table is missing, every pair being decided; None for a whole design."""
     members: tuple[PlanMember, ...] | None = None
     """The members as planned (landings, accept/reject; None: the parts, each accepted)."""
+    blame: str = ""
+    """Where no strong plan exists at any tolerance the pairs allow: which members leave the
+    mix none (one no strong plan orients even alone: :func:`~feederkit.plans.advice.
+    blocking_members`), as ``changeover compile`` says; "" when not asked or not decided."""
 
     @property
     def rejected(self) -> tuple[str, ...]:
@@ -262,8 +269,9 @@ class ToleranceDesign:
                 text += _pairs_words(self.critical.inseparable)
                 return text + self._model_words(text)
             where = "at any tolerance" if limit.hi is None else f"up to {limit.hi:.6g} mm"
+            why = f" ({self.blame})" if self.blame else ""
             return (
-                f"no tolerance makes this mix recognizable: {_limit_words(limit)} {where}"
+                f"no tolerance makes this mix recognizable: {_limit_words(limit)} {where}{why}"
                 + self._model_words()
             )
         step = self.step_at(x)
@@ -375,12 +383,42 @@ def _design_tolerance(
     if up_to is None:
         return ToleranceDesign(names, critical, (), unc, members=members)
     try:
-        return ToleranceDesign(names, critical, table(), unc, members=members)
+        return _blamed(pfs, ToleranceDesign(names, critical, table(), unc, members=members), clock)
     except Timeout as exc:
         if not partial:
             raise
         stopped = str(clock.timeout(exc.reason, partial=True))
         return ToleranceDesign(names, critical, (), unc, stopped, members)
+
+
+BLAME_SHARE = 0.5
+"""The share of the design's time left that saying which members leave no strong plan may take."""
+
+
+def _blamed(
+    pfs: Sequence[PushFunction], design: ToleranceDesign, clock: DesignClock
+) -> ToleranceDesign:
+    """``design`` with its :attr:`~ToleranceDesign.blame` where no strong plan exists from
+    the finest tolerance on: the members no strong plan orients even alone (or two landings
+    of one part together), checked with a sensor inside that first step, within
+    ``BLAME_SHARE`` of the time left."""
+    limit = design.plan_limit
+    if design.uncertainty.is_ideal or limit is None or limit.length is not None or limit.lo > 0.0:
+        return design
+    top = limit.hi if limit.hi is not None else design.critical.critical_tolerance
+    if top is None:
+        return design
+    left = clock.deadline.remaining()
+    blame = blocking_members(
+        pfs,
+        ToleranceSensor(top / 2.0),
+        design.uncertainty,
+        PlanningOptions(),
+        part_offsets(pfs),
+        design.members,
+        None if left is None else BLAME_SHARE * left,
+    )
+    return replace(design, blame=blame.words) if blame.members else design
 
 
 @dataclass(frozen=True)

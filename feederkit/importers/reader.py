@@ -89,10 +89,11 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
         outline, unit, named = read_outline_file(p, options.units)
         budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
         budget.loops(1 + len(outline.holes))
-        # A size no feeder part has is likelier a unit mistake (an outline in metres read
-        # as mm): said as for drawings and meshes.
-        given = options.units is not None
-        warnings += size_warnings(outline_size(outline), unit, given, not named)
+        # A file that names no units is read as mm: at a size no feeder part has, a unit
+        # mistake is likelier (an outline in metres), said as for drawings and meshes. A
+        # file that says "mm" is taken at its word (the paper's figures are 1 mm across).
+        if not named:
+            warnings += size_warnings(outline_size(outline), unit, False, True)
         if name:
             outline = dataclasses.replace(outline, name=name)
         if options.com is not None:
