@@ -249,6 +249,8 @@ def test_a_commands_shorter_time_limit_bounds_the_import_and_names_itself():
     assert opts.limits.seconds == 5.0 and opts.limits.seconds_option == "--time-limit"
     assert within_limit(ImportOptions(), PlanningOptions(time_limit_s=300.0)) == ImportOptions()
     assert within_limit(ImportOptions(), PlanningOptions()) == ImportOptions()
+    tiny = within_limit(ImportOptions(), PlanningOptions(time_limit_s=1e-4))
+    assert tiny.limits.seconds == 1.0  # IMPORT_MIN_S: a limit that short is the planner's
     late = Budget(replace(opts.limits, seconds=1e-9), "f.stl")
     time.sleep(0.01)
     with pytest.raises(InputError, match=r"f\.stl: the import took longer .* \(use --time-limit"):

@@ -326,11 +326,19 @@ def plan_command(
         raise CheckFailed(made.unoriented)
 
 
+IMPORT_MIN_S = 1.0
+"""The least a plan's ``--time-limit`` leaves the import of its parts (:func:`within_limit`):
+reading an ordinary file takes milliseconds, and a limit too short for any plan is answered
+by the planner (no plan found, what it proved), not refused as input."""
+
+
 def within_limit(import_opts: ImportOptions, options: PlanningOptions) -> ImportOptions:
     """The import options with the import's time limit no longer than the plan's
-    ``--time-limit`` (which then names itself when an import runs out of it: a mesh of
-    hundreds of resting poses whose congruent landings take a minute to merge)."""
-    limits, limit = import_opts.limits, options.time_limit_s
+    ``--time-limit`` (at least ``IMPORT_MIN_S``), which then names itself when an import
+    runs out of it: a mesh of hundreds of resting poses whose congruent landings took a
+    minute to merge."""
+    limits = import_opts.limits
+    limit = None if options.time_limit_s is None else max(options.time_limit_s, IMPORT_MIN_S)
     if limit is None or limit >= limits.seconds:
         return import_opts
     return replace(
