@@ -369,8 +369,8 @@ def _chord_sagitta(h: np.ndarray) -> Callable[[int, np.ndarray, np.ndarray], np.
     Along a convex counter-clockwise chain the distance from its chord is concave, largest
     at the vertex where the edges' direction passes the chord's: a binary search on the
     unwrapped edge directions finds it, so each ``m`` costs O(n log n) instead of O(n m)
-    (a 20,000-point circle at its shape-tolerance bound, whose chords hold about 200
-    vertices: 10 s to 0.3 s for the mechanics). A hull that is not a convex
+    (a 20,000-point arc at its shape-tolerance bound, whose chords hold about 200
+    vertices: its uncertain mechanics 11 s -> 2 s). A hull that is not a convex
     counter-clockwise chain (a hand-written file) measures every vertex between the ends.
     """
     n = len(h)
