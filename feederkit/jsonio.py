@@ -9,6 +9,7 @@ a rename). A character device such as ``/dev/null`` is written as it is (nothing
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import math
@@ -180,6 +181,35 @@ def is_device(path: str | os.PathLike[str]) -> bool:
         return False
 
 
+SQLITE_MAGIC = b"SQLite format 3\x00"
+"""The first 16 bytes of every SQLite database file (a feederkit catalog)."""
+
+SQLITE_SIDE_SUFFIXES = ("-wal", "-shm", "-journal")
+"""SQLite's files beside a database ``DB``: ``DB-wal``, ``DB-shm``, ``DB-journal``."""
+
+
+def _is_database(path: Path) -> bool:
+    """Whether the regular file at ``path`` is an SQLite database (:data:`SQLITE_MAGIC`)."""
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(len(SQLITE_MAGIC)) == SQLITE_MAGIC
+    except OSError:
+        return False
+
+
+def _database_file(target: Path) -> Path | None:
+    """The SQLite database that a write to ``target`` would destroy: ``target`` itself, or
+    the database beside it whose journal or shared-memory file it is; None for any other."""
+    if target.is_file() and _is_database(target):
+        return target
+    for suffix in SQLITE_SIDE_SUFFIXES:
+        if target.name.endswith(suffix) and len(target.name) > len(suffix):
+            main = target.with_name(target.name[: -len(suffix)])
+            if main.is_file() and _is_database(main):
+                return main
+    return None
+
+
 def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
     """Where a file written to ``path`` lands: through symbolic links to the file they name
     (a plan written to ``current.plan.json``, a link to a versioned file, updates that file,
@@ -187,7 +217,8 @@ def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
     character device such as ``/dev/null`` (written as it is, :func:`is_device`). Bad input
     when that is a folder, a standard stream (``/dev/stdout``: the command prints there too),
     or exists and is neither a regular file nor a character device (a pipe, socket or block
-    device, which a rename would replace)."""
+    device, which a rename would replace), or an SQLite database or its side files (a
+    catalog: ``-o feederkit.db`` would replace every part and changeover with one file)."""
     given = Path(path)
     if _is_stream(given):
         raise InputError(
@@ -195,6 +226,13 @@ def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
             "too): give a file, or /dev/null to run the command only for its checks"
         )
     target = Path(os.path.realpath(given)) if given.is_symlink() else given
+    database = _database_file(target)
+    if database is not None:
+        whose = "" if database == target else f" of the database {database}"
+        raise InputError(
+            f"{given}: cannot write the {what} over an SQLite database{whose} (a feederkit "
+            "catalog?): give the file another path"
+        )
     try:
         st = os.stat(target)
     except OSError:
@@ -249,16 +287,31 @@ def _write_device(f: OutputFile, target: Path) -> None:
         raise _cannot(f.path, f.what, exc) from None
 
 
-def _stage(f: OutputFile, mode: int) -> tuple[Path, str | None]:
+def _stage(f: OutputFile, mode: int | None) -> tuple[Path, str | None]:
     """Write ``f`` in full to a temporary file beside its :func:`destination`; return that
-    destination and the temporary's path (None for a character device, written on commit)."""
+    destination and the temporary's path (None for a character device, written on commit).
+
+    ``mode`` None: a file replaced keeps its permissions and (where the process may set it)
+    its group, as writing it in place would (a plan folder shared with a controller's
+    account through its group stays readable there); a new file gets those of ``open``."""
     target = destination(f.path, f.what)
     if is_device(target):
         return target, None
+    group = -1
+    if mode is None:
+        try:
+            st = os.stat(target)
+        except OSError:
+            mode = 0o666 & ~_umask()
+        else:
+            mode, group = st.st_mode & 0o777, st.st_gid
     fd, tmp = _temporary(f.path, target, f.what)
     data = _bytes(f)
     try:
         with os.fdopen(fd, "wb") as fh:
+            if group != -1:  # not a member of that group: the process's own group stays
+                with contextlib.suppress(OSError):
+                    os.fchown(fh.fileno(), -1, group)
             os.fchmod(fh.fileno(), mode)
             fh.write(data)
             fh.flush()
@@ -277,15 +330,15 @@ class StagedFiles:
     The slow part (where a full disk or an unwritable folder shows) happens on staging;
     :meth:`commit` then renames every temporary onto its target, which on one file system
     does not fail halfway for lack of space. Leaving a ``with`` block without a commit
-    discards the temporaries. ``mode`` sets the permissions; by default those of a newly
-    created file (0666 less the umask), as a plain ``open(path, "w")`` gives, so a
-    controller's account can read a plan file. A file a commit replaces is kept (a hard
+    discards the temporaries. ``mode`` sets the permissions; by default a file replaced
+    keeps its own (and its group), and a new one gets those of a newly created file (0666
+    less the umask), as a plain ``open(path, "w")`` gives, so a controller's account can
+    read a plan file. A file a commit replaces is kept (a hard
     link beside it) until the block ends, so :meth:`undo` can put it back. A character
     device (``/dev/null``) is written on commit, as it is; nothing undoes that.
     """
 
     def __init__(self, files: Iterable[OutputFile], mode: int | None = None) -> None:
-        mode = 0o666 & ~_umask() if mode is None else mode
         self._staged: list[tuple[OutputFile, Path, str | None]] = []
         self._kept: dict[Path, str] = {}
         self._done: list[Path] = []

@@ -219,3 +219,67 @@ def test_compile_json_has_warnings_and_a_file_member_is_refused(db, tmp_path, ca
     src = str(CATALOG / "octagon.json")
     args = ["changeover", "compile", "f", "--mix", f"{src},rectangle-2x1", "--catalog", str(db)]
     assert "catalog part" in one_line_error(capsys, args)
+
+
+def test_no_output_may_be_the_catalog_itself(db, tmp_path, capsys):
+    before = db.read_bytes()
+    for args in (
+        [*FIG27, "--tolerance", "0.01", "-o", str(db)],
+        ["plan", "octagon", "--tolerance", "0.01", "-o", str(db)],
+        ["plan", "octagon", "--tolerance", "0.01", "--report", f"{db}-wal.html", "-o", f"{db}-wal"],
+    ):
+        err = one_line_error(capsys, [*args, "--catalog", str(db)])
+        assert "over an SQLite database" in err
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    err = one_line_error(
+        capsys, ["changeover", "export", "fig27", "-o", str(db), "--catalog", str(db)]
+    )
+    assert "over an SQLite database" in err
+    listed = json.loads(ok(capsys, ["catalog", "list", "--json", "--catalog", str(db)]).out)
+    assert len(listed) == len(PARTS) + 1 and db.read_bytes() != b""
+    assert before[:16] == db.read_bytes()[:16] == b"SQLite format 3\x00"
+
+
+def test_a_list_option_given_twice_is_refused(db, capsys):
+    args = ["changeover", "compile", "x", "--mix", "octagon", "--mix=rectangle-2x1"]
+    err = one_line_error(capsys, [*args, "--tolerance", "0.01", "--catalog", str(db)])
+    assert "--mix given twice" in err and "comma-separated" in err
+    err = one_line_error(capsys, ["design", "sensor", "--mix", "a", "--mix", "b"])
+    assert "--mix given twice" in err
+    assert json.loads(ok(capsys, ["changeover", "list", "--json", "--catalog", str(db)]).out) == []
+
+
+def test_every_input_is_checked_before_an_existing_name_is_refused(db, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    for extra, said in (
+        (["--shape-tolerance", "50"], "shape tolerance 50 mm"),
+        (["--landings", "down"], "has no landing down"),
+    ):
+        err = one_line_error(capsys, [*FIG27, "--tolerance", "0.01", *extra, "--catalog", str(db)])
+        assert said in err and "already exists" not in err
+
+
+def test_show_names_the_declared_uncertainty(db, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--rotation-error", "0.5", "--catalog", str(db)])
+    out = ok(capsys, ["changeover", "show", "fig27", "--catalog", str(db)]).out
+    assert "uncertainty: rotation error ±0.5°, shape tolerance 0 mm" in out
+    data = json.loads(
+        ok(capsys, ["changeover", "show", "fig27", "--json", "--catalog", str(db)]).out
+    )
+    assert data["uncertainty"]["rotation_error_deg"] == pytest.approx(0.5)
+    assert data["uncertainty_declared"] is True
+
+
+def test_run_warns_of_a_stored_tolerance_the_plan_does_not_declare(db, tmp_path, capsys):
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    plan = tmp_path / "fig27.json"
+    ok(capsys, ["changeover", "export", "fig27", "-o", str(plan), "--catalog", str(db)])
+    run = ["run", str(plan), "octagon", "--all", "--json", "--catalog", str(db)]
+    assert json.loads(ok(capsys, run).out)["warnings"] == []
+    src = str(CATALOG / "octagon.json")
+    add = ["catalog", "add", src, "--revise", "--shape-tolerance", "0.005"]
+    ok(capsys, [*add, "--catalog", str(db)])
+    warnings = json.loads(ok(capsys, run).out)["warnings"]
+    assert any("octagon r2 stores a shape tolerance of 0.005 mm" in w for w in warnings)
+    pinned = ["run", str(plan), "octagon@1", "--all", "--json", "--catalog", str(db)]
+    assert json.loads(ok(capsys, pinned).out)["warnings"] == []

@@ -211,3 +211,49 @@ def test_a_failed_rename_puts_back_the_files_already_replaced(tmp_path: Path, mo
     monkeypatch.setattr(os, "replace", real_replace)
     assert a.read_text() == "old a" and b.read_text() == "old b"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "b.json"]
+
+
+def test_a_file_replaced_keeps_its_permissions_and_group(tmp_path: Path) -> None:
+    target = tmp_path / "line3.plan.json"
+    target.write_text("{}")
+    os.chmod(target, 0o640)
+    groups = [g for g in os.getgroups() if g != os.stat(target).st_gid] or [os.getgid()]
+    if os.geteuid() == 0:
+        groups = [1] + groups  # root may give the file any group (daemon)
+    os.chown(target, -1, groups[0])
+    write_text_atomic(target, '{"a": 1}')
+    st = os.stat(target)
+    assert stat.S_IMODE(st.st_mode) == 0o640 and st.st_gid == groups[0]
+    assert read_json(target) == {"a": 1}
+
+
+def _database(path: Path) -> None:
+    import sqlite3
+
+    conn = sqlite3.connect(path)
+    conn.execute("create table parts (name text)")
+    conn.commit()
+    conn.close()
+
+
+@pytest.mark.parametrize("suffix", ["", "-wal", "-shm", "-journal"])
+def test_an_sqlite_database_and_its_side_files_are_never_overwritten(
+    tmp_path: Path, suffix: str
+) -> None:
+    db = tmp_path / "feederkit.db"
+    _database(db)
+    before = db.read_bytes()
+    target = Path(f"{db}{suffix}")
+    with pytest.raises(InputError) as exc:
+        write_text_atomic(target, "{}", what="plan file")
+    text = str(exc.value)
+    assert "\n" not in text and "cannot write the plan file over an SQLite database" in text
+    assert db.read_bytes() == before and not (suffix and target.exists())
+    link = tmp_path / "current.db"
+    link.symlink_to(db)
+    with pytest.raises(InputError):
+        write_text_atomic(link, "{}")  # through a link too
+    assert db.read_bytes() == before
+    other = tmp_path / "notes-wal"  # a name like a side file, with no database beside it
+    write_text_atomic(other, "{}")
+    assert read_json(other) == {}

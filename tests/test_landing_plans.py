@@ -422,3 +422,13 @@ def test_a_changeover_over_landings_is_stored_with_its_landings(tmp_path):
         ("down", 0.5),
     ]
     assert default.rejected == frozenset()
+
+
+def test_a_plan_over_landings_restates_what_they_are_in_its_conventions(tmp_path, capsys):
+    src = write_outline(tmp_path, "ell", ELL_RING, [ELL_HOLE])
+    plan, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5", "--accept", "up"])
+    text = json.loads((tmp_path / "plan.json").read_text())["conventions"]
+    assert "'down' mirrored about the part frame's y axis" in text and '"reject": true' in text
+    bar = write_outline(tmp_path, "bar", [[0, 0], [30, 0], [30, 10], [0, 10]])
+    plan_cli(tmp_path, capsys, [bar, "--tolerance", "0.5"])
+    assert "Landings:" not in json.loads((tmp_path / "plan.json").read_text())["conventions"]

@@ -89,7 +89,7 @@ def test_a_bound_of_the_inseparable_goal_is_stated_for_that_goal_when_lumping_ma
         "no plan found within the time limit of 1 s (a plan needs at least 4 operations)"
     )
     assert _fallback_of(m, apart=True) == (
-        "no plan found within the time limit of 1 s (one that tells every pair of states apart "
+        "no plan found within the time limit of 1 s (one whose results list no states together "
         "needs at least 4 operations)"
     )
 

@@ -189,6 +189,28 @@ def _command_path(args: Sequence[str]) -> str:
     return " ".join(["feederkit", *_command_words(args)[0]])
 
 
+def _refuse_lists_given_twice(args: Sequence[str]) -> None:
+    """Refuse an option whose value is a comma-separated list (``--mix A,B``, its metavar
+    says so) given more than once: click keeps the last, which would drop the earlier
+    list's parts from a mix without a word."""
+    _words, command = _command_words(args)
+    given = list(args[: args.index("--")] if "--" in args else args)
+    for param in getattr(command, "params", []):
+        metavar = getattr(param, "metavar", None) or ""
+        if getattr(param, "param_type_name", "") != "option" or "," not in metavar:
+            continue
+        if getattr(param, "multiple", False):
+            continue
+        names = [n for n in param.opts if n.startswith("--")]
+        count = sum(1 for a in given if a in names or a.startswith(tuple(n + "=" for n in names)))
+        if count > 1:
+            raise UsageError(
+                f"{names[0]} given {'twice' if count == 2 else f'{count} times'} (a later one "
+                "would replace the earlier): "
+                f"give one list, comma-separated: {names[0]} {metavar}"
+            )
+
+
 def _group_alone(args: Sequence[str]) -> list[str] | None:
     """The words of a group given without a command and nothing else (``[]`` for
     ``feederkit`` alone, ``["part"]``), else None."""
@@ -426,6 +448,7 @@ def _run_app(args: list[str]) -> int:
                 args=[*group, "--help"], prog_name="feederkit", standalone_mode=False
             )
         return 2
+    _refuse_lists_given_twice(args)
     try:
         code = _click_command().main(args=args, prog_name="feederkit", standalone_mode=False)
     except SystemExit as exc:

@@ -55,6 +55,7 @@ from feederkit.cli.common import (
 from feederkit.cli.importopts import takes_import_options, with_com
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
+from feederkit.jsonio import SQLITE_SIDE_SUFFIXES
 from feederkit.landing.model import DEFAULT_SIDE_PROBABILITY, Landing, check_side_probability
 from feederkit.part import Part
 from feederkit.uncertainty import Uncertainty, check_for_part
@@ -236,10 +237,6 @@ def opened(option: Path | None, wait: float, *, create: bool = False) -> Iterato
         conn.close()
 
 
-SIDE_FILES = ("-wal", "-shm", "-journal")
-"""SQLite's files beside a catalog ``DB``: ``DB-wal``, ``DB-shm``, ``DB-journal``."""
-
-
 @contextmanager
 def opened_for_import(option: Path | None, wait: float) -> Iterator[Connection]:
     """The catalog connection of ``add`` and ``import``, which create a missing catalog.
@@ -253,7 +250,7 @@ def opened_for_import(option: Path | None, wait: float) -> Iterator[Connection]:
     """
     path = catalog_path(option)
     before = _file_state(path)
-    sides_before = {s for s in SIDE_FILES if _file_state(Path(f"{path}{s}")) is not None}
+    sides_before = {s for s in SQLITE_SIDE_SUFFIXES if _file_state(Path(f"{path}{s}")) is not None}
     try:
         conn = open_catalog(path, create=True, wait=wait)
     except BaseException:
@@ -309,7 +306,7 @@ def _put_back(path: Path, before: int | None, sides_before: set[str]) -> None:
         else:
             with path.open("r+b") as fh:
                 fh.truncate(0)
-        for side in SIDE_FILES:
+        for side in SQLITE_SIDE_SUFFIXES:
             if side not in sides_before:
                 Path(f"{path}{side}").unlink(missing_ok=True)
     except OSError:

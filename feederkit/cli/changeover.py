@@ -102,6 +102,7 @@ from feederkit.mix.changeover import (
     landing_rows,
     load_changeover,
     member_name,
+    mix_landings,
     stale_revisions,
 )
 from feederkit.mix.pairs import PairWitness
@@ -471,8 +472,6 @@ def compile_command(
     path = resolve_catalog_path(catalog)
     if ":" in mix:  # every input is checked before the catalog's changeovers
         check_mix_names(mix, part_names(path))
-    if not replace and changeover_exists(path, name):
-        raise InputError(f"a changeover named {name!r} already exists (use --replace)")
     terms = (*FLAG_TERMS, *LANDING_TERMS)
     with flag_words(terms):
         loaded = load_parts(members, catalog=path)
@@ -483,6 +482,9 @@ def compile_command(
     with flag_words(terms), stored_tolerance_words(declared):  # one line, before any warning
         for pf in loaded.push_functions:
             check_for_part(uncertainty, pf.part)
+        mix_landings(path, loaded, over.get("landings"))  # a landing a part does not have
+    if not replace and changeover_exists(path, name):  # every input is checked before this
+        raise InputError(f"a changeover named {name!r} already exists (use --replace)")
     print_warnings(declared.warnings)
 
     def outputs(c: CompiledChangeover, text: str) -> list[OutputFile]:
@@ -759,10 +761,13 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
     co = load_changeover(resolve_catalog_path(catalog), name)
     print_warnings(co.warnings)
     witnesses = co.witnesses()
+    declared = co.plan.get("uncertainty")  # None: a version-1 plan, the ideal model
     if json_out:
         print_json(
             {
                 **_info_dict(co.info, co.plan),
+                "uncertainty": IDEAL.to_dict() if declared is None else declared,
+                "uncertainty_declared": declared is not None,  # as list --json
                 "landings": landing_rows(co.plan, co.rejected),
                 "cycle_time": co.plan["stats"].get("cycle_time"),
                 "unrecognizable_pairs": [w.to_dict() for w in witnesses],
@@ -777,8 +782,9 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
         f"[bold]changeover {escape(info.name)}[/]: "
         f"{escape(shares_text(info.parts, co.plan))}\n"
         + ("" if lands is None else f"{escape(lands)}\n")
-        + f"sensor: {sensor_text(dict(info.sensor))}\ncreated {info.created_at} by "
-        f"{escape(info.created_by)}",
+        + f"sensor: {sensor_text(dict(info.sensor))}\n"
+        f"uncertainty: {escape(uncertainty_text(declared))}\n"
+        f"created {info.created_at} by {escape(info.created_by)}",
         highlight=False,
     )
     view = as_plan(co.plan)

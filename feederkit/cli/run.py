@@ -16,6 +16,7 @@ including a plan that fails verification.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -32,6 +33,7 @@ from feederkit.cli.plan_render import (
 )
 from feederkit.errors import CheckFailed, InputError
 from feederkit.landing.plan import load_landings
+from feederkit.loading import load_parts
 from feederkit.plans.execute import execute
 from feederkit.plans.match import match_part, same_geometry
 from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan
@@ -81,6 +83,7 @@ def run_command(
         indices = list(range(len(plan.parts)))
     # The fragile states of the parts run (a SOURCE's member), not of every part of the mix.
     warnings = [w for w in (plan.low_margin_warning(),) if w] + plan.fragile_warnings(indices)
+    warnings += stored_beyond(plan, sources or [], catalog)
     if not json_out:
         for w in warnings:
             console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)
@@ -129,6 +132,33 @@ def run_command(
         raise CheckFailed(failed[0].message)
     if not report.ok:
         raise CheckFailed(f"the plan failed verification: {report.first_problem()}")
+
+
+def stored_beyond(plan: Plan, sources: Sequence[str], catalog: str | None) -> list[str]:
+    """A line per catalog part among ``sources`` whose revision stores a shape or COM
+    tolerance larger than the plan declares: the run checks the plan at what it declares,
+    so a plan made before the revision stored it passes without covering it."""
+    if not sources:
+        return []
+    declared = plan.uncertainty
+    out = []
+    for t in load_parts(list(sources), catalog=catalog).tolerances:
+        for what, stored, planned in (
+            ("shape", t.shape_tolerance_mm, declared.shape_tolerance_mm),
+            ("COM", t.com_tolerance_mm, declared.com_tolerance_mm),
+        ):
+            if stored is not None and stored > planned + STORED_EPS_MM:
+                out.append(
+                    f"{t.label} stores a {what} tolerance of {stored:g} mm, more than the "
+                    f"{planned:g} mm this plan declares: the run checks the plan at what it "
+                    "declares; plan (or compile) again to cover the stored tolerance"
+                )
+    return out
+
+
+STORED_EPS_MM = 1e-9
+"""A stored tolerance counts as larger than the declared one past this (mm): the plan
+declares the stored value itself when it took it from the catalog."""
 
 
 def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:

@@ -454,6 +454,22 @@ def stale_revisions(
     return out
 
 
+def mix_landings(
+    catalog: str | os.PathLike[str],
+    loaded: LoadedParts,
+    landings: str | Sequence[str] | None = None,
+) -> list[tuple[Landing, ...]]:
+    """The landings planned for each of the ``loaded`` catalog parts: their revisions' stored
+    landings, those named in ``landings`` (None: all). InputError for a part given as a file,
+    a landing a part does not have, or a mesh pose that pushing cannot orient."""
+    return [
+        checked_landings(
+            f"{n}@{r}", select_landings(_stored_landings(catalog, n, r, pf), landings or "all")
+        )
+        for (n, r), pf in zip(loaded.revisions, loaded.push_functions, strict=True)
+    ]
+
+
 def compile_changeover(
     catalog: str | os.PathLike[str],
     name: str,
@@ -501,18 +517,13 @@ def compile_changeover(
     request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
     plan fails verification.
     """
-    if not replace and changeover_exists(catalog, name):
-        raise InputError(f"a changeover named {name!r} already exists")
     if loaded is None:
         loaded = load_parts([_source(m) for m in members], catalog=catalog)
     pfs = list(loaded.push_functions)
     revisions = loaded.revisions  # InputError for a part given as a file
-    per_part = [
-        checked_landings(
-            f"{n}@{r}", select_landings(_stored_landings(catalog, n, r, pf), landings or "all")
-        )
-        for (n, r), pf in zip(revisions, pfs, strict=True)
-    ]
+    per_part = mix_landings(catalog, loaded, landings)
+    if not replace and changeover_exists(catalog, name):  # after every input is checked
+        raise InputError(f"a changeover named {name!r} already exists")
     rejected: frozenset[str] = frozenset()
     if plans_over_landings(per_part, landings is not None, accept is not None):
         mix = plan_landing_members(

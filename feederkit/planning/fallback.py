@@ -383,7 +383,7 @@ def fallback(
         if blind is not None:
             return blind, False, None, lower, TIES_NONE, None
         reason = last if last == "memory" else stop
-        which = "one that tells every pair of states apart" if apart else "a plan"
+        which = "one whose results list no states together" if apart else "a plan"
         # A plan the searches found whose tree or its verification did not fit: more time
         # would give it.
         seen = (

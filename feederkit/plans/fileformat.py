@@ -102,12 +102,24 @@ LED_WINDOWS = (
 """What an LED plan's ``conventions`` adds: the rule of ``sensors.LedSensor.window``."""
 
 
-def conventions_for(sensor: Sensor) -> str:
+LANDINGS = (
+    "Landings: a part entry with 'landing' is the part as it lands on the belt, 'up' as "
+    "drawn, 'down' mirrored about the part frame's y axis (x to -x, the COM too), 'pose-K' a "
+    "solid's resting pose K; its 'hull', 'com', states and poses are those of that landing, in "
+    'its own frame, and every result entry names the landing. A result with "reject": true '
+    "is a landing the next station cannot take: the part is to be diverted, not placed."
+)
+"""What a plan over landings adds to its ``conventions`` paragraph (design.md, "Landings"):
+the mirror axis of ``down`` decides every face-down pose, and a reject leaf asks for an
+action of its own."""
+
+
+def conventions_for(sensor: Sensor, landings: bool = False) -> str:
     """The ``conventions`` paragraph of a plan with this sensor (design.md): CONVENTIONS,
-    and for an LED array the rule its reading windows follow (:data:`LED_WINDOWS`)."""
-    if isinstance(sensor, LedSensor):
-        return f"{CONVENTIONS} {LED_WINDOWS}"
-    return CONVENTIONS
+    for an LED array the rule its reading windows follow (:data:`LED_WINDOWS`), and for a
+    plan over ``landings`` what they are (:data:`LANDINGS`)."""
+    text = f"{CONVENTIONS} {LED_WINDOWS}" if isinstance(sensor, LedSensor) else CONVENTIONS
+    return f"{text} {LANDINGS}" if landings else text
 
 
 MAX_FILE_NODES = 100_000
@@ -348,7 +360,9 @@ def plan_from_result(
         ),
         root=root,
         stats=stats,
-        conventions=conventions_for(machine.sensor),
+        conventions=conventions_for(
+            machine.sensor, members is not None and any(m.landing for m in members)
+        ),
         uncertainty=getattr(machine, "uncertainty", IDEAL) if uncertainty is None else uncertainty,
     )
 
