@@ -70,6 +70,17 @@ class Drawing:
     frames: int
     nested: int = 0
     warnings: tuple[str, ...] = ()
+    edges: tuple[EdgeLine, ...] = ()
+    """The outlines drawn again just inside themselves (:func:`edge_line`), that line left
+    out: a chamfer or deburred edge drawn in a top view."""
+
+
+@dataclass(frozen=True)
+class EdgeLine:
+    """A part's outline drawn again ``band`` mm inside it all along: its bounds ``box``."""
+
+    box: tuple[float, float, float, float]
+    band: float
 
 
 def nest(loops: Sequence[Polygon]) -> list[int]:
@@ -102,13 +113,78 @@ def _children(loops: Sequence[Polygon]) -> dict[int, list[int]]:
     return children
 
 
-def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = None) -> Drawing:
+EDGE_BAND_SHARE = 0.1
+"""An edge line (:func:`edge_line`) runs at most this share of the outline's size inside it."""
+
+
+EDGE_SPREAD = 1.5
+"""Along an edge line the farthest point of either loop from the other is at most this many
+times their nearest distance: a line offset with sharp corners lies sqrt(2) times the band
+from the outline's corners."""
+
+
+EDGE_MEAN_SPREAD = 1.25
+"""Along an edge line the band's mean width (its area over the loops' mean length) is at most
+this many times the nearest distance."""
+
+
+def edge_line(outer: Polygon, inner: Polygon, gap: float) -> float | None:
+    """The band's width when ``inner`` (a loop inside ``outer``) runs along it just inside
+    it all along, as a chamfer or deburred edge is drawn in a top view: the band at most
+    :data:`EDGE_BAND_SHARE` of the outline's size and of even width (:data:`EDGE_SPREAD`,
+    :data:`EDGE_MEAN_SPREAD`); else None.
+
+    >>> from shapely.geometry import box
+    >>> edge_line(box(0, 0, 60, 40), box(1, 1, 59, 39), 0.01)
+    1.0
+    >>> edge_line(box(0, 0, 60, 40), box(20, 10, 40, 30), 0.01) is None  # a window
+    True
+    """
+    x0, y0, x1, y1 = outer.bounds
+    near = float(outer.exterior.distance(inner.exterior))
+    if not 0.0 < near <= EDGE_BAND_SHARE * max(x1 - x0, y1 - y0):
+        return None
+    if outer.exterior.hausdorff_distance(inner.exterior) > EDGE_SPREAD * near + 2.0 * gap:
+        return None
+    mean = (outer.area - inner.area) / (0.5 * (outer.exterior.length + inner.exterior.length))
+    return near if mean <= EDGE_MEAN_SPREAD * near + 2.0 * gap else None
+
+
+def _edge_lines(loops: list[Loop], gap: float) -> tuple[list[Loop], list[EdgeLine]]:
+    """``loops`` without the edge lines of the outermost ones: a loop's largest inner loop
+    that runs along it just inside it (:func:`edge_line`) and holds loops of its own (what
+    the part's holes and windows are). Left in, the line made the part a 1 mm ring with its
+    holes as parts cut from it, or a small plate a "drawing frame" around its window. An
+    inner loop holding nothing is kept: a thin ring (a gasket) is a part."""
+    polys = [lp.polygon for lp in loops]
+    parent = nest(polys)
+    kids: dict[int, list[int]] = {}
+    for i, p in enumerate(parent):
+        kids.setdefault(p, []).append(i)
+    drop: set[int] = set()
+    found = []
+    for i in kids.get(-1, []):
+        inside = kids.get(i, [])
+        if not inside or not kids.get(inside[0]):
+            continue
+        band = edge_line(polys[i], polys[inside[0]], gap)
+        if band is not None:
+            drop.add(inside[0])
+            found.append(EdgeLine(tuple(float(v) for v in polys[i].bounds), band))  # type: ignore[arg-type]
+    return [lp for k, lp in enumerate(loops) if k not in drop], found
+
+
+def regions_from_loops(
+    found: Sequence[Loop | Polygon], budget: Budget | None = None, gap: float = 0.0
+) -> Drawing:
     """Parts (largest loop first) from closed loops; skips drawing frames.
 
     A loop at even nesting depth is a part, the loops directly inside it are its holes; parts
     inside a part's holes (a cut sheet: pieces cut from a plate's window) are separate parts.
     Drawing frames (:func:`.frames.frame_kind`) around the parts are dropped; each one costs a
-    nesting of all loops, so the deadline of ``budget`` is checked between them.
+    nesting of all loops, so the deadline of ``budget`` is checked between them. Then an
+    outermost loop's edge line (:func:`_edge_lines`; ``gap`` the flatten tolerance) is left
+    out, so its holes are the part's.
     """
     loops = sorted(
         (lp if isinstance(lp, Loop) else Loop(lp, 1, lp.area) for lp in found),
@@ -124,6 +200,9 @@ def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = 
             break
         loops = [lp for k, lp in enumerate(loops) if k != 0 and (drop == 1 or k != kids[0])]
         frames += 1
+    if budget is not None:
+        budget.check_time()
+    loops, edges = _edge_lines(loops, gap)
     polys = [lp.polygon for lp in loops]
     parent = nest(polys)
     depth = [0] * len(polys)
@@ -158,7 +237,9 @@ def regions_from_loops(found: Sequence[Loop | Polygon], budget: Budget | None = 
             while k >= 0 and k != first:
                 k = parent[k]
             nested += k == first
-    return Drawing(regions=tuple(r for _, r in regions), frames=frames, nested=nested)
+    return Drawing(
+        regions=tuple(r for _, r in regions), frames=frames, nested=nested, edges=tuple(edges)
+    )
 
 
 CONCENTRIC_CENTRE = 0.02
@@ -381,7 +462,7 @@ def drawing_from_lines(
     split = [lp.polygon.bounds for lp in loops if lp.split]
     if split:
         notes.append(side_by_side_note(split))
-    drawing = regions_from_loops(loops, budget)
+    drawing = regions_from_loops(loops, budget, gap)
     if not drawing.regions:
         raise InputError(f"{label}: no closed outline outside a drawing frame")
     blocks = [free_title_block(r, healed[: len(snapped)], gap) for r in drawing.regions]
@@ -400,4 +481,4 @@ def drawing_from_lines(
     if doubt:
         notes.append(doubt)
     notes += open_line_notes(dangles, drawing.regions, gap)
-    return Drawing(drawing.regions, drawing.frames, drawing.nested, tuple(notes))
+    return replace(drawing, warnings=tuple(notes))

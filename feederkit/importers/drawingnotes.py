@@ -202,3 +202,14 @@ def _nearly_closed(group: shapely.Geometry, ends: np.ndarray, gap: float) -> boo
     if apart > NEARLY_CLOSED * max(x1 - x0, y1 - y0):
         return False
     return abs(float(shapely.area(Polygon(chain.coords)))) > gap * chain.length
+
+
+def edge_line_note(box: Sequence[float], band: float) -> str:
+    """The warning for an outline drawn again just inside itself, that line left out
+    (:func:`feederkit.importers.drawing.edge_line`): both readings of such a drawing named."""
+    return (
+        f"the outline ({box_words(box)}) is drawn again {band:.3g} mm inside it all along: "
+        "taken for a chamfer or edge line drawn in a top view, not a hole, so the loops it "
+        "holds are the part's holes; if the two lines are a drawing frame, the part is what "
+        "they hold: leave the frame's layer out with --layer, or delete the frame"
+    )

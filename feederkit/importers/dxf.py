@@ -33,7 +33,7 @@ from shapely.geometry import Polygon
 from feederkit.errors import InputError
 from feederkit.importers.budget import MAX_COORD_MM, Budget
 from feederkit.importers.drawing import Counterbore, Drawing, counterbores, drawing_from_lines
-from feederkit.importers.drawingnotes import merged_note
+from feederkit.importers.drawingnotes import edge_line_note, merged_note
 from feederkit.importers.flatten import NonFiniteCurve, cubic_flattening
 from feederkit.importers.loops import Region, closing_lines
 from feederkit.importers.model import ImportedOutline, ImportOptions
@@ -1087,6 +1087,7 @@ def _read_doc(
     warnings_ += [counterbore_note(b, drawing, drawn, flatten_mm) for b in bores]
     if drawing.frames:
         warnings_.append(f"skipped {drawing.frames} drawing frame(s) around the part")
+    warnings_ += [edge_line_note(e.box, e.band) for e in drawing.edges]
     regions = list(drawing.regions)
     chosen = regions if options.all_parts else regions[:1]
     others = (

@@ -37,6 +37,18 @@ TITLE_BLOCK_SHARE = 0.7
 title-block cells (faces made by lines touching the border)."""
 
 
+FRAME_DOUBLE_MIN_MM = 120.0
+"""A double-line frame is at least this long, a drawing sheet's (A6 is 148 mm long; an A4
+sheet's frame drawn at 2:1 is 148 mm): a smaller rectangle with a line just inside it is a
+plate whose edge (a chamfer, a deburred edge) is drawn in a top view (:mod:`.drawing`'s
+edge lines), as a 60 x 40 mm plate with a line 1 mm inside it is."""
+
+
+TITLE_BLOCK_MIN_CELLS = 2
+"""A single-line frame's title block has at least this many cells besides the sheet: one
+face cut off a rectangle is a fillet drawn over an untrimmed corner, or a bend line's strip."""
+
+
 FRAME_HOLE_SHARE = 0.1
 """A rectangle holding one hole whose box is at most this share of its own may be a bare
 single-line drawing frame around one part: imported as a plate, with a warning."""
@@ -72,28 +84,49 @@ def _is_rectangle(loop: Polygon) -> bool:
 def frame_kind(top: Loop, loops: Sequence[Loop], kids: Sequence[int]) -> int:
     """How many loops (from the largest) a drawing frame takes: 0 (not a frame), 1 or 2.
 
-    A frame is a thin border, not a part: either a double line whose border (outer minus the
-    inner rectangle) is a small share of its box (2 loops), or a single rectangle whose
-    title-block lines touch it (1 loop: its sheet is one large face beside small cells,
-    inside the frame when the frame is one closed line; lines closing a face against a
-    closed outline from outside are a view or dimension drawn against a part).
+    A frame is a thin border, not a part: either a double line, a drawing sheet's size
+    (:data:`FRAME_DOUBLE_MIN_MM`), whose border (outer minus the inner rectangle) is a small
+    share of its box (2 loops), or a single rectangle whose title-block lines touch it (1
+    loop: its sheet is one large face beside at least :data:`TITLE_BLOCK_MIN_CELLS` small
+    cells, not all strips across it, inside the frame when the frame is one closed line;
+    lines closing a face against a closed outline from outside are a view or dimension
+    drawn against a part).
     A rectangle whose holes hold parts but which has neither mark is a plate: a cut sheet
     keeps its material.
     """
     if not kids or not _is_rectangle(top.polygon):
         return 0
+    x0, y0, x1, y1 = top.polygon.bounds
     inner = loops[kids[0]]
-    if _is_rectangle(inner.polygon) and inner.polygon.area >= (1.0 - FRAME_MATERIAL) * (
-        top.polygon.area
+    if (
+        max(x1 - x0, y1 - y0) >= FRAME_DOUBLE_MIN_MM
+        and _is_rectangle(inner.polygon)
+        and inner.polygon.area >= (1.0 - FRAME_MATERIAL) * top.polygon.area
     ):
         return 2
     if (
-        top.faces >= 2
+        len(top.cells) >= TITLE_BLOCK_MIN_CELLS
         and not top.outside
         and top.largest_face >= TITLE_BLOCK_SHARE * top.polygon.area
+        and not _strips(top.cells, top.polygon.bounds)
     ):
         return 1
     return 0
+
+
+def _strips(cells: Sequence[tuple[float, float, float, float]], box: Sequence[float]) -> bool:
+    """Whether every cell spans the rectangle ``box`` from side to side, all of them one way:
+    the strips between lines running across it (a plate's bend lines or slits), not a title
+    block's cells, which lie in a corner of the sheet."""
+    x0, y0, x1, y1 = box
+    tol = STRIP_SPAN * max(x1 - x0, y1 - y0)
+    tall = all(c[1] <= y0 + tol and c[3] >= y1 - tol for c in cells)
+    wide = all(c[0] <= x0 + tol and c[2] >= x1 - tol for c in cells)
+    return tall or wide
+
+
+STRIP_SPAN = 1e-3
+"""A cell spans its rectangle when it reaches within this share of its size of both sides."""
 
 
 def _round(poly: Polygon) -> bool:

@@ -228,6 +228,9 @@ class Loop:
     """Whether the loop is one of several closed lines lying side by side (sharing edges)
     that tiled a group's merged loop and were read apart (parts nested for common-line
     cutting, a view drawn against its part)."""
+    cells: tuple[tuple[float, float, float, float], ...] = ()
+    """Bounds of the faces merged into the loop other than the largest: a drawing frame's
+    title-block cells, or the strips between a plate's bend lines."""
 
 
 def _near(lines: np.ndarray, others: np.ndarray, tol: float) -> bool:
@@ -589,9 +592,22 @@ def closed_loops(
                             else ()
                         ),
                         split=outer and bool(apart),
+                        cells=_cells_of(own),
                     )
                 )
     return loops, dangles
+
+
+def _cells_of(faces: Sequence[Polygon]) -> tuple[tuple[float, float, float, float], ...]:
+    """The bounds of every face but the largest (:attr:`Loop.cells`)."""
+    if len(faces) < 2:
+        return ()
+    largest = max(range(len(faces)), key=lambda k: faces[k].area)
+    return tuple(
+        tuple(float(v) for v in f.bounds)  # type: ignore[misc]
+        for k, f in enumerate(faces)
+        if k != largest
+    )
 
 
 def open_ends(lines: Sequence[np.ndarray], tol: float) -> np.ndarray:
