@@ -11,12 +11,16 @@ from __future__ import annotations
 
 import math
 import random
+import time
 
 import pytest
 from shapely import Polygon, affinity, hausdorff_distance
 
 import feederkit.catalog as cat
 from feederkit.cli.app import main
+from feederkit.errors import InputError
+from feederkit.importers import ImportOptions
+from feederkit.importers.budget import Budget
 from feederkit.landing import (
     congruence_rotations,
     congruent,
@@ -282,7 +286,7 @@ def test_merging_congruent_landings_polls_the_callers_deadline():
     calls: list[int] = []
     merged = merge_congruent("p", candidates, lambda: calls.append(1))
     assert [(x.name, x.merged) for x in merged] == [("a", ("c",)), ("b", ("d",))]
-    assert len(calls) == 4  # b~a, c~a, d~a, d~b
+    assert len(calls) >= 4  # before b~a, c~a, d~a, d~b, and inside each search
 
     def out_of_time() -> None:
         if len(calls) >= 6:
@@ -291,3 +295,27 @@ def test_merging_congruent_landings_polls_the_callers_deadline():
 
     with pytest.raises(TimeoutError):
         merge_congruent("p", candidates, out_of_time)
+
+
+class _Late(Exception):
+    pass
+
+
+def test_the_mirror_comparison_polls_its_deadline_and_shares_the_imports_limit(tmp_path):
+    ring = [(0, 0), (40, 0), (40, 10), (10, 10), (10, 25), (0, 25)]
+    holes = [[(x, 2), (x + 1, 2), (x + 1, 3), (x, 3)] for x in range(12, 38, 3)]
+    ell = make_part(make_outline("ell", ring, holes=holes))
+    polls = []
+
+    def check() -> None:
+        polls.append(1)
+        if len(polls) > 3:
+            raise _Late
+
+    with pytest.raises(_Late):
+        landings_of_outline(ell, check=check)
+    assert [x.name for x in landings_of_outline(ell)] == ["up", "down"]
+    # A limit counted from an instant already past refuses at the first poll, naming it.
+    spent = ImportOptions().counting_from(time.monotonic() - 60.0)
+    with pytest.raises(InputError, match="took longer than 30 s"):
+        landings_of_outline(ell, check=Budget(spent.limits, "ell.dxf").check_time)

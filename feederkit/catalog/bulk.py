@@ -197,9 +197,10 @@ def import_directory(
         if progress:
             progress("read", k, len(files), str(path))
         try:
-            result, parts = import_parts(path, options)
+            timed = options.counting_from()  # the file's reading and its landings: one limit
+            result, parts = import_parts(path, timed)
             names = [check_part_name(p.part.name, FOLDER_RENAME_ADVICE) for p in parts]
-            landings = [landings_for(p, options, path, side_probability) for p in parts]
+            landings = [landings_for(p, timed, path, side_probability) for p in parts]
         except InputError as exc:
             bad.append(_bad_line(path, exc))
             continue

@@ -45,6 +45,7 @@ from feederkit.importers import (
     build_part,
     import_parts,
 )
+from feederkit.importers.budget import Budget
 from feederkit.jsonio import parse_json
 from feederkit.landing.mesh import landings_of_mesh, pose_name
 from feederkit.landing.model import (
@@ -186,7 +187,8 @@ def landings_for(
     merged (without the file, only the imported pose).
     """
     if imported.source.kind != "mesh":
-        return landings_of_outline(imported.part, side_probability)
+        budget = Budget(options.limits, str(source or imported.part.name))
+        return landings_of_outline(imported.part, side_probability, budget.check_time)
     if source is None:
         return _imported_pose(imported)
     return landings_of_mesh(
@@ -455,6 +457,7 @@ def add_file(
     if name is not None:
         check_part_name(name, "give --name a name without ',' or ':'")
     check_side_probability(side_probability)
+    options = options.counting_from()  # the file's reading and its landings: one limit
     result, parts = import_parts(path, options, name)
     for p in parts:
         check_part_name(p.part.name)  # a name from the file, before anything is written

@@ -49,8 +49,9 @@ class ImportLimits:
     ``crossings``: pairs of drawn lines whose bounding boxes overlap (noding them costs
     about 0.5 s per 50,000); ``faces``: mesh triangles; ``hull_faces``: faces of a mesh's
     convex hull (the resting pose search grows with their square: 4,000 take about 3 s);
-    ``seconds``: wall time of the whole import; ``seconds_option``: the option that allows
-    more (a command whose own ``--time-limit`` is shorter names that one).
+    ``seconds``: wall time of the whole import (from ``started`` when given); ``seconds_option``:
+    the option that allows more (a command whose own ``--time-limit`` is shorter names that
+    one).
     """
 
     entities: int = DEFAULT_MAX_ENTITIES
@@ -61,6 +62,9 @@ class ImportLimits:
     hull_faces: int = DEFAULT_MAX_HULL_FACES
     seconds: float = DEFAULT_TIME_LIMIT_S
     seconds_option: str = "--import-time-limit"
+    started: float | None = None
+    """The ``time.monotonic()`` instant the seconds count from (None: each budget's start):
+    the files' reading and their landings then share one limit."""
 
     def __post_init__(self) -> None:
         for what, option in OPTION.items():
@@ -80,7 +84,8 @@ class Budget:
     def __init__(self, limits: ImportLimits, label: str) -> None:
         self.limits = limits
         self.label = label
-        self.deadline = time.monotonic() + limits.seconds
+        start = time.monotonic() if limits.started is None else limits.started
+        self.deadline = start + limits.seconds
         self.counts = dict.fromkeys(OPTION, 0)
 
     def _add(self, what: str, n: int, noun: str) -> None:

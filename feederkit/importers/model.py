@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import time
+from dataclasses import dataclass, field, replace
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import ImportLimits
@@ -65,6 +66,13 @@ class ImportOptions:
             raise InputError(f"--space must be model or paper, got {self.space!r}")
         if not self.flatten_tolerance > 0.0:
             raise InputError(f"--flatten-tolerance must be > 0, got {self.flatten_tolerance:g}")
+
+    def counting_from(self, instant: float | None = None) -> ImportOptions:
+        """These options with the import's time limit counted from ``instant`` (a
+        ``time.monotonic()`` value; default now): a file's reading and its landings then
+        share one limit (:attr:`ImportLimits.started`)."""
+        started = time.monotonic() if instant is None else instant
+        return replace(self, limits=replace(self.limits, started=started))
 
     def as_key(self) -> dict[str, object]:
         """The options that change the imported part (stored with a revision, compared later)."""

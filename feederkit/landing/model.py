@@ -26,6 +26,7 @@ import math
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -168,30 +169,34 @@ def congruence_tolerance(a: Part, b: Part) -> float:
     return min(CONGRUENCE_TOL_MM, CONGRUENCE_REL_TOL * max(a.size, b.size))
 
 
-@dataclass(frozen=True)
 class _Shape:
-    """A part's outline about its COM, prepared for the rotation search."""
+    """A part's outline about its COM, prepared for the rotation search.
 
-    polygon: shapely.Polygon
-    points: np.ndarray  # (n, 2) the vertices of every ring
-    radii: np.ndarray  # (n,) their distances from the COM
-    samples: cKDTree  # the boundary, sampled every ``spacing`` at most
-    spacing: float
-    near: shapely.Geometry  # the region grown by the tolerance
-    band: shapely.Geometry  # the boundary grown by the tolerance
+    ``near`` (the region grown by the tolerance) and ``band`` (the boundary grown by it) are
+    made when :func:`_within` first asks: on a plate of thousands of holes they cost
+    seconds, and most comparisons end before any rotation is tried."""
 
+    def __init__(self, part: Part, tol: float, spacing: float = 0.0) -> None:
+        self.polygon = affinity.translate(part.outline.polygon(), -part.com[0], -part.com[1])
+        boundary = self.polygon.boundary
+        self.points = shapely.get_coordinates(boundary)  # (n, 2) the vertices of every ring
+        self.radii = np.hypot(self.points[:, 0], self.points[:, 1])  # from the COM
+        self.spacing = max(tol, boundary.length / _MAX_SAMPLES, spacing)
+        # The boundary sampled every ``spacing`` at most.
+        self.samples = cKDTree(shapely.get_coordinates(shapely.segmentize(boundary, self.spacing)))
+        self.tol = tol
 
-def _shape(part: Part, tol: float, spacing: float = 0.0) -> _Shape:
-    poly = affinity.translate(part.outline.polygon(), -part.com[0], -part.com[1])
-    boundary = poly.boundary
-    points = shapely.get_coordinates(boundary)
-    spacing = max(tol, boundary.length / _MAX_SAMPLES, spacing)
-    samples = cKDTree(shapely.get_coordinates(shapely.segmentize(boundary, spacing)))
-    near, band = shapely.buffer(poly, tol), shapely.buffer(boundary, tol)
-    shapely.prepare(near)
-    shapely.prepare(band)
-    radii = np.hypot(points[:, 0], points[:, 1])
-    return _Shape(poly, points, radii, samples, spacing, near, band)
+    @cached_property
+    def near(self) -> shapely.Geometry:
+        grown = shapely.buffer(self.polygon, self.tol)
+        shapely.prepare(grown)
+        return grown
+
+    @cached_property
+    def band(self) -> shapely.Geometry:
+        grown = shapely.buffer(self.polygon.boundary, self.tol)
+        shapely.prepare(grown)
+        return grown
 
 
 def _turned(points: np.ndarray, phi: float) -> np.ndarray:
@@ -244,7 +249,7 @@ _COARSE_REL = 1.0 / 128.0
 """:func:`_ruled_out` samples the boundaries every this share of the part's size."""
 
 
-def _ruled_out(a: Part, b: Part, tol: float) -> bool:
+def _ruled_out(a: Part, b: Part, tol: float, check: Callable[[], None] = lambda: None) -> bool:
     """Whether :func:`_bound` on coarsely sampled boundaries (every :data:`_COARSE_REL` of
     the size) already excludes every rotation. Its bounds stay valid lower bounds (a sample
     within half the spacing of every boundary point), only weaker: a part unlike its mirror
@@ -253,13 +258,14 @@ def _ruled_out(a: Part, b: Part, tol: float) -> bool:
     spacing = _COARSE_REL * max(a.size, b.size)
     if spacing <= 2.0 * tol:
         return False
-    sa, sb = _shape(a, tol, spacing), _shape(b, tol, spacing)
+    sa, sb = _Shape(a, tol, spacing), _Shape(b, tol, spacing)
     leaf = spacing / max(float(sa.radii.max()), float(sb.radii.max()))
     h0 = math.pi / _START_INTERVALS
     todo = [((2 * k + 1) * h0, h0) for k in range(_START_INTERVALS)]
     for _ in range(max(1, CONGRUENCE_MAX_WORK // (2 * len(sa.points)))):
         if not todo:
             return True
+        check()
         phi, h = todo.pop()
         if _bound(sa, sb, phi, h, tol) is None:
             continue
@@ -269,18 +275,23 @@ def _ruled_out(a: Part, b: Part, tol: float) -> bool:
     return False
 
 
-def _search(a: Part, b: Part, tol: float, first: bool) -> list[float]:
+def _search(
+    a: Part, b: Part, tol: float, first: bool, check: Callable[[], None] = lambda: None
+) -> list[float]:
     """Rotations (rad) about the COMs that bring ``a`` within ``tol`` of ``b``.
 
     Branch and bound over the circle: an interval is dropped when :func:`_bound` shows no
     rotation in it can work, the others are examined closest first (the largest vertex gap
     at their centre), within :data:`CONGRUENCE_MAX_WORK`; a rotation counts only when
     :func:`_within` holds there. ``first``: stop at the first; else one rotation per run of
-    adjacent intervals that work, the closest within it (:func:`_polish`).
+    adjacent intervals that work, the closest within it (:func:`_polish`). ``check`` is
+    called before each interval (a deadline: an outline of thousands of holes takes
+    tenths of a second an interval).
     """
-    if not _may_match(a, b, tol) or _ruled_out(a, b, tol):
+    if not _may_match(a, b, tol) or _ruled_out(a, b, tol, check):
         return []
-    sa, sb = _shape(a, tol), _shape(b, tol)
+    check()
+    sa, sb = _Shape(a, tol), _Shape(b, tol)
     leaf = _LEAF_SHARE * tol / max(float(sa.radii.max()), float(sb.radii.max()))
     h0 = math.pi / _START_INTERVALS
     heap: list[tuple[float, float, float]] = []
@@ -296,6 +307,7 @@ def _search(a: Part, b: Part, tol: float, first: bool) -> list[float]:
     for _ in range(max(1, CONGRUENCE_MAX_WORK // (2 * len(sa.points)))):
         if not heap:
             break
+        check()
         largest, phi, h = heapq.heappop(heap)
         if largest <= tol and _within(sa, sb, phi):
             found.append((phi, h, largest))
@@ -366,21 +378,27 @@ def congruence_rotations(a: Part, b: Part, tol: float | None = None) -> list[flo
     return sorted(0.0 if d > 360.0 - 1e-9 else d for d in degrees)
 
 
-def congruent(a: Part, b: Part, tol: float | None = None) -> bool:
+def congruent(
+    a: Part, b: Part, tol: float | None = None, check: Callable[[], None] | None = None
+) -> bool:
     """Whether a rigid motion of the plane maps ``a`` (outline, holes, COM) onto ``b``, up to
-    ``tol`` (mm, default :func:`congruence_tolerance`; see :func:`congruence_rotations`)."""
+    ``tol`` (mm, default :func:`congruence_tolerance`; see :func:`congruence_rotations`);
+    ``check`` is called as the search goes (a deadline, which raises)."""
     t = congruence_tolerance(a, b) if tol is None else tol
-    return bool(_search(a, b, t, first=True))
+    return bool(_search(a, b, t, first=True, check=check or (lambda: None)))
 
 
 def landings_of_outline(
-    part: Part, side_probability: float = DEFAULT_SIDE_PROBABILITY
+    part: Part,
+    side_probability: float = DEFAULT_SIDE_PROBABILITY,
+    check: Callable[[], None] | None = None,
 ) -> tuple[Landing, ...]:
     """The landings of a flat part: ``up`` and ``down``, or ``up`` alone when they are one.
 
     ``side_probability`` is the probability of ``up`` (0 < P < 1). When the mirror image is
     congruent to the part (a mirror-symmetric outline: its two sides are the same shape on
-    the belt) there is one landing, ``up``, with probability 1.
+    the belt) there is one landing, ``up``, with probability 1. ``check`` is polled while
+    the two are compared (an import's deadline: a plate of 4,900 holes took 19 s there).
 
     >>> from feederkit.outline import make_outline
     >>> from feederkit.part import make_part
@@ -395,7 +413,7 @@ def landings_of_outline(
     p = check_side_probability(side_probability)
     up = renamed(part, f"{part.name}/{UP}")
     down = mirror_part(part, f"{part.name}/{DOWN}")
-    if congruent(part, down):
+    if congruent(part, down, check=check):
         return (Landing(part.name, UP, 1.0, up, merged=(DOWN,)),)
     return (Landing(part.name, UP, p, up), Landing(part.name, DOWN, 1.0 - p, down))
 
@@ -417,7 +435,7 @@ def merge_congruent(
         for k, (gname, gprob, gpart, merged) in enumerate(groups):
             if check is not None:
                 check()
-            if congruent(part, gpart):
+            if congruent(part, gpart, check=check):
                 merged.append(name)
                 groups[k] = (gname, gprob + prob, gpart, merged)
                 break

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import re
+import time
 from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -24,6 +25,7 @@ from pathlib import Path
 from feederkit.catalog import Revision, default_catalog_path, get_revision, landings_for
 from feederkit.errors import InputError
 from feederkit.importers import ImportOptions
+from feederkit.importers.budget import Budget
 from feederkit.importers.reader import MESH_SUFFIXES, import_parts
 from feederkit.landing.model import (
     Landing,
@@ -251,9 +253,9 @@ def _landings_of(
     outline or DXF file (one when the sides are congruent), every resting pose of a mesh."""
     path = Path(source)
     if path.is_file():
-        if path.suffix.lower() not in MESH_SUFFIXES:
-            return landings_of_outline(pf.part)
         opts = options or ImportOptions()
+        if path.suffix.lower() not in MESH_SUFFIXES:
+            return landings_of_outline(pf.part, check=Budget(opts.limits, source).check_time)
         _, imported = import_parts(path, opts)
         same = [x for x in imported if x.part.name == pf.part.name]
         return landings_for((same or imported)[0], opts, path)
@@ -281,10 +283,17 @@ def load_landings(
     Raises InputError as :func:`load_parts` does, for a landing a part does not have, and
     for a selected landing that pushing cannot orient (a mesh pose on a round face).
     """
+    started = time.monotonic()
     loaded = load_parts(sources, catalog=catalog, options=options)
     db = None if catalog is None else str(Path(catalog))
     per_part = [
-        checked_landings(source, select_landings(_landings_of(source, pf, db, options), which))
+        checked_landings(
+            source,
+            select_landings(
+                _landings_of(source, pf, db, (options or ImportOptions()).counting_from(started)),
+                which,
+            ),
+        )
         for source, pf in zip(loaded.origins, loaded.push_functions, strict=True)
     ]
     return LoadedLandings(loaded, tuple(per_part))
