@@ -327,3 +327,20 @@ def test_resting_poses_of_a_tilted_plate_put_face_down_first(tmp_path):
     mesh, _, _ = load_mesh(path, None)
     poses = resting_poses(solid(mesh, False, str(path)))
     assert poses[0].normal[2] < -0.99 and poses[1].normal[2] > 0.99
+
+
+@pytest.mark.parametrize("kind", ["stl", "obj"])
+def test_a_nan_corner_is_named_not_dropped_with_its_triangles(tmp_path, kind):
+    # Dropped silently, its triangles left a hole the import blamed on the shape ("give
+    # --com"), and with --com a frustum lost a corner and was planned.
+    box = trimesh.creation.box(extents=(20, 10, 4))
+    vertices = np.asarray(box.vertices, dtype=float).copy()
+    vertices[0, 0] = math.nan
+    broken = trimesh.Trimesh(vertices, box.faces, process=False)
+    path = tmp_path / f"box.{kind}"
+    broken.export(path)
+    with pytest.raises(InputError, match="a corner with a NaN or infinite coordinate"):
+        import_parts(path, ImportOptions())
+    box.export(tmp_path / f"ok.{kind}")
+    (ip,) = import_parts(tmp_path / f"ok.{kind}", ImportOptions())[1]
+    assert ip.part.outline.polygon().area == pytest.approx(200.0)

@@ -154,6 +154,26 @@ def _needs_module(path: Path, exc: ImportError) -> InputError:
     )
 
 
+def _refuse_non_finite(path: Path, mesh: object) -> None:
+    """Refuse a mesh whose triangles use a vertex with a NaN or infinite coordinate (a
+    damaged export): processing would drop those triangles without a word, and the solid
+    that is left has a hole or a corner missing, which the import would blame on the mesh's
+    shape (a frustum lost a corner this way and was planned)."""
+    import trimesh
+
+    geoms = mesh.dump() if isinstance(mesh, trimesh.Scene) else [mesh]
+    bad = 0
+    for geom in geoms:
+        if isinstance(geom, trimesh.Trimesh) and len(geom.faces):
+            wrong = ~np.isfinite(np.asarray(geom.vertices, dtype=float)).all(axis=1)
+            bad += int(np.count_nonzero(wrong[np.asarray(geom.faces)].any(axis=1)))
+    if bad:
+        raise InputError(
+            f"{path}: {plural(bad, 'triangle')} of the mesh {'has' if bad == 1 else 'have'} a "
+            "corner with a NaN or infinite coordinate (a damaged export): export the mesh again"
+        )
+
+
 def load_mesh(
     path: Path, units: str | None, budget: Budget | None = None
 ) -> tuple[trimesh.Trimesh, str, list[str]]:
@@ -168,7 +188,11 @@ def load_mesh(
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
-            mesh = trimesh.load_mesh(path, file_type=path.suffix.lower().lstrip("."), process=True)
+            mesh = trimesh.load_mesh(path, file_type=path.suffix.lower().lstrip("."), process=False)
+            _refuse_non_finite(path, mesh)
+            for geom in mesh.dump() if isinstance(mesh, trimesh.Scene) else [mesh]:
+                if isinstance(geom, trimesh.Trimesh):
+                    geom.process()  # as trimesh's own load does: NaN faces out, vertices merged
     except InputError:
         raise
     except ImportError as exc:  # an optional module trimesh wanted for this file's content
