@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from feederkit.importers import ImportOptions, import_parts
 
 
@@ -201,7 +203,7 @@ def test_a_mesh_whose_only_triangle_has_a_nan_says_why_none_is_left(tmp_path):
         "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\n"
         "vertex nan 10 0\nendloop\nendfacet\nendsolid t\n"
     )
-    with pytest.raises(InputError, match="no triangles .*NaN or infinite coordinates"):
+    with pytest.raises(InputError, match="1 triangle of the mesh has a corner with a NaN"):
         import_parts(path, ImportOptions())
 
 
@@ -228,3 +230,13 @@ def test_an_outline_file_with_a_byte_order_mark_is_read(tmp_path):
     path.write_bytes(b"\xef\xbb\xbf" + json.dumps(data).encode("utf-8"))
     [part] = import_parts(path, ImportOptions())[1]
     assert part.part.name == "bom" and part.part.outline.vertices[2] == (20.0, 10.0)
+
+
+@pytest.mark.parametrize(("side", "word"), [(1e-6, "smaller than 1 mm"), (1e9, "larger than 2 m")])
+def test_a_file_that_says_mm_still_warns_at_a_size_no_part_has(tmp_path, side, word):
+    ring = [[0, 0], [side, 0], [side, side], [0, side]]
+    path = tmp_path / "plate.json"
+    path.write_text(json.dumps({"name": "plate", "units": "mm", "vertices": ring}))
+    [part] = import_parts(path, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "check the units" in w]
+    assert word in note and "read in mm from the file" in note

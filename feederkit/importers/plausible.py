@@ -30,6 +30,26 @@ def outline_size(outline: Outline) -> float:
     return diameter_of(convex_hull(outline.vertices))
 
 
+NAMED_MIN_MM = 0.01
+"""An outline file that names its units is taken at its word down to this size (mm): the
+paper's figures in ``catalog/`` are 1 mm across; no feeder carries a part of 10 µm."""
+
+NAMED_MAX_MM = 10_000.0
+"""... and up to this size (mm): no feeder carries a part 10 m across."""
+
+
+def named_unit_warnings(size_mm: float, unit_name: str) -> list[str]:
+    """:func:`size_warnings` for a file that names its units, only outside
+    :data:`NAMED_MIN_MM` .. :data:`NAMED_MAX_MM` (a 1 nm or 1000 km part).
+
+    >>> named_unit_warnings(1.0, "mm"), len(named_unit_warnings(1e-6, "mm"))
+    ([], 1)
+    """
+    if NAMED_MIN_MM <= size_mm <= NAMED_MAX_MM:
+        return []
+    return size_warnings(size_mm, unit_name, False)
+
+
 def size_warnings(size_mm: float, unit_name: str, given: bool, unitless: bool = False) -> list[str]:
     """A warning when a part of ``size_mm`` (read in ``unit_name``) is implausibly small or large.
 

@@ -22,7 +22,7 @@ from feederkit.importers.model import (
     ImportResult,
 )
 from feederkit.importers.orientable import Orientability, orientability
-from feederkit.importers.plausible import outline_size, size_warnings
+from feederkit.importers.plausible import named_unit_warnings, outline_size, size_warnings
 from feederkit.mechanics.modelerror import KeptTolerance, kept_part
 from feederkit.outline import read_outline_file, unit_scale
 from feederkit.part import Part, make_part
@@ -91,9 +91,13 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
         budget.loops(1 + len(outline.holes))
         # A file that names no units is read as mm: at a size no feeder part has, a unit
         # mistake is likelier (an outline in metres), said as for drawings and meshes. A
-        # file that says "mm" is taken at its word (the paper's figures are 1 mm across).
+        # file that says "mm" is taken at its word (the paper's figures are 1 mm across)
+        # but for sizes no part has at all (1 nm, 1000 km).
+        size = outline_size(outline)
         if not named:
-            warnings += size_warnings(outline_size(outline), unit, False, True)
+            warnings += size_warnings(size, unit, False, True)
+        else:
+            warnings += named_unit_warnings(size, unit)
         if name:
             outline = dataclasses.replace(outline, name=name)
         if options.com is not None:
