@@ -190,3 +190,17 @@ class PollsLeft(Deadline):
         self.left -= 1
         if self.left < 0:
             raise Timeout("time")
+
+
+def made_as_drawn(text_or_plan) -> bool:
+    """Whether a plan file (its text or its object) is one not made over landings, as
+    design.md writes it: no part entry names a landing or a share, and every result entry
+    names the landing ``up`` (the part as given)."""
+    import json
+
+    data = json.loads(text_or_plan) if isinstance(text_or_plan, str) else text_or_plan
+    from feederkit.plans.fileformat import result_nodes
+
+    parts_plain = all("landing" not in p and "share" not in p for p in data["parts"])
+    entries = [e for node in result_nodes(data) for e in node["result"]]
+    return parts_plain and bool(entries) and all(e.get("landing") == "up" for e in entries)

@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import pytest
 import trimesh
-from shared import one_line_error
+from shared import made_as_drawn, one_line_error
 
 from feederkit.angles import ActionRange
 from feederkit.cli.app import main
@@ -133,7 +133,7 @@ def test_mirror_symmetric_part_has_one_landing_and_plans_as_before(tmp_path):
         members=[PlanMember("bar")],
     )
     assert same.plan == plain.plan  # members that change nothing write today's file
-    assert "landing" not in json.dumps(plain.plan)
+    assert made_as_drawn(plain.plan)
 
 
 def test_rejected_landing_never_reaches_an_accept_leaf_and_costs_no_extra_length():
@@ -309,7 +309,7 @@ def test_sides_no_plan_tells_apart_exit_1_and_the_plan_is_still_written(tmp_path
 def test_a_symmetric_outline_plans_exactly_as_before(tmp_path, capsys):
     src = write_outline(tmp_path, "bar", [[0, 0], [30, 0], [30, 10], [0, 10]])
     plan, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5"])
-    assert "landing" not in json.dumps(plan)
+    assert made_as_drawn(plan)
 
 
 def test_box_mesh_plan_names_its_poses_and_runs_on_every_one(tmp_path, capsys, box_path):

@@ -23,7 +23,6 @@ from pathlib import Path
 
 import pytest
 from edge_oracle import check_plan, circle_distance, mechanics
-from shared import one_line_error
 
 from feederkit.angles import ANGLE_EPS, boundary_cells, norm360
 from feederkit.cli.app import main
@@ -165,8 +164,13 @@ def test_the_command_line_refuses_it_with_exit_2(tmp_path, capsys):
     s = 1e6
     verts = [[0.0, 0.0], [s, 0.0], [s, s + 5e-4], [0.0, s]]
     path.write_text(json.dumps({"name": "raised-square", "units": "mm", "vertices": verts}))
-    err = one_line_error(capsys, ["plan", str(path), "--tolerance", "1e-4"], code=2)
-    assert "finer than the parts' diameters are known" in err
+    from feederkit.cli.app import main
+
+    assert main(["plan", str(path), "--tolerance", "1e-4"]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    # A square a kilometre across said to be in mm is warned about first (its units).
+    assert [x[:7] for x in lines] == ["warning", "error: "] and "check the units" in lines[0]
+    assert "finer than the parts' diameters are known" in lines[1]
 
 
 @pytest.mark.parametrize("unc", MODELS)

@@ -114,13 +114,37 @@ def expanded(d: dict) -> dict:
 
 
 def upgraded(d: dict) -> dict:
-    """A version-1 plan file's object as version 2 writes it: the ideal model declared."""
+    """A version-1 plan file's object as version 2 writes it: the ideal model declared, and
+    every result entry naming its landing (``up``: the file's parts name none)."""
     out: dict = {}
     for key, value in d.items():
-        out[key] = 2 if key == "version" else value
+        out[key] = (
+            2 if key == "version" else _as_drawn(value) if key in ("root", "nodes") else value
+        )
         if key == "sensor":
             out["uncertainty"] = IDEAL.to_dict()
     return out
+
+
+def _as_drawn(node):
+    """A copy of ``node`` with each result entry naming the landing ``up`` right after its
+    part (an explicit stack: the plans here are hundreds of operations deep)."""
+    top: list = [None]
+    stack: list = [(node, top, 0)]
+    while stack:
+        src, parent, key = stack.pop()
+        if isinstance(src, list):
+            parent[key] = dst = [None] * len(src)
+            stack.extend((v, dst, i) for i, v in enumerate(src))
+        elif isinstance(src, dict):
+            if {"part", "state"} <= set(src) and "landing" not in src:
+                rest = {k: v for k, v in src.items() if k != "part"}
+                src = {"part": src["part"], "landing": "up"} | rest
+            parent[key] = dst = dict.fromkeys(src)
+            stack.extend((v, dst, k) for k, v in src.items())
+        else:
+            parent[key] = src
+    return top[0]
 
 
 def test_the_model_is_frozen_and_typed():

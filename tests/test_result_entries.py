@@ -140,7 +140,8 @@ def test_a_design_at_a_critical_tolerance_is_pruned_to_what_ends_there(unc):
     assert all(node["result"] for node in result_nodes(made.plan))
     # the planner's masks say what the file's results say (the warnings read them)
     machine = made.result.machine
-    names = [(p["name"], p.get("landing")) for p in made.plan["parts"]]
+    # every result entry names its landing: "up" in a plan not made over landings
+    names = [(p["name"], p.get("landing", "up")) for p in made.plan["parts"]]
     masks = {
         frozenset(
             (*names[machine.states[i].part], m)
@@ -155,7 +156,7 @@ def test_a_design_at_a_critical_tolerance_is_pruned_to_what_ends_there(unc):
         ended: dict[int, set] = {}
         for p, pf in enumerate(pfs):
             for leaf, state in _follow(made.plan, p, pf, x * (1 + 1e-6)):
-                ended.setdefault(leaf, set()).add((pf.part.name, None, state))
+                ended.setdefault(leaf, set()).add((pf.part.name, "up", state))
         for node in result_nodes(made.plan):
             assert _entries(node) == ended[id(node)]
 
@@ -242,7 +243,7 @@ def test_pruning_keeps_every_state_a_brute_force_follow_ends_in(seed):
     for p, pf in enumerate(pfs):
         name = data["parts"][p]["name"]
         for leaf, state in _follow(data, p, pf, tolerance):
-            assert (name, None, state) in _entries(nodes[leaf]), (name, state)
+            assert (name, "up", state) in _entries(nodes[leaf]), (name, state)
     assert verify_declared(data).ok
 
 

@@ -122,6 +122,26 @@ def conventions_for(sensor: Sensor, landings: bool = False) -> str:
     return f"{text} {LANDINGS}" if landings else text
 
 
+AS_DRAWN = "up"
+"""The landing a result entry names in a plan not made over landings (design.md: every
+result entry names its landing): the part as given, whose part entry has no ``landing``."""
+
+
+def member_keys(members: Sequence[tuple[str, str | None]]) -> dict[tuple[str, str | None], int]:
+    """Each member's index by the ``(part, landing)`` a result entry names: its own, and for
+    a member without a landing also ``(part, AS_DRAWN)``, as the writer names it.
+
+    >>> member_keys([("bar", None)])
+    {('bar', None): 0, ('bar', 'up'): 0}
+    """
+    out: dict[tuple[str, str | None], int] = {}
+    for p, (name, landing) in enumerate(members):
+        out[(name, landing)] = p
+        if landing is None:
+            out.setdefault((name, AS_DRAWN), p)
+    return out
+
+
 MAX_FILE_NODES = 100_000
 """A plan whose file would hold more nodes than this is refused: no controller wants it.
 Shared subplans count once (they are written once, in ``"nodes"``)."""
@@ -473,9 +493,7 @@ def _shape(root: Node) -> _Shape:
 def _leaf_dict(leaf: Leaf) -> dict[str, Any]:
     entries = []
     for e in leaf.results:
-        entry: dict[str, Any] = {"part": e.part}
-        if e.landing is not None:
-            entry["landing"] = e.landing
+        entry: dict[str, Any] = {"part": e.part, "landing": e.landing or AS_DRAWN}
         entry.update(state=e.state, pose_deg=e.pose_deg)
         entries.append(entry)
     out: dict[str, Any] = {"result": entries}

@@ -56,7 +56,7 @@ from feederkit.plans.advice import (
     unlike_twins_words,
 )
 from feederkit.plans.certify import certificate, ideal_length, largest_uncertainty
-from feederkit.plans.fileformat import plan_to_dict, result_nodes
+from feederkit.plans.fileformat import member_keys, plan_to_dict, result_nodes
 from feederkit.plans.model import PlanMember, low_margin_words, member_label
 from feederkit.plans.readplan import as_plan
 from feederkit.plans.strong import ideal_view, verify_strong
@@ -330,8 +330,7 @@ def listed_tree(result: PlanResult, data: dict[str, Any]) -> PlanTree:
     their masks is the planner's own.
     """
     machine = result.machine
-    parts = [(part["name"], part.get("landing")) for part in data["parts"]]
-    index = {key: p for p, key in enumerate(parts)}
+    index = member_keys([(part["name"], part.get("landing")) for part in data["parts"]])
     shared = data.get("nodes") or {}
 
     def resolve(raw: Any) -> Any:

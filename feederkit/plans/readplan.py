@@ -33,6 +33,7 @@ from feederkit.jsonio import parse_json
 from feederkit.landing.model import LANDING_RE
 from feederkit.mechanics.push import StableState
 from feederkit.plans.fileformat import (
+    AS_DRAWN,
     FORMAT,
     READABLE_VERSIONS,
     check_shares,
@@ -382,6 +383,8 @@ def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) 
                 e.get("state"),
                 e.get("pose_deg"),
             )
+            if landing == AS_DRAWN and type(part) is str and (part, None) in ids:
+                landing = None  # a plan not made over landings: its parts name none
             listed = (
                 ids.get((part, landing))
                 if type(part) is str and (landing is None or type(landing) is str)
@@ -404,6 +407,8 @@ def _check_leaf(c: _Checker, node: dict[str, Any], where: str, known: _Members) 
         if part not in names:
             raise c.fail(f"{where} names the unknown part {part!r}")
         landing = _check_landing(c, ed.get("landing"), f"{where} result")
+        if landing == AS_DRAWN and (part, None) in parts:
+            landing = None  # a plan not made over landings: its parts name none
         member = parts.get((part, landing))
         if member is None:
             listed = ", ".join(str(k[1]) for k in parts if k[0] == part)

@@ -49,7 +49,7 @@ from feederkit.planning.budget import Deadline
 from feederkit.planning.reindex import map_masks
 from feederkit.planning.tree import PlanResult, Step
 from feederkit.plans.execute import rounding_inset
-from feederkit.plans.fileformat import result_nodes
+from feederkit.plans.fileformat import member_keys, result_nodes
 from feederkit.plans.model import PlanPart, member_label, names_several, push_function_of
 from feederkit.plans.verify import (
     PartCheck,
@@ -219,7 +219,7 @@ class _Run:
         self.tighten = tighten
         self.lowered = 0  # margins lowered to what their rotation keeps (``tighten``)
         self.shared = plan.get("nodes") or {}
-        self.by_name = {n: p for p, n in enumerate(model.members)}
+        self.by_name = member_keys(model.members)
         # Per (node, state): (worst operations, paths, paths to a reject, paths to an
         # unrecognized result), from the node on.
         self.tally: dict[tuple[int, State], Tally] = {}
