@@ -231,3 +231,20 @@ def test_plan_of_a_catalog_mesh_picks_its_stored_poses(tmp_path, capsys, box_stl
     stored = {x.name: x.probability for x in cat.get_revision(db, "box").landings}
     total = stored["pose-0"] + stored["pose-4"]
     assert shares == pytest.approx([stored["pose-0"] / total, stored["pose-4"] / total])
+
+
+def test_exporting_a_mesh_part_says_the_file_holds_one_pose(tmp_path, box_stl, capsys):
+    db = str(tmp_path / "c.db")
+    assert main(["catalog", "add", str(box_stl), "--catalog", db]) == 0
+    capsys.readouterr()
+    out = tmp_path / "box.json"
+    assert main(["catalog", "export", "box", "-o", str(out), "--json", "--catalog", db]) == 0
+    [warning] = json.loads(capsys.readouterr().out)["warnings"]
+    assert "mesh part of 3 landings" in warning and "covers that pose only" in warning
+    flat = tmp_path / "ell.json"
+    ring = [(0, 0), (40, 0), (40, 10), (10, 10), (10, 25), (0, 25)]
+    save_outline_json(make_outline("ell", ring), flat)
+    assert main(["catalog", "add", str(flat), "--catalog", db]) == 0
+    capsys.readouterr()
+    assert main(["catalog", "export", "ell", "-o", str(out), "--json", "--catalog", db]) == 0
+    assert json.loads(capsys.readouterr().out)["warnings"] == []

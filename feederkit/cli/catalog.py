@@ -50,6 +50,7 @@ from feederkit.cli.common import (
     flag_words,
     plural,
     print_json,
+    print_warnings,
     progress_bar,
 )
 from feederkit.cli.importopts import takes_import_options, with_com
@@ -844,15 +845,37 @@ def cmd_export(
     part, which = asked_revision(name, revision)
     with opened(catalog, DEFAULT_WAIT) as conn:
         rev = export_part(conn, part, output, which)
+    warnings = _landings_left_out(rev)
     if json_out:
-        print_json({"name": rev.name, "revision": rev.revision, "output": str(output)})
+        print_json(
+            {
+                "name": rev.name,
+                "revision": rev.revision,
+                "output": str(output),
+                "warnings": warnings,
+            }
+        )
         return
+    print_warnings(warnings)
     console.print(
         f"wrote {output} ({rev.name} revision {rev.revision})",
         highlight=False,
         markup=False,
         soft_wrap=True,
     )
+
+
+def _landings_left_out(rev: Revision) -> list[str]:
+    """A warning when the outline file holds one landing of several: a mesh's other resting
+    poses are the catalog's, and a file made from it plans the exported pose alone."""
+    if rev.source_kind != "mesh" or len(rev.landings) < 2:
+        return []
+    names = ", ".join(x.name for x in rev.landings)
+    return [
+        f"{rev.name} is a mesh part of {len(rev.landings)} landings ({names}): the outline "
+        "file holds the imported pose's outline alone, so a plan of the file covers that pose "
+        "only (plan the catalog part, or the mesh file, for every landing)"
+    ]
 
 
 catalog_app.command("init")(cmd_init)
