@@ -31,6 +31,15 @@ def _ring(msp, poly: Polygon) -> None:
     msp.add_lwpolyline(list(poly.exterior.coords)[:-1], close=True)
 
 
+def _rings(path: Path, *polys: Polygon):
+    """A drawing of ``polys`` as closed polylines, imported: the part and every warning."""
+    doc, msp = _doc()
+    for poly in polys:
+        _ring(msp, poly)
+    doc.saveas(path)
+    return _imported(path)
+
+
 def _imported(path: Path):
     result, parts = import_parts(path, ImportOptions())
     (ip,) = parts
@@ -60,39 +69,21 @@ def test_an_l_plate_with_its_edge_line_is_the_plate_with_its_hole(tmp_path, band
 
 
 def test_a_small_rectangle_with_its_edge_line_is_no_drawing_frame(tmp_path):
-    doc, msp = _doc()
-    plate = box(0, 0, 60, 40)
-    _ring(msp, plate)
-    _ring(msp, box(1, 1, 59, 39))
-    window = box(35, 22, 50, 30)
-    _ring(msp, window)
-    path = tmp_path / "rect.dxf"
-    doc.saveas(path)
-    ip, said = _imported(path)
+    plate, window = box(0, 0, 60, 40), box(35, 22, 50, 30)
+    ip, said = _rings(tmp_path / "rect.dxf", plate, box(1, 1, 59, 39), window)
     _truth(ip, plate.difference(window))
     assert "drawn again 1 mm inside" in said and "if the two lines are a drawing frame" in said
 
 
 def test_a_thin_ring_holding_nothing_stays_a_ring(tmp_path):
-    doc, msp = _doc()
-    _ring(msp, box(0, 0, 60, 40))
-    _ring(msp, box(1, 1, 59, 39))
-    path = tmp_path / "gasket.dxf"
-    doc.saveas(path)
-    ip, said = _imported(path)
+    ip, said = _rings(tmp_path / "gasket.dxf", box(0, 0, 60, 40), box(1, 1, 59, 39))
     _truth(ip, box(0, 0, 60, 40).difference(box(1, 1, 59, 39)))
     assert "drawn again" not in said
 
 
 def test_a_sheet_sized_double_line_frame_is_still_a_frame(tmp_path):
-    doc, msp = _doc()
-    _ring(msp, box(0, 0, 297, 210))
-    _ring(msp, box(10, 10, 287, 200))
     part = box(100, 80, 150, 130)
-    _ring(msp, part)
-    path = tmp_path / "a4.dxf"
-    doc.saveas(path)
-    ip, said = _imported(path)
+    ip, said = _rings(tmp_path / "a4.dxf", box(0, 0, 297, 210), box(10, 10, 287, 200), part)
     _truth(ip, part)
     assert "skipped 1 drawing frame(s)" in said
 
