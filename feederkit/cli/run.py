@@ -138,11 +138,12 @@ def stored_beyond(plan: Plan, sources: Sequence[str], catalog: str | None) -> li
     """A line per catalog part among ``sources`` whose revision stores a shape or COM
     tolerance larger than the plan declares: the run checks the plan at what it declares,
     so a plan made before the revision stored it passes without covering it."""
-    if not sources:
+    names = list(dict.fromkeys(s for s in sources if not Path(s).exists()))  # catalog parts
+    if not names:
         return []
     declared = plan.uncertainty
     out = []
-    for t in load_parts(list(sources), catalog=catalog).tolerances:
+    for t in load_parts(names, catalog=catalog).tolerances:
         for what, stored, planned in (
             ("shape", t.shape_tolerance_mm, declared.shape_tolerance_mm),
             ("COM", t.com_tolerance_mm, declared.com_tolerance_mm),
