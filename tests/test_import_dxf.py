@@ -202,7 +202,8 @@ def test_empty_and_corrupt_files(tmp_path):
 
 def test_text_only(tmp_path):
     path = fx.write_entities(tmp_path / "text.dxf", lambda m: m.add_text("hello"))
-    bad(path, "no outline geometry.*TEXT")
+    bad(path, "no outline geometry.*model space: only TEXT x1")
+    bad(fx.write_plate(tmp_path / "plate.dxf"), "in the paper space: it is empty", space="paper")
 
 
 def test_open_outline(tmp_path):

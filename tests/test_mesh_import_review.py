@@ -344,3 +344,10 @@ def test_a_nan_corner_is_named_not_dropped_with_its_triangles(tmp_path, kind):
     box.export(tmp_path / f"ok.{kind}")
     (ip,) = import_parts(tmp_path / f"ok.{kind}", ImportOptions())[1]
     assert ip.part.outline.polygon().area == pytest.approx(200.0)
+
+
+def test_a_ply_missing_a_coordinate_field_says_which(tmp_path):
+    path = tmp_path / "x-only.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n")
+    with pytest.raises(InputError, match=r"not a readable mesh \(its data lack the field 'y'\)"):
+        import_parts(path, ImportOptions())

@@ -1061,7 +1061,8 @@ def _read_doc(
     drawn, skipped, notes, flatten_mm, unseen = dxf_lines(doc, options, scale, str(path), budget)
     warnings_ += notes
     if not drawn.lines:
-        what = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items())) or "nothing"
+        found = ", ".join(f"{k} x{v}" for k, v in sorted(skipped.items()))
+        what = f"only {found}" if found else "it is empty"
         if damage is not None:
             raise InputError(
                 f"{path}: damaged DXF file ({damage}): what ezdxf could recover holds no "

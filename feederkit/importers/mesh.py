@@ -199,6 +199,8 @@ def load_mesh(
         raise _needs_module(path, exc) from None
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types on broken files
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        if isinstance(exc, KeyError) and exc.args:  # a field the format needs is missing
+            reason = f"its data lack the field {exc.args[0]!r}"
         raise InputError(f"{path}: not a readable mesh ({reason})") from None
     if isinstance(mesh, trimesh.Scene):
         geoms = [g for g in mesh.dump() if isinstance(g, trimesh.Trimesh)]
