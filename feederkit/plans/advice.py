@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import shapely
@@ -32,8 +33,9 @@ from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
 from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
 from feederkit.plans.certify import decided_exists
+from feederkit.plans.fileformat import distinct_nodes
 from feederkit.plans.model import PlanMember
-from feederkit.sensors import Sensor
+from feederkit.sensors import Sensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import plural
 
@@ -59,6 +61,51 @@ def ideal_plan_words(
         f"the plan is the ideal model's: on a feeder that vibrates it holds {what} (its "
         f"margins say ±{min_margin:.4g}°: drops near a hilltop may go either way, fragile "
         "states merge); plan with --rotation-error DEG for one that holds it"
+    )
+
+
+THIN_BRANCH_SHARE = 0.01
+"""A reading branch narrower than this share of a tolerance sensor's window (twice its
+tolerance) tells states apart by diameters closer than the sensor can read."""
+
+
+def thin_branch_words(
+    plan: Mapping[str, Any], sensor: Sensor, uncertainty: Uncertainty
+) -> str | None:
+    """A warning when a plan made for parts exactly as drawn (shape tolerance 0) has reading
+    branches narrower than :data:`THIN_BRANCH_SHARE` of the sensor's window, else None.
+
+    Two states whose diameters differ by d leave a branch d wide at each end of the window
+    they share (section 5's tolerance model): a reading there names one of them, which holds
+    only while the parts are made to better than d. A 0.05 mm drawing difference between two
+    parts gave a 0.0007 mm branch under a 0.1 mm sensor; with a declared shape tolerance the
+    model covers the parts' own spread instead.
+
+    >>> root = {"action_deg": None, "margin_deg": None, "branches": [
+    ...     {"reading": [9.9, 10.1], "next": {"result": []}},
+    ...     {"reading": [10.1, 10.1005], "next": {"result": []}}]}
+    >>> thin_branch_words({"root": root}, ToleranceSensor(0.1), IDEAL)[:40]
+    '1 reading branch is narrower than 1% of '
+    """
+    if not isinstance(sensor, ToleranceSensor) or uncertainty.shape_tolerance_mm > 0.0:
+        return None
+    least = THIN_BRANCH_SHARE * 2.0 * sensor.tolerance
+    thin = [
+        b["reading"]
+        for node in distinct_nodes(plan)
+        if len(node.get("branches") or ()) > 1
+        for b in node["branches"]
+        if b.get("reading") is not None and b["reading"][1] - b["reading"][0] < least
+    ]
+    if not thin:
+        return None
+    lo, hi = min(thin, key=lambda r: r[1] - r[0])
+    return (
+        f"{plural(len(thin), 'reading branch is', 'reading branches are')} narrower than "
+        f"{THIN_BRANCH_SHARE:.0%} of the sensor's window of ±{sensor.tolerance:g} mm (the "
+        f"narrowest {hi - lo:.2g} mm, reads {lo:.6g} .. {hi:.6g} mm): a reading there tells "
+        "states apart by diameters closer than that, as drawn; a part made to a looser "
+        "tolerance may read in another's branch: declare it with --shape-tolerance"
     )
 
 

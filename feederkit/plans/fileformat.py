@@ -227,11 +227,11 @@ def _reading(machine: PushAlignMachine, branch: Any) -> tuple[float, float] | No
     return (min(b.lo for b in split), max(b.hi for b in split))
 
 
-def result_nodes(plan: Mapping[str, Any]) -> Iterator[Mapping[str, Any]]:
-    """Every distinct result NODE of a plan file's object (a shared subplan's once, its
-    ``"ref"`` resolved), in pre-order, without building the :class:`Plan` model: for a
-    caller that only reads the results of a plan it made (a large mix's plan has tens of
-    thousands of nodes, and the model takes seconds to check). The object is trusted."""
+def distinct_nodes(plan: Mapping[str, Any]) -> Iterator[Mapping[str, Any]]:
+    """Every distinct NODE of a plan file's object (a shared subplan's once, its ``"ref"``
+    resolved), in pre-order, without building the :class:`Plan` model: for a caller that
+    only reads a plan it made (a large mix's plan has tens of thousands of nodes, and the
+    model takes seconds to check). The object is trusted."""
     shared = plan.get("nodes") or {}
     seen: set[int] = set()
     stack = [plan["root"]]
@@ -242,10 +242,14 @@ def result_nodes(plan: Mapping[str, Any]) -> Iterator[Mapping[str, Any]]:
         if id(node) in seen:
             continue
         seen.add(id(node))
-        if "result" in node:
-            yield node
-        else:
+        yield node
+        if "result" not in node:
             stack.extend(b["next"] for b in reversed(node["branches"]))
+
+
+def result_nodes(plan: Mapping[str, Any]) -> Iterator[Mapping[str, Any]]:
+    """Every distinct result NODE of a plan file's object (:func:`distinct_nodes`)."""
+    return (node for node in distinct_nodes(plan) if "result" in node)
 
 
 def file_nodes(root: Node) -> int:

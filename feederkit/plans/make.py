@@ -52,6 +52,7 @@ from feederkit.plans.advice import (
     short_chords_words,
     smaller_error_words,
     spread_words,
+    thin_branch_words,
     ties_cut_words,
     unlike_twins_words,
 )
@@ -290,6 +291,9 @@ def _make_plan(
     spread = spread_words(result, pfs)
     if spread is not None:
         warnings.append(spread)
+    thin = thin_branch_words(data, sensor, unc)
+    if thin is not None:
+        warnings.append(thin)
     unoriented = unlike_twins_words(result, pfs)
     cut = ties_cut_words(result, opts)
     if cut is not None:
