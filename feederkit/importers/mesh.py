@@ -10,6 +10,7 @@ face pointing up is turned over about the x axis.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -154,17 +155,14 @@ def _needs_module(path: Path, exc: ImportError) -> InputError:
     )
 
 
-def _refuse_non_finite(path: Path, mesh: object) -> None:
+def _refuse_non_finite(path: Path, geoms: Sequence[trimesh.Trimesh]) -> None:
     """Refuse a mesh whose triangles use a vertex with a NaN or infinite coordinate (a
     damaged export): processing would drop those triangles without a word, and the solid
     that is left has a hole or a corner missing, which the import would blame on the mesh's
     shape (a frustum lost a corner this way and was planned)."""
-    import trimesh
-
-    geoms = mesh.dump() if isinstance(mesh, trimesh.Scene) else [mesh]
     bad = 0
     for geom in geoms:
-        if isinstance(geom, trimesh.Trimesh) and len(geom.faces):
+        if len(geom.faces):
             wrong = ~np.isfinite(np.asarray(geom.vertices, dtype=float)).all(axis=1)
             bad += int(np.count_nonzero(wrong[np.asarray(geom.faces)].any(axis=1)))
     if bad:
@@ -189,10 +187,13 @@ def load_mesh(
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
             mesh = trimesh.load_mesh(path, file_type=path.suffix.lower().lstrip("."), process=False)
-            _refuse_non_finite(path, mesh)
-            for geom in mesh.dump() if isinstance(mesh, trimesh.Scene) else [mesh]:
-                if isinstance(geom, trimesh.Trimesh):
-                    geom.process()  # as trimesh's own load does: NaN faces out, vertices merged
+            # A scene's bodies as placed (``dump`` makes transformed copies), each checked and
+            # processed on its own, as trimesh's own load does: NaN faces out, vertices merged.
+            loaded = mesh.dump() if isinstance(mesh, trimesh.Scene) else [mesh]
+            geoms = [g for g in loaded if isinstance(g, trimesh.Trimesh)]
+            _refuse_non_finite(path, geoms)
+            for geom in geoms:
+                geom.process()
     except InputError:
         raise
     except ImportError as exc:  # an optional module trimesh wanted for this file's content
@@ -203,7 +204,6 @@ def load_mesh(
             reason = f"its data lack the field {exc.args[0]!r}"
         raise InputError(f"{path}: not a readable mesh ({reason})") from None
     if isinstance(mesh, trimesh.Scene):
-        geoms = [g for g in mesh.dump() if isinstance(g, trimesh.Trimesh)]
         mesh = trimesh.util.concatenate(geoms) if geoms else None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise InputError(
