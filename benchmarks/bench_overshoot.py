@@ -24,7 +24,7 @@ every basin with ``--all``, the geometry at the simulated size: ``down`` the ang
 start hilltop to the normal and ``H mm`` the height come down from it (the radius function's
 drop), ``over`` the far hilltop's angle past the normal and ``h mm`` its height above the well,
 ``h/H``; the pushes filed under it, how many ``went`` over, how many of those the model's
-outcome sets ``miss`` (``mechanics.uncertain.fence_outcomes`` for the start, rotation error 1
+outcome sets ``miss`` (``mechanics.outcomes.fence_outcomes`` for the start, rotation error 1
 degree), the farthest ``start`` (degrees from its hilltop, 0 when carried back over it) that
 went over and the ``most`` hilltops one push went over. The overshoot rules
 (``mechanics.uncertain.OVERSHOOT_DEG_MM``, ``OVERSHOOT_BAND_DEG``, docs/uncertainty.md,
@@ -44,8 +44,8 @@ import numpy as np
 
 from feederkit.angles import norm360
 from feederkit.landing.model import landings_of_outline
+from feederkit.mechanics.outcomes import fence_outcomes
 from feederkit.mechanics.push import PushFunction, radius
-from feederkit.mechanics.uncertain import fence_outcomes
 from feederkit.outline import make_outline
 from feederkit.part import Part, make_part
 from feederkit.sim.pushalign import size_scale

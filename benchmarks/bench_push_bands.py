@@ -10,7 +10,7 @@ breathing on the part) start at ``--step``, 2 ``--step``, ... up to ``--reach`` 
 either side of the hilltop, each with ``--frictions`` belt and fence frictions drawn from the
 simulator's default ranges (belt 0.4-0.6, fence 0.1-0.3; seed 0). A push *misses* when the
 state it settles in is not in the model's outcome set for its start
-(``mechanics.uncertain.fence_outcomes`` under rotation error 1 degree, no shape or COM
+(``mechanics.outcomes.fence_outcomes`` under rotation error 1 degree, no shape or COM
 tolerance: the push bands, the depth rule, the overshoot rule). Printed per part: pushes
 settled, misses, and the hilltops missed with the farthest start missed (degrees from the
 hilltop). The model claims no misses (docs/uncertainty.md, "Push bands"); exit 1 when there
@@ -28,8 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from feederkit.landing.model import landings_of_outline
+from feederkit.mechanics.outcomes import fence_outcomes
 from feederkit.mechanics.push import push_function
-from feederkit.mechanics.uncertain import UncertainMechanics, fence_outcomes, uncertain_mechanics
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
 from feederkit.sim.pushalign import PushAligner, size_scale
 from feederkit.sources import load_part
 from feederkit.uncertainty import Uncertainty

@@ -23,7 +23,9 @@ from feederkit.angles import ActionRange, width_key
 from feederkit.errors import PlanningError
 from feederkit.machine import MachineState, PushAlignMachine, build_machine
 from feederkit.mechanics import push_function
-from feederkit.mechanics.uncertain import max_rotation_error, outcome_set, uncertain_mechanics
+from feederkit.mechanics.certificates import max_rotation_error
+from feederkit.mechanics.outcomes import outcome_set
+from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.planning.api import plan
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.options import PlanningOptions

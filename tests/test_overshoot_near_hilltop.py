@@ -14,8 +14,9 @@ import pytest
 
 from feederkit.landing.model import landings_of_outline
 from feederkit.mechanics import uncertain
+from feederkit.mechanics.outcomes import fence_outcomes
 from feederkit.mechanics.push import push_function
-from feederkit.mechanics.uncertain import fence_outcomes, uncertain_mechanics
+from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.sources import load_part

@@ -12,12 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from feederkit.mechanics.outcomes import fence_outcomes
 from feederkit.mechanics.push import push_function
-from feederkit.mechanics.uncertain import (
-    ROLL_WELL_FACTOR,
-    fence_outcomes,
-    uncertain_mechanics,
-)
+from feederkit.mechanics.uncertain import ROLL_WELL_FACTOR, uncertain_mechanics
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.planning.solvable import NoStrongPlan

@@ -18,17 +18,13 @@ from feederkit.angles import norm360
 from feederkit.errors import InputError
 from feederkit.mechanics import action_ranges, diameter, push, push_function
 from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
+from feederkit.mechanics.certificates import max_rotation_error, max_shape_tolerance
+from feederkit.mechanics.outcomes import action_map, fence_outcomes, outcome_at, outcome_set
 from feederkit.mechanics.uncertain import (
     PUSH_BAND_DEG,
     PUSH_BAND_FACTOR,
     SHALLOW_WELL_FACTOR,
-    action_map,
-    fence_outcomes,
-    max_rotation_error,
-    max_shape_tolerance,
     mechanics_to_dict,
-    outcome_at,
-    outcome_set,
     uncertain_mechanics,
     width_range,
 )

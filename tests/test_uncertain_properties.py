@@ -20,13 +20,9 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from feederkit.mechanics.uncertain import (
-    UncertainMechanics,
-    fence_outcomes,
-    max_rotation_error,
-    outcome_set,
-    uncertain_mechanics,
-)
+from feederkit.mechanics.certificates import max_rotation_error
+from feederkit.mechanics.outcomes import fence_outcomes, outcome_set
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.sources import load_part

@@ -16,9 +16,10 @@ from feederkit.angles import ActionRange
 from feederkit.machine.inseparable import inseparable_masks
 from feederkit.machine.model import MachineState, OutcomeRange, PushAlignMachine
 from feederkit.mechanics.actions import action_ranges
+from feederkit.mechanics.outcomes import action_map
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS, look_alike, unlike_pairs
-from feederkit.mechanics.uncertain import UncertainMechanics, action_map, uncertain_mechanics
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
 from feederkit.sensors import NoSensor, Sensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 

@@ -30,9 +30,8 @@ docs/uncertainty.md gives the derivations and the measured price of conservatism
 
 from __future__ import annotations
 
-import bisect
 import math
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +42,6 @@ from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.part import Part
 from feederkit.uncertainty import Uncertainty, check_for_part
-from feederkit.uncertainty import max_shape_tolerance as shape_tolerance_limit
 
 _BISECT_STEPS = 48
 BOUNDARY_EPS_DEG = 1e-9
@@ -1337,179 +1335,6 @@ def _overlay(
     return tuple(out)
 
 
-# --- outcome sets ---------------------------------------------------------------------------
-
-
-def fence_outcomes(mech: UncertainMechanics, lo_deg: float, hi_deg: float) -> frozenset[int]:
-    """Physical states a push can end in from any fence orientation in the closed [lo, hi].
-
-    Exact at zero uncertainty (the ideal push, both neighbours exactly at a divergent
-    orientation, closed to within ``BOUNDARY_EPS_DEG`` so rounding cannot lose a side); a
-    superset otherwise. O(log cells + cells met).
-    """
-    lo_deg, hi_deg = lo_deg - BOUNDARY_EPS_DEG, hi_deg + BOUNDARY_EPS_DEG
-    cells = mech.cells
-    q = len(cells)
-    if hi_deg - lo_deg >= 360.0 or q == 1:
-        return frozenset(t for cell in cells for t in cell.targets)
-    los = mech.cell_los
-    base = los[0]
-    x = base + norm360(lo_deg - base)
-    y = x + (hi_deg - lo_deg)
-    i = bisect.bisect_right(los, x) - 1
-    if i > 0 and not cells[i].closed and x <= cells[i - 1].hi:
-        i -= 1  # x closes the band before this open cell
-    j = bisect.bisect_right(los, y) - 1
-    if j >= 0 and j < len(los) and not cells[j % q].closed and y <= los[j]:
-        j -= 1  # an open cell starting at y does not hold it
-    out: set[int] = set()
-    for k in range(i, j + 1):
-        out |= cells[k % q].targets
-    return frozenset(out)
-
-
-def _window(mech: UncertainMechanics, state: int, action: float, err: float) -> tuple[float, float]:
-    rest_lo, rest_hi = mech.states[state].rest_deg
-    return rest_lo - action - err, rest_hi - action + err
-
-
-def outcome_set(
-    mech: UncertainMechanics, state: int, action_deg: float, rotation_error_deg: float | None = None
-) -> frozenset[int]:
-    """Physical states the part can end in from physical ``state`` after the rotation ``action``.
-
-    The robot turns by ``action +- rotation_error`` (closed; default the declared error) and
-    the part rests anywhere in its rest interval; ``theta' = theta - a`` (design.md).
-    """
-    err = mech.uncertainty.rotation_error_deg if rotation_error_deg is None else rotation_error_deg
-    return fence_outcomes(mech, *_window(mech, state, action_deg, err))
-
-
-def action_map(
-    mech: UncertainMechanics, state: int, rotation_error_deg: float | None = None
-) -> tuple[tuple[float, float, frozenset[int]], ...]:
-    """The piecewise-constant outcome sets of every rotation from physical ``state``.
-
-    Sorted ``(lo, hi, targets)``: every rotation strictly inside ``(lo, hi)`` (``lo`` in
-    [0, 360), ``hi`` may pass 360) has the outcome set ``targets``; together they cover the
-    circle. At zero uncertainty these are the ideal action ranges (definition 9) with
-    singleton targets; at a boundary itself :func:`outcome_set` gives the union of both sides.
-    """
-    err = mech.uncertainty.rotation_error_deg if rotation_error_deg is None else rotation_error_deg
-    x, y = _window(mech, state, 0.0, err)
-    if y - x >= 360.0 or len(mech.cells) == 1:
-        return ((0.0, 360.0, fence_outcomes(mech, 0.0, 360.0)),)
-    ends = sorted({v for cell in mech.cells for v in (cell.lo, cell.hi)})
-    cuts = sorted({norm360(x - e) for e in ends} | {norm360(y - e) for e in ends})
-    merged: list[float] = []
-    for v in cuts:
-        if not merged or v - merged[-1] > 1e-12:
-            merged.append(v)
-    if len(merged) > 1 and merged[0] + 360.0 - merged[-1] <= 1e-12:
-        merged.pop()
-    out: list[tuple[float, float, frozenset[int]]] = []
-    for k, lo in enumerate(merged):
-        hi = merged[k + 1] if k + 1 < len(merged) else merged[0] + 360.0
-        mid = (lo + hi) / 2.0
-        targets = fence_outcomes(mech, x - mid, y - mid)
-        if out and out[-1][2] == targets:
-            out[-1] = (out[-1][0], hi, targets)
-        else:
-            out.append((lo, hi, targets))
-    if len(out) > 1 and out[0][2] == out[-1][2]:
-        first = out.pop(0)
-        out[-1] = (out[-1][0], first[1] + 360.0, first[2])
-    return tuple(out)
-
-
-def outcome_at(
-    amap: Sequence[tuple[float, float, frozenset[int]]], action_deg: float
-) -> frozenset[int]:
-    """The outcome set of a rotation strictly inside one of ``amap``'s ranges."""
-    a = norm360(action_deg)
-    los = [lo for lo, _, _ in amap]
-    k = bisect.bisect_right(los, a) - 1
-    return amap[k][2] if k >= 0 else amap[-1][2]
-
-
-# --- certificates ---------------------------------------------------------------------------
-
-
-def max_rotation_error(
-    mech: UncertainMechanics,
-    states: Iterable[int],
-    action_deg: float,
-    assumed: Mapping[int, frozenset[int]] | None = None,
-) -> float:
-    """The largest rotation error (deg, a supremum) keeping every outcome within the plan's sets.
-
-    For each physical state ``s`` in ``states`` the plan assumes outcomes ``assumed[s]``
-    (default: the outcome set at the declared error). Every error strictly below the result
-    keeps ``outcome_set(s, action, err)`` within it: the distance from the action's window to
-    the nearest cell whose targets leave the assumed set (bands included), less
-    ``BOUNDARY_EPS_DEG`` (closer than that counts as touching). Exact for the model (the
-    cells); 0 when even an exact rotation leaves the set; at most 90.
-    """
-    best = 90.0  # the smallest state's distance so far (before the boundary allowance)
-    ends = {v for cell in mech.cells for v in (cell.lo, cell.hi)}
-    for s in states:
-        allowed = assumed[s] if assumed is not None else outcome_set(mech, s, action_deg)
-        x0, y0 = _window(mech, s, action_deg, 0.0)
-        dist = sorted({norm360(e - y0) for e in ends} | {norm360(x0 - e) for e in ends} | {0.0})
-        dist = [d for d in dist if d < best] + [best]
-        for k, d in enumerate(dist[:-1]):
-            nxt = dist[k + 1]
-            if not fence_outcomes(mech, x0 - d, y0 + d) <= allowed:
-                best = d
-                break
-            mid = (d + nxt) / 2.0
-            if not fence_outcomes(mech, x0 - mid, y0 + mid) <= allowed:
-                best = d
-                break
-    # A window within BOUNDARY_EPS_DEG of a cell's end counts as on it (both sides'
-    # outcomes), so the supremum the model can honour stops that far short. Taken once, of
-    # the smallest distance, so the result is the same however the states are grouped.
-    return best if best >= 90.0 else max(0.0, best - BOUNDARY_EPS_DEG)
-
-
-def max_shape_tolerance(
-    part: Part,
-    base: Uncertainty,
-    checks: Sequence[tuple[int, float, frozenset[int]]],
-    *,
-    rel_tol: float = 1e-3,
-) -> float:
-    """The largest shape tolerance (mm) under which every ``(ideal state, action, allowed)`` holds.
-
-    A check holds when every ideal member of every outcome of the physical state holding the
-    ideal state, after ``action`` at ``base``'s rotation error and COM tolerance, is in the
-    ``allowed`` ideal ids. Found by bisection on :func:`uncertain_mechanics` (outcome sets grow
-    with the tolerance) to ``rel_tol`` of the bound, half the smallest hull edge; returns the
-    lower end of the final bracket, so the checks hold there; 0 when they fail at t = 0.
-    """
-
-    def holds(t: float) -> bool:
-        unc = Uncertainty(base.rotation_error_deg, t, base.com_tolerance_mm)
-        mech = uncertain_mechanics(part, unc)
-        for ideal, action, allowed in checks:
-            for start in mech.destinations[ideal]:
-                out = outcome_set(mech, start, action)
-                if any(mm not in allowed for p in out for mm in mech.states[p].members):
-                    return False
-        return True
-
-    limit = shape_tolerance_limit(part)
-    if not holds(0.0):
-        return 0.0
-    lo, hi = 0.0, limit * (1.0 - 1e-9)
-    if holds(hi):
-        return hi
-    while hi - lo > rel_tol * limit:
-        mid = (lo + hi) / 2.0
-        lo, hi = (mid, hi) if holds(mid) else (lo, mid)
-    return lo
-
-
 def mechanics_to_dict(mech: UncertainMechanics) -> dict[str, object]:
     """The physical states and bands as JSON-ready lists (for ``part analyze`` and plan files)."""
     return {
@@ -1544,15 +1369,9 @@ __all__ = [
     "PhysicalState",
     "RestCandidate",
     "UncertainMechanics",
-    "action_map",
-    "fence_outcomes",
     "gyration_rel",
-    "max_rotation_error",
-    "max_shape_tolerance",
     "mechanics_to_dict",
-    "outcome_at",
     "ordinary_push_band_deg",
-    "outcome_set",
     "uncertain_mechanics",
     "width_range",
 ]

@@ -4,7 +4,7 @@ A strong plan must reach its result for every outcome the declared uncertainty a
 every reading the sensor can give. :func:`verify_strong` checks a plan file on mechanics
 rebuilt from the file alone (each part's hull and COM, the declared ``uncertainty``), never
 from the machine the planner used: every start physical state runs through the plan; at an
-action every outcome of :func:`~feederkit.mechanics.uncertain.outcome_set` is followed; at a
+action every outcome of :func:`~feederkit.mechanics.outcomes.outcome_set` is followed; at a
 node every branch whose closed reading interval the state's reading set meets is followed,
 and a reading that no branch holds is a failure (interval arithmetic over the branches' ends,
 :meth:`~feederkit.sensors.Sensor.uncovered_reading`, not sampling). Every path must end in a
@@ -37,14 +37,11 @@ from feederkit.errors import CheckFailed, InputError
 from feederkit.machine import PushAlignMachine, members
 from feederkit.machine.build import snap_intervals
 from feederkit.mechanics.analysis import FRAGILE_BARRIER_REL
+from feederkit.mechanics.certificates import max_rotation_error
+from feederkit.mechanics.outcomes import outcome_set
 from feederkit.mechanics.push import PushFunction, resting_widths
 from feederkit.mechanics.symmetry import DIAMETER_REL_EPS
-from feederkit.mechanics.uncertain import (
-    UncertainMechanics,
-    max_rotation_error,
-    outcome_set,
-    uncertain_mechanics,
-)
+from feederkit.mechanics.uncertain import UncertainMechanics, uncertain_mechanics
 from feederkit.planning.budget import Deadline
 from feederkit.planning.reindex import map_masks
 from feederkit.planning.tree import PlanResult, Step

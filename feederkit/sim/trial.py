@@ -19,8 +19,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from feederkit.angles import norm360
+from feederkit.mechanics.outcomes import outcome_set
 from feederkit.mechanics.push import PushFunction, push
-from feederkit.mechanics.uncertain import UncertainMechanics, outcome_set
+from feederkit.mechanics.uncertain import UncertainMechanics
 from feederkit.plans.model import Leaf, Plan, PlanPart, Step, push_function_of
 from feederkit.sensors import Sensor
 from feederkit.sim.pushalign import TILT_MAX_DEG, PushAligner, range_distance
