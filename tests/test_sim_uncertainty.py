@@ -23,14 +23,18 @@ from hypothesis import strategies as st
 
 from feederkit.cli.app import main
 from feederkit.errors import InputError
-from feederkit.mechanics.push import push_function
+from feederkit.mechanics.push import edge_normals, push, push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
 from feederkit.plans.fileformat import plan_json, plan_to_dict
 from feederkit.plans.make import make_plan
+from feederkit.plans.model import PlanPart
 from feederkit.plans.readplan import plan_from_dict
 from feederkit.plans.verify import verify_declared
 from feederkit.sensors import ToleranceSensor
 from feederkit.sim.sampling import (
     FrictionRange,
+    TrialDraw,
     draw_rotation_error,
     draw_trial,
     friction_range,
@@ -288,6 +292,35 @@ def test_a_perturbed_part_stays_within_its_tolerance():
         assert min(math.dist(v, w) for w in pp.hull) <= 0.2 + 1e-9
     assert math.dist(got.part.com, pp.com) <= 0.2 + 1e-9
     assert set(b for b in got.basin_of_edge if b is not None) <= {s.id for s in pf.states}
+
+
+# A review's part: edge 2 is near-metastable (its normal 0.79 deg, its resting range ends at
+# 0.976 deg), so a displaced vertex can turn that edge's normal past the range's end.
+NEAR_METASTABLE = [
+    [-17.604, 18.516], [-28.628, 4.723], [-19.767, -0.687], [-19.285, -3.432],
+    [-2.459, -28.549], [16.287, -23.487], [19.661, -14.399], [19.499, -2.659],
+]  # fmt: skip
+
+
+def test_a_displaced_stable_edge_is_its_own_state_past_its_drawn_range():
+    """A rest on a drawn stable edge is that state's pose however far its normal moved; the
+    drawn range's basin named the neighbour (a physics check scored parts resting on edge 2,
+    reading its width and given its result, as wrong accepts)."""
+    pf = push_function(make_part(make_outline("rp1", NEAR_METASTABLE, com=(-3.862, -3.057))))
+    pp = PlanPart("rp1", None, pf.part.com, pf.part.hull, pf.states)
+    near = next(s for s in pf.states if s.edge == 2)
+    hi = near.resting_range_deg[1]
+    offsets = [(0.0, 0.0)] * len(pp.hull)
+    turn = math.radians(edge_normals(pp.hull)[2])
+    offsets[3] = (-0.05 * math.cos(turn), -0.05 * math.sin(turn))  # within t = 0.05 mm
+    got = perturbed_part(pp, pf, TrialDraw(tuple(offsets), (0.0, 0.0), 0.5, 0.2))
+    normal = edge_normals(got.part.hull)[2]
+    assert normal > hi + 0.01  # past the drawn range: its basin is the neighbour's
+    assert push(pf, normal).edge != 2
+    assert got.basin_of_edge[2] == near.id
+    # Every other edge keeps its own state too.
+    for s in pf.states:
+        assert got.basin_of_edge[s.edge] == s.id
 
 
 # ---------------------------------------------------------------- the simulator (MuJoCo)

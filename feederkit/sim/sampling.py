@@ -15,6 +15,7 @@ without sampling.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -154,9 +155,13 @@ def draw_rotation_error(rng: np.random.Generator, rotation_error_deg: float) -> 
 class PerturbedPart:
     """A trial's part: the drawn hull and COM displaced by a :class:`TrialDraw`.
 
-    ``basin_of_edge[k]`` is the drawn part's stable state id whose resting range holds the
-    normal of the perturbed hull's edge ``k`` (the basin of a rest candidate, F3 of
-    :mod:`feederkit.mechanics.uncertain`), None when no stable state's range holds it.
+    ``basin_of_edge[k]`` is the drawn part's stable state id for a rest on the perturbed
+    hull's edge ``k``: the state of the drawn edge it is (the same two vertices, displaced),
+    when that edge is a stable state's, else the state whose resting range holds its normal
+    (the basin of a rest candidate, F3 of :mod:`feederkit.mechanics.uncertain`); None when no
+    stable state's range holds it. A rest on a drawn stable edge is that state's pose however
+    far its normal moved: near a metastable edge the displaced normal may leave the drawn
+    resting range by a hundredth of a degree, and its basin would name the neighbour.
     """
 
     part: Part
@@ -170,16 +175,38 @@ def perturbed_part(plan_part: PlanPart, nominal: PushFunction, draw: TrialDraw) 
     shape-tolerance bound, half the smallest hull edge, which the plan file's check enforces).
     """
     verts = [
-        [x + dx, y + dy]
+        (x + dx, y + dy)
         for (x, y), (dx, dy) in zip(plan_part.hull, draw.vertex_offsets, strict=True)
     ]
     com = [plan_part.com[0] + draw.com_offset[0], plan_part.com[1] + draw.com_offset[1]]
-    part = make_part(make_outline(plan_part.name, verts, com=com))
+    part = make_part(make_outline(plan_part.name, [list(v) for v in verts], com=com))
     id_of_edge = {s.edge: s.id for s in nominal.states}
+    # A stable edge by its two drawn vertices (indices into the plan's hull).
+    drawn = _source_vertices(nominal.part.hull, plan_part.hull)
+    m = len(drawn)
+    by_ends = {(drawn[e], drawn[(e + 1) % m]): i for e, i in id_of_edge.items()}
+    source = _source_vertices(part.hull, verts)
     basins: list[int | None] = []
-    for normal in edge_normals(part.hull):
-        basins.append(id_of_edge.get(push(nominal, normal).edge))
+    for k, normal in enumerate(edge_normals(part.hull)):
+        ends = (source[k], source[(k + 1) % len(part.hull)])
+        if None not in ends and ends in by_ends:
+            basins.append(by_ends[ends])  # the drawn stable edge itself, displaced
+        else:
+            basins.append(id_of_edge.get(push(nominal, normal).edge))
     return PerturbedPart(part, tuple(basins))
+
+
+def _source_vertices(hull: Sequence[Point], verts: Sequence[Point]) -> list[int | None]:
+    """For each vertex of ``hull``, the index of the vertex of ``verts`` it is (a hull is
+    renumbered and may drop a vertex that fell inside), None when none lies within rounding."""
+    pts = np.asarray(verts, dtype=float)
+    tol = 1e-9 * max(1.0, float(np.ptp(pts, axis=0).max()))
+    out: list[int | None] = []
+    for x, y in hull:
+        d = np.hypot(pts[:, 0] - x, pts[:, 1] - y)
+        i = int(np.argmin(d))
+        out.append(i if d[i] <= tol else None)
+    return out
 
 
 __all__ = [
