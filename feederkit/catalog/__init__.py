@@ -11,6 +11,7 @@ from feederkit.catalog.changeovers import (
     get_changeover,
     list_changeovers,
     remove_changeover,
+    revision_stamps,
     save_changeover,
 )
 from feederkit.catalog.model import (
@@ -111,6 +112,7 @@ __all__ = [
     "remove_part",
     "resolve_catalog_path",
     "revision_history",
+    "revision_stamps",
     "save_changeover",
     "schema_version",
     "set_busy_notifier",

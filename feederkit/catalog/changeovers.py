@@ -39,6 +39,28 @@ def _revision_id(conn: sqlite3.Connection, name: str, revision: int) -> int:
     return int(row[0])
 
 
+RevisionStamp = tuple[Any, ...]
+"""What a stored revision is (source file, options, hull, COM, when it was added), so that a
+revision removed and added again under its number is not taken for the one a plan was made
+from."""
+
+_STAMP_SQL = (
+    "SELECT source_sha256, options_json, outline_json, hull_json, com_x, com_y, created_at "
+    "FROM revisions WHERE id = ?"
+)
+
+
+def _stamp(conn: sqlite3.Connection, rid: int) -> RevisionStamp:
+    return tuple(conn.execute(_STAMP_SQL, (rid,)).fetchone())
+
+
+def revision_stamps(catalog: CatalogLike, mix: Sequence[tuple[str, int]]) -> list[RevisionStamp]:
+    """The :data:`RevisionStamp` of each ``(name, revision)``, read now (InputError for one
+    the catalog does not have); :func:`save_changeover` compares them with the stored ones."""
+    with _conn(catalog) as conn:
+        return [_stamp(conn, _revision_id(conn, str(n), int(r))) for n, r in mix]
+
+
 def save_changeover(
     catalog: CatalogLike,
     name: str,
@@ -49,8 +71,13 @@ def save_changeover(
     replace: bool = False,
     created_by: str | None = None,
     before_commit: Callable[[], None] | None = None,
+    stamps: Sequence[RevisionStamp] | None = None,
 ) -> ChangeoverInfo:
     """Store a changeover in one transaction: the mix's exact revisions, sensor, and plan JSON.
+
+    ``stamps`` are the revisions' :func:`revision_stamps` as the plan was made from them: a
+    revision removed and added again meanwhile has the same number and other contents, and
+    is refused rather than stored against a plan not made for it.
 
     ``before_commit`` runs inside that transaction once the rows are written: write the plan
     and report files there, so that the changeover is committed only when they were written
@@ -75,6 +102,16 @@ def save_changeover(
     who, when = created_by or current_user(), now_utc()
     with _conn(catalog) as conn, transaction(conn, before_commit=before_commit):
         ids = [_revision_id(conn, n, r) for n, r in mix]
+        if stamps is not None and [_stamp(conn, i) for i in ids] != list(stamps):
+            gone = [
+                f"{n}@{r}"
+                for (n, r), i, was in zip(mix, ids, stamps, strict=True)
+                if _stamp(conn, i) != was
+            ]
+            raise InputError(
+                f"{', '.join(gone)} replaced in the catalog while the plan was made (removed and "
+                "added again under the same number): nothing stored; compile the changeover again"
+            )
         old = conn.execute("SELECT id FROM changeovers WHERE name = ?", (name,)).fetchone()
         if old is not None:
             if not replace:

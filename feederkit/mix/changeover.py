@@ -26,6 +26,7 @@ from feederkit.catalog import (
     get_changeover,
     get_revision,
     list_changeovers,
+    revision_stamps,
     save_changeover,
 )
 from feederkit.errors import InputError
@@ -521,6 +522,7 @@ def compile_changeover(
         loaded = load_parts([_source(m) for m in members], catalog=catalog)
     pfs = list(loaded.push_functions)
     revisions = loaded.revisions  # InputError for a part given as a file
+    stamps = revision_stamps(catalog, revisions)  # what the plan is made from
     per_part = mix_landings(catalog, loaded, landings)
     if not replace and changeover_exists(catalog, name):  # after every input is checked
         raise InputError(f"a changeover named {name!r} already exists")
@@ -564,6 +566,7 @@ def compile_changeover(
                 text,
                 replace=replace,
                 before_commit=staged.commit,
+                stamps=stamps,
             )
         except BaseException:
             # An interrupt after the COMMIT (leaving the catalog's context) must not take the
