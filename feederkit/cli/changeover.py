@@ -29,7 +29,9 @@ from rich.markup import escape
 from rich.table import Table
 
 from feederkit.catalog import (
+    DEFAULT_WAIT,
     UNREADABLE,
+    check_name,
     declared_uncertainties,
     list_changeovers,
     part_names,
@@ -37,6 +39,7 @@ from feederkit.catalog import (
     resolve_catalog_path,
 )
 from feederkit.cell import annotate_cycle_time, cycle_time_text
+from feederkit.cli.catalog import WaitOpt, opened
 from feederkit.cli.catalog_analyze import add_pair_column, pair_cell
 from feederkit.cli.common import (
     COMMAND_START,
@@ -435,6 +438,7 @@ def compile_command(
     com_tolerance: ComToleranceOpt = None,
     landings: LandingsOpt = None,
     accept: AcceptOpt = None,
+    wait: WaitOpt = DEFAULT_WAIT,
 ) -> None:
     """Plan one verified sequence of push-align operations that orients (and, where possible,
     recognizes) every part of the mix, and store it against the parts' exact revisions.
@@ -452,6 +456,7 @@ def compile_command(
     cannot be.
     """
     started = COMMAND_START.started()  # --time-limit bounds the plan, then the report's design
+    check_name(name, "changeover")  # before any work: the store would refuse it at the end
     members, shares = parse_mix_shares(mix)
     check_output_folders(output, report)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
@@ -525,6 +530,7 @@ def compile_command(
             loaded=loaded,
             started=started,
             on_stored=lambda: stored_and_written(name, path, output, report),
+            wait=wait,
             **over,
         )
     plan, witnesses = compiled.plan, list(compiled.witnesses)
@@ -797,10 +803,11 @@ def show_command(name: NameArg, json_out: JsonOpt = False, catalog: CatalogOpt =
 
 
 @changeover_app.command("remove")
-def remove_command(name: NameArg, catalog: CatalogOpt = None) -> None:
+def remove_command(name: NameArg, catalog: CatalogOpt = None, wait: WaitOpt = DEFAULT_WAIT) -> None:
     """Delete a stored changeover (its parts stay in the catalog)."""
     path = resolve_catalog_path(catalog)
-    remove_changeover(path, name)
+    with opened(catalog, wait) as conn:
+        remove_changeover(conn, name)
     console.print(f"removed changeover {name!r} from {path}", highlight=False, markup=False)
 
 

@@ -18,14 +18,17 @@ import dataclasses
 import math
 import os
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from contextlib import closing
 from dataclasses import dataclass
 from typing import Any
 
 from feederkit.catalog import (
+    DEFAULT_WAIT,
     ChangeoverInfo,
     get_changeover,
     get_revision,
     list_changeovers,
+    open_catalog,
     revision_stamps,
     save_changeover,
 )
@@ -488,6 +491,7 @@ def compile_changeover(
     loaded: LoadedParts | None = None,
     started: float | None = None,
     on_stored: Callable[[], None] | None = None,
+    wait: float = DEFAULT_WAIT,
 ) -> CompiledChangeover:
     """Plan, verify and store the changeover ``name`` for ``members`` (catalog parts).
 
@@ -512,7 +516,8 @@ def compile_changeover(
     (:func:`feederkit.catalog.declared_tolerances`); ``started`` the instant the time limit
     counts from (:func:`~feederkit.plans.make.make_plan`);
     ``on_stored`` is called once the changeover and its files are in place, also when an
-    interrupt comes after that (it then goes on up: the caller can say what was done).
+    interrupt comes after that (it then goes on up: the caller can say what was done);
+    ``wait`` the seconds the store waits while another process writes the catalog.
     Raises InputError for an existing name (unless ``replace``), bad parts, a landing a part does
     not have or an accepted name no landing has, PlanningError when no plan meets the
     request (an accepted and a rejected landing no plan tells apart), CheckFailed when the
@@ -556,10 +561,10 @@ def compile_changeover(
     text, view = read_back(made.plan)
     compiled = dataclasses.replace(compiled, view=view)
     files = [] if outputs is None else list(outputs(compiled, text))
-    with StagedFiles(files) as staged:
+    with StagedFiles(files) as staged, closing(open_catalog(catalog, wait=wait)) as conn:
         try:
             save_changeover(
-                catalog,
+                conn,
                 name,
                 revisions,
                 sensor.to_dict(),
