@@ -135,6 +135,21 @@ def test_two_squares_with_different_coms_read_as_one_diameter():
     assert distinguishable(a, b, NoSensor()).kind == "sensorless"
 
 
+def test_parts_of_different_diameters_that_read_alike_are_said_to_read_alike():
+    """A review's mix: diameters 2.0-2.87 mm under a ±0.4368 mm sensor were given "a single
+    diameter value", which sent a reader looking for a symmetry; the reason says the sensor
+    reads them alike, and names the sensor."""
+    quad = push_function(make_part(make_outline("q", [[0, 0], [3, 0], [2.5, 2], [0.5, 1.6]])))
+    down = [[-x, y] for x, y in [[0, 0], [3, 0], [2.5, 2], [0.5, 1.6]]]
+    bar = push_function(make_part(make_outline("q-down", down)))  # its other side
+    diameters = [s.diameter for s in quad.states]
+    assert max(diameters) - min(diameters) > 0.5
+    w = distinguishable(quad, bar, ToleranceSensor(0.5))
+    assert w is not None and w.kind == "single-diameter"
+    assert w.reason.startswith("every state of both parts reads alike to the sensor")
+    assert "±0.5 mm" in w.reason
+
+
 def test_witness_to_dict_has_exactly_the_agreed_keys():
     pa = random_part(21, "A")
     pc = build_lookalike(pa, "push-diameter", 0).part

@@ -44,7 +44,10 @@ REASON_SAME_PDF = (
 REASON_SENSORLESS = (
     "no sensor: readings carry no information, parts cannot be recognized (section 8.6)"
 )
-REASON_SINGLE = "a single diameter value: every state of both parts reads alike (section 8.4)"
+REASON_SINGLE = (
+    "every state of both parts reads alike to the sensor, whatever their diameters: to it they "
+    "have a single diameter value (section 8.4)"
+)
 REASON_SAME_DIAMETERS = (
     "these states keep equal diameters under every action "
     "(the push-diameter functions agree on them)"
@@ -168,12 +171,18 @@ def _reason(
         return "same-push-diameter", REASON_SAME_PDF
     diams = [s.diameter for s in pf_a.states] + [s.diameter for s in pf_b.states]
     if all(sensor.can_read_alike(x, y) for x in diams for y in diams):
-        return "single-diameter", REASON_SINGLE
+        return "single-diameter", _single_reason(sensor.describe())
     da = [s.diameter for s in pf_a.states]
     db = [s.diameter for s in pf_b.states]
     if all(abs(da[i] - db[j]) <= LENGTH_TOL_MM for i, j in pairs):
         return "same-diameters", REASON_SAME_DIAMETERS
     return "tolerance", _tolerance_reason(sensor.describe())
+
+
+@functools.lru_cache(maxsize=64)
+def _single_reason(described: str) -> str:
+    """:data:`REASON_SINGLE` naming the sensor, one string per sensor (as below)."""
+    return REASON_SINGLE + f" ({described})"
 
 
 @functools.lru_cache(maxsize=64)
