@@ -235,8 +235,8 @@ def short_chords_words(pfs: Sequence[PushFunction], t: float) -> str:
             f"{head}, or the part imported with --hull-tolerance {coarser:.3g} (its resting "
             "states kept, no edge that short), may have a plan (docs/uncertainty.md)"
         )
-    if not arc:
-        return f"{head}, may have a plan (docs/uncertainty.md)"
+    if not arc:  # one remedy: no comma before its verb
+        return f"{head} may have a plan (docs/uncertainty.md)"
     return (
         f"{head}, may have a plan; a coarser --hull-tolerance cannot help: import lowers it "
         f"to what keeps {name}'s resting states (chords across its arcs would hold the part "
