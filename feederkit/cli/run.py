@@ -82,7 +82,8 @@ def run_command(
     if not sources:
         indices = list(range(len(plan.parts)))
     # The fragile states of the parts run (a SOURCE's member), not of every part of the mix.
-    warnings = [w for w in (plan.low_margin_warning(),) if w] + plan.fragile_warnings(indices)
+    held = (plan.low_margin_warning(), plan.ideal_model_warning())
+    warnings = [w for w in held if w] + plan.fragile_warnings(indices)
     warnings += stored_beyond(plan, sources or [], catalog)
     if not json_out:
         for w in warnings:

@@ -255,7 +255,8 @@ def simulate_command(
         uncertainty=data.uncertainty.to_dict(),
         uncertainty_declared=data.uncertainty_declared,
     )
-    for line in [data.low_margin_warning(), *(r.tolerance_warning() for r in real)]:
+    held = [data.low_margin_warning(), data.ideal_model_warning()]
+    for line in [*held, *(r.tolerance_warning() for r in real)]:
         if line:
             err_console.print(f"warning: {line}", style="yellow", highlight=False, markup=False)
     columns = (

@@ -31,38 +31,13 @@ from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.lumping import may_lump, unresolvable_pairs
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
-from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
+from feederkit.planning.tree import PlanResult, leaf_masks
 from feederkit.plans.certify import decided_exists
 from feederkit.plans.fileformat import distinct_nodes
 from feederkit.plans.model import PlanMember
 from feederkit.sensors import Sensor, ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
 from feederkit.words import plural
-
-
-def ideal_plan_words(
-    unc: Uncertainty, min_margin: float, certificate: Certificate | None
-) -> str | None:
-    """One line when a plan made on the ideal model holds less on a feeder that vibrates
-    than its margins say: the certificate is computed with the vibration the planner's
-    model has under any rotation error (fragile states merged, a push band at each hilltop,
-    ``strong.strong_model``), where an ideal plan may hold no rotation error at all.
-
-    >>> print(ideal_plan_words(IDEAL, 5.0, Certificate(3.0, 0.0, 2)))
-    the plan is the ideal model's: on a feeder that vibrates it holds rotation errors up to ±3° ...
-    """
-    if not unc.is_ideal or certificate is None or not math.isfinite(min_margin):
-        return None
-    held = certificate.max_rotation_error_deg
-    if held >= min_margin - 1e-9:
-        return None
-    what = "no rotation error at all" if held <= 0.0 else f"rotation errors up to ±{held:.4g}°"
-    return (
-        f"the plan is the ideal model's: on a feeder that vibrates it holds {what} (its "
-        f"margins say ±{min_margin:.4g}°: drops near a hilltop may go either way, fragile "
-        "states merge); plan with --rotation-error DEG for one that holds it"
-    )
-
 
 THIN_BRANCH_SHARE = 0.01
 """A reading branch narrower than this share of a tolerance sensor's window (twice its

@@ -47,7 +47,6 @@ from feederkit.planning.tree import Step as TreeStep
 from feederkit.plans.advice import (
     SMALLER_ERROR_S,
     blocking_members,
-    ideal_plan_words,
     lump_shapes,
     short_chords_words,
     smaller_error_words,
@@ -58,7 +57,7 @@ from feederkit.plans.advice import (
 )
 from feederkit.plans.certify import certificate, ideal_length, largest_uncertainty
 from feederkit.plans.fileformat import member_keys, plan_to_dict, result_nodes
-from feederkit.plans.model import PlanMember, low_margin_words, member_label
+from feederkit.plans.model import PlanMember, ideal_plan_words, low_margin_words, member_label
 from feederkit.plans.readplan import as_plan
 from feederkit.plans.strong import ideal_view, verify_strong
 from feederkit.plans.timelimit import (

@@ -455,6 +455,30 @@ def low_margin_words(min_margin_deg: float | None, rotation_error_deg: float = 0
     )
 
 
+def ideal_plan_words(
+    unc: Uncertainty, min_margin: float, certificate: Certificate | None
+) -> str | None:
+    """One line when a plan made on the ideal model holds less on a feeder that vibrates
+    than its margins say: the certificate is computed with the vibration the planner's
+    model has under any rotation error (fragile states merged, a push band at each hilltop,
+    ``strong.strong_model``), where an ideal plan may hold no rotation error at all.
+
+    >>> print(ideal_plan_words(IDEAL, 5.0, Certificate(3.0, 0.0, 2)))
+    the plan is the ideal model's: on a feeder that vibrates it holds rotation errors up to ±3° ...
+    """
+    if not unc.is_ideal or certificate is None or not math.isfinite(min_margin):
+        return None
+    held = certificate.max_rotation_error_deg
+    if held >= min_margin - 1e-9:
+        return None
+    what = "no rotation error at all" if held <= 0.0 else f"rotation errors up to ±{held:.4g}°"
+    return (
+        f"the plan is the ideal model's: on a feeder that vibrates it holds {what} (its "
+        f"margins say ±{min_margin:.4g}°: drops near a hilltop may go either way, fragile "
+        "states merge); plan with --rotation-error DEG for one that holds it"
+    )
+
+
 @dataclass(frozen=True)
 class Plan:
     """A plan: its sensor, its declared uncertainty, its parts (in order), the tree from
@@ -588,3 +612,12 @@ class Plan:
         A strong plan's margins are slack beyond its declared rotation error (its outcome
         sets already cover that error), so what it holds is the two together."""
         return low_margin_words(self.stats.min_margin_deg, self.uncertainty.rotation_error_deg)
+
+    def ideal_model_warning(self) -> str | None:
+        """A warning when the plan was made on the ideal model and its certificate holds less
+        on a feeder that vibrates than its margins say (None otherwise): ``plan`` says it when
+        it makes the plan, and ``run``, ``simulate`` and the report say it again of the file."""
+        margin = self.stats.min_margin_deg
+        if margin is None:
+            return None
+        return ideal_plan_words(self.uncertainty, margin, self.stats.certificate)
