@@ -1,13 +1,32 @@
-"""The report after review 66b (docs/reports.md): the sensor design's critical tolerances
-rounded down as the terminal rounds them (F5)."""
+"""The report and plots after review 66b (docs/reports.md): the sensor design's critical
+tolerances rounded down as the terminal rounds them (F5), and part names the plot's font
+cannot draw (F7)."""
 
 from __future__ import annotations
 
+import json
+import os
 import random
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
 
 from feederkit.design.sensor import shown_tolerance
+from feederkit.mechanics.push import push_function
+from feederkit.outline import make_outline
+from feederkit.part import make_part
+from feederkit.reports import part_figure, part_plot_bytes
 from feederkit.reports.design_html import design_section, tolerance_mm
+from feederkit.reports.partplot import drawable
 from feederkit.sensors import LedSensor
+
+ROOT = Path(__file__).resolve().parents[1]
+OCTAGON = [(1, 0), (2, 0), (3, 1), (3, 2), (2, 3), (1, 3), (0, 2), (0, 1)]
+CJK = "日本語パーツ"
+CJK_ESCAPED = "\\u65e5\\u672c\\u8a9e\\u30d1\\u30fc\\u30c4"
 
 # --- F5: critical tolerances as the terminal shows them ------------------------------------------
 
@@ -48,3 +67,52 @@ def test_the_report_shows_tolerances_as_the_terminal_does():
     for x in values:
         assert tolerance_mm(x) == shown_tolerance(x), x
         assert float(tolerance_mm(x)) <= float(f"{x:.9g}")
+
+
+# --- F7: part names the plot's font cannot draw ---------------------------------------------------
+
+
+def cjk_part():
+    return make_part(make_outline(CJK, OCTAGON))
+
+
+@pytest.mark.parametrize("fmt", ["png", "svg"])
+def test_a_name_the_font_cannot_draw_warns_nothing(fmt):
+    pf = push_function(cjk_part())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        data = part_plot_bytes(pf, fmt)
+    assert data
+    assert [str(w.message) for w in caught] == []  # was "Glyph 26085 ... missing from font(s)"
+
+
+def test_a_name_the_font_cannot_draw_is_shown_escaped_and_says_so():
+    fig = part_figure(push_function(cjk_part()))
+    title = fig.axes[0].get_title()
+    first, note = title.split("\n")
+    assert first == f"{CJK_ESCAPED}: 8 stable states"
+    assert "\\uXXXX" in note and "cannot draw" in note
+    assert drawable(title) == (title, False)  # every character has a glyph: no empty boxes
+    # names the font draws are drawn as they are, on one line
+    for name in ("bracket-a", "Linie 3 \u2013 M\u00fcller", "\u00c5ngstr\u00f6m \u00b5m"):
+        assert drawable(name) == (name, False)
+        title = part_figure(push_function(make_part(make_outline(name, OCTAGON)))).axes[0]
+        assert title.get_title() == f"{name}: 8 stable states"
+    assert drawable("a\U00020000b") == ("a\\U00020000b", True)  # CJK extension B: 8 digits
+
+
+def test_part_plot_prints_no_python_warning(tmp_path):
+    src = tmp_path / "jp.json"
+    src.write_text(json.dumps({"name": CJK, "vertices": OCTAGON}), encoding="utf-8")
+    out = tmp_path / "jp.png"
+    done = subprocess.run(
+        [sys.executable, "-m", "feederkit", "part", "plot", str(src), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},  # this tree's feederkit
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""  # was 6 pairs of "UserWarning: Glyph ... missing" lines
+    assert out.read_bytes().startswith(b"\x89PNG")
