@@ -1,29 +1,33 @@
 """The report and plots after review 66b (docs/reports.md): the sensor design's critical
-tolerances rounded down as the terminal rounds them (F5), and part names the plot's font
-cannot draw (F7)."""
+tolerances rounded down as the terminal rounds them (F5), part names the plot's font cannot
+draw (F7), and the changeover's name heading its report (F10)."""
 
 from __future__ import annotations
 
 import json
 import os
 import random
+import shutil
 import subprocess
 import sys
 import warnings
 from pathlib import Path
 
 import pytest
+from shared import cli_ok
+from test_report import rectangle_plan
 
 from feederkit.design.sensor import shown_tolerance
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
-from feederkit.reports import part_figure, part_plot_bytes
+from feederkit.reports import part_figure, part_plot_bytes, render_report
 from feederkit.reports.design_html import design_section, tolerance_mm
 from feederkit.reports.partplot import drawable
 from feederkit.sensors import LedSensor
 
 ROOT = Path(__file__).resolve().parents[1]
+CATALOG = ROOT / "catalog"
 OCTAGON = [(1, 0), (2, 0), (3, 1), (3, 2), (2, 3), (1, 3), (0, 2), (0, 1)]
 CJK = "日本語パーツ"
 CJK_ESCAPED = "\\u65e5\\u672c\\u8a9e\\u30d1\\u30fc\\u30c4"
@@ -116,3 +120,56 @@ def test_part_plot_prints_no_python_warning(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stderr == ""  # was 6 pairs of "UserWarning: Glyph ... missing" lines
     assert out.read_bytes().startswith(b"\x89PNG")
+
+
+# --- F10: the changeover's name heads its report -------------------------------------------------
+
+
+def heading_of(html: str) -> tuple[str, str]:
+    title = html.split("<title>", 1)[1].split("</title>", 1)[0]
+    h1 = html.split("<h1", 1)[1].split("</h1>", 1)[0]
+    return title, h1
+
+
+def test_a_changeovers_report_is_headed_by_its_name():
+    plan = rectangle_plan()
+    title, h1 = heading_of(render_report(plan, changeover="Linie 3 \u2013 <M\u00fcller>"))
+    assert "Linie 3 \u2013 &lt;M\u00fcller&gt;" in title
+    assert 'data-changeover="Linie 3 \u2013 &lt;M\u00fcller&gt;"' in h1
+    assert "Changeover \u2018Linie 3 \u2013 &lt;M\u00fcller&gt;\u2019 report: rect" in h1
+    # a plan file has no name: its page is headed as before
+    title, h1 = heading_of(render_report(plan))
+    assert title == "feederkit report: rect"
+    assert h1 == ">Plan report: rect"
+
+
+@pytest.fixture()
+def db(tmp_path, capsys) -> Path:
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    for name in ("isosceles-right-triangle", "octagon"):
+        shutil.copy(CATALOG / f"{name}.json", folder)
+    path = tmp_path / "parts.db"
+    cli_ok(capsys, ["catalog", "init", "--catalog", str(path)])
+    cli_ok(capsys, ["catalog", "import", str(folder), "--catalog", str(path)])
+    return path
+
+
+def test_compile_and_report_name_the_changeover(db, tmp_path, capsys, monkeypatch):
+    import feederkit.reports
+
+    given: list[object] = []
+
+    def fake_report(plan, *, changeover=None, **_kw):
+        given.append(changeover)
+        return "<p></p>"
+
+    monkeypatch.setattr(feederkit.reports, "render_report", fake_report)
+    html = str(tmp_path / "r.html")
+    mix = ["--mix", "isosceles-right-triangle,octagon", "--tolerance", "0.01"]
+    cli_ok(
+        capsys,
+        ["changeover", "compile", "line 1", *mix, "--report", html, "--catalog", str(db)],
+    )
+    cli_ok(capsys, ["changeover", "report", "line 1", "-o", html, "--catalog", str(db)])
+    assert given == ["line 1", "line 1"]
