@@ -343,6 +343,7 @@ def changeover_report(
     plots_until: float | None = None,
     cautions: Sequence[str] = (),
     view: Plan | None = None,
+    name: str | None = None,
 ) -> str:
     """The changeover's HTML report: the plan with its cycle time (``stats.cycle_time``) and,
     for a mix, the sensor design (critical tolerances and the plan length against the
@@ -350,7 +351,8 @@ def changeover_report(
     (None: ``REPORT_DESIGN_LIMIT_S``); ``verification``: the compile's own of the plan (None:
     made here), ``plots_until``: the command's time limit for the part plots
     (``render_report``); ``cautions`` open the page (parts revised since); ``view``: the
-    plan as its file reads back, when the caller has it (else read here, once)."""
+    plan as its file reads back, when the caller has it (else read here, once); ``name``: the
+    changeover's, which heads the page."""
     from feederkit.design import sensor
     from feederkit.reports import render_report
 
@@ -370,6 +372,7 @@ def changeover_report(
         verification=verification,
         cautions=cautions,
         plots_until=plots_until,
+        changeover=name,
     )
 
 
@@ -506,6 +509,7 @@ def compile_command(
                 c.made.report,
                 until,
                 view=c.view,
+                name=name,
             )
             files.append(OutputFile(report, html, "report"))
         return files
@@ -902,6 +906,7 @@ def report_command(
         budget,
         plots_until=started + limit,
         cautions=co.warnings,
+        name=name,
     )
     write_files([OutputFile(output, html, "report")])
     note_written((output, "report"))

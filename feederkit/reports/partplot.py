@@ -12,8 +12,10 @@ matplotlib is imported inside the functions, never when feederkit is imported.
 
 from __future__ import annotations
 
+import functools
 import io
 import re
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,6 +27,7 @@ from feederkit.outline import Outline
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.font_manager import FontProperties
 
 STATE_COLOURS = (
     "#1f77b4",
@@ -42,10 +45,52 @@ STATE_COLOURS = (
 
 FORMATS = ("png", "svg")
 
+TITLE_SIZE = 11
+"""The title's font size (pt)."""
+
+UNDRAWN_NOTE = "(\\uXXXX: a character of the name the plot's font cannot draw)"
+"""The title's second line when :func:`drawable` replaced characters of the part's name."""
+
 
 def state_colour(sid: int) -> str:
     """The colour of stable state ``sid``."""
     return STATE_COLOURS[sid % len(STATE_COLOURS)]
+
+
+@functools.lru_cache(maxsize=8)
+def _charmaps(fonts: tuple[str, ...]) -> tuple[frozenset[int], ...]:
+    """The code points each font file has a glyph for."""
+    from matplotlib.font_manager import get_font
+
+    return tuple(frozenset(get_font(f).get_charmap()) for f in fonts)
+
+
+def _fonts(prop: FontProperties) -> tuple[str, ...]:
+    """The font files matplotlib draws ``prop``'s text with, its fallbacks in order
+    (``_find_fonts_by_props``, matplotlib >= 3.6; else the one ``findfont`` gives)."""
+    from matplotlib import font_manager
+
+    find = getattr(font_manager.fontManager, "_find_fonts_by_props", None)
+    found = find(prop) if find is not None else [font_manager.findfont(prop)]
+    return tuple(found)  # FontPath (3.11) keeps its face index in a collection
+
+
+def drawable(text: str, prop: FontProperties | None = None) -> tuple[str, bool]:
+    """``text`` with each character the plot's fonts have no glyph for written as its
+    escape (``\\u65e5``), and whether any was. A part name is any printable Unicode
+    (docs/catalog.md) and the plot's bundled font (DejaVu Sans) has no CJK glyphs: matplotlib
+    would draw empty boxes and print a raw ``UserWarning`` on stderr for each."""
+    from matplotlib.font_manager import FontProperties
+
+    maps = _charmaps(_fonts(prop if prop is not None else FontProperties(size=TITLE_SIZE)))
+    out = [c if c.isspace() or any(ord(c) in m for m in maps) else _escape(c) for c in text]
+    return "".join(out), out != list(text)
+
+
+def _escape(c: str) -> str:
+    """A character as Python writes it escaped: ``\\u65e5``, ``\\U0001f600``."""
+    n = ord(c)
+    return f"\\u{n:04x}" if n <= 0xFFFF else f"\\U{n:08x}"
 
 
 def _arcs(lo: float, hi: float) -> list[tuple[float, float]]:
@@ -205,7 +250,8 @@ def part_figure(
     """The part plot of a push function's part as a matplotlib figure (Agg canvas).
 
     Every state, edge and function is the push function's; ``outline`` only draws the plate
-    (its holes) around that part's hull.
+    (its holes) around that part's hull. Characters of the title the fonts cannot draw are
+    shown escaped, under a line that says so (:func:`drawable`).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -214,6 +260,7 @@ def part_figure(
     # per member) for margins these four panels always need.
     fig = Figure(figsize=(7.0, 10.0))
     FigureCanvasAgg(fig)
+    label, replaced = drawable(title if title is not None else pf.part.name)
     grid = fig.add_gridspec(
         4,
         1,
@@ -221,14 +268,16 @@ def part_figure(
         left=0.11,
         right=0.97,
         bottom=0.06,
-        top=0.96,
+        top=0.945 if replaced else 0.96,  # room for the title's second line
         hspace=0.42,
     )
     ax0 = fig.add_subplot(grid[0])
     _draw_outline(ax0, pf, outline)
-    label = title if title is not None else pf.part.name
+    heading = f"{label}: {pf.n} stable state{'s' if pf.n != 1 else ''}"
     ax0.set_title(
-        f"{label}: {pf.n} stable state{'s' if pf.n != 1 else ''}", fontsize=11, parse_math=False
+        f"{heading}\n{UNDRAWN_NOTE}" if replaced else heading,
+        fontsize=TITLE_SIZE,
+        parse_math=False,
     )
     axes = [fig.add_subplot(grid[i]) for i in (1, 2, 3)]
     for ax in axes[1:]:
@@ -255,12 +304,17 @@ def part_plot_bytes(
     pf: PushFunction, fmt: str, title: str | None = None, outline: Outline | None = None
 ) -> bytes:
     """The part plot encoded as ``png`` or ``svg`` (SVG: UTF-8, fonts drawn as paths, the same
-    bytes on every run); ``outline`` as in :func:`part_figure`."""
+    bytes on every run); ``outline`` as in :func:`part_figure`. matplotlib's warnings are
+    kept off stderr (design.md: one clear line, never raw Python output)."""
     import matplotlib
 
     if fmt not in FORMATS:
         raise ValueError(f"unsupported plot format {fmt!r}")
-    with matplotlib.rc_context({"svg.hashsalt": "feederkit", "svg.fonttype": "path"}):
+    with (
+        warnings.catch_warnings(),
+        matplotlib.rc_context({"svg.hashsalt": "feederkit", "svg.fonttype": "path"}),
+    ):
+        warnings.simplefilter("ignore")
         fig = part_figure(pf, title, outline)
         buf = io.BytesIO()
         meta = {"Date": None} if fmt == "svg" else {"Software": "feederkit"}

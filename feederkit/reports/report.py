@@ -163,6 +163,21 @@ def _shares(plan: Plan) -> list[float | None]:
     return list(plan.shares())
 
 
+def heading(plan: Plan, changeover: str | None = None) -> tuple[str, str]:
+    """The page's ``<title>`` text and ``<h1>`` element (HTML). A stored changeover's report
+    names it, so that two changeovers of one mix (another sensor or uncertainty) and their
+    printed pages can be told apart; a plan file has no name, so its page names its parts."""
+    names = esc(", ".join(dict.fromkeys(p.name for p in plan.parts)))
+    if changeover is None:
+        what = "Changeover" if len(plan.parts) > 1 else "Plan"
+        return f"feederkit report: {names}", f"<h1>{what} report: {names}</h1>"
+    name = esc(changeover)
+    return (
+        f"feederkit changeover \u2018{name}\u2019: {names}",
+        f'<h1 data-changeover="{name}">Changeover \u2018{name}\u2019 report: {names}</h1>',
+    )
+
+
 def render_report(
     plan: Plan | Mapping[str, Any],
     *,
@@ -175,6 +190,7 @@ def render_report(
     verification: VerificationReport | None = None,
     cautions: Sequence[str] = (),
     plots_until: float | None = None,
+    changeover: str | None = None,
 ) -> str:
     """The HTML report of a plan (or a plan file's JSON object, checked; design.md).
 
@@ -190,7 +206,8 @@ def render_report(
     caller has it (else it is made here), gives the banner; ``cautions`` are lines the page
     must say first (a stored changeover whose parts have newer revisions);
     ``plots_until``, a ``time.monotonic()`` instant (a command's time limit) past which the
-    part plots are not drawn (each member then names the command that draws it). Raises
+    part plots are not drawn (each member then names the command that draws it);
+    ``changeover``, the stored changeover's name, heads the page (:func:`heading`). Raises
     InputError for a malformed plan or option.
     """
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
@@ -203,14 +220,14 @@ def render_report(
     numbered = places(plan)
     trace = trace_plan(plan, numbered)
     draw = drawing_for(plan, member_rings(plan, outlines))
-    names = ", ".join(dict.fromkeys(p.name for p in plan.parts))
+    title, h1 = heading(plan, changeover)
     twins = plan_twins(plan, numbered, outlines)
     tree = tree_html(plan, numbered, trace, draw, twins={t.node_id: t for t in twins})
     given = list(unrecognizable or [])
     found = confusions(plan, numbered, trace)
     body = "".join(
         [
-            f"<h1>{'Changeover' if len(plan.parts) > 1 else 'Plan'} report: {esc(names)}</h1>",
+            h1,
             "".join(
                 f'<div class="banner caution" id="caution-{i}">Warning: {esc(c)}.</div>'
                 for i, c in enumerate(cautions)
@@ -234,7 +251,7 @@ def render_report(
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
         f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-        f"<title>feederkit report: {esc(names)}</title><style>{CSS}</style></head>"
+        f"<title>{title}</title><style>{CSS}</style></head>"
         f'<body><main>{body}<footer class="muted">Made by feederkit from a plan file '
         "(Akella &amp; Mason 1999, push-align operations with partial sensing).</footer>"
         "</main></body></html>\n"
