@@ -40,6 +40,7 @@ from feederkit.catalog import (
     resolve_catalog_path,
     revision_history,
 )
+from feederkit.catalog.export import export_warnings
 from feederkit.cli.catalog_analyze import analyze_command
 from feederkit.cli.common import (
     DONE_WORK,
@@ -839,13 +840,14 @@ def cmd_export(
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
-    """Write a part's outline file (design.md outline format)."""
+    """Write a part's outline file (design.md outline format); warn of what the file has
+    no field for (a mesh's other landings, a side probability, stored tolerances)."""
     if output.suffix.lower() != ".json":
         raise InputError(f"{output}: the outline file must end in .json")
     part, which = asked_revision(name, revision)
     with opened(catalog, DEFAULT_WAIT) as conn:
         rev = export_part(conn, part, output, which)
-    warnings = _landings_left_out(rev)
+    warnings = export_warnings(rev)
     if json_out:
         print_json(
             {
@@ -863,19 +865,6 @@ def cmd_export(
         markup=False,
         soft_wrap=True,
     )
-
-
-def _landings_left_out(rev: Revision) -> list[str]:
-    """A warning when the outline file holds one landing of several: a mesh's other resting
-    poses are the catalog's, and a file made from it plans the exported pose alone."""
-    if rev.source_kind != "mesh" or len(rev.landings) < 2:
-        return []
-    names = ", ".join(x.name for x in rev.landings)
-    return [
-        f"{rev.name} is a mesh part of {len(rev.landings)} landings ({names}): the outline "
-        "file holds the imported pose's outline alone, so a plan of the file covers that pose "
-        "only (plan the catalog part, or the mesh file, for every landing)"
-    ]
 
 
 catalog_app.command("init")(cmd_init)
