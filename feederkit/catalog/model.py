@@ -123,6 +123,34 @@ def could_be_part_name(source: str) -> bool:
     return is_valid_name(name) and not name.lower().endswith(FILE_SUFFIXES)
 
 
+def split_revision(text: str) -> tuple[str, int | None]:
+    """A part argument ``NAME@REV`` as (name, revision), a plain ``NAME`` as (name, None).
+
+    The one reading of ``NAME@REV`` for the catalog commands and a catalog SOURCE: a name holds
+    no '@', so a valid name before the last '@' is a part and what follows must be a revision
+    number; anything else (``abc``, ``-1``) is one InputError in the words every command uses,
+    not "no part named 'NAME@abc'" (:func:`bad_revision`). Text whose part before the last '@'
+    is no valid name is returned whole, to be answered as an unknown name.
+
+    >>> split_revision("clip@2"), split_revision("clip")
+    (('clip', 2), ('clip', None))
+    """
+    name, at, rev = text.rpartition("@")
+    if not at or not is_valid_name(name):
+        return text, None
+    if not (rev.isascii() and rev.isdigit()):
+        raise InputError(bad_revision(name, rev))
+    if int(rev) < 1:
+        raise InputError(f"{text}: revisions are numbered from 1")
+    return name, int(rev)
+
+
+def bad_revision(name: str, rev: str) -> str:
+    """What is wrong with ``NAME@REV`` whose ``rev`` is no number (``part 'clip' has no
+    revision 'abc' (NAME@REV takes a revision number)``)."""
+    return f"part {name!r} has no revision {rev!r} (NAME@REV takes a revision number)"
+
+
 def is_valid_text(text: str) -> bool:
     """Whether ``text`` read from the catalog is UTF-8 (bad bytes come back as surrogates)."""
     try:

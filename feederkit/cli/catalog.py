@@ -6,7 +6,6 @@ catalog is ``--catalog PATH``, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.d
 
 from __future__ import annotations
 
-import re
 import sqlite3
 import stat
 import sys
@@ -41,6 +40,7 @@ from feederkit.catalog import (
     revision_history,
 )
 from feederkit.catalog.export import export_warnings
+from feederkit.catalog.model import split_revision
 from feederkit.cli.catalog_analyze import analyze_command
 from feederkit.cli.common import (
     DONE_WORK,
@@ -780,9 +780,6 @@ def cmd_show(
     console.print(table)
 
 
-_REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>[0-9]+)$")
-
-
 def asked_revision(text: str, revision: int | None) -> tuple[str, int | None]:
     """The part and revision (None: the latest) of ``NAME`` or ``NAME@REV`` with
     ``--revision``; InputError when both name a revision and they differ.
@@ -794,17 +791,6 @@ def asked_revision(text: str, revision: int | None) -> tuple[str, int | None]:
     if at is not None and revision is not None and at != revision:
         raise InputError(f"{text}: the revision is given twice ({at} and --revision {revision})")
     return part, at if at is not None else revision
-
-
-def split_revision(text: str) -> tuple[str, int | None]:
-    """``NAME@REV`` as (name, revision); plain ``NAME`` as (name, None)."""
-    found = _REVISION_RE.match(text)
-    if found is None:
-        return text, None
-    rev = int(found["rev"])
-    if rev < 1:
-        raise InputError(f"{text}: revisions are numbered from 1")
-    return found["name"], rev
 
 
 def cmd_remove(
