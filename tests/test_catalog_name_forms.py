@@ -5,6 +5,8 @@
 from __future__ import annotations
 
 import json
+import sqlite3
+import unicodedata
 from pathlib import Path
 
 import pytest
@@ -76,3 +78,87 @@ def test_split_revision_is_the_one_reading():
         split_revision("clip@0")
     with pytest.raises(InputError, match=r"part 'clip' has no revision 'x2'"):
         split_revision("clip@x2")
+
+
+# Names equal under Unicode normalisation (NFC, typed on Linux; NFD, a macOS file name) are
+# one name: stored in NFC, found in either form, old NFD rows too.
+
+LOOK = "Ünïcode part"
+NFC = unicodedata.normalize("NFC", LOOK)
+NFD = unicodedata.normalize("NFD", LOOK)
+
+
+def names(capsys: pytest.CaptureFixture[str], db: str) -> list[str]:
+    """The part names ``catalog list --json`` gives."""
+    return [
+        p["name"] for p in json.loads(cli(capsys, "catalog", "list", "--json", "--catalog", db))
+    ]
+
+
+def test_nfd_and_nfc_names_are_one_name(tmp_path, capsys):
+    assert NFC != NFD
+    (tmp_path / "nfc").mkdir()
+    (tmp_path / "nfd").mkdir()
+    quad_file(tmp_path / "nfc" / f"{NFC}.json")
+    quad_file(tmp_path / "nfd" / f"{NFD}.json", x=2.5)  # another file, the same-looking name
+    db = str(tmp_path / "c.db")
+    cli(capsys, "catalog", "import", str(tmp_path / "nfc"), "--catalog", db)
+    err = one_line_error(capsys, ["catalog", "import", str(tmp_path / "nfd"), "--catalog", db])
+    assert "duplicate name" in err and "--revise" in err
+    assert names(capsys, db) == [NFC]
+    cli(capsys, "catalog", "import", str(tmp_path / "nfd"), "--revise", "--catalog", db)
+    assert names(capsys, db) == [NFC]
+    assert cat.get_revision(db, NFD).revision == 2
+    # --name in NFD is stored in NFC, and refused as a duplicate of the part.
+    other = quad_file(tmp_path / "other.json", x=2.6)
+    err = one_line_error(capsys, ["catalog", "add", str(other), "--name", NFD, "--catalog", db])
+    assert "duplicate name" in err
+    cli(capsys, "catalog", "add", str(other), "--name", f"{NFD} 2", "--catalog", db)
+    assert names(capsys, db) == [NFC, f"{NFC} 2"]
+
+
+def test_a_part_is_found_however_its_name_was_typed(tmp_path, capsys):
+    db = str(tmp_path / "c.db")
+    source = quad_file(tmp_path / "q.json")
+    cli(capsys, "catalog", "add", str(source), "--name", NFC, "--catalog", db)
+    other = quad_file(tmp_path / "r.json", x=2.7)
+    cli(capsys, "catalog", "add", str(other), "--name", "r", "--catalog", db)
+    shown = json.loads(cli(capsys, "catalog", "show", NFD, "--json", "--catalog", db))
+    assert shown["name"] == NFC and shown["revisions"][0]["revision"] == 1
+    cli(capsys, "catalog", "show", f"{NFD}@1", "--catalog", db)
+    cli(capsys, "catalog", "export", NFD, "-o", str(tmp_path / "out.json"), "--catalog", db)
+    analyzed = json.loads(cli(capsys, "part", "analyze", NFD, "--json", "--catalog", db))
+    assert analyzed[0]["name"] == NFC
+    # --mix finds it; the changeover stores the part, which show then lists as its user.
+    compile_mix = ["changeover", "compile", "mx", "--mix", f"{NFD},r", "--tolerance", "0.2"]
+    code = main([*compile_mix, "--catalog", db])
+    capsys.readouterr()
+    assert code in (0, 1)
+    assert cat.get_changeover(db, "mx").info.parts == ((NFC, 1), ("r", 1))
+    shown = json.loads(cli(capsys, "catalog", "show", NFD, "--json", "--catalog", db))
+    assert shown["changeovers"] == ["mx"]
+    cli(capsys, "catalog", "remove", NFD, "--force", "--catalog", db)
+    assert names(capsys, db) == ["r"]
+
+
+def test_names_stored_in_nfd_by_older_versions_are_still_found(tmp_path, capsys):
+    db = str(tmp_path / "c.db")
+    source = quad_file(tmp_path / "q.json")
+    cli(capsys, "catalog", "add", str(source), "--name", NFC, "--catalog", db)
+    with sqlite3.connect(db) as conn:  # as an older feederkit stored a macOS file's name
+        conn.execute("UPDATE parts SET name = ?", (NFD,))
+    assert cat.get_revision(db, NFC).name == NFD
+    assert json.loads(cli(capsys, "catalog", "show", NFC, "--json", "--catalog", db))["name"] == NFD
+    # The same file again is that part (unchanged), another file under the name a duplicate.
+    again = ["catalog", "add", str(source), "--name", NFC, "--json", "--catalog", db]
+    out = json.loads(cli(capsys, *again))
+    assert out[0]["status"] == "unchanged"
+    other = quad_file(tmp_path / "other.json", x=2.6)
+    err = one_line_error(capsys, ["catalog", "add", str(other), "--name", NFC, "--catalog", db])
+    assert "duplicate name" in err
+    # Both forms stored by an older version: each is found by its own form.
+    cli(capsys, "catalog", "add", str(other), "--name", "tmp", "--catalog", db)
+    with sqlite3.connect(db) as conn:
+        conn.execute("UPDATE parts SET name = ? WHERE name = 'tmp'", (NFC,))
+    assert cat.get_revision(db, NFC).source_path == str(other.resolve())
+    assert cat.get_revision(db, NFD).source_path == str(source.resolve())

@@ -53,13 +53,25 @@ def _name_problem(name: object) -> str | None:
     return None
 
 
+def name_key(name: str) -> str:
+    """``name`` in Unicode normal form NFC: the form the catalog stores and compares names in.
+
+    'Ü' typed on Linux is one code point, a macOS file name spells it 'U' and a combining
+    diaeresis (NFD); both look the same, so they must name the same part, not two.
+    """
+    return unicodedata.normalize("NFC", name)
+
+
 def check_name(name: str, what: str = "part") -> str:
-    """Return ``name`` when it is a valid catalog name, else raise InputError.
+    """Return ``name`` in NFC (:func:`name_key`) when it is a valid catalog name, else raise
+    InputError.
 
     Valid: 1-200 characters and at most 240 UTF-8 bytes (names are used as file names), no
     '@', '/', '\\', no leading '-', no surrounding spaces, not '.' or '..', and no control,
-    bidi-override or zero-width characters.
+    bidi-override or zero-width characters; the NFC form is what is checked, and stored.
     """
+    if isinstance(name, str):
+        name = name_key(name)
     problem = _name_problem(name)
     if problem is not None:
         shown = repr(_clip(name)) if isinstance(name, str) else type(name).__name__
@@ -88,9 +100,10 @@ def check_part_name(name: str, advice: str = PART_NAME_ADVICE) -> str:
 
     A catalog name (:func:`check_name`) without ',' or ':', which ``--mix`` reads as syntax.
     Parts stored before this rule keep their names (they list, show and plan by name);
-    ``advice`` says how to give the part another name where it was made.
+    ``advice`` says how to give the part another name where it was made. Returns the name in
+    NFC, as :func:`check_name`.
     """
-    check_name(name)
+    name = check_name(name)
     ch = mix_separator(name)
     if ch is not None:
         raise InputError(

@@ -734,7 +734,7 @@ def cmd_show(
     with opened(catalog, DEFAULT_WAIT) as conn:
         rev = get_revision(conn, part, which)
         history = revision_history(conn, part)
-        users = [c.name for c in list_changeovers(conn) if any(n == part for n, _ in c.parts)]
+        users = [c.name for c in list_changeovers(conn) if any(n == rev.name for n, _ in c.parts)]
     data = revision_dict(rev, history, users)
     if json_out:
         print_json(data)
