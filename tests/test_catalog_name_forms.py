@@ -162,3 +162,39 @@ def test_names_stored_in_nfd_by_older_versions_are_still_found(tmp_path, capsys)
         conn.execute("UPDATE parts SET name = ? WHERE name = 'tmp'", (NFC,))
     assert cat.get_revision(db, NFC).source_path == str(other.resolve())
     assert cat.get_revision(db, NFD).source_path == str(source.resolve())
+
+
+# catalog list pads by terminal columns: wide characters take 2, combining marks 0.
+
+WIDE = ("日本語パーツ", "ａｂ")
+"""CJK and full-width Latin names: two columns a character."""
+
+
+def test_display_width():
+    from feederkit.cli.catalog import display_width
+
+    assert [display_width(n) for n in (*WIDE, NFC, NFD, "t-clip")] == [12, 4, 12, 12, 6]
+
+
+def columns(text: str) -> int:
+    """The test's own count of terminal columns (wide 2, combining 0, else 1)."""
+    return sum(
+        0 if unicodedata.combining(ch) else 2 if unicodedata.east_asian_width(ch) in "WF" else 1
+        for ch in text
+    )
+
+
+def test_list_columns_line_up_with_wide_and_combining_names(tmp_path, capsys):
+    db = str(tmp_path / "c.db")
+    source = quad_file(tmp_path / "q.json")
+    for name in (*WIDE, "nfd", "t-clip"):
+        cli(capsys, "catalog", "add", str(source), "--name", name, "--catalog", db)
+    with sqlite3.connect(db) as conn:  # an NFD name, as older versions stored it
+        conn.execute("UPDATE parts SET name = ? WHERE name = 'nfd'", (NFD,))
+    lines = cli(capsys, "catalog", "list", "--catalog", db).splitlines()
+    rows = [line for line in lines if " outline " in line]
+    assert len(rows) == 4
+    assert any(NFD in row for row in rows) and all(any(n in r for r in rows) for n in WIDE)
+    starts = {columns(row[: row.index(" outline ")]) for row in rows}
+    assert starts == {columns(lines[0][: lines[0].index(" kind")])}, rows  # one column
+    assert {columns(row) for row in rows} == {len(lines[1])}  # as wide as the rule

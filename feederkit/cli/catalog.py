@@ -10,6 +10,7 @@ import sqlite3
 import stat
 import sys
 import textwrap
+import unicodedata
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -389,7 +390,7 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Pa
     )
     for k, col in enumerate(IMPORT_HEADERS):
         if k in WHOLE_COLUMNS:
-            table.add_column(col, no_wrap=True, min_width=max(len(r[k]) for r in rows))
+            table.add_column(col, no_wrap=True, min_width=max(display_width(r[k]) for r in rows))
         else:
             table.add_column(col, justify="right" if k in (1, 4) else "left")
     for row in rows:
@@ -402,7 +403,7 @@ def _table_width(rows: list[tuple[str, ...]]) -> int:
     """The narrowest the summary table can be with every cell whole and each header broken
     only between words: its columns and the two spaces between them."""
     widths = [
-        max([len(r[k]) for r in rows] + [len(w) for w in header.split()])
+        max([display_width(r[k]) for r in rows] + [len(w) for w in header.split()])
         for k, header in enumerate(IMPORT_HEADERS)
     ]
     return sum(widths) + 2 * (len(widths) - 1)
@@ -625,17 +626,43 @@ def _date(stamp: str) -> str:
     return stamp[:10]
 
 
+def display_width(text: str) -> int:
+    """The columns ``text`` takes on a terminal: 2 for a wide or full-width character (East
+    Asian width W or F: CJK, full-width Latin), 0 for a combining mark (Unicode Mn, Me: the
+    accents of an NFD name) and a conjoining Hangul vowel or final consonant (U+1160-U+11FF),
+    1 for any other. ``len`` counts code points, which misaligns columns holding such names
+    (wcwidth's rules, without the dependency; names hold no control or format characters).
+    """
+    if text.isascii():
+        return len(text)
+    width = 0
+    for ch in text:
+        if unicodedata.category(ch) in ("Mn", "Me") or "\u1160" <= ch <= "\u11ff":
+            continue
+        width += 2 if unicodedata.east_asian_width(ch) in ("W", "F") else 1
+    return width
+
+
+def _pad(text: str, width: int, right: bool) -> str:
+    """``text`` padded with spaces to ``width`` terminal columns (:func:`display_width`)."""
+    fill = " " * (width - display_width(text))
+    return fill + text if right else text + fill
+
+
 def plain_table(
     headers: tuple[str, ...], rows: list[tuple[str, ...]], right: tuple[int, ...]
 ) -> str:
     """Columns padded to their widest cell: fast for catalogs of thousands of parts (rich's
-    Table takes seconds there) and never truncated, so it can be piped and grepped."""
-    widths = [max([len(h)] + [len(r[k]) for r in rows]) for k, h in enumerate(headers)]
+    Table takes seconds there) and never truncated, so it can be piped and grepped. Widths
+    are terminal columns (:func:`display_width`), so rows of CJK, full-width or NFD names
+    line up with the others."""
+    widths = [
+        max([display_width(h)] + [display_width(r[k]) for r in rows]) for k, h in enumerate(headers)
+    ]
 
     def line(cells: tuple[str, ...]) -> str:
         return "  ".join(
-            c.rjust(w) if k in right else c.ljust(w)
-            for k, (c, w) in enumerate(zip(cells, widths, strict=True))
+            _pad(c, w, k in right) for k, (c, w) in enumerate(zip(cells, widths, strict=True))
         ).rstrip()
 
     rule = "  ".join("-" * w for w in widths)
