@@ -8,7 +8,6 @@ A SOURCE that names an existing file is read as a file (``.json``, ``.dxf``, ``.
 from __future__ import annotations
 
 import dataclasses
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +20,7 @@ from feederkit.catalog import (
     landings_for,
     part_from_revision,
 )
+from feederkit.catalog.model import bad_revision, split_revision
 from feederkit.catalog.store import NoSuchPartError
 from feederkit.errors import InputError
 from feederkit.importers import (
@@ -34,8 +34,6 @@ from feederkit.outline import unit_scale
 from feederkit.part import Part, make_part
 
 Point = tuple[float, float]
-
-_REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>\d+)$")
 
 
 @dataclass(frozen=True)
@@ -54,8 +52,7 @@ def _from_catalog(source: str, com: Point | None, catalog: str | None) -> Loaded
     db = Path(catalog) if catalog is not None else default_catalog_path()
     if not db.is_file():
         raise InputError(f"{source}: no such file or catalog part (no catalog at {db})")
-    m = _REVISION_RE.match(source)
-    name, rev = (m["name"], int(m["rev"])) if m else (source, None)
+    name, rev = split_revision(source)
     try:
         revision = get_revision(db, name, rev)
     except NoSuchPartError as exc:  # a damaged row or catalog says so in its own line
@@ -134,8 +131,7 @@ def load_parts_with_warnings(
         name, at, rev = source.rpartition("@")
         if at and could_be_part_name(name):  # NAME@REV with a revision that is no number
             raise InputError(
-                f"{source}: no such file, nor a catalog part: part {name!r} has no revision "
-                f"{rev!r} (NAME@REV takes a revision number)"
+                f"{source}: no such file, nor a catalog part: {bad_revision(name, rev)}"
             )
         raise InputError(f"{source}: no such file")
     found = _from_catalog(source, opts.com, catalog)  # a mistyped name says so first

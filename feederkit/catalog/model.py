@@ -53,13 +53,25 @@ def _name_problem(name: object) -> str | None:
     return None
 
 
+def name_key(name: str) -> str:
+    """``name`` in Unicode normal form NFC: the form the catalog stores and compares names in.
+
+    'Ü' typed on Linux is one code point, a macOS file name spells it 'U' and a combining
+    diaeresis (NFD); both look the same, so they must name the same part, not two.
+    """
+    return unicodedata.normalize("NFC", name)
+
+
 def check_name(name: str, what: str = "part") -> str:
-    """Return ``name`` when it is a valid catalog name, else raise InputError.
+    """Return ``name`` in NFC (:func:`name_key`) when it is a valid catalog name, else raise
+    InputError.
 
     Valid: 1-200 characters and at most 240 UTF-8 bytes (names are used as file names), no
     '@', '/', '\\', no leading '-', no surrounding spaces, not '.' or '..', and no control,
-    bidi-override or zero-width characters.
+    bidi-override or zero-width characters; the NFC form is what is checked, and stored.
     """
+    if isinstance(name, str):
+        name = name_key(name)
     problem = _name_problem(name)
     if problem is not None:
         shown = repr(_clip(name)) if isinstance(name, str) else type(name).__name__
@@ -88,9 +100,10 @@ def check_part_name(name: str, advice: str = PART_NAME_ADVICE) -> str:
 
     A catalog name (:func:`check_name`) without ',' or ':', which ``--mix`` reads as syntax.
     Parts stored before this rule keep their names (they list, show and plan by name);
-    ``advice`` says how to give the part another name where it was made.
+    ``advice`` says how to give the part another name where it was made. Returns the name in
+    NFC, as :func:`check_name`.
     """
-    check_name(name)
+    name = check_name(name)
     ch = mix_separator(name)
     if ch is not None:
         raise InputError(
@@ -121,6 +134,34 @@ def could_be_part_name(source: str) -> bool:
     file and should be reported as one."""
     name = re.sub(r"@[0-9]+$", "", source)
     return is_valid_name(name) and not name.lower().endswith(FILE_SUFFIXES)
+
+
+def split_revision(text: str) -> tuple[str, int | None]:
+    """A part argument ``NAME@REV`` as (name, revision), a plain ``NAME`` as (name, None).
+
+    The one reading of ``NAME@REV`` for the catalog commands and a catalog SOURCE: a name holds
+    no '@', so a valid name before the last '@' is a part and what follows must be a revision
+    number; anything else (``abc``, ``-1``) is one InputError in the words every command uses,
+    not "no part named 'NAME@abc'" (:func:`bad_revision`). Text whose part before the last '@'
+    is no valid name is returned whole, to be answered as an unknown name.
+
+    >>> split_revision("clip@2"), split_revision("clip")
+    (('clip', 2), ('clip', None))
+    """
+    name, at, rev = text.rpartition("@")
+    if not at or not is_valid_name(name):
+        return text, None
+    if not (rev.isascii() and rev.isdigit()):
+        raise InputError(bad_revision(name, rev))
+    if int(rev) < 1:
+        raise InputError(f"{text}: revisions are numbered from 1")
+    return name, int(rev)
+
+
+def bad_revision(name: str, rev: str) -> str:
+    """What is wrong with ``NAME@REV`` whose ``rev`` is no number (``part 'clip' has no
+    revision 'abc' (NAME@REV takes a revision number)``)."""
+    return f"part {name!r} has no revision {rev!r} (NAME@REV takes a revision number)"
 
 
 def is_valid_text(text: str) -> bool:

@@ -27,6 +27,8 @@ from feederkit.catalog.model import (
     check_part_name,
     is_mix_name,
     is_valid_name,
+    is_valid_text,
+    name_key,
     shown_name,
 )
 from feederkit.catalog.schema import (
@@ -135,8 +137,43 @@ def _dumps(data: Any) -> str:
 
 
 def _part_id(conn: sqlite3.Connection, name: str) -> int | None:
-    row = conn.execute("SELECT id FROM parts WHERE name = ?", (name,)).fetchone()
-    return None if row is None else int(row[0])
+    """The id of the part ``name`` names (:func:`_find_part`), or None."""
+    found = _find_part(conn, name)
+    return None if found is None else found[0]
+
+
+def _stored_name(conn: sqlite3.Connection, name: str) -> str:
+    """The name the catalog stores the part ``name`` under (:func:`_find_part`); ``name``
+    itself when no part has it, for the caller's "no part named" line."""
+    found = _find_part(conn, name)
+    return name if found is None else found[1]
+
+
+def _find_part(conn: sqlite3.Connection, name: str) -> tuple[int, str] | None:
+    """(id, stored name) of the part ``name`` names, however its letters are composed.
+
+    Names are stored in NFC (:func:`~feederkit.catalog.model.name_key`), but older versions
+    stored them as typed, so a macOS (NFD) name may be stored as such. The name exactly as
+    stored wins (two parts that an older version stored in both forms each keep theirs); else
+    its NFC form; else a stored name whose NFC form is ``name``'s, the first by name. Only the
+    last looks beyond the index, at the names holding non-ASCII characters (ASCII names have
+    one form), and only for a name that is not stored as typed or in NFC.
+    """
+    row = conn.execute("SELECT id, name FROM parts WHERE name = ?", (name,)).fetchone()
+    if row is not None or not isinstance(name, str) or name.isascii():
+        return None if row is None else (int(row[0]), row[1])
+    key = name_key(name)
+    if key != name:
+        row = conn.execute("SELECT id, name FROM parts WHERE name = ?", (key,)).fetchone()
+        if row is not None:
+            return int(row[0]), row[1]
+    rows = conn.execute(
+        "SELECT id, name FROM parts WHERE length(CAST(name AS BLOB)) > length(name) ORDER BY name"
+    )
+    for pid, stored in rows:
+        if isinstance(stored, str) and is_valid_text(stored) and name_key(stored) == key:
+            return int(pid), stored
+    return None
 
 
 def _latest(
@@ -826,8 +863,10 @@ def _unknown(conn: sqlite3.Connection, name: str) -> NoSuchPartError:
 
 def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -> Revision:
     """A stored revision of a part (default: the latest), checked; InputError when there is
-    none (suggesting the nearest names) or when its row is damaged."""
+    none (suggesting the nearest names) or when its row is damaged. ``name`` finds the part
+    in any Unicode normal form (:func:`_find_part`); ``Revision.name`` is the stored one."""
     with _conn(catalog) as conn:
+        name = _stored_name(conn, name)
         if revision is None:
             row = conn.execute(
                 _REVISION_SQL + " ORDER BY r.revision DESC LIMIT 1", (name,)
@@ -847,6 +886,7 @@ def get_revision(catalog: CatalogLike, name: str, revision: int | None = None) -
 def revision_history(catalog: CatalogLike, name: str) -> list[tuple[int, str, str, str]]:
     """(revision, created_at, created_by, sha256) of each revision of a part, oldest first."""
     with _conn(catalog) as conn:
+        name = _stored_name(conn, name)
         rows = conn.execute(
             "SELECT r.revision, r.created_at, r.created_by, r.source_sha256 FROM revisions r "
             "JOIN parts p ON p.id = r.part_id WHERE p.name = ? ORDER BY r.revision",

@@ -6,11 +6,11 @@ catalog is ``--catalog PATH``, else ``$FEEDERKIT_CATALOG``, else ``./feederkit.d
 
 from __future__ import annotations
 
-import re
 import sqlite3
 import stat
 import sys
 import textwrap
+import unicodedata
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -40,6 +40,8 @@ from feederkit.catalog import (
     resolve_catalog_path,
     revision_history,
 )
+from feederkit.catalog.export import export_warnings
+from feederkit.catalog.model import split_revision
 from feederkit.cli.catalog_analyze import analyze_command
 from feederkit.cli.common import (
     DONE_WORK,
@@ -388,7 +390,7 @@ def _print_summary(outcomes: list[AddOutcome] | tuple[AddOutcome, ...], root: Pa
     )
     for k, col in enumerate(IMPORT_HEADERS):
         if k in WHOLE_COLUMNS:
-            table.add_column(col, no_wrap=True, min_width=max(len(r[k]) for r in rows))
+            table.add_column(col, no_wrap=True, min_width=max(display_width(r[k]) for r in rows))
         else:
             table.add_column(col, justify="right" if k in (1, 4) else "left")
     for row in rows:
@@ -401,7 +403,7 @@ def _table_width(rows: list[tuple[str, ...]]) -> int:
     """The narrowest the summary table can be with every cell whole and each header broken
     only between words: its columns and the two spaces between them."""
     widths = [
-        max([len(r[k]) for r in rows] + [len(w) for w in header.split()])
+        max([display_width(r[k]) for r in rows] + [len(w) for w in header.split()])
         for k, header in enumerate(IMPORT_HEADERS)
     ]
     return sum(widths) + 2 * (len(widths) - 1)
@@ -624,17 +626,43 @@ def _date(stamp: str) -> str:
     return stamp[:10]
 
 
+def display_width(text: str) -> int:
+    """The columns ``text`` takes on a terminal: 2 for a wide or full-width character (East
+    Asian width W or F: CJK, full-width Latin), 0 for a combining mark (Unicode Mn, Me: the
+    accents of an NFD name) and a conjoining Hangul vowel or final consonant (U+1160-U+11FF),
+    1 for any other. ``len`` counts code points, which misaligns columns holding such names
+    (wcwidth's rules, without the dependency; names hold no control or format characters).
+    """
+    if text.isascii():
+        return len(text)
+    width = 0
+    for ch in text:
+        if unicodedata.category(ch) in ("Mn", "Me") or "\u1160" <= ch <= "\u11ff":
+            continue
+        width += 2 if unicodedata.east_asian_width(ch) in ("W", "F") else 1
+    return width
+
+
+def _pad(text: str, width: int, right: bool) -> str:
+    """``text`` padded with spaces to ``width`` terminal columns (:func:`display_width`)."""
+    fill = " " * (width - display_width(text))
+    return fill + text if right else text + fill
+
+
 def plain_table(
     headers: tuple[str, ...], rows: list[tuple[str, ...]], right: tuple[int, ...]
 ) -> str:
     """Columns padded to their widest cell: fast for catalogs of thousands of parts (rich's
-    Table takes seconds there) and never truncated, so it can be piped and grepped."""
-    widths = [max([len(h)] + [len(r[k]) for r in rows]) for k, h in enumerate(headers)]
+    Table takes seconds there) and never truncated, so it can be piped and grepped. Widths
+    are terminal columns (:func:`display_width`), so rows of CJK, full-width or NFD names
+    line up with the others."""
+    widths = [
+        max([display_width(h)] + [display_width(r[k]) for r in rows]) for k, h in enumerate(headers)
+    ]
 
     def line(cells: tuple[str, ...]) -> str:
         return "  ".join(
-            c.rjust(w) if k in right else c.ljust(w)
-            for k, (c, w) in enumerate(zip(cells, widths, strict=True))
+            _pad(c, w, k in right) for k, (c, w) in enumerate(zip(cells, widths, strict=True))
         ).rstrip()
 
     rule = "  ".join("-" * w for w in widths)
@@ -733,7 +761,7 @@ def cmd_show(
     with opened(catalog, DEFAULT_WAIT) as conn:
         rev = get_revision(conn, part, which)
         history = revision_history(conn, part)
-        users = [c.name for c in list_changeovers(conn) if any(n == part for n, _ in c.parts)]
+        users = [c.name for c in list_changeovers(conn) if any(n == rev.name for n, _ in c.parts)]
     data = revision_dict(rev, history, users)
     if json_out:
         print_json(data)
@@ -779,9 +807,6 @@ def cmd_show(
     console.print(table)
 
 
-_REVISION_RE = re.compile(r"^(?P<name>.+)@(?P<rev>[0-9]+)$")
-
-
 def asked_revision(text: str, revision: int | None) -> tuple[str, int | None]:
     """The part and revision (None: the latest) of ``NAME`` or ``NAME@REV`` with
     ``--revision``; InputError when both name a revision and they differ.
@@ -793,17 +818,6 @@ def asked_revision(text: str, revision: int | None) -> tuple[str, int | None]:
     if at is not None and revision is not None and at != revision:
         raise InputError(f"{text}: the revision is given twice ({at} and --revision {revision})")
     return part, at if at is not None else revision
-
-
-def split_revision(text: str) -> tuple[str, int | None]:
-    """``NAME@REV`` as (name, revision); plain ``NAME`` as (name, None)."""
-    found = _REVISION_RE.match(text)
-    if found is None:
-        return text, None
-    rev = int(found["rev"])
-    if rev < 1:
-        raise InputError(f"{text}: revisions are numbered from 1")
-    return found["name"], rev
 
 
 def cmd_remove(
@@ -839,13 +853,14 @@ def cmd_export(
     catalog: CatalogOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
-    """Write a part's outline file (design.md outline format)."""
+    """Write a part's outline file (design.md outline format); warn of what the file has
+    no field for (a mesh's other landings, a side probability, stored tolerances)."""
     if output.suffix.lower() != ".json":
         raise InputError(f"{output}: the outline file must end in .json")
     part, which = asked_revision(name, revision)
     with opened(catalog, DEFAULT_WAIT) as conn:
         rev = export_part(conn, part, output, which)
-    warnings = _landings_left_out(rev)
+    warnings = export_warnings(rev)
     if json_out:
         print_json(
             {
@@ -863,19 +878,6 @@ def cmd_export(
         markup=False,
         soft_wrap=True,
     )
-
-
-def _landings_left_out(rev: Revision) -> list[str]:
-    """A warning when the outline file holds one landing of several: a mesh's other resting
-    poses are the catalog's, and a file made from it plans the exported pose alone."""
-    if rev.source_kind != "mesh" or len(rev.landings) < 2:
-        return []
-    names = ", ".join(x.name for x in rev.landings)
-    return [
-        f"{rev.name} is a mesh part of {len(rev.landings)} landings ({names}): the outline "
-        "file holds the imported pose's outline alone, so a plan of the file covers that pose "
-        "only (plan the catalog part, or the mesh file, for every landing)"
-    ]
 
 
 catalog_app.command("init")(cmd_init)
