@@ -39,3 +39,20 @@ def at_most(x: float, digits: int = 6) -> str:
     exact = Decimal(x)  # the float's exact binary value
     quantum = Decimal(1).scaleb(exact.adjusted() - digits + 1)
     return format(exact.quantize(quantum, rounding=ROUND_FLOOR), "g")
+
+
+FLOAT_NOISE_DIGITS = 9
+"""Significant digits a tolerance is snapped to before it is shown (0.3 minus float noise
+shows as 0.3)."""
+
+
+def shown_tolerance(x: float) -> str:
+    """A critical tolerance or step bound for display, the terminal's and the report's: rid
+    of float noise (:data:`FLOAT_NOISE_DIGITS`), then rounded down to 6 significant digits
+    (:func:`at_most`: the printed value works, 0.4552137502 shows as 0.455213, not 0.455214).
+    The values themselves (``--json``) are kept exact.
+
+    >>> shown_tolerance(0.3 - 1e-12), shown_tolerance(0.4552137502)
+    ('0.3', '0.455213')
+    """
+    return at_most(float(f"{x:.{FLOAT_NOISE_DIGITS}g}"))

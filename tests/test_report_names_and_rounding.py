@@ -17,14 +17,14 @@ import pytest
 from shared import cli_ok
 from test_report import rectangle_plan
 
-from feederkit.design.sensor import shown_tolerance
 from feederkit.mechanics.push import push_function
 from feederkit.outline import make_outline
 from feederkit.part import make_part
 from feederkit.reports import part_figure, part_plot_bytes, render_report
-from feederkit.reports.design_html import design_section, tolerance_mm
+from feederkit.reports.design_html import design_section
 from feederkit.reports.partplot import drawable
 from feederkit.sensors import LedSensor
+from feederkit.words import shown_tolerance
 
 ROOT = Path(__file__).resolve().parents[1]
 CATALOG = ROOT / "catalog"
@@ -62,15 +62,14 @@ def test_the_design_section_never_rounds_a_critical_tolerance_up():
     assert "0.455214" not in led
 
 
-def test_the_report_shows_tolerances_as_the_terminal_does():
-    # One rule (feederkit.design.sensor.shown_tolerance), which the reports layer may not import.
+def test_shown_tolerances_never_round_up():
+    # One rule (feederkit.words.shown_tolerance) for the terminal and the report.
     rng = random.Random(66)
     values = [CRITICAL, 0.3 - 1e-12, 0.3, 6.0274084767, 0.000123456789, 0.0, 12.5, 1e-7]
     values += [rng.uniform(0.0, 10.0) for _ in range(500)]
     values += [round(rng.uniform(0.0, 2.0), rng.randint(1, 8)) for _ in range(500)]
     for x in values:
-        assert tolerance_mm(x) == shown_tolerance(x), x
-        assert float(tolerance_mm(x)) <= float(f"{x:.9g}")
+        assert float(shown_tolerance(x)) <= float(f"{x:.9g}"), x
 
 
 # --- F7: part names the plot's font cannot draw ---------------------------------------------------

@@ -61,12 +61,12 @@ from feederkit.design.sensor import (
     design_tolerance,
     landing_design_members,
     member_landing_rows,
-    shown_tolerance,
 )
 from feederkit.errors import InputError
 from feederkit.landing.plan import landing_names, load_landings
 from feederkit.mechanics import push_function
 from feederkit.mix.changeover import plans_over_landings
+from feederkit.words import shown_tolerance
 
 design_app = typer.Typer(
     rich_markup_mode="markdown",

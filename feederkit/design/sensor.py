@@ -46,20 +46,7 @@ from feederkit.plans.make import check_plan_members
 from feederkit.plans.model import Plan, PlanMember
 from feederkit.sensors import ToleranceSensor
 from feederkit.uncertainty import IDEAL, Uncertainty
-from feederkit.words import at_most
-
-FLOAT_NOISE_DIGITS = 9
-"""Significant digits a computed tolerance is snapped to before it is shown: diameters that
-differ by exactly 0.6 mm give a critical tolerance of 0.3 mm minus float noise (1e-12), which
-must show as 0.3, not as 0.299999 beside a step that ends at 0.3."""
-
-
-def shown_tolerance(x: float) -> str:
-    """A critical tolerance or step bound for display: rid of float noise
-    (:data:`FLOAT_NOISE_DIGITS`), then rounded down to 6 significant digits (``at_most``: the
-    printed value works). The values themselves (``--json``) are kept exact."""
-    return at_most(float(f"{x:.{FLOAT_NOISE_DIGITS}g}"))
-
+from feederkit.words import shown_tolerance
 
 MODEL_NOTE = "ideal model: plans assume no rotation error"
 """The model note of the ideal model (all three bounds zero)."""

@@ -15,26 +15,13 @@ from typing import Any
 from feederkit.errors import InputError
 from feederkit.reports.svgkit import esc, num
 from feederkit.sensors import LED_EDGE_REL, LedSensor, Sensor
-from feederkit.words import at_most
+from feederkit.words import shown_tolerance
 
 WIDTH, HEIGHT, PAD = 520, 220, 44
 """The plot's size and its left/bottom padding (px)."""
 
 MAX_PAIRS = 12
 """Pairs listed in the table, tightest first (the rest are counted)."""
-
-FLOAT_NOISE_DIGITS = 9
-"""Significant digits a tolerance is snapped to before it is shown (0.3 minus float noise
-shows as 0.3): ``feederkit.design.sensor.FLOAT_NOISE_DIGITS``."""
-
-
-def tolerance_mm(x: float) -> str:
-    """A critical tolerance or step bound as the terminal shows it
-    (``feederkit.design.sensor.shown_tolerance``, which this layer may not import; a test
-    holds the two equal): float noise snapped off, then 6 significant digits rounded down
-    (``at_most``), so the page never states a tolerance at which the mix is not recognizable
-    (0.4552137502 shows as 0.455213, not 0.455214)."""
-    return at_most(float(f"{x:.{FLOAT_NOISE_DIGITS}g}"))
 
 
 def design_section(design: Mapping[str, Any], sensor: Sensor | None = None) -> str:
@@ -124,11 +111,11 @@ def led_terms(sensor: LedSensor, critical: float | None) -> str:
         return text + "."
     coarsest = led_pitch(critical, e)
     if reads < critical:
-        text += f", within the {tolerance_mm(critical)} mm that keeps the mix recognizable"
+        text += f", within the {shown_tolerance(critical)} mm that keeps the mix recognizable"
     else:
         text += (
-            f", not within the {tolerance_mm(critical)} mm up to which this design keeps the mix "
-            "recognizable"
+            f", not within the {shown_tolerance(critical)} mm up to which this design keeps the "
+            "mix recognizable"
         )
     if coarsest is None:
         text += f"; at a noise of {num(e, 6)} mm no pitch reads that finely"
@@ -154,7 +141,7 @@ def _pairs_table(pairs: Sequence[Mapping[str, Any]]) -> str:
         + (
             "none: no sensor separates them"
             if p.get("critical_tolerance_mm") is None
-            else f"{tolerance_mm(float(p['critical_tolerance_mm']))} mm"
+            else f"{shown_tolerance(float(p['critical_tolerance_mm']))} mm"
         )
         + "</td></tr>"
         for p in shown
@@ -195,8 +182,8 @@ def _steps_table(
     """The length steps as a table; for a plan read by ``led``, each step's pitches at its
     noise (an array reading as finely needs at most that step's length)."""
     body = "".join(
-        f"<tr><td>{tolerance_mm(lo)} &lt; tolerance &le; "
-        f"{'&infin;' if hi is None else tolerance_mm(hi)} mm</td>"
+        f"<tr><td>{shown_tolerance(lo)} &lt; tolerance &le; "
+        f"{'&infin;' if hi is None else shown_tolerance(hi)} mm</td>"
         + ("" if led is None else _pitch_cell(lo, hi, led))
         + (
             '<td colspan="2">no strong plan</td></tr>'
@@ -269,7 +256,7 @@ def _step_plot(
             f'<line x1="{x(critical):.1f}" y1="10" x2="{x(critical):.1f}" y2="{10 + h}" '
             'stroke="#d55e00" stroke-dasharray="4 3"/>'
             f'<text x="{x(critical) - 4:.1f}" y="22" text-anchor="end" font-size="11" '
-            f'fill="#d55e00">critical {tolerance_mm(critical)} mm</text>'
+            f'fill="#d55e00">critical {shown_tolerance(critical)} mm</text>'
         )
     axes = (
         f'<line x1="{PAD}" y1="{10 + h}" x2="{PAD + w}" y2="{10 + h}" stroke="#444"/>'
