@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import sys
 import time
 from collections.abc import Iterable, Iterator, Sequence
@@ -38,6 +37,7 @@ from feederkit.catalog import (
     RevisionTolerances,
     declared_tolerances,
 )
+from feederkit.catalog.model import split_revision
 from feederkit.catalog.tolerances import TOLERANCE_WORDS
 from feederkit.cell import CellSettings, cycle_time_text, load_cell, resolve_settings
 from feederkit.errors import FeederkitError, InputError, PlanningError
@@ -350,13 +350,12 @@ is shown with the flag."""
 
 
 def check_mix_revision(item: str) -> None:
-    """Refuse a ``--mix`` item ``NAME@REV`` whose revision is not a number, in the catalog's
-    words for a revision it does not have (not as a missing file)."""
-    name, at, rev = item.rpartition("@")
-    if at and name and not re.fullmatch(r"[0-9]+", rev):
-        raise InputError(
-            f"--mix {item}: part {name!r} has no revision {rev!r} (revisions are numbers: {name}@2)"
-        )
+    """Refuse a ``--mix`` item ``NAME@REV`` whose revision is not a number, in the words every
+    command uses for it (:func:`feederkit.catalog.split_revision`), not as a missing file."""
+    try:
+        split_revision(item)
+    except InputError as exc:
+        raise InputError(f"--mix {item}: {exc}") from None
 
 
 def add_name_column(table: Table, header: str, **kwargs: Any) -> None:
