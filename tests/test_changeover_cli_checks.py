@@ -4,8 +4,10 @@ before any planning (it used to be refused by the store, after the plan and its 
 
 from __future__ import annotations
 
+import json
 import sqlite3
 import time
+import unicodedata
 from pathlib import Path
 
 import pytest
@@ -68,3 +70,21 @@ def test_a_bad_changeover_name_is_refused_before_the_plan(db, capsys, monkeypatc
     err = one_line_error(capsys, [*args, "--report", str(report), "--catalog", str(db)])
     assert "invalid changeover name 'bad/name'" in err
     assert not report.exists()
+
+
+def test_a_changeover_name_is_one_name_however_it_is_spelled(db, capsys):
+    """'Linie Ü' typed on Linux (NFC) and pasted from a macOS file name (NFD) look the same:
+    one changeover, as one part (catalog.md, names)."""
+    nfc, nfd = unicodedata.normalize("NFC", "Linie Ü"), unicodedata.normalize("NFD", "Linie Ü")
+    assert nfc != nfd
+    args = ["--mix", "octagon,rectangle-2x1", "--tolerance", "0.1", "--rotation-error", "0"]
+    assert main(["changeover", "compile", nfd, *args, "--catalog", str(db)]) == 0
+    capsys.readouterr()
+    err = one_line_error(capsys, ["changeover", "compile", nfc, *args, "--catalog", str(db)])
+    assert "already exists" in err
+    assert main(["changeover", "show", nfc, "--catalog", str(db)]) == 0
+    capsys.readouterr()
+    assert main(["changeover", "remove", nfc, "--catalog", str(db)]) == 0
+    capsys.readouterr()
+    assert main(["changeover", "list", "--json", "--catalog", str(db)]) == 0
+    assert json.loads(capsys.readouterr().out) == []

@@ -25,6 +25,7 @@ from feederkit.catalog.model import (
     could_be_part_name,
     is_mix_name,
     is_valid_name,
+    name_key,
 )
 from feederkit.catalog.schema import (
     DEFAULT_WAIT,
@@ -86,6 +87,7 @@ __all__ = [
     "add_file",
     "add_outline",
     "check_name",
+    "name_key",
     "check_part_name",
     "connect",
     "could_be_part_name",

@@ -13,6 +13,7 @@ from feederkit.catalog.model import (
     check_name,
     is_valid_name,
     is_valid_text,
+    name_key,
     shown_name,
 )
 from feederkit.catalog.schema import transaction
@@ -85,7 +86,7 @@ def save_changeover(
     ``replace``. Raises InputError for unknown parts or revisions, an empty mix, a part listed
     twice, a plan that is not JSON, or a catalog error (busy, read-only, disk full).
     """
-    check_name(name, "changeover")
+    name = check_name(name, "changeover")  # in NFC, as part names are
     mix = [(str(n), int(r)) for n, r in part_revisions]
     if not mix:
         raise InputError(f"changeover {name!r}: the mix has no parts")
@@ -112,7 +113,9 @@ def save_changeover(
                 f"{', '.join(gone)} replaced in the catalog while the plan was made (removed and "
                 "added again under the same number): nothing stored; compile the changeover again"
             )
-        old = conn.execute("SELECT id FROM changeovers WHERE name = ?", (name,)).fetchone()
+        old = conn.execute(
+            "SELECT id FROM changeovers WHERE name IN (?, ?)", _spellings(name)
+        ).fetchone()
         if old is not None:
             if not replace:
                 raise InputError(f"a changeover named {name!r} already exists")
@@ -166,13 +169,19 @@ def _info(conn: sqlite3.Connection, row: Sequence[Any]) -> ChangeoverInfo:
     )
 
 
+def _spellings(name: str) -> tuple[str, str]:
+    """A changeover name as typed and in NFC (:func:`~feederkit.catalog.model.name_key`):
+    names are stored in NFC, and older versions stored them as typed."""
+    return name, name_key(name)
+
+
 def get_changeover(catalog: CatalogLike, name: str) -> Changeover:
     """The changeover ``name`` with its plan JSON text; InputError when there is none."""
     with _conn(catalog) as conn:
         row = conn.execute(
             "SELECT id, name, created_at, created_by, sensor_json, plan_json FROM changeovers "
-            "WHERE name = ?",
-            (name,),
+            "WHERE name IN (?, ?)",
+            _spellings(name),
         ).fetchone()
         if row is None:
             names = [r[0] for r in conn.execute("SELECT name FROM changeovers")]
@@ -243,6 +252,6 @@ def _uncertainty_of(plan_json: object) -> tuple[int, str | None]:
 def remove_changeover(catalog: CatalogLike, name: str) -> None:
     """Delete a changeover (its parts stay); InputError when there is none."""
     with _conn(catalog) as conn, transaction(conn):
-        cur = conn.execute("DELETE FROM changeovers WHERE name = ?", (name,))
+        cur = conn.execute("DELETE FROM changeovers WHERE name IN (?, ?)", _spellings(name))
         if cur.rowcount == 0:
             raise InputError(f"no changeover named {name!r} in the catalog")

@@ -28,6 +28,7 @@ from feederkit.catalog import (
     get_changeover,
     get_revision,
     list_changeovers,
+    name_key,
     open_catalog,
     revision_stamps,
     save_changeover,
@@ -433,8 +434,9 @@ def strong_witnesses(
 
 
 def changeover_exists(catalog: str | os.PathLike[str], name: str) -> bool:
-    """Whether the catalog stores a changeover called ``name``."""
-    return any(c.name == name for c in list_changeovers(catalog))
+    """Whether the catalog stores a changeover called ``name`` (as typed or in NFC)."""
+    names = {name, name_key(name)}
+    return any(c.name in names for c in list_changeovers(catalog))
 
 
 def stale_revisions(
