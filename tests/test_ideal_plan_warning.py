@@ -57,3 +57,10 @@ def test_simulate_says_it(ideal_plan, capsys):
     pytest.importorskip("mujoco")
     assert main(["simulate", str(ideal_plan), "--trials", "1"]) in (0, 1)
     assert WORDS in words(capsys.readouterr().err)
+
+
+def test_the_report_says_it(ideal_plan, tmp_path):
+    page = tmp_path / "r0.html"
+    assert main(["report", str(ideal_plan), "-o", str(page)]) == 0
+    html = page.read_text()
+    assert 'id="ideal-model"' in html and WORDS.replace("'", "&#x27;") in words(html)

@@ -122,6 +122,9 @@ def _banners(
     warning = plan.low_margin_warning()
     if warning:
         out += f'<div class="banner caution" id="low-margin">Warning: {esc(warning)}.</div>'
+    ideal = plan.ideal_model_warning()
+    if ideal:
+        out += f'<div class="banner caution" id="ideal-model">Warning: {esc(ideal)}.</div>'
     fragile = plan.fragile_warnings()  # the lines plan and run print, members as named here
     if fragile:
         lines = "<br>".join(f"Warning: {esc(w)}." for w in fragile)
