@@ -58,7 +58,7 @@ ALLOWED: dict[str, set[str]] = {
     "reports": _FILES | {"planning", "plans"},
     "sim": _FILES | {"planning", "plans"},
     # Sensor design: the tolerances at which parts and plans change (uses mixes and plans).
-    "design": _FILES | {"planning", "plans", "mix"},
+    "design": _FILES | {"planning", "plans", "mix", "reports"},
     "demo": _FILES | {"planning", "plans", "mix", "landing.plan", "design", "reports", "sim"},
     "cli": _FILES
     | {"feederkit", "planning", "plans", "mix", "landing.plan", "design", "reports", "sim", "demo"},

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import pytest
@@ -219,3 +220,20 @@ def test_the_length_table_prints_each_breakpoint_once(capsys) -> None:
     assert len(ends) >= 2
     for (_lo, hi), (lo, _hi) in zip(ends, ends[1:], strict=False):
         assert lo == hi
+
+
+def test_a_name_the_font_cannot_draw_is_drawn_escaped_without_warnings(capsys, tmp_path):
+    """A part named in CJK: matplotlib printed raw "Glyph ... missing" warnings on stderr and
+    drew empty boxes in the title; the title holds the name escaped, as the part plots do."""
+    from feederkit.outline import load_outline_json, save_outline_json
+
+    named = tmp_path / "日本語.json"
+    outline = load_outline_json(CATALOG / "quadrilateral.json")
+    save_outline_json(outline.__class__(**{**outline.__dict__, "name": "日本語"}), named)
+    plot = tmp_path / "steps.svg"
+    args = ["design", "sensor", str(named), MIX[1], "--plot", str(plot), "--rotation-error", "0"]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(args) == 0
+    assert not [w for w in caught if "Glyph" in str(w.message)]
+    assert "Glyph" not in capsys.readouterr().err

@@ -7,10 +7,12 @@ what they can tell apart, :mod:`feederkit.design.pitches`).
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 from feederkit.design.sensor import PitchDesign, ToleranceDesign
 from feederkit.errors import InputError
+from feederkit.reports.partplot import drawable
 
 PLOT_SUFFIXES = (".png", ".svg")
 
@@ -27,16 +29,18 @@ def plot_design(design: ToleranceDesign | PitchDesign, path: str | Path) -> Path
 
     fig, ax = plt.subplots(figsize=(7.0, 4.0))
     try:
-        if isinstance(design, ToleranceDesign):
-            _tolerance(ax, design)
-        else:
-            _pitches(ax, design)
-        ax.set_ylabel("operations")
-        ax.grid(True, alpha=0.3)
-        if ax.get_legend_handles_labels()[0]:  # none when there is no step to draw
-            ax.legend(loc="upper left")
-        fig.tight_layout()
-        fig.savefig(out)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a glyph the font lacks is drawn escaped (titles)
+            if isinstance(design, ToleranceDesign):
+                _tolerance(ax, design)
+            else:
+                _pitches(ax, design)
+            ax.set_ylabel("operations")
+            ax.grid(True, alpha=0.3)
+            if ax.get_legend_handles_labels()[0]:  # none when there is no step to draw
+                ax.legend(loc="upper left")
+            fig.tight_layout()
+            fig.savefig(out)
     finally:
         plt.close(fig)
     return out
@@ -67,8 +71,8 @@ def _tolerance(ax, design: ToleranceDesign) -> None:
     u = design.uncertainty
     ax.set_xlabel("sensor tolerance (mm)" + ("" if u.is_ideal else
                   f"; strong plans, rotation error {u.rotation_error_deg:g} deg"))  # fmt: skip
-    ax.set_title("optimal plan length by sensor tolerance (" + ", ".join(design.parts[:4])
-                 + (", ..." if len(design.parts) > 4 else "") + ")")  # fmt: skip
+    names = drawable(", ".join(design.parts[:4]) + (", ..." if len(design.parts) > 4 else ""))[0]
+    ax.set_title(f"optimal plan length by sensor tolerance ({names})")
 
 
 def _pitches(ax, design: PitchDesign) -> None:
