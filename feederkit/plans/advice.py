@@ -295,6 +295,12 @@ def spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
         f"{', '.join(str(m) for m in machine.states[i].members)} over {spread:.3g} degrees"
         for i, spread in sorted(found.items(), key=lambda kv: -kv[1])
     )
+    return resting_spread_words(named)
+
+
+def resting_spread_words(named: str) -> str:
+    """The warning of :func:`spread_words` around ``named`` (``PART states 1, 2 over 28
+    degrees; ...``): ``plan`` says it of the machine, the report of the plan file."""
     return (
         f"some results name a resting state made of several stable states, shallow wells a "
         f"breath of vibration crosses (docs/uncertainty.md): {named}; there the part rests "

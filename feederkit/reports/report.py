@@ -37,7 +37,7 @@ from feederkit.reports.style import CSS
 from feederkit.reports.svgkit import Ring, esc
 from feederkit.reports.trace import Place, confusions, places, trace_plan
 from feederkit.reports.tree_html import drawing_for, tree_html
-from feederkit.reports.twins import TwinLeaf, twin_leaves, unoriented_words
+from feederkit.reports.twins import TwinLeaf, spread_words_of, twin_leaves, unoriented_words
 
 CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:"
 """The page may load nothing: inline styles and data-URI images only."""
@@ -88,7 +88,8 @@ def tree_section(numbered: Sequence[Place], tree: str) -> str:
         '<h2>The plan</h2><p class="muted">Each box is a plan node with the states the part '
         "may be in, drawn on the fence. Each edge says the rotation the robot applies and the "
         "reading that leads there. Shaded boxes are the final poses: green one known pose, blue "
-        "poses no plan tells apart that look alike (symmetric or nearly so), orange poses no "
+        "poses no plan tells apart that look alike (symmetric or nearly so) or one resting "
+        "state over several poses (oriented only that far), orange poses no "
         "plan tells apart that do not look alike (the part is not oriented between them), red "
         "parts the plan cannot tell apart, yellow a reject leaf: landings the next station "
         "cannot take, recirculated or re-dropped.</p>"
@@ -129,6 +130,9 @@ def _banners(
     if fragile:
         lines = "<br>".join(f"Warning: {esc(w)}." for w in fragile)
         out += f'<div class="banner caution" id="fragile-states">{lines}</div>'
+    spread = spread_words_of(plan, twins)
+    if spread:
+        out += f'<div class="banner caution" id="spread">Warning: {esc(spread)}.</div>'
     unoriented = unoriented_words(plan, twins)
     if unoriented:
         out += f'<div class="banner caution" id="unoriented">Warning: {esc(unoriented)}.</div>'

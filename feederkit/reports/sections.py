@@ -376,7 +376,8 @@ def lookalike_section(
         )
     else:
         body = "<p>One part only: nothing to recognize.</p>"
-    body += _alike_poses(plan, [t for t in twins if t.oriented])
+    body += _alike_poses(plan, [t for t in twins if t.oriented and not t.merged])
+    body += _merged_poses(plan, [t for t in twins if t.oriented and t.merged])
     body += _unoriented_poses(plan, [t for t in twins if not t.oriented])
     return f'<section id="lookalikes"><h2>Parts the plan cannot tell apart</h2>{body}</section>'
 
@@ -420,6 +421,18 @@ def _unlike_words(twin: TwinLeaf) -> str:
     if len(twin.states) < 3:
         return ""
     return ", not alike: " + ", ".join(f"s{a} and s{b}" for a, b in twin.unlike)
+
+
+def _merged_poses(plan: Plan, twins: Sequence[TwinLeaf]) -> str:
+    """The leaves whose listed poses of one part are one resting state of the declared
+    uncertainty's model (:attr:`TwinLeaf.merged`): oriented only as far as that state."""
+    if not twins:
+        return ""
+    return (
+        '<p id="merged-poses">Resting states made of several stable states, shallow wells a '
+        "breath of vibration crosses (docs/uncertainty.md): the part rests anywhere over "
+        f"those poses, oriented only that far:</p><ul>{_twin_items(plan, twins)}</ul>"
+    )
 
 
 def _unoriented_poses(plan: Plan, twins: Sequence[TwinLeaf]) -> str:

@@ -203,6 +203,13 @@ def _result_node(
             "apart and that do not look alike"
         )
         kind = "unoriented"
+    elif len(members) == 1 and twin is not None and twin.merged:
+        label = plan.parts[next(iter(members))].label
+        head = (
+            f"done: {label}, resting anywhere over {len(node.results)} poses (one resting "
+            "state: shallow wells a breath of vibration crosses), oriented only that far"
+        )
+        kind = "symmetric"
     elif len(members) == 1:
         label = plan.parts[next(iter(members))].label
         head = f"done: {label}, one of {len(node.results)} poses that no plan tells apart"

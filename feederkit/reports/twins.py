@@ -19,7 +19,9 @@ from dataclasses import dataclass, replace
 from feederkit.angles import norm360
 from feederkit.mechanics.push import PushFunction, push_function
 from feederkit.mechanics.symmetry import unlike_pairs
+from feederkit.mechanics.uncertain import uncertain_mechanics
 from feederkit.outline import Outline
+from feederkit.plans.advice import resting_spread_words
 from feederkit.plans.model import Leaf, Plan, PlanPart, push_function_of
 from feederkit.reports.trace import Place
 
@@ -36,6 +38,11 @@ class TwinLeaf:
     states: tuple[int, ...]
     unlike: tuple[tuple[int, int], ...]
     outline: bool
+    merged: tuple[tuple[int, ...], ...] = ()
+    """Groups of the listed states that are one resting state of the declared uncertainty's
+    model (a physical state: shallow wells a breath of vibration crosses) and do not all look
+    alike: the part rests anywhere over their poses, oriented only that far. Their pairs are
+    not in ``unlike``: no plan could tell them apart, the part itself does not stay apart."""
 
     @property
     def oriented(self) -> bool:
@@ -62,7 +69,8 @@ def twin_leaves(
     the pairs of its states whose poses do not look alike (:func:`unlike_pairs`); each
     member's ``outlines[k]`` (None: the hull only)."""
     pfs: dict[int, PushFunction] = {}
-    found: dict[tuple[int, tuple[int, ...]], tuple[tuple[int, int], ...]] = {}
+    physical: dict[int, dict[int, int]] = {}
+    found: dict[tuple[int, tuple[int, ...]], tuple[tuple[tuple[int, int], ...], Groups]] = {}
     out = []
     for place in numbered:
         leaf = place.node
@@ -75,10 +83,61 @@ def twin_leaves(
         if (m, states) not in found:
             if m not in pfs:
                 pfs[m] = compared_push_function(plan.parts[m], outlines[m])
-            pairs = unlike_pairs(pfs[m], [(s,) for s in states])
-            found[(m, states)] = tuple((states[a], states[b]) for a, b in pairs)
-        out.append(TwinLeaf(place.node_id, m, states, found[(m, states)], outlines[m] is not None))
+                physical[m] = physical_states(plan, m)
+            pairs = [
+                (states[a], states[b]) for a, b in unlike_pairs(pfs[m], [(s,) for s in states])
+            ]
+            found[(m, states)] = _split_merged(pairs, physical[m])
+        unlike, merged = found[(m, states)]
+        out.append(TwinLeaf(place.node_id, m, states, unlike, outlines[m] is not None, merged))
     return out
+
+
+Groups = tuple[tuple[int, ...], ...]
+
+
+def physical_states(plan: Plan, member: int) -> dict[int, int]:
+    """Each stable state of the member's as the declared uncertainty's model groups them
+    (:func:`~feederkit.mechanics.uncertain.uncertain_mechanics`: the physical state holding
+    it); empty on the ideal model, where every state is its own."""
+    if plan.uncertainty.is_ideal:
+        return {}
+    mech = uncertain_mechanics(push_function_of(plan.parts[member]).part, plan.uncertainty)
+    return {i: s.id for s in mech.states for i in s.members}
+
+
+def _split_merged(
+    pairs: Sequence[tuple[int, int]], physical: dict[int, int]
+) -> tuple[tuple[tuple[int, int], ...], Groups]:
+    """The unlike ``pairs`` of states in different physical states, and the groups of states
+    joined by an unlike pair within one physical state (:attr:`TwinLeaf.merged`)."""
+    apart: list[tuple[int, int]] = []
+    within: dict[int, set[int]] = {}
+    for a, b in pairs:
+        if a in physical and physical.get(b) == physical[a]:
+            within.setdefault(physical[a], set()).update((a, b))
+        else:
+            apart.append((a, b))
+    return tuple(apart), tuple(tuple(sorted(g)) for _, g in sorted(within.items()))
+
+
+def spread_words_of(plan: Plan, twins: Sequence[TwinLeaf]) -> str | None:
+    """The warning ``plan`` gives of results that name a resting state made of several
+    unlike stable states (:func:`~feederkit.plans.advice.resting_spread_words`), for the
+    leaves of the plan file; None when there are none."""
+    named: dict[tuple[int, tuple[int, ...]], None] = {}
+    for t in twins:
+        for g in t.merged:
+            named[(t.member, g)] = None
+    if not named:
+        return None
+    items = []
+    for m, g in named:
+        part = plan.parts[m]
+        normals = [part.state(s).normal_deg for s in g]
+        spread = max(norm360(b - a) for a in normals for b in normals if norm360(b - a) < 180.0)
+        items.append(f"{part.label} states {', '.join(map(str, g))} over {spread:.3g} degrees")
+    return resting_spread_words("; ".join(items))
 
 
 def unoriented_words(plan: Plan, twins: Sequence[TwinLeaf]) -> str | None:
