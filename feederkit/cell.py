@@ -133,8 +133,8 @@ class CellProfile:
 
 
 # Per section, per key: (what the value must be, its check).
-_POSITIVE = ("a positive number", lambda v: v > 0.0)
-_NONNEGATIVE = ("zero or a positive number", lambda v: v >= 0.0)
+_POSITIVE = ("a finite positive number", lambda v: v > 0.0)
+_NONNEGATIVE = ("zero or a finite positive number", lambda v: v >= 0.0)
 _ROTATION = ("a number in [0, 90)", lambda v: 0.0 <= v < 90.0)
 _FIELDS: dict[str, dict[str, tuple[str, Any] | None]] = {
     "sensor": {"model": None, "tolerance_mm": _POSITIVE, "pitch_mm": _POSITIVE,
@@ -180,12 +180,36 @@ def _timing_problems(robot: RobotSection, belt: BeltSection) -> list[str]:
     return problems
 
 
+def _as_float(value: float) -> float:
+    """``value`` as a float; an integer too large for one is infinite (a 300-digit integer
+    is no number of seconds or millimetres, and must be named like ``1e400``)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
+
+
+def _shown(value: object) -> str:
+    """A profile's value as the message quotes it, a long one cut (a 300-digit integer)."""
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
+
+
+def _sections() -> str:
+    return ", ".join(f"[{s}]" for s in _FIELDS)
+
+
 def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
     """A profile from the parsed TOML tables; CellProfileError names every bad field."""
     problems: list[str] = []
     bad_model = False
     values: dict[str, dict[str, Any]] = {name: {} for name in _FIELDS}
     for section, table in data.items():
+        if not isinstance(table, dict) and section not in _FIELDS:  # before any [section]
+            owner = [s for s, keys in _FIELDS.items() if section in keys]
+            where = f"[{owner[0]}]" if owner else f"one of {_sections()}"
+            problems.append(f"{section} is a key outside any section: it goes in {where}")
+            continue
         if section not in _FIELDS:
             problems.append(f"unknown section [{section}] (the sections are {', '.join(_FIELDS)})")
             continue
@@ -204,7 +228,7 @@ def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
                     bad_model = True
                     problems.append(
                         f"{name} must be one of {', '.join(map(repr, SENSOR_MODELS))}, "
-                        f"got {value!r}"
+                        f"got {_shown(value)}"
                     )
                     continue
                 values[section][key] = value
@@ -213,10 +237,10 @@ def parse_cell(data: dict[str, Any], source: str) -> CellProfile:
             if (
                 isinstance(value, bool)
                 or not isinstance(value, int | float)
-                or not math.isfinite(value)
+                or not math.isfinite(_as_float(value))
                 or not ok(float(value))
             ):
-                problems.append(f"{name} must be {what} of{_unit(key)}, got {value!r}")
+                problems.append(f"{name} must be {what} of{_unit(key)}, got {_shown(value)}")
                 continue
             values[section][key] = float(value)
     sensor = values["sensor"]
@@ -264,7 +288,7 @@ def load_cell(path: str | Path | None = None, *, directory: str | Path = ".") ->
     if path is not None:
         return read_cell(path)
     default = Path(directory) / DEFAULT_CELL_FILE
-    if default.is_file():
+    if default.exists():  # a folder or an unreadable file is refused, not passed over
         return read_cell(default)
     return CellProfile()
 

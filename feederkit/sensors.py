@@ -792,11 +792,11 @@ def make_sensor(
         raise InputError("--noise goes with --led-pitch")
     if tolerance is not None:
         if not math.isfinite(tolerance) or tolerance <= 0.0:
-            raise InputError(f"--tolerance must be a positive number of mm, got {tolerance}")
+            raise InputError(f"--tolerance must be a finite positive number of mm, got {tolerance}")
         return ToleranceSensor(float(tolerance))
     if led_pitch is not None:
         if not math.isfinite(led_pitch) or led_pitch <= 0.0:
-            raise InputError(f"--led-pitch must be a positive number of mm, got {led_pitch}")
+            raise InputError(f"--led-pitch must be a finite positive number of mm, got {led_pitch}")
         e = 0.0 if noise is None else noise
         if not math.isfinite(e) or e < 0.0:
             raise InputError(f"--noise must be zero or a positive number of mm, got {noise}")

@@ -99,14 +99,17 @@ def test_the_working_directorys_profile_is_found(tmp_path):
             '[sensor]\nmodel = "tolerance"\ntolerance_mm = 0.1\npitch_mm = 1\n',
             "sensor.pitch_mm goes",
         ),
-        ('[sensor]\nmodel = "led"\npitch_mm = 0\n', "sensor.pitch_mm must be a positive"),
+        ('[sensor]\nmodel = "led"\npitch_mm = 0\n', "sensor.pitch_mm must be a finite positive"),
         ('[sensor]\nmodel = "led"\npitch_mm = 1\nnoise_mm = -1\n', "sensor.noise_mm must be"),
         ("[robot]\nrotation_error_deg = 200\n", "robot.rotation_error_deg must be"),
-        ("[robot]\npick_place_s = -1\n", "robot.pick_place_s must be zero or a positive"),
-        ("[robot]\nrotation_speed_deg_s = 0\n", "robot.rotation_speed_deg_s must be a positive"),
+        ("[robot]\npick_place_s = -1\n", "robot.pick_place_s must be zero or a finite positive"),
+        (
+            "[robot]\nrotation_speed_deg_s = 0\n",
+            "robot.rotation_speed_deg_s must be a finite positive",
+        ),
         ('[robot]\npick_place_s = "fast"\n', "robot.pick_place_s must be"),
         ("[robot]\npick_place_s = true\n", "robot.pick_place_s must be"),
-        ("[belt]\nspeed_m_s = nan\n", "belt.speed_m_s must be a positive"),
+        ("[belt]\nspeed_m_s = nan\n", "belt.speed_m_s must be a finite positive"),
         ("[belt]\ndrop_to_fence_mm = -5\n", "belt.drop_to_fence_mm must be"),
         ("belt = 3\n", "belt must be a table"),
     ],
@@ -127,7 +130,9 @@ def test_every_bad_field_gets_its_own_line():
 def test_a_bad_required_value_is_named_once_not_also_missing():
     with pytest.raises(CellProfileError) as info:
         parse_cell({"sensor": {"model": "tolerance", "tolerance_mm": -1}}, "x")
-    assert info.value.problems == ("sensor.tolerance_mm must be a positive number of mm, got -1",)
+    assert info.value.problems == (
+        "sensor.tolerance_mm must be a finite positive number of mm, got -1",
+    )
     with pytest.raises(CellProfileError) as info:
         parse_cell({"sensor": {"model": "led"}}, "x")
     assert info.value.problems == ("sensor.pitch_mm is required with model = 'led'",)

@@ -286,7 +286,7 @@ def test_an_exact_search_off_course_hands_the_rest_of_the_limit_to_the_fallback(
 
 @pytest.mark.parametrize("bad", [0.0, -5.0, math.inf, math.nan, True, "100"])
 def test_bad_memory_limits_are_refused_in_one_line(bad):
-    with pytest.raises(InputError, match="the memory limit must be a positive number of MB"):
+    with pytest.raises(InputError, match="the memory limit must be a finite positive number of MB"):
         PlanningOptions(memory_limit_mb=bad)
 
 

@@ -314,13 +314,13 @@ def test_within_the_limit_the_design_is_the_unlimited_one(catalog_mix, uncertain
 
 @pytest.mark.parametrize("limit", [0, -1.0, math.nan, math.inf, True])
 def test_a_bad_time_limit_is_input_error(catalog_mix, limit):
-    with pytest.raises(InputError, match="time limit must be a positive number of seconds"):
+    with pytest.raises(InputError, match="time limit must be a finite positive number of seconds"):
         design_tolerance(catalog_mix, time_limit_s=limit)
 
 
 @pytest.mark.parametrize("limit", [0, -1.0, math.nan, math.inf, True])
 def test_a_bad_memory_limit_is_input_error(catalog_mix, limit):
-    with pytest.raises(InputError, match="memory limit must be a positive number of MB"):
+    with pytest.raises(InputError, match="memory limit must be a finite positive number of MB"):
         design_tolerance(catalog_mix, memory_limit_mb=limit)
 
 
@@ -372,7 +372,7 @@ def in_tmp(tmp_path, monkeypatch):
 @pytest.mark.parametrize("value", ["0", "-1", "nan"])
 def test_cli_bad_time_limit_is_one_line_exit_2(capsys, in_tmp, value):
     err = one_line_error(capsys, ["design", "sensor", *MIX, "--time-limit", value])
-    assert err.startswith("error: the time limit must be a positive number of seconds")
+    assert err.startswith("error: the time limit must be a finite positive number of seconds")
     assert "(--time-limit)" in err
 
 
@@ -391,7 +391,7 @@ def test_cli_memory_limit_is_one_line(capsys, in_tmp):
     assert err.startswith("result: the sensor design did not finish within the memory limit")
     assert err.rstrip().endswith("allow more memory with --memory-limit MB")
     err = one_line_error(capsys, ["design", "sensor", *MIX, "--memory-limit", "-5"])
-    assert err.startswith("error: the memory limit must be a positive number of MB")
+    assert err.startswith("error: the memory limit must be a finite positive number of MB")
     assert not list(in_tmp.iterdir())
 
 

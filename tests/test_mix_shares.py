@@ -47,10 +47,10 @@ def test_shares_are_normalised_and_default_to_equal():
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
-        ("a:-0.2,b", "share of a must be a positive number, got '-0.2'"),
-        ("a:0,b:0", "share of a must be a positive number, got '0' (leave a part out"),
-        ("a:nan,b", "share of a must be a positive number, got 'nan'"),
-        ("a:inf,b", "share of a must be a positive number, got 'inf'"),
+        ("a:-0.2,b", "share of a must be a finite positive number, got '-0.2'"),
+        ("a:0,b:0", "share of a must be a finite positive number, got '0' (leave a part out"),
+        ("a:nan,b", "share of a must be a finite positive number, got 'nan'"),
+        ("a:inf,b", "share of a must be a finite positive number, got 'inf'"),
         ("a:lots,b", "share of a must be a number, got 'lots'"),
         ("a:0.5,a:0.5", "a is listed twice"),
         (":0.5,b", "names no part"),
@@ -194,7 +194,7 @@ def test_timed_objectives_need_the_cells_timing(db, tmp_path, capsys):
     ("text", "needle"),
     [
         ("[robot]\npick_place_s = 1\nspeed = 2\n", "unknown key robot.speed"),
-        ("[belt]\nspeed_m_s = -0.1\n", "belt.speed_m_s must be a positive"),
+        ("[belt]\nspeed_m_s = -0.1\n", "belt.speed_m_s must be a finite positive"),
         ("[robot]\nrotation_speed_deg_s = inf\n", "robot.rotation_speed_deg_s must be"),
     ],
 )

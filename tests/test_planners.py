@@ -497,8 +497,8 @@ def test_the_time_limit_holds_for_the_goal_fixpoint_too():
         ({"min_margin_deg": math.nan}, "the minimum margin must be in"),
         ({"min_margin_deg": 180.0}, "the minimum margin must be in"),
         ({"min_margin_deg": "5"}, "the minimum margin must be in"),
-        ({"time_limit_s": 0.0}, "the time limit must be a positive number of seconds"),
-        ({"time_limit_s": math.inf}, "the time limit must be a positive number of seconds"),
+        ({"time_limit_s": 0.0}, "the time limit must be a finite positive number of seconds"),
+        ({"time_limit_s": math.inf}, "the time limit must be a finite positive number of seconds"),
     ],
 )
 def test_bad_options_are_refused_once_in_library_words(options, message):

@@ -167,7 +167,7 @@ def parse_mix_shares(text: str) -> tuple[list[str], tuple[float, ...] | None]:
         if not (math.isfinite(value) and value > 0.0):
             hint = " (leave a part out of the mix rather than give it no share)"
             raise InputError(
-                f"--mix: the share of {name} must be a positive number, got "
+                f"--mix: the share of {name} must be a finite positive number, got "
                 f"{share.strip()!r}{hint if value == 0.0 else ''}"
             )
         given.append(value)

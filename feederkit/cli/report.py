@@ -116,10 +116,10 @@ def report_command(
     data = load_plan(plan, max_plan_mb)
     if seconds_per_op is not None and not (math.isfinite(seconds_per_op) and seconds_per_op > 0):
         raise InputError(
-            f"--seconds-per-op must be a positive number of seconds, got {seconds_per_op:g}"
+            f"--seconds-per-op must be a finite positive number of seconds, got {seconds_per_op:g}"
         )
     if simulate is not None and simulate < 1:
-        raise InputError(f"--simulate must be a positive number of trials, got {simulate}")
+        raise InputError(f"--simulate must be a finite positive number of trials, got {simulate}")
     simulation = None if simulate is None else _simulate(data, simulate, seed)
     # One verification: the page's banner shows it, the exit code says it (design.md).
     verdict = verify_declared(data)

@@ -38,7 +38,7 @@ def normalised_shares(shares: Sequence[float], members: int) -> tuple[float, ...
             or not isinstance(s, int | float)
             or not (math.isfinite(s) and s > 0.0)
         ):
-            raise InputError(f"a member's share must be a positive number, got {s!r}")
+            raise InputError(f"a member's share must be a finite positive number, got {s!r}")
     total = math.fsum(float(s) for s in values)
     if abs(total - 1.0) <= SHARE_SUM_TOL:
         return tuple(float(s) for s in values)

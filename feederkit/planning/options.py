@@ -190,7 +190,9 @@ class PlanningOptions:
                 or not isinstance(t, int | float)
                 or not (math.isfinite(t) and t > 0.0)
             ):
-                raise InputError(f"the time limit must be a positive number of seconds, got {t}")
+                raise InputError(
+                    f"the time limit must be a finite positive number of seconds, got {t}"
+                )
             set_(self, "time_limit_s", float(t))
         mem = self.memory_limit_mb
         if mem is not None:
@@ -199,7 +201,9 @@ class PlanningOptions:
                 or not isinstance(mem, int | float)
                 or not (math.isfinite(mem) and mem > 0.0)
             ):
-                raise InputError(f"the memory limit must be a positive number of MB, got {mem}")
+                raise InputError(
+                    f"the memory limit must be a finite positive number of MB, got {mem}"
+                )
             set_(self, "memory_limit_mb", float(mem))
         if not isinstance(self.fallback, bool):
             raise InputError(f"the fallback must be True or False, got {self.fallback!r}")
