@@ -522,32 +522,43 @@ def cycle_time_dict(plan: Any, settings: CellSettings) -> dict[str, Any] | None:
     return {"profile": settings.describe_source(), **cycle_time(plan, settings.profile).to_dict()}
 
 
+def _rate(ppm: float) -> str:
+    """Parts per minute in words: one decimal, in powers of ten past a million (a profile
+    whose every time is near 0 gave a 300-digit figure)."""
+    return f"{ppm:.1f}" if ppm < 1e6 else f"{ppm:.3g}"
+
+
 def annotate_cycle_time(made: Any, settings: CellSettings) -> dict[str, Any] | None:
     """Put :func:`cycle_time_dict` of a made plan in its plan file as ``stats.cycle_time``
-    (before the file is written or stored, so reports and ``changeover show`` find it) and
-    return it; nothing is added when the profile has no timing."""
+    (null when the profile has no timing) and the profile it was made with as
+    ``stats.cell_profile`` (design.md: every output names the profile it used), before the
+    file is written or stored, so reports and ``changeover show`` find them; return the
+    cycle time."""
     cycle = cycle_time_dict(made, settings)
-    if cycle is not None:
-        made.plan["stats"]["cycle_time"] = cycle
+    made.plan["stats"]["cycle_time"] = cycle
+    made.plan["stats"]["cell_profile"] = settings.describe_source()
     return cycle
 
 
 def cycle_time_text(
-    cycle: dict[str, Any] | None, profile: str | None = None, *, name_profile: bool = True
+    cycle: dict[str, Any] | None,
+    profile: str | None = None,
+    *,
+    name_profile: bool = True,
+    missing: Sequence[str] = (),
 ) -> str:
     """A ``cycle_time_dict`` in words, for terminal output and reports; ``profile`` names
-    the profile when there is no cycle time (``CellSettings.describe``); ``name_profile``
-    False leaves the profile out of a known cycle time (an output whose header names it)."""
+    the profile when there is no cycle time (``CellSettings.describe``) and ``missing`` the
+    timing fields it lacks (:meth:`CellProfile.missing_timing`); ``name_profile`` False
+    leaves the profile out of a known cycle time (an output whose header names it)."""
     if cycle is None:
         where = f" ({profile})" if profile else ""
-        return (
-            f"cycle time: not known, the cell profile gives no robot and belt timing{where}; "
-            "see docs/cell.md"
-        )
+        lacks = f"no {', '.join(missing)}" if missing else "no robot and belt timing"
+        return f"cycle time: not known, the cell profile gives {lacks}{where}; see docs/cell.md"
     ppm = cycle.get("parts_per_minute")
-    rate = "" if ppm is None else f", {ppm:.1f} parts/min"
+    rate = "" if ppm is None else f", {_rate(ppm)} parts/min"
     worst = cycle.get("worst_parts_per_minute")
-    worst_rate = "" if worst is None else f", {worst:.1f} parts/min"
+    worst_rate = "" if worst is None else f", {_rate(worst)} parts/min"
     where = f" (cell profile: {cycle['profile']})" if name_profile else ""
     return (
         f"cycle time: {cycle['expected_s']:.2f} s per part expected{rate}; "

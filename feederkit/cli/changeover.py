@@ -576,7 +576,7 @@ def compile_command(
         view = compiled.view or as_plan(plan)  # checked once, for the drawing and the table
         console.print(plan_tree(view))
         console.print(stats_table(view, compiled.made.report))
-        console.print(escape(cycle_line(cycle)), highlight=False)
+        console.print(escape(cycle_line(cycle, settings)), highlight=False)
         if witnesses:
             console.print(_pairs_table(witnesses))
         console.print(f"stored changeover {name!r} in {path}", highlight=False, markup=False)

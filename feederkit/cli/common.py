@@ -768,10 +768,18 @@ def cell_settings(
         )
 
 
-def cycle_line(cycle: dict[str, Any] | None) -> str:
+def cycle_line(cycle: dict[str, Any] | None, settings: CellSettings | None = None) -> str:
     """The cycle time in words for an output whose header already names the cell profile
-    (``cell profile: ...``, docs/cell.md): the profile is not named a second time."""
-    return cycle_time_text(cycle, name_profile=False)
+    (``cell profile: ...``, docs/cell.md): a known one does not name it a second time; an
+    unknown one names it and the timing fields it lacks (``settings``)."""
+    if settings is None:
+        return cycle_time_text(cycle, name_profile=False)
+    return cycle_time_text(
+        cycle,
+        settings.describe_source(),
+        name_profile=False,
+        missing=settings.profile.missing_timing(),
+    )
 
 
 def cell_planning_options(

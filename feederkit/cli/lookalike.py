@@ -89,7 +89,8 @@ def lookalike_command(
     )
     table.add_row("similar to the source", _yes(check.similar))
     table.add_row(
-        "center of mass", f"({part.com[0]:.6g}, {part.com[1]:.6g}) mm, stated in the file"
+        "center of mass",
+        f"({part.com[0] + 0.0:.6g}, {part.com[1] + 0.0:.6g}) mm, stated in the file",  # no -0
     )
     if json_out:
         if output is not None:

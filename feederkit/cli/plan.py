@@ -19,7 +19,7 @@ import typer
 from rich.markup import escape
 
 from feederkit.catalog import DeclaredTolerances
-from feederkit.cell import annotate_cycle_time
+from feederkit.cell import BUILT_IN, annotate_cycle_time
 from feederkit.cli.common import (
     COMMAND_START,
     DEFAULT_TIME_LIMIT_S,
@@ -158,11 +158,12 @@ def _header(
     sensor_given: bool,
     landings: str | None = None,
     declared: DeclaredTolerances | None = None,
+    why_sensorless: str = "no sensor option given",
 ) -> str:
     names = escape(", ".join(dict.fromkeys(p["name"] for p in plan["parts"])))
     sensor = sensor_text(plan["sensor"])
     if not sensor_given:
-        sensor = "none — no sensor option given, so the plan is sensorless"
+        sensor = f"none — {why_sensorless}, so the plan is sensorless"
     stats = plan["stats"]
     lines = "" if landings is None else f"{escape(landings)}\n"
     return (
@@ -244,7 +245,12 @@ def plan_command(
     uncertainty = uncertainty_option(  # the flags, checked before the parts are loaded
         settings.rotation_error_deg, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
     )
-    json_found(sources=list(sources), sensor=sensor.to_dict(), uncertainty=uncertainty.to_dict())
+    json_found(
+        sources=list(sources),
+        cell=settings.to_dict(),
+        sensor=sensor.to_dict(),
+        uncertainty=uncertainty.to_dict(),
+    )
     with flag_words(terms):
         which = "all" if landings in (None, "all") else landing_names(landings)
         found = load_landings(
@@ -309,10 +315,16 @@ def plan_command(
         sensor_given = sensorless or sensor.informative
         words = None if planned is None else _landings_text(planned)
         console.print(escape(settings.describe()), highlight=False)
-        console.print(_header(plan, sensor_given, words, declared), highlight=False)
+        # The header's first line names the profile: say whether it or no option chose this.
+        why = (
+            "no sensor option given"
+            if settings.profile.source == BUILT_IN
+            else "no sensor option given, and the profile gives no sensor"
+        )
+        console.print(_header(plan, sensor_given, words, declared, why), highlight=False)
         console.print(plan_tree(view))
         console.print(stats_table(view, made.report))
-        console.print(escape(cycle_line(cycle)), highlight=False)
+        console.print(escape(cycle_line(cycle, settings)), highlight=False)
         print_written(output, report)
     if planned is not None:
         lumps = landing_lumps(planned)

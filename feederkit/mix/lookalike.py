@@ -185,6 +185,7 @@ def _apply(
 
 
 def _make(name: str, pts: Sequence[Point], com: Point, scale: float = 1.0) -> Part | None:
+    com = (com[0] + 0.0, com[1] + 0.0)  # no -0.0: the file and the screen said "(-0, -0)"
     if scale != 1.0:
         pts = [(com[0] + scale * (x - com[0]), com[1] + scale * (y - com[1])) for x, y in pts]
     try:
