@@ -522,6 +522,10 @@ def cycle_time_dict(plan: Any, settings: CellSettings) -> dict[str, Any] | None:
     return {"profile": settings.describe_source(), **cycle_time(plan, settings.profile).to_dict()}
 
 
+TIMING_FIELDS = 4
+"""The fields a cycle time needs (:meth:`CellProfile.missing_timing`)."""
+
+
 def _rate(ppm: float) -> str:
     """Parts per minute in words: one decimal, in powers of ten past a million (a profile
     whose every time is near 0 gave a 300-digit figure)."""
@@ -553,7 +557,8 @@ def cycle_time_text(
     leaves the profile out of a known cycle time (an output whose header names it)."""
     if cycle is None:
         where = f" ({profile})" if profile else ""
-        lacks = f"no {', '.join(missing)}" if missing else "no robot and belt timing"
+        some = 0 < len(missing) < TIMING_FIELDS  # else none at all, or not known which
+        lacks = f"no {', '.join(missing)}" if some else "no robot and belt timing"
         return f"cycle time: not known, the cell profile gives {lacks}{where}; see docs/cell.md"
     ppm = cycle.get("parts_per_minute")
     rate = "" if ppm is None else f", {_rate(ppm)} parts/min"

@@ -776,7 +776,7 @@ def cycle_line(cycle: dict[str, Any] | None, settings: CellSettings | None = Non
         return cycle_time_text(cycle, name_profile=False)
     return cycle_time_text(
         cycle,
-        settings.describe_source(),
+        settings.profile.source,
         name_profile=False,
         missing=settings.profile.missing_timing(),
     )
