@@ -34,10 +34,12 @@ from feederkit.cli.plan_render import (
 from feederkit.errors import CheckFailed, InputError
 from feederkit.landing.plan import load_landings
 from feederkit.loading import load_parts
+from feederkit.part import Part
 from feederkit.plans.execute import execute
-from feederkit.plans.match import match_part, same_geometry
-from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan
+from feederkit.plans.match import match_part, offsets_words, same_geometry
+from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan, PlanPart
 from feederkit.plans.verify import VerificationReport, verify_declared
+from feederkit.sim.likeness import refusal_words
 from feederkit.sources import load_part
 
 
@@ -168,14 +170,16 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
     in a plan over landings, every landing of that part the plan holds, each checked
     against the source's own landing (docs/plans.md: every member is run)."""
     part = load_part(source, catalog=catalog)
-    if not plan.over_landings:
-        return [match_part(plan, part, source)]
     try:  # the plan's name for the part: a renamed file of the same geometry is the part
-        name = plan.parts[match_part(plan, part, source)].name
-    except InputError:
-        if not any(m.name == part.name for m in plan.parts):
-            raise
-        name = part.name  # a plan of other landings only (down): checked landing by landing
+        k = match_part(plan, part, source)
+    except InputError as exc:
+        if not plan.over_landings or not any(m.name == part.name for m in plan.parts):
+            hints = (_likeness_hint(plan, m, part, source) for m in plan.parts)
+            raise InputError(f"{exc}{next((h for h in hints if h), '')}") from None
+        k = None  # a plan of other landings only (down): checked landing by landing
+    if not plan.over_landings:
+        return [k]
+    name = part.name if k is None else plan.parts[k].name
     held = tuple(dict.fromkeys(m.landing for m in plan.parts if m.name == name and m.landing))
     out = []
     # Only the landings the plan holds: another may be one pushing cannot orient (a mesh
@@ -184,13 +188,45 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
         for j, member in enumerate(plan.parts):
             if member.name != name or member.landing != x.name:
                 continue
-            if not same_geometry(x.part, member):
+            if not same_geometry(x.part, member, plan.uncertainty):
                 raise InputError(
-                    f"{source}: its {x.name} landing differs from the plan's (its hull or COM "
-                    "is not the one the plan was made for)"
+                    f"{source}: its {x.name} landing differs from the plan's ("
+                    f"{offsets_words(x.part, member, plan.uncertainty)})"
+                    + _likeness_hint(plan, member, x.part, source)
                 )
             out.append(j)
     return sorted(out) or [match_part(plan, part, source)]
+
+
+LIKENESS_REL = 1e-3
+"""A SOURCE whose hull a turn, mirror, shift or unit brings within this share of the part's
+size (plus the declared shape tolerance) of the plan's is named as the plan's part in another
+frame or units (a drawing flattened again differs by rounding)."""
+
+
+def _likeness_hint(plan: Plan, member: PlanPart, part: Part, source: str) -> str:
+    """``"; ..."``: the SOURCE is the plan's ``member`` in other units or another frame, in
+    the words ``simulate --part`` uses (:func:`feederkit.sim.likeness.refusal_words`), or a
+    drawing with other hull vertices than the plan's simplified hull; empty otherwise."""
+    allowed = plan.uncertainty.shape_tolerance_mm + LIKENESS_REL * member.size
+    words = refusal_words(
+        member.hull,
+        member.com,
+        part.hull,
+        part.com,
+        allowed,
+        source=source,
+        name=member.name,
+        is_file=Path(source).exists(),
+        give="give NAME as the SOURCE",
+    )
+    if words is None and len(part.hull) != len(member.hull):
+        return (
+            "; a drawing's hull simplified on import (--hull-tolerance) has other vertices: "
+            "give the catalog part the plan was made from (NAME@REV), or check the drawing "
+            "with feederkit simulate --part, which allows for the simplification"
+        )
+    return words or ""
 
 
 def _of_them(report: VerificationReport) -> str:

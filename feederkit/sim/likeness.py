@@ -151,8 +151,9 @@ def likely_units(scale: float) -> tuple[str, str] | None:
     return None
 
 
-def _units_words(scale: float, source: str, name: str, is_file: bool) -> str:
-    """The remedy for a SOURCE at another scale: its units."""
+def _units_words(scale: float, source: str, name: str, is_file: bool, give: str | None) -> str:
+    """The remedy for a SOURCE at another scale: its units; ``give`` how the command then
+    takes the catalog part (default ``simulate``'s ``--part NAME=...``)."""
     size = f"{scale:.4g} times smaller" if scale >= 1.0 else f"{1.0 / scale:.4g} times larger"
     units = likely_units(scale)
     if units is None:
@@ -164,7 +165,7 @@ def _units_words(scale: float, source: str, name: str, is_file: bool) -> str:
     return (
         f"; its hull is {size} than the plan's: the file's units differ from the plan's part "
         f"({why}): import it with `feederkit catalog add {where} {option} --name NAME` and "
-        f"give --part {name}=NAME (simulate reads a file in its own units)"
+        + (give or f"give --part {name}=NAME (simulate reads a file in its own units)")
     )
 
 
@@ -189,6 +190,7 @@ def refusal_words(
     source: str,
     name: str,
     is_file: bool,
+    give: str | None = None,
 ) -> str | None:
     """Why a SOURCE whose hull the match check refused may still be the plan's part: in other
     units (its size a unit's factor from the plan's, or beyond :data:`FAR_SCALE`, and its
@@ -203,7 +205,7 @@ def refusal_words(
     if found.distance_mm > allowed_mm:
         return None
     if units:
-        return _units_words(scale, source, name, is_file)
+        return _units_words(scale, source, name, is_file, give)
     return _frame_words(found, size) if found.motion_words(size) else None
 
 
