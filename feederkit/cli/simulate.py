@@ -40,7 +40,7 @@ from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_pl
 from feederkit.errors import CheckFailed, InputError
 from feederkit.importers import ImportOptions
 from feederkit.part import Part
-from feederkit.plans.model import REJECTED_WORDS, UNRECOGNIZED_WORDS
+from feederkit.plans.model import REJECTED_WORDS, UNRECOGNIZED_WORDS, member_label
 from feederkit.sim.api import (
     DEFAULT_BELT_SPEED,
     DEFAULT_FRICTION_BELT_RANGE,
@@ -118,7 +118,7 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         for r in rows[:SHOWN_ROWS]:
             t.add_row(
                 str(r.index),
-                escape(r.part),
+                escape(member_label(r.part, r.landing)),  # a landing the plan rejects, or not
                 f"{r.start_deg:.2f}",
                 str(r.step),
                 escape(r.cause or ""),

@@ -221,7 +221,7 @@ def width_accuracy_warning(slack: tuple[float, str] | None, scale: float = 1.0) 
     scaled = (
         ""
         if scale == 1.0
-        else f"; {accuracy:.3g} mm at the plan's size, simulated {scale:.3g} times larger"
+        else f"; {accuracy:.3g} mm at the plan's size, simulated at {scale:.3g} times its size"
     )
     return (
         f"{words} is no coarser than the simulator's width accuracy (about "
