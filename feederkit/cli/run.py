@@ -40,6 +40,7 @@ from feederkit.plans.match import match_part, offsets_words, same_geometry
 from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan, PlanPart
 from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.sim.likeness import refusal_words
+from feederkit.sim.real import hull_distance
 from feederkit.sources import load_part
 
 
@@ -204,6 +205,11 @@ size (plus the declared shape tolerance) of the plan's is named as the plan's pa
 frame or units (a drawing flattened again differs by rounding)."""
 
 
+SIMPLIFIED_REL = 0.01
+"""A SOURCE with other hull vertices than the plan's, whose hull lies within this share of
+the part's size of the plan's, may be the drawing of a hull import simplified."""
+
+
 def _likeness_hint(plan: Plan, member: PlanPart, part: Part, source: str) -> str:
     """``"; ..."``: the SOURCE is the plan's ``member`` in other units or another frame, in
     the words ``simulate --part`` uses (:func:`feederkit.sim.likeness.refusal_words`), or a
@@ -220,7 +226,8 @@ def _likeness_hint(plan: Plan, member: PlanPart, part: Part, source: str) -> str
         is_file=Path(source).exists(),
         give="give NAME as the SOURCE",
     )
-    if words is None and len(part.hull) != len(member.hull):
+    near = hull_distance(part.hull, member.hull) <= SIMPLIFIED_REL * member.size
+    if words is None and len(part.hull) != len(member.hull) and near:
         return (
             "; a drawing's hull simplified on import (--hull-tolerance) has other vertices: "
             "give the catalog part the plan was made from (NAME@REV), or check the drawing "
