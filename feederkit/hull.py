@@ -10,6 +10,8 @@ import heapq
 import math
 from collections.abc import Iterable, Sequence
 
+import numpy as np
+
 Point = tuple[float, float]
 
 REL_LENGTH_TOL = 1e-9
@@ -204,17 +206,26 @@ def _chord_line(p: Point, q: Point) -> tuple[float, float, float]:
     return nx, ny, nx * p[0] + ny * p[1]
 
 
-def _distance_to_ring(ring: Sequence[Point], p: Point) -> float:
-    """Distance from ``p`` to the boundary of the ring (segment by segment)."""
-    best = math.inf
+def _distance_to_segments(a: np.ndarray, b: np.ndarray, p: Point) -> float:
+    """Distance from ``p`` to the nearest of the segments ``a[i] -> b[i]``."""
+    d = b - a
+    len2 = np.einsum("ij,ij->i", d, d)
+    w = np.asarray(p, dtype=float) - a
+    t = np.divide(np.einsum("ij,ij->i", w, d), len2, out=np.zeros_like(len2), where=len2 > 0)
+    t = np.clip(t, 0.0, 1.0)
+    return float(np.hypot(*(w - t[:, None] * d).T).min())
+
+
+def _near_ring(ring: np.ndarray, p: Point, lo: int, hi: int, limit: float) -> bool:
+    """Whether ``p`` lies within ``limit`` of the ring's boundary: the segments from vertex
+    ``lo`` to vertex ``hi`` (cyclic, where ``p`` was made) are asked first, all of them only
+    when those are farther. The answer is the whole ring's either way; asking every segment
+    of a 400,000-point ellipse's hull for each refitted vertex took minutes."""
     n = len(ring)
-    for i in range(n):
-        (ax, ay), (bx, by) = ring[i], ring[(i + 1) % n]
-        dx, dy = bx - ax, by - ay
-        len2 = dx * dx + dy * dy
-        t = 0.0 if len2 == 0.0 else max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / len2))
-        best = min(best, math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy))
-    return best
+    idx = np.arange(lo, lo + (hi - lo) % n + 1) % n
+    if _distance_to_segments(ring[idx], ring[(idx + 1) % n], p) <= limit:
+        return True
+    return _distance_to_segments(ring, np.roll(ring, -1, axis=0), p) <= limit
 
 
 def _refit(ring: Sequence[Point], kept: list[int], length_tol: float) -> list[Point] | None:
@@ -225,6 +236,7 @@ def _refit(ring: Sequence[Point], kept: list[int], length_tol: float) -> list[Po
     not give a strictly convex ring within ``2 * length_tol`` of the original hull.
     """
     n, m = len(ring), len(kept)
+    arr = np.asarray(ring, dtype=float)
     flats = [
         None
         if (kept[k] + 1) % n == kept[(k + 1) % m]
@@ -246,7 +258,8 @@ def _refit(ring: Sequence[Point], kept: list[int], length_tol: float) -> list[Po
             return None
         x = (l1[2] * l2[1] - l1[1] * l2[2]) / det
         y = (l1[0] * l2[2] - l1[2] * l2[0]) / det
-        if _distance_to_ring(ring, (x, y)) > 2 * length_tol + 1e-12 * (abs(x) + abs(y)):
+        limit = 2 * length_tol + 1e-12 * (abs(x) + abs(y))
+        if not _near_ring(arr, (x, y), kept[k - 1], kept[(k + 1) % m], limit):
             return None
         out.append((x, y))
     for i in range(m):

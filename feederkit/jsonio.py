@@ -269,8 +269,10 @@ def check_writable(path: str | os.PathLike[str], what: str = "file") -> None:
             raise _cannot(path, what, PermissionError(errno.EACCES, os.strerror(errno.EACCES)))
         return
     fd, tmp = _temporary(path, target, what)
-    os.close(fd)
-    os.unlink(tmp)
+    try:
+        os.close(fd)
+    finally:  # a Ctrl-C here must not leave the probe behind
+        os.unlink(tmp)
 
 
 def _bytes(f: OutputFile) -> bytes:
@@ -305,9 +307,9 @@ def _stage(f: OutputFile, mode: int | None) -> tuple[Path, str | None]:
             mode = 0o666 & ~_umask()
         else:
             mode, group = st.st_mode & 0o777, st.st_gid
+    data = _bytes(f)  # before the temporary: encoding a large plan takes a while
     fd, tmp = _temporary(f.path, target, f.what)
-    data = _bytes(f)
-    try:
+    try:  # from the temporary's creation on: a Ctrl-C while writing it takes it away
         with os.fdopen(fd, "wb") as fh:
             if group != -1:  # not a member of that group: the process's own group stays
                 with contextlib.suppress(OSError):

@@ -13,7 +13,7 @@ import math
 import numbers
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -303,12 +303,20 @@ def load_outline_json(path: str | os.PathLike[str], units: str | None = None) ->
 
 
 def read_outline_file(
-    path: str | os.PathLike[str], units: str | None = None
+    path: str | os.PathLike[str],
+    units: str | None = None,
+    count: Callable[[int], None] | None = None,
 ) -> tuple[Outline, str, bool]:
     """:func:`load_outline_json`, the unit its coordinates were read in (canonical name),
     which the catalog records as the source's units (the outline itself is in mm), and
-    whether the file or ``units`` named it (else the coordinates were taken as mm)."""
+    whether the file or ``units`` named it (else the coordinates were taken as mm).
+
+    ``count`` is told the number of points the file lists (outline and holes) as soon as it
+    is parsed, before they are checked and hulled: an import budget refuses a file of a
+    million points in a moment, not after the work it would bound."""
     data = read_json(path, "file")
+    if count is not None and isinstance(data, dict):
+        count(_listed_points(data))
     if units is not None and isinstance(data, dict):
         data = {**data, "units": units}
     try:
@@ -317,6 +325,15 @@ def read_outline_file(
         raise InputError(f"{os.fspath(path)}: {exc}") from None
     assert isinstance(data, dict)  # outline_from_dict refused anything else
     return outline, unit_name(str(data.get("units", "mm"))), "units" in data
+
+
+def _listed_points(data: dict) -> int:
+    """How many points an outline file's ``vertices`` and ``holes`` list (as given)."""
+    rings = [data.get("vertices")]
+    holes = data.get("holes")
+    if isinstance(holes, list):
+        rings += holes
+    return sum(len(r) for r in rings if isinstance(r, list))
 
 
 def save_outline_json(outline: Outline, path: str | os.PathLike[str]) -> None:

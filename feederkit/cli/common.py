@@ -645,13 +645,25 @@ def check_outputs(*outputs: tuple[Path | None, str]) -> None:
         check_writable(path, what)
 
 
-def check_output_folders(output: Path | None, report: Path | None) -> None:
+def check_output_folders(
+    output: Path | None, report: Path | None, sources: Sequence[str] = ()
+) -> None:
     """Refuse ``-o`` and ``--report`` paths that could not be written (:func:`check_outputs`)
     and a ``--report`` not named .html, before any work is done (nor may a page of HTML be
-    written as ``report.txt``)."""
+    written as ``report.txt``); and an output that is one of the ``sources`` read (a
+    mistyped ``-o part.json`` wrote the plan over the part's outline)."""
     if report is not None:
         check_report_name(report)
     check_outputs((output, "plan file"), (report, "report"))
+    for path, what in ((output, "plan file"), (report, "report")):
+        if path is None or is_device(path) or not path.exists():
+            continue
+        for source in sources:
+            if Path(source).is_file() and os.path.samefile(path, source):
+                raise InputError(
+                    f"{path}: the {what} would be written over the SOURCE {source} (a part's "
+                    "file): give the output its own path"
+                )
 
 
 def check_report_name(path: Path) -> None:

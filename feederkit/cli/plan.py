@@ -236,7 +236,7 @@ def plan_command(
     """
     started = COMMAND_START.started()  # --time-limit counts reading the parts too
     terms = (*FLAG_TERMS, *LANDING_TERMS)
-    check_output_folders(output, report)
+    check_output_folders(output, report, sources)
     settings = cell_settings(cell, sensorless, tolerance, led_pitch, noise, rotation_error)
     sensor = settings.sensor
     options = cell_planning_options(

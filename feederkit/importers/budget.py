@@ -111,9 +111,9 @@ class Budget:
         """Count curve entities after block expansion."""
         self._add("entities", n, "entities after block expansion")
 
-    def vertices(self, n: int) -> None:
-        """Count points after flattening (or mesh vertices)."""
-        self._add("vertices", n, "vertices after flattening")
+    def vertices(self, n: int, noun: str = "vertices after flattening") -> None:
+        """Count points after flattening (or mesh vertices, or an outline file's ``noun``)."""
+        self._add("vertices", n, noun)
 
     def segments(self, n: int) -> None:
         """Refuse more line pieces after noding (crossing lines multiply them) than vertices."""

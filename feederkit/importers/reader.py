@@ -86,8 +86,9 @@ def read_source(path: str | Path, options: ImportOptions, name: str | None = Non
     others: list[str] = []
     warnings: list[str] = []
     if suffix in OUTLINE_SUFFIXES:
-        outline, unit, named = read_outline_file(p, options.units)
-        budget.vertices(len(outline.vertices) + sum(len(h) for h in outline.holes))
+        outline, unit, named = read_outline_file(
+            p, options.units, lambda n: budget.vertices(n, "points listed")
+        )
         budget.loops(1 + len(outline.holes))
         # A file that names no units is read as mm: at a size no feeder part has, a unit
         # mistake is likelier (an outline in metres), said as for drawings and meshes. A
@@ -178,7 +179,10 @@ def com_units_note(com: tuple[float, float], units: str) -> str:
 
 
 def build_part(
-    imported: ImportedOutline, options: ImportOptions, extra_warnings: tuple[str, ...] = ()
+    imported: ImportedOutline,
+    options: ImportOptions,
+    extra_warnings: tuple[str, ...] = (),
+    label: str | None = None,
 ) -> ImportedPart:
     """The part of an imported outline: simplified hull, COM check, and its orientability.
 
@@ -190,8 +194,13 @@ def build_part(
     notes = list(extra_warnings) + list(imported.warnings)
     if options.com is not None and imported.source_units != "mm":
         notes.append(com_units_note(options.com, imported.source_units))
+    # The import's time limit, between steps (``label``: the file, which errors name).
+    check = Budget(options.limits, label or imported.outline.name).check_time
     try:
-        part, kept = kept_part(make_part(imported.outline, options.com), tol)
+        exact = make_part(imported.outline, options.com)
+        check()
+        part, kept = kept_part(exact, tol)
+        check()
         if kept is not None and kept.lowered:
             tol = kept.tolerance
             notes.append(lowered_warning(kept))
@@ -215,7 +224,10 @@ def build_part(
 def import_parts(
     path: str | Path, options: ImportOptions, name: str | None = None
 ) -> tuple[ImportResult, list[ImportedPart]]:
-    """Read a source file and build its part(s) (several only with ``options.all_parts``)."""
+    """Read a source file and build its part(s) (several only with ``options.all_parts``),
+    the reading and the building under one import time limit."""
+    if options.limits.started is None:
+        options = options.counting_from()
     result = read_source(path, options, name)
     if options.com is not None and len(result.parts) > 1:
         raise InputError(
@@ -224,7 +236,7 @@ def import_parts(
         )
     shared = result.warnings + tuple(f"left out: {o}" for o in result.others)
     try:
-        built = [build_part(imp, options, shared) for imp in result.parts]
+        built = [build_part(imp, options, shared, str(path)) for imp in result.parts]
     except InputError as exc:  # name the file, as every error reading it does
         if str(exc).startswith(f"{path}:"):
             raise
