@@ -153,7 +153,7 @@ def test_outline_json_counts_against_the_budget(tmp_path):
     path.write_text('{"name": "many", "vertices": [' + pts + "]}")
     refused(
         path,
-        r"more than 4 vertices after flattening .*--max-vertices",
+        r"more than 4 points listed .*--max-vertices",
         limits=ImportLimits(vertices=4),
     )
 

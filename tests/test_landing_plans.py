@@ -341,7 +341,7 @@ def test_run_checks_every_landing_for_fragile_states_each_named_as_the_plan_name
     assert plan_from_dict(box).fragile_warnings() == []
     assert seen == [[["box (pose-0)", "box (pose-2)", "box (pose-4)"]]]  # what run says
     src = write_outline(tmp_path, "ell", [[0, 0], [30, 0], [30, 8], [8, 8], [8, 20], [0, 20]])
-    ell, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5"], name="ell.json")
+    ell, _ = plan_cli(tmp_path, capsys, [src, "--tolerance", "0.5"], name="ell.plan.json")
     assert [p["landing"] for p in ell["parts"]] == ["up", "down"]
     seen.clear()
     plan_from_dict(ell).fragile_warnings()
