@@ -103,12 +103,11 @@ def save_changeover(
     who, when = created_by or current_user(), now_utc()
     with _conn(catalog) as conn, transaction(conn, before_commit=before_commit):
         ids = [_revision_id(conn, n, r) for n, r in mix]
-        if stamps is not None and [_stamp(conn, i) for i in ids] != list(stamps):
-            gone = [
-                f"{n}@{r}"
-                for (n, r), i, was in zip(mix, ids, stamps, strict=True)
-                if _stamp(conn, i) != was
-            ]
+        gone = [] if stamps is None else [
+            f"{n}@{r}" for (n, r), i, was in zip(mix, ids, stamps, strict=True)
+            if _stamp(conn, i) != was
+        ]  # fmt: skip
+        if gone:
             raise InputError(
                 f"{', '.join(gone)} replaced in the catalog while the plan was made (removed and "
                 "added again under the same number): nothing stored; compile the changeover again"
