@@ -372,15 +372,29 @@ def pose_difference(pf: PushFunction, a: int, b: int) -> float:
     return float(pose_differences(pf, [(a, b)])[0])
 
 
+def poses_differences(
+    pf: PushFunction, sets: Sequence[tuple[Sequence[int], Sequence[int]]]
+) -> np.ndarray:
+    """:func:`poses_difference` of every pair ``(g, h)`` of sets of stable states in ``sets``
+    (mm), with one :func:`pose_differences` over all the poses they pair: a dense outline's
+    boundary is sampled and compared once per pose, not once per pair of sets."""
+    pairs = sorted({(i, j) for g, h in sets for i in g for j in h})
+    index = {p: k for k, p in enumerate(pairs)}
+    d = pose_differences(pf, pairs)
+    out = np.zeros(len(sets))
+    for k, (g, h) in enumerate(sets):
+        m = np.array([[d[index[(i, j)]] for j in h] for i in g]).reshape(len(g), len(h))
+        out[k] = max(m.min(axis=1).max(), m.min(axis=0).max())
+    return out
+
+
 def poses_difference(pf: PushFunction, g: Sequence[int], h: Sequence[int]) -> float:
     """How far apart (mm) two sets of poses look (stable states ``g`` and ``h``, e.g. the
     ideal members of two physical resting states): the Hausdorff distance of the sets under
     :func:`pose_difference`, so each pose of either set is this close to one of the other.
     :func:`look_alike` compares it with ``NEAR_SYMMETRIC_REL`` of the part's size.
     """
-    pairs = [(i, j) for i in g for j in h]
-    d = pose_differences(pf, pairs).reshape(len(g), len(h))
-    return float(max(d.min(axis=1).max(), d.min(axis=0).max()))
+    return float(poses_differences(pf, [(g, h)])[0])
 
 
 def look_alike(

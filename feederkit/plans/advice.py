@@ -25,7 +25,11 @@ from feederkit.machine.build import build_machine
 from feederkit.machine.widths import Offsets, widen_widths
 from feederkit.mechanics.modelerror import keeping_tolerance
 from feederkit.mechanics.push import PushFunction
-from feederkit.mechanics.symmetry import NEAR_SYMMETRIC_REL, poses_difference, unlike_pairs
+from feederkit.mechanics.symmetry import (
+    NEAR_SYMMETRIC_REL,
+    look_alike,
+    poses_differences,
+)
 from feederkit.part import make_part
 from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.lumping import may_lump, unresolvable_pairs
@@ -236,18 +240,26 @@ def unlike_twins_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str |
     rotation error."""
     machine = result.machine
     lumped = set(result.lumped_pairs)
-    found: dict[tuple[int, int], None] = {}
+    listed: list[tuple[int, list[int]]] = []  # (part, its states a leaf lists together)
     for mask in leaf_masks(result.root):
         by_part: dict[int, list[int]] = {}
         for i in members(mask):
             if not machine.states[i].reject:  # a reject result needs no telling apart
                 by_part.setdefault(machine.states[i].part, []).append(i)
-        for part, idx in by_part.items():
-            if len(idx) < 2:
-                continue
-            groups = [machine.states[i].ideal_states for i in idx]
-            for a, b in unlike_pairs(pfs[part], groups):
-                i, j = idx[a], idx[b]
+        listed.extend((part, idx) for part, idx in by_part.items() if len(idx) > 1)
+    # One comparison per part of the states its leaves list: look_alike decides pair by
+    # pair, and a dense outline's boundary is then sampled once per pose, not once per leaf.
+    alike: dict[int, set[tuple[int, int]]] = {}
+    for part in {part for part, _idx in listed}:
+        used = sorted({i for p, idx in listed if p == part for i in idx})
+        near = look_alike(pfs[part], [machine.states[i].ideal_states for i in used])
+        alike[part] = {(i, used[k]) for i, row in zip(used, near, strict=True) for k in row}
+    found: dict[tuple[int, int], None] = {}
+    for part, idx in listed:
+        for a, i in enumerate(idx):
+            for j in idx[a + 1 :]:
+                if (i, j) in alike[part]:
+                    continue
                 if (i, j) not in lumped or machine.states[i].alike(machine.states[j]):
                     found[(i, j)] = None
     if not found:
@@ -277,17 +289,26 @@ def spread_words(result: PlanResult, pfs: Sequence[PushFunction]) -> str | None:
     poses, docs/uncertainty.md), with the angle their normals span; None when there are
     none. Congruent ones (a regular polygon's) orient the part and are not named."""
     machine = result.machine
+    merged = {
+        i: machine.states[i]
+        for mask in leaf_masks(result.root)
+        for i in members(mask)
+        if len(machine.states[i].members) > 1
+    }
+    # Per part, one comparison of every member of its merged states (pair by pair alike).
+    alike: dict[int, set[tuple[int, int]]] = {}
+    for part in {s.part for s in merged.values()}:
+        poses = sorted({m for s in merged.values() if s.part == part for m in s.members})
+        near = look_alike(pfs[part], [(m,) for m in poses])
+        alike[part] = {(m, poses[k]) for m, row in zip(poses, near, strict=True) for k in row}
     found: dict[int, float] = {}
-    for mask in leaf_masks(result.root):
-        for i in members(mask):
-            s = machine.states[i]
-            if len(s.members) < 2 or i in found:
-                continue
-            pf = pfs[s.part]
-            if not unlike_pairs(pf, [(m,) for m in s.members]):
-                continue
-            normals = [pf.states[m].normal_deg for m in s.members]
-            found[i] = norm360(normals[-1] - normals[0])
+    for i, s in merged.items():
+        pairs = [(a, b) for k, a in enumerate(s.members) for b in s.members[k + 1 :]]
+        if all((a, b) in alike[s.part] for a, b in pairs):
+            continue
+        pf = pfs[s.part]
+        normals = [pf.states[m].normal_deg for m in s.members]
+        found[i] = norm360(normals[-1] - normals[0])
     if not found:
         return None
     named = "; ".join(
@@ -565,12 +586,14 @@ def lump_shapes(
     the default lumping rule bounds by ``NEAR_SYMMETRIC_REL``), in words: near symmetry the
     user can accept, or (lumping ``any``) a warning that the plan leaves them unoriented."""
     worst, size = 0.0, 1.0
+    by_part: dict[int, list[tuple[tuple[int, ...], tuple[int, ...]]]] = {}
     for i, j in pairs:
         a, b = machine.states[i], machine.states[j]
-        if a.part != b.part:
-            continue  # parts that behave alike: reported as pairs of the mix
-        pf = pfs[a.part]
-        d = poses_difference(pf, a.ideal_states, b.ideal_states)
+        if a.part == b.part:  # parts that behave alike: reported as pairs of the mix
+            by_part.setdefault(a.part, []).append((a.ideal_states, b.ideal_states))
+    for part, sets in by_part.items():
+        pf = pfs[part]
+        d = float(np.max(poses_differences(pf, sets)))
         if d / pf.part.size >= worst / size:
             worst, size = d, pf.part.size
     if worst == 0.0:
