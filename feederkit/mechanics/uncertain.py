@@ -30,6 +30,8 @@ docs/uncertainty.md gives the derivations and the measured price of conservatism
 
 from __future__ import annotations
 
+import bisect
+import heapq
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -1229,7 +1231,13 @@ def _fence_cells(
 
 
 def _overshoot_chain(
-    pf: PushFunction, peaks: np.ndarray, heights: np.ndarray, k: int, way: int, eps: float
+    pf: PushFunction,
+    div: np.ndarray,
+    peaks: np.ndarray,
+    heights: np.ndarray,
+    k: int,
+    way: int,
+    eps: float,
 ) -> list[int]:
     """The ideal states a push coming down from hilltop ``k`` (``way`` +1: counter-clockwise)
     may go on to over near, low hilltops: past the state below ``k`` over its far hilltop
@@ -1238,8 +1246,7 @@ def _overshoot_chain(
     :data:`OVERSHOOT_CLIMB_REL` times as high above the well as ``k`` (with ``2 eps`` to
     spare, F1); and on from the state beyond by the same rule, from ``k`` or from any
     hilltop gone over since (the turn the part came down with carries it on), over at most
-    :data:`OVERSHOOT_MAX_HILLTOPS`."""
-    div = np.asarray(pf.divergent_deg, dtype=float)
+    :data:`OVERSHOOT_MAX_HILLTOPS`. ``div``: the hilltops (``pf.divergent_deg``) as an array."""
     m = len(div)
     rs = pf.range_state
     out: list[int] = []
@@ -1280,9 +1287,15 @@ def _band_overshoots(
     states :func:`_overshoot_chain` reaches on that side. ``hi`` may pass 360."""
     div = np.asarray(pf.divergent_deg, dtype=float)
     out: list[tuple[float, float, frozenset[int]]] = []
+    top_lo = np.array([b.top_lo_deg for b in bands], dtype=float)
+    top_w = np.array([b.top_hi_deg - b.top_lo_deg for b in bands], dtype=float)
     for k, d in enumerate(div):
         lo, hi = d, d  # the band holding hilltop k (F2 and push band)
-        for b in bands:
+        # The bands that may hold it, found at once (a 5,000-gon has as many hilltops as
+        # bands); each is then decided exactly as below, in order (the last one holds it).
+        off = np.mod(d - top_lo + 1e-6, 360.0) - 1e-6
+        near = np.flatnonzero((off <= top_w + 1e-6) | (off >= 360.0 - 1e-5))
+        for b in (bands[i] for i in near):
             off = norm360(d - b.top_lo_deg + 1e-6) - 1e-6
             if off <= b.top_hi_deg - b.top_lo_deg:
                 lo, hi = d - off - (b.top_lo_deg - b.lo_deg), d - off + (b.hi_deg - b.top_lo_deg)
@@ -1290,7 +1303,7 @@ def _band_overshoots(
             (1, (lo, max(hi, d + OVERSHOOT_BAND_DEG))),
             (-1, (min(lo, d - OVERSHOOT_BAND_DEG), hi)),
         ):
-            reached = _overshoot_chain(pf, peaks, heights, k, way, eps)
+            reached = _overshoot_chain(pf, div, peaks, heights, k, way, eps)
             if reached:
                 out.append((*zone, frozenset().union(*(dest[i] for i in reached))))
     return out
@@ -1315,24 +1328,58 @@ def _overlay(
         spans.append((x, min(y, base + 360.0), extra))
         if y > base + 360.0:
             spans.append((base, y - 360.0, extra))
+    ends = sorted({v for a, b, _ in spans for v in (a, b)})
+    pieces = [(cell, a, b) for cell in cells for a, b in _pieces(cell, ends)]
+    covering = _covering([(a, b) for _cell, a, b in pieces], spans)
     out: list[FenceCell] = []
-    for cell in cells:
-        cuts = sorted(
-            {cell.lo, cell.hi} | {v for a, b, _ in spans for v in (a, b) if cell.lo < v < cell.hi}
-        )
-        for a, b in zip(cuts, cuts[1:], strict=False):
-            targets = cell.targets.union(*(extra for x, y, extra in spans if x <= a and b <= y))
-            if (
-                out
-                and out[-1].hi == a
-                and out[-1].closed == cell.closed
-                and (out[-1].targets == targets)
-                and out[-1].lo >= cell.lo
-            ):
-                out[-1] = FenceCell(out[-1].lo, b, cell.closed, targets)
-            else:
-                out.append(FenceCell(a, b, cell.closed, targets))
+    for (cell, a, b), over in zip(pieces, covering, strict=True):
+        targets = cell.targets.union(*(spans[i][2] for i in over))
+        if (
+            out
+            and out[-1].hi == a
+            and out[-1].closed == cell.closed
+            and (out[-1].targets == targets)
+            and out[-1].lo >= cell.lo
+        ):
+            out[-1] = FenceCell(out[-1].lo, b, cell.closed, targets)
+        else:
+            out.append(FenceCell(a, b, cell.closed, targets))
     return tuple(out)
+
+
+def _pieces(cell: FenceCell, ends: Sequence[float]) -> list[tuple[float, float]]:
+    """``cell`` cut at every one of ``ends`` (sorted, distinct) strictly inside it, in order."""
+    inside = ends[bisect.bisect_right(ends, cell.lo) : bisect.bisect_left(ends, cell.hi)]
+    cuts = sorted({cell.lo, cell.hi, *inside})
+    return list(zip(cuts, cuts[1:], strict=False))
+
+
+def _covering(
+    pieces: Sequence[tuple[float, float]], spans: Sequence[tuple[float, float, frozenset[int]]]
+) -> list[list[int]]:
+    """Per piece ``(a, b)``, the indices of the spans ``(x, y, _)`` with ``x <= a`` and
+    ``b <= y``, found by one sweep over the pieces' middles (no end of a span lies inside a
+    piece, so a span holding its middle holds it); each found span is checked exactly, and a
+    piece too short for a middle is checked against every span."""
+    order = sorted(range(len(spans)), key=lambda i: spans[i][0])
+    by_mid = sorted(range(len(pieces)), key=lambda k: (pieces[k][0] + pieces[k][1]) / 2.0)
+    out: list[list[int]] = [[] for _ in pieces]
+    active: dict[int, None] = {}
+    ending: list[tuple[float, int]] = []
+    nxt = 0
+    for k in by_mid:
+        a, b = pieces[k]
+        mid = (a + b) / 2.0
+        while nxt < len(order) and spans[order[nxt]][0] < mid:
+            i = order[nxt]
+            active[i] = None
+            heapq.heappush(ending, (spans[i][1], i))
+            nxt += 1
+        while ending and ending[0][0] <= mid:
+            active.pop(heapq.heappop(ending)[1], None)
+        held = active if a < mid < b else range(len(spans))
+        out[k] = sorted(i for i in held if spans[i][0] <= a and b <= spans[i][1])
+    return out
 
 
 def mechanics_to_dict(mech: UncertainMechanics) -> dict[str, object]:
