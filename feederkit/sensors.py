@@ -465,7 +465,7 @@ class ToleranceSensor:
         return ToleranceSensor(max(self.tolerance - inset, self.tolerance / 2.0))
 
     def describe(self) -> str:
-        return f"diameter sensor: a reading lies within \u00b1{self.tolerance:.4g} mm of it"
+        return f"diameter sensor: a reading lies within \u00b1{self.tolerance:.12g} mm of it"
 
     def to_dict(self) -> dict[str, Any]:
         return {"model": "tolerance", "tolerance_mm": self.tolerance}
@@ -668,7 +668,7 @@ class LedSensor:
 
     def describe(self) -> str:
         return (
-            f"LED array: beams every {self.pitch:.4g} mm, alignment noise {self.noise:.4g} mm; "
+            f"LED array: beams every {self.pitch:.12g} mm, alignment noise {self.noise:.12g} mm; "
             "the reading is the blocked beams times the pitch"
         )
 

@@ -347,3 +347,12 @@ def test_sensor_dicts_round_trip(sensor):
 def test_broken_sensor_dicts_are_bad_input(data, message):
     with pytest.raises(InputError, match=message):
         sensor_from_dict(data)
+
+
+def test_a_sensor_is_described_at_the_precision_it_was_given():
+    # 0.143673 and 0.143674 mm may be either side of a mix's critical tolerance: both were
+    # shown as "±0.1437 mm", above the critical one.
+    assert "±0.143673 mm" in ToleranceSensor(0.143673).describe()
+    assert "±0.143674 mm" in ToleranceSensor(0.143674).describe()
+    led = LedSensor(0.51234, 0.012345).describe()
+    assert "every 0.51234 mm, alignment noise 0.012345 mm" in led
