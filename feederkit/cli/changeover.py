@@ -95,7 +95,7 @@ from feederkit.cli.common import (
 from feederkit.cli.plan_render import plan_tree, sensor_text, stats_table
 from feederkit.errors import CheckFailed, InputError
 from feederkit.jsonio import OutputFile, write_files
-from feederkit.landing.plan import landing_names
+from feederkit.landing.plan import landing_names, left_out_words
 from feederkit.loading import load_parts
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.changeover import (
@@ -103,6 +103,7 @@ from feederkit.mix.changeover import (
     changeover_exists,
     compile_changeover,
     landing_rows,
+    left_out_landings,
     load_changeover,
     member_name,
     mix_landings,
@@ -493,7 +494,8 @@ def compile_command(
         mix_landings(path, loaded, over.get("landings"))  # a landing a part does not have
     if not replace and changeover_exists(path, name):  # every input is checked before this
         raise InputError(f"a changeover named {name!r} already exists (use --replace)")
-    print_warnings(declared.warnings)
+    left = left_out_landings(path, loaded, over.get("landings"))
+    print_warnings([*declared.warnings, *left_out_words(left, "the changeover")])
 
     def outputs(c: CompiledChangeover, text: str) -> list[OutputFile]:
         # Runs before the changeover is stored, on the plan as its file reads back.

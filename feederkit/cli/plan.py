@@ -284,7 +284,13 @@ def plan_command(
         names = {x.name for x in every} | {m for x in every for m in x.merged}
         taken = _accepted_names(accept, names)  # bad input: one line, before any warning
         pfs = [push_function(x.part) for x in every]
-        print_warnings([*declared.warnings, *found.warnings(over_landings=True)])
+        print_warnings(
+            [
+                *declared.warnings,
+                *found.warnings(over_landings=True),
+                *found.left_out_words("the plan"),
+            ]
+        )
         json_found(members=[x.label for x in every])
         with (
             searching("planning and verifying", options.time_limit_s),

@@ -78,8 +78,11 @@ def run_command(
         raise InputError(f"--start-deg must be a finite angle in degrees, got {start_deg}")
     plan = load_plan(plan_path, max_plan_mb)
     indices: list[int] = []
+    left: list[str] = []
     for source in sources or []:
-        for k in _members_of(plan, source, catalog):
+        found, words = _members_of(plan, source, catalog)
+        left += words
+        for k in found:
             if k not in indices:
                 indices.append(k)
     if not sources:
@@ -87,7 +90,7 @@ def run_command(
     # The fragile states of the parts run (a SOURCE's member), not of every part of the mix.
     held = (plan.low_margin_warning(), plan.ideal_model_warning())
     warnings = [w for w in held if w] + plan.fragile_warnings(indices)
-    warnings += stored_beyond(plan, sources or [], catalog)
+    warnings += stored_beyond(plan, sources or [], catalog) + left
     if not json_out:
         for w in warnings:
             console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)
@@ -166,10 +169,12 @@ STORED_EPS_MM = 1e-9
 declares the stored value itself when it took it from the catalog."""
 
 
-def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
+def _members_of(plan: Plan, source: str, catalog: str | None) -> tuple[list[int], list[str]]:
     """The plan's members a SOURCE names: its part (same hull and COM, ``match_part``) or,
     in a plan over landings, every landing of that part the plan holds, each checked
-    against the source's own landing (docs/plans.md: every member is run)."""
+    against the source's own landing (docs/plans.md: every member is run); and a line when
+    the part also lands in ways the plan does not hold (not run: a part landing so is not
+    oriented by the plan)."""
     part = load_part(source, catalog=catalog)
     try:  # the plan's name for the part: a renamed file of the same geometry is the part
         k = match_part(plan, part, source)
@@ -179,13 +184,14 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
             raise InputError(f"{exc}{next((h for h in hints if h), '')}") from None
         k = None  # a plan of other landings only (down): checked landing by landing
     if not plan.over_landings:
-        return [k]
+        return [k], []
     name = part.name if k is None else plan.parts[k].name
     held = tuple(dict.fromkeys(m.landing for m in plan.parts if m.name == name and m.landing))
     out = []
     # Only the landings the plan holds: another may be one pushing cannot orient (a mesh
     # pose on a round face), which loading it would refuse.
-    for x in load_landings([source], catalog=catalog, which=held).all:
+    found = load_landings([source], catalog=catalog, which=held)
+    for x in found.all:
         for j, member in enumerate(plan.parts):
             if member.name != name or member.landing != x.name:
                 continue
@@ -196,7 +202,7 @@ def _members_of(plan: Plan, source: str, catalog: str | None) -> list[int]:
                     + _likeness_hint(plan, member, x.part, source)
                 )
             out.append(j)
-    return sorted(out) or [match_part(plan, part, source)]
+    return sorted(out) or [match_part(plan, part, source)], found.left_out_words("the plan")
 
 
 LIKENESS_REL = 1e-3

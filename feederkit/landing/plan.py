@@ -202,6 +202,12 @@ class LoadedLandings:
 
     parts: LoadedParts
     landings: tuple[tuple[Landing, ...], ...]
+    left_out: tuple[tuple[Landing, ...], ...] = ()
+    """Per part, its landings that ``which`` did not select (a part may still land so)."""
+
+    def left_out_words(self, what: str) -> list[str]:
+        """:func:`left_out_words` of the landings ``which`` did not select."""
+        return left_out_words(self.left_out, what)
 
     @property
     def all(self) -> tuple[Landing, ...]:
@@ -222,6 +228,24 @@ class LoadedLandings:
             return list(self.parts.warnings)
         members = [(x.part_name, x.name, push_function(x.part)) for x in self.all]
         return [*self.parts.import_warnings, *member_fragile_warnings(members)]
+
+
+def left_out_words(left_out: Sequence[Sequence[Landing]], what: str) -> list[str]:
+    """A line per part that lands in a way ``what`` (e.g. "the plan") leaves out (its
+    ``left_out`` landings, per part), with the share of drops that land so: a part landing
+    so is not oriented by it."""
+    out = []
+    for lands in left_out:
+        named = [x for x in lands if x.probability > 0.0]
+        if not named:
+            continue
+        ways = ", ".join(f"{x.name} in {100.0 * x.probability:.3g} %" for x in named)
+        out.append(
+            f"{named[0].part_name} also lands {ways} of drops, which {what} leaves out "
+            "(--landings): a part landing so is not oriented by it (to plan every landing "
+            "and reject some, name the ones the next station takes with --accept)"
+        )
+    return out
 
 
 def landing_names(text: str, what: str = "--landings") -> tuple[str, ...]:
@@ -286,14 +310,17 @@ def load_landings(
     started = time.monotonic()
     loaded = load_parts(sources, catalog=catalog, options=options)
     db = None if catalog is None else str(Path(catalog))
-    per_part = [
-        checked_landings(
-            source,
-            select_landings(
-                _landings_of(source, pf, db, (options or ImportOptions()).counting_from(started)),
-                which,
-            ),
-        )
+    opts = (options or ImportOptions()).counting_from(started)
+    every = [
+        _landings_of(source, pf, db, opts)
         for source, pf in zip(loaded.origins, loaded.push_functions, strict=True)
     ]
-    return LoadedLandings(loaded, tuple(per_part))
+    per_part = [
+        checked_landings(source, select_landings(lands, which))
+        for source, lands in zip(loaded.origins, every, strict=True)
+    ]
+    left = [
+        tuple(x for x in lands if x.name not in {c.name for c in chosen})
+        for lands, chosen in zip(every, per_part, strict=True)
+    ]
+    return LoadedLandings(loaded, tuple(per_part), tuple(left))

@@ -476,6 +476,23 @@ def mix_landings(
     ]
 
 
+def left_out_landings(
+    catalog: str | os.PathLike[str],
+    loaded: LoadedParts,
+    landings: str | Sequence[str] | None = None,
+) -> list[tuple[Landing, ...]]:
+    """Per loaded catalog part, its stored landings that ``landings`` (None: all) does not
+    name: the ways it lands that a changeover of those landings leaves out."""
+    if landings in (None, "all"):
+        return []
+    out = []
+    for (n, r), pf in zip(loaded.revisions, loaded.push_functions, strict=True):
+        every = _stored_landings(catalog, n, r, pf)
+        chosen = {x.name for x in select_landings(every, landings)}
+        out.append(tuple(x for x in every if x.name not in chosen))
+    return out
+
+
 def compile_changeover(
     catalog: str | os.PathLike[str],
     name: str,
