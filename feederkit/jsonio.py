@@ -228,10 +228,14 @@ def destination(path: str | os.PathLike[str], what: str = "file") -> Path:
     target = Path(os.path.realpath(given)) if given.is_symlink() else given
     database = _database_file(target)
     if database is not None:
-        whose = "" if database == target else f" of the database {database}"
+        whose = (
+            "an SQLite database"
+            if database == target
+            else f"a side file (journal or shared memory) of the SQLite database {database}"
+        )
         raise InputError(
-            f"{given}: cannot write the {what} over an SQLite database{whose} (a feederkit "
-            "catalog?): give the file another path"
+            f"{given}: cannot write the {what} over {whose} (a feederkit catalog?): give the "
+            "file another path"
         )
     try:
         st = os.stat(target)

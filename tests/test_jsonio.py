@@ -247,7 +247,9 @@ def test_an_sqlite_database_and_its_side_files_are_never_overwritten(
     with pytest.raises(InputError) as exc:
         write_text_atomic(target, "{}", what="plan file")
     text = str(exc.value)
-    assert "\n" not in text and "cannot write the plan file over an SQLite database" in text
+    said = "an SQLite database" if not suffix else "a side file (journal or shared memory) of "
+    assert "\n" not in text and f"cannot write the plan file over {said}" in text
+    assert "of the database" not in text  # "over an SQLite database of the database X"
     assert db.read_bytes() == before and not (suffix and target.exists())
     link = tmp_path / "current.db"
     link.symlink_to(db)

@@ -35,6 +35,7 @@ from feederkit.cli.common import (
     json_option,
     plural,
     print_json,
+    print_warnings,
 )
 from feederkit.cli.plan_render import DEFAULT_MAX_PLAN_MB, MaxPlanMbOpt, load_plan
 from feederkit.errors import CheckFailed, InputError
@@ -108,8 +109,6 @@ def _print_summary(s: SimulationSummary, declared: str) -> None:
         console.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
     if s.beyond_certified:
         console.print(f"[yellow]note:[/] {escape(s.beyond_certified)}", highlight=False)
-    if s.width_warning:
-        console.print(f"[yellow]warning:[/] {escape(s.width_warning)}", highlight=False)
     rows = s.went_wrong
     if rows:
         t = Table(title="trials that went wrong (model errors first)", title_justify="left")
@@ -256,9 +255,7 @@ def simulate_command(
         uncertainty_declared=data.uncertainty_declared,
     )
     held = [data.low_margin_warning(), data.ideal_model_warning()]
-    for line in [*held, *(r.tolerance_warning() for r in real)]:
-        if line:
-            err_console.print(f"warning: {line}", style="yellow", highlight=False, markup=False)
+    print_warnings(line for line in [*held, *(r.tolerance_warning() for r in real)] if line)
     columns = (
         TextColumn("simulating"),
         BarColumn(),
@@ -294,12 +291,10 @@ def simulate_command(
                 "uncertainty_declared": data.uncertainty_declared,
             }
         )
-        if summary.width_warning:  # the human output says it beside the failures
-            err_console.print(
-                f"warning: {summary.width_warning}", style="yellow", highlight=False, markup=False
-            )
     else:
         _print_summary(summary, data.uncertainty_words())
+    if summary.width_warning:  # stderr, one line, as every warning (docs/cli.md)
+        print_warnings([summary.width_warning])
     if require_success is not None and summary.success_rate < require_success:
         raise CheckFailed(
             f"{summary.successes} of {plural(summary.trials, 'trial')} succeeded "
