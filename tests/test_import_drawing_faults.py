@@ -224,6 +224,23 @@ def test_an_open_outline_of_lines_is_said_to_surround_the_part(tmp_path, hole):
 
 
 @pytest.mark.parametrize(
+    "beside",
+    [
+        lambda msp: msp.add_lwpolyline([(110, 0), (140, 0), (140, 8), (110, 8)], close=True),
+        lambda msp: msp.add_circle((130, 10), 6),
+    ],
+    ids=["label box", "washer"],
+)
+def test_an_open_outline_beside_a_smaller_loop_is_named(tmp_path, beside):
+    # The plate's outline open by 0.5 mm and a label box (or a washer) beside it: the loop
+    # was imported as the part with no word (the open lines were simply left out).
+    (ip,) = parts(drawing(tmp_path / "open.dxf", lambda msp: _open_outline(msp, beside)))
+    (note,) = noted(ip, "open outline", "lies beside the imported part")
+    assert "0.5 mm apart" in note and "more than the part's" in note
+    assert area(ip) < 300  # still the loop: the warning is what tells the user
+
+
+@pytest.mark.parametrize(
     "hole",
     [
         lambda msp: _lines(msp, [*WINDOW, (50, 10.3)], close=False),  # the last LINE 0.3 short

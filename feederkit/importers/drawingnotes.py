@@ -137,6 +137,22 @@ def open_line_notes(
         ends = _free_ends(g)
         if _nearly_closed(g, ends, gap):
             nearly.append((g, ends))
+    # An open outline beside the part that, closed between its ends, holds more than the
+    # part: the drawing's real outline left open (a LINE stopping short, a polyline whose
+    # closed flag is missing), and the part imported some other loop (a label box).
+    larger = [
+        (g, ends)
+        for g, ends in nearly
+        if not any(g is a for a in around) and _closed_area(g) > part.area
+    ]
+    if larger:
+        g, ends = max(larger, key=lambda x: _closed_area(x[0]))
+        notes.append(
+            f"an open outline ({box_words(g.bounds)}, {ends_words(ends)}) lies beside the "
+            f"imported part and, closed, would hold {_closed_area(g):.4g} mm², more than the "
+            f"part's {part.area:.4g} mm²: the drawing's real outline may be open and the part "
+            "imported another loop; close the outline in the drawing"
+        )
     inside: list[tuple[shapely.Geometry, np.ndarray]] = []
     if nearly:
         solids = [Polygon(r.shell, r.holes) for r in regions]
@@ -202,6 +218,15 @@ def _nearly_closed(group: shapely.Geometry, ends: np.ndarray, gap: float) -> boo
     if apart > NEARLY_CLOSED * max(x1 - x0, y1 - y0):
         return False
     return abs(float(shapely.area(Polygon(chain.coords)))) > gap * chain.length
+
+
+def _closed_area(group: shapely.Geometry) -> float:
+    """The area a connected group of open lines that is one chain holds when closed
+    between its ends (0 for one that is no chain)."""
+    chain = shapely.line_merge(group)
+    if not isinstance(chain, LineString) or len(chain.coords) < 3:
+        return 0.0
+    return abs(float(shapely.area(Polygon(chain.coords))))
 
 
 def edge_line_note(box: Sequence[float], band: float) -> str:
