@@ -190,7 +190,25 @@ def test_two_separate_parts_equal_in_size_are_not_called_the_largest(tmp_path):
     bigger = fx.write_entities(tmp_path / "bigger.dxf", lambda msp: two(msp, 21.0))
     [part] = import_parts(bigger, ImportOptions())[1]
     [note] = [w for w in part.warnings if "separate parts" in w]
-    assert "imported the largest (use --all-parts for all)" in note
+    assert "imported the one of the largest outline, area 840.0 mm2 at" in note
+    assert note.endswith("(use --all-parts for all)")
+
+
+def test_a_part_chosen_by_its_outline_says_how_much_its_holes_take(tmp_path):
+    # A 50 x 30 plate with a D10 hole (1421.6 mm2 of material, flattened) beside a 48 x 31
+    # plate (1488): the first is imported, by its outline; "the largest" then listed a
+    # larger part left out.
+    import fixtures_cad as fx
+
+    def build(msp) -> None:
+        msp.add_lwpolyline([(0, 0), (50, 0), (50, 30), (0, 30)], close=True)
+        msp.add_circle((25, 15), 5)
+        msp.add_lwpolyline([(100, 0), (148, 0), (148, 31), (100, 31)], close=True)
+
+    path = fx.write_entities(tmp_path / "two.dxf", build)
+    [part] = import_parts(path, ImportOptions())[1]
+    [note] = [w for w in part.warnings if "separate parts" in w]
+    assert "the one of the largest outline, area 1421.6 mm2 (1500.0 inside its outline)" in note
 
 
 def test_a_mesh_whose_only_triangle_has_a_nan_says_why_none_is_left(tmp_path):

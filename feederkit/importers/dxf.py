@@ -947,7 +947,9 @@ def _describe(region: Region) -> str:
     xs = [p[0] for p in region.shell]
     ys = [p[1] for p in region.shell]
     cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
-    return f"area {region.area:.1f} mm2 at ({cx:.1f}, {cy:.1f})"
+    # Parts are chosen by their outline's area; a part with holes has less material.
+    inside = f" ({region.loop_area:.1f} inside its outline)" if region.holes else ""
+    return f"area {region.area:.1f} mm2{inside} at ({cx:.1f}, {cy:.1f})"
 
 
 def read_dxf(
@@ -1107,7 +1109,7 @@ def _read_doc(
         top = regions[0].loop_area
         ties = sum(1 for r in regions if r.loop_area >= top * (1.0 - AREA_TIE_REL))
         which = (
-            "the largest"
+            f"the one of the largest outline, {_describe(regions[0])}"
             if ties == 1
             else f"one of the {ties} largest, equal in size: {_describe(regions[0])}"
         )
