@@ -10,6 +10,7 @@ probability is their sum, named after its most probable pose.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from feederkit.errors import InputError
@@ -59,12 +60,38 @@ def landings_of_mesh(
             raise InputError(f"{p}: no pose {k}: the mesh has {len(poses)} resting poses")
         part = _pose_part(s, poses[k], options.com, label, hull_tolerance)
         return (Landing(label, pose_name(k), 1.0, renamed(part, f"{label}/{pose_name(k)}")),)
+    check = _naming_poses(budget, len(poses))
     candidates = []
     for k, pose in enumerate(poses):
-        budget.check_time()
+        check()
         part = _pose_part(s, pose, None, label, hull_tolerance)
         candidates.append((pose_name(k), pose.probability, part))
-    return merge_congruent(label, candidates, budget.check_time)
+    return merge_congruent(label, candidates, check)
+
+
+ROUND_BODY_POSES = 100
+"""A mesh with this many resting poses or more is named as a near-round body when its
+landings run out of the import's time (a tessellated ball rests on every facet)."""
+
+
+def _naming_poses(budget: Budget, poses: int) -> Callable[[], None]:
+    """The budget's deadline, its refusal naming what the import was doing: comparing the
+    mesh's resting poses (one per facet a body can rest on), which no larger limit may
+    finish for a ball of a thousand facets."""
+
+    def check() -> None:
+        try:
+            budget.check_time()
+        except InputError as exc:
+            why = f"; it was comparing the mesh's {poses} resting poses"
+            if poses >= ROUND_BODY_POSES:
+                why += (
+                    " (a near-round body such as a ball rests on every facet, and none of "
+                    "them is a flat pose a fence can orient)"
+                )
+            raise InputError(f"{exc}{why}") from None
+
+    return check
 
 
 def _pose_part(s, pose, com2d, label: str, hull_tolerance: float | None) -> Part:
