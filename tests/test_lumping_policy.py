@@ -407,8 +407,10 @@ def test_the_command_line_refuses_unlike_poses_with_one_line_and_exit_1(tmp_path
     pts = [[0, 0], [5, 0], [5, 2.3], [4.8, 2.5], [0, 2.5]]
     cut.write_text(json.dumps({"name": "cut", "vertices": pts}))
     assert main(["plan", str(cut), "--sensorless", "--landings", "up"]) == 1
-    err = capsys.readouterr().err
-    assert err.startswith("result: no strong plan exists") and len(err.strip().splitlines()) == 1
+    *warnings, result = capsys.readouterr().err.strip().splitlines()
+    assert result.startswith("result: no strong plan exists")
+    # Only the face-down landing --landings leaves out is warned of, each warning one line.
+    assert len(warnings) == 1 and warnings[0].startswith("warning: cut also lands down")
 
 
 def test_the_command_line_plans_the_near_symmetric_part(tmp_path, capsys):

@@ -601,6 +601,8 @@ def compile_command(
         )
     if compiled.made.unoriented is not None:
         raise CheckFailed(f"changeover {name!r}: {compiled.made.unoriented}")
+    if compiled.made.holds_nothing is not None:
+        raise CheckFailed(f"changeover {name!r}: {compiled.made.holds_nothing}")
 
 
 def _shares(plan: dict[str, Any]) -> dict[str, float]:

@@ -342,6 +342,8 @@ def plan_command(
             raise CheckFailed(pairs_message(witnesses, lumped))
     if made.unoriented is not None:
         raise CheckFailed(made.unoriented)
+    if made.holds_nothing is not None:
+        raise CheckFailed(made.holds_nothing)
 
 
 IMPORT_MIN_S = 1.0

@@ -88,6 +88,11 @@ class MadePlan:
     """When some result lists poses of one part that do not look alike and that no plan can
     tell apart (:func:`~feederkit.plans.advice.unlike_twins_words`): the words saying so (a
     command exits 1)."""
+    holds_nothing: str | None = None
+    """When the plan is the ideal model's and its certificate holds no rotation error at all
+    on a feeder that vibrates (:func:`~feederkit.plans.model.ideal_plan_words`): a result to
+    act on, in words (a command exits 1): such a plan fails on the belt with an exact robot
+    (a drop near a hilltop goes either way)."""
 
 
 def make_plan(
@@ -303,9 +308,20 @@ def _make_plan(
             f"{margin}; ask for a minimum margin or check the plan with feederkit simulate"
         )
     held = ideal_plan_words(unc, result.min_margin, result.certificate)
+    nothing = None
     if held is not None:
         warnings.append(held)
-    return MadePlan(data, result, report, tuple(warnings + notes), unoriented)
+        if result.certificate is not None and result.certificate.max_rotation_error_deg <= 0.0:
+            nothing = HOLDS_NOTHING_WORDS
+    return MadePlan(data, result, report, tuple(warnings + notes), unoriented, nothing)
+
+
+HOLDS_NOTHING_WORDS = (
+    "the plan is the ideal model's and holds no rotation error on a feeder that vibrates "
+    "(see the warning): with an exact robot a drop near a hilltop may still go either way; "
+    "plan with --rotation-error DEG, or check this plan with feederkit simulate"
+)
+"""The result line of a plan that :attr:`MadePlan.holds_nothing`."""
 
 
 def _time_left(opts: PlanningOptions, started: float, walk_s: float) -> bool:
