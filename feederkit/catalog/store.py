@@ -49,7 +49,7 @@ from feederkit.importers import (
 )
 from feederkit.importers.budget import Budget
 from feederkit.jsonio import parse_json
-from feederkit.landing.mesh import landings_of_mesh, pose_name
+from feederkit.landing.mesh import judged_by_landings, landings_of_mesh, pose_name
 from feederkit.landing.model import (
     DEFAULT_SIDE_PROBABILITY,
     Landing,
@@ -303,6 +303,7 @@ def write_revision(
     """
     if landings is None:
         landings = landings_for(imported)
+    imported = judged_by_landings(imported, landings)  # a mesh: orientable by its landings
     part = imported.part
     name = check_part_name(part.name)
     who = created_by or current_user()

@@ -10,13 +10,16 @@ probability is their sum, named after its most probable pose.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import dataclasses
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from feederkit.errors import InputError
 from feederkit.importers.budget import Budget
 from feederkit.importers.mesh import load_mesh, pose_outline, resting_poses, solid
 from feederkit.importers.model import ImportOptions
+from feederkit.importers.orientable import orientability
+from feederkit.importers.reader import NOT_ORIENTABLE, ImportedPart
 from feederkit.landing.model import Landing, merge_congruent, renamed
 from feederkit.mechanics.modelerror import kept_part
 from feederkit.outline import make_outline
@@ -92,6 +95,35 @@ def _naming_poses(budget: Budget, poses: int) -> Callable[[], None]:
             raise InputError(f"{exc}{why}") from None
 
     return check
+
+
+def judged_by_landings(imported: ImportedPart, landings: Sequence[Landing]) -> ImportedPart:
+    """A mesh part judged orientable by its landings rather than by its imported pose alone.
+
+    The import judges the pose it imports (``pose-0``, the likeliest single facet: a
+    cylinder's round end, 17 % of drops, disk-like) while ``plan`` judges a mesh by its
+    landings (the cylinder on its side, 83 %, orients): when some landing of positive
+    probability is orientable (:func:`~feederkit.importers.orientability`), so is the part,
+    and the import's warning names the landings that are not and their share of drops.
+    Flat parts, and meshes with one landing or an orientable imported pose, are unchanged.
+    """
+    if imported.source.kind != "mesh" or len(landings) < 2 or imported.orientability.orientable:
+        return imported
+    verdicts = [(x, orientability(x.part, imported.hull_tolerance)) for x in landings]
+    good = [(x, v) for x, v in verdicts if v.orientable and x.probability > 0.0]
+    if not good:
+        return imported
+    bad = [x for x, v in verdicts if not v.orientable]
+    share = 100.0 * sum(x.probability for x in bad)
+    old = f"{NOT_ORIENTABLE}: {imported.orientability.reason}"
+    note = (
+        f"{', '.join(x.name for x in bad)} ({share:.3g} % of drops) {NOT_ORIENTABLE}: "
+        f"{imported.orientability.reason}; its landings "
+        f"{', '.join(x.name for x, _v in good)} are, and a plan orients the part by them"
+    )
+    best = max(good, key=lambda g: g[0].probability)[1]
+    warnings = tuple(note if w == old else w for w in imported.warnings)
+    return dataclasses.replace(imported, orientability=best, warnings=warnings)
 
 
 def _pose_part(s, pose, com2d, label: str, hull_tolerance: float | None) -> Part:
