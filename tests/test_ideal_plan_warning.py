@@ -24,7 +24,8 @@ def words(text: str) -> str:
 def ideal_plan(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("ideal") / "r0.plan.json"
     args = ["plan", str(CATALOG / "rectangle-2x1.json"), "--tolerance", "0.05"]
-    assert main([*args, "--rotation-error", "0", "-o", str(out)]) == 0
+    # Written, and a result to act on: it holds no rotation error on a feeder that vibrates.
+    assert main([*args, "--rotation-error", "0", "-o", str(out)]) == 1
     return out
 
 

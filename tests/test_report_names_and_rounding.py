@@ -57,6 +57,7 @@ def test_the_design_section_never_rounds_a_critical_tolerance_up():
     assert "0 &lt; tolerance &le; 0.3 mm" in html  # float noise is not shown as 0.299999
     assert "<td>quad25/up</td><td>quad25/down</td><td>0.455213 mm</td>" in html  # the pairs
     assert "critical 0.455213 mm" in html  # the plot's mark
+    assert "0.4552 mm" not in html  # the axis's end, under the mark, said 0.4552: too coarse
     led = design_section(DESIGN, LedSensor(0.1, 0.02))
     assert "within the 0.455213 mm that keeps the mix recognizable" in led
     assert "0.455214" not in led
@@ -172,3 +173,29 @@ def test_compile_and_report_name_the_changeover(db, tmp_path, capsys, monkeypatc
     )
     cli_ok(capsys, ["changeover", "report", "line 1", "-o", html, "--catalog", str(db)])
     assert given == ["line 1", "line 1"]
+
+
+def test_the_design_plot_labels_the_critical_tolerance_rounded_down(tmp_path):
+    # design sensor --plot said "critical tolerance 0.4909 mm" for 0.490866 mm, at which the
+    # triangle and the octagon cannot be told apart (the terminal said 0.490866).
+    from pathlib import Path
+
+    import matplotlib
+
+    from feederkit.design.plot import plot_design
+    from feederkit.design.sensor import design_tolerance
+    from feederkit.mechanics.push import push_function
+    from feederkit.outline import load_outline_json
+    from feederkit.part import make_part
+
+    catalog = Path(__file__).resolve().parents[1] / "catalog"
+    pfs = [
+        push_function(make_part(load_outline_json(catalog / f"{n}.json")))
+        for n in ("equilateral-triangle", "octagon")
+    ]
+    design = design_tolerance(pfs)
+    shown = shown_tolerance(design.critical_tolerance)
+    with matplotlib.rc_context({"svg.fonttype": "none"}):  # the labels as text
+        svg = plot_design(design, tmp_path / "d.svg").read_text()
+    assert f"critical tolerance {shown} mm" in svg
+    assert float(shown) <= design.critical_tolerance

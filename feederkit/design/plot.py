@@ -13,6 +13,7 @@ from pathlib import Path
 from feederkit.design.sensor import PitchDesign, ToleranceDesign
 from feederkit.errors import InputError
 from feederkit.reports.partplot import drawable
+from feederkit.words import shown_tolerance
 
 PLOT_SUFFIXES = (".png", ".svg")
 
@@ -67,7 +68,8 @@ def _tolerance(ax, design: ToleranceDesign) -> None:
         drawn = True
     x = design.critical_tolerance
     if x is not None:
-        ax.axvline(x, color="C3", linestyle="--", label=f"critical tolerance {x:.4g} mm")
+        label = f"critical tolerance {shown_tolerance(x)} mm"  # rounded down: it works
+        ax.axvline(x, color="C3", linestyle="--", label=label)
     u = design.uncertainty
     ax.set_xlabel("sensor tolerance (mm)" + ("" if u.is_ideal else
                   f"; strong plans, rotation error {u.rotation_error_deg:g} deg"))  # fmt: skip

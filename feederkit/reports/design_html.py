@@ -231,7 +231,8 @@ def _step_plot(
     if not rows:
         return ""
     ends = [hi for _lo, hi, _n, _e in rows if hi is not None]
-    x_max = max(ends + [critical or 0.0, rows[-1][0] * 2.0]) or 1.0
+    # Past the critical tolerance: the axis's end is no tolerance the mix is recognized at.
+    x_max = max(ends + [1.25 * (critical or 0.0), rows[-1][0] * 2.0]) or 1.0
     y_max = max(n for _lo, _hi, n, _e in rows) + 1
     w, h = WIDTH - PAD - 10, HEIGHT - PAD - 10
 
