@@ -175,6 +175,7 @@ def test_a_drawing_past_its_line_limit_stops_and_says_what_it_left_out():
     assert len(before.splitlines()) < 100  # 60 labels (a few results wrap), not ~500
     left = re.search(r"(\d+) more operations", " ".join(note.split()))
     assert left is not None and 0 < int(left.group(1)) < 121  # 121 distinct steps in all
+    assert "not drawn here (in the plan file)" in before  # a cut branch says so
     whole = Console(file=io.StringIO(), width=200)
     whole.print(plan_tree(plan))
     assert "the drawing stops" not in whole.file.getvalue()

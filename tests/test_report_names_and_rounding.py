@@ -199,3 +199,25 @@ def test_the_design_plot_labels_the_critical_tolerance_rounded_down(tmp_path):
         svg = plot_design(design, tmp_path / "d.svg").read_text()
     assert f"critical tolerance {shown} mm" in svg
     assert float(shown) <= design.critical_tolerance
+
+
+def test_one_parts_plan_over_its_landings_is_a_plan_report(tmp_path, capsys):
+    # Both landings of one part were headed "Changeover report: quadrilateral".
+    from feederkit.cli.app import main
+
+    html = tmp_path / "q.html"
+    args = ["plan", str(CATALOG / "quadrilateral.json"), "--tolerance", "0.2"]
+    assert main([*args, "-o", str(tmp_path / "q.json"), "--report", str(html)]) in (0, 1)
+    capsys.readouterr()
+    assert heading_of(html.read_text())[1] == ">Plan report: quadrilateral"
+
+
+def test_poses_that_all_look_alike_name_no_unlike_pair():
+    # A triangle's three poses, all alike, ended in an empty "not alike: ".
+    from feederkit.reports.sections import _unlike_words
+    from feederkit.reports.twins import TwinLeaf
+
+    alike = TwinLeaf(1, 0, (0, 1, 2), (), False, ())
+    assert _unlike_words(alike) == ""
+    apart = TwinLeaf(1, 0, (0, 1, 2), ((0, 2),), False, ())
+    assert _unlike_words(apart) == ", not alike: s0 and s2"

@@ -97,9 +97,10 @@ def _op_text(step: Step, number: int) -> Text:
 
 
 PLAN_TREE_LINES = 1000
-"""The terminal drawing of a plan stops after this many lines: a plan of a large mix can
-have tens of thousands, which no one reads in a terminal and which take longer to draw than
-the plan took to make. The plan file holds it whole; ``feederkit report`` draws it."""
+"""The terminal drawing of a plan stops after this many entries (lines before wrapping): a
+plan of a large mix can have tens of thousands, which no one reads in a terminal and which
+take longer to draw than the plan took to make. The plan file holds it whole; ``feederkit
+report`` draws it."""
 
 
 def plan_tree(plan: Plan | Mapping[str, Any], max_lines: int = PLAN_TREE_LINES) -> Tree:
@@ -163,13 +164,17 @@ def plan_tree(plan: Plan | Mapping[str, Any], max_lines: int = PLAN_TREE_LINES) 
                 else:
                     later.append((add(op, line), b.next, number + 1))
             stack.extend(reversed(later))
+    for parent, _step, _number in stack:
+        if not parent.children and isinstance(parent.label, Text):  # a branch cut bare
+            parent.label.append(" → not drawn here (in the plan file)", style="cyan")
     if stack:
         every = [n for n, _number in plan.walk()]
         ops = sum(1 for n in every if isinstance(n, Step) and id(n) not in drawn)
         results = sum(1 for n in every if isinstance(n, Leaf) and id(n) not in drawn)
         tree.add(
             Text(
-                f"... the drawing stops after {lines} lines: {plural(ops, 'more operation')} "
+                f"... the drawing stops after {lines} entries: "
+                f"{plural(ops, 'more operation')} "
                 f"and {plural(results, 'more result')} are in the plan file (feederkit run "
                 "PLAN --all walks every path; feederkit report draws more of it)",
                 style="cyan",

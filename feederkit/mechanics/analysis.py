@@ -108,7 +108,7 @@ def fragile_member_warnings(
     fragile = [members for members in fragile if members]
     if len(fragile) > FRAGILE_LINES:
         named = "; ".join(
-            f"{label} ({', '.join(map(str, ids))})"
+            f"{label} ({'state' if len(ids) == 1 else 'states'} {', '.join(map(str, ids))})"
             for members in fragile
             for label, _, ids in members
         )

@@ -174,9 +174,10 @@ def heading(plan: Plan, changeover: str | None = None) -> tuple[str, str]:
     """The page's ``<title>`` text and ``<h1>`` element (HTML). A stored changeover's report
     names it, so that two changeovers of one mix (another sensor or uncertainty) and their
     printed pages can be told apart; a plan file has no name, so its page names its parts."""
-    names = esc(", ".join(dict.fromkeys(p.name for p in plan.parts)))
+    parts = list(dict.fromkeys(p.name for p in plan.parts))  # one part's landings: one name
+    names = esc(", ".join(parts))
     if changeover is None:
-        what = "Changeover" if len(plan.parts) > 1 else "Plan"
+        what = "Changeover" if len(parts) > 1 else "Plan"
         return f"feederkit report: {names}", f"<h1>{what} report: {names}</h1>"
     name = esc(changeover)
     return (

@@ -418,7 +418,7 @@ def _alike_poses(plan: Plan, twins: Sequence[TwinLeaf]) -> str:
 
 def _unlike_words(twin: TwinLeaf) -> str:
     """Which of a leaf's poses do not look alike, when it lists more than two."""
-    if len(twin.states) < 3:
+    if len(twin.states) < 3 or not twin.unlike:  # all alike: nothing to name
         return ""
     return ", not alike: " + ", ".join(f"s{a} and s{b}" for a, b in twin.unlike)
 
