@@ -221,3 +221,29 @@ def test_poses_that_all_look_alike_name_no_unlike_pair():
     assert _unlike_words(alike) == ""
     apart = TwinLeaf(1, 0, (0, 1, 2), ((0, 2),), False, ())
     assert _unlike_words(apart) == ", not alike: s0 and s2"
+
+
+def test_a_small_member_of_a_mix_of_sizes_is_drawn_magnified(tmp_path, capsys):
+    # Every pose of a 1 mm part beside a 100 mm one was drawn sub-pixel: a fence bar only.
+    from feederkit.cli.app import main
+
+    big = tmp_path / "plate.json"
+    big.write_text(
+        json.dumps({"name": "plate", "vertices": [[0, 0], [100, 0], [100, 40], [0, 60]]})
+    )
+    small = tmp_path / "chip.json"
+    small.write_text(json.dumps({"name": "chip", "vertices": [[0, 0], [1, 0], [0.2, 0.7]]}))
+    html = tmp_path / "r.html"
+    args = ["plan", str(big), str(small), "--tolerance", "0.2", "--landings", "up"]
+    assert main([*args, "-o", str(tmp_path / "p.json"), "--report", str(html)]) in (0, 1)
+    capsys.readouterr()
+    text = html.read_text()
+    poses = [f for f in text.split("<figure")[1:] if '<svg class="pose"' in f.split(">", 1)[1]]
+    chip = [f for f in poses if 'data-part="chip"' in f.split(">", 1)[0]]
+    plate = [f for f in poses if 'data-part="plate"' in f.split(">", 1)[0]]
+
+    def caption(figure: str) -> str:
+        return figure.split("<figcaption>", 1)[1].split("</figcaption>", 1)[0]
+
+    assert chip and all("\u00d7" in caption(f) for f in chip)
+    assert plate and not any("\u00d7" in caption(f) for f in plate)

@@ -35,10 +35,10 @@ def _states_table(index: int, entry: PlanPart, draw: Drawing) -> str:
             entry.hull,
             entry.com,
             s.pose_deg,
-            radius_mm=draw.radius_mm,
+            radius_mm=draw.radius(index),
             colour=draw.colours[index],
             px=POSE_PX,
-            title=f"{entry.label}, state {s.id} on the fence",
+            title=f"{entry.label}, state {s.id} on the fence{draw.magnified(index)}",
         )
         lo, hi = s.resting_range_deg
         rows.append(

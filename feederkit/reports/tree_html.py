@@ -37,22 +37,44 @@ each): the plan of a 50-part mix drew 111,656 of them, a 151 MB page no browser 
 Its last item says how much it left out; the plan file has all of it."""
 
 
+SMALLEST_DRAWN = 0.25
+"""A member is drawn at least this share of the mix's scale across: a part of a mix whose
+largest is a hundred times its size was a fence bar and no part (sub-pixel); such a member
+is magnified to this share, and its caption says how much."""
+
+
 @dataclass(frozen=True)
 class Drawing:
     """What the tree needs to draw each member (by index in ``plan.parts``): its rings
-    (outline and holes, or hull), colour, and the one scale of the mix."""
+    (outline and holes, or hull), colour, the one scale of the mix (``radius_mm``) and each
+    member's own (``radii``: the mix's, or smaller for a member magnified,
+    :data:`SMALLEST_DRAWN`)."""
 
     rings: Sequence[Sequence[Ring]]
     colours: Sequence[str]
     radius_mm: float
+    radii: Sequence[float] = ()
+
+    def radius(self, m: int) -> float:
+        """The scale member ``m`` is drawn at (mm from the centre to the box's edge)."""
+        return self.radii[m] if self.radii else self.radius_mm
+
+    def magnified(self, m: int) -> str:
+        """`` ×N`` for a member drawn larger than the mix's scale, else ``""``."""
+        times = self.radius_mm / self.radius(m)
+        return f" \u00d7{times:.2g}" if times > 1.0 + 1e-9 else ""
 
 
 def drawing_for(plan: Plan, rings: Sequence[Sequence[Ring]]) -> Drawing:
-    """One common scale for the whole mix, a colour per member in plan order."""
+    """One common scale for the whole mix (small members magnified to
+    :data:`SMALLEST_DRAWN` of it), a colour per member in plan order."""
+    reaches = [reach(p.hull, p.com) for p in plan.parts]
+    scale = max(reaches)
     return Drawing(
         rings=tuple(rings),
         colours=tuple(part_colour(i) for i in range(len(plan.parts))),
-        radius_mm=max(reach(p.hull, p.com) for p in plan.parts),
+        radius_mm=scale,
+        radii=tuple(min(scale, r / SMALLEST_DRAWN) for r in reaches),
     )
 
 
@@ -95,7 +117,7 @@ def _state_figure(
         part.hull,
         part.com,
         pose_deg,
-        radius_mm=draw.radius_mm,
+        radius_mm=draw.radius(m),
         colour=draw.colours[m],
         px=px,
         title=title,
@@ -105,7 +127,7 @@ def _state_figure(
         f'data-landing="{esc(part.landing or "")}" data-state="{sid}" '
         f'data-pose-deg="{num(pose_deg, 4)}">{svg}'
         f'<figcaption>{esc(label)} s{sid}<span class="pose-deg"> {num(pose_deg, 1)}\u00b0</span>'
-        f"</figcaption></figure>"
+        f"{esc(draw.magnified(m))}</figcaption></figure>"
     )
 
 
