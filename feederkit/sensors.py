@@ -643,12 +643,14 @@ class LedSensor:
             ]
         n = len(diameters)
         extents = [self.counts(d) for d in diameters]
-        c_lo = min(c for c, _ in extents)
-        c_hi = max(c for _, c in extents)
+        # The states that can block a count change only where an extent starts or ends:
+        # one cell per run of counts between those, not one per count (a pitch of 0.1 um
+        # has ten million counts per millimetre of diameters).
+        bounds = sorted({c for lo, hi in extents for c in (lo, hi + 1)})
         cells = []
-        for c in range(c_lo, c_hi + 1):
-            members = [i for i in range(n) if extents[i][0] <= c <= extents[i][1]]
-            cells.append((float(c), float(c), _mask(members, labels)))
+        for a, nxt in zip(bounds, bounds[1:], strict=False):
+            members = [i for i in range(n) if extents[i][0] <= a <= extents[i][1]]
+            cells.append((float(a), float(nxt - 1), _mask(members, labels)))
         return [
             ReadingBranch(*self.window(int(a), int(b)), m)
             for a, b, m in _merge_cells(cells, gap=1.0)
