@@ -193,6 +193,32 @@ def test_a_newer_part_revision_is_warned_about(db, tmp_path, capsys):
     assert any("latest is 2" in w for w in json.loads(cap.out)["warnings"])
 
 
+def test_a_revision_that_puts_the_same_file_back_keeps_the_changeover_up_to_date(
+    db, tmp_path, capsys
+):
+    # octagon@3 is the file of octagon@1 again: the changeover made for @1 was called out of
+    # date (export exit 1), and a script recompiling on exit 1 compiled for nothing.
+    ok(capsys, [*FIG27, "--tolerance", "0.01", "--catalog", str(db)])
+    original = tmp_path / "parts" / "octagon.json"
+    kept = original.read_bytes()
+    data = json.loads(kept)
+    data["vertices"][0] = [data["vertices"][0][0] * 1.1, data["vertices"][0][1]]
+    original.write_text(json.dumps(data))
+    ok(capsys, ["catalog", "add", str(original), "--revise", "--catalog", str(db)])
+    shown = json.loads(
+        ok(capsys, ["changeover", "show", "fig27", "--json", "--catalog", str(db)]).out
+    )
+    assert any("latest is 2" in w for w in shown["warnings"])  # another file: out of date
+    original.write_bytes(kept)
+    ok(capsys, ["catalog", "add", str(original), "--revise", "--catalog", str(db)])
+    out = tmp_path / "e.json"
+    cap = ok(
+        capsys, ["changeover", "export", "fig27", "-o", str(out), "--json", "--catalog", str(db)]
+    )
+    exported = json.loads(cap.out)
+    assert exported["up_to_date"] is True and exported["warnings"] == []
+
+
 def test_compile_stores_nothing_when_its_files_cannot_be_written(db, tmp_path, capsys, monkeypatch):
     import feederkit.cli.common
 

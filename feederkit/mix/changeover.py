@@ -25,6 +25,7 @@ from typing import Any
 from feederkit.catalog import (
     DEFAULT_WAIT,
     ChangeoverInfo,
+    Revision,
     get_changeover,
     get_revision,
     list_changeovers,
@@ -448,7 +449,10 @@ def stale_revisions(
     out = []
     for name, rev in revisions:
         try:
-            latest = get_revision(catalog, name, None).revision
+            newest = get_revision(catalog, name, None)
+            latest = newest.revision
+            if latest > rev and _same_contents(newest, get_revision(catalog, name, rev)):
+                continue  # the same file again (a revision put back): the plan is its plan
         except InputError as exc:
             out.append(f"{name}: {exc}")
             continue
@@ -458,6 +462,17 @@ def stale_revisions(
                 f"{latest}; compile it again to plan for the latest"
             )
     return out
+
+
+def _same_contents(a: Revision, b: Revision) -> bool:
+    """Whether two revisions of a part store the same part: the same file's bytes, import
+    options and tolerances (the outline, hull, COM and landings follow from them)."""
+    return (
+        a.source_sha256 == b.source_sha256
+        and dict(a.options) == dict(b.options)
+        and a.shape_tolerance_mm == b.shape_tolerance_mm
+        and a.com_tolerance_mm == b.com_tolerance_mm
+    )
 
 
 def mix_landings(
