@@ -26,6 +26,7 @@ from feederkit.catalog import (
 )
 from feederkit.catalog.schema import no_catalog
 from feederkit.cli.common import (
+    COMMAND_START,
     CatalogOpt,
     ComToleranceOpt,
     JsonOpt,
@@ -36,9 +37,9 @@ from feederkit.cli.common import (
     ToleranceOpt,
     add_name_column,
     console,
-    err_console,
     flag_tolerance,
     flag_words,
+    limit_instant,
     plural,
     print_json,
     print_warnings,
@@ -48,6 +49,7 @@ from feederkit.cli.common import (
     with_flags,
 )
 from feederkit.cli.plan_render import sensor_text
+from feederkit.design.limit import check_limits
 from feederkit.errors import CheckFailed, InputError
 from feederkit.importers.orientable import orientability
 from feederkit.landing.model import Landing
@@ -193,6 +195,11 @@ def analysis_uncertainty(
     return uncertainty_option(rotation_error, shape_tolerance, com_tolerance)
 
 
+def _why_undecided(result: MixAnalysis) -> str:
+    """Why checks under the uncertainty were left undecided."""
+    return "too many sets, or the time limit" if result.cut else "too many sets"
+
+
 def analyze_command(
     sensorless: SensorlessOpt = False,
     tolerance: ToleranceOpt = None,
@@ -203,6 +210,16 @@ def analyze_command(
     com_tolerance: ComToleranceOpt = None,
     json_out: JsonOpt = False,
     catalog: CatalogOpt = None,
+    time_limit: Annotated[
+        float | None,
+        typer.Option(
+            "--time-limit",
+            metavar="S",
+            help="Seconds, from the command's start, for the checks under a declared "
+            "uncertainty; the members and pairs left are counted undecided (exit 1). "
+            "Default: no limit.",
+        ),
+    ] = None,
 ) -> None:
     """Behaviour classes (same push function, same push-diameter function: section 8.3) of the
     catalog's parts, and with a sensor every pair of parts no plan can tell apart, with its
@@ -224,11 +241,14 @@ def analyze_command(
     orients even alone is listed once and its pairs are not checked.
 
     Exit 1 when some pair cannot be told apart (without a sensor: whenever there are two
-    members or more, as no pair is told apart), or some member has no strong plan alone
-    (design.md: a result to act on)."""
+    members or more, as no pair is told apart), or some member has no strong plan alone,
+    or ``--time-limit`` ended the checks (design.md: a result to act on)."""
+    started = COMMAND_START.started()
     sensor = make_sensor(
         sensorless=sensorless, tolerance=tolerance, led_pitch=led_pitch, noise=noise
     )
+    with flag_words():
+        time_limit = check_limits(time_limit, None)[0]
     # The flags, checked before the catalog is read.
     analysis_uncertainty(
         rotation_error, flag_tolerance(shape_tolerance), flag_tolerance(com_tolerance)
@@ -243,8 +263,21 @@ def analyze_command(
     skipped += too_small
     over_landings = owners is not None
     # A tolerance too large for a member is refused first: one line naming it and the flag.
-    with flag_words(), err_console.status("analyzing ..."):
-        result = analyze_mix(pfs, sensor, uncertainty=unc)
+    with flag_words(), progress_bar() as bar:
+        # Counts of the members and pairs checked under the uncertainty (the ideal model's
+        # exact analysis before them is quick).
+        task = bar.add_task("analyzing (members, then pairs)", total=None)
+
+        def advance(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        result = analyze_mix(
+            pfs,
+            sensor,
+            uncertainty=unc,
+            deadline=limit_instant(started, time_limit),
+            progress=advance,
+        )
     if json_out:
         data = result.to_dict()
         data["skipped"] = skipped
@@ -295,6 +328,12 @@ def analyze_command(
             f"{named}{more}; no mix that plans one has a strong plan (a finer sensor or tighter "
             "tolerances may help; else leave it out of the mix or, for a landing, reject it: "
             "changeover compile --accept)"
+        )
+    if result.cut:
+        problems.append(
+            f"the time limit of {time_limit:g} s ended the checks under {_under(unc)}: "
+            f"{result.undecided_alone} {what} alone and {plural(result.undecided, 'pair')} "
+            "not decided (allow more time with --time-limit S)"
         )
     if problems:
         raise CheckFailed("; and ".join(problems))
@@ -425,7 +464,7 @@ def _print_report(
             "no strong plan orients alone",
             f"{len(result.alone)}"
             + (
-                f" ({result.undecided_alone} undecided: too many sets)"
+                f" ({result.undecided_alone} undecided: {_why_undecided(result)})"
                 if result.undecided_alone
                 else ""
             ),
@@ -434,7 +473,11 @@ def _print_report(
         summary.add_row(
             "apart only on the ideal model",
             f"{len(result.strong_pairs)}"
-            + (f" ({result.undecided} undecided: too many sets)" if result.undecided else "")
+            + (
+                f" ({result.undecided} undecided: {_why_undecided(result)})"
+                if result.undecided
+                else ""
+            )
             + (
                 " (pairs with a member no strong plan orients alone not checked)"
                 if result.alone

@@ -7,7 +7,7 @@ the classes (parts with one push function share a sensorless plan, Corollary 5).
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -61,6 +61,9 @@ class MixAnalysis:
     mix holding one fails, so its pairs are not checked."""
     undecided_alone: int = 0
     """Members whose check alone ran out of sets (their pairs are checked)."""
+    cut: bool = False
+    """The deadline ended the checks under ``uncertainty``: the members and pairs left are
+    counted in ``undecided_alone`` and ``undecided`` (not checked)."""
 
     @property
     def shared_push(self) -> list[BehaviourClass]:
@@ -115,6 +118,7 @@ class MixAnalysis:
             "no_strong_plan_alone": [
                 {"part": self.names[i], "states": list(states)} for i, states in self.alone
             ],
+            "cut_by_time_limit": self.cut,
         }
 
 
@@ -125,6 +129,8 @@ def analyze_mix(
     angle_tol: float = ANGLE_TOL_DEG,
     length_tol: float = LENGTH_TOL_MM,
     uncertainty: Uncertainty | None = None,
+    deadline: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> MixAnalysis:
     """Classes (push, push-diameter) and, with a sensor, the exact unrecognizable pairs; under
     a declared ``uncertainty`` (rotation error, shape and COM tolerances: design.md), also
@@ -133,6 +139,10 @@ def analyze_mix(
     intervals under a shape or COM tolerance) checked for strong plans on its own, after
     each member alone (:func:`~feederkit.mix.strongpairs.check_alone`): a pair holding a
     member no strong plan orients alone is that member's failure, not the pair's.
+
+    The checks under the uncertainty stop at ``deadline`` (a ``time.monotonic()`` instant;
+    None: none), each check run whole: the members and pairs left are counted undecided and
+    ``cut`` says so. ``progress(done, total)`` is called as they go (members, then pairs).
 
     Raises InputError naming the part when a tolerance is too large for one
     (:func:`~feederkit.uncertainty.check_for_part`), before any work, as ``plan`` does."""
@@ -159,8 +169,19 @@ def analyze_mix(
     mechs = None if unc.is_ideal else physical_mechanics(pfs, unc)  # once for every check
     # The parts' own widths, as make_plan reads each state (once for every check).
     offs = [] if mechs is None else part_offsets(pfs)
+    cut = False
+
+    def late() -> bool:
+        return deadline is not None and time.monotonic() >= deadline
+
     if mechs is not None:
         for i, pf in enumerate(pfs):
+            if progress is not None:
+                progress(i, len(pfs))
+            if cut or late():
+                cut = True
+                undecided_alone += 1
+                continue
             verdict = check_alone(pf, sensor, unc, mechanics=mechs[i], offsets=offs[i])
             undecided_alone += not verdict.decided
             if verdict.decided and not verdict.orients:
@@ -170,8 +191,17 @@ def analyze_mix(
         confused = {(w.index_a, w.index_b) for w in pairs}
         hopeless = {i for i, _states in alone}
         near = reading_pairs(pfs, sensor, unc, mechanics=mechs, offsets=offs)
-        for i, j in sorted(set(todo) | near):
-            if (i, j) in confused or i in hopeless or j in hopeless:
+        checked = [
+            (i, j)
+            for i, j in sorted(set(todo) | near)
+            if (i, j) not in confused and i not in hopeless and j not in hopeless
+        ]
+        for k, (i, j) in enumerate(checked):
+            if progress is not None:
+                progress(len(pfs) + k, len(pfs) + len(checked))
+            if cut or late():
+                cut = True
+                undecided += 1
                 continue
             check = check_strong_pair(
                 pfs[i],
@@ -205,4 +235,5 @@ def analyze_mix(
         undecided=undecided,
         alone=tuple(alone),
         undecided_alone=undecided_alone,
+        cut=cut,
     )
