@@ -891,23 +891,53 @@ def _run(ks: Sequence[int], m: int) -> list[int]:
     return [(start + i) % m for i in range(len(ks))]
 
 
-def _on_hill(peaks: np.ndarray, wells: np.ndarray, eps: float, vibration: float) -> bool:
+def _barrier_growth(t: float, c: float, spans_rad: np.ndarray, rho_min: float) -> np.ndarray:
+    """How much higher than drawn each of a run's barriers may stand for a shape within
+    ``t`` and a COM within ``c`` (mm; ``spans_rad``: per state, the angle from its normal to
+    the farther of its two hilltops; ``rho_min``: the COM's least distance to a vertex).
+
+    A vertex moved by at most ``t`` moves each radius by at most ``t``: ``2 t``. A COM moved
+    by ``d`` (``|d| <= c``) moves the radius at ``theta`` by ``-<d, u(theta)>`` (a hilltop's,
+    the distance to its vertex, to second order: ``c^2 / (2 rho)``), so a barrier between a
+    normal and a hilltop ``s`` radians away changes by at most ``c s`` plus that term, never
+    more than ``2 c`` (F1): a smooth hilltop's chords stay a hill under a COM tolerance (a
+    cam's R15 end at 0.1 mm rested on its top when ``2 (t + c)`` was counted)."""
+    second = c * c / rho_min if rho_min > 0.0 else 2.0 * c
+    return 2.0 * t + np.minimum(c * spans_rad + second, 2.0 * c)
+
+
+def _hilltop_spans(pf: PushFunction, div: np.ndarray, order: Sequence[int]) -> np.ndarray:
+    """Per resting range ``k`` of ``order``, the angle (radians) from its state's normal to
+    the farther of the range's two hilltops (``div[k]`` and ``div[k + 1]``)."""
+    m = len(div)
+    ks = np.asarray(order)
+    normals = np.asarray([pf.states[pf.range_state[k]].normal_deg for k in order])
+
+    def apart(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.abs(np.mod(a - b + 180.0, 360.0) - 180.0)
+
+    return np.radians(np.maximum(apart(normals, div[ks]), apart(div[(ks + 1) % m], normals)))
+
+
+def _on_hill(peaks: np.ndarray, wells: np.ndarray, growth: np.ndarray, vibration: float) -> bool:
     """Whether a run of stable states (``wells``, the drawn radius at their normals, CCW;
     ``peaks`` at the hilltops around and between them, both ends included) is the facets of a
     hill, not a resting state: a part dropped there rolls off to a real minimum.
 
     That is a flattened arc's chords where its smooth radius function (through the chords'
-    ends, the hilltops) has a maximum: every state's barrier (``noise``, the largest) is below
-    the vibration for every shape (plus ``2 eps``, F1); a hilltop between them stands higher
-    than ``noise`` above both hilltops where the run is left; and no well sinks more than
-    ``noise`` below the lower of those (a well that deep is a real minimum). A single stable
-    state never is one (no hilltop lies between its two), nor a run down a slope.
+    ends, the hilltops) has a maximum: every state's barrier is below the vibration for every
+    shape (plus its ``growth``, :func:`_barrier_growth`, at most ``2 eps``: F1); a hilltop
+    between them stands higher than ``noise`` (the largest drawn barrier) above both hilltops
+    where the run is left; and no well sinks more than ``noise`` below the lower of those (a
+    well that deep is a real minimum). A single stable state never is one (no hilltop lies
+    between its two), nor a run down a slope.
     """
-    noise = float((np.minimum(peaks[:-1], peaks[1:]) - wells).max())
+    barriers = np.minimum(peaks[:-1], peaks[1:]) - wells
+    noise = float(barriers.max())
     top = float(peaks[1:-1].max(initial=-math.inf))
     low = float(min(peaks[0], peaks[-1]))
     return (
-        noise + 2.0 * eps < vibration
+        float((barriers + growth).max()) < vibration
         and top - max(peaks[0], peaks[-1]) > noise
         and low - float(wells.min()) <= noise
     )
@@ -963,7 +993,8 @@ def uncertain_mechanics(
     threshold = vibration_mm + 2.0 * eps
 
     cands = _rest_candidates(pf, t, c)
-    rho_max = float(np.hypot(*(h - com).T).max())
+    rho = np.hypot(*(h - com).T)
+    rho_max, rho_min = float(rho.max()), float(rho.min())
     # Crossing graph: ideal state i -> its neighbour across a hill when some rest candidate in
     # i's basin may lie less than the vibration below that hilltop for some shape (F1: its
     # resting height is within r(normal) +- rho_max * half-width, r's slope bound, +- eps).
@@ -1046,7 +1077,7 @@ def uncertain_mechanics(
         and _on_hill(
             peaks[np.asarray([*order, (order[-1] + 1) % m])],
             heights[np.asarray([rs[k] for k in order])],
-            eps,
+            _barrier_growth(t, c, _hilltop_spans(pf, div, order), rho_min),
             vibration_mm,
         )
     }
@@ -1155,12 +1186,36 @@ def _descent_reach(
     )
 
 
-def _climb(prof: _Profile, start: float, limit: float, level: float, base: float) -> float | None:
+def _gap_reach(
+    prof: _Profile, start_lo: float, start_hi: float, reach_lo: float, reach_hi: float
+) -> tuple[float, float]:
+    """:func:`_descent_reach` for pushes starting in a gap between bands, which cross no
+    hilltop (:func:`_fence_cells`): each leaves the gap through one of its ends and from
+    there descends the perturbed radius function, so at an orientation it reaches the drawn
+    radius is at most ``2 eps`` above its lowest on the way from that end (F1 at both
+    points): the reach ends where the drawn radius first rises more than ``2 eps`` above
+    that running minimum. Tighter than one level for the whole gap, whose highest start
+    (beside another band) let a push from the gap's other end climb a shallow hill there
+    (a cam's flank reached its round end's top facets)."""
+    base = math.floor(start_lo / 360.0) * 360.0
+    hi = _climb(prof, start_hi, reach_hi, None, base)
+    lo = _climb(prof, start_lo, reach_lo, None, base)
+    return (
+        reach_lo if lo is None else max(reach_lo, lo),
+        reach_hi if hi is None else min(reach_hi, hi),
+    )
+
+
+def _climb(
+    prof: _Profile, start: float, limit: float, level: float | None, base: float
+) -> float | None:
     """The first orientation from ``start`` toward ``limit`` where the drawn radius exceeds
     ``level`` (the far end of its bisection bracket, plus ``BOUNDARY_EPS_DEG``), or None.
 
     The radius at ``start`` is at most ``level``; it is monotone between consecutive extrema,
     so the first extremum (or ``limit``) above the level closes the piece holding the crossing.
+    ``level`` None: the running minimum of the drawn radius from ``start`` on, plus ``2 eps``
+    (:func:`_gap_reach`; the minimum of a monotone piece is at one of its ends).
     """
     step = 1.0 if limit >= start else -1.0
     s, lim = start - base, limit - base
@@ -1169,13 +1224,16 @@ def _climb(prof: _Profile, start: float, limit: float, level: float, base: float
     pts, vals = prof.pos[mask][:: int(step)], prof.val[mask][:: int(step)]
     pts = np.concatenate([pts, [lim]])
     vals = np.concatenate([vals, _radius(prof.hull, prof.com, np.asarray([lim]))])
+    low = float(_radius(prof.hull, prof.com, np.asarray([s]))[0]) if level is None else 0.0
     x0 = s
     for p, v in zip(pts.tolist(), vals.tolist(), strict=True):
-        if v > level:
+        top = low + 2.0 * prof.eps if level is None else level
+        if v > top:
             lo, hi = np.asarray([min(x0, p)]), np.asarray([max(x0, p)])
-            a, b = _level_crossing(prof.hull, prof.com, lo, hi, np.asarray([level]))
+            a, b = _level_crossing(prof.hull, prof.com, lo, hi, np.asarray([top]))
             far = max(a[0], b[0]) if step > 0 else min(a[0], b[0])
             return base + far + step * BOUNDARY_EPS_DEG
+        low = min(low, v)
         x0 = p
     return None
 
@@ -1224,7 +1282,7 @@ def _fence_cells(
         gap_region = (b_lo, b_lo + 360.0) if q == 1 else (t_lo, next_top_hi)
         if profile is not None and q > 1:
             region = _descent_reach(profile, b_lo, b_hi, *region)
-            gap_region = _descent_reach(profile, b_hi, n_lo, *gap_region)
+            gap_region = _gap_reach(profile, b_hi, n_lo, *gap_region)
         cells.append(FenceCell(b_lo, b_hi, True, _cell_targets(arr, dest, *region)))
         cells.append(FenceCell(b_hi, n_lo, False, _cell_targets(arr, dest, *gap_region)))
     return tuple(cells)
