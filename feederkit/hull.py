@@ -11,6 +11,7 @@ import math
 from collections.abc import Iterable, Sequence
 
 import numpy as np
+import shapely
 
 Point = tuple[float, float]
 
@@ -322,3 +323,19 @@ def point_in_convex(hull: Sequence[Point], p: Point, margin: float = 0.0) -> boo
         if _cross(a, b, p) / length <= margin:
             return False
     return True
+
+
+def hull_distance(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]]) -> float:
+    """The Hausdorff distance (mm) between two convex polygons as regions.
+
+    For convex regions it is the largest difference of their support functions over all
+    directions: the most a fence, pushing either, can feel them differ. Exact: the farthest
+    point of one region from the other is one of its vertices.
+
+    >>> hull_distance([(0, 0), (2, 0), (2, 1), (0, 1)], [(0, 0), (2, 0), (2, 1.5), (0, 1.5)])
+    0.5
+    """
+    pa, pb = shapely.Polygon(a), shapely.Polygon(b)
+    da = shapely.distance(pb, shapely.points(np.asarray(a, dtype=float)))
+    db = shapely.distance(pa, shapely.points(np.asarray(b, dtype=float)))
+    return float(max(np.max(da), np.max(db)))

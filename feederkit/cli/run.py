@@ -32,6 +32,7 @@ from feederkit.cli.plan_render import (
     verification_table,
 )
 from feederkit.errors import CheckFailed, InputError
+from feederkit.hull import hull_distance
 from feederkit.landing.plan import load_landings
 from feederkit.loading import load_parts
 from feederkit.part import Part
@@ -40,7 +41,6 @@ from feederkit.plans.match import match_part, offsets_words, same_geometry
 from feederkit.plans.model import UNRECOGNIZED_WORDS, Plan, PlanPart
 from feederkit.plans.verify import VerificationReport, verify_declared
 from feederkit.sim.likeness import refusal_words
-from feederkit.sim.real import hull_distance
 from feederkit.sources import load_part
 
 

@@ -20,6 +20,7 @@ import numpy as np
 import shapely
 
 from feederkit.angles import norm360
+from feederkit.hull import contact_hull, hull_distance
 from feederkit.machine import PushAlignMachine, members, search_space
 from feederkit.machine.build import build_machine
 from feederkit.machine.widths import Offsets, widen_widths
@@ -35,7 +36,7 @@ from feederkit.planning.budget import Deadline, Timeout
 from feederkit.planning.lumping import may_lump, unresolvable_pairs
 from feederkit.planning.options import Lumping, PlanningOptions
 from feederkit.planning.problem import Problem
-from feederkit.planning.tree import PlanResult, leaf_masks
+from feederkit.planning.tree import Certificate, PlanResult, leaf_masks
 from feederkit.plans.certify import decided_exists
 from feederkit.plans.fileformat import distinct_nodes
 from feederkit.plans.model import PlanMember
@@ -731,4 +732,35 @@ def _sides_words(
     return (
         f"two landings of one part each have a strong plan alone but none together "
         f"({listed}): plan only one side (--landings {side})"
+    )
+
+
+def drawing_distance_words(
+    pfs: Sequence[PushFunction], unc: Uncertainty, certificate: Certificate | None
+) -> str | None:
+    """One line when a part's drawing lies farther from the plan's hull (the import's
+    simplification, ``--hull-tolerance``) than the plan's certified shape tolerance allows
+    beyond the declared one: the certificate and the declared shape tolerance are measured
+    from the plan's hulls, so a part made within the declared tolerance of its *drawing* is
+    then not covered (a fillet plate imported at 0.05 mm lay 0.037 mm from its hull while its
+    plan declared 0.01 mm). None when every drawing is covered, or with no certificate."""
+    if certificate is None:
+        return None
+    held = certificate.max_shape_tolerance_mm
+    t = unc.shape_tolerance_mm
+    far = []
+    for pf in pfs:
+        part = pf.part
+        d = hull_distance(contact_hull(part.outline.vertices), part.hull)
+        if d > 1e-6 * part.size and held < d + t - 1e-9:
+            far.append(f"{part.name}'s lies {d:.4g} mm from its hull")
+    if not far:
+        return None
+    return (
+        "the plan's hulls simplify the drawings (the import's hull tolerance): "
+        + "; ".join(far)
+        + f"; the plan holds a shape tolerance of {held:.4g} mm from its hulls, less than that "
+        f"plus the declared {t:g} mm, so a part made within the declared tolerance of its "
+        "drawing is not covered by the certificate: import with a smaller --hull-tolerance, "
+        "or check the plan on the drawing with feederkit simulate --part"
     )

@@ -47,6 +47,7 @@ from feederkit.planning.tree import Step as TreeStep
 from feederkit.plans.advice import (
     SMALLER_ERROR_S,
     blocking_members,
+    drawing_distance_words,
     lump_shapes,
     short_chords_words,
     smaller_error_words,
@@ -298,6 +299,9 @@ def _make_plan(
     thin = thin_branch_words(data, sensor, unc)
     if thin is not None:
         warnings.append(thin)
+    drawn = drawing_distance_words(pfs, unc, result.certificate)
+    if drawn is not None:
+        warnings.append(drawn)
     unoriented = unlike_twins_words(result, pfs)
     cut = ties_cut_words(result, opts)
     if cut is not None:

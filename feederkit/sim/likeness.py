@@ -21,6 +21,8 @@ import numpy as np
 import shapely
 from scipy.optimize import minimize_scalar
 
+from feederkit.hull import hull_distance
+
 Point = tuple[float, float]
 
 SAMPLES = 720
@@ -96,10 +98,8 @@ def _turned(points: np.ndarray, deg: float) -> np.ndarray:
 
 
 def _distance(a: np.ndarray, b: np.ndarray) -> float:
-    """The Hausdorff distance of two convex polygons as regions (``real.hull_distance``)."""
-    da = shapely.distance(shapely.Polygon(b), shapely.points(a))
-    db = shapely.distance(shapely.Polygon(a), shapely.points(b))
-    return float(max(np.max(da), np.max(db)))
+    """The Hausdorff distance of two convex polygons as regions (:func:`hull_distance`)."""
+    return hull_distance(a, b)
 
 
 def _best_turn(plan: np.ndarray, source: np.ndarray) -> tuple[float, float]:

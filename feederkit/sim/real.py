@@ -29,11 +29,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import shapely
 
 from feederkit.catalog import could_be_part_name, default_catalog_path, get_revision
 from feederkit.catalog import part_from_revision as revision_part
 from feederkit.errors import InputError
+from feederkit.hull import hull_distance
 from feederkit.importers import ImportOptions
 from feederkit.importers.model import CAD_SUFFIXES, DEFAULT_FLATTEN_TOLERANCE
 from feederkit.importers.reader import effective_hull_tolerance
@@ -213,19 +213,6 @@ class RealPart:
 
 def _rounded(value: float | None) -> float | None:
     return None if value is None else round(value, 6)
-
-
-def hull_distance(a: Sequence[Point], b: Sequence[Point]) -> float:
-    """The Hausdorff distance (mm) between two convex polygons as regions.
-
-    For convex regions it is the largest difference of their support functions over all
-    directions: the most a fence, pushing either, can feel them differ. Exact: the farthest
-    point of one region from the other is one of its vertices.
-    """
-    pa, pb = shapely.Polygon(a), shapely.Polygon(b)
-    da = shapely.distance(pb, shapely.points(np.asarray(a, dtype=float)))
-    db = shapely.distance(pa, shapely.points(np.asarray(b, dtype=float)))
-    return float(max(np.max(da), np.max(db)))
 
 
 def exact_part(part: Part, name: str | None = None) -> Part:
