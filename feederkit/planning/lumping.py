@@ -353,9 +353,11 @@ def _listed(machine: PushAlignMachine, pairs: Sequence[Pair]) -> str:
         ids = "/".join(str(k) for k in s.ideal_states)
         return f"{machine.part_names[s.part]} state {ids}"
 
-    listed = "; ".join(f"{name(i)} with {name(j)}" for i, j in pairs[:WORDS_PAIRS])
-    if len(pairs) > WORDS_PAIRS:
-        listed += f"; and {len(pairs) - WORDS_PAIRS} more pairs"
+    # A wandering state and its twin (planning.wandering) have one name: each pair once.
+    named = list(dict.fromkeys(f"{name(i)} with {name(j)}" for i, j in pairs))
+    listed = "; ".join(named[:WORDS_PAIRS])
+    if len(named) > WORDS_PAIRS:
+        listed += f"; and {len(named) - WORDS_PAIRS} more pairs"
     return listed
 
 
