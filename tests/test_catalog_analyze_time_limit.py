@@ -40,6 +40,9 @@ def test_a_spent_limit_leaves_every_check_undecided(db: str, capsys) -> None:
     data = json.loads(out.out)
     assert data["cut_by_time_limit"] is True
     assert data["counts"]["undecided_alone"] == data["counts"]["parts"]
+    # Every pair that was to be checked is undecided, and the JSON says how many there were.
+    c = data["counts"]
+    assert c["undecided_pairs"] == c["pairs_checked_under_uncertainty"]
     assert "the time limit of 0.001 s ended the checks" in " ".join(out.err.split())
 
 
@@ -47,6 +50,7 @@ def test_without_a_limit_every_check_runs(db: str, capsys) -> None:
     code = main([*ARGS, "--catalog", db])
     data = json.loads(capsys.readouterr().out)
     assert data["cut_by_time_limit"] is False and data["counts"]["undecided_alone"] == 0
+    assert data["counts"]["undecided_pairs"] <= data["counts"]["pairs_checked_under_uncertainty"]
     assert code in (0, 1)
 
 

@@ -79,3 +79,12 @@ def test_bad_input_is_one_error_line_and_exit_2(args, tmp_path, monkeypatch, cap
     assert len(lines) == 1 and lines[0].startswith("error: "), captured.err
     assert "Traceback" not in captured.err
     assert not list(tmp_path.iterdir()), "bad input wrote a file"
+
+
+def test_a_memory_limit_below_what_the_command_holds_is_bad_input(capsys, tmp_path) -> None:
+    # 50 MB: Python and feederkit alone hold about 100; every search ran out at once and
+    # answered "no plan found within the memory limit" after loading the parts.
+    assert main(["plan", PART, "--memory-limit", "50", "-o", str(tmp_path / "p.json")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--memory-limit 50 MB is no more than the command already" in err[0]
+    assert not (tmp_path / "p.json").exists()

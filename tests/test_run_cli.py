@@ -159,7 +159,7 @@ def test_a_small_margin_is_warned_about(tri, capsys):
 
     _corrupt(plan, shrink)
     assert main(["run", str(plan), "--start-deg", "200"]) == 0
-    assert "below" in capsys.readouterr().out
+    assert "below" in capsys.readouterr().err  # warnings on stderr (docs/cli.md)
     assert main(["run", str(plan), "--start-deg", "200", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["warnings"]
 
@@ -181,7 +181,7 @@ def test_run_repeats_the_fragile_states_plan_warned_about(tmp_path, capsys):
     (warning,) = json.loads(capsys.readouterr().out)["warnings"]
     assert "warning: " + warning == planned[0]
     assert main(["run", str(plan), "--all"]) == 0
-    assert "fragile states" in capsys.readouterr().out
+    assert "fragile states" in capsys.readouterr().err  # warnings on stderr (docs/cli.md)
 
 
 def test_a_plan_file_over_the_size_limit_is_refused(tri, capsys):

@@ -15,10 +15,10 @@ def test_run_of_one_member_warns_of_its_own_fragile_states_only(tmp_path, capsys
     plan = str(tmp_path / "p.json")
     flags = ["--tolerance", "0.5", "--landings", "up", "-o", plan]
     assert run_cli(capsys, "plan", bracket, washer, *flags)[0] == 0
-    _, out, _ = run_cli(capsys, "run", plan)
-    every = " ".join(out.split())
+    _, _, err = run_cli(capsys, "run", plan)  # warnings on stderr (docs/cli.md)
+    every = " ".join(err.split())
     assert "l-bracket (up): fragile states" in every and "d-washer (up): fragile states" in every
-    rc, out, _ = run_cli(capsys, "run", plan, bracket)
-    one = " ".join(out.split())
+    rc, _, err = run_cli(capsys, "run", plan, bracket)
+    one = " ".join(err.split())
     assert rc == 0 and "l-bracket (up): fragile states" in one
     assert "d-washer" not in one

@@ -457,7 +457,8 @@ def compile_command(
     mix: its plan declares one uncertainty).
     Exit 1 when some parts or landings cannot be told apart, the two sides of one part too
     (the plan is still written and stored), or when an accepted and a rejected landing
-    cannot be.
+    cannot be, or when a plan made on the ideal model (``--rotation-error 0``) holds no
+    rotation error on a feeder that vibrates (stored; check it with ``feederkit simulate``).
     """
     started = COMMAND_START.started()  # --time-limit bounds the plan, then the report's design
     check_name(name, "changeover")  # before any work: the store would refuse it at the end

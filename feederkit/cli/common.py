@@ -9,6 +9,7 @@ flag that sets them (``--min-margin``). Warnings print as one ``warning:`` line 
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import time
@@ -44,6 +45,7 @@ from feederkit.errors import FeederkitError, InputError, PlanningError
 from feederkit.jsonio import OutputFile, check_writable, is_device
 from feederkit.mechanics.push import PushFunction
 from feederkit.mix.pairs import PairWitness
+from feederkit.planning.budget import rss_mb
 from feederkit.planning.options import PlanningOptions
 from feederkit.planning.solvable import NoStrongPlan
 from feederkit.plans.model import Plan
@@ -813,6 +815,14 @@ def cell_planning_options(
             f"--objective {objective} needs the cell's timing: {missing} "
             f"({settings.describe()}; docs/cell.md)"
         )
+    if memory_limit is not None and math.isfinite(memory_limit) and memory_limit > 0:
+        held = rss_mb()
+        if memory_limit <= held:
+            # No search fits: it would end at once with "no plan within the memory limit".
+            raise InputError(
+                f"--memory-limit {memory_limit:g} MB is no more than the command already holds "
+                f"({held:.0f} MB: Python, its libraries and the parts): give more"
+            )
     with flag_words():
         return PlanningOptions(
             objective=objective,

@@ -232,7 +232,9 @@ def plan_command(
     the declared uncertainty (``--rotation-error``, default 1 degree) it is a strong plan,
     verified for every outcome; the shape and COM tolerances default to the largest the
     parts' catalog revisions store. Exit 1 when some parts of a mix, or some landings, cannot
-    be told apart (the plan is still written) or an accepted and a rejected landing cannot be.
+    be told apart (the plan is still written) or an accepted and a rejected landing cannot be,
+    or when a plan made on the ideal model (``--rotation-error 0``) holds no rotation error
+    on a feeder that vibrates (written; check it with ``feederkit simulate``).
     """
     started = COMMAND_START.started()  # --time-limit counts reading the parts too
     terms = (*FLAG_TERMS, *LANDING_TERMS)

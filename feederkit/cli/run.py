@@ -23,7 +23,7 @@ from typing import Annotated, Any
 import typer
 
 from feederkit.angles import norm360
-from feederkit.cli.common import CatalogOpt, JsonOpt, console, print_json
+from feederkit.cli.common import CatalogOpt, JsonOpt, console, print_json, print_warnings
 from feederkit.cli.plan_render import (
     DEFAULT_MAX_PLAN_MB,
     MaxPlanMbOpt,
@@ -92,8 +92,7 @@ def run_command(
     warnings = [w for w in held if w] + plan.fragile_warnings(indices)
     warnings += stored_beyond(plan, sources or [], catalog) + left
     if not json_out:
-        for w in warnings:
-            console.print(f"warning: {w}", style="yellow", highlight=False, markup=False)
+        print_warnings(warnings)  # stderr, one line each (docs/cli.md)
     if not json_out:
         console.print(
             f"declared uncertainty: {plan.uncertainty_words()}",

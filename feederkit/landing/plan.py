@@ -239,7 +239,11 @@ def left_out_words(left_out: Sequence[Sequence[Landing]], what: str) -> list[str
         named = [x for x in lands if x.probability > 0.0]
         if not named:
             continue
-        ways = ", ".join(f"{x.name} in {100.0 * x.probability:.3g} %" for x in named)
+        ways = ", ".join(
+            f"{'in ' if x.name.startswith('pose-') else ''}{x.name} in "
+            f"{100.0 * x.probability:.3g} %"
+            for x in named
+        )
         out.append(
             f"{named[0].part_name} also lands {ways} of drops, which {what} leaves out "
             "(--landings): a part landing so is not oriented by it (to plan every landing "

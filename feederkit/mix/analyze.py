@@ -61,6 +61,9 @@ class MixAnalysis:
     mix holding one fails, so its pairs are not checked."""
     undecided_alone: int = 0
     """Members whose check alone ran out of sets (their pairs are checked)."""
+    uncertain_pairs: int = 0
+    """Pairs to check under ``uncertainty`` (those that may read alike, less those the exact
+    analysis or a member's failure alone decides): ``undecided`` counts among them."""
     cut: bool = False
     """The deadline ended the checks under ``uncertainty``: the members and pairs left are
     counted in ``undecided_alone`` and ``undecided`` (not checked)."""
@@ -89,6 +92,7 @@ class MixAnalysis:
             "candidate_pairs": self.candidates,
             "unrecognizable_pairs": n * (n - 1) // 2 if self.pairs is None else len(self.pairs),
             "apart_only_on_the_ideal_model": len(self.strong_pairs),
+            "pairs_checked_under_uncertainty": self.uncertain_pairs,
             "undecided_pairs": self.undecided,
             "no_strong_plan_alone": len(self.alone),
             "undecided_alone": self.undecided_alone,
@@ -170,6 +174,7 @@ def analyze_mix(
     # The parts' own widths, as make_plan reads each state (once for every check).
     offs = [] if mechs is None else part_offsets(pfs)
     cut = False
+    checked: list[tuple[int, int]] = []
 
     def late() -> bool:
         return deadline is not None and time.monotonic() >= deadline
@@ -235,5 +240,6 @@ def analyze_mix(
         undecided=undecided,
         alone=tuple(alone),
         undecided_alone=undecided_alone,
+        uncertain_pairs=len(checked),
         cut=cut,
     )

@@ -322,8 +322,9 @@ def _make_plan(
 
 HOLDS_NOTHING_WORDS = (
     "the plan is the ideal model's and holds no rotation error on a feeder that vibrates "
-    "(see the warning): with an exact robot a drop near a hilltop may still go either way; "
-    "plan with --rotation-error DEG, or check this plan with feederkit simulate"
+    "(see the warning): by the planner's model of such a feeder, a drop near a hilltop may go "
+    "either way even with an exact robot; plan with --rotation-error DEG, or check this plan "
+    "with feederkit simulate before it goes to the line"
 )
 """The result line of a plan that :attr:`MadePlan.holds_nothing`."""
 
