@@ -65,3 +65,19 @@ def test_the_report_says_it(ideal_plan, tmp_path):
     assert main(["report", str(ideal_plan), "-o", str(page)]) == 0
     html = page.read_text()
     assert 'id="ideal-model"' in html and WORDS.replace("'", "&#x27;") in words(html)
+
+
+def test_changeover_export_says_it(tmp_path, capsys):
+    import json
+
+    db = str(tmp_path / "c.db")
+    assert main(["catalog", "add", str(CATALOG / "rectangle-2x1.json"), "--catalog", db]) == 0
+    args = ["changeover", "compile", "r0", "--mix", "rectangle-2x1", "--tolerance", "0.05"]
+    assert main([*args, "--rotation-error", "0", "--catalog", db]) == 1  # stored, exit 1
+    capsys.readouterr()
+    out = tmp_path / "r0.json"
+    assert main(["changeover", "export", "r0", "-o", str(out), "--json", "--catalog", db]) == 0
+    shown = capsys.readouterr()
+    assert WORDS in words(shown.err)
+    data = json.loads(shown.out)
+    assert data["up_to_date"] is True and data["plan_warnings"][0].startswith(WORDS)
