@@ -1178,6 +1178,19 @@ def _descent_reach(
     base = math.floor(start_lo / 360.0) * 360.0
     inside = prof.val[(prof.pos > start_lo - base) & (prof.pos < start_hi - base)]
     level = float(max(r0.max(), inside.max(initial=-math.inf))) + 2.0 * prof.eps
+    return _cut_reach(prof, start_lo, start_hi, reach_lo, reach_hi, level)
+
+
+def _cut_reach(
+    prof: _Profile,
+    start_lo: float,
+    start_hi: float,
+    reach_lo: float,
+    reach_hi: float,
+    level: float | None,
+) -> tuple[float, float]:
+    """The reach cut on each side where :func:`_climb` from that end of the starts stops."""
+    base = math.floor(start_lo / 360.0) * 360.0
     hi = _climb(prof, start_hi, reach_hi, level, base)
     lo = _climb(prof, start_lo, reach_lo, level, base)
     return (
@@ -1197,13 +1210,7 @@ def _gap_reach(
     that running minimum. Tighter than one level for the whole gap, whose highest start
     (beside another band) let a push from the gap's other end climb a shallow hill there
     (a cam's flank reached its round end's top facets)."""
-    base = math.floor(start_lo / 360.0) * 360.0
-    hi = _climb(prof, start_hi, reach_hi, None, base)
-    lo = _climb(prof, start_lo, reach_lo, None, base)
-    return (
-        reach_lo if lo is None else max(reach_lo, lo),
-        reach_hi if hi is None else min(reach_hi, hi),
-    )
+    return _cut_reach(prof, start_lo, start_hi, reach_lo, reach_hi, None)
 
 
 def _climb(
